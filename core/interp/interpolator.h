@@ -1,0 +1,104 @@
+// Interpolating scattered spectra: one interface, three methods (the paper's octant method,
+// Delaunay through Qhull, nearest neighbour). Every answer carries its provenance: which samples
+// were blended, where they are, with which weights, by which method, and whether it worked.
+//
+// Coordinates are (θi, θo, φ) for isotropic data (3D) or (θi, φi, θo, φo) for anisotropic data
+// (4D), in degrees. Pure: no I/O.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/status.h"
+
+namespace brdf::interp {
+
+enum class Method { kOctant, kDelaunay, kNearest };
+const char* MethodName(Method m);  // "octant", "delaunay", "nearest"
+Result<Method> ParseMethod(const std::string& name);
+
+enum class InterpStatus {
+  kOk,
+  kEmptyOctant,         // octant method: an octant (orthant) around the query holds no sample
+  kNoEnclosingSimplex,  // octant method: no tetrahedron (simplex) of the cube encloses the query
+  kOutsideHull,         // Delaunay: the query lies outside the convex hull of the samples
+};
+const char* InterpStatusName(InterpStatus s);  // "ok", "empty_octant", ...
+
+// Options shared by all methods.
+struct Options {
+  // Per-axis multipliers applied to coordinates before distances are measured (empty = all 1).
+  // Raw degrees make φ span twice θ's range; scaling changes which neighbours win.
+  std::vector<double> axis_scale;
+  // Symmetry augmentation, isotropic (3D) data only. Both off by default: the paper's method as
+  // published. mirror_phi adds (θi, θo, −φ) for every sample; reciprocity adds (θo, θi, φ).
+  // Augmented copies keep the id of the sample they copy and rank after all measured samples.
+  bool mirror_phi = false;
+  bool reciprocity = false;
+};
+
+// Scattered samples: N points of `dims` coordinates, each with a spectrum of `bands` values and
+// an id (a reading id, or a CSV row index). Order matters: ties go to the earlier sample.
+class SampleSet {
+ public:
+  SampleSet(int dims, int bands) : dims_(dims), bands_(bands) {}
+
+  // Appends a sample; coords.size() == dims, spectrum.size() == bands.
+  Status Add(std::int64_t id, std::span<const double> coords, std::span<const double> spectrum);
+
+  int dims() const { return dims_; }
+  int bands() const { return bands_; }
+  std::size_t size() const { return ids_.size(); }
+  std::int64_t id(std::size_t i) const { return ids_[i]; }
+  std::span<const double> coords(std::size_t i) const {
+    return {coords_.data() + i * static_cast<std::size_t>(dims_), static_cast<std::size_t>(dims_)};
+  }
+  std::span<const double> spectrum(std::size_t i) const {
+    return {values_.data() + i * static_cast<std::size_t>(bands_),
+            static_cast<std::size_t>(bands_)};
+  }
+
+ private:
+  int dims_;
+  int bands_;
+  std::vector<std::int64_t> ids_;
+  std::vector<double> coords_;  // size() * dims
+  std::vector<double> values_;  // size() * bands
+};
+
+// One blended vertex of an answer.
+struct Vertex {
+  std::int64_t id = 0;         // the sample's id
+  std::size_t index = 0;       // the sample's position in the SampleSet
+  std::vector<double> coords;  // where the vertex is (after symmetry augmentation, unscaled)
+  double weight = 0;           // barycentric weight (nearest: 1)
+};
+
+struct Interpolation {
+  Method method = Method::kOctant;
+  InterpStatus status = InterpStatus::kOk;
+  std::vector<double> spectrum;  // `bands` values when status == kOk, empty otherwise
+  std::vector<Vertex> vertices;  // the blended samples (octant: 4 or 5; Delaunay: dims+1)
+  std::string detail;            // e.g. which octant was empty, which tetrahedron enclosed
+};
+
+class Interpolator {
+ public:
+  virtual ~Interpolator() = default;
+  virtual Method method() const = 0;
+  virtual int dims() const = 0;
+  // query.size() == dims(). Thread-safe (const): many threads may evaluate at once.
+  virtual Interpolation Evaluate(std::span<const double> query) const = 0;
+};
+
+// Builds the index for `samples` (3D or 4D). Errors: wrong dims, empty set, bad options
+// (e.g. symmetry options on 4D data, axis_scale of the wrong length or non-positive),
+// Qhull failures (degenerate input) for Delaunay.
+Result<std::unique_ptr<Interpolator>> MakeInterpolator(Method method,
+                                                       std::shared_ptr<const SampleSet> samples,
+                                                       const Options& options = {});
+
+}  // namespace brdf::interp

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs exactly the Debian 12 packages brdfd needs to build, test and run. Idempotent: packages
+# already present are left alone and apt is not touched at all when nothing is missing.
+# Uses sudo only when not root. Usage: deploy/install-deps.sh [--with-extras]
+#   --with-extras  also the tools for fuzzing and benchmarks against scipy (clang, scipy).
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
+  libserialport-dev libmodbus-dev libspdlog-dev libfmt-dev libsqlite3-dev sqlite3
+  libqhull-dev libtomlplusplus-dev libcli11-dev libsystemd-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  python3 python3-numpy python3-grpcio python3-protobuf python3-serial
+  python3-scipy python3-matplotlib colord-data
+)
+if [[ "${1:-}" == "--with-extras" ]]; then
+  packages+=(clang-14 libclang-rt-14-dev)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then
+  if ! command -v sudo >/dev/null; then
+    echo "install-deps: need root or sudo to install: ${missing[*]}" >&2
+    exit 1
+  fi
+  SUDO="sudo"
+fi
+echo "install-deps: installing ${#missing[@]} package(s): ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

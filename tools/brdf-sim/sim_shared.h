@@ -1,0 +1,124 @@
+// What the parts of brdf-sim share: the simulated clock scale, what is mounted in front of the
+// meter, the faults to inject, and the two seams between the endpoints and the optical model.
+//
+//   PR-650 endpoint (pty) ──MeterBackend──▶ optics (lamp, sample, white, dark, noise)
+//                                               │ StagePoseSource
+//   Modbus endpoint (TCP, RTU pty) ─────────────┘ (live axis positions)
+//   control unit id ──▶ SimControl (mounted target, faults), read by both endpoints
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <vector>
+
+#include "core/pose.h"
+
+namespace brdf::sim {
+
+// Simulated durations run `factor` times faster than real time (factor 1 = real time).
+struct TimeScale {
+  double factor = 1.0;
+  std::chrono::nanoseconds ToReal(double sim_seconds) const {
+    return std::chrono::nanoseconds(static_cast<std::int64_t>(sim_seconds / factor * 1e9));
+  }
+  double ToSim(std::chrono::nanoseconds real) const { return real.count() * 1e-9 * factor; }
+};
+
+enum class MountedTarget : int { kSample = 0, kWhite = 1, kDark = 2 };
+
+// The meter's setup as the PR-650 endpoint understands it (from the S command).
+struct MeterSetup {
+  int integration_ms = 0;  // 0 = adaptive
+  int averages = 1;
+};
+
+struct SimMeasurement {
+  int quality_code = 0;           // 0, or 10/18/19 from the light level, or an injected code
+  int integration_ms = 0;         // what the meter used (adaptive picks one from the light level)
+  double duration_s = 0;          // simulated time the measurement takes
+  std::vector<double> radiance;   // 101 values, 380–780 nm every 4 nm, W·m⁻²·sr⁻¹·nm⁻¹
+  double integrated = 0;          // integrated radiance (the D5 intensity line)
+};
+
+// Implemented by the optical model: what the meter would read right now.
+class MeterBackend {
+ public:
+  virtual ~MeterBackend() = default;
+  virtual SimMeasurement Measure(const MeterSetup& setup) = 0;
+};
+
+// Implemented by the stage simulator: where the axes are right now (degrees, α β γ δ).
+class StagePoseSource {
+ public:
+  virtual ~StagePoseSource() = default;
+  virtual Pose LivePose() const = 0;
+};
+
+struct SerialFaults {
+  bool silent = false;        // the meter answers nothing (not in remote mode, cable switch)
+  int garbage_next = 0;       // the next N replies are replaced by garbage bytes
+  int truncate_next = 0;      // the next N replies stop half-way
+  int quality_code = 0;       // force this quality code ...
+  int quality_count = 0;      // ... for the next N measurements
+  double vanish_seconds = 0;  // >0: the port vanishes during the next D5 transfer, back after this
+};
+
+struct ModbusFaults {
+  int exception_code = 0;      // reply with this exception (2 or 6) ...
+  int exception_count = 0;     // ... to the next N requests
+  int late_reply_ms = 0;       // delay the next N replies by this much (real ms) ...
+  int late_count = 0;
+  bool drop_connection = false;  // close the TCP connection at the next request
+  bool alarm_mid_move = false;   // the next move raises an alarm half-way
+  bool stall = false;            // the next move never clears MOVE
+};
+
+// Mutable shared state, thread-safe. Set from flags at start-up and at runtime through the
+// control unit id of the Modbus endpoint.
+class SimControl {
+ public:
+  MountedTarget mounted() const {
+    std::lock_guard l(mu_);
+    return mounted_;
+  }
+  void set_mounted(MountedTarget t) {
+    std::lock_guard l(mu_);
+    mounted_ = t;
+  }
+  SerialFaults serial() const {
+    std::lock_guard l(mu_);
+    return serial_;
+  }
+  void set_serial(const SerialFaults& f) {
+    std::lock_guard l(mu_);
+    serial_ = f;
+  }
+  ModbusFaults modbus() const {
+    std::lock_guard l(mu_);
+    return modbus_;
+  }
+  void set_modbus(const ModbusFaults& f) {
+    std::lock_guard l(mu_);
+    modbus_ = f;
+  }
+  // Atomically applies `fn` to the faults (to count down "next N" faults).
+  template <typename Fn>
+  auto UpdateSerial(Fn fn) {
+    std::lock_guard l(mu_);
+    return fn(serial_);
+  }
+  template <typename Fn>
+  auto UpdateModbus(Fn fn) {
+    std::lock_guard l(mu_);
+    return fn(modbus_);
+  }
+
+ private:
+  mutable std::mutex mu_;
+  MountedTarget mounted_ = MountedTarget::kSample;
+  SerialFaults serial_;
+  ModbusFaults modbus_;
+};
+
+}  // namespace brdf::sim
