@@ -18,7 +18,8 @@ class Clock {
   virtual ~Clock() = default;
   // Monotonic now.
   virtual TimePoint Now() const = 0;
-  // Sleeps for `d`, returning early (false) if `cancel` is cancelled meanwhile. True if slept fully.
+  // Sleeps for `d`, returning early (false) if `cancel` is cancelled meanwhile. True if slept
+  // fully.
   virtual bool SleepFor(Duration d, const CancelToken* cancel = nullptr) const = 0;
 
   // The process-wide real clock (std::chrono::steady_clock).

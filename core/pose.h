@@ -24,7 +24,8 @@ struct Directions {
   friend bool operator==(const Directions&, const Directions&) = default;
 };
 
-// The isotropic reduction: (θi, θo, φ) with φ = |φo − φi| folded into [0, 180]. 180 = specular side.
+// The isotropic reduction: (θi, θo, φ) with φ = |φo − φi| folded into [0, 180]. 180 = specular
+// side.
 struct IsoDirection {
   double theta_i = 0;
   double theta_o = 0;

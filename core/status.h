@@ -56,29 +56,45 @@ class [[nodiscard]] Status {
 };
 
 // Convenience constructors.
-inline Status InvalidArgument(std::string m) { return {StatusCode::kInvalidArgument, std::move(m)}; }
-inline Status NotFound(std::string m) { return {StatusCode::kNotFound, std::move(m)}; }
+inline Status InvalidArgument(std::string m) {
+  return {StatusCode::kInvalidArgument, std::move(m)};
+}
+inline Status NotFound(std::string m) {
+  return {StatusCode::kNotFound, std::move(m)};
+}
 inline Status FailedPrecondition(std::string m) {
   return {StatusCode::kFailedPrecondition, std::move(m)};
 }
-inline Status Timeout(std::string m) { return {StatusCode::kTimeout, std::move(m)}; }
-inline Status Cancelled(std::string m) { return {StatusCode::kCancelled, std::move(m)}; }
+inline Status Timeout(std::string m) {
+  return {StatusCode::kTimeout, std::move(m)};
+}
+inline Status Cancelled(std::string m) {
+  return {StatusCode::kCancelled, std::move(m)};
+}
 inline Status DeviceError(int device_code, std::string m) {
   return {StatusCode::kDeviceError, std::move(m), device_code};
 }
-inline Status ProtocolError(std::string m) { return {StatusCode::kProtocolError, std::move(m)}; }
-inline Status Disconnected(std::string m) { return {StatusCode::kDisconnected, std::move(m)}; }
+inline Status ProtocolError(std::string m) {
+  return {StatusCode::kProtocolError, std::move(m)};
+}
+inline Status Disconnected(std::string m) {
+  return {StatusCode::kDisconnected, std::move(m)};
+}
 inline Status ConfigurationError(std::string m) {
   return {StatusCode::kConfigurationError, std::move(m)};
 }
-inline Status IoError(std::string m) { return {StatusCode::kIoError, std::move(m)}; }
-inline Status Internal(std::string m) { return {StatusCode::kInternal, std::move(m)}; }
+inline Status IoError(std::string m) {
+  return {StatusCode::kIoError, std::move(m)};
+}
+inline Status Internal(std::string m) {
+  return {StatusCode::kInternal, std::move(m)};
+}
 
 // A value or the Status that explains why there is none.
 template <typename T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : v_(std::move(value)) {}  // NOLINT: implicit by design
+  Result(T value) : v_(std::move(value)) {}        // NOLINT: implicit by design
   Result(Status status) : v_(std::move(status)) {  // NOLINT: implicit by design
     assert(!std::get<Status>(v_).ok() && "Result built from an OK status has no value");
   }

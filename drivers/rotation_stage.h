@@ -22,12 +22,12 @@ inline constexpr std::array<Axis, 4> kAllAxes = {Axis::kAlpha, Axis::kBeta, Axis
 const char* AxisName(Axis axis);  // "alpha", "beta", "gamma", "delta"
 
 struct AxisState {
-  double position_deg = 0;  // feedback position converted to degrees
-  bool moving = false;      // MOVE
-  bool in_position = false; // IN-POS
-  bool ready = false;       // READY
-  bool alarm = false;       // ALM-A
-  int alarm_code = 0;       // present alarm code, 0 = none
+  double position_deg = 0;   // feedback position converted to degrees
+  bool moving = false;       // MOVE
+  bool in_position = false;  // IN-POS
+  bool ready = false;        // READY
+  bool alarm = false;        // ALM-A
+  int alarm_code = 0;        // present alarm code, 0 = none
 };
 
 // Target for a move. An axis left empty stays where it is.
@@ -43,7 +43,8 @@ class RotationStage {
   virtual void Disconnect() = 0;
   virtual bool connected() const = 0;
 
-  // Whether this rig has the axis (γ and δ are optional; without δ the operator moves the detector).
+  // Whether this rig has the axis (γ and δ are optional; without δ the operator moves the
+  // detector).
   virtual bool HasAxis(Axis axis) const = 0;
 
   // Moves all named axes (concurrently where the hardware allows) and waits until every one is in

@@ -23,26 +23,26 @@ struct MeterIdentity {
 };
 
 struct MeasurementSettings {
-  int integration_ms = 0;  // 0 = adaptive (the meter chooses), else 10–6000 ms
-  int averages = 1;        // 1–99 measurements averaged by the meter
+  int integration_ms = 0;       // 0 = adaptive (the meter chooses), else 10–6000 ms
+  int averages = 1;             // 1–99 measurements averaged by the meter
   bool sync_to_source = false;  // sync integration to the lamp's flicker (uses F)
 };
 
 // What happened during one measurement (the meter holds the data until transferred).
 struct MeasurementOutcome {
-  int quality_code = 0;     // the meter's final quality code (0 = OK)
-  bool flagged = false;     // usable but flagged by the quality policy (e.g. 18 low light)
-  int integration_ms = 0;   // integration actually used (after any adaptation); 0 = adaptive
-  int attempts = 1;         // measurements taken, including policy retries
-  std::string note;         // what the policy did, for the log and the reading ("halved to 250 ms")
+  int quality_code = 0;    // the meter's final quality code (0 = OK)
+  bool flagged = false;    // usable but flagged by the quality policy (e.g. 18 low light)
+  int integration_ms = 0;  // integration actually used (after any adaptation); 0 = adaptive
+  int attempts = 1;        // measurements taken, including policy retries
+  std::string note;        // what the policy did, for the log and the reading ("halved to 250 ms")
 };
 
 struct SpectrumReport {
   WavelengthGrid grid;
   std::vector<double> radiance;  // W·m⁻²·sr⁻¹·nm⁻¹ when units_code == 0
   int quality_code = 0;
-  int units_code = 0;            // 0 radiance, 1 irradiance, 2 uncalibrated
-  double integrated = 0;         // the meter's integrated intensity line
+  int units_code = 0;     // 0 radiance, 1 irradiance, 2 uncalibrated
+  double integrated = 0;  // the meter's integrated intensity line
 };
 
 class Spectroradiometer {

@@ -34,11 +34,11 @@ struct MeterSetup {
 };
 
 struct SimMeasurement {
-  int quality_code = 0;           // 0, or 10/18/19 from the light level, or an injected code
-  int integration_ms = 0;         // what the meter used (adaptive picks one from the light level)
-  double duration_s = 0;          // simulated time the measurement takes
-  std::vector<double> radiance;   // 101 values, 380–780 nm every 4 nm, W·m⁻²·sr⁻¹·nm⁻¹
-  double integrated = 0;          // integrated radiance (the D5 intensity line)
+  int quality_code = 0;          // 0, or 10/18/19 from the light level, or an injected code
+  int integration_ms = 0;        // what the meter used (adaptive picks one from the light level)
+  double duration_s = 0;         // simulated time the measurement takes
+  std::vector<double> radiance;  // 101 values, 380–780 nm every 4 nm, W·m⁻²·sr⁻¹·nm⁻¹
+  double integrated = 0;         // integrated radiance (the D5 intensity line)
 };
 
 // Implemented by the optical model: what the meter would read right now.
@@ -65,9 +65,9 @@ struct SerialFaults {
 };
 
 struct ModbusFaults {
-  int exception_code = 0;      // reply with this exception (2 or 6) ...
-  int exception_count = 0;     // ... to the next N requests
-  int late_reply_ms = 0;       // delay the next N replies by this much (real ms) ...
+  int exception_code = 0;   // reply with this exception (2 or 6) ...
+  int exception_count = 0;  // ... to the next N requests
+  int late_reply_ms = 0;    // delay the next N replies by this much (real ms) ...
   int late_count = 0;
   bool drop_connection = false;  // close the TCP connection at the next request
   bool alarm_mid_move = false;   // the next move raises an alarm half-way
