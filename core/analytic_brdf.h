@@ -13,8 +13,8 @@
 namespace brdf {
 
 struct AnalyticBrdfParams {
-  // Diffuse albedo as a smooth function of wavelength: albedo(λ) = base + amp·exp(−((λ−peak)/width)²)
-  // (a warm paint by default), divided by π for the Lambertian BRDF.
+  // Diffuse albedo as a smooth function of wavelength: albedo(λ) = base +
+  // amp·exp(−((λ−peak)/width)²) (a warm paint by default), divided by π for the Lambertian BRDF.
   double diffuse_base = 0.25;
   double diffuse_amp = 0.45;
   double diffuse_peak_nm = 610;
@@ -39,8 +39,11 @@ class AnalyticBrdf {
 
   // f(λ) in sr⁻¹ for directions in the sample frame (degrees). Zero when either direction is
   // below the surface (θ > 90°).
+  // (Also zero for θ < 0 and for non-finite angles or wavelength, so that it is finite everywhere.
+  // The span overload writes min(out.size(), grid.count) values.)
   double Evaluate(const Directions& d, double wavelength_nm) const;
-  void EvaluateSpectrum(const Directions& d, const WavelengthGrid& grid, std::span<double> out) const;
+  void EvaluateSpectrum(const Directions& d, const WavelengthGrid& grid,
+                        std::span<double> out) const;
   std::vector<double> EvaluateSpectrum(const Directions& d, const WavelengthGrid& grid) const;
 
  private:
