@@ -32,7 +32,10 @@ struct AxisState {
 
 // Target for a move. An axis left empty stays where it is.
 struct StageTarget {
-  std::optional<double> alpha, beta, gamma, delta;
+  std::optional<double> alpha = std::nullopt;
+  std::optional<double> beta = std::nullopt;
+  std::optional<double> gamma = std::nullopt;
+  std::optional<double> delta = std::nullopt;
 };
 
 class RotationStage {

@@ -1,0 +1,47 @@
+#include "core/plan/analyze_plan.h"
+
+#include <string>
+#include <utility>
+
+#include "core/plan/check_fields.h"
+#include "core/plan/expand_steps.h"
+#include "core/plan/plan_settings.h"
+
+namespace brdf::plan {
+
+PlanAnalysis AnalyzePlan(const v1::Plan& plan, const RigDescription& rig) {
+  PlanAnalysis out;
+  ProblemSink sink;
+  CheckPlanFields(plan, rig, sink);
+  if (!sink.empty()) {
+    out.problems = sink.Take();
+    return out;
+  }
+  std::vector<Step> steps = ExpandCheckedPlan(plan, rig, sink);
+  if (steps.size() > static_cast<std::size_t>(kMaxSteps)) {
+    sink.Add("", "the plan expands to more than " + std::to_string(kMaxSteps) +
+                     " steps (the cap); use coarser steps, fewer targets, or split the plan");
+  }
+  out.problems = sink.Take();
+  if (!out.problems.empty()) return out;
+  out.summary = SummarizeSteps(steps, rig, ResolveSettings(plan).measurement);
+  out.steps = std::move(steps);
+  return out;
+}
+
+std::vector<Problem> ValidatePlan(const v1::Plan& plan, const RigDescription& rig) {
+  return AnalyzePlan(plan, rig).problems;
+}
+
+Result<std::vector<Step>> ExpandPlan(const v1::Plan& plan, const RigDescription& rig) {
+  PlanAnalysis a = AnalyzePlan(plan, rig);
+  if (!a.valid()) {
+    return InvalidArgument("plan \"" + plan.name() + "\" is not valid for this rig (" +
+                           std::to_string(a.problems.size()) + " problem" +
+                           (a.problems.size() == 1 ? "" : "s") + "); fix:\n" +
+                           FormatProblems(a.problems));
+  }
+  return std::move(a.steps);
+}
+
+}  // namespace brdf::plan

@@ -1,0 +1,61 @@
+#include "core/plan/timing.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace brdf::plan {
+
+StepTimer::StepTimer(const RigDescription& rig, const MeasurementChoice& measurement)
+    : rig_(rig), measurement_(measurement) {}
+
+double StepTimer::MotionSeconds(const Pose& from, const Pose& to) const {
+  auto axis = [](double a, double b, const AxisTravel& travel) {
+    return travel.speed_deg_s > 0 ? std::fabs(b - a) / travel.speed_deg_s : 0.0;
+  };
+  double t = std::max(axis(from.alpha, to.alpha, rig_.alpha), axis(from.beta, to.beta, rig_.beta));
+  if (rig_.has_gamma_axis) t = std::max(t, axis(from.gamma, to.gamma, rig_.gamma));
+  if (rig_.has_detector_arm) t = std::max(t, axis(from.delta, to.delta, rig_.delta));
+  return t;
+}
+
+StepTime StepTimer::Advance(const Step& step) {
+  StepTime t;
+  if (step.is_reading()) {
+    const double averages = std::max<double>(1, measurement_.averages);
+    const double integration = measurement_.adaptive() ? rig_.adaptive_integration_s
+                                                       : measurement_.integration_ms / 1000.0;
+    const double integration_min =
+        measurement_.adaptive() ? rig_.min_integration_s : measurement_.integration_ms / 1000.0;
+    t.estimate_s = rig_.reading_overhead_s + integration * averages + rig_.meter_transfer_s;
+    t.lower_bound_s = integration_min * averages + rig_.meter_transfer_s;
+    after_reading_ = true;
+  } else if (step.kind == v1::STEP_KIND_MOVE) {
+    const double motion = MotionSeconds(stage_, step.pose);
+    double estimate = motion > 0 ? motion + rig_.move_settle_s : 0.0;
+    double lower = motion;
+    if (after_reading_) {
+      estimate = std::max(0.0, estimate - rig_.meter_transfer_s);
+      lower = std::max(0.0, lower - rig_.meter_transfer_s);
+    }
+    t = {estimate, lower};
+    stage_ = step.pose;
+    after_reading_ = false;
+  } else {
+    t.estimate_s = step.kind == v1::STEP_KIND_PROMPT ? rig_.operator_action_s : 0.0;
+    after_reading_ = false;
+  }
+  elapsed_.estimate_s += t.estimate_s;
+  elapsed_.lower_bound_s += t.lower_bound_s;
+  return t;
+}
+
+std::vector<StepTime> EstimateSteps(std::span<const Step> steps, const RigDescription& rig,
+                                    const MeasurementChoice& measurement) {
+  StepTimer timer(rig, measurement);
+  std::vector<StepTime> times;
+  times.reserve(steps.size());
+  for (const Step& s : steps) times.push_back(timer.Advance(s));
+  return times;
+}
+
+}  // namespace brdf::plan

@@ -1,0 +1,62 @@
+// How long steps take: an estimate (what the operator should expect) and a physical lower
+// bound (what no scheduling can beat). Used for the plan summary, the "every M minutes"
+// reference rule, and the executor's ETA.
+//
+// The model, per step (times in seconds, RigDescription's parameters):
+//   reading (REFERENCE, DARK, SAMPLE):
+//     estimate    = reading_overhead_s + integration · averages + meter_transfer_s
+//     lower bound = integration_min · averages + meter_transfer_s
+//     where integration is integration_ms / 1000, or adaptive_integration_s when adaptive
+//     (for the lower bound: min_integration_s, the meter's shortest, when adaptive).
+//   move: the motorized axes (α, β, and γ / δ when present) move at the same time, so
+//     motion = max over moving axes of |Δ reading| / speed_deg_s.
+//     estimate    = motion + move_settle_s      (0 when nothing moves)
+//     lower bound = motion
+//     A move right after a reading overlaps that reading's data transfer (the executor starts
+//     the move once the meter has measured, while the spectrum comes down the serial line), so
+//     meter_transfer_s is taken off both: max(0, … − meter_transfer_s).
+//   prompt: estimate = operator_action_s; lower bound = 0 (operator time is not physics).
+// The lower bound therefore sums exactly what cannot overlap: integration, data transfer not
+// hidden behind motion, and motion not hidden behind a transfer. The rig starts at pose 0.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "core/plan/plan_settings.h"
+#include "core/plan/rig_description.h"
+#include "core/plan/step.h"
+
+namespace brdf::plan {
+
+struct StepTime {
+  double estimate_s = 0;
+  double lower_bound_s = 0;
+};
+
+// A running clock over a list of steps, fed one step at a time in order.
+class StepTimer {
+ public:
+  StepTimer(const RigDescription& rig, const MeasurementChoice& measurement);
+
+  // The time of `step`, given the steps fed before it; advances the clock.
+  StepTime Advance(const Step& step);
+
+  double elapsed_estimate_s() const { return elapsed_.estimate_s; }
+  double elapsed_lower_bound_s() const { return elapsed_.lower_bound_s; }
+
+ private:
+  double MotionSeconds(const Pose& from, const Pose& to) const;
+
+  RigDescription rig_;
+  MeasurementChoice measurement_;
+  Pose stage_;                  // where the motorized axes are
+  bool after_reading_ = false;  // the previous step was a reading
+  StepTime elapsed_;
+};
+
+// The time of every step of a list (StepTimer over the list).
+std::vector<StepTime> EstimateSteps(std::span<const Step> steps, const RigDescription& rig,
+                                    const MeasurementChoice& measurement);
+
+}  // namespace brdf::plan

@@ -1,0 +1,383 @@
+#include "drivers/pr650/pr650_spectroradiometer.h"
+
+#include <iostream>
+
+#include "drivers/pr650/context_wait.h"
+#include "drivers/pr650/quality_codes.h"
+
+namespace brdf::drivers {
+
+namespace {
+
+using pr650::SetupFields;
+
+constexpr std::string_view kModel = "PR-650";
+
+long long Millis(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(d).count();
+}
+
+std::string JoinNotes(const std::vector<std::string>& notes) {
+  std::string out;
+  for (const std::string& n : notes) {
+    if (n.empty()) continue;
+    if (!out.empty()) out += "; ";
+    out += n;
+  }
+  return out;
+}
+
+}  // namespace
+
+Pr650Spectroradiometer::Pr650Spectroradiometer(Pr650Options options, LinkFactory link_factory)
+    : options_(std::move(options)), link_factory_(std::move(link_factory)) {
+  if (!options_.log) {
+    options_.log = [](std::string_view message) { std::clog << "pr650: " << message << '\n'; };
+  }
+  framing_.quiet_gap = options_.quiet_gap;
+  framing_.stall_timeout = options_.stall_timeout;
+}
+
+Pr650Spectroradiometer::~Pr650Spectroradiometer() {
+  DropLink();
+}
+
+void Pr650Spectroradiometer::Log(const std::string& message) const {
+  options_.log(message);
+}
+
+void Pr650Spectroradiometer::DropLink() {
+  if (link_) link_->Close();
+  link_.reset();
+  connected_ = false;
+  holds_measurement_ = false;
+  meter_setup_.reset();
+  late_reply_until_.reset();
+}
+
+void Pr650Spectroradiometer::Disconnect() {
+  DropLink();
+  lost_connection_ = false;
+}
+
+Status Pr650Spectroradiometer::RequireConnected() const {
+  if (connected_) return Status::Ok();
+  if (lost_connection_) {
+    return Disconnected("PR-650 on " + options_.port +
+                        " lost its connection earlier: connect again once the port is back");
+  }
+  return FailedPrecondition("PR-650 on " + options_.port + " is not connected: call Connect first");
+}
+
+Status Pr650Spectroradiometer::WithSilenceHint(const Status& status, const CallContext& ctx) const {
+  // Only silence within the meter's own reply time suggests a meter problem; a caller's deadline
+  // that passed first does not.
+  if (status.code() != StatusCode::kTimeout || ctx.expired()) return status;
+  return Status(StatusCode::kTimeout,
+                status.message() +
+                    "; the meter may have been switched off or have left remote mode: check "
+                    "its power and cable, then connect again (power-cycle it first if it stays "
+                    "silent)");
+}
+
+// ---- Connect -----------------------------------------------------------------------------------
+
+Status Pr650Spectroradiometer::OpenWithRtsDrop(const CallContext& ctx) {
+  const pr650::SerialSettings settings{options_.port, options_.baud,
+                                       options_.hardware_flow_control};
+  Result<std::unique_ptr<pr650::SerialLink>> made = link_factory_(settings, options_.log);
+  if (!made.ok()) return made.status();
+  std::unique_ptr<pr650::SerialLink> link = std::move(made).value();
+  BRDF_RETURN_IF_ERROR(link->Open(port_seen_));
+  port_seen_ = true;
+  // The meter only enters remote mode on a first command shortly after power-on; the drivers that
+  // work drop RTS for more than 50 ms (closing the port) before talking to it.
+  BRDF_RETURN_IF_ERROR(link->SetRts(false));
+  BRDF_RETURN_IF_ERROR(
+      pr650::WaitChecked(options_.rts_drop, ctx, "dropping RTS on " + options_.port));
+  link->Close();
+  BRDF_RETURN_IF_ERROR(link->Open(true));
+  BRDF_RETURN_IF_ERROR(link->SetRts(true));
+  link_ = std::move(link);
+  return pr650::WaitChecked(options_.wake_settle, ctx, "letting the PR-650 settle after RTS");
+}
+
+Status Pr650Spectroradiometer::Wake(const CallContext& ctx) {
+  const std::string command = *pr650::BacklightCommand(options_.wake_backlight);
+  Status last;
+  for (int attempt = 1; attempt <= options_.wake_attempts; ++attempt) {
+    Result<std::string> reply = Exchange(command, 1, options_.reply_timeout, ctx);
+    if (reply.ok()) {
+      Result<int> code = pr650::ParseStatusReply(*reply, command);
+      if (code.ok() && *code == 0) return Status::Ok();
+      last = code.ok() ? ProtocolError("PR-650 on " + options_.port + " answered " + command +
+                                       " with status " + std::to_string(*code) + " instead of 000")
+                       : code.status();
+    } else {
+      last = reply.status();
+      // Silence and noise are what a meter outside remote mode gives; anything else (cancel,
+      // deadline, vanished port) ends the attempts.
+      const bool retryable = last.code() == StatusCode::kProtocolError ||
+                             (last.code() == StatusCode::kTimeout && !ctx.expired());
+      if (!retryable) return last;
+    }
+    Log("wake-up attempt " + std::to_string(attempt) + " of " +
+        std::to_string(options_.wake_attempts) + " on " + options_.port +
+        " failed: " + last.ToString());
+  }
+  if (last.code() == StatusCode::kTimeout) {
+    return Timeout("PR-650 on " + options_.port + " did not answer " + command + " in " +
+                   std::to_string(options_.wake_attempts) + " attempts (" +
+                   std::to_string(Millis(options_.reply_timeout)) +
+                   " ms each): the meter is not in remote mode. Power-cycle the meter and connect "
+                   "within 5 s of switching it on; check that the cable's XFER/CTRLR switch is on "
+                   "CTRLR and that the cable is in the meter's RS-232 port");
+  }
+  return last.WithContext("PR-650 on " + options_.port + " did not wake up after " +
+                          std::to_string(options_.wake_attempts) + " attempts");
+}
+
+Status Pr650Spectroradiometer::Connect(const CallContext& ctx) {
+  if (connected_) return Status::Ok();
+  BRDF_RETURN_IF_ERROR(ValidatePr650Options(options_));
+  DropLink();
+  Status status = OpenWithRtsDrop(ctx);
+  if (status.ok()) status = Wake(ctx);
+  if (!status.ok()) {
+    DropLink();
+    return status;
+  }
+  connected_ = true;
+  lost_connection_ = false;
+  // The meter keeps its own setup across a reconnect, but not necessarily ours.
+  meter_setup_.reset();
+  return Status::Ok();
+}
+
+// ---- Exchanges ---------------------------------------------------------------------------------
+
+Status Pr650Spectroradiometer::DiscardLateReply(const CallContext& ctx) {
+  if (!late_reply_until_) return Status::Ok();
+  const auto until = *late_reply_until_;
+  const auto now = ctx.clock().Now();
+  if (now >= until) {
+    late_reply_until_.reset();
+    return Status::Ok();
+  }
+  // A reply to an abandoned command may still be on its way (the meter finishes what it started);
+  // wait for it so it is not read as the answer to the next command.
+  Result<std::string> late =
+      pr650::ReadReply(*link_, {"an abandoned command", 1, until - now}, framing_, ctx);
+  if (late.ok()) {
+    Log("discarded a late reply on " + options_.port + ": \"" + pr650::Printable(*late) + "\"");
+  } else if (late.status().code() == StatusCode::kCancelled ||
+             late.status().code() == StatusCode::kDisconnected || ctx.expired()) {
+    return late.status();
+  }
+  late_reply_until_.reset();
+  return Status::Ok();
+}
+
+Result<std::string> Pr650Spectroradiometer::Exchange(std::string_view command, std::size_t lines,
+                                                     Duration timeout, const CallContext& ctx) {
+  if (!link_) return RequireConnected();
+  Status status = DiscardLateReply(ctx);
+  if (status.ok()) {
+    const auto now = ctx.clock().Now();
+    if (now < next_command_at_) {
+      status = pr650::WaitChecked(next_command_at_ - now, ctx, "pacing PR-650 commands");
+    }
+  }
+  if (status.ok()) status = link_->FlushInput();
+  bool sent = false;
+  if (status.ok()) {
+    status = link_->Write(std::string(command) + "\n", ctx);
+    sent = status.ok();
+  }
+  const auto sent_at = ctx.clock().Now();
+  Result<std::string> reply =
+      status.ok() ? pr650::ReadReply(*link_, {command, lines, timeout}, framing_, ctx)
+                  : Result<std::string>(status);
+  next_command_at_ = ctx.clock().Now() + options_.command_pacing;
+  if (reply.ok()) return reply;
+
+  switch (reply.status().code()) {
+    case StatusCode::kDisconnected:
+      DropLink();
+      lost_connection_ = true;
+      break;
+    case StatusCode::kCancelled:
+    case StatusCode::kTimeout:
+      // A command the meter received may still be answered: remember until when.
+      if (sent && sent_at + timeout > ctx.clock().Now()) {
+        late_reply_until_ = std::max(late_reply_until_.value_or(sent_at), sent_at + timeout);
+      }
+      break;
+    default:
+      break;
+  }
+  // The reader's messages name the command already; the link's do not.
+  if (reply.status().code() == StatusCode::kDisconnected ||
+      reply.status().code() == StatusCode::kCancelled) {
+    return reply.status().WithContext("PR-650 " + std::string(command));
+  }
+  return reply.status();
+}
+
+pr650::SetupFields Pr650Spectroradiometer::CurrentSetup() const {
+  if (meter_setup_) return *meter_setup_;
+  if (configured_) return *configured_;
+  SetupFields fields;
+  fields.accessory = options_.accessory;
+  return fields;
+}
+
+Status Pr650Spectroradiometer::SendSetup(const SetupFields& fields, const CallContext& ctx) {
+  Result<std::string> command = pr650::FormatSetupCommand(fields);
+  if (!command.ok()) return command.status();
+  meter_setup_.reset();  // unknown until the meter accepts
+  Result<std::string> reply = Exchange(*command, 1, options_.measurement_timeout, ctx);
+  if (!reply.ok()) return WithSilenceHint(reply.status(), ctx);
+  Result<int> code = pr650::ParseSetupReply(*reply);
+  if (!code.ok()) return code.status();
+  if (*code != 0) {
+    return DeviceError(*code, "PR-650 on " + options_.port + " rejected the setup " + *command +
+                                  ": " + pr650::DescribeSetupReply(*code) +
+                                  "; check the measurement settings (and the lens accessory)");
+  }
+  meter_setup_ = fields;
+  return Status::Ok();
+}
+
+// ---- Spectroradiometer -------------------------------------------------------------------------
+
+Result<MeterIdentity> Pr650Spectroradiometer::Identify(const CallContext& ctx) {
+  BRDF_RETURN_IF_ERROR(RequireConnected());
+  Result<std::string> serial_reply =
+      Exchange(pr650::kSerialNumberCommand, 1, options_.reply_timeout, ctx);
+  if (!serial_reply.ok()) return WithSilenceHint(serial_reply.status(), ctx);
+  Result<std::string> serial = pr650::ParseSerialNumberReply(*serial_reply);
+  if (!serial.ok()) return serial.status();
+
+  Result<std::string> layout_reply =
+      Exchange(pr650::kLayoutCommand, 1, options_.reply_timeout, ctx);
+  if (!layout_reply.ok()) return WithSilenceHint(layout_reply.status(), ctx);
+  Result<pr650::SpectralLayout> layout = pr650::ParseLayoutReply(*layout_reply);
+  if (!layout.ok()) return layout.status();
+  grid_ = layout->grid();
+  return MeterIdentity{std::string(kModel), *serial, grid_};
+}
+
+Status Pr650Spectroradiometer::Configure(const MeasurementSettings& settings,
+                                         const CallContext& ctx) {
+  BRDF_RETURN_IF_ERROR(RequireConnected());
+  SetupFields fields;
+  fields.accessory = options_.accessory;
+  fields.integration_ms = settings.integration_ms;
+  fields.averages = settings.averages;
+  fields.sync = settings.sync_to_source;
+  fields.si_units = true;
+  if (Result<std::string> check = pr650::FormatSetupCommand(fields); !check.ok()) {
+    return check.status();
+  }
+  if (fields.sync) {
+    // Sync mode uses the lamp frequency the meter measured last (F).
+    Result<std::string> reply =
+        Exchange(pr650::kFlickerCommand, 1, options_.measurement_timeout, ctx);
+    if (!reply.ok()) return WithSilenceHint(reply.status(), ctx);
+    Result<pr650::FlickerReply> flicker = pr650::ParseFlickerReply(*reply);
+    if (!flicker.ok()) return flicker.status();
+    if (flicker->quality_code != 0) {
+      return DeviceError(flicker->quality_code,
+                         "PR-650 on " + options_.port + " could not measure the lamp's flicker: " +
+                             pr650::DescribeQualityCode(flicker->quality_code) +
+                             "; check the lamp, or configure without sync to source");
+    }
+    Log("lamp flicker measured at " + std::to_string(flicker->frequency_hz) + " Hz");
+  }
+  configured_.reset();
+  BRDF_RETURN_IF_ERROR(SendSetup(fields, ctx));
+  configured_ = fields;
+  return Status::Ok();
+}
+
+Result<MeasurementOutcome> Pr650Spectroradiometer::Measure(const CallContext& ctx) {
+  BRDF_RETURN_IF_ERROR(RequireConnected());
+  holds_measurement_ = false;
+  // Each Measure starts from the configured settings: an adaptation made for one pose (a halved
+  // integration time) does not carry into the next.
+  if (configured_ && meter_setup_ != configured_)
+    BRDF_RETURN_IF_ERROR(SendSetup(*configured_, ctx));
+
+  std::vector<std::string> notes;
+  for (int attempt = 1;; ++attempt) {
+    Result<std::string> reply =
+        Exchange(pr650::kMeasureCommand, 1, options_.measurement_timeout, ctx);
+    if (!reply.ok()) return WithSilenceHint(reply.status(), ctx);
+    Result<int> code = pr650::ParseStatusReply(*reply, pr650::kMeasureCommand);
+    if (!code.ok()) return code.status();
+
+    const SetupFields current = CurrentSetup();
+    const pr650::MeasureLoopState state{current.integration_ms, current.sync, attempt,
+                                        options_.max_measure_attempts};
+    const pr650::QualityDecision decision =
+        pr650::DecideQuality(options_.quality_policy, *code, state);
+    if (!decision.note.empty()) {
+      notes.push_back(decision.note);
+      Log("measurement " + std::to_string(attempt) + " on " + options_.port + ": " + decision.note);
+    }
+
+    using Kind = pr650::QualityDecision::Kind;
+    switch (decision.kind) {
+      case Kind::kAccept:
+      case Kind::kAcceptFlagged: {
+        holds_measurement_ = true;
+        MeasurementOutcome outcome;
+        outcome.quality_code = *code;
+        outcome.flagged = decision.kind == Kind::kAcceptFlagged;
+        outcome.integration_ms = current.integration_ms;
+        outcome.attempts = attempt;
+        outcome.note = JoinNotes(notes);
+        return outcome;
+      }
+      case Kind::kRemeasure:
+        if (decision.new_integration_ms != current.integration_ms ||
+            decision.new_sync != current.sync) {
+          SetupFields changed = current;
+          changed.integration_ms = decision.new_integration_ms;
+          changed.sync = decision.new_sync;
+          BRDF_RETURN_IF_ERROR(SendSetup(changed, ctx));
+        }
+        break;
+      case Kind::kFail: {
+        const pr650::QualityCodeInfo* info = pr650::FindQualityCode(*code);
+        std::string hint = info && *info->hint ? info->hint : "see the PR-650 manual";
+        return DeviceError(*code, "PR-650 on " + options_.port + " measurement failed after " +
+                                      std::to_string(attempt) + " attempt(s): " + JoinNotes(notes) +
+                                      "; " + hint);
+      }
+    }
+  }
+}
+
+Result<SpectrumReport> Pr650Spectroradiometer::TransferSpectrum(const CallContext& ctx) {
+  BRDF_RETURN_IF_ERROR(RequireConnected());
+  if (!holds_measurement_) {
+    return FailedPrecondition("PR-650 on " + options_.port +
+                              " holds no accepted measurement: call Measure first");
+  }
+  Result<std::string> reply = Exchange(pr650::kSpectrumCommand, pr650::SpectrumReplyLines(grid_),
+                                       options_.reply_timeout, ctx);
+  if (!reply.ok()) return WithSilenceHint(reply.status(), ctx);
+  Result<pr650::SpectrumReply> spectrum = pr650::ParseSpectrumReply(*reply, grid_);
+  if (!spectrum.ok()) return spectrum.status();
+  SpectrumReport report;
+  report.grid = spectrum->grid;
+  report.radiance = std::move(spectrum->values);
+  report.quality_code = spectrum->quality_code;
+  report.units_code = spectrum->units_code;
+  report.integrated = spectrum->integrated;
+  return report;
+}
+
+}  // namespace brdf::drivers

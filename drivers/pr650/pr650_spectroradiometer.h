@@ -1,0 +1,93 @@
+// The PR-650 SpectraScan behind the Spectroradiometer interface. Other meters (PR-655/670: PHOTO
+// to enter remote mode, CR-terminated commands, M5 for the spectrum) would be sibling classes
+// over the same SerialLink seam.
+//
+// Connect opens the port, drops RTS (> 50 ms, by close and reopen), waits for the meter to settle
+// and sends B<n> until it answers "000" (bounded attempts). A silent meter is kTimeout with the
+// operator's remedy: power-cycle it and connect within 5 s; XFER/CTRLR on CTRLR.
+//
+// Every exchange: wait out the pacing, empty the input buffer, write the command + LF, read the
+// reply (reply_reader.h), parse it (pr650_protocol.h). If a call is cancelled or times out while
+// the meter may still answer (an M0 takes up to 30 s), the next exchange first waits for and
+// discards that late reply, so it is never mistaken for the answer to a new command.
+//
+// M0 reply: the reference gives only "000" for success. This driver (and brdf-sim) read it as a
+// 3-digit status whose value is the quality code ("018" = low light); D5 repeats the code.
+//
+// Errors: kTimeout, kCancelled, kDeviceError (device_code = quality code, or the S reply's bad
+// field position / 50), kProtocolError, kDisconnected (port vanished: Connect again once it is
+// back), kConfigurationError (options, port name), kInvalidArgument (settings),
+// kFailedPrecondition (not connected, nothing measured).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "drivers/pr650/pr650_options.h"
+#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/reply_reader.h"
+#include "drivers/pr650/serial_link.h"
+#include "drivers/spectroradiometer.h"
+
+namespace brdf::drivers {
+
+class Pr650Spectroradiometer final : public Spectroradiometer {
+ public:
+  // Makes the (closed) link for a port; tests may hand in their own transport.
+  using LinkFactory = std::function<Result<std::unique_ptr<pr650::SerialLink>>(
+      const pr650::SerialSettings&, pr650::LogSink)>;
+
+  explicit Pr650Spectroradiometer(Pr650Options options,
+                                  LinkFactory link_factory = pr650::MakeSerialLink);
+  ~Pr650Spectroradiometer() override;
+
+  Status Connect(const CallContext& ctx) override;
+  void Disconnect() override;
+  bool connected() const override { return connected_; }
+
+  Result<MeterIdentity> Identify(const CallContext& ctx) override;
+  Status Configure(const MeasurementSettings& settings, const CallContext& ctx) override;
+  Result<MeasurementOutcome> Measure(const CallContext& ctx) override;
+  Result<SpectrumReport> TransferSpectrum(const CallContext& ctx) override;
+
+  const Pr650Options& options() const { return options_; }
+
+ private:
+  using Duration = std::chrono::steady_clock::duration;
+
+  Status OpenWithRtsDrop(const CallContext& ctx);
+  Status Wake(const CallContext& ctx);
+  Status RequireConnected() const;
+  // Sends `command` and reads a reply of `lines` lines, the first byte within `timeout`.
+  Result<std::string> Exchange(std::string_view command, std::size_t lines, Duration timeout,
+                               const CallContext& ctx);
+  Status DiscardLateReply(const CallContext& ctx);
+  Status SendSetup(const pr650::SetupFields& fields, const CallContext& ctx);
+  pr650::SetupFields CurrentSetup() const;
+  void DropLink();
+  // A "did not answer" timeout with what the operator can check.
+  Status WithSilenceHint(const Status& status, const CallContext& ctx) const;
+  void Log(const std::string& message) const;
+
+  Pr650Options options_;
+  LinkFactory link_factory_;
+  pr650::FramingOptions framing_;
+
+  std::unique_ptr<pr650::SerialLink> link_;
+  bool connected_ = false;
+  bool port_seen_ = false;        // the port has opened before: a missing port has vanished
+  bool lost_connection_ = false;  // the link went down under us (vs never connected)
+
+  std::optional<pr650::SetupFields> configured_;   // what Configure asked for
+  std::optional<pr650::SetupFields> meter_setup_;  // what the meter was last set to (S accepted)
+  WavelengthGrid grid_ = WavelengthGrid::Pr650();  // from D120 once identified
+  bool holds_measurement_ = false;
+
+  std::chrono::steady_clock::time_point next_command_at_{};
+  std::optional<std::chrono::steady_clock::time_point> late_reply_until_;
+};
+
+}  // namespace brdf::drivers

@@ -1,0 +1,92 @@
+#include "drivers/pr650/reply_reader.h"
+
+#include "drivers/pr650/pr650_protocol.h"
+
+namespace brdf::drivers::pr650 {
+
+namespace {
+
+long long Millis(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(d).count();
+}
+
+bool Complete(std::string_view bytes, std::size_t lines) {
+  return EndsWithLineEnd(bytes) && CountCompleteLines(bytes) >= lines;
+}
+
+std::string Progress(std::string_view bytes, std::size_t lines) {
+  return std::to_string(CountCompleteLines(bytes)) + " of " + std::to_string(lines) + " line(s), " +
+         std::to_string(bytes.size()) + " bytes, ending \"" +
+         Printable(bytes.substr(bytes.size() > 24 ? bytes.size() - 24 : 0)) + "\"";
+}
+
+}  // namespace
+
+Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
+                              const FramingOptions& framing, const CallContext& ctx) {
+  const Clock& clock = ctx.clock();
+  const std::string command(request.command);
+  const auto first_deadline = clock.Now() + request.first_byte_timeout;
+  std::string reply;
+  auto last_byte = clock.Now();
+
+  auto append = [&](const std::string& bytes) -> Status {
+    reply += bytes;
+    last_byte = clock.Now();
+    if (reply.size() > framing.max_reply_bytes) {
+      return ProtocolError("PR-650 reply to " + command + " on " + link.port() + " exceeds " +
+                           std::to_string(framing.max_reply_bytes) +
+                           " bytes without ending: line noise or a wrong baud rate; check the "
+                           "cable and that the meter is set to 9600 baud");
+    }
+    return Status::Ok();
+  };
+
+  while (true) {
+    auto until = first_deadline;
+    if (!reply.empty()) {
+      const bool complete = Complete(reply, request.lines);
+      const auto gap = complete ? framing.quiet_gap : framing.stall_timeout;
+      if (clock.Now() - last_byte >= gap) {
+        if (complete) return reply;
+        return ProtocolError("PR-650 reply to " + command + " on " + link.port() +
+                             " stopped after " + Progress(reply, request.lines) +
+                             " and nothing more came for " +
+                             std::to_string(Millis(framing.stall_timeout)) +
+                             " ms: the reply is truncated; check the cable and retry");
+      }
+      until = last_byte + gap;
+    }
+
+    Result<std::string> bytes = link.Read(until, ctx);
+    if (!bytes.ok()) return bytes.status();
+    if (!bytes->empty()) {
+      BRDF_RETURN_IF_ERROR(append(*bytes));
+      continue;
+    }
+
+    const bool deadline_passed = ctx.expired();
+    const bool no_answer = reply.empty() && clock.Now() >= first_deadline;
+    if (!deadline_passed && !no_answer) continue;
+
+    // One last look before giving up: a reply that arrived in the final moment is a reply.
+    Result<std::string> late = link.Read(clock.Now(), ctx);
+    if (!late.ok()) return late.status();
+    if (!late->empty()) BRDF_RETURN_IF_ERROR(append(*late));
+    if (deadline_passed) {
+      if (Complete(reply, request.lines)) return reply;
+      if (reply.empty()) {
+        return Timeout("PR-650 on " + link.port() + " did not answer " + command +
+                       " before the call's deadline");
+      }
+      return Timeout("call deadline passed while reading the PR-650's reply to " + command +
+                     " on " + link.port() + " (" + Progress(reply, request.lines) + ")");
+    }
+    if (reply.empty()) {
+      return Timeout("PR-650 on " + link.port() + " did not answer " + command + " within " +
+                     std::to_string(Millis(request.first_byte_timeout)) + " ms");
+    }
+  }
+}
+
+}  // namespace brdf::drivers::pr650

@@ -1,0 +1,62 @@
+// The control unit of the simulated stage bus: a Modbus unit id (100 by default) whose holding
+// registers set what is mounted in front of the meter and which faults the simulator injects,
+// so tests and an operator can act on a running brdf-sim over the same Modbus link (TCP or RTU)
+// the stage uses. Writes go into brdf::sim::SimControl; reads return its current values, so a
+// "next N" counter reads back how many are left.
+//
+// Holding registers (PDU addresses, 0-based; a manual-style "4xxxx" number is address + 40001):
+//
+//   addr  name                      values
+//   ----  ------------------------  ------------------------------------------------------------
+//      0  mounted target            0 sample, 1 white reference, 2 dark (shutter closed)
+//      1  power-cycle meter         write 1: the PR-650 endpoint power-cycles the meter; reads 0
+//     10  serial.silent             0/1: the meter answers nothing
+//     11  serial.garbage_next       N: the next N meter replies are garbage bytes
+//     12  serial.truncate_next      N: the next N meter replies stop half-way
+//     13  serial.quality_code       force this quality code ...
+//     14  serial.quality_count      ... for the next N measurements
+//  15-16  serial.vanish_ms          32-bit, high word first: >0 = the port vanishes during the next
+//                                   D5 transfer and comes back after this many (simulated) ms
+//     20  modbus.exception_code     exception (2 illegal address, 6 busy, ...) to reply with ...
+//     21  modbus.exception_count    ... to the next N axis requests (the request is not applied)
+//     22  modbus.late_reply_ms      delay the next N axis replies by this many real ms ...
+//     23  modbus.late_count         ... (the request is applied on arrival; only the reply is late)
+//     24  modbus.drop_connection    1: close the TCP connection at the next axis request (over RTU:
+//                                   leave that request unanswered)
+//     25  modbus.alarm_mid_move     1: the next move raises an alarm (code 0x30) half-way
+//     26  modbus.stall              1: the next move never clears MOVE (until STOP or ALM-RST)
+//
+// Registers 2–9 and 17–19 read 0 and refuse writes (exception 02), as do addresses past 26.
+// A value out of range (mounted 3, a flag of 2, exception code 12) is refused with exception 03
+// and nothing of that write is applied. Faults apply to the axis unit ids only, never to the
+// control unit itself, so setting a fault cannot consume it.
+//
+// Example (modbus-cli style): write 6 to 100:20 and 2 to 100:21 → the next two axis requests
+// answer "device busy".
+#pragma once
+
+#include <cstdint>
+
+namespace brdf::sim::control_map {
+
+inline constexpr int kDefaultUnitId = 100;
+
+inline constexpr std::uint16_t kMountedTarget = 0;
+inline constexpr std::uint16_t kPowerCycleMeter = 1;
+inline constexpr std::uint16_t kSerialSilent = 10;
+inline constexpr std::uint16_t kSerialGarbageNext = 11;
+inline constexpr std::uint16_t kSerialTruncateNext = 12;
+inline constexpr std::uint16_t kSerialQualityCode = 13;
+inline constexpr std::uint16_t kSerialQualityCount = 14;
+inline constexpr std::uint16_t kSerialVanishMs = 15;  // 2 registers, high word first
+inline constexpr std::uint16_t kModbusExceptionCode = 20;
+inline constexpr std::uint16_t kModbusExceptionCount = 21;
+inline constexpr std::uint16_t kModbusLateReplyMs = 22;
+inline constexpr std::uint16_t kModbusLateCount = 23;
+inline constexpr std::uint16_t kModbusDropConnection = 24;
+inline constexpr std::uint16_t kModbusAlarmMidMove = 25;
+inline constexpr std::uint16_t kModbusStall = 26;
+
+inline constexpr std::uint16_t kRegisterCount = 27;  // addresses 0–26
+
+}  // namespace brdf::sim::control_map

@@ -1,0 +1,196 @@
+#include "tools/brdf-sim/stage_tcp_endpoint.h"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <sys/select.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <span>
+#include <utility>
+
+namespace brdf::sim {
+
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+constexpr int kMbapLength = 7;
+
+}  // namespace
+
+StageTcpEndpoint::~StageTcpEndpoint() {
+  Stop();
+}
+
+bool StageTcpEndpoint::Start(const std::string& host, int port, std::string* error) {
+  ctx_ = modbus_new_tcp(host.c_str(), port);
+  if (ctx_ == nullptr) {
+    *error = "stage simulator: cannot create a Modbus TCP context for " + host + ": " +
+             modbus_strerror(errno);
+    return false;
+  }
+  // A client that sends half a request must not stall the others for long.
+  modbus_set_byte_timeout(ctx_, 0, 200'000);
+  listen_fd_ = modbus_tcp_listen(ctx_, 16);
+  if (listen_fd_ < 0) {
+    *error = "stage simulator: cannot listen on " + host + ":" + std::to_string(port) + ": " +
+             modbus_strerror(errno) + "; choose another --modbus-port (0 picks a free one)";
+    modbus_free(ctx_);
+    ctx_ = nullptr;
+    return false;
+  }
+  sockaddr_in addr{};
+  socklen_t len = sizeof addr;
+  if (::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&addr), &len) == 0) {
+    port_ = ntohs(addr.sin_port);
+  }
+  if (::pipe2(wake_, O_CLOEXEC | O_NONBLOCK) != 0) {
+    *error = std::string("stage simulator: cannot create a pipe: ") + std::strerror(errno);
+    ::close(listen_fd_);
+    listen_fd_ = -1;
+    modbus_free(ctx_);
+    ctx_ = nullptr;
+    return false;
+  }
+  stopping_ = false;
+  thread_ = std::thread([this] { Run(); });
+  return true;
+}
+
+void StageTcpEndpoint::Stop() {
+  if (thread_.joinable()) {
+    stopping_ = true;
+    const char byte = 1;
+    [[maybe_unused]] const auto n = ::write(wake_[1], &byte, 1);
+    thread_.join();
+  }
+  for (auto& [fd, client] : clients_) ::close(fd);
+  clients_.clear();
+  clients_count_ = 0;
+  if (listen_fd_ >= 0) ::close(listen_fd_);
+  listen_fd_ = -1;
+  for (int& fd : wake_) {
+    if (fd >= 0) ::close(fd);
+    fd = -1;
+  }
+  if (ctx_ != nullptr) {
+    modbus_set_socket(ctx_, -1);
+    modbus_free(ctx_);
+    ctx_ = nullptr;
+  }
+}
+
+void StageTcpEndpoint::Run() {
+  while (!stopping_) {
+    fd_set readable;
+    FD_ZERO(&readable);
+    FD_SET(listen_fd_, &readable);
+    FD_SET(wake_[0], &readable);
+    int max_fd = std::max(listen_fd_, wake_[0]);
+    std::chrono::milliseconds wait(1000);
+    const auto now = SteadyClock::now();
+    for (const auto& [fd, client] : clients_) {
+      FD_SET(fd, &readable);
+      max_fd = std::max(max_fd, fd);
+      if (!client.queue.empty()) {
+        wait = std::min(wait, std::max(std::chrono::milliseconds(0),
+                                       std::chrono::duration_cast<std::chrono::milliseconds>(
+                                           client.queue.front().due - now) +
+                                           std::chrono::milliseconds(1)));
+      }
+    }
+    timeval tv{static_cast<time_t>(wait.count() / 1000),
+               static_cast<suseconds_t>((wait.count() % 1000) * 1000)};
+    const int n = ::select(max_fd + 1, &readable, nullptr, nullptr, &tv);
+    if (n < 0 && errno != EINTR) break;
+    if (n > 0) {
+      if (FD_ISSET(wake_[0], &readable)) {
+        char drain[16];
+        while (::read(wake_[0], drain, sizeof drain) > 0) {
+        }
+      }
+      if (stopping_) break;
+      if (FD_ISSET(listen_fd_, &readable)) Accept();
+      std::vector<int> ready;
+      for (const auto& [fd, client] : clients_) {
+        if (FD_ISSET(fd, &readable)) ready.push_back(fd);
+      }
+      for (int fd : ready) Receive(fd);
+    }
+    SendDue();
+  }
+}
+
+void StageTcpEndpoint::Accept() {
+  int listen_fd = listen_fd_;
+  const int fd = modbus_tcp_accept(ctx_, &listen_fd);
+  if (fd < 0) return;
+  clients_[fd];
+  clients_count_ = static_cast<int>(clients_.size());
+}
+
+void StageTcpEndpoint::CloseClient(int fd) {
+  ::close(fd);
+  clients_.erase(fd);
+  clients_count_ = static_cast<int>(clients_.size());
+}
+
+void StageTcpEndpoint::Receive(int fd) {
+  std::uint8_t request[MODBUS_TCP_MAX_ADU_LENGTH];
+  modbus_set_socket(ctx_, fd);
+  const int rc = modbus_receive(ctx_, request);
+  if (rc <= kMbapLength) {  // closed by the peer, a broken or half request
+    CloseClient(fd);
+    return;
+  }
+  const std::uint8_t unit = request[6];
+  const StageReply reply =
+      dispatcher_.Handle(unit,
+                         std::span<const std::uint8_t>(request + kMbapLength,
+                                                       static_cast<std::size_t>(rc - kMbapLength)),
+                         StageTransport::kTcp);
+  switch (reply.kind) {
+    case StageReply::Kind::kDrop:
+      CloseClient(fd);
+      return;
+    case StageReply::Kind::kSilent:
+      return;
+    case StageReply::Kind::kReply:
+      break;
+  }
+  std::vector<std::uint8_t> frame{request[0], request[1], 0, 0};  // transaction id, protocol 0
+  const auto length = static_cast<std::uint16_t>(reply.pdu.size() + 1);
+  frame.push_back(static_cast<std::uint8_t>(length >> 8));
+  frame.push_back(static_cast<std::uint8_t>(length & 0xFF));
+  frame.push_back(unit);
+  frame.insert(frame.end(), reply.pdu.begin(), reply.pdu.end());
+
+  Client& client = clients_[fd];
+  auto due = SteadyClock::now() + reply.delay;
+  if (!client.queue.empty()) due = std::max(due, client.queue.back().due);
+  client.queue.push_back({due, std::move(frame)});
+}
+
+void StageTcpEndpoint::SendDue() {
+  const auto now = SteadyClock::now();
+  std::vector<int> broken;
+  for (auto& [fd, client] : clients_) {
+    while (!client.queue.empty() && client.queue.front().due <= now) {
+      const std::vector<std::uint8_t> bytes = std::move(client.queue.front().bytes);
+      client.queue.pop_front();
+      const ssize_t sent = ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+      if (sent != static_cast<ssize_t>(bytes.size())) {
+        broken.push_back(fd);
+        break;
+      }
+    }
+  }
+  for (int fd : broken) CloseClient(fd);
+}
+
+}  // namespace brdf::sim
