@@ -1,0 +1,255 @@
+// The simulator's PR-650 endpoint on its own, through a plain POSIX client on the pty: the exact
+// bytes of each reply, setup checking, remote-mode entry, faults.
+#include "tools/brdf-sim/pr650_endpoint.h"
+
+#include <fcntl.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include "tests/drivers_pr650/pr650_test_rig.h"
+
+namespace brdf::testing {
+namespace {
+
+using namespace std::chrono_literals;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+using SteadyClock = std::chrono::steady_clock;
+
+// A raw serial client: writes bytes, reads until the line has been quiet for a while.
+class RawClient {
+ public:
+  explicit RawClient(const std::string& path) {
+    fd_ = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+    if (fd_ >= 0) {
+      termios t{};
+      ::tcgetattr(fd_, &t);
+      ::cfmakeraw(&t);
+      ::tcsetattr(fd_, TCSANOW, &t);
+    }
+  }
+  ~RawClient() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  bool ok() const { return fd_ >= 0; }
+
+  // Sends `bytes` and returns everything that arrives until `quiet` passes without a byte (or
+  // `limit` overall). `hangup` is set when the port hung up.
+  std::string Ask(const std::string& bytes, std::chrono::milliseconds quiet = 80ms,
+                  std::chrono::milliseconds limit = 5s) {
+    if (::write(fd_, bytes.data(), bytes.size()) != static_cast<ssize_t>(bytes.size())) return {};
+    std::string out;
+    const auto end = SteadyClock::now() + limit;
+    auto last = SteadyClock::now();
+    while (SteadyClock::now() < end && SteadyClock::now() - last < quiet) {
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, 5) <= 0) continue;
+      char buffer[512];
+      const ssize_t n = ::read(fd_, buffer, sizeof buffer);
+      if (n > 0) {
+        out.append(buffer, static_cast<std::size_t>(n));
+        last = SteadyClock::now();
+      } else if (p.revents & (POLLHUP | POLLERR)) {
+        hangup = true;
+        break;
+      }
+    }
+    return out;
+  }
+
+  bool hangup = false;
+
+ private:
+  int fd_ = -1;
+};
+
+class Pr650EndpointTest : public ::testing::Test {
+ protected:
+  void Start(sim::Pr650EndpointOptions options = FastEndpointOptions()) {
+    endpoint_ = std::make_unique<sim::Pr650Endpoint>(backend_, control_, options);
+    ASSERT_TRUE(endpoint_->Start().ok());
+    client_ = std::make_unique<RawClient>(endpoint_->path());
+    ASSERT_TRUE(client_->ok());
+  }
+
+  FakeMeterBackend backend_;
+  sim::SimControl control_;
+  std::unique_ptr<sim::Pr650Endpoint> endpoint_;
+  std::unique_ptr<RawClient> client_;
+};
+
+TEST_F(Pr650EndpointTest, PathIsAStableLinkToAPtySlave) {
+  Start();
+  char target[256] = {};
+  ASSERT_GT(::readlink(endpoint_->path().c_str(), target, sizeof target - 1), 0);
+  EXPECT_EQ(std::string(target), endpoint_->slave_path());
+  EXPECT_THAT(endpoint_->slave_path(), StartsWith("/dev/pts/"));
+  const std::string path = endpoint_->path();
+  endpoint_->Stop();
+  EXPECT_NE(::access(path.c_str(), F_OK), 0);  // removed on Stop
+}
+
+TEST_F(Pr650EndpointTest, RepliesAreByteExact) {
+  Start();
+  EXPECT_EQ(client_->Ask("B3\n"), "000\r\n");
+  EXPECT_EQ(client_->Ask("D120\n"), "0101,008.0,0380.,0780.,004.\r\n");
+  EXPECT_EQ(client_->Ask("D110\n"), "60925301\r\n");
+  EXPECT_EQ(client_->Ask("S01,,,,,0,01,1\n"), "00\r\n");
+  EXPECT_EQ(client_->Ask("F\n"), "00,100.0\r\n");
+  EXPECT_EQ(client_->Ask("M0\n"), "000\r\n");
+
+  const std::string d5 = client_->Ask("D5\n");
+  ASSERT_EQ(d5.size(), 6u + 11u + 101u * 17u);
+  EXPECT_THAT(d5, StartsWith("00,0\r\n"));
+  double integrated = 0;
+  for (double v : FakeMeterBackend::Spectrum(0.0123)) integrated += 4 * v;
+  char line[32];
+  std::snprintf(line, sizeof line, "%.3E\r\n", integrated);
+  EXPECT_EQ(d5.substr(6, 11), line);
+  EXPECT_EQ(d5.substr(17, 17), "0380.,1.230E-02\r\n");
+  EXPECT_EQ(d5.substr(17 + 17, 17), "0384.,1.255E-02\r\n");
+  EXPECT_EQ(d5.substr(d5.size() - 17), "0780.,3.690E-02\r\n");
+}
+
+TEST_F(Pr650EndpointTest, CommandsInAnyCaseEndedByCrOrLf) {
+  Start();
+  EXPECT_EQ(client_->Ask("b3\r"), "000\r\n");
+  EXPECT_EQ(client_->Ask("d120\r\n"), "0101,008.0,0380.,0780.,004.\r\n");
+  EXPECT_EQ(client_->Ask("s01,,,,,500,01,1\n"), "00\r\n");
+  EXPECT_EQ(client_->Ask("m0\r"), "000\r\n");
+  ASSERT_FALSE(backend_.setups().empty());
+  EXPECT_EQ(backend_.setups().back().integration_ms, 500);
+}
+
+TEST_F(Pr650EndpointTest, SetupFieldsAreCheckedWithTheBadFieldPosition) {
+  Start();
+  ASSERT_EQ(client_->Ask("B3\n"), "000\r\n");
+  const std::pair<const char*, const char*> cases[] = {
+      {"S01,,,,,0,01,1", "00"},    {"S,,,,,0,1,1", "00"},       {"S1,,,,,500,,1", "00"},
+      {"S01,,,,100,0,01,1", "00"}, {"S13,,,,,0,01,1", "01"},    {"S02,,,,,0,01,1", "50"},
+      {"S01,x,,,,0,01,1", "02"},   {"S01,,,1,,0,01,1", "50"},   {"S01,,,,300,0,01,1", "05"},
+      {"S01,,,,,5,01,1", "06"},    {"S01,,,,,6001,01,1", "06"}, {"S01,,,,,0,00,1", "07"},
+      {"S01,,,,,0,100,1", "07"},   {"S01,,,,,0,01,2", "08"},    {"S01,,,,,0,01,1,0", "09"},
+  };
+  for (const auto& [command, reply] : cases) {
+    EXPECT_EQ(client_->Ask(std::string(command) + "\n"), std::string(reply) + "\r\n") << command;
+  }
+  // A rejected setup leaves the previous one in place.
+  ASSERT_EQ(client_->Ask("S01,,,,,250,03,1\n"), "00\r\n");
+  ASSERT_EQ(client_->Ask("S01,,,,,5,01,1\n"), "06\r\n");
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  EXPECT_EQ(backend_.setups().back().integration_ms, 250);
+  EXPECT_EQ(backend_.setups().back().averages, 3);
+}
+
+TEST_F(Pr650EndpointTest, UnknownCommandsGetNoReply) {
+  Start();
+  ASSERT_EQ(client_->Ask("B3\n"), "000\r\n");
+  EXPECT_EQ(client_->Ask("M1\n"), "");
+  EXPECT_EQ(client_->Ask("HELLO\n"), "");
+  EXPECT_EQ(client_->Ask("B4\n"), "");
+}
+
+TEST_F(Pr650EndpointTest, RemoteModeOnlyWithinTheWakeWindow) {
+  sim::Pr650EndpointOptions o = FastEndpointOptions();
+  o.time_scale.factor = 1;
+  o.wake_window_s = 0.2;
+  Start(o);
+  std::this_thread::sleep_for(300ms);
+  EXPECT_EQ(client_->Ask("B3\n"), "");
+  EXPECT_FALSE(endpoint_->remote_mode());
+  // Stand-alone until power-cycled, however often it is asked.
+  EXPECT_EQ(client_->Ask("B3\n"), "");
+
+  endpoint_->PowerCycle();
+  EXPECT_EQ(client_->Ask("B3\n"), "000\r\n");
+  EXPECT_TRUE(endpoint_->remote_mode());
+}
+
+TEST_F(Pr650EndpointTest, ZeroWakeWindowMeansAlways) {
+  sim::Pr650EndpointOptions o = FastEndpointOptions();
+  o.wake_window_s = 0;
+  o.time_scale.factor = 1000;  // "5 s" would be over in 5 ms
+  Start(o);
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(client_->Ask("B3\n"), "000\r\n");
+}
+
+TEST_F(Pr650EndpointTest, PowerCycleForgetsTheMeasurementAndSetup) {
+  Start();
+  ASSERT_EQ(client_->Ask("S01,,,,,250,01,1\n"), "00\r\n");
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  endpoint_->PowerCycle();
+  ASSERT_EQ(client_->Ask("B3\n"), "000\r\n");
+  const std::string d5 = client_->Ask("D5\n");
+  EXPECT_THAT(d5, HasSubstr("0380.,0.000E+00\r\n"));
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  EXPECT_EQ(backend_.setups().back().integration_ms, 0);
+}
+
+TEST_F(Pr650EndpointTest, SilentFaultAnswersNothing) {
+  Start();
+  control_.set_serial({.silent = true});
+  EXPECT_EQ(client_->Ask("B3\n"), "");
+  control_.set_serial({});
+  EXPECT_EQ(client_->Ask("B3\n"), "000\r\n");
+}
+
+TEST_F(Pr650EndpointTest, InjectedQualityLeadsM0AndD5AndCountsDown) {
+  Start();
+  control_.set_serial({.quality_code = 19, .quality_count = 1});
+  EXPECT_EQ(client_->Ask("M0\n"), "019\r\n");
+  EXPECT_THAT(client_->Ask("D5\n"), StartsWith("19,0\r\n"));
+  EXPECT_EQ(control_.serial().quality_count, 0);
+  EXPECT_EQ(client_->Ask("M0\n"), "000\r\n");
+}
+
+TEST_F(Pr650EndpointTest, GarbageAndTruncationKeepTheReplysShapeOrCutIt) {
+  Start();
+  control_.set_serial({.garbage_next = 1});
+  const std::string garbage = client_->Ask("D120\n");
+  EXPECT_EQ(garbage.size(), std::string("0101,008.0,0380.,0780.,004.\r\n").size());
+  EXPECT_NE(garbage, "0101,008.0,0380.,0780.,004.\r\n");
+  EXPECT_THAT(garbage, ::testing::EndsWith("\r\n"));
+
+  control_.set_serial({.truncate_next = 1});
+  EXPECT_EQ(client_->Ask("D120\n"), "0101,008.0,038");  // the first half
+  EXPECT_EQ(control_.serial().truncate_next, 0);
+  EXPECT_EQ(client_->Ask("D120\n"), "0101,008.0,0380.,0780.,004.\r\n");
+}
+
+TEST_F(Pr650EndpointTest, RepliesArePacedAtTheSerialRate) {
+  Start();  // 10x time: 1734 bytes at 960 bytes/s are 1.8 s simulated, 0.18 s real
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  const auto start = SteadyClock::now();
+  const std::string d5 = client_->Ask("D5\n", 60ms);
+  EXPECT_EQ(d5.size(), 1734u);
+  EXPECT_GE(SteadyClock::now() - start, 170ms);
+}
+
+TEST_F(Pr650EndpointTest, VanishingPortHangsUpAndComesBackAtTheSameLink) {
+  Start();
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  control_.set_serial({.vanish_seconds = 2.0});  // 0.2 s real
+  const std::string partial = client_->Ask("D5\n");
+  EXPECT_TRUE(client_->hangup);
+  EXPECT_GT(partial.size(), 0u);
+  EXPECT_LT(partial.size(), 1734u);
+  EXPECT_EQ(control_.serial().vanish_seconds, 0);
+
+  const auto end = SteadyClock::now() + 3s;
+  while (::access(endpoint_->path().c_str(), F_OK) != 0 && SteadyClock::now() < end) {
+    std::this_thread::sleep_for(10ms);
+  }
+  RawClient again(endpoint_->path());
+  ASSERT_TRUE(again.ok());
+  // The meter itself stayed on: still in remote mode, still holding its measurement.
+  EXPECT_EQ(again.Ask("B3\n"), "000\r\n");
+  EXPECT_EQ(again.Ask("D5\n").size(), 1734u);
+}
+
+}  // namespace
+}  // namespace brdf::testing

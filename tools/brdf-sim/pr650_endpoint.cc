@@ -1,0 +1,365 @@
+#include "tools/brdf-sim/pr650_endpoint.h"
+
+#include <poll.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstdio>
+
+#include "tools/brdf-sim/pr650_sim_protocol.h"
+
+namespace brdf::sim {
+
+namespace {
+
+constexpr auto kSlice = std::chrono::milliseconds(20);
+// A reply nobody reads (the pty's buffer is full) is given up after this long.
+constexpr auto kWriteStall = std::chrono::seconds(2);
+
+std::string Upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string Trim(const std::string& s) {
+  const auto first = s.find_first_not_of(" \t");
+  if (first == std::string::npos) return {};
+  const auto last = s.find_last_not_of(" \t");
+  return s.substr(first, last - first + 1);
+}
+
+// Junk of the same shape as the reply it replaces (same line count and lengths), so a driver
+// gets a complete-looking reply that does not parse: what a wrong baud rate or line noise gives.
+std::string Garble(const std::string& line, unsigned seed) {
+  static const char kJunk[] = "\x7f#~?@%&\xff\xfe\x1b!*";
+  std::string out(line.size(), '#');
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = kJunk[(seed + i * 7) % (sizeof kJunk - 1)];
+  return out;
+}
+
+}  // namespace
+
+Pr650Endpoint::Pr650Endpoint(MeterBackend& backend, SimControl& control,
+                             Pr650EndpointOptions options)
+    : backend_(backend), control_(control), options_(std::move(options)) {}
+
+Pr650Endpoint::~Pr650Endpoint() {
+  Stop();
+}
+
+Status Pr650Endpoint::Start() {
+  Stop();
+  {
+    std::lock_guard lock(mu_);
+    BRDF_RETURN_IF_ERROR(pty_.Open());
+    Status status = link_.Create(options_.link_path);
+    if (status.ok()) status = link_.PointAt(pty_.slave_path());
+    if (!status.ok()) {
+      pty_.Close();
+      link_.Remove();
+      return status;
+    }
+    power_on_ = SteadyClock::now();
+    remote_ = false;
+    standalone_ = false;
+    input_.clear();
+  }
+  stop_ = false;
+  thread_ = std::thread([this] { Run(); });
+  return Status::Ok();
+}
+
+void Pr650Endpoint::Stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+  std::lock_guard lock(mu_);
+  pty_.Close();
+  link_.Remove();
+}
+
+std::string Pr650Endpoint::path() const {
+  std::lock_guard lock(mu_);
+  return link_.path();
+}
+
+std::string Pr650Endpoint::slave_path() const {
+  std::lock_guard lock(mu_);
+  return pty_.slave_path();
+}
+
+void Pr650Endpoint::PowerCycle() {
+  std::lock_guard lock(mu_);
+  power_on_ = SteadyClock::now();
+  ++power_epoch_;
+  remote_ = false;
+  standalone_ = false;
+  setup_ = MeterSetup{};
+  sync_ = false;
+  last_ = Measurement{};
+  input_.clear();
+  // Whatever was sent to the meter while it was off is lost.
+  if (pty_.is_open()) ::tcflush(pty_.master_fd(), TCIFLUSH);
+}
+
+bool Pr650Endpoint::remote_mode() const {
+  std::lock_guard lock(mu_);
+  return remote_;
+}
+
+std::vector<std::string> Pr650Endpoint::commands() const {
+  std::lock_guard lock(mu_);
+  return commands_;
+}
+
+std::vector<MeterSetup> Pr650Endpoint::measured_setups() const {
+  std::lock_guard lock(mu_);
+  return measured_setups_;
+}
+
+bool Pr650Endpoint::SleepReal(std::chrono::nanoseconds d) {
+  const auto end = SteadyClock::now() + d;
+  while (!stop_) {
+    const auto now = SteadyClock::now();
+    if (now >= end) return true;
+    std::this_thread::sleep_for(std::min<SteadyClock::duration>(end - now, kSlice));
+  }
+  return false;
+}
+
+void Pr650Endpoint::Run() {
+  while (!stop_) {
+    int fd = -1;
+    {
+      std::lock_guard lock(mu_);
+      fd = pty_.master_fd();
+    }
+    if (fd < 0) {
+      SleepReal(kSlice);
+      continue;
+    }
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(kSlice.count())) <= 0) continue;
+    char buffer[512];
+    const ssize_t n = (p.revents & POLLIN) ? ::read(fd, buffer, sizeof buffer) : -1;
+    if (n <= 0) {
+      // No reader on the slave side for a moment (cannot happen while the keep-alive slave
+      // descriptor is open, but never spin).
+      SleepReal(kSlice);
+      continue;
+    }
+    std::vector<std::string> complete;
+    {
+      std::lock_guard lock(mu_);
+      for (ssize_t i = 0; i < n; ++i) {
+        const char c = buffer[i];
+        if (c == '\r' || c == '\n') {
+          std::string command = Trim(input_);
+          input_.clear();
+          if (!command.empty()) complete.push_back(Upper(command));
+        } else if (input_.size() < 256) {
+          input_.push_back(c);
+        }
+      }
+    }
+    for (const std::string& command : complete) {
+      if (stop_) break;
+      Handle(command);
+    }
+  }
+}
+
+void Pr650Endpoint::Handle(const std::string& command) {
+  const SerialFaults faults = control_.serial();
+  unsigned epoch = 0;
+  {
+    std::lock_guard lock(mu_);
+    commands_.push_back(command);
+    if (faults.silent) return;
+    if (!remote_) {
+      const double since_power_on = options_.time_scale.ToSim(
+          std::chrono::duration_cast<std::chrono::nanoseconds>(SteadyClock::now() - power_on_));
+      if (standalone_ || (options_.wake_window_s > 0 && since_power_on > options_.wake_window_s)) {
+        standalone_ = true;  // first command too late: stand-alone until power-cycled
+        return;
+      }
+      remote_ = true;
+    }
+    epoch = power_epoch_;
+  }
+
+  if (command.size() == 2 && command[0] == 'B' && command[1] >= '0' && command[1] <= '3') {
+    Reply({"000"});
+    return;
+  }
+  if (command[0] == 'S') {
+    const Pr650SetupResult result = ApplyPr650Setup(std::string_view(command).substr(1));
+    if (result.reply_code == 0) {
+      std::lock_guard lock(mu_);
+      setup_ = result.setup;
+      sync_ = result.sync;
+    }
+    char text[8];
+    std::snprintf(text, sizeof text, "%02d", result.reply_code);
+    Reply({text});
+    return;
+  }
+  if (command == "F") {
+    char text[32];
+    std::snprintf(text, sizeof text, "00,%.1f", options_.flicker_hz);
+    Reply({text});
+    return;
+  }
+  if (command == "M0") {
+    MeterSetup setup;
+    {
+      std::lock_guard lock(mu_);
+      setup = setup_;
+      measured_setups_.push_back(setup);
+    }
+    SimMeasurement m = backend_.Measure(setup);
+    const int forced = control_.UpdateSerial([](SerialFaults& f) {
+      if (f.quality_count <= 0) return -1;
+      --f.quality_count;
+      return f.quality_code;
+    });
+    if (forced >= 0) m.quality_code = forced;
+    if (!SleepReal(options_.time_scale.ToReal(std::max(0.0, m.duration_s)))) return;
+    {
+      std::lock_guard lock(mu_);
+      if (epoch != power_epoch_) return;  // switched off mid-measurement: no reply
+      last_ = Measurement{true, m.quality_code, m.integrated, std::move(m.radiance)};
+    }
+    char text[8];
+    std::snprintf(text, sizeof text, "%03d", std::clamp(m.quality_code, 0, 999));
+    Reply({text});
+    return;
+  }
+  if (command == "D5") {
+    Measurement last;
+    {
+      std::lock_guard lock(mu_);
+      last = last_;
+    }
+    const double vanish = control_.UpdateSerial([](SerialFaults& f) {
+      const double seconds = f.vanish_seconds;
+      f.vanish_seconds = 0;
+      return seconds;
+    });
+    Reply(Pr650SpectrumLines(last.quality_code, 0, last.integrated, last.radiance), vanish);
+    return;
+  }
+  if (command == "D110") {
+    std::string serial = options_.serial_number.substr(0, 8);
+    serial.resize(8, ' ');
+    Reply({serial});
+    return;
+  }
+  if (command == "D120") {
+    Reply({Pr650LayoutLine()});
+    return;
+  }
+  // Unknown or unsupported (M1–M6, D1, D2, ...): the simulated meter does not answer.
+}
+
+void Pr650Endpoint::Reply(std::vector<std::string> lines, double vanish_seconds) {
+  const Pr650WireQuirks& q = options_.quirks;
+  const auto [garble, truncate] = control_.UpdateSerial([](SerialFaults& f) {
+    const bool g = f.garbage_next > 0;
+    const bool t = !g && f.truncate_next > 0;
+    if (g) --f.garbage_next;
+    if (t) --f.truncate_next;
+    return std::pair{g, t};
+  });
+
+  const char* eol = q.line_ending == Pr650WireQuirks::LineEnding::kLf   ? "\n"
+                    : q.line_ending == Pr650WireQuirks::LineEnding::kCr ? "\r"
+                                                                        : "\r\n";
+  std::string bytes;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const std::string line = garble ? Garble(lines[i], static_cast<unsigned>(i)) : lines[i];
+    bytes += line;
+    const bool bare_cr = q.d5_header_bare_cr && i == 0 && lines.size() > 2;
+    bytes += bare_cr ? "\r" : eol;
+  }
+  if (truncate) bytes.resize(bytes.size() / 2);
+
+  if (q.reply_delay.count() > 0 && !SleepReal(q.reply_delay)) return;
+  if (vanish_seconds > 0) {
+    // Part of the report goes out, then the port is gone.
+    if (!WriteOut(bytes.substr(0, bytes.size() / 3))) return;
+    Vanish(vanish_seconds);
+    return;
+  }
+  WriteOut(bytes);
+}
+
+bool Pr650Endpoint::WriteOut(const std::string& bytes) {
+  const Pr650WireQuirks& q = options_.quirks;
+  int fd = -1;
+  {
+    std::lock_guard lock(mu_);
+    fd = pty_.master_fd();
+  }
+  if (fd < 0) return false;
+  // Serial pacing: one byte is 10 bits (start, 8 data, stop) on the wire.
+  const double byte_sim_s = 10.0 / std::max(options_.baud, 1);
+  const std::size_t piece =
+      q.piece_bytes > 0 ? static_cast<std::size_t>(q.piece_bytes) : bytes.size();
+  const auto start = SteadyClock::now();
+  auto paused = SteadyClock::duration::zero();  // piece gaps do not count as transmission time
+  std::size_t sent = 0;
+  auto last_progress = start;
+  while (sent < bytes.size()) {
+    if (stop_) return false;
+    // Never write across the end of the current piece.
+    std::size_t chunk = std::min(bytes.size(), (sent / piece + 1) * piece) - sent;
+    if (options_.pace_replies) {
+      // Send what is due by now (at least one byte), then wait for the next byte's time.
+      const auto elapsed =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(SteadyClock::now() - start - paused);
+      const auto due =
+          static_cast<std::size_t>(options_.time_scale.ToSim(elapsed) / byte_sim_s) + 1;
+      if (due <= sent) {
+        SleepReal(std::chrono::microseconds(500));
+        continue;
+      }
+      chunk = std::min(chunk, due - sent);
+    }
+    const ssize_t n = ::write(fd, bytes.data() + sent, chunk);
+    if (n > 0) {
+      sent += static_cast<std::size_t>(n);
+      last_progress = SteadyClock::now();
+      if (sent % piece == 0 && sent < bytes.size() && q.piece_gap.count() > 0) {
+        const auto before = SteadyClock::now();
+        if (!SleepReal(q.piece_gap)) return false;
+        paused += SteadyClock::now() - before;
+      }
+      continue;
+    }
+    if (n < 0 && errno != EAGAIN && errno != EINTR) return false;
+    if (SteadyClock::now() - last_progress > kWriteStall) return false;  // nobody is reading
+    pollfd p{fd, POLLOUT, 0};
+    ::poll(&p, 1, static_cast<int>(kSlice.count()));
+  }
+  return true;
+}
+
+void Pr650Endpoint::Vanish(double seconds) {
+  {
+    std::lock_guard lock(mu_);
+    pty_.Close();
+    link_.Unlink();
+    input_.clear();
+  }
+  if (!SleepReal(options_.time_scale.ToReal(seconds))) return;
+  std::lock_guard lock(mu_);
+  // The meter itself stayed on: it is still in remote mode and still holds its measurement.
+  if (pty_.Open().ok()) {
+    if (!link_.PointAt(pty_.slave_path()).ok()) pty_.Close();
+  }
+}
+
+}  // namespace brdf::sim

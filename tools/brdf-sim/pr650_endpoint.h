@@ -1,0 +1,141 @@
+// The simulated PR-650 on a pseudo-terminal: a thread that speaks the meter's remote-mode protocol
+// (/work/shared/reference/pr650.md) byte for byte, asking a MeterBackend what it would measure.
+//
+//   commands (case-insensitive, ended by CR or LF)     replies (lines end CR LF)
+//   B0 … B3                                             000
+//   S<acc1>,<acc2>,<acc3>,<acc4>,<sync>,<integ>,<avg>,<units>   pp (00 ok, 01–08 bad field, 09 too
+//                                                       many fields, 50 accessory not fitted)
+//   F                                                   qq,freq  ("00,100.0")
+//   M0                                                  a 3-digit status = the quality code ("000",
+//                                                       "018"), after the measurement's duration
+//   D5                                                  qq,U / integrated / 101 × "0380.,r.rrrEsee"
+//   D110                                                the serial number, blank-padded to 8
+//   D120                                                0101,008.0,0380.,0780.,004.
+//   anything else                                       no reply
+//
+// Remote mode starts only if the first command arrives within wake_window_s (simulated) of
+// power-on (Start or PowerCycle); otherwise the meter stays in stand-alone mode and answers
+// nothing until power-cycled. Faults come from SimControl::serial() at each command; the "next N"
+// counters are counted down through SimControl::UpdateSerial.
+//
+// The port path is a stable symlink to the current pty slave (path()). When the port "vanishes"
+// (SerialFaults::vanish_seconds, during the next D5) the pty is closed (a driver holding it sees a
+// hang-up, EIO), the link is removed, and after the pause a new pty is made and the link points at
+// it. The new pty usually has a different /dev/pts number, so drivers must open the link path, and
+// reopen it by name after a disconnect (the PR-650 driver does).
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/status.h"
+#include "tools/brdf-sim/pr650_pty.h"
+#include "tools/brdf-sim/sim_shared.h"
+
+namespace brdf::sim {
+
+// Ways real meters and USB adapters deliver replies that a driver must cope with. The defaults are
+// the meter's own: CR LF, one write per reply, no delay.
+struct Pr650WireQuirks {
+  enum class LineEnding { kCrLf, kLf, kCr };
+  LineEnding line_ending = LineEnding::kCrLf;
+  // D5 header and integrated line run together with a bare CR ("00,0\r1.234E+01\r\n").
+  bool d5_header_bare_cr = false;
+  // > 0: replies leave in pieces of this many bytes, piece_gap apart (real time).
+  int piece_bytes = 0;
+  std::chrono::milliseconds piece_gap{0};
+  // Real-time delay before each reply starts.
+  std::chrono::milliseconds reply_delay{0};
+};
+
+struct Pr650EndpointOptions {
+  TimeScale time_scale;
+  // Simulated seconds after power-on within which the first command enters remote mode (the
+  // meter's ~5 s); 0 = always.
+  double wake_window_s = 5.0;
+  // Send reply bytes at the serial rate (baud / 10 bytes per simulated second), so a D5 takes
+  // ~1.8 s simulated like the real meter; off: as fast as the pty takes them.
+  bool pace_replies = false;
+  int baud = 9600;
+  // Where the stable port link goes; empty: a private temporary directory.
+  std::string link_path;
+  std::string serial_number = "60925301";
+  double flicker_hz = 100.0;  // what F reports (a 50 Hz mains lamp flickers at 100 Hz)
+  Pr650WireQuirks quirks;
+};
+
+class Pr650Endpoint {
+ public:
+  Pr650Endpoint(MeterBackend& backend, SimControl& control, Pr650EndpointOptions options = {});
+  ~Pr650Endpoint();
+  Pr650Endpoint(const Pr650Endpoint&) = delete;
+  Pr650Endpoint& operator=(const Pr650Endpoint&) = delete;
+
+  // Creates the pty and the link, powers the meter on and starts the thread.
+  Status Start();
+  // Stops the thread and removes the pty and the link. Idempotent.
+  void Stop();
+
+  // The path drivers open: the stable link. brdf-sim prints it as "pr650 <path>".
+  std::string path() const;
+  // The current pty slave (/dev/pts/N); changes when the port vanishes and comes back.
+  std::string slave_path() const;
+
+  // Switches the meter off and on: it leaves remote mode, forgets its setup and last measurement,
+  // and the wake-up window starts again.
+  void PowerCycle();
+
+  bool remote_mode() const;
+  // Every command received so far, upper-cased, without its line end (also those not answered).
+  std::vector<std::string> commands() const;
+  // Setups the backend has been asked to measure with, in order.
+  std::vector<MeterSetup> measured_setups() const;
+
+ private:
+  using SteadyClock = std::chrono::steady_clock;
+
+  struct Measurement {
+    bool valid = false;
+    int quality_code = 0;
+    double integrated = 0;
+    std::vector<double> radiance;
+  };
+
+  void Run();
+  void Handle(const std::string& command);
+  // Sends `lines` as one reply (line ends, quirks and faults applied). `vanish_after`: for a D5
+  // with the vanish fault, the number of bytes after which the port vanishes.
+  void Reply(std::vector<std::string> lines, double vanish_seconds = 0);
+  // Writes `bytes` to the master, paced; false if the port went away or the endpoint stopped.
+  bool WriteOut(const std::string& bytes);
+  // Sleeps `d` real time unless stopping; false if stopped.
+  bool SleepReal(std::chrono::nanoseconds d);
+  void Vanish(double seconds);
+
+  MeterBackend& backend_;
+  SimControl& control_;
+  const Pr650EndpointOptions options_;
+
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+
+  mutable std::mutex mu_;  // guards everything below
+  Pr650Pty pty_;
+  Pr650PtyLink link_;
+  std::string input_;  // bytes of a command not yet ended
+  SteadyClock::time_point power_on_;
+  unsigned power_epoch_ = 0;  // bumped by PowerCycle; a measurement spanning one is dropped
+  bool remote_ = false;
+  bool standalone_ = false;  // the wake-up window was missed: silent until power-cycled
+  MeterSetup setup_;
+  bool sync_ = false;
+  Measurement last_;
+  std::vector<std::string> commands_;
+  std::vector<MeterSetup> measured_setups_;
+};
+
+}  // namespace brdf::sim

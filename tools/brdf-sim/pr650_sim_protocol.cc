@@ -1,0 +1,119 @@
+#include "tools/brdf-sim/pr650_sim_protocol.h"
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+namespace brdf::sim {
+
+namespace {
+
+// A field of digits only (1–4 of them), as a number; std::nullopt otherwise.
+std::optional<int> Digits(std::string_view field) {
+  if (field.empty() || field.size() > 4) return std::nullopt;
+  int value = 0;
+  for (char c : field) {
+    if (c < '0' || c > '9') return std::nullopt;
+    value = value * 10 + (c - '0');
+  }
+  return value;
+}
+
+}  // namespace
+
+std::string FormatPr650Number(double value) {
+  if (!std::isfinite(value) || std::abs(value) < 1e-99) return "0.000E+00";
+  if (std::abs(value) >= 9.9995e99) return value < 0 ? "-9.999E+99" : "9.999E+99";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3E", value);
+  std::string out = text;
+  // Rounding can carry a value just under 1e-99 to "1.000E-100"; the meter has two exponent digits.
+  if (out.size() > (value < 0 ? 10u : 9u)) return "0.000E+00";
+  return out;
+}
+
+std::vector<std::string> Pr650SpectrumLines(int quality_code, int units_code, double integrated,
+                                            const std::vector<double>& radiance) {
+  std::vector<std::string> lines;
+  lines.reserve(kPr650Bands + 2);
+  char text[48];
+  std::snprintf(text, sizeof text, "%02d,%d", quality_code, units_code);
+  lines.emplace_back(text);
+  lines.push_back(FormatPr650Number(integrated));
+  for (int i = 0; i < kPr650Bands; ++i) {
+    const double v =
+        i < static_cast<int>(radiance.size()) ? radiance[static_cast<std::size_t>(i)] : 0.0;
+    std::snprintf(text, sizeof text, "%04d.,%s", kPr650FirstNm + kPr650StepNm * i,
+                  FormatPr650Number(v).c_str());
+    lines.emplace_back(text);
+  }
+  return lines;
+}
+
+std::string Pr650LayoutLine() {
+  char text[48];
+  std::snprintf(text, sizeof text, "%04d,008.0,%04d.,%04d.,%03d.", kPr650Bands, kPr650FirstNm,
+                kPr650FirstNm + kPr650StepNm * (kPr650Bands - 1), kPr650StepNm);
+  return text;
+}
+
+Pr650SetupResult ApplyPr650Setup(std::string_view fields) {
+  std::vector<std::string_view> f;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = fields.find(',', start);
+    f.push_back(fields.substr(start, comma == std::string_view::npos ? comma : comma - start));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  Pr650SetupResult r;
+  if (f.size() > 8) {
+    r.reply_code = 9;
+    return r;
+  }
+  f.resize(8);  // missing trailing fields are empty: defaults
+  auto bad = [&](int position) {
+    r.reply_code = position;
+    return r;
+  };
+
+  // 1: accessory 1, 01–12; only the MS-75 lens (01) is fitted.
+  if (!f[0].empty()) {
+    const auto a = Digits(f[0]);
+    if (!a || *a < 1 || *a > 12) return bad(1);
+    if (*a != 1) return bad(50);
+  }
+  // 2–4: further accessories, none fitted (0 or empty).
+  for (int i = 1; i <= 3; ++i) {
+    if (f[static_cast<std::size_t>(i)].empty()) continue;
+    const auto a = Digits(f[static_cast<std::size_t>(i)]);
+    if (!a || *a > 12) return bad(i + 1);
+    if (*a != 0) return bad(50);
+  }
+  // 5: sync: empty or 0 off, 1 = last F result, or 40–250 Hz.
+  if (!f[4].empty()) {
+    const auto s = Digits(f[4]);
+    if (!s || (*s > 1 && (*s < 40 || *s > 250))) return bad(5);
+    r.sync = *s != 0;
+  }
+  // 6: integration, 0 (adaptive) or 10–6000 ms.
+  if (!f[5].empty()) {
+    const auto t = Digits(f[5]);
+    if (!t || (*t != 0 && (*t < 10 || *t > 6000))) return bad(6);
+    r.setup.integration_ms = *t;
+  }
+  // 7: averages 01–99.
+  if (!f[6].empty()) {
+    const auto n = Digits(f[6]);
+    if (!n || *n < 1 || *n > 99 || f[6].size() > 2) return bad(7);
+    r.setup.averages = *n;
+  }
+  // 8: units, 0 English or 1 SI.
+  if (!f[7].empty()) {
+    const auto u = Digits(f[7]);
+    if (!u || *u > 1 || f[7].size() > 1) return bad(8);
+  }
+  return r;
+}
+
+}  // namespace brdf::sim

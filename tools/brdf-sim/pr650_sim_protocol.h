@@ -1,0 +1,46 @@
+// The meter's side of the PR-650 text protocol, for the simulator: how the meter formats its
+// numbers and reports, and how it checks a setup (S) command. Written independently of the
+// driver's parser on purpose: the simulator stands in for the device, so it must not share the
+// code it is used to test.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tools/brdf-sim/sim_shared.h"
+
+namespace brdf::sim {
+
+// The PR-650 band layout: 101 bands, 380–780 nm, 4 nm apart, 8 nm bandwidth.
+inline constexpr int kPr650Bands = 101;
+inline constexpr int kPr650FirstNm = 380;
+inline constexpr int kPr650StepNm = 4;
+
+// "1.234E-02": the meter's 9-character number. Values too small for a 2-digit exponent print as
+// 0.000E+00, too large ones as 9.999E+99; a negative value carries a leading '-' (10 characters).
+std::string FormatPr650Number(double value);
+
+// The D5 report as lines without line ends: "qq,U", the integrated intensity, then one
+// "0380.,r.rrrEsee" line per band. `radiance` is padded with zeros or cut to 101 bands.
+std::vector<std::string> Pr650SpectrumLines(int quality_code, int units_code, double integrated,
+                                            const std::vector<double>& radiance);
+
+// The D120 layout line: "0101,008.0,0380.,0780.,004.".
+std::string Pr650LayoutLine();
+
+// The outcome of an S command.
+struct Pr650SetupResult {
+  int reply_code = 0;  // 0 accepted; 1–8 (9: too many fields) position of the bad field; 50
+                       // accessory not fitted
+  MeterSetup setup;    // the new setup when accepted
+  bool sync = false;   // sync field set (1 or 40–250 Hz)
+};
+
+// Checks and applies "S<acc1>,<acc2>,<acc3>,<acc4>,<sync>,<integ>,<avg>,<units>" (`fields` is the
+// text after the S). Empty fields take the meter's defaults (adaptive integration, 1 average, no
+// sync). The simulated meter has only the standard MS-75 lens (accessory 01) fitted: asking for
+// any other accessory is the accessory error 50.
+Pr650SetupResult ApplyPr650Setup(std::string_view fields);
+
+}  // namespace brdf::sim
