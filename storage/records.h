@@ -1,0 +1,140 @@
+// What storage keeps, as plain C++ values: sessions, their planned steps, the readings taken at
+// those steps, the devices seen and the audit trail. These mirror the tables in schema.md one to
+// one; the enums are stored as the lower-case words their ToString returns.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/pose.h"
+#include "core/session_state.h"
+#include "core/status.h"
+#include "core/wavelength_grid.h"
+
+namespace brdf::storage {
+
+// Session states are core's (core/session_state.h: SessionState, SessionStateName,
+// ParseSessionState, IsTerminal, and the transition table the daemon follows). Storage only
+// refuses to leave a terminal state and to mark a session completed while steps are pending.
+
+// What a step does. Only reference, dark and sample steps produce a reading.
+enum class StepKind { kMove, kPrompt, kReference, kDark, kSample };
+
+// pending until done (its reading, if any, stored) or skipped (with a note saying why).
+enum class StepState { kPending, kDone, kSkipped };
+
+// The reading a measuring step produced: I(λ) of the sample, I0(λ) of the white standard, or the
+// dark (ambient) D(λ).
+enum class ReadingKind { kSample, kReference, kDark };
+
+std::string_view ToString(SessionState state);  // SessionStateName
+std::string_view ToString(StepKind kind);
+std::string_view ToString(StepState state);
+std::string_view ToString(ReadingKind kind);
+// kInvalidArgument naming the accepted words when `text` is not one of them. (Session states:
+// brdf::ParseSessionState.)
+Result<StepKind> ParseStepKind(std::string_view text);
+Result<StepState> ParseStepState(std::string_view text);
+Result<ReadingKind> ParseReadingKind(std::string_view text);
+
+// running, pausing and awaiting_operator: a daemon was driving the session.
+bool IsActive(SessionState state);
+// The reading a step of this kind produces; nullopt for move and prompt.
+std::optional<ReadingKind> ReadingKindFor(StepKind kind);
+
+// Seconds since the Unix epoch (UTC), fractional. All timestamps in storage use it.
+using UnixSeconds = double;
+
+// What the daemon knows when a session is submitted.
+struct NewSession {
+  std::string name;
+  std::string plan_kind;        // "sample_rotation", "sample_fixed", … (the plan's own word)
+  std::string plan_json;        // the plan as submitted, verbatim
+  std::string created_by_role;  // the submitter's role ("operator", "admin")
+  std::optional<double> white_reflectance;  // ρw of the white standard (the paper's 0.99)
+  std::string meter_serial;        // the spectroradiometer expected/used; may be filled later
+  std::string config_json = "{}";  // anything else worth keeping (rig config, settings)
+};
+
+struct SessionRecord {
+  std::int64_t id = 0;
+  std::string name;
+  std::string plan_kind;
+  std::string plan_json;
+  SessionState state = SessionState::kQueued;
+  std::string state_reason;  // why it is in that state ("operator paused", an error message)
+  UnixSeconds created_at = 0;
+  std::optional<UnixSeconds> started_at;   // first time it became running
+  std::optional<UnixSeconds> finished_at;  // when it became completed, aborted or failed
+  std::string created_by_role;
+  int total_steps = 0;
+  int done_steps = 0;  // steps finished: done or skipped
+  std::optional<double> white_reflectance;
+  std::string meter_serial;
+  std::string config_json;
+};
+
+// One planned step. Steps are numbered 0, 1, 2, … in execution order.
+struct StepRecord {
+  std::int64_t session_id = 0;  // filled by the store
+  int step_index = 0;
+  StepKind kind = StepKind::kSample;
+  Pose pose;                                   // where the rig goes for this step (degrees)
+  std::optional<std::string> prompt;           // prompt steps: the instruction to the operator
+  std::optional<std::string> prompt_kind;      // prompt steps: the plan's word for the action
+                                               // ("relocate_detector", "mount_white", …)
+  std::optional<std::string> expected_action;  // prompt steps: what the confirmation asserts
+  std::optional<Directions> target;            // reading steps: θi φi θo φo planned (degrees)
+  std::string label;  // short human name ("sample δ 22.5° α 10° β -35° γ 0°")
+  StepState state = StepState::kPending;    // filled by the store
+  std::optional<std::string> note;          // why it was skipped
+  std::optional<UnixSeconds> completed_at;  // when it became done or skipped
+};
+
+// One measured spectrum and everything needed to use it again: where the rig was, what the meter
+// said, and which reference (and dark) reading it is to be divided by.
+struct ReadingRecord {
+  std::int64_t id = 0;          // filled by the store
+  std::int64_t session_id = 0;  // filled by the store
+  int step_index = 0;           // filled by the store
+  ReadingKind kind = ReadingKind::kSample;
+  Pose pose;              // the pose actually reached
+  Directions directions;  // θi φi θo φo in the sample frame (degrees)
+  WavelengthGrid grid;
+  std::vector<double> spectrum;  // grid.count values (radiance as the meter reported it)
+  int quality_code = 0;          // the meter's quality code (0 = OK)
+  bool flagged = false;          // usable but flagged by the quality policy
+  int integration_ms = 0;        // 0 = adaptive
+  int attempts = 1;              // measurements taken, including retries
+  std::string note;              // what the quality policy did ("halved to 250 ms")
+  std::optional<std::int64_t> reference_reading_id;  // the I0 this sample is divided by
+  std::optional<std::int64_t> dark_reading_id;       // the D subtracted, when measured
+  std::string meter_serial;
+  UnixSeconds recorded_at = 0;  // 0: the store uses its clock
+};
+
+// A device seen by the daemon; recorded once per (session, kind, model, serial).
+struct DeviceRecord {
+  std::int64_t id = 0;
+  std::optional<std::int64_t> session_id;  // nullopt: seen at daemon level, not for a session
+  std::string kind;                        // "spectroradiometer", "rotation_stage"
+  std::string model;
+  std::string serial;
+  UnixSeconds first_seen = 0;  // 0: the store uses its clock
+};
+
+// Who did what. `actor` is a token's NAME ("lab-pc-2"), never the token itself.
+struct AuditRecord {
+  std::int64_t id = 0;
+  UnixSeconds at = 0;  // 0: the store uses its clock
+  std::string role;
+  std::string actor;
+  std::string action;  // "session.create", "session.pause", …
+  std::optional<std::int64_t> session_id;
+  std::string detail;
+};
+
+}  // namespace brdf::storage

@@ -1,0 +1,203 @@
+#include "storage/schema.h"
+
+#include <array>
+#include <cstdio>
+#include <string>
+
+namespace brdf::storage {
+namespace {
+
+// Version 1: everything. Kept verbatim once released; later changes are new migrations.
+constexpr std::string_view kV1 = R"sql(
+CREATE TABLE sessions (
+  id                INTEGER PRIMARY KEY,
+  name              TEXT    NOT NULL,
+  plan_kind         TEXT    NOT NULL,
+  plan_json         TEXT    NOT NULL,
+  state             TEXT    NOT NULL DEFAULT 'queued' CHECK (state IN ('queued', 'running',
+                      'pausing', 'paused', 'awaiting_operator', 'completed', 'aborted', 'failed')),
+  state_reason      TEXT    NOT NULL DEFAULT '',
+  created_at        REAL    NOT NULL,
+  started_at        REAL,
+  finished_at       REAL,
+  created_by_role   TEXT    NOT NULL DEFAULT '',
+  total_steps       INTEGER NOT NULL CHECK (total_steps >= 0),
+  done_steps        INTEGER NOT NULL DEFAULT 0
+                      CHECK (done_steps >= 0 AND done_steps <= total_steps),
+  white_reflectance REAL,
+  meter_serial      TEXT    NOT NULL DEFAULT '',
+  config_json       TEXT    NOT NULL DEFAULT '{}'
+);
+CREATE INDEX sessions_by_state ON sessions (state);
+
+CREATE TABLE steps (
+  session_id      INTEGER NOT NULL REFERENCES sessions (id),
+  step_index      INTEGER NOT NULL CHECK (step_index >= 0),
+  kind            TEXT    NOT NULL
+                    CHECK (kind IN ('move', 'prompt', 'reference', 'dark', 'sample')),
+  alpha           REAL    NOT NULL,
+  beta            REAL    NOT NULL,
+  gamma           REAL    NOT NULL,
+  delta           REAL    NOT NULL,
+  prompt          TEXT,
+  prompt_kind     TEXT,
+  expected_action TEXT,
+  target_theta_i  REAL,
+  target_phi_i    REAL,
+  target_theta_o  REAL,
+  target_phi_o    REAL,
+  label           TEXT    NOT NULL DEFAULT '',
+  state           TEXT    NOT NULL DEFAULT 'pending'
+                    CHECK (state IN ('pending', 'done', 'skipped')),
+  note            TEXT,
+  completed_at    REAL,
+  PRIMARY KEY (session_id, step_index),
+  CHECK ((target_theta_i IS NULL) = (target_phi_i IS NULL) AND
+         (target_theta_i IS NULL) = (target_theta_o IS NULL) AND
+         (target_theta_i IS NULL) = (target_phi_o IS NULL))
+) WITHOUT ROWID;
+-- Where a session resumes: the first pending step, found without scanning finished ones.
+CREATE INDEX steps_pending ON steps (session_id, step_index) WHERE state = 'pending';
+
+CREATE TABLE readings (
+  id                   INTEGER PRIMARY KEY,
+  session_id           INTEGER NOT NULL REFERENCES sessions (id),
+  step_index           INTEGER NOT NULL,
+  kind                 TEXT    NOT NULL CHECK (kind IN ('sample', 'reference', 'dark')),
+  alpha                REAL    NOT NULL,
+  beta                 REAL    NOT NULL,
+  gamma                REAL    NOT NULL,
+  delta                REAL    NOT NULL,
+  theta_i              REAL    NOT NULL,
+  phi_i                REAL    NOT NULL,
+  theta_o              REAL    NOT NULL,
+  phi_o                REAL    NOT NULL,
+  wl_start_nm          REAL    NOT NULL,
+  wl_step_nm           REAL    NOT NULL CHECK (wl_step_nm > 0),
+  wl_count             INTEGER NOT NULL CHECK (wl_count > 0),
+  spectrum             BLOB    NOT NULL
+                         CHECK (typeof(spectrum) = 'blob' AND length(spectrum) = 8 * wl_count),
+  quality_code         INTEGER NOT NULL DEFAULT 0,
+  flagged              INTEGER NOT NULL DEFAULT 0 CHECK (flagged IN (0, 1)),
+  integration_ms       INTEGER NOT NULL DEFAULT 0 CHECK (integration_ms >= 0),
+  attempts             INTEGER NOT NULL DEFAULT 1 CHECK (attempts >= 0),
+  note                 TEXT    NOT NULL DEFAULT '',
+  reference_reading_id INTEGER REFERENCES readings (id),
+  dark_reading_id      INTEGER REFERENCES readings (id),
+  meter_serial         TEXT    NOT NULL DEFAULT '',
+  recorded_at          REAL    NOT NULL,
+  -- One reading per step, enforced by the database itself: a retried write cannot duplicate.
+  UNIQUE (session_id, step_index),
+  FOREIGN KEY (session_id, step_index) REFERENCES steps (session_id, step_index)
+);
+-- Streaming a session's readings in id order.
+CREATE INDEX readings_by_session ON readings (session_id, id);
+
+CREATE TABLE devices (
+  id         INTEGER PRIMARY KEY,
+  session_id INTEGER REFERENCES sessions (id),
+  kind       TEXT    NOT NULL,
+  model      TEXT    NOT NULL,
+  serial     TEXT    NOT NULL,
+  first_seen REAL    NOT NULL
+);
+-- A device is recorded once per session (or once at daemon level when session_id is NULL).
+CREATE UNIQUE INDEX devices_identity ON devices (ifnull(session_id, 0), kind, model, serial);
+
+CREATE TABLE audit (
+  id         INTEGER PRIMARY KEY,
+  at         REAL    NOT NULL,
+  role       TEXT    NOT NULL,
+  actor      TEXT    NOT NULL,
+  action     TEXT    NOT NULL,
+  session_id INTEGER REFERENCES sessions (id),
+  detail     TEXT    NOT NULL DEFAULT ''
+);
+CREATE INDEX audit_by_session ON audit (session_id, id) WHERE session_id IS NOT NULL;
+)sql";
+
+constexpr std::array<Migration, 1> kMigrations{{
+    {1, "create sessions, steps, readings, devices and audit", kV1},
+}};
+
+std::string Hex(std::int64_t v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "0x%llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+}  // namespace
+
+std::span<const Migration> SchemaMigrations() {
+  return kMigrations;
+}
+
+int LatestSchemaVersion() {
+  return kMigrations.back().version;
+}
+
+Result<int> SchemaVersion(Database& db) {
+  Result<std::int64_t> v = db.QueryInt64("PRAGMA user_version");
+  if (!v.ok()) return v.status();
+  return static_cast<int>(*v);
+}
+
+Status Migrate(Database& db, std::span<const Migration> migrations) {
+  for (std::size_t i = 0; i < migrations.size(); ++i) {
+    if (migrations[i].version != static_cast<int>(i) + 1) {
+      return Internal("schema migrations must be numbered 1, 2, 3, …; entry " + std::to_string(i) +
+                      " has version " + std::to_string(migrations[i].version) +
+                      " (a bug in brdfd's storage)");
+    }
+  }
+  const int latest = static_cast<int>(migrations.size());
+
+  // Looks at the file; refuses (touching nothing) what this build must not modify.
+  auto check = [&](int version) -> Status {
+    Result<std::int64_t> app = db.QueryInt64("PRAGMA application_id");
+    if (!app.ok()) return app.status();
+    Result<std::int64_t> objects = db.QueryInt64("SELECT count(*) FROM sqlite_schema");
+    if (!objects.ok()) return objects.status();
+    if (*app != kApplicationId && (*app != 0 || version != 0 || *objects != 0)) {
+      return FailedPrecondition(
+          db.path() + " is not a brdfd database (application_id " + Hex(*app) +
+          ", schema version " + std::to_string(version) + ", " + std::to_string(*objects) +
+          " schema objects): point brdfd at a new or brdfd-made database file");
+    }
+    if (version > latest) {
+      return FailedPrecondition(
+          db.path() + " has schema version " + std::to_string(version) +
+          ", newer than the latest this brdfd knows (" + std::to_string(latest) +
+          "): it was written by a newer brdfd. Run that newer brdfd, or point this one at another "
+          "database file; do not edit the version by hand");
+    }
+    return Status::Ok();
+  };
+
+  Result<int> version = SchemaVersion(db);
+  if (!version.ok()) return version.status();
+  BRDF_RETURN_IF_ERROR(check(*version));
+  if (*version == latest) return Status::Ok();
+
+  for (const Migration& m : migrations) {
+    if (m.version <= *version) continue;
+    const std::string what = "migrating " + db.path() + " to schema version " +
+                             std::to_string(m.version) + " (" + std::string(m.description) + ")";
+    Result<Transaction> tx = Transaction::Begin(db);
+    if (!tx.ok()) return tx.status().WithContext(what);
+    // Another process may have migrated between our look and our write lock: look again.
+    Result<int> now = SchemaVersion(db);
+    if (!now.ok()) return now.status().WithContext(what);
+    BRDF_RETURN_IF_ERROR(check(*now));
+    if (*now >= m.version) continue;
+    BRDF_RETURN_IF_ERROR(db.Exec(m.sql).WithContext(what));
+    BRDF_RETURN_IF_ERROR(db.Exec("PRAGMA user_version = " + std::to_string(m.version) +
+                                 "; PRAGMA application_id = " + std::to_string(kApplicationId))
+                             .WithContext(what));
+    BRDF_RETURN_IF_ERROR(tx->Commit().WithContext(what));
+    *version = m.version;
+  }
+  return Status::Ok();
+}
+
+}  // namespace brdf::storage
