@@ -1,0 +1,197 @@
+#include "core/interp/delaunay.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <string>
+#include <utility>
+
+#include "core/interp/barycentric.h"
+#include "core/interp/delaunay_locate.h"
+#include "core/interp/delaunay_qhull.h"
+#include "core/interp/point_cloud.h"
+
+namespace brdf::interp {
+namespace {
+
+const char* AxisNames(int dims) { return dims == 3 ? "(θi, θo, φ)" : "(θi, φi, θo, φo)"; }
+
+std::string FormatPoint(std::span<const double> x) {
+  std::string out = "(";
+  char buffer[32];
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    std::snprintf(buffer, sizeof buffer, "%s%.6g", i == 0 ? "" : ", ", x[i]);
+    out += buffer;
+  }
+  return out + ")";
+}
+
+}  // namespace
+
+struct DelaunayInterpolator::Impl {
+  std::shared_ptr<const SampleSet> samples;
+  int dims = 0;
+  std::array<double, 4> scale{1, 1, 1, 1};
+  // Per triangulated point: the SampleSet index it comes from and its (unscaled) coordinates,
+  // together so that an answer's vertex costs one cache miss, not two.
+  struct Point {
+    std::size_t sample = 0;
+    std::array<double, 4> coords{};
+  };
+  std::vector<Point> points;
+  SimplexLocator locator;
+
+  Interpolation Answer(std::span<const double> query, std::int32_t hint,
+                       std::int32_t* found) const;
+};
+
+Interpolation DelaunayInterpolator::Impl::Answer(std::span<const double> query,
+                                                 std::int32_t hint, std::int32_t* found) const {
+  Interpolation out;
+  out.method = Method::kDelaunay;
+  if (query.size() != static_cast<std::size_t>(dims)) {
+    out.status = InterpStatus::kOutsideHull;
+    out.detail = "query has " + std::to_string(query.size()) + " coordinates; expected " +
+                 std::to_string(dims) + " " + AxisNames(dims);
+    return out;
+  }
+  std::array<double, 4> x{};
+  for (int i = 0; i < dims; ++i) x[i] = query[i] * scale[i];
+  const SimplexLocation loc =
+      locator.LocateFrom(std::span<const double>(x.data(), query.size()), hint);
+  if (!loc.inside) {
+    out.status = InterpStatus::kOutsideHull;
+    out.detail = FormatPoint(query) + " is outside the convex hull of the " +
+                 std::to_string(points.size()) + " triangulated points";
+    return out;
+  }
+  *found = loc.simplex;
+
+  const std::size_t bands = static_cast<std::size_t>(samples->bands());
+  const std::span<const std::int32_t> corners = locator.vertices(loc.simplex);
+  // The vertex spectra are scattered over the sample set: start fetching all of them now, so
+  // that the misses overlap each other and the allocations below instead of queueing.
+  std::array<const Point*, kMaxSimplexVertices> vertex{};
+  std::array<const double*, kMaxSimplexVertices> spectra{};
+  for (std::size_t m = 0; m < corners.size(); ++m) {
+    vertex[m] = &points[static_cast<std::size_t>(corners[m])];
+    spectra[m] = samples->spectrum(vertex[m]->sample).data();
+    for (std::size_t b = 0; b < bands; b += 8) __builtin_prefetch(spectra[m] + b);
+  }
+  out.status = InterpStatus::kOk;
+  out.spectrum.resize(bands);
+  out.vertices.resize(corners.size());
+  for (std::size_t m = 0; m < corners.size(); ++m) {
+    Vertex& v = out.vertices[m];
+    v.id = samples->id(vertex[m]->sample);
+    v.index = vertex[m]->sample;
+    v.coords.assign(vertex[m]->coords.begin(), vertex[m]->coords.begin() + dims);
+    v.weight = loc.weights[m];
+  }
+  // The shared blend: same vertices and weights, bit-identical spectrum whichever method.
+  BlendSpectra(std::span<const double>(loc.weights.data(), corners.size()),
+               std::span<const double* const>(spectra.data(), corners.size()), out.spectrum);
+  out.detail = "simplex " + std::to_string(loc.simplex);
+  return out;
+}
+
+Result<std::unique_ptr<DelaunayInterpolator>> DelaunayInterpolator::Create(
+    std::shared_ptr<const SampleSet> samples, const Options& options) {
+  if (samples == nullptr) return InvalidArgument("Delaunay interpolation: no sample set given");
+  // Measured samples, then symmetry copies, scaled: the same cloud every method searches.
+  Result<PointCloud> built = BuildPointCloud(*samples, options);
+  if (!built.ok()) return built.status().WithContext("Delaunay interpolation");
+  const PointCloud& cloud = built.value();
+  const int dims = cloud.dims;
+  const std::size_t count = cloud.size();
+  std::array<double, 4> scale{1, 1, 1, 1};
+  std::copy(cloud.scale.begin(), cloud.scale.end(), scale.begin());
+
+  // Coincident points (after scaling) would make Qhull drop one of them arbitrarily: keep the
+  // lowest rank (stable sort, so each run of equal points starts with it).
+  std::vector<std::size_t> order(count);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  const auto less = [&](std::size_t a, std::size_t b) {
+    const auto pa = cloud.scaled_point(a);
+    const auto pb = cloud.scaled_point(b);
+    return std::lexicographical_compare(pa.begin(), pa.end(), pb.begin(), pb.end());
+  };
+  std::stable_sort(order.begin(), order.end(), less);
+  std::vector<bool> keep(count, true);
+  for (std::size_t i = 1; i < count; ++i) {
+    if (!less(order[i - 1], order[i])) keep[order[i]] = false;
+  }
+
+  std::vector<Impl::Point> points;
+  std::vector<double> distinct;
+  for (std::size_t p = 0; p < count; ++p) {
+    if (!keep[p]) continue;
+    Impl::Point& point = points.emplace_back();
+    point.sample = cloud.sample[p];
+    const auto raw = cloud.point(p);
+    std::copy(raw.begin(), raw.end(), point.coords.begin());
+    const auto scaled = cloud.scaled_point(p);
+    distinct.insert(distinct.end(), scaled.begin(), scaled.end());
+  }
+
+  Result<QhullTriangulation> triangulation = TriangulateWithQhull(distinct, dims);
+  if (!triangulation.ok()) return triangulation.status();
+  Result<SimplexLocator> locator =
+      SimplexLocator::Build(distinct, dims, std::move(triangulation).value());
+  if (!locator.ok()) return locator.status();
+  auto impl = std::make_unique<const Impl>(
+      Impl{std::move(samples), dims, scale, std::move(points), std::move(locator).value()});
+  return std::unique_ptr<DelaunayInterpolator>(new DelaunayInterpolator(std::move(impl)));
+}
+
+DelaunayInterpolator::DelaunayInterpolator(std::unique_ptr<const Impl> impl)
+    : impl_(std::move(impl)) {}
+DelaunayInterpolator::~DelaunayInterpolator() = default;
+
+int DelaunayInterpolator::dims() const { return impl_->dims; }
+
+Interpolation DelaunayInterpolator::Evaluate(std::span<const double> query) const {
+  std::int32_t found = -1;
+  return impl_->Answer(query, -1, &found);
+}
+
+Interpolation DelaunayInterpolator::EvaluateFrom(std::span<const double> query,
+                                                 LocateHint& hint) const {
+  return impl_->Answer(query, hint.simplex, &hint.simplex);
+}
+
+Status DelaunayInterpolator::EvaluateBatch(std::span<const double> queries,
+                                           std::vector<Interpolation>& out) const {
+  const auto d = static_cast<std::size_t>(impl_->dims);
+  if (queries.size() % d != 0) {
+    return InvalidArgument("Delaunay batch: " + std::to_string(queries.size()) +
+                           " coordinates is not a whole number of " + std::to_string(d) +
+                           "-D queries");
+  }
+  const std::size_t n = queries.size() / d;
+  out.clear();
+  out.reserve(n);
+  LocateHint hint;
+  for (std::size_t q = 0; q < n; ++q) out.push_back(EvaluateFrom(queries.subspan(q * d, d), hint));
+  return Status::Ok();
+}
+
+std::size_t DelaunayInterpolator::point_count() const { return impl_->points.size(); }
+std::size_t DelaunayInterpolator::simplex_count() const {
+  return impl_->locator.simplex_count();
+}
+std::size_t DelaunayInterpolator::flat_simplex_count() const {
+  return impl_->locator.degenerate_count();
+}
+
+Result<std::unique_ptr<Interpolator>> MakeDelaunayInterpolator(
+    std::shared_ptr<const SampleSet> samples, const Options& options) {
+  Result<std::unique_ptr<DelaunayInterpolator>> made =
+      DelaunayInterpolator::Create(std::move(samples), options);
+  if (!made.ok()) return made.status();
+  return std::unique_ptr<Interpolator>(std::move(made).value());
+}
+
+}  // namespace brdf::interp

@@ -1,0 +1,76 @@
+// Delaunay interpolation of scattered spectra: the samples are triangulated once (Qhull), and a
+// query is answered by the simplex that contains it, blending its dims+1 vertex spectra with the
+// query's barycentric coordinates. This is what scipy's LinearNDInterpolator, Octave's and
+// MATLAB's griddata do, and what the paper compares its octant method against.
+//
+// Called by MakeInterpolator (factory.cc) for Method::kDelaunay. Pure: no I/O.
+//
+// Rules where the interface leaves a choice:
+// - Options.axis_scale multiplies coordinates before triangulating (the metric decides which
+//   triangulation is "Delaunay"); vertex coordinates in answers are unscaled.
+// - Symmetry augmentation (3D only), in this order: the measured samples; then, with mirror_phi,
+//   (θi, θo, −φ) of each; then, with reciprocity, (θo, θi, φ) of every point so far. Copies keep
+//   the id and SampleSet index of the sample they copy.
+// - Coincident points (after scaling) keep the first in that order: a measured sample wins over
+//   a copy, an earlier sample over a later one.
+// - A query outside the convex hull answers kOutsideHull. A query beyond a hull face by less than
+//   1e-10 of the simplex's size is inside (rounding on the data's boundary planes).
+// - Weights are >= 0 and sum to 1 (rounding noise clamped), so every band lies between the
+//   vertices' smallest and largest values.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "core/interp/interpolator.h"
+#include "core/status.h"
+
+namespace brdf::interp {
+
+// Triangulates `samples` (3D or 4D) after Options.axis_scale and symmetry augmentation.
+// Errors: wrong dims, empty set, bad options, too few distinct points, degenerate input (all
+// points on a plane / hyperplane) that Qhull cannot triangulate.
+Result<std::unique_ptr<Interpolator>> MakeDelaunayInterpolator(
+    std::shared_ptr<const SampleSet> samples, const Options& options);
+
+// Where the previous answer was found; lets ordered queries (along a scan, a space-filling
+// curve, a rendering's neighbouring pixels) start their search there. One per thread or per
+// sequence of queries; any value is safe.
+struct LocateHint {
+  std::int32_t simplex = -1;
+};
+
+class DelaunayInterpolator final : public Interpolator {
+ public:
+  static Result<std::unique_ptr<DelaunayInterpolator>> Create(
+      std::shared_ptr<const SampleSet> samples, const Options& options);
+  ~DelaunayInterpolator() override;
+
+  Method method() const override { return Method::kDelaunay; }
+  int dims() const override;
+  // Thread-safe. The search starts from a precomputed simplex near the query.
+  Interpolation Evaluate(std::span<const double> query) const override;
+  // Thread-safe for distinct hints. Starts from hint.simplex when the query is near it and
+  // stores the answer's simplex back (unchanged when the query is outside the hull).
+  Interpolation EvaluateFrom(std::span<const double> query, LocateHint& hint) const;
+  // queries: n * dims() coordinates, row-major. Fills `out` with n answers, each search starting
+  // from the previous answer: fastest when consecutive queries are close. Errors when
+  // queries.size() is not a multiple of dims().
+  Status EvaluateBatch(std::span<const double> queries, std::vector<Interpolation>& out) const;
+
+  // Distinct points triangulated (after augmentation and removal of coincident points).
+  std::size_t point_count() const;
+  std::size_t simplex_count() const;
+  // Flat simplices Qhull's Qt produced (cospherical input such as regular grids); never answers.
+  std::size_t flat_simplex_count() const;
+
+ private:
+  struct Impl;
+  explicit DelaunayInterpolator(std::unique_ptr<const Impl> impl);
+  std::unique_ptr<const Impl> impl_;
+};
+
+}  // namespace brdf::interp

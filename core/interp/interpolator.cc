@@ -1,0 +1,83 @@
+// The small, method-independent parts of interpolator.h: names, parsing, and SampleSet::Add.
+#include "core/interp/interpolator.h"
+
+#include <cmath>
+
+namespace brdf::interp {
+
+const char* MethodName(Method m) {
+  switch (m) {
+    case Method::kOctant:
+      return "octant";
+    case Method::kDelaunay:
+      return "delaunay";
+    case Method::kNearest:
+      return "nearest";
+  }
+  return "unknown";
+}
+
+Result<Method> ParseMethod(const std::string& name) {
+  for (Method m : {Method::kOctant, Method::kDelaunay, Method::kNearest}) {
+    if (name == MethodName(m)) return m;
+  }
+  return InvalidArgument("unknown interpolation method '" + name +
+                         "'; use one of: octant, delaunay, nearest");
+}
+
+const char* InterpStatusName(InterpStatus s) {
+  switch (s) {
+    case InterpStatus::kOk:
+      return "ok";
+    case InterpStatus::kEmptyOctant:
+      return "empty_octant";
+    case InterpStatus::kNoEnclosingSimplex:
+      return "no_enclosing_simplex";
+    case InterpStatus::kOutsideHull:
+      return "outside_hull";
+  }
+  return "unknown";
+}
+
+Status SampleSet::Add(std::int64_t id, std::span<const double> coords,
+                      std::span<const double> spectrum) {
+  const std::string where = "sample " + std::to_string(size()) + " (id " + std::to_string(id) + ")";
+  if (dims_ != 3 && dims_ != 4) {
+    return InvalidArgument(where + ": the set was made for " + std::to_string(dims_) +
+                           " coordinates; interpolation needs 3 (θi, θo, φ) or 4 (θi, φi, θo, φo)");
+  }
+  if (bands_ < 1) {
+    return InvalidArgument(where + ": the set was made for " + std::to_string(bands_) +
+                           " bands; a spectrum needs at least one");
+  }
+  if (coords.size() != static_cast<std::size_t>(dims_)) {
+    return InvalidArgument(where + " has " + std::to_string(coords.size()) +
+                           " coordinates; this set holds " + std::to_string(dims_));
+  }
+  if (spectrum.size() != static_cast<std::size_t>(bands_)) {
+    return InvalidArgument(where + " has " + std::to_string(spectrum.size()) +
+                           " spectral values; this set holds " + std::to_string(bands_));
+  }
+  for (std::size_t j = 0; j < coords.size(); ++j) {
+    if (!std::isfinite(coords[j])) {
+      return InvalidArgument(where + ": coordinate " + std::to_string(j) +
+                             " is not a finite number; drop or fix the reading");
+    }
+  }
+  for (std::size_t b = 0; b < spectrum.size(); ++b) {
+    if (!std::isfinite(spectrum[b])) {
+      return InvalidArgument(where + ": spectral value " + std::to_string(b) +
+                             " is not a finite number; drop or fix the reading");
+    }
+  }
+  // Indices are 32-bit inside the search index (with up to four symmetry copies per sample).
+  if (size() >= (std::size_t{1} << 29)) {
+    return InvalidArgument(where + ": too many samples (the limit is 2^29)");
+  }
+  ids_.push_back(id);
+  coords_.insert(coords_.end(), coords.begin(), coords.end());
+  values_.insert(values_.end(), spectrum.begin(), spectrum.end());
+  return Status::Ok();
+}
+
+}  // namespace brdf::interp

@@ -1,0 +1,81 @@
+// The geometry of the paper's octant method that does not depend on how the nearest points are
+// found: how orthants are numbered and named, how the cube of winners is cut into simplices, and
+// how the answer is assembled from the winners. Both octant implementations (the brute-force
+// reference and the indexed one) end here, so they agree bit for bit whenever their searches
+// agree. See ../../../shared/reference/interpolation.md. Pure: no I/O.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+
+#include "core/interp/interpolator.h"
+#include "core/interp/point_cloud.h"
+
+namespace brdf::interp {
+
+inline constexpr int kMaxDims = 4;
+inline constexpr int kMaxOrthants = 1 << kMaxDims;
+// "No point in this orthant" in a winners array.
+inline constexpr std::uint32_t kNoPoint = std::numeric_limits<std::uint32_t>::max();
+
+// Orthants are numbered by bit pattern: bit j is set when coordinate j is on the "+" side, i.e.
+// x[j] >= p[j] (a point on a splitting plane belongs to the + side). In 3D (axes θi, θo, φ) the
+// paper's letters are A=0 (−,−,−), B=1 (+,−,−), C=3 (+,+,−), D=2 (−,+,−), E=4 (−,−,+), F=5 (+,−,+),
+// G=7 (+,+,+), H=6 (−,+,+). A point with a NaN coordinate (or a NaN query) is in no orthant.
+template <int D>
+inline int OrthantOf(const double* x, const double* p) {
+  int code = 0;
+#pragma GCC unroll 4
+  for (int j = 0; j < D; ++j) code |= (x[j] >= p[j] ? 1 : 0) << j;
+  return code;
+}
+inline int OrthantOf(const double* x, const double* p, int dims) {
+  return dims == 3 ? OrthantOf<3>(x, p) : OrthantOf<4>(x, p);
+}
+
+// "A" … "H" for 3D orthants (the paper's corner letters).
+char OctantLetter(int orthant);
+// "octant E (θi−, θo−, φ+)" in 3D, "orthant 5 (θi+, φi−, θo+, φo−)" in 4D.
+std::string OrthantName(int orthant, int dims);
+
+// The simplices of the cube of winners, in the order they are tried, as orthant numbers
+// (dims + 1 per simplex; the vertices of an answer come in this order).
+//   3D: the paper's five tetrahedra ABCF, ACDH, AEFH, CFGH, ACFH.
+//   4D: the Kuhn (Freudenthal) triangulation: one simplex per permutation π of the axes
+//       (0, 1, 2, 3), permutations in lexicographic order; the simplex walks from corner 0 (all −)
+//       to corner 15 (all +) setting bit π0, then π1, π2, π3. All 24 share the main diagonal 0–15.
+struct CubeSimplex {
+  int corners[kMaxDims + 1];
+};
+std::span<const CubeSimplex> CubeSimplices(int dims);
+// "tetrahedron ACFH" in 3D; "Kuhn simplex 3 of 24 (corners 0-1-5-7-15)" in 4D (built once).
+const std::string& SimplexName(int simplex_index, int dims);
+
+// The result of the octant method's search: per orthant o, the rank (in the PointCloud) of the
+// point nearest to the query, or kNoPoint, and a pointer to that point's scaled coordinates
+// (wherever the search keeps a copy; the values are the cloud's).
+struct OrthantWinners {
+  std::array<std::uint32_t, kMaxOrthants> rank;
+  std::array<const double*, kMaxOrthants> scaled;
+};
+
+// Builds the octant method's answer from the winners. `scaled_query` is the query in the cloud's
+// scaled space. Empty orthant → kEmptyOctant (detail names every empty one); otherwise the first
+// simplex of CubeSimplices that encloses the query (degenerate ones are skipped) → kOk with its
+// vertices, weights and blended spectrum; none → kNoEnclosingSimplex.
+Interpolation AssembleOctantAnswer(const PointCloud& cloud, const SampleSet& samples,
+                                   const OrthantWinners& winners,
+                                   std::span<const double> scaled_query);
+
+// The answer for a query that has the wrong number of coordinates or a non-finite one, with the
+// failure status the method uses for "no data around here" (octant: kEmptyOctant, since no orthant
+// of a NaN query holds a sample; nearest: kOutsideHull). The detail says what is wrong.
+Interpolation InvalidQueryAnswer(Method method, InterpStatus status, std::span<const double> query,
+                                 int dims);
+// True when the query has `dims` finite coordinates.
+bool ValidQuery(std::span<const double> query, int dims);
+
+}  // namespace brdf::interp

@@ -1,0 +1,70 @@
+// The point set an interpolation method actually searches: the measured samples, then their
+// symmetry copies (Options.mirror_phi, Options.reciprocity), with every coordinate multiplied by
+// Options.axis_scale. All methods see the same cloud, so they agree on what "nearest" and "ties go
+// to the earlier sample" mean. Pure: no I/O.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/interp/interpolator.h"
+#include "core/status.h"
+
+namespace brdf::interp {
+
+// Checks `options` for data of `dims` coordinates. Errors (kInvalidArgument) name the option:
+// axis_scale of the wrong length or with a value that is not finite and positive; mirror_phi or
+// reciprocity on 4D (anisotropic) data, where they are not symmetries.
+Status ValidateOptions(const Options& options, int dims);
+
+// A point's rank is its position in the cloud: measured samples first, in SampleSet order
+// (rank i = sample i), then one block of copies per symmetry, each block in sample order:
+//   mirror_phi only:        (θi, θo, −φ)
+//   reciprocity only:       (θo, θi, φ)
+//   both:                   (θi, θo, −φ), then (θo, θi, φ), then (θo, θi, −φ)
+// (the two symmetries generate a group of four images; all of them are exact for isotropic data).
+// Rank is the tie-breaker: of two points at the same distance the lower rank wins, so a measured
+// sample always beats a copy. Copies that coincide with their original are kept: they can never
+// win.
+struct PointCloud {
+  int dims = 0;
+  std::vector<double> scale;          // dims multipliers (all 1 when axis_scale is empty)
+  std::vector<double> coords;         // size() × dims, unscaled: the point's own coordinates
+  std::vector<double> scaled;         // size() × dims: coords[j] * scale[j], one multiplication
+  std::vector<std::uint32_t> sample;  // size(): the SampleSet index the point copies
+
+  std::size_t size() const { return sample.size(); }
+  std::span<const double> point(std::size_t rank) const {
+    return {coords.data() + rank * static_cast<std::size_t>(dims), static_cast<std::size_t>(dims)};
+  }
+  std::span<const double> scaled_point(std::size_t rank) const {
+    return {scaled.data() + rank * static_cast<std::size_t>(dims), static_cast<std::size_t>(dims)};
+  }
+  // The query in the cloud's (scaled) space: query[j] * scale[j].
+  void ScaleQuery(std::span<const double> query, std::span<double> out) const {
+    for (std::size_t j = 0; j < scale.size(); ++j) out[j] = query[j] * scale[j];
+  }
+};
+
+// Squared Euclidean distance in the cloud's scaled space, summed in axis order. Every search uses
+// this one definition, so "nearest" and "tie" mean the same thing bit for bit in all of them.
+template <int D>
+inline double SquaredDistance(const double* a, const double* b) {
+  double sum = 0.0;
+#pragma GCC unroll 4
+  for (int j = 0; j < D; ++j) {
+    const double d = a[j] - b[j];
+    sum += d * d;
+  }
+  return sum;
+}
+inline double SquaredDistance(const double* a, const double* b, int dims) {
+  return dims == 3 ? SquaredDistance<3>(a, b) : SquaredDistance<4>(a, b);
+}
+
+// Errors: a SampleSet that is empty or not 3D/4D, and everything ValidateOptions rejects.
+Result<PointCloud> BuildPointCloud(const SampleSet& samples, const Options& options);
+
+}  // namespace brdf::interp

@@ -1,0 +1,22 @@
+// `brdf-interp synth`: writes a synthetic samples CSV (synthetic_samples.h), or with
+// --coordinates-only a queries CSV of the same points.
+#pragma once
+
+#include <cstdint>
+#include <ostream>
+#include <string>
+
+namespace brdf::interp_tool {
+
+struct SynthRequest {
+  std::string grid = "paper";  // "paper" or "random"
+  std::size_t count = 0;       // random: number of points
+  std::uint64_t seed = 1;
+  int dims = 3;  // random only; the paper's grid is 3D
+  bool coordinates_only = false;
+  std::string output_path;  // "" or "-": standard output
+};
+
+int RunSynth(const SynthRequest& request, std::ostream& err);
+
+}  // namespace brdf::interp_tool
