@@ -1,0 +1,191 @@
+// brdf-sim's configuration: defaults, the TOML file, the flags over it, and the checks.
+#include "tools/brdf-sim/sim_config.h"
+
+#include <gtest/gtest.h>
+
+#include <CLI/CLI.hpp>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "tests/support/test_env.h"
+
+namespace brdf::sim {
+namespace {
+
+// Parses `args` the way main does: file first (if --config is among them), then the flags.
+Status ParseLikeMain(std::vector<std::string> args, SimConfig& config) {
+  args.insert(args.begin(), "brdf-sim");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  if (auto path = FindConfigPath(static_cast<int>(argv.size()), argv.data())) {
+    BRDF_RETURN_IF_ERROR(LoadConfigFile(*path, config));
+  }
+  CLI::App app("brdf-sim");
+  AddRunFlags(app, config);
+  try {
+    app.parse(static_cast<int>(argv.size()), argv.data());
+  } catch (const CLI::ParseError& e) {
+    return InvalidArgument(e.what());
+  }
+  FinishFlags(app, config);
+  return ValidateConfig(config);
+}
+
+TEST(SimConfigTest, DefaultsArePlausibleAndValid) {
+  SimConfig c;
+  EXPECT_TRUE(ValidateConfig(c).ok());
+  EXPECT_EQ(c.time_scale, 1.0);
+  EXPECT_EQ(c.modbus_port, 0);
+  EXPECT_TRUE(c.detector_arm);
+  EXPECT_TRUE(c.pacing);
+  EXPECT_EQ(c.mounted, MountedTarget::kSample);
+  EXPECT_EQ(c.axes[kAlphaAxis].min_deg, 0);
+  EXPECT_EQ(c.axes[kAlphaAxis].max_deg, 90);
+  EXPECT_EQ(c.axes[kDeltaAxis].max_deg, 180);
+  for (const AxisSettings& a : c.axes) EXPECT_GT(a.home_speed_deg_s, 0);
+}
+
+TEST(SimConfigTest, FlagsSetFields) {
+  SimConfig c;
+  ASSERT_TRUE(
+      ParseLikeMain({"--time-scale", "50", "--seed", "9", "--modbus-port", "1502", "--rtu",
+                     "--no-detector-arm", "--no-pacing", "--wake-window", "2.5", "--anisotropic",
+                     "--mounted", "white", "--beta-home-speed", "40", "--gamma-min", "-90"},
+                    c)
+          .ok());
+  EXPECT_EQ(c.time_scale, 50);
+  EXPECT_EQ(c.optics.seed, 9u);
+  EXPECT_EQ(c.modbus_port, 1502);
+  EXPECT_TRUE(c.rtu);
+  EXPECT_FALSE(c.detector_arm);
+  EXPECT_FALSE(c.pacing);
+  EXPECT_EQ(c.wake_window_s, 2.5);
+  EXPECT_TRUE(c.optics.anisotropic);
+  EXPECT_EQ(c.mounted, MountedTarget::kWhite);
+  EXPECT_EQ(c.axes[kBetaAxis].home_speed_deg_s, 40);
+  EXPECT_EQ(c.axes[kGammaAxis].min_deg, -90);
+
+  SimConfig manual;
+  ASSERT_TRUE(ParseLikeMain({"--no-detector-arm", "--manual-delta", "45"}, manual).ok());
+  EXPECT_FALSE(manual.detector_arm);
+  EXPECT_EQ(manual.manual_delta_deg, 45);
+  SimConfig bad;
+  EXPECT_FALSE(ParseLikeMain({"--manual-delta", "200"}, bad).ok());
+}
+
+TEST(SimConfigTest, FaultFlagsMirrorTheFaultStructs) {
+  SimConfig c;
+  ASSERT_TRUE(
+      ParseLikeMain({"--serial-silent", "--serial-garbage-next", "2", "--serial-truncate-next", "3",
+                     "--serial-quality-code", "18", "--serial-vanish-seconds", "1.5",
+                     "--modbus-exception-code", "6", "--modbus-exception-count", "4",
+                     "--modbus-late-reply-ms", "800", "--modbus-drop-connection",
+                     "--modbus-alarm-mid-move", "--modbus-stall"},
+                    c)
+          .ok());
+  EXPECT_TRUE(c.serial_faults.silent);
+  EXPECT_EQ(c.serial_faults.garbage_next, 2);
+  EXPECT_EQ(c.serial_faults.truncate_next, 3);
+  EXPECT_EQ(c.serial_faults.quality_code, 18);
+  EXPECT_EQ(c.serial_faults.quality_count, 1);  // a code without a count: the next one
+  EXPECT_EQ(c.serial_faults.vanish_seconds, 1.5);
+  EXPECT_EQ(c.modbus_faults.exception_code, 6);
+  EXPECT_EQ(c.modbus_faults.exception_count, 4);
+  EXPECT_EQ(c.modbus_faults.late_reply_ms, 800);
+  EXPECT_EQ(c.modbus_faults.late_count, 1);
+  EXPECT_TRUE(c.modbus_faults.drop_connection);
+  EXPECT_TRUE(c.modbus_faults.alarm_mid_move);
+  EXPECT_TRUE(c.modbus_faults.stall);
+}
+
+TEST(SimConfigTest, FileIsReadAndFlagsOverrideIt) {
+  testing::TempDir dir;
+  ASSERT_FALSE(dir.path().empty()) << dir.error();
+  const auto path = dir.file("sim.toml");
+  std::ofstream(path) << R"(
+time_scale = 20
+seed = 5
+mounted = "dark"
+[modbus]
+port = 1600
+[pr650]
+pacing = false
+[stage]
+detector_arm = false
+[stage.alpha]
+home_speed_deg_s = 10
+max_deg = 80
+[faults.serial]
+quality_code = 29
+quality_count = 3
+[optics]
+ambient_radiance = 1e-5
+[optics.lamp]
+color_temperature_k = 3000
+)";
+  SimConfig c;
+  ASSERT_TRUE(ParseLikeMain({"--config", path.string(), "--time-scale", "40"}, c).ok());
+  EXPECT_EQ(c.time_scale, 40);  // the flag wins
+  EXPECT_EQ(c.optics.seed, 5u);
+  EXPECT_EQ(c.mounted, MountedTarget::kDark);
+  EXPECT_EQ(c.modbus_port, 1600);
+  EXPECT_FALSE(c.pacing);
+  EXPECT_FALSE(c.detector_arm);
+  EXPECT_EQ(c.axes[kAlphaAxis].home_speed_deg_s, 10);
+  EXPECT_EQ(c.axes[kAlphaAxis].max_deg, 80);
+  EXPECT_EQ(c.axes[kAlphaAxis].min_deg, 0);  // untouched
+  EXPECT_EQ(c.serial_faults.quality_code, 29);
+  EXPECT_EQ(c.serial_faults.quality_count, 3);
+  EXPECT_EQ(c.optics.ambient_radiance, 1e-5);
+  EXPECT_EQ(c.optics.lamp.color_temperature_k, 3000);
+  EXPECT_EQ(c.config_path, path.string());
+}
+
+TEST(SimConfigTest, FileErrorsNameTheKey) {
+  SimConfig c;
+  Status unknown = LoadConfigString("[stage.alpha]\nsped_deg_s = 3\n", "x.toml", c);
+  EXPECT_EQ(unknown.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(unknown.message().find("stage.alpha.sped_deg_s"), std::string::npos)
+      << unknown.message();
+  Status type = LoadConfigString("time_scale = \"fast\"\n", "x.toml", c);
+  EXPECT_NE(type.message().find("time_scale"), std::string::npos) << type.message();
+  Status syntax = LoadConfigString("time_scale = = 3\n", "x.toml", c);
+  EXPECT_NE(syntax.message().find("x.toml:1"), std::string::npos) << syntax.message();
+  Status mounted = LoadConfigString("mounted = \"grey\"\n", "x.toml", c);
+  EXPECT_NE(mounted.message().find("grey"), std::string::npos) << mounted.message();
+  // A failed load leaves the configuration as it was.
+  EXPECT_TRUE(LoadConfigString("seed = 3\n[modbus]\nport = \"x\"\n", "x.toml", c).code() ==
+              StatusCode::kInvalidArgument);
+  EXPECT_EQ(c.optics.seed, SimConfig().optics.seed);
+  EXPECT_EQ(LoadConfigFile("/nonexistent/brdf-sim.toml", c).code(), StatusCode::kNotFound);
+}
+
+TEST(SimConfigTest, ValidationRejectsImpossibleSettings) {
+  auto invalid = [](auto mutate) {
+    SimConfig c;
+    mutate(c);
+    return ValidateConfig(c).code() == StatusCode::kInvalidArgument;
+  };
+  EXPECT_TRUE(invalid([](SimConfig& c) { c.time_scale = 0; }));
+  EXPECT_TRUE(invalid([](SimConfig& c) { c.modbus_port = 70000; }));
+  EXPECT_TRUE(invalid([](SimConfig& c) { c.axes[kBetaAxis].home_speed_deg_s = -1; }));
+  EXPECT_TRUE(invalid([](SimConfig& c) { c.axes[kAlphaAxis].min_deg = 95; }));
+  EXPECT_TRUE(invalid([](SimConfig& c) { c.serial_faults.quality_code = 123; }));
+  EXPECT_TRUE(invalid([](SimConfig& c) { c.optics.noise_scale = -1; }));
+  EXPECT_TRUE(invalid([](SimConfig& c) { c.log_level = "loud"; }));
+  SimConfig c;
+  EXPECT_FALSE(ParseLikeMain({"--mounted", "grey"}, c).ok());
+}
+
+TEST(SimConfigTest, FindConfigPathAcceptsBothSpellings) {
+  const char* a[] = {"brdf-sim", "--seed", "1", "--config", "a.toml"};
+  const char* b[] = {"brdf-sim", "--config=b.toml"};
+  const char* none[] = {"brdf-sim", "--seed", "1"};
+  EXPECT_EQ(FindConfigPath(5, a), "a.toml");
+  EXPECT_EQ(FindConfigPath(2, b), "b.toml");
+  EXPECT_FALSE(FindConfigPath(3, none).has_value());
+}
+
+}  // namespace
+}  // namespace brdf::sim

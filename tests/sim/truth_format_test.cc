@@ -1,0 +1,75 @@
+// `brdf-sim truth` output, in-process: the text and JSON forms carry the true BRDF exactly.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tools/brdf-sim/optics.h"
+#include "tools/brdf-sim/rig_truth.h"
+
+namespace brdf::sim {
+namespace {
+
+// The numbers of a JSON array named `key` (a minimal reader for our own flat output).
+std::vector<double> JsonArray(const std::string& json, const std::string& key) {
+  std::vector<double> out;
+  const std::size_t start = json.find("\"" + key + "\":[");
+  if (start == std::string::npos) return out;
+  const char* p = json.c_str() + start + key.size() + 4;
+  while (*p != ']' && *p != '\0') {
+    char* end = nullptr;
+    out.push_back(std::strtod(p, &end));
+    p = end;
+    if (*p == ',') ++p;
+  }
+  return out;
+}
+
+TEST(TruthFormatTest, TextHasOneBandPerLineAndRoundTrips) {
+  TruthQuery q;
+  q.directions = {35, 0, 50, 150};
+  std::istringstream in(FormatTruth(q));
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line.rfind("#", 0), 0u) << "first line is a comment: " << line;
+  const auto truth = TrueBrdf(q.directions);
+  const auto grid = WavelengthGrid::Pr650();
+  std::size_t k = 0;
+  double nm = 0, value = 0;
+  while (in >> nm >> value) {
+    ASSERT_LT(k, grid.count);
+    EXPECT_EQ(nm, grid.at(k));
+    EXPECT_EQ(value, truth[k]);
+    ++k;
+  }
+  EXPECT_EQ(k, grid.count);
+}
+
+TEST(TruthFormatTest, JsonCarriesDirectionsAndSpectrum) {
+  TruthQuery q;
+  q.directions = {20, 30, 40, 250};
+  q.anisotropic = true;
+  q.json = true;
+  const std::string json = FormatTruth(q);
+  EXPECT_NE(json.find("\"anisotropic\":true"), std::string::npos);
+  EXPECT_NE(json.find("\"phi_i\":30"), std::string::npos);
+  const auto nm = JsonArray(json, "wavelength_nm");
+  const auto brdf = JsonArray(json, "brdf");
+  EXPECT_EQ(brdf, TrueBrdf(q.directions, true));
+  ASSERT_EQ(nm.size(), 101u);
+  EXPECT_EQ(nm.front(), 380);
+  EXPECT_EQ(nm.back(), 780);
+}
+
+TEST(TruthFormatTest, RejectsNonFiniteAngles) {
+  TruthQuery q;
+  q.directions.theta_o = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(ValidateTruthQuery(q).code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(ValidateTruthQuery(q).message().find("--theta-o"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace brdf::sim

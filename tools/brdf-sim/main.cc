@@ -1,0 +1,187 @@
+// brdf-sim: a whole simulated rig in one process. A PR-650 on a pty and the rotation stage on
+// Modbus TCP (and RTU on a pty with --rtu), joined by the optical model, so the daemon and the
+// tests can run plans without hardware. `brdf-sim truth` prints the virtual sample's true BRDF.
+//
+// stdout carries only the start-up contract (tools/brdf-sim/README.md), one line each, flushed:
+//   pr650 <port path>
+//   modbus-tcp <host>:<port>
+//   modbus-rtu <pty path>        (with --rtu only)
+//   control-unit <unit id>
+//   ready
+// Everything else (logs) goes to stderr. SIGTERM or SIGINT stops it cleanly with exit code 0.
+#include <signal.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "tools/brdf-sim/optics.h"
+#include "tools/brdf-sim/pr650_endpoint.h"
+#include "tools/brdf-sim/rig_manual_detector.h"
+#include "tools/brdf-sim/rig_truth.h"
+#include "tools/brdf-sim/sim_config.h"
+#include "tools/brdf-sim/sim_shared.h"
+#include "tools/brdf-sim/stage_simulator.h"
+
+namespace brdf::sim {
+namespace {
+
+constexpr int kUsageError = 2;
+constexpr int kStartError = 1;
+
+StageSimConfig StageConfigFrom(const SimConfig& c) {
+  StageSimConfig s;
+  s.time_scale = TimeScale{c.time_scale};
+  s.tcp_host = c.modbus_host;
+  s.tcp_port = c.modbus_port;
+  s.serve_tcp = true;
+  s.serve_rtu = c.rtu;
+  for (std::size_t i = 0; i < s.axes.size(); ++i) {
+    s.axes[i].min_deg = c.axes[i].min_deg;
+    s.axes[i].max_deg = c.axes[i].max_deg;
+    s.axes[i].home_speed_deg_s = c.axes[i].home_speed_deg_s;
+  }
+  s.axes[kDeltaAxis].present = c.detector_arm;
+  return s;
+}
+
+Pr650EndpointOptions MeterOptionsFrom(const SimConfig& c) {
+  Pr650EndpointOptions o;
+  o.time_scale = TimeScale{c.time_scale};
+  o.wake_window_s = c.wake_window_s;
+  o.pace_replies = c.pacing;
+  o.link_path = c.pr650_link;
+  return o;
+}
+
+// One start-up line on stdout, flushed at once: a test may be waiting for it.
+void Announce(const std::string& line) {
+  std::fputs((line + "\n").c_str(), stdout);
+  std::fflush(stdout);
+}
+
+int Run(const SimConfig& config, const sigset_t& stop_signals) {
+  SimControl control;
+  control.set_mounted(config.mounted);
+  control.set_serial(config.serial_faults);
+  control.set_modbus(config.modbus_faults);
+
+  // The control unit's power-cycle register reaches the meter through this pointer, set once the
+  // meter exists and before either endpoint starts serving.
+  Pr650Endpoint* meter_ptr = nullptr;
+  StageSimulator stage(StageConfigFrom(config), control, [&meter_ptr] {
+    if (meter_ptr != nullptr) {
+      spdlog::info("control unit: power-cycling the PR-650");
+      meter_ptr->PowerCycle();
+    }
+  });
+  // Without a detector arm the stage has no δ: the detector stays where the operator put it.
+  ManualDetectorPose manual_detector(stage, config.manual_delta_deg);
+  const StagePoseSource& live_pose =
+      config.detector_arm ? static_cast<const StagePoseSource&>(stage) : manual_detector;
+  RigOptics optics(live_pose, control, config.optics);
+  Pr650Endpoint meter(optics, control, MeterOptionsFrom(config));
+  meter_ptr = &meter;
+
+  if (Status s = meter.Start(); !s.ok()) {
+    spdlog::error("cannot start the simulated PR-650: {}", s.ToString());
+    return kStartError;
+  }
+  std::string error;
+  if (!stage.Start(&error)) {
+    spdlog::error(
+        "cannot start the simulated stage on {}:{}: {}; pick another --modbus-port "
+        "(0 = any free port)",
+        config.modbus_host, config.modbus_port, error);
+    meter.Stop();
+    return kStartError;
+  }
+  spdlog::info(
+      "PR-650 on {} (pty {}), Modbus TCP on {}:{}{}{}, time scale {}, seed {}, {} sample, "
+      "{} mounted",
+      meter.path(), meter.slave_path(), config.modbus_host, stage.tcp_port(),
+      config.rtu ? ", Modbus RTU on " : "", config.rtu ? stage.rtu_path() : "", config.time_scale,
+      config.optics.seed, config.optics.anisotropic ? "brushed (anisotropic)" : "paint-like",
+      MountedTargetName(config.mounted));
+
+  Announce("pr650 " + meter.path());
+  Announce("modbus-tcp " + config.modbus_host + ":" + std::to_string(stage.tcp_port()));
+  if (config.rtu) Announce("modbus-rtu " + stage.rtu_path());
+  Announce("control-unit " + std::to_string(stage.control_unit_id()));
+  Announce("ready");
+
+  int signal_number = 0;
+  while (sigwait(&stop_signals, &signal_number) != 0) {
+  }
+  spdlog::info("signal {} received: stopping", signal_number);
+  // The stage first: its control unit is what could still power-cycle the meter.
+  stage.Shutdown();
+  meter.Stop();
+  return 0;
+}
+
+void SetUpLogging(const std::string& level) {
+  auto logger = spdlog::stderr_color_mt("brdf-sim");
+  spdlog::set_default_logger(logger);
+  spdlog::set_level(spdlog::level::from_str(level));
+}
+
+}  // namespace
+}  // namespace brdf::sim
+
+int main(int argc, char** argv) {
+  using namespace brdf::sim;
+
+  // Block the stop signals before any thread starts, so every thread inherits the mask and the
+  // main thread alone receives them in sigwait. Writes to a closed socket or pty must fail with
+  // EPIPE, not kill the process.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGTERM);
+  sigaddset(&stop_signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+
+  SimConfig config;
+  TruthQuery truth;
+  CLI::App app(
+      "brdf-sim: a simulated spectral BRDF rig (PR-650 on a pty, rotation stage on Modbus)");
+  AddRunFlags(app, config);
+  CLI::App* truth_cmd = app.add_subcommand(
+      "truth", "Print the virtual sample's true BRDF (sr^-1), 380-780 nm / 4 nm");
+  AddTruthFlags(*truth_cmd, truth);
+  app.require_subcommand(0, 1);
+
+  // The file first, so that flags override it.
+  if (auto path = FindConfigPath(argc, argv)) {
+    if (brdf::Status s = LoadConfigFile(*path, config); !s.ok()) {
+      std::fprintf(stderr, "brdf-sim: %s\n", s.ToString().c_str());
+      return kUsageError;
+    }
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  if (*truth_cmd) {
+    if (brdf::Status s = ValidateTruthQuery(truth); !s.ok()) {
+      std::fprintf(stderr, "brdf-sim: %s\n", s.ToString().c_str());
+      return kUsageError;
+    }
+    std::fputs(FormatTruth(truth).c_str(), stdout);
+    return 0;
+  }
+
+  FinishFlags(app, config);
+  if (brdf::Status s = ValidateConfig(config); !s.ok()) {
+    std::fprintf(stderr, "brdf-sim: %s\n", s.ToString().c_str());
+    return kUsageError;
+  }
+  SetUpLogging(config.log_level);
+  return Run(config, stop_signals);
+}

@@ -1,0 +1,86 @@
+// The rig's optics as brdf-sim models them: what the PR-650 reads right now. A tungsten lamp lights
+// whatever is mounted on the holder (the virtual sample, the white standard, or the dark shutter);
+// the holder's live pose (from the stage simulator) sets the incident and viewing directions; the
+// detector adds noise and picks an integration time. This is the MeterBackend behind the PR-650
+// endpoint, and TrueBrdf is the ground truth that tests compare the daemon's results against.
+//
+// Radiance the meter sees (W·m⁻²·sr⁻¹·nm⁻¹), with E(λ) the lamp's irradiance at normal incidence:
+//   sample: E(λ) · f(θi, φi, θo, φo, λ) · cos θi + ambient
+//   white:  E(λ) · ρw / π · cos θi + ambient          (Lambertian, ρw = 0.99)
+//   dark:   ambient                                   (the shutter is closed)
+// A lamp or detector below the mounted surface contributes nothing but the ambient level. So the
+// daemon's BRDF, (I − D) / (I0 − D) · ρw / π · cos θi,ref / cos θi, reproduces f within the noise.
+#pragma once
+
+#include <cstdint>
+#include <mutex>
+#include <random>
+#include <vector>
+
+#include "core/analytic_brdf.h"
+#include "core/pose.h"
+#include "core/wavelength_grid.h"
+#include "tools/brdf-sim/rig_detector.h"
+#include "tools/brdf-sim/rig_lamp.h"
+#include "tools/brdf-sim/sim_shared.h"
+
+namespace brdf::sim {
+
+struct OpticsConfig {
+  LampConfig lamp;
+  DetectorConfig detector;
+  // The white standard's reflectance (the paper's RS-3: 0.99 ± 0.01), spectrally flat.
+  double white_reflectance = 0.99;
+  // Stray light and detector dark signal, spectrally flat (W·m⁻²·sr⁻¹·nm⁻¹). Seen in every reading;
+  // alone with the shutter closed. Low enough that a dark reading earns quality 10 or 18.
+  double ambient_radiance = 5e-6;
+  // The virtual sample: AnalyticBrdf::PaintLike(), or Brushed() when anisotropic.
+  bool anisotropic = false;
+  // Seeds the noise: the same seed and the same sequence of measurements give the same readings.
+  std::uint64_t seed = 1;
+  // Standard deviations scale by this (0 = noiseless, for tests that want exact values).
+  double noise_scale = 1.0;
+};
+
+// The virtual sample's BRDF model.
+AnalyticBrdf SampleBrdf(bool anisotropic);
+
+// Ground truth: the virtual sample's BRDF (sr⁻¹) on the PR-650 grid (380–780 nm every 4 nm) for
+// directions in the sample frame (degrees). Zero where either direction is below the surface.
+std::vector<double> TrueBrdf(const Directions& directions, bool anisotropic = false);
+
+class RigOptics final : public MeterBackend {
+ public:
+  // `stage` and `control` must outlive this object.
+  RigOptics(const StagePoseSource& stage, SimControl& control, OpticsConfig config = {});
+
+  // One measurement of whatever is mounted, at the stage's live pose. Applies an injected quality
+  // code (SimControl's SerialFaults.quality_code for the next quality_count measurements, counted
+  // down here, so the PR-650 endpoint does not apply it again). Thread-safe.
+  SimMeasurement Measure(const MeterSetup& setup) override;
+
+  // The noiseless radiance the meter would see for `target` at `pose`, on the PR-650 grid.
+  std::vector<double> ExpectedRadiance(MountedTarget target, const Pose& pose) const;
+
+  // The virtual sample's BRDF (sr⁻¹) for directions in the sample frame.
+  std::vector<double> TrueBrdf(const Directions& directions) const;
+
+  const OpticsConfig& config() const { return config_; }
+  const Lamp& lamp() const { return lamp_; }
+  const Detector& detector() const { return detector_; }
+  static WavelengthGrid Grid() { return WavelengthGrid::Pr650(); }
+
+ private:
+  const StagePoseSource& stage_;
+  SimControl& control_;
+  const OpticsConfig config_;
+  const Lamp lamp_;
+  const Detector detector_;
+  const AnalyticBrdf sample_;
+  const std::vector<double> lamp_spectrum_;  // E(λ) on the grid
+
+  std::mutex noise_mu_;  // guards rng_
+  std::mt19937_64 rng_;
+};
+
+}  // namespace brdf::sim

@@ -1,0 +1,99 @@
+// brdf-sim's configuration: built-in defaults, then a TOML file (--config), then command-line
+// flags, each overriding the one before. README.md lists every flag and key.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/status.h"
+#include "tools/brdf-sim/optics.h"
+#include "tools/brdf-sim/sim_shared.h"
+
+namespace CLI {
+class App;
+}
+
+namespace brdf::sim {
+
+// One axis of the simulated stage: how far it may turn, and how fast it homes. A move runs at the
+// speed the driver writes into the drive's operation data, as on a real AZ drive.
+struct AxisSettings {
+  double home_speed_deg_s = 20;
+  double min_deg = 0;
+  double max_deg = 0;
+};
+
+// Axis order in SimConfig::axes (the Modbus unit id is index + 1).
+enum AxisIndex : int { kAlphaAxis = 0, kBetaAxis = 1, kGammaAxis = 2, kDeltaAxis = 3 };
+inline constexpr std::array<const char*, 4> kAxisNames = {"alpha", "beta", "gamma", "delta"};
+
+struct SimConfig {
+  std::string config_path;  // the --config file read, if any (for the log)
+  double time_scale = 1.0;  // simulated time runs this many times faster than real time
+
+  std::string modbus_host = "127.0.0.1";
+  int modbus_port = 0;          // 0 = an ephemeral port, printed at start-up
+  bool rtu = false;             // also serve Modbus RTU on a pty
+  bool detector_arm = true;     // δ is a motorized axis (unit 4); false: the operator moves it
+  double manual_delta_deg = 0;  // without the arm: where the operator put the detector (δ)
+  bool pacing = true;           // pace PR-650 replies at 9600 baud
+  double wake_window_s = 5;     // the PR-650 enters remote mode only within this long of power-on
+                                // (simulated seconds; 0 = any time)
+  std::string pr650_link;       // where the PR-650 port link goes (empty: a private temp dir)
+
+  std::array<AxisSettings, 4> axes = {{
+      // home speed, min, max
+      {20, 0, 90},      // α tilt
+      {20, -180, 180},  // β rotation about the vertical
+      {20, -180, 180},  // γ dial about the normal
+      {20, 0, 180},     // δ detector arm
+  }};
+
+  MountedTarget mounted = MountedTarget::kSample;
+  SerialFaults serial_faults;
+  ModbusFaults modbus_faults;
+
+  // Lamp, detector, white standard, ambient level, noise; also --seed (optics.seed) and
+  // --anisotropic (optics.anisotropic), which only the optics use.
+  OpticsConfig optics;
+
+  std::string log_level = "info";  // trace, debug, info, warn, error, off
+};
+
+// `brdf-sim truth`: the true BRDF at one direction.
+struct TruthQuery {
+  Directions directions;
+  bool anisotropic = false;
+  bool json = false;
+};
+
+// Names of mounted targets as flags and the control unit spell them: sample, white, dark.
+const char* MountedTargetName(MountedTarget target);
+std::optional<MountedTarget> ParseMountedTarget(const std::string& name);
+
+// The value of --config in argv (both "--config PATH" and "--config=PATH"), if any. Read before
+// the flags so that the flags can override the file.
+std::optional<std::string> FindConfigPath(int argc, const char* const* argv);
+
+// Reads a TOML file over `config`. Unknown keys are errors (a typo must not go unnoticed). The
+// message names the file, the key and what is expected.
+Status LoadConfigFile(const std::string& path, SimConfig& config);
+Status LoadConfigString(const std::string& toml_text, const std::string& source_name,
+                        SimConfig& config);
+
+// Registers the run flags on `app`, bound to `config` (a flag that is not given leaves the field).
+// Call FinishFlags after parsing.
+void AddRunFlags(CLI::App& app, SimConfig& config);
+// Applies what the flags imply (a fault code without a count means "the next one").
+void FinishFlags(CLI::App& app, SimConfig& config);
+
+// Registers `truth`'s flags on its subcommand, bound to `query`.
+void AddTruthFlags(CLI::App& truth, TruthQuery& query);
+
+// Checks ranges: time scale > 0, port 0–65535, speeds > 0, min < max, and so on.
+Status ValidateConfig(const SimConfig& config);
+
+}  // namespace brdf::sim
