@@ -16,7 +16,9 @@
 namespace brdf::interp {
 namespace {
 
-const char* AxisNames(int dims) { return dims == 3 ? "(θi, θo, φ)" : "(θi, φi, θo, φo)"; }
+const char* AxisNames(int dims) {
+  return dims == 3 ? "(θi, θo, φ)" : "(θi, φi, θo, φo)";
+}
 
 std::string FormatPoint(std::span<const double> x) {
   std::string out = "(";
@@ -43,12 +45,11 @@ struct DelaunayInterpolator::Impl {
   std::vector<Point> points;
   SimplexLocator locator;
 
-  Interpolation Answer(std::span<const double> query, std::int32_t hint,
-                       std::int32_t* found) const;
+  Interpolation Answer(std::span<const double> query, std::int32_t hint, std::int32_t* found) const;
 };
 
-Interpolation DelaunayInterpolator::Impl::Answer(std::span<const double> query,
-                                                 std::int32_t hint, std::int32_t* found) const {
+Interpolation DelaunayInterpolator::Impl::Answer(std::span<const double> query, std::int32_t hint,
+                                                 std::int32_t* found) const {
   Interpolation out;
   out.method = Method::kDelaunay;
   if (query.size() != static_cast<std::size_t>(dims)) {
@@ -150,7 +151,9 @@ DelaunayInterpolator::DelaunayInterpolator(std::unique_ptr<const Impl> impl)
     : impl_(std::move(impl)) {}
 DelaunayInterpolator::~DelaunayInterpolator() = default;
 
-int DelaunayInterpolator::dims() const { return impl_->dims; }
+int DelaunayInterpolator::dims() const {
+  return impl_->dims;
+}
 
 Interpolation DelaunayInterpolator::Evaluate(std::span<const double> query) const {
   std::int32_t found = -1;
@@ -178,7 +181,34 @@ Status DelaunayInterpolator::EvaluateBatch(std::span<const double> queries,
   return Status::Ok();
 }
 
-std::size_t DelaunayInterpolator::point_count() const { return impl_->points.size(); }
+InterpStatus DelaunayInterpolator::EvaluateSpectrum(std::span<const double> query,
+                                                    std::span<double> spectrum,
+                                                    LocateHint& hint) const {
+  const Impl& im = *impl_;
+  const auto bands = static_cast<std::size_t>(im.samples->bands());
+  if (query.size() != static_cast<std::size_t>(im.dims) || spectrum.size() != bands) {
+    return InterpStatus::kOutsideHull;
+  }
+  std::array<double, 4> x{};
+  for (int i = 0; i < im.dims; ++i) x[i] = query[i] * im.scale[i];
+  const SimplexLocation loc =
+      im.locator.LocateFrom(std::span<const double>(x.data(), query.size()), hint.simplex);
+  if (!loc.inside) return InterpStatus::kOutsideHull;
+  hint.simplex = loc.simplex;
+  const std::span<const std::int32_t> corners = im.locator.vertices(loc.simplex);
+  std::array<const double*, kMaxSimplexVertices> spectra{};
+  for (std::size_t m = 0; m < corners.size(); ++m) {
+    spectra[m] =
+        im.samples->spectrum(im.points[static_cast<std::size_t>(corners[m])].sample).data();
+  }
+  BlendSpectra(std::span<const double>(loc.weights.data(), corners.size()),
+               std::span<const double* const>(spectra.data(), corners.size()), spectrum);
+  return InterpStatus::kOk;
+}
+
+std::size_t DelaunayInterpolator::point_count() const {
+  return impl_->points.size();
+}
 std::size_t DelaunayInterpolator::simplex_count() const {
   return impl_->locator.simplex_count();
 }

@@ -36,9 +36,10 @@ namespace brdf::interp {
 Result<std::unique_ptr<Interpolator>> MakeDelaunayInterpolator(
     std::shared_ptr<const SampleSet> samples, const Options& options);
 
-// Where the previous answer was found; lets ordered queries (along a scan, a space-filling
-// curve, a rendering's neighbouring pixels) start their search there. One per thread or per
-// sequence of queries; any value is safe.
+// Where the previous answer was found. Ordered queries (along a scan, a space-filling curve, a
+// rendering's neighbouring pixels) often fall in the same simplex; that simplex is tried first
+// and, when it holds the query, no search is needed. One per thread or per sequence of queries;
+// any value is safe.
 struct LocateHint {
   std::int32_t simplex = -1;
 };
@@ -53,13 +54,19 @@ class DelaunayInterpolator final : public Interpolator {
   int dims() const override;
   // Thread-safe. The search starts from a precomputed simplex near the query.
   Interpolation Evaluate(std::span<const double> query) const override;
-  // Thread-safe for distinct hints. Starts from hint.simplex when the query is near it and
-  // stores the answer's simplex back (unchanged when the query is outside the hull).
+  // Thread-safe for distinct hints. Tries hint.simplex first (else searches as Evaluate does)
+  // and stores the answer's simplex back (unchanged when the query is outside the hull).
   Interpolation EvaluateFrom(std::span<const double> query, LocateHint& hint) const;
-  // queries: n * dims() coordinates, row-major. Fills `out` with n answers, each search starting
-  // from the previous answer: fastest when consecutive queries are close. Errors when
+  // queries: n * dims() coordinates, row-major. Fills `out` with n answers, each trying the
+  // previous answer's simplex first: fastest when consecutive queries are close. Errors when
   // queries.size() is not a multiple of dims().
   Status EvaluateBatch(std::span<const double> queries, std::vector<Interpolation>& out) const;
+  // The spectrum alone, for bulk work (rendering, resampling, benchmarks against scipy, which
+  // returns values only): no provenance, no allocation. spectrum.size() must be the sample
+  // set's band count. Returns kOk (spectrum filled) or kOutsideHull (spectrum untouched); a
+  // query or spectrum of the wrong size is kOutsideHull too. Thread-safe for distinct hints.
+  InterpStatus EvaluateSpectrum(std::span<const double> query, std::span<double> spectrum,
+                                LocateHint& hint) const;
 
   // Distinct points triangulated (after augmentation and removal of coincident points).
   std::size_t point_count() const;

@@ -17,9 +17,6 @@ constexpr double kStepEps = 100 * std::numeric_limits<double>::epsilon();
 constexpr double kHullEps = 1e-10;
 // A simplex whose edge matrix has a reciprocal condition number below this is flat.
 constexpr double kFlatRcond = 1000 * std::numeric_limits<double>::epsilon();
-// A hint is used when the query's barycentric coordinates in it are all above −kHintReach:
-// the query is then within a few simplices of it.
-constexpr double kHintReach = 0.0;
 
 template <int D>
 inline void Barycentric(const double* transform, const double* x, double* c) {
@@ -413,7 +410,6 @@ SimplexLocation SimplexLocator::From(const double* x, std::int32_t hint) const {
     Barycentric<D>(records<D>()[static_cast<std::size_t>(hint)].transform, x, c);
     const double lowest = *std::min_element(c, c + K);
     if (lowest >= -kStepEps) return Inside<D>(hint, c);
-    if (lowest >= -kHintReach) return Walk<D>(x, hint);
   }
   return Walk<D>(x, GridStart(x));
 }

@@ -98,10 +98,10 @@ Result<QhullTriangulation> TriangulateWithQhull(std::span<const double> points, 
   const int exit_code = qh_new_qhull(qh, dims, static_cast<int>(count), coords.data(), False,
                                      options, nullptr, errors.file());
   if (exit_code != 0) {
-    return InvalidArgument("Delaunay triangulation of " + std::to_string(count) +
-                           " points failed (Qhull exit code " + std::to_string(exit_code) +
-                           "; are all samples on one plane or hyperplane?): " +
-                           FirstLines(errors.Text(), 4));
+    return InvalidArgument(
+        "Delaunay triangulation of " + std::to_string(count) + " points failed (Qhull exit code " +
+        std::to_string(exit_code) +
+        "; are all samples on one plane or hyperplane?): " + FirstLines(errors.Text(), 4));
   }
 
   // Number the lower (Delaunay) facets; upper ones (the point at infinity's) are the outside.
@@ -135,9 +135,8 @@ Result<QhullTriangulation> TriangulateWithQhull(std::span<const double> points, 
       }
       out.vertices.push_back(id);
       auto* neighbour = static_cast<facetT*>(neighbours->e[i].p);
-      out.neighbours.push_back(neighbour->upperdelaunay
-                                   ? -1
-                                   : static_cast<std::int32_t>(neighbour->visitid) - 1);
+      out.neighbours.push_back(
+          neighbour->upperdelaunay ? -1 : static_cast<std::int32_t>(neighbour->visitid) - 1);
     }
   }
   if (out.vertices.empty()) {

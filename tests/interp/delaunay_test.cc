@@ -187,10 +187,9 @@ TEST_P(DelaunayDims, IsExactAtEverySample) {
     ASSERT_EQ(r.status, InterpStatus::kOk) << r.detail;
     const auto want = bumpy->spectrum(i);
     ExpectNear(r.spectrum, std::vector<double>(want.begin(), want.end()), 1e-9);
-    const auto top = std::max_element(r.vertices.begin(), r.vertices.end(),
-                                       [](const Vertex& a, const Vertex& b) {
-                                         return a.weight < b.weight;
-                                       });
+    const auto top =
+        std::max_element(r.vertices.begin(), r.vertices.end(),
+                         [](const Vertex& a, const Vertex& b) { return a.weight < b.weight; });
     EXPECT_EQ(top->index, i);
     EXPECT_NEAR(top->weight, 1.0, 1e-9);
   }
@@ -321,7 +320,9 @@ TEST_P(DelaunayDims, WalkAgreesWithScanningEverySimplex) {
 }
 
 INSTANTIATE_TEST_SUITE_P(ThreeAndFourD, DelaunayDims, ::testing::Values(3, 4),
-                         [](const auto& param_info) { return std::to_string(param_info.param) + "D"; });
+                         [](const auto& param_info) {
+                           return std::to_string(param_info.param) + "D";
+                         });
 
 TEST(Delaunay, RegularGridIsTriangulatedDespiteCosphericalPoints) {
   // The rig measures on a grid: many points on common spheres, Qhull's hard case (option Qz).
@@ -408,8 +409,8 @@ TEST(Delaunay, ReciprocityAddsSwappedCopies) {
   const LinearField base = MakeField(3, rng);
   LinearField f = base;  // make it symmetric in θi ↔ θo so the copies are consistent
   for (int b = 0; b < kBands; ++b) f.slope[b * 3 + 1] = f.slope[b * 3 + 0];
-  std::vector<std::vector<double>> pts = {{0, 0, 0}, {0, 90, 0}, {90, 90, 0}, {0, 0, 360},
-                                          {0, 90, 360}, {90, 90, 360}};
+  std::vector<std::vector<double>> pts = {{0, 0, 0},   {0, 90, 0},   {90, 90, 0},
+                                          {0, 0, 360}, {0, 90, 360}, {90, 90, 360}};
   while (pts.size() < 400) {
     auto x = RandomPoint(3, rng);
     if (x[0] <= x[1]) pts.push_back(x);
@@ -494,6 +495,32 @@ TEST(Delaunay, HintedAndBatchedQueriesMatchPlainOnes) {
               InterpStatus::kOk);
   }
   EXPECT_FALSE(interp->EvaluateBatch(std::span<const double>(queries.data(), 5), batch).ok());
+}
+
+TEST(Delaunay, SpectrumOnlyQueriesMatchFullAnswers) {
+  std::mt19937_64 rng(47);
+  const LinearField f = MakeField(3, rng);
+  auto set = SamplesOf(BoxCloud(3, 1000, rng), f);
+  auto interp = Make(set);
+  ASSERT_NE(interp, nullptr);
+  LocateHint hint;
+  std::vector<double> spectrum(kBands);
+  for (int q = 0; q < 1000; ++q) {
+    auto x = RandomPoint(3, rng);
+    if (q % 10 == 0) x[1] = 95;  // beyond the box: outside
+    const Interpolation full = interp->Evaluate(x);
+    std::fill(spectrum.begin(), spectrum.end(), -1.0);
+    const InterpStatus status = interp->EvaluateSpectrum(x, spectrum, hint);
+    ASSERT_EQ(status, full.status) << "query " << q;
+    if (status == InterpStatus::kOk) {
+      EXPECT_EQ(spectrum, full.spectrum);  // the same blend, bit for bit
+    } else {
+      EXPECT_EQ(spectrum, std::vector<double>(kBands, -1.0));  // untouched
+    }
+  }
+  std::vector<double> short_spectrum(kBands - 1);
+  EXPECT_EQ(interp->EvaluateSpectrum(RandomPoint(3, rng), short_spectrum, hint),
+            InterpStatus::kOutsideHull);
 }
 
 TEST(Delaunay, ConcurrentQueriesGiveTheSequentialAnswers) {
