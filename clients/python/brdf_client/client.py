@@ -1,0 +1,381 @@
+"""BrdfClient: brdfd's gRPC API (proto/brdf/v1/brdf.proto) as Python methods.
+
+    from brdf_client import BrdfClient
+    with BrdfClient("127.0.0.1:50051", token="...") as brdf:
+        session = brdf.submit_plan("examples/plans/demo.json", start_now=True)
+        final = brdf.wait(session.session_id, on_event=lambda e: print(e.describe()))
+        data = brdf.load_readings(session.session_id)            # ReadingSet: NumPy arrays
+        r = brdf.interpolate(session.session_id, 30, 40, 160)      # InterpolationResult
+        print(r.status, r.wavelengths, r.spectrum, r.vertex_ids, r.weights)
+
+Control calls return the API's own messages (brdf_pb2.Session, RigStatus, ValidatePlanResponse:
+their fields are documented in brdf.proto); data and interpolation calls return NumPy-based
+objects (ReadingSet, InterpolationResult, InterpolationBatch). Every failed call raises BrdfError
+with the gRPC status code and the daemon's message.
+
+Units: degrees for angles, nm for wavelengths, sr⁻¹ for a BRDF, W·m⁻²·sr⁻¹·nm⁻¹ for radiance.
+"""
+
+import os
+import time
+
+import grpc
+
+from . import names
+from ._stubs import brdf_pb2, brdf_pb2_grpc
+from .errors import BrdfError
+from .events import Event
+from .interpolation import (InterpolationBatch, InterpolationResult, direction_query,
+                            interpolation_options)
+from .plans import to_plan
+from .readings import ReadingSet, kinds_to_enums
+
+
+def _read_pem(value, what):
+    """PEM bytes from bytes, or from a file path."""
+    if value is None or isinstance(value, bytes):
+        return value
+    try:
+        with open(value, "rb") as f:
+            return f.read()
+    except OSError as e:
+        raise ValueError(f"cannot read the {what} {value}: {e.strerror}") from e
+
+
+class BrdfClient:
+    """A connection to one brdfd.
+
+    Args:
+      address: "host:port" (e.g. "127.0.0.1:50051", the daemon's [server] listen) or
+               "unix:/path/to/socket".
+      token:   the bearer token ([[auth.tokens]] in the daemon's configuration); sent as
+               "authorization: Bearer <token>" on every call. None: $BRDF_TOKEN if set, else no
+               token (for a daemon configured without tokens). An "analyst" token may only read;
+               an "operator" token may call everything.
+      tls:     connect over TLS ([server.tls] in the daemon's configuration). Implied by any of
+               the three certificate arguments.
+      root_certificates: PEM (bytes or a file path) of the CA that signed the daemon's
+               certificate; None: the system's trust store.
+      client_certificate, client_key: PEM (bytes or paths) for mutual TLS (the daemon's
+               [server.tls] client_ca).
+      server_name: the name to check the daemon's certificate against, when it differs from the
+               address' host (e.g. connecting by IP to a certificate issued for "rig-pc").
+      timeout: deadline of unary calls, seconds. Streams take their own `timeout` (default none).
+    """
+
+    def __init__(self, address, token=None, *, tls=False, root_certificates=None,
+                 client_certificate=None, client_key=None, server_name=None, timeout=30.0):
+        self.address = address
+        self.timeout = timeout
+        if token is None:
+            token = os.environ.get("BRDF_TOKEN") or None
+        self._metadata = (("authorization", f"Bearer {token}"),) if token else ()
+        options = []
+        if server_name:
+            options.append(("grpc.ssl_target_name_override", server_name))
+        if tls or root_certificates or client_certificate or client_key:
+            if bool(client_certificate) != bool(client_key):
+                raise ValueError("mutual TLS needs both client_certificate and client_key")
+            credentials = grpc.ssl_channel_credentials(
+                root_certificates=_read_pem(root_certificates, "CA certificate"),
+                private_key=_read_pem(client_key, "client key"),
+                certificate_chain=_read_pem(client_certificate, "client certificate"))
+            self._channel = grpc.secure_channel(address, credentials, options=options)
+        else:
+            self._channel = grpc.insecure_channel(address, options=options)
+        self._control = brdf_pb2_grpc.ControlStub(self._channel)
+        self._data = brdf_pb2_grpc.DataStub(self._channel)
+        self._interp = brdf_pb2_grpc.InterpolationStub(self._channel)
+
+    # --- connection ----------------------------------------------------------------------------
+
+    def close(self):
+        """Closes the channel (open streams end)."""
+        self._channel.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def wait_ready(self, timeout=10.0):
+        """Blocks until the channel is connected; BrdfError(UNAVAILABLE) after `timeout` s."""
+        try:
+            grpc.channel_ready_future(self._channel).result(timeout=timeout)
+        except grpc.FutureTimeoutError:
+            raise BrdfError(grpc.StatusCode.UNAVAILABLE,
+                            f"brdfd at {self.address} did not answer within {timeout:g} s; check "
+                            "the address and that the daemon runs", "connect") from None
+
+    def _unary(self, rpc, request, method, timeout=None):
+        try:
+            return rpc(request, metadata=self._metadata,
+                       timeout=self.timeout if timeout is None else timeout)
+        except grpc.RpcError as e:
+            raise BrdfError.from_rpc_error(e, method) from None
+
+    def _stream(self, rpc, request, method, timeout=None):
+        call = rpc(request, metadata=self._metadata, timeout=timeout)
+        try:
+            for item in call:
+                yield item
+        except grpc.RpcError as e:
+            raise BrdfError.from_rpc_error(e, method) from None
+        finally:
+            call.cancel()  # a no-op when the stream ended; frees it when the caller stopped early
+
+    # --- Control: plans and sessions -----------------------------------------------------------
+
+    def validate_plan(self, plan):
+        """Checks a plan (Plan, dict, JSON text or JSON file path) without storing it.
+
+        Returns brdf_pb2.ValidatePlanResponse: .valid, .problems (field_path, message),
+        .summary (step_count, sample_readings, operator_interventions, estimated_duration_s, ...).
+        """
+        return self._unary(self._control.ValidatePlan,
+                           brdf_pb2.ValidatePlanRequest(plan=to_plan(plan)), "Control.ValidatePlan")
+
+    def submit_plan(self, plan, start_now=False):
+        """Stores a plan as a new session; returns the brdf_pb2.Session (QUEUED, or RUNNING).
+
+        `plan`: a Plan message, a dict (the JSON form), JSON text, or a path to a JSON plan file.
+        An invalid plan raises BrdfError(INVALID_ARGUMENT) listing every problem.
+        """
+        request = brdf_pb2.SubmitPlanRequest(plan=to_plan(plan), start_now=start_now)
+        return self._unary(self._control.SubmitPlan, request, "Control.SubmitPlan").session
+
+    def start(self, session_id):
+        """Starts a QUEUED session (it stays QUEUED while another one holds the rig)."""
+        return self._unary(self._control.StartSession,
+                           brdf_pb2.StartSessionRequest(session_id=session_id),
+                           "Control.StartSession").session
+
+    def pause(self, session_id, immediate=False):
+        """Pauses a running session: after the current step (default), or at once (immediate:
+        the step in progress is cancelled and run again on resume)."""
+        mode = brdf_pb2.PAUSE_MODE_IMMEDIATE if immediate else brdf_pb2.PAUSE_MODE_DEFERRED
+        return self._unary(self._control.PauseSession,
+                           brdf_pb2.PauseSessionRequest(session_id=session_id, mode=mode),
+                           "Control.PauseSession").session
+
+    def resume(self, session_id):
+        """Resumes a PAUSED or PAUSING session."""
+        return self._unary(self._control.ResumeSession,
+                           brdf_pb2.ResumeSessionRequest(session_id=session_id),
+                           "Control.ResumeSession").session
+
+    def abort(self, session_id, reason=""):
+        """Stops a session for good (its readings are kept)."""
+        return self._unary(self._control.AbortSession,
+                           brdf_pb2.AbortSessionRequest(session_id=session_id, reason=reason),
+                           "Control.AbortSession").session
+
+    def answer_prompt(self, session_id, step_index=None, note=""):
+        """Confirms that the manual action of the pending prompt is done.
+
+        step_index: the prompt's Prompt.step_index; None: the session's pending prompt (fetched
+        first). A step_index that is not the pending prompt's raises FAILED_PRECONDITION, so a
+        late answer never confirms the next prompt.
+        """
+        if step_index is None:
+            session = self.get_session(session_id)
+            if not session.HasField("pending_prompt"):
+                raise BrdfError(grpc.StatusCode.FAILED_PRECONDITION,
+                                f"session {session_id} has no pending prompt (state "
+                                f"{names.state_name(session.state)})", "Control.AnswerPrompt")
+            step_index = session.pending_prompt.step_index
+        request = brdf_pb2.AnswerPromptRequest(session_id=session_id, step_index=step_index,
+                                               note=note)
+        return self._unary(self._control.AnswerPrompt, request, "Control.AnswerPrompt").session
+
+    def get_session(self, session_id):
+        """One session, with its plan, progress, pending prompt and last fault."""
+        return self._unary(self._control.GetSession,
+                           brdf_pb2.GetSessionRequest(session_id=session_id), "Control.GetSession")
+
+    def list_sessions(self, states=None, page_size=0, limit=None):
+        """Sessions, newest first, optionally only those in `states` ("running", ...).
+
+        Follows the daemon's pages until `limit` sessions (None: all); `page_size` sets how many
+        come per call (0: the daemon's 100). Session.plan is empty here; get_session returns it.
+        """
+        if isinstance(states, (str, int)):
+            states = [states]
+        wanted = [names.to_enum(s, names.STATES, "session state") for s in (states or [])]
+        sessions, token = [], ""
+        while True:
+            page = self._unary(self._control.ListSessions,
+                               brdf_pb2.ListSessionsRequest(states=wanted, page_size=page_size,
+                                                            page_token=token),
+                               "Control.ListSessions")
+            sessions.extend(page.sessions)
+            token = page.next_page_token
+            if limit is not None and len(sessions) >= limit:
+                return sessions[:limit]
+            if not token:
+                return sessions
+
+    def rig_status(self):
+        """brdf_pb2.RigStatus: devices' connection states, live pose, meter serial, active session."""
+        return self._unary(self._control.GetRigStatus, brdf_pb2.GetRigStatusRequest(),
+                           "Control.GetRigStatus")
+
+    def watch(self, session_id, timeout=None):
+        """Yields the session's events (Event): a snapshot, then state changes, prompts, step
+        completions and faults, until the session ends. `timeout`: deadline of the whole stream,
+        seconds (BrdfError DEADLINE_EXCEEDED when it passes); None: none."""
+        for event in self._stream(self._control.WatchSession,
+                                  brdf_pb2.WatchSessionRequest(session_id=session_id),
+                                  "Control.WatchSession", timeout):
+            yield Event.from_proto(event)
+
+    def wait(self, session_id, on_event=None, on_prompt=None, timeout=None, poll_s=10.0,
+             stop_states=()):
+        """Follows a session until it is terminal; returns the final brdf_pb2.Session.
+
+        on_event(event): called for every Event (progress displays).
+        on_prompt(prompt): called for each operator prompt (brdf_pb2.Prompt) once; when given, the
+            prompt is answered after it returns (unless it returns False) — a script that does the
+            manual action itself, e.g. setting the simulator's mounted target. None: prompts are
+            left for the operator.
+        timeout: give up after this many seconds (BrdfError DEADLINE_EXCEEDED); None: never.
+        poll_s: the watch is renewed this often, so a prompt is seen even if its event was lost by
+            a slow watcher (a renewed watch starts with a snapshot holding the pending prompt).
+        stop_states: also return when the session enters one of these states (short names),
+            e.g. ("paused",) to stop waiting when a fault pauses the session (see last_fault).
+        """
+        stop = {names.to_enum(s, names.STATES, "session state") for s in stop_states}
+        stop |= names.TERMINAL_STATES
+        until = None if timeout is None else time.monotonic() + timeout
+        answered = set()
+        while True:
+            left = None if until is None else until - time.monotonic()
+            if left is not None and left <= 0:
+                raise BrdfError(grpc.StatusCode.DEADLINE_EXCEEDED,
+                                f"session {session_id} did not finish within {timeout:g} s",
+                                "wait")
+            span = poll_s if left is None else min(poll_s, left)
+            try:
+                for event in self.watch(session_id, timeout=span):
+                    if on_event:
+                        on_event(event)
+                    state = (event.data.to if event.kind == "state_changed" else
+                             event.data.state if event.kind == "snapshot" else None)
+                    if state in stop:
+                        break
+                    prompt = None
+                    if event.kind == "prompt":
+                        prompt = event.data
+                    elif event.kind == "snapshot" and event.data.HasField("pending_prompt"):
+                        prompt = event.data.pending_prompt
+                    # A prompt raised again (after a pause and resume) has a new raised_at.
+                    key = None if prompt is None else (prompt.step_index,
+                                                       prompt.raised_at.SerializeToString())
+                    if prompt is not None and on_prompt and key not in answered:
+                        answered.add(key)
+                        if on_prompt(prompt) is not False:
+                            self._answer_if_pending(session_id, prompt.step_index)
+            except BrdfError as e:
+                if e.code != grpc.StatusCode.DEADLINE_EXCEEDED:
+                    raise
+            session = self.get_session(session_id)
+            if session.state in stop:
+                return session
+
+    def _answer_if_pending(self, session_id, step_index):
+        try:
+            self.answer_prompt(session_id, step_index, note="answered by brdf_client")
+        except BrdfError as e:
+            # Paused (or aborted) meanwhile: the prompt comes again on resume, and is answered then.
+            if e.code != grpc.StatusCode.FAILED_PRECONDITION:
+                raise
+
+    # --- Data ----------------------------------------------------------------------------------
+
+    def readings(self, session_id, kinds=None, after_id=0, follow=False, batch_size=None,
+                 timeout=None):
+        """Yields the session's readings in id order, as ReadingSet chunks (NumPy arrays).
+
+        kinds: "sample", "reference", "dark" or a list of them; None: all.
+        after_id: only readings with a larger id (to resume).
+        follow: keep going as new readings are taken, until the session ends.
+        batch_size: readings per chunk; None: 1 when following (each as it lands), else 500.
+        """
+        if batch_size is None:
+            batch_size = 1 if follow else 500
+        request = brdf_pb2.StreamReadingsRequest(session_id=session_id,
+                                                 kinds=kinds_to_enums(kinds), after_id=after_id,
+                                                 follow=follow)
+        chunk = []
+        for reading in self._stream(self._data.StreamReadings, request, "Data.StreamReadings",
+                                    timeout):
+            chunk.append(reading)
+            if len(chunk) >= batch_size:
+                yield ReadingSet.from_protos(chunk)
+                chunk = []
+        if chunk:
+            yield ReadingSet.from_protos(chunk)
+
+    def load_readings(self, session_id, kinds=None, timeout=None):
+        """Every stored reading of the session (of `kinds`) as one ReadingSet."""
+        return ReadingSet.concat(self.readings(session_id, kinds=kinds, timeout=timeout))
+
+    # --- Interpolation -------------------------------------------------------------------------
+
+    def interpolate(self, session_id, theta_i, theta_o, phi=None, *, phi_i=None, phi_o=None,
+                    method="octant", quantity="brdf", axis_scale=None, mirror_phi=False,
+                    reciprocity=False):
+        """The spectrum at one direction, from the session's SAMPLE readings.
+
+        Direction, degrees: (theta_i, theta_o, phi) for isotropic sessions (φ = |φo − φi| in
+        [0, 180], 180 = specular side), or theta_i, theta_o with phi_i and phi_o (four angles).
+        method: "octant" (the paper's), "delaunay" or "nearest".
+        quantity: "brdf" (sr⁻¹), "reflectance" (ratio) or "radiance" (W·m⁻²·sr⁻¹·nm⁻¹).
+        axis_scale, mirror_phi, reciprocity: brdf.proto's InterpolationOptions.
+
+        Returns an InterpolationResult. A direction the method cannot fill is not an error: check
+        result.ok / result.status ("empty_octant", "outside_hull", ...).
+        """
+        if (phi_i is None) != (phi_o is None):
+            raise ValueError("give phi_i and phi_o together (four angles), or phi alone")
+        if phi_i is not None:
+            if phi is not None:
+                raise ValueError("give either phi (isotropic) or phi_i and phi_o, not both")
+            direction = (theta_i, phi_i, theta_o, phi_o)
+        else:
+            if phi is None:
+                raise ValueError("phi is missing: give (theta_i, theta_o, phi), degrees")
+            direction = (theta_i, theta_o, phi)
+        request = brdf_pb2.InterpolateRequest(
+            session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
+            quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"),
+            direction=direction_query(direction),
+            options=interpolation_options(axis_scale, mirror_phi, reciprocity))
+        response = self._unary(self._interp.Interpolate, request, "Interpolation.Interpolate")
+        return InterpolationResult.from_proto(response.result)
+
+    def interpolate_batch(self, session_id, directions, method="octant", quantity="brdf",
+                          axis_scale=None, mirror_phi=False, reciprocity=False, chunk_size=0,
+                          timeout=None):
+        """Spectra at many directions: `directions` is (N, 3) (θi, θo, φ) or (N, 4)
+        (θi, φi, θo, φo), degrees. Returns an InterpolationBatch in the order asked (spectra
+        (N, m) with NaN rows where the method could not fill the direction)."""
+        queries = [direction_query(d) for d in directions]
+        request = brdf_pb2.InterpolateBatchRequest(
+            session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
+            quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"), directions=queries,
+            options=interpolation_options(axis_scale, mirror_phi, reciprocity),
+            chunk_size=chunk_size)
+        results = [None] * len(queries)
+        for chunk in self._stream(self._interp.InterpolateBatch, request,
+                                  "Interpolation.InterpolateBatch", timeout):
+            for k, r in enumerate(chunk.results):
+                results[chunk.first_index + k] = InterpolationResult.from_proto(r)
+        missing = [i for i, r in enumerate(results) if r is None]
+        if missing:
+            raise BrdfError(grpc.StatusCode.INTERNAL,
+                            f"the daemon answered {len(queries) - len(missing)} of {len(queries)} "
+                            f"directions (first missing: index {missing[0]})",
+                            "Interpolation.InterpolateBatch")
+        return InterpolationBatch(results)

@@ -1,0 +1,177 @@
+"""Interpolation answers with their provenance, as NumPy (InterpolationResult, InterpolationBatch).
+
+brdfd builds a spectrum at an unmeasured direction by blending measured readings: the paper's
+octant method and Delaunay blend the 4 readings of an enclosing tetrahedron with barycentric
+weights, nearest takes one. Each answer names those readings (vertices: reading id, position,
+weight), so a figure can draw the tetrahedron and the spectra that went into the blend.
+"""
+
+import dataclasses
+
+import numpy as np
+
+from . import names
+from ._stubs import brdf_pb2
+from .readings import grid_wavelengths
+
+ISO_AXES = ("theta_i", "theta_o", "phi")
+FOUR_AXES = ("theta_i", "phi_i", "theta_o", "phi_o")
+
+
+@dataclasses.dataclass
+class Vertex:
+    """One reading blended into an answer.
+
+    reading_id: the reading (a mirrored or reciprocal copy keeps the id of the reading it copies).
+    coords:     where it sits, degrees, in the query's axis order ((θi, θo, φ) for isotropic).
+    weight:     its barycentric weight (the weights of an OK answer sum to 1).
+    """
+
+    reading_id: int
+    coords: np.ndarray
+    weight: float
+
+
+@dataclasses.dataclass
+class InterpolationResult:
+    """The answer for one direction.
+
+    Attributes:
+      query:       the direction asked for, degrees, in the order of `axes`.
+      axes:        ("theta_i", "theta_o", "phi") or ("theta_i", "phi_i", "theta_o", "phi_o").
+      status:      "ok", or why there is no spectrum: "empty_octant", "no_enclosing_simplex",
+                   "outside_hull".
+      method:      the method used: "octant", "delaunay" or "nearest".
+      quantity:    "brdf" (sr⁻¹), "reflectance" (ratio) or "radiance" (W·m⁻²·sr⁻¹·nm⁻¹).
+      wavelengths: (m,) nm.
+      spectrum:    (m,) in the quantity's unit; empty unless ok.
+      vertices:    the blended readings (octant and Delaunay: 4 for isotropic; nearest: 1).
+      detail:      the daemon's note (which octant was empty, which tetrahedron enclosed).
+    """
+
+    query: np.ndarray
+    axes: tuple
+    status: str
+    method: str
+    quantity: str
+    wavelengths: np.ndarray
+    spectrum: np.ndarray
+    vertices: list
+    detail: str
+
+    @property
+    def ok(self):
+        """True when a spectrum was built."""
+        return self.status == "ok"
+
+    @property
+    def unit(self):
+        """The unit of `spectrum`, for labels ("sr⁻¹" for a BRDF)."""
+        return names.QUANTITY_UNITS.get(self.quantity, "")
+
+    @property
+    def vertex_ids(self):
+        """(k,) reading ids of the vertices."""
+        return np.array([v.reading_id for v in self.vertices], dtype=np.int64)
+
+    @property
+    def vertex_coords(self):
+        """(k, d) positions of the vertices, degrees, in the order of `axes`."""
+        if not self.vertices:
+            return np.zeros((0, len(self.axes)))
+        return np.array([v.coords for v in self.vertices], dtype=float)
+
+    @property
+    def weights(self):
+        """(k,) barycentric weights of the vertices."""
+        return np.array([v.weight for v in self.vertices], dtype=float)
+
+    def at(self, wavelength_nm):
+        """The spectrum at `wavelength_nm` (linear between bands; NaN when not ok)."""
+        if not self.ok:
+            return float("nan")
+        lo, hi = self.wavelengths[0], self.wavelengths[-1]
+        if not lo <= wavelength_nm <= hi:
+            raise ValueError(f"{wavelength_nm} nm is outside the spectrum's {lo:g}–{hi:g} nm")
+        return float(np.interp(wavelength_nm, self.wavelengths, self.spectrum))
+
+    @classmethod
+    def from_proto(cls, result):
+        """Converts a brdf.v1.InterpolationResult."""
+        which = result.query.WhichOneof("direction")
+        if which == "four":
+            d = result.query.four
+            query, axes = (d.theta_i, d.phi_i, d.theta_o, d.phi_o), FOUR_AXES
+        else:
+            d = result.query.iso
+            query, axes = (d.theta_i, d.theta_o, d.phi), ISO_AXES
+        return cls(
+            query=np.array(query, dtype=float), axes=axes,
+            status=names.status_name(result.status), method=names.method_name(result.method),
+            quantity=names.quantity_name(result.quantity),
+            wavelengths=grid_wavelengths(result.grid),
+            spectrum=np.array(result.spectrum, dtype=float),
+            vertices=[Vertex(v.reading_id, np.array(v.coords, dtype=float), v.weight)
+                      for v in result.vertices],
+            detail=result.detail)
+
+
+class InterpolationBatch:
+    """The answers for many directions, in the order asked.
+
+    Attributes:
+      results:     list of InterpolationResult.
+      wavelengths: (m,) nm (of the first OK answer; empty when none is OK).
+      spectra:     (N, m), NaN rows where no spectrum could be built.
+      ok:          (N,) bool.
+      statuses:    (N,) str.
+    """
+
+    def __init__(self, results):
+        self.results = list(results)
+        good = [r for r in self.results if r.ok]
+        self.wavelengths = good[0].wavelengths if good else np.zeros(0)
+        m = len(self.wavelengths)
+        self.spectra = np.full((len(self.results), m), np.nan)
+        for i, r in enumerate(self.results):
+            if r.ok and len(r.spectrum) == m:
+                self.spectra[i] = r.spectrum
+        self.ok = np.array([r.ok for r in self.results], dtype=bool)
+        self.statuses = np.array([r.status for r in self.results], dtype=object)
+
+    def __len__(self):
+        return len(self.results)
+
+    def __iter__(self):
+        return iter(self.results)
+
+    def __getitem__(self, i):
+        return self.results[i]
+
+    def at(self, wavelength_nm):
+        """(N,) the spectra at `wavelength_nm` (NaN where not OK)."""
+        if len(self.wavelengths) == 0:
+            return np.full(len(self.results), np.nan)
+        return np.array([np.interp(wavelength_nm, self.wavelengths, s) if np.isfinite(s).all()
+                         else np.nan for s in self.spectra])
+
+
+def direction_query(direction):
+    """A brdf.v1.DirectionQuery from (θi, θo, φ) or (θi, φi, θo, φo), degrees."""
+    d = [float(x) for x in direction]
+    if len(d) == 3:
+        return brdf_pb2.DirectionQuery(
+            iso=brdf_pb2.IsoDirection(theta_i=d[0], theta_o=d[1], phi=d[2]))
+    if len(d) == 4:
+        return brdf_pb2.DirectionQuery(
+            four=brdf_pb2.Directions(theta_i=d[0], phi_i=d[1], theta_o=d[2], phi_o=d[3]))
+    raise ValueError(f"a direction is (θi, θo, φ) or (θi, φi, θo, φo) in degrees, "
+                     f"not {len(d)} numbers")
+
+
+def interpolation_options(axis_scale=None, mirror_phi=False, reciprocity=False):
+    """A brdf.v1.InterpolationOptions, or None when every option is at its default."""
+    if not axis_scale and not mirror_phi and not reciprocity:
+        return None
+    return brdf_pb2.InterpolationOptions(axis_scale=list(axis_scale or []),
+                                         mirror_phi=mirror_phi, reciprocity=reciprocity)

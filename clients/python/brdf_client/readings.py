@@ -1,0 +1,156 @@
+"""A session's readings as NumPy arrays (ReadingSet).
+
+brdfd stores every reading raw (spectral radiance as the meter reported it, with its pose and
+provenance); a ReadingSet holds n of them column-wise, so analysis code can slice by kind, pose
+or direction without loops. Units: degrees for angles, nm for wavelengths, W·m⁻²·sr⁻¹·nm⁻¹ for
+radiance (brdf.proto).
+"""
+
+import dataclasses
+
+import numpy as np
+
+from . import names
+
+
+def grid_wavelengths(grid):
+    """The wavelengths (nm) of a brdf.v1.WavelengthGrid: start_nm + k · step_nm, k < count."""
+    return grid.start_nm + grid.step_nm * np.arange(grid.count, dtype=float)
+
+
+@dataclasses.dataclass
+class ReadingSet:
+    """n readings of one session, column-wise. Row i of every array is reading i.
+
+    Attributes:
+      ids:            (n,) int64 reading ids, increasing in the order they were taken.
+      kinds:          (n,) str, "sample", "reference" or "dark".
+      step_index:     (n,) int, the plan step that took each reading.
+      poses:          (n, 4) holder and detector pose (α, β, γ, δ), degrees (stage readings).
+      directions:     (n, 4) (θi, φi, θo, φo), degrees, in the sample's frame.
+      iso:            (n, 3) (θi, θo, φ), degrees: the isotropic reduction (φ = 180 specular side).
+      wavelengths:    (m,) nm, shared by every reading.
+      spectra:        (n, m) spectral radiance, W·m⁻²·sr⁻¹·nm⁻¹, as measured (darks not subtracted).
+      quality:        (n,) the meter's quality code (PR-650: 0 OK, 18 low light, ...).
+      flagged:        (n,) bool, kept but suspect (see flag_reasons).
+      flag_reasons:   (n,) str.
+      reference_ids:  (n,) the REFERENCE reading a SAMPLE reading is divided by; 0 otherwise.
+      dark_ids:       (n,) the DARK reading subtracted from a SAMPLE/REFERENCE reading; 0: none.
+      integration_ms: (n,) integration time actually used, ms.
+      labels:         (n,) str, the plan step's label.
+    """
+
+    ids: np.ndarray
+    kinds: np.ndarray
+    step_index: np.ndarray
+    poses: np.ndarray
+    directions: np.ndarray
+    iso: np.ndarray
+    wavelengths: np.ndarray
+    spectra: np.ndarray
+    quality: np.ndarray
+    flagged: np.ndarray
+    flag_reasons: np.ndarray
+    reference_ids: np.ndarray
+    dark_ids: np.ndarray
+    integration_ms: np.ndarray
+    labels: np.ndarray
+
+    def __len__(self):
+        return len(self.ids)
+
+    @classmethod
+    def empty(cls, wavelengths=None):
+        """A set of no readings (on `wavelengths`, default none)."""
+        m = 0 if wavelengths is None else len(wavelengths)
+        return cls(
+            ids=np.zeros(0, dtype=np.int64), kinds=np.zeros(0, dtype=object),
+            step_index=np.zeros(0, dtype=int), poses=np.zeros((0, 4)), directions=np.zeros((0, 4)),
+            iso=np.zeros((0, 3)),
+            wavelengths=np.zeros(0) if wavelengths is None else np.asarray(wavelengths, float),
+            spectra=np.zeros((0, m)), quality=np.zeros(0, dtype=int),
+            flagged=np.zeros(0, dtype=bool), flag_reasons=np.zeros(0, dtype=object),
+            reference_ids=np.zeros(0, dtype=np.int64), dark_ids=np.zeros(0, dtype=np.int64),
+            integration_ms=np.zeros(0, dtype=int), labels=np.zeros(0, dtype=object))
+
+    @classmethod
+    def from_protos(cls, readings):
+        """Builds a set from brdf.v1.Reading messages (all on the same wavelength grid)."""
+        readings = list(readings)
+        if not readings:
+            return cls.empty()
+        grid = readings[0].grid
+        for r in readings:
+            if (r.grid.start_nm, r.grid.step_nm, r.grid.count) != (grid.start_nm, grid.step_nm,
+                                                                    grid.count):
+                raise ValueError(
+                    f"reading {r.id} is on a different wavelength grid ({r.grid.start_nm} nm + "
+                    f"{r.grid.step_nm} nm × {r.grid.count}) than reading {readings[0].id} "
+                    f"({grid.start_nm} nm + {grid.step_nm} nm × {grid.count}); load them apart")
+            if len(r.radiance) != grid.count:
+                raise ValueError(f"reading {r.id} has {len(r.radiance)} radiance values for a "
+                                 f"grid of {grid.count} bands")
+        return cls(
+            ids=np.array([r.id for r in readings], dtype=np.int64),
+            kinds=np.array([names.reading_kind_name(r.kind) for r in readings], dtype=object),
+            step_index=np.array([r.step_index for r in readings], dtype=int),
+            poses=np.array([(r.pose.alpha, r.pose.beta, r.pose.gamma, r.pose.delta)
+                            for r in readings], dtype=float),
+            directions=np.array([(r.directions.theta_i, r.directions.phi_i, r.directions.theta_o,
+                                  r.directions.phi_o) for r in readings], dtype=float),
+            iso=np.array([(r.iso.theta_i, r.iso.theta_o, r.iso.phi) for r in readings],
+                         dtype=float),
+            wavelengths=grid_wavelengths(grid),
+            spectra=np.array([list(r.radiance) for r in readings], dtype=float),
+            quality=np.array([r.quality_code for r in readings], dtype=int),
+            flagged=np.array([r.flagged for r in readings], dtype=bool),
+            flag_reasons=np.array([r.flag_reason for r in readings], dtype=object),
+            reference_ids=np.array([r.reference_id for r in readings], dtype=np.int64),
+            dark_ids=np.array([r.dark_id for r in readings], dtype=np.int64),
+            integration_ms=np.array([r.integration_ms for r in readings], dtype=int),
+            labels=np.array([r.label for r in readings], dtype=object))
+
+    @classmethod
+    def concat(cls, sets):
+        """One set holding the readings of `sets`, in order."""
+        sets = [s for s in sets if len(s)]
+        if not sets:
+            return cls.empty()
+        for s in sets[1:]:
+            if not np.array_equal(s.wavelengths, sets[0].wavelengths):
+                raise ValueError("cannot join readings on different wavelength grids")
+        fields = {}
+        for f in dataclasses.fields(cls):
+            if f.name == "wavelengths":
+                fields[f.name] = sets[0].wavelengths
+            else:
+                fields[f.name] = np.concatenate([getattr(s, f.name) for s in sets])
+        return cls(**fields)
+
+    def select(self, mask):
+        """The readings where `mask` (a bool array or index array) holds."""
+        fields = {f.name: (getattr(self, f.name) if f.name == "wavelengths" else
+                           getattr(self, f.name)[mask]) for f in dataclasses.fields(self)}
+        return ReadingSet(**fields)
+
+    def of_kind(self, kind):
+        """Only the readings of `kind` ("sample", "reference" or "dark")."""
+        return self.select(self.kinds == kind)
+
+    def index_of(self, reading_id):
+        """Row of the reading with this id; KeyError when it is not in the set."""
+        rows = np.flatnonzero(self.ids == reading_id)
+        if rows.size == 0:
+            raise KeyError(f"reading {reading_id} is not in this set of {len(self)} readings")
+        return int(rows[0])
+
+
+# Reading kinds accepted by BrdfClient.readings(kinds=...).
+def kinds_to_enums(kinds):
+    """("sample", ...) or enum numbers → the ReadingKind numbers StreamReadings filters on."""
+    if kinds is None:
+        return []
+    if isinstance(kinds, (str, int)):
+        kinds = [kinds]
+    return [names.to_enum(k, names.READING_KINDS, "reading kind") for k in kinds]
+

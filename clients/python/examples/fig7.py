@@ -1,0 +1,17 @@
+#!/usr/bin/env python3
+"""Figure 7: sample points in (α, β, δ) and (θi, θo, φ), a query and its tetrahedron → OUT/fig7.png
+
+    clients/python/examples/fig7.py --address 127.0.0.1:50051 --token TOKEN --session ID --out DIR
+
+(--help lists the options.) The drawing lives in brdf_client/figures/fig7.py.
+"""
+
+import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+
+from brdf_client.figures import fig7  # noqa: E402  pylint: disable=wrong-import-position
+
+if __name__ == "__main__":
+    sys.exit(fig7.main())
