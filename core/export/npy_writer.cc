@@ -1,0 +1,86 @@
+#include "core/export/npy_writer.h"
+
+#include <bit>
+#include <cstdint>
+#include <cstring>
+
+namespace brdf::exports {
+
+std::string NpyHeader(std::span<const std::size_t> shape) {
+  std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (";
+  for (std::size_t i = 0; i < shape.size(); ++i) {
+    if (i > 0) dict += ", ";
+    dict += std::to_string(shape[i]);
+  }
+  if (shape.size() == 1) dict += ",";  // a one-element tuple needs its comma
+  dict += "), }";
+  // 6 magic + 2 version + 2 length bytes precede the header; the header ends with '\n'.
+  const std::size_t preamble = 10;
+  std::size_t total = preamble + dict.size() + 1;
+  total = (total + kNpyAlignment - 1) / kNpyAlignment * kNpyAlignment;
+  const std::size_t header_len = total - preamble;
+  dict.append(header_len - dict.size() - 1, ' ');
+  dict += '\n';
+
+  std::string out = "\x93NUMPY";
+  out += static_cast<char>(1);
+  out += static_cast<char>(0);
+  out += static_cast<char>(header_len & 0xff);
+  out += static_cast<char>((header_len >> 8) & 0xff);
+  out += dict;
+  return out;
+}
+
+void AppendLittleEndian(std::span<const double> values, std::string& out) {
+  const std::size_t at = out.size();
+  out.resize(at + values.size() * sizeof(double));
+  char* dst = out.data() + at;
+  if constexpr (std::endian::native == std::endian::little) {
+    std::memcpy(dst, values.data(), values.size() * sizeof(double));
+  } else {
+    for (double v : values) {
+      const auto bits = std::bit_cast<std::uint64_t>(v);
+      for (int b = 0; b < 8; ++b) *dst++ = static_cast<char>((bits >> (8 * b)) & 0xff);
+    }
+  }
+}
+
+Status NpyGridWriter::Begin(const RegularGrid& grid, const WavelengthGrid& bands) {
+  grid_ = grid;
+  next_slice_ = 0;
+  const std::size_t shape[4] = {grid.theta_i.count, grid.theta_o.count, grid.phi.count,
+                                bands.count};
+  const std::string header = NpyHeader(shape);
+  out_.write(header.data(), static_cast<std::streamsize>(header.size()));
+  if (!out_) return IoError("writing the .npy header failed: is the disk full or read-only?");
+  return Status::Ok();
+}
+
+Status NpyGridWriter::WriteSlice(std::size_t theta_i_index, std::span<const double> values,
+                                 std::span<const interp::InterpStatus> /*statuses*/) {
+  if (theta_i_index != next_slice_) {
+    return Internal("NpyGridWriter: slice " + std::to_string(theta_i_index) +
+                    " arrived, expected " + std::to_string(next_slice_));
+  }
+  ++next_slice_;
+  buffer_.clear();
+  AppendLittleEndian(values, buffer_);
+  out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+  if (!out_) {
+    return IoError("writing the .npy data failed at θi slice " + std::to_string(theta_i_index) +
+                   ": is the disk full?");
+  }
+  return Status::Ok();
+}
+
+Status NpyGridWriter::Finish(const GridReport& /*report*/) {
+  if (next_slice_ != grid_.theta_i.count) {
+    return Internal("NpyGridWriter: finished after " + std::to_string(next_slice_) + " of " +
+                    std::to_string(grid_.theta_i.count) + " slices");
+  }
+  out_.flush();
+  if (!out_) return IoError("flushing the .npy file failed: is the disk full?");
+  return Status::Ok();
+}
+
+}  // namespace brdf::exports

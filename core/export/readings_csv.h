@@ -1,0 +1,31 @@
+// The readings of a session as CSV, one row per reading, with a '#' comment block that documents
+// the quantity, units and angle convention so that the file explains itself:
+//   id,kind,alpha_deg,beta_deg,gamma_deg,delta_deg,theta_i_deg,phi_i_deg,theta_o_deg,phi_o_deg,
+//   quality_code,flagged,integration_ms,reference_id,dark_id,<λ1>,<λ2>,…
+// Spectral columns are headed by wavelength in nm.
+//   radiance:            every reading (sample, reference, dark), raw as the meter reported it
+//                        (no dark subtracted: dark_id names the dark reading to subtract);
+//   reflectance, brdf:   the sample readings whose quantity can be computed (session_data.h);
+//                        the others are listed in the header with the reason.
+#pragma once
+
+#include <ostream>
+#include <vector>
+
+#include "core/export/session_data.h"
+#include "core/status.h"
+
+namespace brdf::exports {
+
+struct ReadingsCsvReport {
+  std::size_t rows = 0;
+  std::vector<SkippedReading> skipped;  // sample readings left out (reflectance, brdf)
+};
+
+// Errors: kFailedPrecondition for a session without readings (or, for reflectance/brdf, without
+// a usable sample reading); kInvalidArgument when the readings to write are not all on one
+// wavelength grid (radiance; the message names the reading); kIoError when the stream fails.
+Result<ReadingsCsvReport> WriteReadingsCsv(const Session& session, Quantity quantity,
+                                           std::ostream& out, const DeriveOptions& options = {});
+
+}  // namespace brdf::exports

@@ -1,0 +1,92 @@
+#include "core/fit/fit_report.h"
+
+#include <charconv>
+#include <cmath>
+
+namespace brdf::fit {
+namespace {
+
+std::string Num(double v) {
+  if (std::isnan(v)) return "nan";
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+// Three significant digits, for the comment block and the terminal.
+std::string Short(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 4);
+  return std::string(buf, r.ptr);
+}
+
+std::string ResidualText(const Residuals& r) {
+  return "RMS " + Short(r.rms) + " sr⁻¹, relative RMS " + Short(r.relative_rms) + " (" +
+         Short(100 * r.relative_rms) + " %), max |r| " + Short(r.max_abs) + " sr⁻¹";
+}
+
+std::string CookTorranceShared(const CookTorranceFit& ct) {
+  if (ct.band.empty() || ct.sharing != ParameterSharing::kSharedAcrossBands) return "";
+  return ": α = " + Short(ct.band.front().alpha) + ", F0 = " + Short(ct.band.front().f0);
+}
+
+}  // namespace
+
+std::string FitSummary(const LambertFit* lambert, const CookTorranceFit* ct) {
+  std::string s;
+  if (lambert != nullptr) s += "Lambert: " + ResidualText(lambert->overall) + "\n";
+  if (ct != nullptr) {
+    s += "Cook-Torrance GGX (α, F0 " + std::string(ParameterSharingName(ct->sharing)) + ")" +
+         CookTorranceShared(*ct) + ": " + ResidualText(ct->overall) +
+         (ct->converged ? "" : " (search stopped at its evaluation cap)") + "\n";
+  }
+  return s;
+}
+
+std::string FitReportCsv(const FitReportInfo& info, const LambertFit* lambert,
+                         const CookTorranceFit* ct) {
+  std::string h;
+  h += "# brdfd model evaluation: session " + std::to_string(info.session_id);
+  if (!info.session_name.empty()) h += " \"" + info.session_name + "\"";
+  h += "\n# data: BRDF f(λ) in sr⁻¹ of " + std::to_string(info.observations) +
+       " sample readings (" + std::to_string(info.left_out) +
+       " left out), fitted band by band by least squares on f, every value weighted alike\n";
+  h += "# residuals: rms = √(Σ r² / n) in sr⁻¹; rel_rms = √(Σ r² / Σ f²) (0 = perfect, 1 = no "
+       "better than f = 0)\n";
+  if (lambert != nullptr) {
+    h += "# lambert: f = ρ(λ) / π, ρ = π · mean f (closed form); overall " +
+         ResidualText(lambert->overall) + "\n";
+  }
+  if (ct != nullptr) {
+    h += "# cook_torrance: f = kd/π + ks · D · F · G1(ωi) G1(ωo) / (4 cos θi cos θo), GGX D with "
+         "roughness α, Schlick F with F0, Smith G1; kd, ks per band; α and F0 " +
+         std::string(ct->sharing == ParameterSharing::kPerBand ? "per band"
+                                                               : "shared by all bands") +
+         CookTorranceShared(*ct) + "; Nelder-Mead over (α, F0), (kd, ks) solved exactly; " +
+         std::to_string(ct->evaluations) + " evaluations" +
+         (ct->converged ? "" : ", stopped at the evaluation cap") + "\n";
+    h += "# cook_torrance overall " + ResidualText(ct->overall) + "\n";
+  }
+  if (lambert == nullptr && ct == nullptr) return h;
+  h += "wavelength_nm";
+  if (lambert != nullptr) h += ",lambert_albedo,lambert_rms,lambert_rel_rms";
+  if (ct != nullptr) h += ",ct_kd,ct_ks,ct_alpha,ct_f0,ct_rms,ct_rel_rms";
+  h += '\n';
+  const WavelengthGrid grid = lambert != nullptr ? lambert->grid : ct->grid;
+  for (std::size_t b = 0; b < grid.count; ++b) {
+    h += Num(grid.at(b));
+    if (lambert != nullptr) {
+      h += ',' + Num(lambert->albedo[b]) + ',' + Num(lambert->band_residuals[b].rms) + ',' +
+           Num(lambert->band_residuals[b].relative_rms);
+    }
+    if (ct != nullptr) {
+      const CookTorranceParams& p = ct->band[b];
+      h += ',' + Num(p.kd) + ',' + Num(p.ks) + ',' + Num(p.alpha) + ',' + Num(p.f0) + ',' +
+           Num(ct->band_residuals[b].rms) + ',' + Num(ct->band_residuals[b].relative_rms);
+    }
+    h += '\n';
+  }
+  return h;
+}
+
+}  // namespace brdf::fit

@@ -1,0 +1,306 @@
+// Regular grids: axes and step errors, the NPY header (parsed here independently of the writer,
+// from the format's published description), NaN counting, parallel == serial bit for bit,
+// progress and cancellation, the CSV form.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <regex>
+#include <sstream>
+
+#include "core/export/grid_text.h"
+#include "core/export/npy_writer.h"
+#include "core/export/regular_grid.h"
+#include "core/export/synthetic_session.h"
+#include "export_test_util.h"
+
+namespace brdf::exports {
+namespace {
+
+CallContext LongContext(CancelToken token = CancelToken()) {
+  return CallContext::WithTimeout(std::chrono::hours(1), std::move(token));
+}
+
+// An NPY v1.0 file's header, read as the format describes it.
+struct ParsedNpy {
+  bool ok = false;
+  std::string descr;
+  bool fortran = true;
+  std::vector<std::size_t> shape;
+  std::size_t data_offset = 0;
+};
+
+ParsedNpy ParseNpy(const std::string& bytes) {
+  ParsedNpy p;
+  if (bytes.size() < 10 || bytes.compare(0, 6, "\x93NUMPY") != 0) return p;
+  if (bytes[6] != 1 || bytes[7] != 0) return p;
+  const std::size_t len = static_cast<unsigned char>(bytes[8]) |
+                          (static_cast<std::size_t>(static_cast<unsigned char>(bytes[9])) << 8);
+  if (bytes.size() < 10 + len) return p;
+  const std::string header = bytes.substr(10, len);
+  if (header.back() != '\n') return p;
+  std::smatch m;
+  if (!std::regex_search(header, m, std::regex(R"('descr':\s*'([^']*)')"))) return p;
+  p.descr = m[1];
+  if (!std::regex_search(header, m, std::regex(R"('fortran_order':\s*(True|False))"))) return p;
+  p.fortran = m[1] == "True";
+  if (!std::regex_search(header, m, std::regex(R"('shape':\s*\(([^)]*)\))"))) return p;
+  const std::string dims = m[1];
+  const std::regex number(R"(\d+)");
+  for (std::sregex_iterator it(dims.begin(), dims.end(), number), end; it != end; ++it) {
+    p.shape.push_back(std::stoul(it->str()));
+  }
+  p.data_offset = 10 + len;
+  p.ok = true;
+  return p;
+}
+
+// A source that fails in known places: outside_hull for θi > 60°, empty_octant for φ < 30°, and
+// otherwise a spectrum that encodes the direction.
+interp::InterpStatus PatternSource(const IsoDirection& at, std::span<double> out) {
+  if (at.theta_i > 60) return interp::InterpStatus::kOutsideHull;
+  if (at.phi < 30) return interp::InterpStatus::kEmptyOctant;
+  for (std::size_t b = 0; b < out.size(); ++b) {
+    out[b] = at.theta_i + 100 * at.theta_o + 1e4 * at.phi + 1e6 * static_cast<double>(b);
+  }
+  return interp::InterpStatus::kOk;
+}
+
+TEST(RegularGrid, StepsGiveTheExpectedAxes) {
+  Result<RegularGrid> centres = MakeRegularGrid(1, 1, 1, GridPlacement::kCellCentres);
+  ASSERT_TRUE(centres.ok());
+  EXPECT_EQ(centres->theta_i.count, 90u);
+  EXPECT_EQ(centres->theta_o.count, 90u);
+  EXPECT_EQ(centres->phi.count, 180u);
+  EXPECT_DOUBLE_EQ(centres->theta_i.at(0), 0.5);
+  EXPECT_DOUBLE_EQ(centres->phi.at(179), 179.5);
+  Result<RegularGrid> nodes = MakeRegularGrid(2.5, 5, 10, GridPlacement::kNodes);
+  ASSERT_TRUE(nodes.ok());
+  EXPECT_EQ(nodes->theta_i.count, 37u);
+  EXPECT_EQ(nodes->theta_o.count, 19u);
+  EXPECT_EQ(nodes->phi.count, 19u);
+  EXPECT_DOUBLE_EQ(nodes->phi.at(18), 180.0);
+}
+
+TEST(RegularGrid, BadStepsAreRefusedNamingTheAxis) {
+  for (double bad : {0.0, -1.0, 7.0, 100.0, std::nan("")}) {
+    Result<RegularGrid> g = MakeRegularGrid(1, bad, 1, GridPlacement::kCellCentres);
+    ASSERT_FALSE(g.ok()) << bad;
+    EXPECT_EQ(g.status().code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(g.status().message().find("θo"), std::string::npos) << g.status().message();
+  }
+  EXPECT_FALSE(MakeRegularGrid(1, 1, 7, GridPlacement::kNodes).ok());  // 180/7 is not whole
+  RegularGrid outside{{0, 1, 91}, {0, 1, 2}, {0, 1, 2}};               // θi up to 90 is fine …
+  EXPECT_TRUE(ValidateRegularGrid(outside).ok());
+  outside.theta_i.count = 92;  // … 91 is not
+  EXPECT_EQ(ValidateRegularGrid(outside).code(), StatusCode::kInvalidArgument);
+}
+
+TEST(Npy, HeaderParsesAndAlignsTheData) {
+  for (const std::vector<std::size_t>& shape :
+       {std::vector<std::size_t>{90, 90, 180, 101}, {5}, {3, 4}, {1234567, 2, 3, 4}}) {
+    const std::string h = NpyHeader(shape);
+    const ParsedNpy p = ParseNpy(h);
+    ASSERT_TRUE(p.ok) << h;
+    EXPECT_EQ(p.descr, "<f8");
+    EXPECT_FALSE(p.fortran);
+    EXPECT_EQ(p.shape, shape);
+    EXPECT_EQ(p.data_offset, h.size());
+    EXPECT_EQ(h.size() % 64, 0u);
+  }
+  // A one-dimensional shape is a Python one-element tuple.
+  EXPECT_NE(NpyHeader(std::vector<std::size_t>{5}).find("(5,)"), std::string::npos);
+}
+
+TEST(Npy, GridFileHoldsTheValuesInCOrderAsLittleEndianDoubles) {
+  Result<RegularGrid> grid = MakeRegularGrid(10, 15, 30, GridPlacement::kCellCentres);
+  ASSERT_TRUE(grid.ok());
+  const WavelengthGrid bands{400, 100, 3};
+  std::ostringstream out;
+  NpyGridWriter npy(out);
+  MemoryGrid memory;
+  ASSERT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), npy).ok());
+  ASSERT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), memory).ok());
+  const std::string bytes = out.str();
+  const ParsedNpy p = ParseNpy(bytes);
+  ASSERT_TRUE(p.ok);
+  EXPECT_EQ(p.shape, (std::vector<std::size_t>{9, 6, 6, 3}));
+  ASSERT_EQ(bytes.size(), p.data_offset + 9 * 6 * 6 * 3 * 8);
+  for (std::size_t i = 0; i < memory.values().size(); ++i) {
+    std::uint64_t bits = 0;
+    for (int b = 0; b < 8; ++b) {
+      bits |=
+          static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[p.data_offset + 8 * i + b]))
+          << (8 * b);
+    }
+    double v;
+    std::memcpy(&v, &bits, 8);
+    const double want = memory.values()[i];
+    if (std::isnan(want)) {
+      EXPECT_TRUE(std::isnan(v));
+    } else {
+      EXPECT_EQ(v, want);
+    }
+  }
+  // Cell (θi index 2, θo index 3, φ index 4), band 1: θi 25, θo 52.5, φ 135.
+  EXPECT_EQ(memory.spectrum(2, 3, 4)[1], 25 + 100 * 52.5 + 1e4 * 135 + 1e6);
+}
+
+TEST(Grid, CellsTheSourceCannotFillAreNaNAndCounted) {
+  Result<RegularGrid> grid = MakeRegularGrid(5, 5, 5, GridPlacement::kCellCentres);
+  ASSERT_TRUE(grid.ok());
+  const WavelengthGrid bands{400, 50, 4};
+  MemoryGrid memory;
+  Result<GridReport> report =
+      ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), memory);
+  ASSERT_TRUE(report.ok());
+  // Expected counts, from the axes: θi > 60 → 6 of 18 values; φ < 30 → 6 of 36 values.
+  const std::size_t cells = 18 * 18 * 36;
+  const std::size_t outside = 6 * 18 * 36;
+  const std::size_t empty = 12 * 18 * 6;
+  EXPECT_EQ(report->cells, cells);
+  EXPECT_EQ(report->by_status.at(interp::InterpStatus::kOutsideHull), outside);
+  EXPECT_EQ(report->by_status.at(interp::InterpStatus::kEmptyOctant), empty);
+  EXPECT_EQ(report->nan_cells, outside + empty);
+  EXPECT_EQ(report->filled, cells - outside - empty);
+  std::size_t nan_cells = 0;
+  for (std::size_t c = 0; c < cells; ++c) {
+    const bool ok = memory.statuses()[c] == interp::InterpStatus::kOk;
+    for (std::size_t b = 0; b < bands.count; ++b) {
+      EXPECT_EQ(std::isnan(memory.values()[c * bands.count + b]), !ok);
+    }
+    nan_cells += !ok;
+  }
+  EXPECT_EQ(nan_cells, report->nan_cells);
+  EXPECT_NE(report->Summary().find(std::to_string(empty) + " empty_octant"), std::string::npos);
+}
+
+class InterpolatedGrid : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    SyntheticSessionOptions o;
+    o.grid = {380, 40, 11};
+    Result<Session> s = SyntheticSession(AnalyticBrdf::PaintLike(), o);
+    ASSERT_TRUE(s.ok());
+    Result<DerivedSamples> d = DeriveSamples(*s, Quantity::kBrdf);
+    ASSERT_TRUE(d.ok());
+    bands_ = d->grid;
+    Result<std::shared_ptr<const interp::SampleSet>> set = ToSampleSet(*d);
+    ASSERT_TRUE(set.ok());
+    auto interpolator = interp::MakeInterpolator(interp::Method::kOctant, *set);
+    ASSERT_TRUE(interpolator.ok());
+    interpolator_ = std::move(*interpolator);
+  }
+  WavelengthGrid bands_;
+  std::unique_ptr<interp::Interpolator> interpolator_;
+};
+
+TEST_F(InterpolatedGrid, ParallelIsBitIdenticalToSerialAndMatchesTheInterpolator) {
+  Result<RegularGrid> grid = MakeRegularGrid(3, 3, 6, GridPlacement::kNodes);
+  ASSERT_TRUE(grid.ok());
+  const SpectrumSource source = InterpolatorSource(*interpolator_);
+  MemoryGrid serial, parallel;
+  std::ostringstream npy1, npy4;
+  NpyGridWriter w1(npy1), w4(npy4);
+  RunControl one{1, {}}, four{4, {}};
+  ASSERT_TRUE(ResampleOnGrid(source, *grid, bands_, one, LongContext(), serial).ok());
+  ASSERT_TRUE(ResampleOnGrid(source, *grid, bands_, four, LongContext(), parallel).ok());
+  ASSERT_TRUE(ResampleOnGrid(source, *grid, bands_, one, LongContext(), w1).ok());
+  ASSERT_TRUE(ResampleOnGrid(source, *grid, bands_, four, LongContext(), w4).ok());
+  ASSERT_EQ(serial.values().size(), parallel.values().size());
+  EXPECT_EQ(std::memcmp(serial.values().data(), parallel.values().data(),
+                        serial.values().size() * sizeof(double)),
+            0);
+  EXPECT_EQ(serial.statuses(), parallel.statuses());
+  EXPECT_EQ(npy1.str(), npy4.str());
+  // Some cells fail (the octant method at the edges of the data), and they are the ones the
+  // interpolator itself refuses.
+  EXPECT_GT(serial.report().nan_cells, 0u);
+  EXPECT_GT(serial.report().filled, 0u);
+  for (std::size_t i = 0; i < grid->theta_i.count; i += 7) {
+    for (std::size_t j = 0; j < grid->theta_o.count; j += 5) {
+      for (std::size_t k = 0; k < grid->phi.count; k += 3) {
+        const double q[3] = {grid->theta_i.at(i), grid->theta_o.at(j), grid->phi.at(k)};
+        const interp::Interpolation direct = interpolator_->Evaluate(q);
+        const std::size_t c = serial.CellIndex(i, j, k);
+        ASSERT_EQ(serial.statuses()[c], direct.status);
+        if (direct.status == interp::InterpStatus::kOk) {
+          for (std::size_t b = 0; b < bands_.count; ++b) {
+            EXPECT_EQ(serial.spectrum(i, j, k)[b], direct.spectrum[b]);
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST_F(InterpolatedGrid, ProgressRisesToOneAndCancellationStopsTheRun) {
+  Result<RegularGrid> grid = MakeRegularGrid(2, 2, 4, GridPlacement::kCellCentres);
+  ASSERT_TRUE(grid.ok());
+  const SpectrumSource source = InterpolatorSource(*interpolator_);
+  std::vector<double> seen;
+  RunControl control{2, [&](double f) { seen.push_back(f); }};
+  MemoryGrid memory;
+  ASSERT_TRUE(ResampleOnGrid(source, *grid, bands_, control, LongContext(), memory).ok());
+  ASSERT_GT(seen.size(), 10u);
+  for (std::size_t i = 1; i < seen.size(); ++i) EXPECT_GE(seen[i], seen[i - 1]);
+  EXPECT_EQ(seen.back(), 1.0);
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1.0), 1);
+
+  // Cancelled a third of the way through, from the progress callback (as a gRPC handler would
+  // when its client goes away).
+  CancelToken token;
+  seen.clear();
+  RunControl cancelling{2, [&](double f) {
+                          seen.push_back(f);
+                          if (f > 0.33) token.Cancel("client went away");
+                        }};
+  MemoryGrid partial;
+  Result<GridReport> r =
+      ResampleOnGrid(source, *grid, bands_, cancelling, LongContext(token), partial);
+  EXPECT_EQ(r.status().code(), StatusCode::kCancelled);
+  EXPECT_NE(r.status().message().find("client went away"), std::string::npos);
+  EXPECT_LT(seen.back(), 0.5);
+  // A deadline in the past stops it too, as kTimeout.
+  const CallContext expired = CallContext::WithTimeout(std::chrono::nanoseconds(0));
+  EXPECT_EQ(ResampleOnGrid(source, *grid, bands_, {}, expired, partial).status().code(),
+            StatusCode::kTimeout);
+}
+
+TEST(GridCsv, RowsPerCellWithStatusAndDocumentedHeader) {
+  Result<RegularGrid> grid = MakeRegularGrid(15, 30, 45, GridPlacement::kCellCentres);
+  ASSERT_TRUE(grid.ok());
+  const WavelengthGrid bands{400, 100, 2};
+  std::ostringstream out;
+  CsvGridWriter csv(out, GridExportInfo{3, "paint", Quantity::kBrdf, "octant", 100, 2});
+  Result<GridReport> report = ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), csv);
+  ASSERT_TRUE(report.ok());
+  const auto rows = testing::CsvRows(out.str());
+  ASSERT_EQ(rows.size(), 1 + 6 * 3 * 4u);
+  EXPECT_EQ(rows[0],
+            (std::vector<std::string>{"theta_i", "theta_o", "phi", "status", "400", "500"}));
+  std::size_t nan_rows = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const bool ok = rows[i][3] == "ok";
+    EXPECT_EQ(rows[i][4] == "nan", !ok);
+    nan_rows += !ok;
+    if (!ok) {
+      const double ti = std::stod(rows[i][0]), phi = std::stod(rows[i][2]);
+      EXPECT_EQ(rows[i][3], ti > 60 ? "outside_hull" : "empty_octant") << ti << " " << phi;
+    }
+  }
+  EXPECT_EQ(nan_rows, report->nan_cells);
+  std::string comments;
+  for (const auto& l : testing::CommentLines(out.str())) comments += l + "\n";
+  EXPECT_NE(comments.find("sr⁻¹"), std::string::npos);
+  EXPECT_NE(comments.find("degrees"), std::string::npos);
+  EXPECT_NE(comments.find(report->Summary()), std::string::npos);
+
+  const std::string json =
+      GridDescriptionJson(*grid, bands, {3, "paint", Quantity::kBrdf, "octant", 100, 2}, *report);
+  EXPECT_NE(json.find("\"shape\": [6, 3, 4, 2]"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"nan_cells\": " + std::to_string(report->nan_cells)), std::string::npos);
+}
+
+}  // namespace
+}  // namespace brdf::exports

@@ -1,0 +1,332 @@
+#include "tools/brdf-export/export_commands.h"
+
+#include <unistd.h>
+
+#include <sstream>
+
+#include "core/analytic_brdf.h"
+#include "core/export/grid_text.h"
+#include "core/export/merl_export.h"
+#include "core/export/merl_reader.h"
+#include "core/export/npy_writer.h"
+#include "core/export/number_text.h"
+#include "core/export/readings_csv.h"
+#include "core/export/regular_grid.h"
+#include "core/export/synthetic_session.h"
+#include "core/fit/fit.h"
+#include "core/fit/fit_report.h"
+#include "tools/brdf-export/cie_tables.h"
+#include "tools/brdf-export/output_file.h"
+#include "tools/brdf-export/progress_line.h"
+#include "tools/brdf-export/session_source.h"
+
+namespace brdf::export_tool {
+namespace {
+
+int Fail(std::ostream& err, const char* command, const Status& st) {
+  err << "brdf-export " << command << ": " << st.ToString() << "\n";
+  switch (st.code()) {
+    case StatusCode::kInvalidArgument:
+    case StatusCode::kNotFound:
+    case StatusCode::kFailedPrecondition:
+      return kExitInvalid;
+    default:
+      return kExitFailure;
+  }
+}
+
+// An export runs without a deadline of its own; the CancelToken is there for API symmetry with
+// the daemon's handlers (Ctrl-C ends the process, and the .partial file is removed on exit paths).
+CallContext RunContext() {
+  return CallContext::WithTimeout(std::chrono::hours(24 * 365));
+}
+
+Result<exports::Session> LoadInput(const CommonOptions& c) {
+  if (c.demo) {
+    if (!c.db_path.empty()) return InvalidArgument("give either --demo or --db, not both");
+    return exports::SyntheticSession(AnalyticBrdf::PaintLike());
+  }
+  if (c.db_path.empty()) {
+    return InvalidArgument(
+        "no database: give --db PATH --session N (or --demo for a synthetic "
+        "session)");
+  }
+  if (c.session_id < 0) return InvalidArgument("no session: give --session N");
+  Result<std::unique_ptr<storage::SessionStore>> store = OpenExistingStore(c.db_path);
+  if (!store.ok()) return store.status();
+  return LoadSession(**store, c.session_id);
+}
+
+Result<std::vector<double>> ParseNumbers(const std::string& text, const char* what) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      std::size_t used = 0;
+      out.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      return InvalidArgument(std::string(what) + ": '" + item + "' in '" + text +
+                             "' is not a number");
+    }
+  }
+  return out;
+}
+
+struct Interpolation {
+  exports::DerivedSamples derived;
+  std::unique_ptr<interp::Interpolator> interpolator;
+};
+
+Result<Interpolation> BuildInterpolator(const exports::Session& session, exports::Quantity q,
+                                        const CommonOptions& c, const InterpChoice& choice,
+                                        std::ostream& err) {
+  Result<interp::Method> method = interp::ParseMethod(choice.method);
+  if (!method.ok()) return method.status();
+  interp::Options options;
+  options.mirror_phi = choice.mirror_phi;
+  options.reciprocity = choice.reciprocity;
+  if (!choice.scale.empty()) {
+    Result<std::vector<double>> scale = ParseNumbers(choice.scale, "--scale");
+    if (!scale.ok()) return scale.status();
+    options.axis_scale = *scale;
+  }
+  if (exports::HasSeveralDialPositions(session)) {
+    err << "brdf-export: warning: session " << session.id
+        << " was measured at several dial positions γ (anisotropic); this export uses the "
+           "isotropic reduction (θi, θo, φ) and folds them together\n";
+  }
+  Result<exports::DerivedSamples> derived = exports::DeriveSamples(session, q, {c.exclude_flagged});
+  if (!derived.ok()) return derived.status();
+  Result<std::shared_ptr<const interp::SampleSet>> set = exports::ToSampleSet(*derived);
+  if (!set.ok()) return set.status();
+  Result<std::unique_ptr<interp::Interpolator>> interpolator =
+      interp::MakeInterpolator(*method, *set, options);
+  if (!interpolator.ok()) return interpolator.status();
+  if (!derived->skipped.empty()) {
+    err << "brdf-export: " << derived->skipped.size()
+        << " sample readings left out; the first: " << derived->skipped.front().reason << "\n";
+  }
+  return Interpolation{std::move(*derived), std::move(*interpolator)};
+}
+
+exports::RunControl Control(const CommonOptions& c, ProgressLine* line) {
+  exports::RunControl control;
+  control.threads = c.threads;
+  if (line != nullptr) control.progress = [line](double f) { line->Update(f); };
+  return control;
+}
+
+bool StderrIsTerminal() {
+  return isatty(STDERR_FILENO) == 1;
+}
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+}  // namespace
+
+int RunCsv(const CommonOptions& c, const CsvOptions& o, std::ostream& err) {
+  Result<exports::Quantity> q = exports::ParseQuantity(o.quantity);
+  if (!q.ok()) return Fail(err, "csv", q.status());
+  Result<exports::Session> session = LoadInput(c);
+  if (!session.ok()) return Fail(err, "csv", session.status());
+  Result<std::unique_ptr<OutputFile>> file = OutputFile::Open(c.output);
+  if (!file.ok()) return Fail(err, "csv", file.status());
+  Result<exports::ReadingsCsvReport> report =
+      exports::WriteReadingsCsv(*session, *q, (*file)->stream(), {c.exclude_flagged});
+  if (!report.ok()) return Fail(err, "csv", report.status());
+  if (Status st = (*file)->Commit(); !st.ok()) return Fail(err, "csv", st);
+  err << "brdf-export csv: session " << session->id << ", " << report->rows << " rows ("
+      << exports::QuantityName(*q) << "), " << report->skipped.size()
+      << " sample readings left out → " << c.output << "\n";
+  return kExitOk;
+}
+
+int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
+  Result<exports::Quantity> q = exports::ParseQuantity(o.quantity);
+  if (!q.ok()) return Fail(err, "grid", q.status());
+  Result<std::vector<double>> steps = ParseNumbers(o.steps, "--steps");
+  if (!steps.ok()) return Fail(err, "grid", steps.status());
+  if (steps->size() == 1) steps->resize(3, steps->front());
+  if (steps->size() != 3) {
+    return Fail(err, "grid",
+                InvalidArgument("--steps '" + o.steps +
+                                "': give dθi,dθo,dφ in degrees (three values) or one for all"));
+  }
+  Result<exports::RegularGrid> grid = exports::MakeRegularGrid(
+      (*steps)[0], (*steps)[1], (*steps)[2],
+      o.nodes ? exports::GridPlacement::kNodes : exports::GridPlacement::kCellCentres);
+  if (!grid.ok()) return Fail(err, "grid", grid.status());
+  std::string format = o.format;
+  if (format.empty()) format = EndsWith(c.output, ".csv") ? "csv" : "npy";
+  if (format != "npy" && format != "csv") {
+    return Fail(err, "grid", InvalidArgument("--format '" + format + "': use npy or csv"));
+  }
+  if (format == "npy" && c.output == "-") {
+    return Fail(err, "grid", InvalidArgument("an .npy grid needs a file: give -o PATH.npy"));
+  }
+  Result<exports::Session> session = LoadInput(c);
+  if (!session.ok()) return Fail(err, "grid", session.status());
+  Result<Interpolation> in = BuildInterpolator(*session, *q, c, o.interp, err);
+  if (!in.ok()) return Fail(err, "grid", in.status());
+
+  const WavelengthGrid bands = in->derived.grid;
+  const double bytes = static_cast<double>(grid->cells()) * static_cast<double>(bands.count) * 8;
+  err << "brdf-export grid: " << grid->theta_i.count << " × " << grid->theta_o.count << " × "
+      << grid->phi.count << " cells × " << bands.count << " bands ("
+      << (format == "npy" ? "" : "at least ") << bytes / 1e6 << " MB) by " << o.interp.method
+      << " on " << exports::ResolveThreads(c.threads) << " threads\n";
+
+  Result<std::unique_ptr<OutputFile>> file = OutputFile::Open(c.output);
+  if (!file.ok()) return Fail(err, "grid", file.status());
+  const exports::GridExportInfo info{session->id,
+                                     session->name,
+                                     *q,
+                                     o.interp.method,
+                                     in->derived.samples.size(),
+                                     in->derived.skipped.size()};
+  exports::NpyGridWriter npy((*file)->stream());
+  exports::CsvGridWriter csv((*file)->stream(), info);
+  exports::GridSink& sink = format == "npy" ? static_cast<exports::GridSink&>(npy) : csv;
+  ProgressLine line(err, "brdf-export grid", StderrIsTerminal());
+  Result<exports::GridReport> report =
+      exports::ResampleOnGrid(exports::InterpolatorSource(*in->interpolator), *grid, bands,
+                              Control(c, c.quiet ? nullptr : &line), RunContext(), sink);
+  line.Finish();
+  if (!report.ok()) return Fail(err, "grid", report.status());
+  if (Status st = (*file)->Commit(); !st.ok()) return Fail(err, "grid", st);
+  if (format == "npy") {
+    Result<std::unique_ptr<OutputFile>> json = OutputFile::Open(c.output + ".json");
+    if (!json.ok()) return Fail(err, "grid", json.status());
+    (*json)->stream() << exports::GridDescriptionJson(*grid, bands, info, *report);
+    if (Status st = (*json)->Commit(); !st.ok()) return Fail(err, "grid", st);
+  }
+  err << "brdf-export grid: " << report->Summary() << " → " << c.output
+      << (format == "npy" ? " (axes, wavelengths, units: " + c.output + ".json)" : "") << "\n";
+  return kExitOk;
+}
+
+int RunMerl(const CommonOptions& c, const MerlOptions& o, std::ostream& out, std::ostream& err) {
+  std::vector<Directions> probes;
+  for (const std::string& p : o.probes) {
+    Result<std::vector<double>> v = ParseNumbers(p, "--probe");
+    if (!v.ok()) return Fail(err, "merl", v.status());
+    if (v->size() != 4) {
+      return Fail(err, "merl", InvalidArgument("--probe '" + p + "': give θi,φi,θo,φo in degrees"));
+    }
+    probes.push_back({(*v)[0], (*v)[1], (*v)[2], (*v)[3]});
+  }
+  if (c.output == "-") {
+    return Fail(err, "merl", InvalidArgument("a MERL .binary needs a file: give -o PATH.binary"));
+  }
+  Result<CieTables> cie = LoadCieTables(o.colord_dir);
+  if (!cie.ok()) return Fail(err, "merl", cie.status());
+  Result<exports::Session> session = LoadInput(c);
+  if (!session.ok()) return Fail(err, "merl", session.status());
+  Result<Interpolation> in =
+      BuildInterpolator(*session, exports::Quantity::kBrdf, c, o.interp, err);
+  if (!in.ok()) return Fail(err, "merl", in.status());
+  const WavelengthGrid bands = in->derived.grid;
+  Result<exports::SpectralRgbWeights> rgb =
+      exports::SpectralRgbWeights::Make(bands, cie->d65, cie->cmf);
+  if (!rgb.ok()) return Fail(err, "merl", rgb.status());
+
+  err << "brdf-export merl: 90 × 90 × 180 cells by " << o.interp.method << " on "
+      << exports::ResolveThreads(c.threads) << " threads, linear sRGB under D65\n";
+  ProgressLine line(err, "brdf-export merl", StderrIsTerminal());
+  const exports::SpectrumSource source = exports::InterpolatorSource(*in->interpolator);
+  Result<exports::MerlExport> table = exports::BuildMerlTable(
+      source, bands, *rgb, Control(c, c.quiet ? nullptr : &line), RunContext());
+  line.Finish();
+  if (!table.ok()) return Fail(err, "merl", table.status());
+  Result<std::unique_ptr<OutputFile>> file = OutputFile::Open(c.output);
+  if (!file.ok()) return Fail(err, "merl", file.status());
+  if (Status st = exports::WriteMerl(table->table, (*file)->stream()); !st.ok()) {
+    return Fail(err, "merl", st);
+  }
+  if (Status st = (*file)->Commit(); !st.ok()) return Fail(err, "merl", st);
+  err << "brdf-export merl: " << table->report.Summary() << " → " << c.output << "\n";
+
+  if (!probes.empty()) {
+    // What the interpolator gives at each probe (its spectrum's RGB) next to what a MERL reader
+    // finds in the file there: tools/check/merl_read.py compares the file side independently.
+    out << "theta_i,phi_i,theta_o,phi_o,status,interp_r,interp_g,interp_b,merl_r,merl_g,merl_b\n";
+    std::vector<double> spectrum(bands.count);
+    for (const Directions& d : probes) {
+      const interp::InterpStatus st = source(ToIsotropic(d), spectrum);
+      const Rgb merl = exports::LookupMerl(table->table, d);
+      using exports::FormatNumber;
+      out << FormatNumber(d.theta_i) << ',' << FormatNumber(d.phi_i) << ','
+          << FormatNumber(d.theta_o) << ',' << FormatNumber(d.phi_o) << ','
+          << interp::InterpStatusName(st);
+      if (st == interp::InterpStatus::kOk) {
+        const Rgb v = rgb->Apply(spectrum);
+        out << ',' << FormatNumber(v.r) << ',' << FormatNumber(v.g) << ',' << FormatNumber(v.b);
+      } else {
+        out << ",,,";
+      }
+      out << ',' << FormatNumber(merl.r) << ',' << FormatNumber(merl.g) << ','
+          << FormatNumber(merl.b) << "\n";
+    }
+  }
+  return kExitOk;
+}
+
+int RunFit(const CommonOptions& c, const FitCommandOptions& o, std::ostream& err) {
+  const bool lambert = o.model == "lambert" || o.model == "both";
+  const bool ct = o.model == "cook-torrance" || o.model == "both";
+  if (!lambert && !ct) {
+    return Fail(err, "fit",
+                InvalidArgument("--model '" + o.model + "': use lambert, cook-torrance or both"));
+  }
+  Result<exports::Session> session = LoadInput(c);
+  if (!session.ok()) return Fail(err, "fit", session.status());
+  if (exports::HasSeveralDialPositions(*session)) {
+    err << "brdf-export: warning: session " << session->id
+        << " was measured at several dial positions γ; the models are isotropic\n";
+  }
+  Result<exports::DerivedSamples> derived =
+      exports::DeriveSamples(*session, exports::Quantity::kBrdf, {c.exclude_flagged});
+  if (!derived.ok()) return Fail(err, "fit", derived.status());
+  fit::Observations data(derived->grid);
+  for (const exports::DerivedSample& s : derived->samples) {
+    if (Status st = data.Add(s.iso, s.values); !st.ok()) {
+      return Fail(err, "fit", st.WithContext("reading " + std::to_string(s.reading_id)));
+    }
+  }
+  std::optional<fit::LambertFit> lambert_fit;
+  std::optional<fit::CookTorranceFit> ct_fit;
+  if (lambert) {
+    Result<fit::LambertFit> r = fit::FitLambert(data);
+    if (!r.ok()) return Fail(err, "fit", r.status());
+    lambert_fit = std::move(*r);
+  }
+  if (ct) {
+    fit::CookTorranceOptions options;
+    options.sharing =
+        o.per_band ? fit::ParameterSharing::kPerBand : fit::ParameterSharing::kSharedAcrossBands;
+    ProgressLine line(err, "brdf-export fit", StderrIsTerminal());
+    if (!c.quiet) options.progress = [&line](double f) { line.Update(f); };
+    Result<fit::CookTorranceFit> r = fit::FitCookTorrance(data, options, RunContext());
+    line.Finish();
+    if (!r.ok()) return Fail(err, "fit", r.status());
+    ct_fit = std::move(*r);
+  }
+  Result<std::unique_ptr<OutputFile>> file = OutputFile::Open(c.output);
+  if (!file.ok()) return Fail(err, "fit", file.status());
+  const fit::FitReportInfo info{session->id, session->name, data.size(), derived->skipped.size()};
+  const fit::LambertFit* l = lambert_fit ? &*lambert_fit : nullptr;
+  const fit::CookTorranceFit* t = ct_fit ? &*ct_fit : nullptr;
+  (*file)->stream() << fit::FitReportCsv(info, l, t);
+  if (Status st = (*file)->Commit(); !st.ok()) return Fail(err, "fit", st);
+  err << "brdf-export fit: session " << session->id << ", " << data.size() << " BRDF readings ("
+      << derived->skipped.size() << " left out) → " << c.output << "\n"
+      << fit::FitSummary(l, t);
+  return kExitOk;
+}
+
+}  // namespace brdf::export_tool
