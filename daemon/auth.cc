@@ -1,0 +1,110 @@
+#include "daemon/auth.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <utility>
+
+namespace brdf::daemon {
+
+bool ConstantTimeEquals(std::string_view a, std::string_view b) {
+  const std::size_t n = std::max(a.size(), b.size());
+  // Different lengths differ, but we still walk max(|a|, |b|) bytes so that the time taken says
+  // nothing about the content.
+  std::uint64_t diff = static_cast<std::uint64_t>(a.size() ^ b.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const unsigned char x = i < a.size() ? static_cast<unsigned char>(a[i]) : 0;
+    const unsigned char y = i < b.size() ? static_cast<unsigned char>(b[i]) : 0;
+    diff |= static_cast<std::uint64_t>(x ^ y);
+  }
+  // Read through a volatile so the compiler cannot turn the loop into an early-exit memcmp.
+  volatile std::uint64_t result = diff;
+  return result == 0;
+}
+
+Authenticator::Authenticator(std::vector<TokenConfig> tokens) : tokens_(std::move(tokens)) {}
+
+namespace {
+
+bool StartsWithBearer(std::string_view header) {
+  static constexpr std::string_view kScheme = "bearer ";
+  if (header.size() < kScheme.size()) return false;
+  for (std::size_t i = 0; i < kScheme.size(); ++i) {
+    if (std::tolower(static_cast<unsigned char>(header[i])) != kScheme[i]) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool Authenticator::Identify(std::string_view header, Caller* caller, AuthFailure* failure) const {
+  *failure = AuthFailure::kNone;
+  if (tokens_.empty()) {
+    *caller = Caller{Role::kOperator, "anonymous"};
+    return true;
+  }
+  if (header.empty()) {
+    *failure = AuthFailure::kMissing;
+    return false;
+  }
+  if (header.size() > kMaxHeaderBytes || !StartsWithBearer(header)) {
+    *failure = AuthFailure::kMalformed;
+    return false;
+  }
+  std::string_view token = header.substr(7);
+  while (!token.empty() && token.front() == ' ') token.remove_prefix(1);
+  while (!token.empty() && (token.back() == ' ' || token.back() == '\r')) token.remove_suffix(1);
+  if (token.empty()) {
+    *failure = AuthFailure::kMalformed;
+    return false;
+  }
+  // Compare with every token: no early exit, so the time does not depend on which one matched.
+  std::size_t match = tokens_.size();
+  for (std::size_t i = 0; i < tokens_.size(); ++i) {
+    const bool equal = ConstantTimeEquals(token, tokens_[i].token);
+    match = equal && match == tokens_.size() ? i : match;
+  }
+  if (match == tokens_.size()) {
+    *failure = AuthFailure::kUnknown;
+    return false;
+  }
+  *caller = Caller{tokens_[match].role, tokens_[match].name};
+  return true;
+}
+
+grpc::Status Authenticator::Authorize(const grpc::ServerContextBase& context, Access access,
+                                      std::string_view rpc, Caller* caller) const {
+  std::string_view header;
+  const auto& metadata = context.client_metadata();
+  auto it = metadata.find("authorization");
+  if (it != metadata.end()) header = std::string_view(it->second.data(), it->second.size());
+
+  AuthFailure failure = AuthFailure::kNone;
+  if (!Identify(header, caller, &failure)) {
+    std::string why;
+    switch (failure) {
+      case AuthFailure::kMissing:
+        why = "no \"authorization\" metadata";
+        break;
+      case AuthFailure::kMalformed:
+        why = "the \"authorization\" metadata is not \"Bearer <token>\"";
+        break;
+      default:
+        why = "the bearer token is not one of this daemon's tokens";
+        break;
+    }
+    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                        std::string(rpc) + ": " + why +
+                            "; send \"authorization: Bearer <token>\" with a token from the "
+                            "daemon's [[auth.tokens]] (brdfctl: --token or $BRDF_TOKEN)");
+  }
+  if (access == Access::kControl && caller->role != Role::kOperator) {
+    return grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
+                        std::string(rpc) + ": token \"" + caller->name + "\" has the role " +
+                            RoleName(caller->role) +
+                            ", which may only read; this call needs an operator token");
+  }
+  return grpc::Status::OK;
+}
+
+}  // namespace brdf::daemon

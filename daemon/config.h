@@ -1,0 +1,172 @@
+// brdfd's configuration: one TOML file (e.g. /etc/brdfd/brdfd.toml). Every key is optional and
+// has the default written next to it below; a file with a wrong type, a value out of range or a
+// key brdfd does not know (a typo must not silently fall back to a default) is refused with
+// kConfigurationError, naming every bad key with its line and the reason:
+//   "config /etc/brdfd/brdfd.toml: line 31, column 1: unknown key stage.axes.alpa (known: alpha,
+//    beta, gamma, delta)".
+//
+//   [server]
+//   listen = "127.0.0.1:50051"          # host:port (port 0: any free port) or "unix:/path"
+//   [server.tls]                        # optional; cert and key together; client_ca → mTLS
+//   cert = "/etc/brdfd/server.crt"
+//   key = "/etc/brdfd/server.key"
+//   client_ca = "/etc/brdfd/clients-ca.crt"
+//
+//   [storage]
+//   database = "/var/lib/brdfd/brdfd.db"
+//
+//   [meter]                             # the PR-650 (pr650.md)
+//   port = "/dev/ttyUSB0"
+//   baud = 9600
+//   hardware_flow_control = false
+//   pacing_ms = 100                     # pause after an exchange before the next command
+//   quiet_gap_ms = 50                   # silence that ends a reply
+//   reply_timeout_ms = 2000             # short replies (B, D110, D120, D5)
+//   measurement_timeout_ms = 30000      # M0, S, F
+//   wake_attempts = 5                   # remote-mode wake-up tries before asking for a power cycle
+//   [meter.quality]                     # overrides of the quality policy, by code
+//   "18" = "accept_and_flag"            # accept, accept_and_flag, retry, retry_then_flag,
+//   "30" = { action = "retry", accept_flagged_when_exhausted = true }  # adapt_integration,
+//                                                                      # sync_off_and_retry, fail
+//   [stage]                             # the rotation stage over Modbus (stage-modbus.md)
+//   transport = "tcp"                   # "tcp" or "rtu"
+//   address = "127.0.0.1:502"           # tcp: host:port
+//   device = "/dev/ttyUSB1"             # rtu: serial device (required for rtu)
+//   baud = 115200                       # rtu
+//   parity = "E"                        # rtu: "N", "E" or "O"
+//   profile = "az"                      # register map: "az", "leadshine" or "moons"
+//   response_timeout_ms = 500
+//   detector_arm_motorized = false      # true: δ is a Modbus axis ([stage.axes.delta] present)
+//   [stage.axes.alpha]                  # also beta, gamma, delta
+//   present = true                      # default: true for alpha and beta, false for gamma, delta
+//   unit_id = 1                         # Modbus unit id 1–247 (default: 1, 2, 3, 4 in axis order)
+//   counts_per_degree = 27.7778         # 10,000 counts per revolution
+//   zero_offset_deg = 0                 # stage reading at geometry.md's model angle 0
+//   sign = 1                            # −1: the stage turns against geometry.md's axis
+//   min_deg = 0                         # travel (defaults: α 0…90, β −180…180, γ −180…180,
+//   max_deg = 90                        #   δ 0…180; δ's limits bind a manual detector too)
+//   speed_deg_s = 10
+//
+//   [sample]
+//   white_reflectance = 0.99            # ρw of the white standard (the RS-3), in (0, 1]
+//
+//   [[auth.tokens]]                     # none: the API needs no token (bind to localhost!)
+//   name = "lab-pc"
+//   token = "at least 16 characters"
+//   role = "operator"                   # "operator" (everything) or "analyst" (read only)
+//
+//   [log]
+//   level = "info"                      # trace, debug, info, warn, error, critical, off
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/plan/rig_description.h"
+#include "core/status.h"
+#include "drivers/pr650/quality_codes.h"
+
+namespace brdf::daemon {
+
+struct TlsConfig {
+  std::string cert;       // PEM certificate chain file
+  std::string key;        // PEM private key file
+  std::string client_ca;  // PEM CA bundle; set: clients must present a certificate it signed
+};
+
+struct ServerConfig {
+  std::string listen = "127.0.0.1:50051";
+  std::optional<TlsConfig> tls;  // unset: plaintext
+};
+
+struct StorageConfig {
+  std::string database = "/var/lib/brdfd/brdfd.db";
+};
+
+struct MeterConfig {
+  std::string port = "/dev/ttyUSB0";
+  int baud = 9600;
+  bool hardware_flow_control = false;
+  int pacing_ms = 100;
+  int quiet_gap_ms = 50;
+  int reply_timeout_ms = 2000;
+  int measurement_timeout_ms = 30000;
+  int wake_attempts = 5;
+  // Rules that replace the driver's defaults for these quality codes (0–99).
+  std::map<int, drivers::pr650::QualityRule> quality_overrides;
+};
+
+struct AxisSettings {
+  bool present = false;
+  int unit_id = 1;
+  double counts_per_degree = 10000.0 / 360.0;
+  double zero_offset_deg = 0;
+  double sign = 1;
+  double min_deg = -180;
+  double max_deg = 180;
+  double speed_deg_s = 10;
+};
+
+struct StageConfig {
+  std::string transport = "tcp";   // "tcp" or "rtu"
+  std::string host = "127.0.0.1";  // tcp (from address)
+  int port = 502;                  // tcp (from address)
+  std::string device;              // rtu
+  int baud = 115200;               // rtu
+  char parity = 'E';               // rtu
+  std::string profile = "az";      // "az", "leadshine", "moons"
+  int response_timeout_ms = 500;
+  bool detector_arm_motorized = false;
+  AxisSettings alpha{true, 1, 10000.0 / 360.0, 0, 1, 0, 90, 10};
+  AxisSettings beta{true, 2, 10000.0 / 360.0, 0, 1, -180, 180, 20};
+  AxisSettings gamma{false, 3, 10000.0 / 360.0, 0, 1, -180, 180, 20};
+  AxisSettings delta{false, 4, 10000.0 / 360.0, 0, 1, 0, 180, 10};
+};
+
+struct SampleConfig {
+  double white_reflectance = 0.99;
+};
+
+enum class Role { kOperator, kAnalyst };
+const char* RoleName(Role role);  // "operator", "analyst"
+
+struct TokenConfig {
+  std::string name;
+  std::string token;
+  Role role = Role::kAnalyst;
+};
+
+struct LogConfig {
+  std::string level = "info";
+};
+
+struct Config {
+  ServerConfig server;
+  StorageConfig storage;
+  MeterConfig meter;
+  StageConfig stage;
+  SampleConfig sample;
+  std::vector<TokenConfig> tokens;  // [[auth.tokens]]
+  LogConfig log;
+};
+
+// Shortest acceptable token, in bytes.
+inline constexpr std::size_t kMinTokenLength = 16;
+// Larger configuration files are refused unread.
+inline constexpr std::size_t kMaxConfigBytes = 1024 * 1024;
+
+// Parses TOML text. `source` names it in messages (the file's path). kConfigurationError listing
+// every problem, one per line, each with its line, key and reason.
+Result<Config> ParseConfig(std::string_view toml_text, std::string_view source = "config");
+
+// Reads and parses a file. kNotFound / kIoError when it cannot be read; else as ParseConfig.
+Result<Config> LoadConfig(const std::string& path);
+
+// What core/plan needs to know about this rig: motorized axes, travel, speeds, the convention
+// (zero offsets and signs), and the meter's transfer time at the configured baud rate.
+plan::RigDescription ToRigDescription(const Config& config);
+
+}  // namespace brdf::daemon

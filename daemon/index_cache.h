@@ -1,0 +1,123 @@
+// IndexCache: the interpolation indexes the Interpolation service answers from, one per
+// (session, quantity, method, options), built from the session's SAMPLE readings with
+// core/interp's MakeInterpolator.
+//
+// Quantities (core/spectrum.h, geometry.md "Reflectance and BRDF"), per sample reading I:
+//   radiance     I − D                                  (D: the dark the reading names, if any)
+//   reflectance  (I − D) / (I0 − D)                     (I0: the reference the reading names)
+//   BRDF         R · ρw / π · cos θi,ref / cos θi       (θi,ref: the reference reading's θi;
+//                                                        ρw: the session's white reflectance)
+// Coordinates: (θi, θo, φ) for isotropic plans (3D), (θi, φi, θo, φo) for anisotropic ones (4D),
+// from each reading's stored directions. Flagged readings are kept (the quality policy chose to
+// keep them); a reading whose quantity cannot be computed (no reference, a reference too dark in
+// a band, a different wavelength grid, directions below the surface) is left out and counted in
+// the snapshot's `skipped`, with the first reason.
+//
+// Freshness and consistency: a snapshot is immutable. Readers hold a shared_ptr<const
+// IndexSnapshot> for as long as they need it (a whole batch), so they always see one consistent
+// set of readings even while new readings land. OnReading (registered as a SessionManager
+// reading listener; quick, never touches the store) only marks the session's samples stale; the
+// next Get reads the new readings from the store (only those after the last one it has: an
+// append, not a re-read), publishes new sample sets and rebuilds the requested index.
+//
+// Memory: the cache keeps at most Options::max_sessions sessions and about Options::max_bytes of
+// samples and indexes, evicting the least recently used session; each session keeps at most
+// max_indexes_per_session indexes (least recently used first out). An evicted session is simply
+// rebuilt from the store on its next query. Snapshots still held by readers stay valid.
+#pragma once
+
+#include <cstdint>
+#include <list>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "core/interp/interpolator.h"
+#include "core/status.h"
+#include "core/wavelength_grid.h"
+#include "daemon/session_manager.h"
+#include "storage/records.h"
+#include "storage/session_store.h"
+
+namespace brdf::daemon {
+
+enum class Quantity { kRadiance = 0, kReflectance = 1, kBrdf = 2 };
+inline constexpr int kQuantityCount = 3;
+const char* QuantityName(Quantity q);  // "radiance", "reflectance", "brdf"
+
+// One index, ready for queries. Immutable once published; Evaluate is thread-safe.
+struct IndexSnapshot {
+  SessionId session = 0;
+  Quantity quantity = Quantity::kBrdf;
+  interp::Method method = interp::Method::kOctant;
+  interp::Options options;
+  bool anisotropic = false;
+  int dims = 3;  // 3: (θi, θo, φ); 4: (θi, φi, θo, φo)
+  WavelengthGrid grid;
+  // Every reading of the session with id ≤ this was considered.
+  std::int64_t through_reading_id = 0;
+  // Sample readings left out for this quantity, and why the first one was.
+  std::size_t skipped = 0;
+  std::string skipped_detail;
+  std::shared_ptr<const interp::SampleSet> samples;
+  std::shared_ptr<const interp::Interpolator> interpolator;
+};
+
+class IndexCache {
+ public:
+  struct Options {
+    std::size_t max_sessions = 8;
+    std::size_t max_bytes = std::size_t{512} << 20;
+    std::size_t max_indexes_per_session = 12;
+    // Readings fetched per store page while loading.
+    int page_size = 512;
+  };
+
+  struct Stats {
+    std::size_t sessions = 0;     // sessions cached now
+    std::size_t bytes = 0;        // estimated memory held now
+    std::uint64_t loads = 0;      // store reads that added readings (first load or append)
+    std::uint64_t builds = 0;     // indexes built
+    std::uint64_t hits = 0;       // queries answered from a cached index
+    std::uint64_t evictions = 0;  // sessions evicted
+  };
+
+  IndexCache(std::shared_ptr<storage::SessionStore> store, Options options);
+  explicit IndexCache(std::shared_ptr<storage::SessionStore> store)
+      : IndexCache(std::move(store), Options()) {}
+  IndexCache(const IndexCache&) = delete;
+  IndexCache& operator=(const IndexCache&) = delete;
+
+  // A reading was committed (SessionManager::AddReadingListener). Marks the session's samples
+  // stale; never blocks on a build or the store.
+  void OnReading(SessionId session, const storage::ReadingRecord& reading);
+
+  // The index for these settings over every reading committed so far. Errors:
+  //   kNotFound            no such session;
+  //   kInvalidArgument     options that do not fit the session (naming "options.axis_scale",
+  //                        "options.mirror_phi", "options.reciprocity");
+  //   kFailedPrecondition  no usable sample reading yet, or the readings cannot be indexed by
+  //                        this method (e.g. Delaunay on readings that all lie in one plane);
+  //   kIoError             the store could not be read.
+  Result<std::shared_ptr<const IndexSnapshot>> Get(SessionId session, Quantity quantity,
+                                                   interp::Method method,
+                                                   const interp::Options& options);
+
+  Stats stats() const;
+
+ private:
+  struct Entry;
+  void Evict(SessionId keep);
+
+  std::shared_ptr<storage::SessionStore> store_;
+  Options options_;
+
+  mutable std::mutex mu_;  // guards everything below (never held while building)
+  std::map<SessionId, std::shared_ptr<Entry>> entries_;
+  std::list<SessionId> lru_;  // most recently used first
+  Stats stats_;
+};
+
+}  // namespace brdf::daemon

@@ -1,0 +1,193 @@
+// brdfd: the spectral BRDF measurement daemon.
+//
+//   brdfd --config /etc/brdfd/brdfd.toml [--log-level L] [--shutdown-timeout S]
+//
+// Start-up: configuration (a bad file exits 2, naming every bad key and why), logging to stderr,
+// the SQLite store, recovery of sessions a dead daemon was driving (they come back paused), the
+// rig (devices connect in the background: an absent device shows as disconnected and is
+// retried, the API is up meanwhile), then the gRPC server. Once serving it prints exactly one
+// line on stdout, "brdfd listening on <address>" (the real port when the configured port is 0),
+// and tells systemd READY=1 when built with libsystemd.
+//
+// SIGTERM / SIGINT: a deferred pause of the running session (the step in progress finishes, for
+// up to --shutdown-timeout, then it is cancelled and redone on resume), the devices close, the
+// server stops, exit 0. A second signal during that wait exits at once (exit 1); the database is
+// crash-safe, so that loses nothing that was committed.
+#include <signal.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "daemon/auth.h"
+#include "daemon/config.h"
+#include "daemon/index_cache.h"
+#include "daemon/rig.h"
+#include "daemon/server.h"
+#include "daemon/session_manager.h"
+#include "storage/session_store.h"
+
+#ifdef BRDF_HAVE_SYSTEMD
+#include <systemd/sd-daemon.h>
+#endif
+
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;        // the store, the address or recovery failed
+constexpr int kExitConfiguration = 2;  // a bad command line or configuration file
+
+void Notify([[maybe_unused]] const std::string& state) {
+#ifdef BRDF_HAVE_SYSTEMD
+  sd_notify(0, state.c_str());
+#endif
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace brdf;
+  using namespace brdf::daemon;
+
+  // Block the stop signals before any thread starts: every thread inherits the mask and only
+  // the main thread takes them, in sigtimedwait. A client that hangs up must not kill us.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGTERM);
+  sigaddset(&stop_signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+
+  std::string config_path;
+  std::string log_level;
+  double shutdown_timeout_s = 60;
+  CLI::App app("brdfd: runs spectral BRDF measurement sessions on a rig and serves them over gRPC");
+  app.add_option("--config", config_path, "TOML configuration file")->required();
+  app.add_option("--log-level", log_level, "Overrides [log] level")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  app.add_option("--shutdown-timeout", shutdown_timeout_s,
+                 "Seconds a SIGTERM waits for the step in progress before cancelling it")
+      ->check(CLI::Range(0.0, 3600.0));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitConfiguration;
+  }
+
+  auto logger = spdlog::stderr_color_mt("brdfd");
+  spdlog::set_default_logger(logger);
+  spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ %v");
+
+  Result<Config> loaded = LoadConfig(config_path);
+  if (!loaded.ok()) {
+    std::fprintf(stderr, "brdfd: %s\n", loaded.status().message().c_str());
+    return kExitConfiguration;
+  }
+  const Config& config = *loaded;
+  spdlog::set_level(spdlog::level::from_str(log_level.empty() ? config.log.level : log_level));
+  spdlog::info("brdfd starting: config {}, database {}, meter {}, stage {} {}:{}", config_path,
+               config.storage.database, config.meter.port, config.stage.transport,
+               config.stage.transport == "rtu" ? config.stage.device : config.stage.host,
+               config.stage.port);
+
+  Result<std::unique_ptr<storage::SessionStore>> opened =
+      storage::SessionStore::Open(config.storage.database);
+  if (!opened.ok()) {
+    spdlog::critical("cannot open the database {}: {}", config.storage.database,
+                     opened.status().ToString());
+    return kExitFailure;
+  }
+  std::shared_ptr<storage::SessionStore> store = std::move(*opened);
+
+  Result<std::unique_ptr<Rig>> rig = Rig::FromConfig(config, Rig::Options());
+  if (!rig.ok()) {
+    std::fprintf(stderr, "brdfd: %s\n", rig.status().message().c_str());
+    return kExitConfiguration;
+  }
+
+  SessionManager::Options manager_options;
+  manager_options.rig_description = ToRigDescription(config);
+  manager_options.white_reflectance = config.sample.white_reflectance;
+  SessionManager manager(store, std::shared_ptr<Rig>(std::move(*rig)), manager_options);
+
+  Result<std::vector<SessionId>> recovered = manager.Recover();
+  if (!recovered.ok()) {
+    spdlog::critical("recovering interrupted sessions failed: {}", recovered.status().ToString());
+    return kExitFailure;
+  }
+  if (!recovered->empty()) {
+    spdlog::warn("{} session(s) were interrupted by the previous run and are now paused",
+                 recovered->size());
+  }
+
+  IndexCache cache(store);
+  const int cache_listener = manager.AddReadingListener(
+      [&cache](SessionId session, const storage::ReadingRecord& reading) {
+        cache.OnReading(session, reading);
+      });
+
+  Authenticator auth(config.tokens);
+  if (!auth.enabled()) {
+    if (IsLoopbackAddress(config.server.listen)) {
+      spdlog::warn("no [[auth.tokens]] configured: every local caller may control the rig");
+    } else {
+      spdlog::error(
+          "no [[auth.tokens]] configured on the non-loopback address {}: ANYONE who "
+          "can reach it may control the rig; add tokens",
+          config.server.listen);
+    }
+  } else {
+    spdlog::info("{} bearer token(s) configured", auth.token_count());
+  }
+
+  Result<std::unique_ptr<Server>> server = Server::Start(config.server, manager, cache, auth);
+  if (!server.ok()) {
+    spdlog::critical("{}", server.status().ToString());
+    manager.RemoveReadingListener(cache_listener);
+    return kExitFailure;
+  }
+  spdlog::info("serving on {} ({})", (*server)->address(), (*server)->tls() ? "TLS" : "plaintext");
+  std::printf("brdfd listening on %s\n", (*server)->address().c_str());
+  std::fflush(stdout);
+  Notify("READY=1\nSTATUS=serving on " + (*server)->address());
+
+  // Wait for SIGTERM / SIGINT.
+  int signal_number = 0;
+  while (signal_number <= 0) signal_number = sigwaitinfo(&stop_signals, nullptr);
+  spdlog::info("{}: pausing the running session (deferred), closing the devices, stopping",
+               signal_number == SIGINT ? "SIGINT" : "SIGTERM");
+  Notify("STOPPING=1");
+
+  std::atomic<bool> done{false};
+  std::thread stopper([&] {
+    manager.Shutdown(std::chrono::milliseconds(static_cast<long>(shutdown_timeout_s * 1000)));
+    manager.RemoveReadingListener(cache_listener);
+    spdlog::info("sessions paused and devices closed; stopping the server");
+    (*server)->Shutdown(std::chrono::seconds(2));
+    done = true;
+  });
+  const timespec poll{0, 100 * 1000 * 1000};
+  while (!done) {
+    if (sigtimedwait(&stop_signals, nullptr, &poll) > 0) {
+      spdlog::warn(
+          "second stop signal: exiting now (committed readings are safe; the session "
+          "resumes from its first unfinished step)");
+      std::fflush(nullptr);
+      std::_Exit(kExitFailure);
+    }
+  }
+  stopper.join();
+  spdlog::info("stopped");
+  return kExitOk;
+}

@@ -1,0 +1,134 @@
+#include "daemon/server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/resource_quota.h>
+#include <grpcpp/security/server_credentials.h>
+#include <grpcpp/server_builder.h>
+#include <spdlog/spdlog.h>
+
+#include <fstream>
+#include <sstream>
+
+namespace brdf::daemon {
+namespace {
+
+// The services by their full names, for the health service's per-service status.
+constexpr const char* kServiceNames[] = {"brdf.v1.Control", "brdf.v1.Data",
+                                         "brdf.v1.Interpolation"};
+
+Result<std::string> ReadPem(const std::string& path, const std::string& key) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    return ConfigurationError("config " + key + ": cannot read \"" + path +
+                              "\"; check the path and that brdfd may read it");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (text.str().empty()) {
+    return ConfigurationError("config " + key + ": \"" + path + "\" is empty; give a PEM file");
+  }
+  return text.str();
+}
+
+std::string HostOf(const std::string& listen) {
+  const std::size_t colon = listen.rfind(':');
+  std::string host = colon == std::string::npos ? listen : listen.substr(0, colon);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
+    host = host.substr(1, host.size() - 2);
+  }
+  return host;
+}
+
+}  // namespace
+
+bool IsLoopbackAddress(const std::string& listen) {
+  if (listen.rfind("unix:", 0) == 0) return true;
+  const std::string host = HostOf(listen);
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
+
+Server::Server(SessionManager& manager, IndexCache& cache, const Authenticator& auth)
+    : control_(manager, auth, stopping_),
+      data_(manager, auth, stopping_),
+      interpolation_(cache, auth, stopping_) {}
+
+Server::~Server() {
+  Shutdown(std::chrono::seconds(1));
+}
+
+Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, SessionManager& manager,
+                                              IndexCache& cache, const Authenticator& auth) {
+  std::shared_ptr<grpc::ServerCredentials> credentials;
+  bool tls = false;
+  if (config.tls.has_value()) {
+    Result<std::string> cert = ReadPem(config.tls->cert, "server.tls.cert");
+    if (!cert.ok()) return cert.status();
+    Result<std::string> key = ReadPem(config.tls->key, "server.tls.key");
+    if (!key.ok()) return key.status();
+    grpc::SslServerCredentialsOptions ssl(GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE);
+    ssl.pem_key_cert_pairs.push_back({*key, *cert});
+    if (!config.tls->client_ca.empty()) {
+      Result<std::string> ca = ReadPem(config.tls->client_ca, "server.tls.client_ca");
+      if (!ca.ok()) return ca.status();
+      ssl.pem_root_certs = *ca;
+      ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
+    }
+    credentials = grpc::SslServerCredentials(ssl);
+    tls = true;
+  } else {
+    credentials = grpc::InsecureServerCredentials();
+    if (!IsLoopbackAddress(config.listen)) {
+      spdlog::warn(
+          "serving {} in PLAINTEXT on a non-loopback address: bearer tokens and data cross the "
+          "network unencrypted; configure [server.tls] (cert, key) or listen on 127.0.0.1",
+          config.listen);
+    }
+  }
+
+  // Both must be set up before the builder is made.
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+
+  std::unique_ptr<Server> server(new Server(manager, cache, auth));
+  grpc::ServerBuilder builder;
+  int selected_port = 0;
+  builder.AddListeningPort(config.listen, credentials, &selected_port);
+  builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
+  grpc::ResourceQuota quota("brdfd");
+  quota.SetMaxThreads(kMaxServerThreads);
+  builder.SetResourceQuota(quota);
+  builder.RegisterService(&server->control_);
+  builder.RegisterService(&server->data_);
+  builder.RegisterService(&server->interpolation_);
+  server->server_ = builder.BuildAndStart();
+  const bool unix_socket = config.listen.rfind("unix:", 0) == 0;
+  if (!server->server_ || (!unix_socket && selected_port == 0)) {
+    return IoError("cannot listen on " + config.listen +
+                   " (address in use, not allowed, or no such interface); change [server] "
+                   "listen or stop the process that holds it");
+  }
+  server->tls_ = tls;
+  server->port_ = selected_port;
+  server->address_ = unix_socket ? config.listen
+                                 : config.listen.substr(0, config.listen.rfind(':') + 1) +
+                                       std::to_string(selected_port);
+  if (grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService()) {
+    health->SetServingStatus(true);
+    for (const char* name : kServiceNames) health->SetServingStatus(name, true);
+  }
+  return server;
+}
+
+void Server::Shutdown(std::chrono::milliseconds grace) {
+  if (shut_down_ || !server_) return;
+  shut_down_ = true;
+  if (grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService()) {
+    health->SetServingStatus(false);
+  }
+  stopping_.Stop();
+  server_->Shutdown(std::chrono::system_clock::now() + grace);
+  server_->Wait();
+}
+
+}  // namespace brdf::daemon

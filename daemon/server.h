@@ -1,0 +1,67 @@
+// The gRPC server: the Control, Data and Interpolation services, the standard health service
+// (grpc.health.v1.Health: "" and each brdf.v1 service SERVING while up) and server reflection,
+// on the configured address, in plaintext or TLS ([server.tls]; client_ca → clients must present
+// a certificate). Synchronous API: each call runs on a thread of gRPC's pool, capped at
+// kMaxServerThreads (calls beyond it fail with RESOURCE_EXHAUSTED instead of piling up).
+#pragma once
+
+#include <grpcpp/server.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "core/status.h"
+#include "daemon/auth.h"
+#include "daemon/config.h"
+#include "daemon/index_cache.h"
+#include "daemon/service_common.h"
+#include "daemon/service_control.h"
+#include "daemon/service_data.h"
+#include "daemon/service_interpolation.h"
+#include "daemon/session_manager.h"
+
+namespace brdf::daemon {
+
+inline constexpr int kMaxServerThreads = 256;
+
+// True for addresses only this machine can reach: 127.0.0.0/8, localhost, ::1, unix sockets.
+bool IsLoopbackAddress(const std::string& listen);
+
+class Server {
+ public:
+  // Builds the services and starts serving on config.listen (port 0: any free port; see
+  // address()). Errors: kConfigurationError when a TLS file cannot be read, kIoError when the
+  // address cannot be bound (in use, not allowed, no such interface). Logs a warning when a
+  // non-loopback address is served in plaintext. `manager`, `cache` and `auth` must outlive it.
+  static Result<std::unique_ptr<Server>> Start(const ServerConfig& config, SessionManager& manager,
+                                               IndexCache& cache, const Authenticator& auth);
+  // Shutdown(1 s) if not called before.
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  // Where it listens, with the port actually bound ("127.0.0.1:43123", "unix:/run/brdfd.sock").
+  const std::string& address() const { return address_; }
+  int port() const { return port_; }
+  bool tls() const { return tls_; }
+
+  // Health → NOT_SERVING, long-lived streams end (after sending what is queued), then calls in
+  // flight get up to `grace` to finish before they are cancelled. Idempotent.
+  void Shutdown(std::chrono::milliseconds grace);
+
+ private:
+  Server(SessionManager& manager, IndexCache& cache, const Authenticator& auth);
+
+  StopSignal stopping_;
+  ControlService control_;
+  DataService data_;
+  InterpolationService interpolation_;
+  std::unique_ptr<grpc::Server> server_;
+  std::string address_;
+  int port_ = 0;
+  bool tls_ = false;
+  bool shut_down_ = false;
+};
+
+}  // namespace brdf::daemon

@@ -1,0 +1,131 @@
+#include "daemon/service_common.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/geometry.h"
+#include "daemon/engine_steps.h"
+
+namespace brdf::daemon {
+
+grpc::Status ToGrpcStatus(const Status& status) {
+  using grpc::StatusCode;
+  StatusCode code = StatusCode::INTERNAL;
+  switch (status.code()) {
+    case brdf::StatusCode::kOk:
+      return grpc::Status::OK;
+    case brdf::StatusCode::kInvalidArgument:
+      code = StatusCode::INVALID_ARGUMENT;
+      break;
+    case brdf::StatusCode::kNotFound:
+      code = StatusCode::NOT_FOUND;
+      break;
+    case brdf::StatusCode::kFailedPrecondition:
+      code = StatusCode::FAILED_PRECONDITION;
+      break;
+    case brdf::StatusCode::kTimeout:
+      code = StatusCode::DEADLINE_EXCEEDED;
+      break;
+    case brdf::StatusCode::kCancelled:
+      code = StatusCode::CANCELLED;
+      break;
+    case brdf::StatusCode::kDeviceError:
+    case brdf::StatusCode::kProtocolError:
+    case brdf::StatusCode::kDisconnected:
+    case brdf::StatusCode::kIoError:
+      code = StatusCode::UNAVAILABLE;
+      break;
+    case brdf::StatusCode::kConfigurationError:
+    case brdf::StatusCode::kInternal:
+      code = StatusCode::INTERNAL;
+      break;
+  }
+  return grpc::Status(code, status.message());
+}
+
+grpc::Status InvalidField(const std::string& field, const std::string& what) {
+  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, field + ": " + what);
+}
+
+namespace {
+std::string Num(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+}  // namespace
+
+Status CheckAngle(double value, double lo, double hi, const std::string& field) {
+  if (!std::isfinite(value)) {
+    return InvalidArgument(field + ": must be a finite angle in degrees (got " + Num(value) + ")");
+  }
+  if (value < lo || value > hi) {
+    return InvalidArgument(field + ": " + Num(value) + "° is outside [" + Num(lo) + ", " + Num(hi) +
+                           "] degrees");
+  }
+  return Status::Ok();
+}
+
+v1::WavelengthGrid ToProtoGrid(const WavelengthGrid& grid) {
+  v1::WavelengthGrid g;
+  g.set_start_nm(grid.start_nm);
+  g.set_step_nm(grid.step_nm);
+  g.set_count(static_cast<std::uint32_t>(grid.count));
+  return g;
+}
+
+v1::ReadingKind ToProtoReadingKind(storage::ReadingKind kind) {
+  switch (kind) {
+    case storage::ReadingKind::kSample:
+      return v1::READING_KIND_SAMPLE;
+    case storage::ReadingKind::kReference:
+      return v1::READING_KIND_REFERENCE;
+    case storage::ReadingKind::kDark:
+      return v1::READING_KIND_DARK;
+  }
+  return v1::READING_KIND_UNSPECIFIED;
+}
+
+v1::Reading ToProtoReading(const storage::ReadingRecord& r, const ReadingExtras& extras) {
+  v1::Reading out;
+  out.set_id(r.id);
+  out.set_session_id(std::to_string(r.session_id));
+  out.set_step_index(r.step_index);
+  out.set_kind(ToProtoReadingKind(r.kind));
+  *out.mutable_pose() = ToProtoPose(r.pose);
+  *out.mutable_directions() = ToProtoDirections(r.directions);
+  const IsoDirection iso = ToIsotropic(r.directions);
+  out.mutable_iso()->set_theta_i(iso.theta_i);
+  out.mutable_iso()->set_theta_o(iso.theta_o);
+  out.mutable_iso()->set_phi(iso.phi);
+  *out.mutable_grid() = ToProtoGrid(r.grid);
+  out.mutable_radiance()->Add(r.spectrum.begin(), r.spectrum.end());
+  out.set_quality_code(r.quality_code);
+  out.set_flagged(r.flagged);
+  if (r.flagged) out.set_flag_reason(r.note.empty() ? "flagged by the quality policy" : r.note);
+  out.set_integration_ms(static_cast<std::uint32_t>(std::max(0, r.integration_ms)));
+  out.set_averages(extras.averages);
+  out.set_reference_id(r.reference_reading_id.value_or(0));
+  out.set_dark_id(r.dark_reading_id.value_or(0));
+  out.set_attempts(static_cast<std::uint32_t>(std::max(1, r.attempts)));
+  *out.mutable_taken_at() = ToTimestamp(r.recorded_at);
+  auto label = extras.step_labels.find(r.step_index);
+  if (label != extras.step_labels.end()) out.set_label(label->second);
+  return out;
+}
+
+void StopSignal::Stop() {
+  {
+    std::lock_guard lock(mu_);
+    stopped_ = true;
+  }
+  cv_.notify_all();
+}
+
+bool StopSignal::WaitFor(std::chrono::steady_clock::duration d) const {
+  std::unique_lock lock(mu_);
+  return cv_.wait_for(lock, d, [this] { return stopped_.load(); });
+}
+
+}  // namespace brdf::daemon

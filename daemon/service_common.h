@@ -1,0 +1,80 @@
+// What the three gRPC services share: the limits every request is checked against, the mapping
+// of brdfd's Status codes onto gRPC codes (session_manager.h's table), argument checks that name
+// the offending field, storage records as the API's messages, and the daemon-wide "stopping"
+// signal that ends long-lived streams at shutdown.
+#pragma once
+
+#include <grpcpp/support/status.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+
+#include "brdf/v1/brdf.pb.h"
+#include "core/status.h"
+#include "core/wavelength_grid.h"
+#include "storage/records.h"
+
+namespace brdf::daemon {
+
+// Largest request the server accepts (a plan at core/plan's step cap is ~8 MB of JSON; a batch of
+// kMaxBatchDirections iso directions is ~3 MB). Larger ones fail with RESOURCE_EXHAUSTED.
+inline constexpr int kMaxReceiveMessageBytes = 16 * 1024 * 1024;
+// Directions per InterpolateBatch request.
+inline constexpr int kMaxBatchDirections = 100000;
+// Results per InterpolateBatch chunk: default, and the most a client may ask (1,024 results of
+// 101 bands with provenance are ~1.2 MB, well under a client's default 4 MiB receive limit).
+inline constexpr std::uint32_t kDefaultChunkSize = 256;
+inline constexpr std::uint32_t kMaxChunkSize = 1024;
+// Free texts (abort reason, prompt note) are stored in the audit log; longer ones are refused.
+inline constexpr std::size_t kMaxNoteBytes = 4096;
+// ListSessions: default and largest page.
+inline constexpr std::uint32_t kDefaultPageSize = 100;
+inline constexpr std::uint32_t kMaxPageSize = 1000;
+// How often a long-lived stream (WatchSession, StreamReadings with follow) looks whether its
+// client went away or the daemon is stopping.
+inline constexpr std::chrono::milliseconds kStreamPollInterval{200};
+
+// brdfd Status → gRPC status, code per session_manager.h: kInvalidArgument → INVALID_ARGUMENT,
+// kNotFound → NOT_FOUND, kFailedPrecondition → FAILED_PRECONDITION, kIoError → UNAVAILABLE,
+// kTimeout → DEADLINE_EXCEEDED, kCancelled → CANCELLED, device errors → UNAVAILABLE, kInternal
+// and kConfigurationError → INTERNAL. The message is kept as it is.
+grpc::Status ToGrpcStatus(const Status& status);
+
+// INVALID_ARGUMENT "<field>: <what>".
+grpc::Status InvalidField(const std::string& field, const std::string& what);
+
+// Checks a finite angle within [lo, hi]; the message names `field` and the range.
+Status CheckAngle(double value, double lo, double hi, const std::string& field);
+
+// The API's messages for storage's records.
+v1::WavelengthGrid ToProtoGrid(const WavelengthGrid& grid);
+v1::ReadingKind ToProtoReadingKind(storage::ReadingKind kind);
+
+// What a Reading message needs beyond the record: the step's label, and the plan's averaging
+// (the meter's averaging count is a plan setting, the same for every reading of a session).
+struct ReadingExtras {
+  std::map<int, std::string> step_labels;
+  std::uint32_t averages = 1;
+};
+v1::Reading ToProtoReading(const storage::ReadingRecord& record, const ReadingExtras& extras);
+
+// Set once at shutdown; streams end when they see it. Waiters wake at once.
+class StopSignal {
+ public:
+  void Stop();
+  bool stopped() const { return stopped_.load(); }
+  // Waits up to `d` or until Stop(); true when stopped.
+  bool WaitFor(std::chrono::steady_clock::duration d) const;
+
+ private:
+  std::atomic<bool> stopped_{false};
+  mutable std::mutex mu_;
+  mutable std::condition_variable cv_;
+};
+
+}  // namespace brdf::daemon

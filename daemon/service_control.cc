@@ -1,0 +1,295 @@
+#include "daemon/service_control.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/plan/plan_proto.h"
+#include "daemon/engine_steps.h"
+
+namespace brdf::daemon {
+
+ControlService::ControlService(SessionManager& manager, const Authenticator& auth,
+                               const StopSignal& stopping)
+    : manager_(manager), auth_(auth), stopping_(stopping) {}
+
+namespace {
+
+// The session id of a request, or INVALID_ARGUMENT naming the field.
+grpc::Status ParseId(const std::string& text, SessionId* id) {
+  Result<SessionId> parsed = ParseSessionId(text, "session_id");
+  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
+  *id = *parsed;
+  return grpc::Status::OK;
+}
+
+grpc::Status CheckNote(const std::string& text, const std::string& field) {
+  if (text.size() > kMaxNoteBytes) {
+    return InvalidField(field, "too long (" + std::to_string(text.size()) + " bytes; at most " +
+                                   std::to_string(kMaxNoteBytes) + ")");
+  }
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
+grpc::Status ControlService::SubmitPlan(grpc::ServerContext* context,
+                                        const v1::SubmitPlanRequest* request,
+                                        v1::SubmitPlanResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kControl, "SubmitPlan", &caller);
+      !st.ok()) {
+    return st;
+  }
+  if (!request->has_plan()) {
+    return InvalidField("plan", "missing; give the plan to run (see ValidatePlan)");
+  }
+  Result<v1::Session> session =
+      manager_.SubmitPlan(request->plan(), caller.ToActor(), request->start_now());
+  if (!session.ok()) return ToGrpcStatus(session.status());
+  *response->mutable_session() = std::move(*session);
+  return grpc::Status::OK;
+}
+
+grpc::Status ControlService::ValidatePlan(grpc::ServerContext* context,
+                                          const v1::ValidatePlanRequest* request,
+                                          v1::ValidatePlanResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "ValidatePlan", &caller);
+      !st.ok()) {
+    return st;
+  }
+  if (!request->has_plan()) {
+    return InvalidField("plan", "missing; give the plan to check");
+  }
+  *response = plan::ToValidatePlanResponse(manager_.ValidatePlan(request->plan()));
+  return grpc::Status::OK;
+}
+
+grpc::Status ControlService::StartSession(grpc::ServerContext* context,
+                                          const v1::StartSessionRequest* request,
+                                          v1::StartSessionResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kControl, "StartSession", &caller);
+      !st.ok()) {
+    return st;
+  }
+  SessionId id = 0;
+  if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
+  Result<v1::Session> session = manager_.Start(id, caller.ToActor());
+  if (!session.ok()) return ToGrpcStatus(session.status());
+  *response->mutable_session() = std::move(*session);
+  return grpc::Status::OK;
+}
+
+grpc::Status ControlService::PauseSession(grpc::ServerContext* context,
+                                          const v1::PauseSessionRequest* request,
+                                          v1::PauseSessionResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kControl, "PauseSession", &caller);
+      !st.ok()) {
+    return st;
+  }
+  SessionId id = 0;
+  if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
+  PauseMode mode = PauseMode::kDeferred;
+  switch (request->mode()) {
+    case v1::PAUSE_MODE_UNSPECIFIED:
+    case v1::PAUSE_MODE_DEFERRED:
+      mode = PauseMode::kDeferred;
+      break;
+    case v1::PAUSE_MODE_IMMEDIATE:
+      mode = PauseMode::kImmediate;
+      break;
+    default:
+      return InvalidField("mode", "unknown pause mode " + std::to_string(request->mode()) +
+                                      "; use PAUSE_MODE_DEFERRED or PAUSE_MODE_IMMEDIATE");
+  }
+  Result<v1::Session> session = manager_.Pause(id, mode, caller.ToActor());
+  if (!session.ok()) return ToGrpcStatus(session.status());
+  *response->mutable_session() = std::move(*session);
+  return grpc::Status::OK;
+}
+
+grpc::Status ControlService::ResumeSession(grpc::ServerContext* context,
+                                           const v1::ResumeSessionRequest* request,
+                                           v1::ResumeSessionResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kControl, "ResumeSession", &caller);
+      !st.ok()) {
+    return st;
+  }
+  SessionId id = 0;
+  if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
+  Result<v1::Session> session = manager_.Resume(id, caller.ToActor());
+  if (!session.ok()) return ToGrpcStatus(session.status());
+  *response->mutable_session() = std::move(*session);
+  return grpc::Status::OK;
+}
+
+grpc::Status ControlService::AbortSession(grpc::ServerContext* context,
+                                          const v1::AbortSessionRequest* request,
+                                          v1::AbortSessionResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kControl, "AbortSession", &caller);
+      !st.ok()) {
+    return st;
+  }
+  SessionId id = 0;
+  if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
+  if (grpc::Status st = CheckNote(request->reason(), "reason"); !st.ok()) return st;
+  const std::string reason =
+      request->reason().empty() ? "aborted by " + caller.name : request->reason();
+  Result<v1::Session> session = manager_.Abort(id, reason, caller.ToActor());
+  if (!session.ok()) return ToGrpcStatus(session.status());
+  *response->mutable_session() = std::move(*session);
+  return grpc::Status::OK;
+}
+
+grpc::Status ControlService::AnswerPrompt(grpc::ServerContext* context,
+                                          const v1::AnswerPromptRequest* request,
+                                          v1::AnswerPromptResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kControl, "AnswerPrompt", &caller);
+      !st.ok()) {
+    return st;
+  }
+  SessionId id = 0;
+  if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
+  if (request->step_index() < 0) {
+    return InvalidField("step_index", "must be ≥ 0 (got " + std::to_string(request->step_index()) +
+                                          "); give the pending prompt's Prompt.step_index");
+  }
+  if (grpc::Status st = CheckNote(request->note(), "note"); !st.ok()) return st;
+  Result<v1::Session> session =
+      manager_.AnswerPrompt(id, request->step_index(), request->note(), caller.ToActor());
+  if (!session.ok()) return ToGrpcStatus(session.status());
+  *response->mutable_session() = std::move(*session);
+  return grpc::Status::OK;
+}
+
+grpc::Status ControlService::GetSession(grpc::ServerContext* context,
+                                        const v1::GetSessionRequest* request,
+                                        v1::Session* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "GetSession", &caller); !st.ok()) {
+    return st;
+  }
+  SessionId id = 0;
+  if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
+  Result<v1::Session> session = manager_.GetSession(id);
+  if (!session.ok()) return ToGrpcStatus(session.status());
+  *response = std::move(*session);
+  return grpc::Status::OK;
+}
+
+grpc::Status ControlService::ListSessions(grpc::ServerContext* context,
+                                          const v1::ListSessionsRequest* request,
+                                          v1::ListSessionsResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "ListSessions", &caller);
+      !st.ok()) {
+    return st;
+  }
+  std::vector<SessionState> states;
+  for (int i = 0; i < request->states_size(); ++i) {
+    const int state = request->states(i);
+    if (!v1::SessionState_IsValid(state) || state == v1::SESSION_STATE_UNSPECIFIED) {
+      return InvalidField("states[" + std::to_string(i) + "]",
+                          "unknown session state " + std::to_string(state));
+    }
+    states.push_back(FromProtoState(static_cast<v1::SessionState>(state)));
+  }
+  // The page token is the id of the last session of the previous page: sessions are listed
+  // newest (highest id) first, so the next page holds the ids below it. Stable under inserts.
+  std::optional<SessionId> before;
+  if (!request->page_token().empty()) {
+    Result<SessionId> token = ParseSessionId(request->page_token(), "page_token");
+    if (!token.ok()) {
+      return InvalidField("page_token",
+                          "\"" + request->page_token() +
+                              "\" is not a token this daemon gave out; pass next_page_token as "
+                              "it was returned, or leave it empty for the first page");
+    }
+    before = *token;
+  }
+  const std::uint32_t page_size =
+      request->page_size() == 0 ? kDefaultPageSize : std::min(request->page_size(), kMaxPageSize);
+
+  Result<std::vector<v1::Session>> sessions = manager_.ListSessions(states);
+  if (!sessions.ok()) return ToGrpcStatus(sessions.status());
+  std::optional<SessionId> last;
+  bool more = false;
+  for (v1::Session& s : *sessions) {
+    Result<SessionId> id = ParseSessionId(s.session_id());
+    if (!id.ok()) continue;
+    if (before.has_value() && *id >= *before) continue;
+    if (static_cast<std::uint32_t>(response->sessions_size()) == page_size) {
+      more = true;
+      break;
+    }
+    last = *id;
+    *response->add_sessions() = std::move(s);
+  }
+  if (more && last.has_value()) response->set_next_page_token(std::to_string(*last));
+  return grpc::Status::OK;
+}
+
+grpc::Status ControlService::GetRigStatus(grpc::ServerContext* context,
+                                          const v1::GetRigStatusRequest* /*request*/,
+                                          v1::RigStatus* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "GetRigStatus", &caller);
+      !st.ok()) {
+    return st;
+  }
+  *response = manager_.GetRigStatus();
+  return grpc::Status::OK;
+}
+
+grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
+                                          const v1::WatchSessionRequest* request,
+                                          grpc::ServerWriter<v1::SessionEvent>* writer) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "WatchSession", &caller);
+      !st.ok()) {
+    return st;
+  }
+  SessionId id = 0;
+  if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
+  Result<std::shared_ptr<EventSubscription>> subscribed = manager_.Subscribe(id);
+  if (!subscribed.ok()) return ToGrpcStatus(subscribed.status());
+  const std::shared_ptr<EventSubscription> sub = *subscribed;
+  spdlog::debug("WatchSession: {} watches session {}", caller.name, id);
+
+  for (;;) {
+    if (context->IsCancelled()) {
+      sub->Close();
+      return grpc::Status(grpc::StatusCode::CANCELLED, "WatchSession: cancelled by the client");
+    }
+    // At shutdown, send what is queued (the pause the shutdown made, typically), then end.
+    const bool stopping = stopping_.stopped();
+    std::optional<v1::SessionEvent> event =
+        sub->Next(stopping ? std::chrono::milliseconds(0) : kStreamPollInterval);
+    if (event.has_value()) {
+      if (!writer->Write(*event)) {
+        sub->Close();
+        return grpc::Status(grpc::StatusCode::CANCELLED, "WatchSession: the client went away");
+      }
+      continue;
+    }
+    if (sub->ended()) return grpc::Status::OK;
+    if (stopping) {
+      sub->Close();
+      return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                          "WatchSession: the daemon is shutting down; watch again once it is "
+                          "back (the session is kept)");
+    }
+  }
+}
+
+}  // namespace brdf::daemon

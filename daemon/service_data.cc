@@ -1,0 +1,118 @@
+#include "daemon/service_data.h"
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include "core/plan/plan_json.h"
+
+namespace brdf::daemon {
+
+DataService::DataService(SessionManager& manager, const Authenticator& auth,
+                         const StopSignal& stopping)
+    : manager_(manager), auth_(auth), stopping_(stopping) {
+  listener_ = manager_.AddReadingListener([this](SessionId, const storage::ReadingRecord&) {
+    {
+      std::lock_guard lock(mu_);
+      ++generation_;
+    }
+    cv_.notify_all();
+  });
+}
+
+DataService::~DataService() {
+  manager_.RemoveReadingListener(listener_);
+}
+
+std::uint64_t DataService::Generation() const {
+  std::lock_guard lock(mu_);
+  return generation_;
+}
+
+void DataService::WaitForReading(std::uint64_t seen, std::chrono::steady_clock::duration d) const {
+  std::unique_lock lock(mu_);
+  cv_.wait_for(lock, d, [&] { return generation_ != seen || stopping_.stopped(); });
+}
+
+grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
+                                         const v1::StreamReadingsRequest* request,
+                                         grpc::ServerWriter<v1::Reading>* writer) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "StreamReadings", &caller);
+      !st.ok()) {
+    return st;
+  }
+  Result<SessionId> id = ParseSessionId(request->session_id(), "session_id");
+  if (!id.ok()) return ToGrpcStatus(id.status());
+  std::set<storage::ReadingKind> kinds;
+  for (int i = 0; i < request->kinds_size(); ++i) {
+    switch (request->kinds(i)) {
+      case v1::READING_KIND_SAMPLE:
+        kinds.insert(storage::ReadingKind::kSample);
+        break;
+      case v1::READING_KIND_REFERENCE:
+        kinds.insert(storage::ReadingKind::kReference);
+        break;
+      case v1::READING_KIND_DARK:
+        kinds.insert(storage::ReadingKind::kDark);
+        break;
+      default:
+        return InvalidField("kinds[" + std::to_string(i) + "]",
+                            "unknown reading kind " + std::to_string(request->kinds(i)) +
+                                "; use READING_KIND_SAMPLE, _REFERENCE or _DARK");
+    }
+  }
+  if (request->after_id() < 0) {
+    return InvalidField("after_id", "must be ≥ 0 (got " + std::to_string(request->after_id()) +
+                                        "); 0 starts from the first reading");
+  }
+
+  storage::SessionStore& store = *manager_.store();
+  Result<storage::SessionRecord> session = store.GetSession(*id);
+  if (!session.ok()) return ToGrpcStatus(session.status());
+
+  // Labels and averaging are fixed at submission: read them once.
+  ReadingExtras extras;
+  if (Result<std::vector<storage::StepRecord>> steps = store.GetSteps(*id); steps.ok()) {
+    for (const storage::StepRecord& step : *steps) extras.step_labels[step.step_index] = step.label;
+  }
+  if (Result<v1::Plan> plan = plan::ParsePlanJson(session->plan_json);
+      plan.ok() && plan->measurement().averages() > 0) {
+    extras.averages = plan->measurement().averages();
+  }
+
+  std::int64_t last = request->after_id();
+  for (;;) {
+    if (context->IsCancelled()) {
+      return grpc::Status(grpc::StatusCode::CANCELLED, "StreamReadings: cancelled by the client");
+    }
+    // Read the state BEFORE the page: a session that had ended before the page was read has no
+    // reading after it, so an empty page then really is the end.
+    bool ended = !request->follow();
+    if (!ended) {
+      Result<storage::SessionRecord> now = store.GetSession(*id);
+      if (!now.ok()) return ToGrpcStatus(now.status());
+      ended = IsTerminal(now->state);
+    }
+    const std::uint64_t generation = Generation();
+    Result<std::vector<storage::ReadingRecord>> page = store.GetReadings(*id, last, kPageSize);
+    if (!page.ok()) return ToGrpcStatus(page.status());
+    for (const storage::ReadingRecord& r : *page) {
+      last = r.id;
+      if (!kinds.empty() && kinds.count(r.kind) == 0) continue;
+      if (!writer->Write(ToProtoReading(r, extras))) {
+        return grpc::Status(grpc::StatusCode::CANCELLED, "StreamReadings: the client went away");
+      }
+    }
+    if (static_cast<int>(page->size()) == kPageSize) continue;  // more stored: next page now
+    if (ended) return grpc::Status::OK;
+    if (stopping_.stopped()) {
+      return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                          "StreamReadings: the daemon is shutting down; resume with after_id = " +
+                              std::to_string(last) + " once it is back");
+    }
+    WaitForReading(generation, kStreamPollInterval);
+  }
+}
+
+}  // namespace brdf::daemon

@@ -1,0 +1,48 @@
+// The Data service (brdf.proto): a session's readings, streamed in id order from the store, a
+// page at a time (memory bounded by one page whatever the session's size). With `follow` the
+// stream stays open and sends readings as they are committed (woken by a SessionManager reading
+// listener), until the session ends, the client cancels, or the daemon stops.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+
+#include "brdf/v1/brdf.grpc.pb.h"
+#include "daemon/auth.h"
+#include "daemon/service_common.h"
+#include "daemon/session_manager.h"
+
+namespace brdf::daemon {
+
+class DataService final : public v1::Data::Service {
+ public:
+  // Readings per page read from the store (and written before the next page is read).
+  static constexpr int kPageSize = 256;
+
+  // Registers a reading listener on `manager` (removed by the destructor). All three must
+  // outlive the service.
+  DataService(SessionManager& manager, const Authenticator& auth, const StopSignal& stopping);
+  ~DataService() override;
+
+  grpc::Status StreamReadings(grpc::ServerContext* context,
+                              const v1::StreamReadingsRequest* request,
+                              grpc::ServerWriter<v1::Reading>* writer) override;
+
+ private:
+  // Woken whenever any reading is committed; followers re-read the store then.
+  std::uint64_t Generation() const;
+  void WaitForReading(std::uint64_t seen, std::chrono::steady_clock::duration d) const;
+
+  SessionManager& manager_;
+  const Authenticator& auth_;
+  const StopSignal& stopping_;
+  int listener_ = 0;
+
+  mutable std::mutex mu_;
+  mutable std::condition_variable cv_;
+  std::uint64_t generation_ = 0;  // guarded by mu_
+};
+
+}  // namespace brdf::daemon

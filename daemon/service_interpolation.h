@@ -1,0 +1,39 @@
+// The Interpolation service (brdf.proto): spectra at directions that were not measured, from the
+// session's index (index_cache.h). Every request is checked before any work: angles finite and
+// in range (θ in [0, 90], φ in [−180, 360]), the direction's form set, enums known, options
+// positive, batches of 1 … kMaxBatchDirections directions with chunks of at most kMaxChunkSize.
+// Isotropic sessions take `iso` directions (φ folded into [0, 180], exact for an isotropic
+// sample) or `four` (reduced to iso); anisotropic sessions take `four` only (φ wrapped into
+// (−180, 180], the range of the stored readings).
+//
+// A batch is answered from ONE snapshot of the index, so all its results see the same readings
+// even while the session goes on. Chunks are written with the synchronous writer, which blocks
+// while the client is slow to read (gRPC flow control): the server never buffers more than a
+// chunk or so per stream. A client that cancels stops the batch at the next chunk.
+#pragma once
+
+#include "brdf/v1/brdf.grpc.pb.h"
+#include "daemon/auth.h"
+#include "daemon/index_cache.h"
+#include "daemon/service_common.h"
+
+namespace brdf::daemon {
+
+class InterpolationService final : public v1::Interpolation::Service {
+ public:
+  // All three must outlive the service.
+  InterpolationService(IndexCache& cache, const Authenticator& auth, const StopSignal& stopping);
+
+  grpc::Status Interpolate(grpc::ServerContext* context, const v1::InterpolateRequest* request,
+                           v1::InterpolateResponse* response) override;
+  grpc::Status InterpolateBatch(grpc::ServerContext* context,
+                                const v1::InterpolateBatchRequest* request,
+                                grpc::ServerWriter<v1::InterpolateBatchChunk>* writer) override;
+
+ private:
+  IndexCache& cache_;
+  const Authenticator& auth_;
+  const StopSignal& stopping_;
+};
+
+}  // namespace brdf::daemon

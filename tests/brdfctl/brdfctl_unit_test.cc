@@ -1,0 +1,271 @@
+// brdfctl's pieces that need no daemon: exit codes, the progress line, the ETA calibration, the
+// prompt hook's environment and exit handling, plan files, the simulator helper's mapping.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "daemon/config.h"
+#include "tests/support/test_env.h"
+#include "tools/brdfctl/eta_calibrator.h"
+#include "tools/brdfctl/exit_codes.h"
+#include "tools/brdfctl/plan_file.h"
+#include "tools/brdfctl/progress_line.h"
+#include "tools/brdfctl/prompt_hook.h"
+#include "tools/brdfctl/rpc_error.h"
+#include "tools/brdfctl/sim_mount.h"
+#include "tools/brdfctl/text_format.h"
+
+namespace brdf::ctl {
+namespace {
+
+TEST(ExitCodes, FollowTheStatusCode) {
+  EXPECT_EQ(ExitCodeFor(grpc::StatusCode::OK), kExitOk);
+  EXPECT_EQ(ExitCodeFor(grpc::StatusCode::INVALID_ARGUMENT), kExitInvalid);
+  EXPECT_EQ(ExitCodeFor(grpc::StatusCode::UNAUTHENTICATED), kExitAuth);
+  EXPECT_EQ(ExitCodeFor(grpc::StatusCode::PERMISSION_DENIED), kExitAuth);
+  for (grpc::StatusCode c : {grpc::StatusCode::NOT_FOUND, grpc::StatusCode::FAILED_PRECONDITION,
+                             grpc::StatusCode::UNAVAILABLE, grpc::StatusCode::INTERNAL,
+                             grpc::StatusCode::DEADLINE_EXCEEDED}) {
+    EXPECT_EQ(ExitCodeFor(c), kExitFailure) << GrpcCodeName(c);
+  }
+}
+
+TEST(RpcError, NamesTheCallTheCodeAndTheMessage) {
+  const std::string text = DescribeRpcError(
+      grpc::Status(grpc::StatusCode::NOT_FOUND, "no session 42"), "GetSession", "host:1");
+  EXPECT_NE(text.find("GetSession"), std::string::npos) << text;
+  EXPECT_NE(text.find("NOT_FOUND"), std::string::npos) << text;
+  EXPECT_NE(text.find("no session 42"), std::string::npos) << text;
+  const std::string down = DescribeRpcError(
+      grpc::Status(grpc::StatusCode::UNAVAILABLE, "connection refused"), "ListSessions", "h:7");
+  EXPECT_NE(down.find("h:7"), std::string::npos) << down;
+}
+
+TEST(TextFormat, ShortNamesAndDurations) {
+  EXPECT_EQ(StateName(v1::SESSION_STATE_AWAITING_OPERATOR), "awaiting_operator");
+  EXPECT_EQ(PromptKindName(v1::PROMPT_KIND_MOUNT_WHITE), "mount_white");
+  v1::SessionState state{};
+  EXPECT_TRUE(ParseStateName("paused", &state));
+  EXPECT_EQ(state, v1::SESSION_STATE_PAUSED);
+  EXPECT_FALSE(ParseStateName("unspecified", &state));
+  EXPECT_FALSE(ParseStateName("runing", &state));
+  EXPECT_EQ(Duration(42), "42 s");
+  EXPECT_EQ(Duration(187), "3:07");
+  EXPECT_EQ(Duration(3723), "1:02:03");
+  EXPECT_EQ(Duration(-1), "?");
+}
+
+TEST(ProgressLine, ShowsCountsPercentEtaPoseAndQuality) {
+  ProgressView v;
+  v.state = "running";
+  v.done_steps = 45;
+  v.total_steps = 120;
+  v.eta_s = 42;
+  v1::Pose pose;
+  pose.set_alpha(20);
+  pose.set_beta(-30);
+  pose.set_delta(22.5);
+  v.pose = pose;
+  v.quality_code = 0;
+  const std::string line = RenderProgressLine(v, 120);
+  EXPECT_NE(line.find("45/120 37%"), std::string::npos) << line;
+  EXPECT_NE(line.find("ETA 42 s"), std::string::npos) << line;
+  EXPECT_NE(line.find("δ 22.5°"), std::string::npos) << line;
+  EXPECT_NE(line.find("q 0"), std::string::npos) << line;
+  EXPECT_LE(DisplayWidth(line), 120u);
+  // The bar is filled in proportion.
+  const std::size_t open = line.find('['), close = line.find(']');
+  ASSERT_NE(open, std::string::npos);
+  const std::string bar = line.substr(open + 1, close - open - 1);
+  const double filled = static_cast<double>(std::count(bar.begin(), bar.end(), '#'));
+  EXPECT_NEAR(filled / static_cast<double>(bar.size()), 45.0 / 120.0, 1.0 / bar.size() + 1e-9);
+}
+
+TEST(ProgressLine, NeverWiderThanTheTerminalAndKeepsTheCounts) {
+  ProgressView v;
+  v.state = "awaiting_operator";
+  v.done_steps = 1999;
+  v.total_steps = 2320;
+  v.eta_s = 36000;
+  v.pose = v1::Pose();
+  v.quality_code = 18;
+  for (int width : {20, 30, 45, 60, 80, 200}) {
+    const std::string line = RenderProgressLine(v, width);
+    EXPECT_LE(DisplayWidth(line), static_cast<std::size_t>(width)) << width << ": " << line;
+    if (width >= 30) {
+      EXPECT_NE(line.find("1999/2320"), std::string::npos) << line;
+    }
+  }
+}
+
+TEST(EtaCalibrator, PassesTheDaemonsEtaThroughUntilItHasSeenEnough) {
+  EtaCalibrator c;
+  c.OnStep(v1::STEP_KIND_MOVE, 100, 0);
+  c.OnStep(v1::STEP_KIND_SAMPLE, 90, 1);
+  EXPECT_FALSE(c.factor().has_value());
+  EXPECT_DOUBLE_EQ(c.Eta(90), 90);
+}
+
+TEST(EtaCalibrator, LearnsTheRigsPaceAndIgnoresPrompts) {
+  // A rig 10× faster than the model: each step takes 10 model seconds in 1 real second.
+  EtaCalibrator c;
+  double eta = 500, t = 0;
+  c.OnStep(v1::STEP_KIND_MOVE, eta, t);
+  for (int i = 0; i < 6; ++i) {
+    eta -= 10;
+    t += 1;
+    c.OnStep(i % 2 ? v1::STEP_KIND_SAMPLE : v1::STEP_KIND_MOVE, eta, t);
+  }
+  // An operator takes 300 real seconds over a prompt the model costs 30 s: not the rig's pace.
+  eta -= 30;
+  t += 300;
+  c.OnStep(v1::STEP_KIND_PROMPT, eta, t);
+  ASSERT_TRUE(c.factor().has_value());
+  EXPECT_NEAR(*c.factor(), 0.1, 1e-9);
+  EXPECT_NEAR(c.Eta(eta), eta * 0.1, 1e-9);
+  // A pause in between is not counted either.
+  c.Interrupt();
+  c.OnStep(v1::STEP_KIND_SAMPLE, eta - 10, t + 1000);
+  EXPECT_NEAR(*c.factor(), 0.1, 1e-9);
+}
+
+TEST(PromptHook, SeesThePromptInItsEnvironment) {
+  testing::TempDir dir("brdfctl-hook");
+  const std::string out = dir.file("env.txt").string();
+  v1::Prompt prompt;
+  prompt.set_step_index(7);
+  prompt.set_kind(v1::PROMPT_KIND_CLOSE_SHUTTER);
+  prompt.set_text("Close the lamp shutter");
+  prompt.mutable_pose()->set_delta(22.5);
+  const Status st = RunPromptHook(
+      "printf '%s|%s|%s|%s|%s' \"$BRDF_SESSION_ID\" \"$BRDF_PROMPT_STEP\" \"$BRDF_PROMPT_KIND\" "
+      "\"$BRDF_PROMPT_DELTA\" \"$BRDF_PROMPT_TEXT\" > '" +
+          out + "'",
+      "12", prompt);
+  ASSERT_TRUE(st.ok()) << st.ToString();
+  std::ifstream in(out);
+  std::string text;
+  std::getline(in, text);
+  EXPECT_EQ(text, "12|7|close_shutter|22.5|Close the lamp shutter");
+}
+
+TEST(PromptHook, AFailingCommandLeavesThePromptPendingWithTheAnswerCommand) {
+  v1::Prompt prompt;
+  prompt.set_step_index(3);
+  prompt.set_kind(v1::PROMPT_KIND_MOUNT_WHITE);
+  const Status st = RunPromptHook("exit 5", "9", prompt);
+  EXPECT_EQ(st.code(), StatusCode::kFailedPrecondition);
+  EXPECT_NE(st.message().find("status 5"), std::string::npos) << st.message();
+  EXPECT_NE(st.message().find("brdfctl answer 9 3"), std::string::npos) << st.message();
+}
+
+TEST(PlanFile, ReadsAPlanAndNamesFileLineAndFieldOnErrors) {
+  testing::TempDir dir("brdfctl-plan");
+  const std::string good = dir.file("good.json").string();
+  std::ofstream(good)
+      << R"({"name": "p", "poseList": {"poses": [{"alpha": 0, "beta": 10, "delta": 45}]}})";
+  Result<v1::Plan> plan = ReadPlanFile(good);
+  ASSERT_TRUE(plan.ok()) << plan.status().ToString();
+  EXPECT_EQ(plan->pose_list().poses_size(), 1);
+
+  const std::string bad = dir.file("bad.json").string();
+  std::ofstream(bad) << "{\n  \"name\": \"p\",\n  \"measurement\": {\"averages\": \"many\"}\n}\n";
+  Result<v1::Plan> broken = ReadPlanFile(bad);
+  ASSERT_FALSE(broken.ok());
+  EXPECT_EQ(broken.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(broken.status().message().find(bad), std::string::npos) << broken.status().message();
+  EXPECT_NE(broken.status().message().find("measurement.averages"), std::string::npos)
+      << broken.status().message();
+  EXPECT_NE(broken.status().message().find("line 3"), std::string::npos)
+      << broken.status().message();
+
+  EXPECT_EQ(ReadPlanFile(dir.file("missing.json").string()).status().code(), StatusCode::kNotFound);
+}
+
+TEST(SimMount, MapsTargetsAndPromptKinds) {
+  EXPECT_EQ(MountedTargetValue("sample"), 0);
+  EXPECT_EQ(MountedTargetValue("white"), 1);
+  EXPECT_EQ(MountedTargetValue("dark"), 2);
+  EXPECT_FALSE(MountedTargetValue("grey").has_value());
+  EXPECT_EQ(TargetForPromptKind("mount_white"), "white");
+  EXPECT_EQ(TargetForPromptKind("mount_sample"), "sample");
+  EXPECT_EQ(TargetForPromptKind("close_shutter"), "dark");
+  EXPECT_EQ(TargetForPromptKind("relocate_detector"), "");
+  EXPECT_EQ(SimMount("no-port", 100, 1).code(), StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace brdf::ctl
+
+namespace brdf::ctl {
+namespace {
+
+std::string ExampleConfigPath() {
+#ifdef BRDF_TEST_SOURCE_DIR
+  const std::string source = BRDF_TEST_SOURCE_DIR;
+#else
+  const char* env = std::getenv("BRDF_SOURCE_DIR");
+  const std::string source = env != nullptr ? env : ".";
+#endif
+  return source + "/deploy/brdfd.example.toml";
+}
+
+std::string ExampleConfigText() {
+  std::ifstream in(ExampleConfigPath());
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// deploy/brdfd.example.toml is what an installer copies; it must load as it is, and its values
+// are the daemon's defaults.
+TEST(ExampleConfig, LoadsAndHoldsTheDefaults) {
+  const std::string text = ExampleConfigText();
+  ASSERT_FALSE(text.empty()) << ExampleConfigPath() << " not found";
+  Result<daemon::Config> config = daemon::ParseConfig(text, "brdfd.example.toml");
+  ASSERT_TRUE(config.ok()) << config.status().ToString();
+  const daemon::Config defaults;
+  EXPECT_EQ(config->server.listen, defaults.server.listen);
+  EXPECT_FALSE(config->server.tls.has_value());
+  EXPECT_EQ(config->storage.database, defaults.storage.database);
+  EXPECT_EQ(config->meter.port, defaults.meter.port);
+  EXPECT_EQ(config->meter.pacing_ms, defaults.meter.pacing_ms);
+  EXPECT_EQ(config->meter.measurement_timeout_ms, defaults.meter.measurement_timeout_ms);
+  EXPECT_TRUE(config->meter.quality_overrides.empty());
+  EXPECT_EQ(config->stage.profile, defaults.stage.profile);
+  EXPECT_EQ(config->stage.detector_arm_motorized, defaults.stage.detector_arm_motorized);
+  EXPECT_DOUBLE_EQ(config->stage.alpha.counts_per_degree, defaults.stage.alpha.counts_per_degree);
+  EXPECT_DOUBLE_EQ(config->stage.beta.speed_deg_s, defaults.stage.beta.speed_deg_s);
+  EXPECT_EQ(config->stage.gamma.present, defaults.stage.gamma.present);
+  EXPECT_DOUBLE_EQ(config->sample.white_reflectance, defaults.sample.white_reflectance);
+  EXPECT_TRUE(config->tokens.empty());
+  EXPECT_EQ(config->log.level, defaults.log.level);
+}
+
+// Its commented-out examples are valid too once uncommented: the tokens, the quality rules.
+TEST(ExampleConfig, CommentedExamplesParseWhenUncommented) {
+  std::istringstream in(ExampleConfigText());
+  std::string line, out;
+  bool in_tokens = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("# [[auth.tokens]]", 0) == 0) in_tokens = true;
+    const bool quality_rule = line.rfind("# \"18\"", 0) == 0 || line.rfind("# \"30\"", 0) == 0;
+    const bool token_key =
+        in_tokens && (line.rfind("# name", 0) == 0 || line.rfind("# token", 0) == 0 ||
+                      line.rfind("# role", 0) == 0 || line.rfind("# [[auth.tokens]]", 0) == 0);
+    out += (quality_rule || token_key ? line.substr(2) : line) + "\n";
+  }
+  Result<daemon::Config> config = daemon::ParseConfig(out, "uncommented example");
+  ASSERT_TRUE(config.ok()) << config.status().ToString();
+  ASSERT_EQ(config->tokens.size(), 2u);
+  EXPECT_EQ(config->tokens[0].role, daemon::Role::kOperator);
+  EXPECT_EQ(config->tokens[1].role, daemon::Role::kAnalyst);
+  EXPECT_EQ(config->meter.quality_overrides.size(), 2u);
+}
+
+}  // namespace
+}  // namespace brdf::ctl

@@ -1,0 +1,93 @@
+#include "tests/brdfctl/ctl_test_rig.h"
+
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+namespace brdf::testing {
+
+using namespace std::chrono_literals;
+
+CtlRig::CtlRig() : dir_("brdfctl-test") {}
+
+CtlRig::~CtlRig() {
+  daemon_.reset();  // first: it must not see its devices vanish under a session
+  sim_control_.reset();
+  sim_.reset();
+}
+
+std::string CtlRig::modbus() const {
+  return sim_->modbus_host() + ":" + std::to_string(sim_->modbus_port());
+}
+
+Status CtlRig::Start() {
+  if (dir_.path().empty()) return IoError("no temporary directory: " + dir_.error());
+  Result<std::unique_ptr<SimProcess>> sim =
+      SimProcess::Start({"--time-scale", "50", "--seed", "3", "--modbus-port", "0", "--wake-window",
+                         "0", "--no-pacing", "--log-level", "warn"});
+  if (!sim.ok()) return sim.status();
+  sim_ = std::move(*sim);
+  Result<std::unique_ptr<ModbusControl>> control =
+      ModbusControl::Connect(sim_->modbus_host(), sim_->modbus_port(), sim_->control_unit());
+  if (!control.ok()) return control.status();
+  sim_control_ = std::move(*control);
+
+  // Like deploy/quickstart.sh's configuration, with the meter's timings shortened for 50×.
+  std::ostringstream toml;
+  toml << "[server]\nlisten = \"127.0.0.1:0\"\n"
+       << "[storage]\ndatabase = \"" << dir_.file("brdfd.db").string() << "\"\n"
+       << "[meter]\nport = \"" << sim_->pr650_path() << "\"\n"
+       << "pacing_ms = 5\nquiet_gap_ms = 20\nreply_timeout_ms = 1000\n"
+       << "measurement_timeout_ms = 5000\nwake_attempts = 3\n"
+       << "[meter.quality]\n\"10\" = \"accept_and_flag\"\n"
+       << "[stage]\ntransport = \"tcp\"\naddress = \"" << modbus() << "\"\n"
+       << "response_timeout_ms = 300\ndetector_arm_motorized = true\n"
+       << "[stage.axes.delta]\npresent = true\n"
+       << "[[auth.tokens]]\nname = \"ctl-operator\"\ntoken = \"" << kCtlOperatorToken
+       << "\"\nrole = \"operator\"\n"
+       << "[[auth.tokens]]\nname = \"ctl-analyst\"\ntoken = \"" << kCtlAnalystToken
+       << "\"\nrole = \"analyst\"\n"
+       << "[log]\nlevel = \"info\"\n";
+  const std::string config = dir_.file("brdfd.toml").string();
+  {
+    std::ofstream out(config);
+    out << toml.str();
+    if (!out) return IoError("cannot write " + config);
+  }
+  Result<std::unique_ptr<DaemonProcess>> daemon = DaemonProcess::Start(
+      {"--config", config, "--shutdown-timeout", "5"}, dir_.file("brdfd.log").string());
+  if (!daemon.ok()) return daemon.status();
+  daemon_ = std::move(*daemon);
+
+  // The devices connect in the background.
+  const auto until = std::chrono::steady_clock::now() + 15s;
+  std::string last;
+  while (std::chrono::steady_clock::now() < until) {
+    Result<CommandResult> rig = Ctl({"rig"});
+    if (rig.ok()) {
+      last = rig->out + rig->err;
+      if (last.find("meter: connected") != std::string::npos &&
+          last.find("stage: connected") != std::string::npos) {
+        return Status::Ok();
+      }
+    }
+    std::this_thread::sleep_for(100ms);
+  }
+  return Timeout("the rig did not connect within 15 s; brdfctl rig said:\n" + last +
+                 "\nbrdfd's log:\n" + log());
+}
+
+std::string CtlRig::log() const {
+  return daemon_ ? daemon_->log() : std::string("(no daemon)");
+}
+
+EnvVars CtlRig::Env(const std::string& token) const {
+  return {{"BRDF_ADDRESS", address()}, {"BRDF_TOKEN", token}};
+}
+
+Result<CommandResult> CtlRig::Ctl(const std::vector<std::string>& args, const std::string& token,
+                                  std::chrono::milliseconds timeout) const {
+  return RunBrdfctl(args, Env(token), timeout);
+}
+
+}  // namespace brdf::testing

@@ -1,0 +1,304 @@
+// brdfd's TOML configuration: defaults, every key, and every way a file can be refused.
+#include "daemon/config.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "tests/support/test_env.h"
+
+namespace brdf::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+// Parses text that must be refused; returns the message.
+std::string Refusal(const std::string& toml) {
+  const Result<Config> r = ParseConfig(toml, "test.toml");
+  EXPECT_FALSE(r.ok()) << "accepted:\n" << toml;
+  if (r.ok()) return "";
+  EXPECT_EQ(r.status().code(), StatusCode::kConfigurationError);
+  return r.status().message();
+}
+
+TEST(ConfigTest, EmptyFileGivesTheDefaults) {
+  const Result<Config> r = ParseConfig("", "empty.toml");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  const Config& c = *r;
+  EXPECT_EQ(c.server.listen, "127.0.0.1:50051");
+  EXPECT_FALSE(c.server.tls.has_value());
+  EXPECT_FALSE(c.storage.database.empty());
+  EXPECT_EQ(c.meter.baud, 9600);
+  EXPECT_EQ(c.meter.pacing_ms, 100);
+  EXPECT_TRUE(c.meter.quality_overrides.empty());
+  EXPECT_EQ(c.stage.transport, "tcp");
+  EXPECT_EQ(c.stage.profile, "az");
+  EXPECT_TRUE(c.stage.alpha.present);
+  EXPECT_TRUE(c.stage.beta.present);
+  EXPECT_FALSE(c.stage.gamma.present);
+  EXPECT_FALSE(c.stage.delta.present);
+  EXPECT_FALSE(c.stage.detector_arm_motorized);
+  EXPECT_DOUBLE_EQ(c.sample.white_reflectance, 0.99);
+  EXPECT_TRUE(c.tokens.empty());
+  EXPECT_EQ(c.log.level, "info");
+}
+
+TEST(ConfigTest, FullFile) {
+  const Result<Config> r = ParseConfig(R"(
+[server]
+listen = "0.0.0.0:6000"
+[server.tls]
+cert = "/etc/brdfd/server.crt"
+key = "/etc/brdfd/server.key"
+client_ca = "/etc/brdfd/ca.crt"
+
+[storage]
+database = "/tmp/brdfd.db"
+
+[meter]
+port = "/dev/ttyS3"
+baud = 19200
+hardware_flow_control = true
+pacing_ms = 50
+quiet_gap_ms = 20
+reply_timeout_ms = 1500
+measurement_timeout_ms = 20000
+wake_attempts = 3
+[meter.quality]
+18 = "fail"
+"30" = { action = "retry", accept_flagged_when_exhausted = true }
+
+[stage]
+transport = "rtu"
+device = "/dev/ttyUSB1"
+baud = 57600
+parity = "N"
+profile = "leadshine"
+response_timeout_ms = 800
+detector_arm_motorized = true
+[stage.axes.alpha]
+unit_id = 5
+counts_per_degree = 100
+zero_offset_deg = 2.5
+sign = -1
+min_deg = -10
+max_deg = 80
+speed_deg_s = 15
+[stage.axes.gamma]
+present = true
+unit_id = 7
+[stage.axes.delta]
+unit_id = 8
+
+[sample]
+white_reflectance = 0.985
+
+[[auth.tokens]]
+name = "lab-pc"
+token = "0123456789abcdef0123"
+role = "operator"
+[[auth.tokens]]
+name = "notebook"
+token = "fedcba9876543210fedc"
+role = "analyst"
+
+[log]
+level = "debug"
+)",
+                                       "full.toml");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  const Config& c = *r;
+  EXPECT_EQ(c.server.listen, "0.0.0.0:6000");
+  ASSERT_TRUE(c.server.tls.has_value());
+  EXPECT_EQ(c.server.tls->client_ca, "/etc/brdfd/ca.crt");
+  EXPECT_EQ(c.storage.database, "/tmp/brdfd.db");
+  EXPECT_EQ(c.meter.port, "/dev/ttyS3");
+  EXPECT_EQ(c.meter.baud, 19200);
+  EXPECT_TRUE(c.meter.hardware_flow_control);
+  EXPECT_EQ(c.meter.measurement_timeout_ms, 20000);
+  ASSERT_EQ(c.meter.quality_overrides.size(), 2u);
+  EXPECT_EQ(c.meter.quality_overrides.at(18).action, drivers::pr650::QualityAction::kFail);
+  EXPECT_EQ(c.meter.quality_overrides.at(30).action, drivers::pr650::QualityAction::kRetry);
+  EXPECT_TRUE(c.meter.quality_overrides.at(30).accept_flagged_when_exhausted);
+  EXPECT_EQ(c.stage.transport, "rtu");
+  EXPECT_EQ(c.stage.device, "/dev/ttyUSB1");
+  EXPECT_EQ(c.stage.parity, 'N');
+  EXPECT_EQ(c.stage.profile, "leadshine");
+  EXPECT_EQ(c.stage.alpha.unit_id, 5);
+  EXPECT_EQ(c.stage.alpha.sign, -1);
+  EXPECT_EQ(c.stage.alpha.max_deg, 80);
+  EXPECT_TRUE(c.stage.gamma.present);
+  EXPECT_TRUE(c.stage.delta.present);  // follows detector_arm_motorized
+  EXPECT_DOUBLE_EQ(c.sample.white_reflectance, 0.985);
+  ASSERT_EQ(c.tokens.size(), 2u);
+  EXPECT_EQ(c.tokens[0].role, Role::kOperator);
+  EXPECT_EQ(c.tokens[1].role, Role::kAnalyst);
+  EXPECT_EQ(c.log.level, "debug");
+
+  const plan::RigDescription rig = ToRigDescription(c);
+  EXPECT_TRUE(rig.has_gamma_axis);
+  EXPECT_TRUE(rig.has_detector_arm);
+  EXPECT_EQ(rig.alpha.max_deg, 80);
+  EXPECT_EQ(rig.alpha.speed_deg_s, 15);
+  EXPECT_EQ(rig.convention.alpha.sign, -1);
+  EXPECT_EQ(rig.convention.alpha.zero_deg, 2.5);
+  // 19200 baud moves the D5 report twice as fast as 9600.
+  Config slow = c;
+  slow.meter.baud = 9600;
+  EXPECT_NEAR(ToRigDescription(slow).meter_transfer_s, 2 * rig.meter_transfer_s, 1e-12);
+  EXPECT_NEAR(ToRigDescription(slow).meter_transfer_s, 1.8, 0.05);  // pr650.md: ~1.8 s
+}
+
+TEST(ConfigTest, UnknownKeysAreRefusedByFullPath) {
+  const std::string m = Refusal("[stage.axes.alpa]\nunit_id = 1\n");
+  EXPECT_THAT(m, HasSubstr("unknown key stage.axes.alpa"));
+  EXPECT_THAT(m, HasSubstr("line 1"));
+  EXPECT_THAT(m, HasSubstr("test.toml"));
+  EXPECT_THAT(Refusal("[server]\nlisten_on = \"x:1\"\n"),
+              HasSubstr("unknown key server.listen_on"));
+  EXPECT_THAT(Refusal("verbose = true\n"), HasSubstr("unknown key verbose"));
+  EXPECT_THAT(Refusal("[stage.axes.beta]\nspeed = 3\n"),
+              HasSubstr("unknown key stage.axes.beta.speed"));
+  EXPECT_THAT(Refusal("[meter.quality]\n30 = { action = \"retry\", flag = true }\n"),
+              HasSubstr("unknown key meter.quality.30.flag"));
+  EXPECT_THAT(Refusal("[[auth.tokens]]\nname = \"a\"\ntoken = \"0123456789abcdef\"\n"
+                      "role = \"operator\"\nexpires = 3\n"),
+              HasSubstr("unknown key auth.tokens[0].expires"));
+}
+
+TEST(ConfigTest, SyntaxErrorsAreStatusesNotExceptions) {
+  const std::string m = Refusal("[server\nlisten = 1\n");
+  EXPECT_THAT(m, HasSubstr("not valid TOML"));
+  EXPECT_THAT(m, HasSubstr("line 1"));
+  EXPECT_THAT(Refusal("a = \"unterminated\n"), HasSubstr("not valid TOML"));
+  EXPECT_THAT(Refusal("[log]\nlevel = \"info\"\n[log]\nlevel = \"debug\"\n"),
+              HasSubstr("not valid TOML"));  // table defined twice
+}
+
+TEST(ConfigTest, WrongTypes) {
+  EXPECT_THAT(Refusal("[meter]\nbaud = \"9600\"\n"), HasSubstr("meter.baud: must be an integer"));
+  EXPECT_THAT(Refusal("[stage]\ndetector_arm_motorized = 1\n"),
+              HasSubstr("stage.detector_arm_motorized: must be true or false"));
+  EXPECT_THAT(Refusal("server = 3\n"), HasSubstr("server: must be a table"));
+  EXPECT_THAT(Refusal("[sample]\nwhite_reflectance = \"high\"\n"), HasSubstr("must be a number"));
+  EXPECT_THAT(Refusal("[auth]\ntokens = 5\n"), HasSubstr("auth.tokens: must be an array"));
+  EXPECT_THAT(Refusal("[meter.quality]\n18 = 3\n"), HasSubstr("meter.quality.18"));
+}
+
+TEST(ConfigTest, ValuesOutOfRange) {
+  EXPECT_THAT(Refusal("[server]\nlisten = \"localhost\"\n"), HasSubstr("server.listen"));
+  EXPECT_THAT(Refusal("[server]\nlisten = \"localhost:70000\"\n"), HasSubstr("port 70000"));
+  EXPECT_THAT(Refusal("[server]\nlisten = \"unix:\"\n"), HasSubstr("socket path"));
+  EXPECT_THAT(Refusal("[storage]\ndatabase = \"\"\n"),
+              HasSubstr("storage.database: must not be empty"));
+  EXPECT_THAT(Refusal("[meter]\nbaud = 9601\n"), HasSubstr("not a standard rate"));
+  EXPECT_THAT(Refusal("[meter]\npacing_ms = -1\n"), HasSubstr("meter.pacing_ms: -1 is outside"));
+  EXPECT_THAT(Refusal("[meter]\nmeasurement_timeout_ms = 10\n"),
+              HasSubstr("meter.measurement_timeout_ms"));
+  EXPECT_THAT(Refusal("[meter.quality]\n123 = \"retry\"\n"), HasSubstr("not a quality code"));
+  EXPECT_THAT(Refusal("[meter.quality]\n18 = \"ignore\"\n"), HasSubstr("\"ignore\" is not one of"));
+  EXPECT_THAT(Refusal("[meter.quality]\n18 = {}\n"), HasSubstr("meter.quality.18.action: missing"));
+  EXPECT_THAT(Refusal("[stage]\ntransport = \"udp\"\n"), HasSubstr("stage.transport"));
+  EXPECT_THAT(Refusal("[stage]\ntransport = \"rtu\"\n"), HasSubstr("stage.device: missing"));
+  EXPECT_THAT(Refusal("[stage]\naddress = \"10.0.0.1\"\n"), HasSubstr("stage.address"));
+  EXPECT_THAT(Refusal("[stage]\naddress = \"10.0.0.1:0\"\n"), HasSubstr("port 0"));
+  EXPECT_THAT(Refusal("[stage]\nparity = \"X\"\n"), HasSubstr("stage.parity"));
+  EXPECT_THAT(Refusal("[stage]\nprofile = \"arcus\"\n"), HasSubstr("stage.profile"));
+  EXPECT_THAT(Refusal("[stage.axes.alpha]\nunit_id = 0\n"), HasSubstr("stage.axes.alpha.unit_id"));
+  EXPECT_THAT(Refusal("[stage.axes.alpha]\ncounts_per_degree = 0\n"),
+              HasSubstr("stage.axes.alpha.counts_per_degree"));
+  EXPECT_THAT(Refusal("[stage.axes.alpha]\nspeed_deg_s = -5\n"),
+              HasSubstr("stage.axes.alpha.speed_deg_s"));
+  EXPECT_THAT(Refusal("[stage.axes.alpha]\nsign = 0.5\n"), HasSubstr("must be 1 or -1"));
+  EXPECT_THAT(Refusal("[stage.axes.beta]\nmin_deg = 10\nmax_deg = 5\n"),
+              HasSubstr("stage.axes.beta.max_deg"));
+  EXPECT_THAT(Refusal("[stage.axes.beta]\nmax_deg = nan\n"), HasSubstr("finite"));
+  EXPECT_THAT(Refusal("[stage.axes.alpha]\npresent = false\n"),
+              HasSubstr("stage.axes.alpha.present"));
+  EXPECT_THAT(Refusal("[stage.axes.gamma]\npresent = true\nunit_id = 1\n"),
+              HasSubstr("stage.axes.gamma.unit_id: 1 is also the unit id of alpha"));
+  EXPECT_THAT(
+      Refusal("[stage]\ndetector_arm_motorized = true\n[stage.axes.delta]\npresent = false\n"),
+      HasSubstr("contradicts"));
+  EXPECT_THAT(Refusal("[stage.axes.delta]\npresent = true\n"), HasSubstr("contradicts"));
+  EXPECT_THAT(Refusal("[sample]\nwhite_reflectance = 0\n"), HasSubstr("sample.white_reflectance"));
+  EXPECT_THAT(Refusal("[sample]\nwhite_reflectance = 1.2\n"),
+              HasSubstr("sample.white_reflectance"));
+  EXPECT_THAT(Refusal("[log]\nlevel = \"verbose\"\n"), HasSubstr("log.level"));
+}
+
+TEST(ConfigTest, TlsNeedsCertAndKey) {
+  EXPECT_THAT(Refusal("[server.tls]\ncert = \"a.crt\"\n"), HasSubstr("server.tls.key: missing"));
+  EXPECT_THAT(Refusal("[server.tls]\nkey = \"a.key\"\n"), HasSubstr("server.tls.cert: missing"));
+  EXPECT_THAT(Refusal("[server.tls]\nclient_ca = \"ca.crt\"\n"), HasSubstr("neither cert nor key"));
+}
+
+TEST(ConfigTest, TokenProblems) {
+  const std::string base =
+      "[[auth.tokens]]\nname = \"a\"\ntoken = \"0123456789abcdef\"\nrole = \"operator\"\n";
+  ASSERT_TRUE(ParseConfig(base).ok());
+  EXPECT_THAT(Refusal("[[auth.tokens]]\nname = \"a\"\ntoken = \"short\"\nrole = \"operator\"\n"),
+              HasSubstr("auth.tokens[0].token: is 5 characters"));
+  EXPECT_THAT(Refusal("[[auth.tokens]]\ntoken = \"0123456789abcdef\"\nrole = \"operator\"\n"),
+              HasSubstr("auth.tokens[0].name: missing"));
+  EXPECT_THAT(Refusal("[[auth.tokens]]\nname = \"a\"\nrole = \"operator\"\n"),
+              HasSubstr("auth.tokens[0].token: missing"));
+  EXPECT_THAT(Refusal("[[auth.tokens]]\nname = \"a\"\ntoken = \"0123456789abcdef\"\n"),
+              HasSubstr("auth.tokens[0].role: missing"));
+  EXPECT_THAT(
+      Refusal("[[auth.tokens]]\nname = \"a\"\ntoken = \"0123456789abcdef\"\nrole = \"admin\"\n"),
+      HasSubstr("auth.tokens[0].role"));
+  EXPECT_THAT(
+      Refusal(base +
+              "[[auth.tokens]]\nname = \"a\"\ntoken = \"0123456789abcdeX\"\nrole = \"analyst\"\n"),
+      HasSubstr("auth.tokens[1].name: \"a\" is used by another token"));
+  const std::string same_secret = Refusal(
+      base + "[[auth.tokens]]\nname = \"b\"\ntoken = \"0123456789abcdef\"\nrole = \"analyst\"\n");
+  EXPECT_THAT(same_secret, HasSubstr("auth.tokens[1].token: is the same secret"));
+  EXPECT_THAT(same_secret, Not(HasSubstr("0123456789abcdef")));  // secrets are never echoed
+}
+
+TEST(ConfigTest, EveryProblemIsReportedAtOnce) {
+  const std::string m =
+      Refusal("[meter]\nbaud = 1\n[stage]\nprofile = \"x\"\n[log]\nlevel = \"loud\"\n[bogus]\n");
+  EXPECT_THAT(m, HasSubstr("meter.baud"));
+  EXPECT_THAT(m, HasSubstr("stage.profile"));
+  EXPECT_THAT(m, HasSubstr("log.level"));
+  EXPECT_THAT(m, HasSubstr("unknown key bogus"));
+}
+
+TEST(ConfigTest, LoadConfigReadsFilesAndReportsMissingOnes) {
+  brdf::testing::TempDir dir("brdf-config-test");
+  ASSERT_FALSE(dir.path().empty()) << dir.error();
+  const std::string path = dir.file("brdfd.toml").string();
+  {
+    std::ofstream out(path);
+    out << "[server]\nlisten = \"127.0.0.1:0\"\n[stage]\nadress = \"x:1\"\n";
+  }
+  const Result<Config> bad = LoadConfig(path);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_THAT(bad.status().message(), HasSubstr(path));
+  EXPECT_THAT(bad.status().message(), HasSubstr("line 4"));
+  EXPECT_THAT(bad.status().message(), HasSubstr("unknown key stage.adress"));
+  {
+    std::ofstream out(path);
+    out << "[server]\nlisten = \"127.0.0.1:0\"\n";
+  }
+  const Result<Config> good = LoadConfig(path);
+  ASSERT_TRUE(good.ok()) << good.status().ToString();
+  EXPECT_EQ(good->server.listen, "127.0.0.1:0");
+  const Result<Config> missing = LoadConfig(dir.file("absent.toml").string());
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.status().code(), StatusCode::kNotFound);
+}
+
+TEST(ConfigTest, OversizedFileIsRefused) {
+  std::string big = "# " + std::string(kMaxConfigBytes, 'x') + "\n";
+  EXPECT_THAT(Refusal(big), HasSubstr("cap"));
+}
+
+}  // namespace
+}  // namespace brdf::daemon

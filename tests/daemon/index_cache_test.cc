@@ -1,0 +1,235 @@
+// IndexCache in process, over a real SQLite store filled through storage's own API: the
+// quantities it derives from raw readings, snapshot consistency while readings land, cache keys,
+// the LRU bound, and its errors.
+#include "daemon/index_cache.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "storage/session_store.h"
+#include "tests/support/test_env.h"
+
+namespace brdf::daemon {
+namespace {
+
+constexpr double kRhoW = 0.98;
+const WavelengthGrid kGrid{400, 100, 4};  // 4 bands: enough to tell them apart
+
+// A session whose steps are: reference (white at θi,ref), dark, then `samples` sample steps.
+// Its readings are written by AddReading in step order.
+class SessionFixture {
+ public:
+  SessionFixture(storage::SessionStore& store, int samples, bool anisotropic = false)
+      : store_(store) {
+    storage::NewSession s;
+    s.name = "cache test";
+    s.plan_kind = "pose_list";
+    s.plan_json = anisotropic ? R"({"poseList": {"poses": [{"alpha": 0, "beta": 0, "delta": 0}]},
+                                    "anisotropic": true})"
+                              : R"({"poseList": {"poses": [{"alpha": 0, "beta": 0, "delta": 0}]}})";
+    s.created_by_role = "operator";
+    s.white_reflectance = kRhoW;
+    std::vector<storage::StepRecord> steps;
+    auto step = [&](storage::StepKind kind) {
+      storage::StepRecord r;
+      r.step_index = static_cast<int>(steps.size());
+      r.kind = kind;
+      steps.push_back(r);
+    };
+    step(storage::StepKind::kReference);
+    step(storage::StepKind::kDark);
+    for (int i = 0; i < samples; ++i) step(storage::StepKind::kSample);
+    Result<std::int64_t> id = store.CreateSession(s, steps);
+    EXPECT_TRUE(id.ok()) << id.status().ToString();
+    id_ = id.ok() ? *id : 0;
+    EXPECT_TRUE(store.SetSessionState(id_, SessionState::kRunning, "test").ok());
+  }
+
+  std::int64_t id() const { return id_; }
+
+  // White: I0 = D + 1 per band, at incidence theta_ref.
+  std::int64_t AddReference(double theta_ref) {
+    return Add(storage::ReadingKind::kReference, {theta_ref, 0, 0, 0}, {1.1, 2.1, 3.1, 4.1});
+  }
+  std::int64_t AddDark() { return Add(storage::ReadingKind::kDark, {}, {0.1, 0.1, 0.1, 0.1}); }
+  // A sample whose reflectance is `r` in every band: I = D + r·(I0 − D).
+  storage::ReadingRecord AddSample(const Directions& d, double r, bool with_reference = true) {
+    const std::int64_t id =
+        Add(storage::ReadingKind::kSample, d, {0.1 + r * 1, 0.1 + r * 2, 0.1 + r * 3, 0.1 + r * 4},
+            with_reference);
+    return *store_.GetReading(id);
+  }
+
+ private:
+  std::int64_t Add(storage::ReadingKind kind, const Directions& d, std::vector<double> spectrum,
+                   bool with_reference = true) {
+    storage::ReadingRecord r;
+    r.kind = kind;
+    r.directions = d;
+    r.grid = kGrid;
+    r.spectrum = std::move(spectrum);
+    if (kind == storage::ReadingKind::kSample) {
+      if (with_reference) r.reference_reading_id = reference_;
+      r.dark_reading_id = dark_;
+    }
+    Result<std::int64_t> id = store_.CompleteStepWithReading(id_, next_step_++, r);
+    EXPECT_TRUE(id.ok()) << id.status().ToString();
+    if (kind == storage::ReadingKind::kReference) reference_ = *id;
+    if (kind == storage::ReadingKind::kDark) dark_ = *id;
+    return id.ok() ? *id : 0;
+  }
+
+  storage::SessionStore& store_;
+  std::int64_t id_ = 0;
+  int next_step_ = 0;
+  std::optional<std::int64_t> reference_;
+  std::optional<std::int64_t> dark_;
+};
+
+class IndexCacheTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto store = storage::SessionStore::Open(dir_.file("cache.db").string());
+    ASSERT_TRUE(store.ok()) << store.status().ToString();
+    store_ = std::move(*store);
+  }
+
+  // Samples on a small (θi, θo, φ) grid around (30, 30, 90), reflectance rising with θo.
+  static void FillGrid(SessionFixture& s, std::vector<storage::ReadingRecord>* out = nullptr) {
+    s.AddReference(10);
+    s.AddDark();
+    for (double ti : {20.0, 40.0}) {
+      for (double to : {20.0, 40.0}) {
+        for (double phi : {60.0, 120.0}) {
+          auto r = s.AddSample({ti, 0, to, phi}, 0.1 + to / 100);
+          if (out != nullptr) out->push_back(r);
+        }
+      }
+    }
+  }
+
+  testing::TempDir dir_{"index-cache-test"};
+  std::shared_ptr<storage::SessionStore> store_;
+};
+
+TEST_F(IndexCacheTest, DerivesRadianceReflectanceAndBrdfFromTheNamedReferenceAndDark) {
+  SessionFixture s(*store_, 8);
+  std::vector<storage::ReadingRecord> samples;
+  FillGrid(s, &samples);
+  IndexCache cache(store_);
+  const storage::ReadingRecord& r = samples[5];  // θi 40, θo 20, φ 120: reflectance 0.3
+  const double coords[] = {40, 20, 120};
+
+  auto value = [&](Quantity q) {
+    auto index = cache.Get(s.id(), q, interp::Method::kNearest, {});
+    EXPECT_TRUE(index.ok()) << index.status().ToString();
+    interp::Interpolation answer = (*index)->interpolator->Evaluate(coords);
+    EXPECT_EQ(answer.vertices.at(0).id, r.id);
+    return answer.spectrum;
+  };
+  const std::vector<double> radiance = value(Quantity::kRadiance);
+  const std::vector<double> reflectance = value(Quantity::kReflectance);
+  const std::vector<double> brdf = value(Quantity::kBrdf);
+  const double cos_ratio =
+      std::cos(10 * std::numbers::pi / 180) / std::cos(40 * std::numbers::pi / 180);
+  for (int b = 0; b < 4; ++b) {
+    EXPECT_NEAR(radiance[b], 0.3 * (b + 1), 1e-12);  // I − D
+    EXPECT_NEAR(reflectance[b], 0.3, 1e-12);         // (I − D) / (I0 − D)
+    EXPECT_NEAR(brdf[b], 0.3 * kRhoW / std::numbers::pi * cos_ratio, 1e-12);
+  }
+}
+
+TEST_F(IndexCacheTest, ReadersKeepTheirSnapshotWhileNewReadingsBuildTheNext) {
+  SessionFixture s(*store_, 9);
+  FillGrid(s);
+  IndexCache cache(store_);
+  auto first = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kDelaunay, {});
+  ASSERT_TRUE(first.ok()) << first.status().ToString();
+  EXPECT_EQ((*first)->samples->size(), 8u);
+  // Same settings, nothing new: the same snapshot.
+  auto again = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kDelaunay, {});
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->get(), first->get());
+
+  // A reading lands and is announced: the next query sees it, the held snapshot does not change.
+  const storage::ReadingRecord added = s.AddSample({30, 0, 30, 90}, 0.9);
+  cache.OnReading(s.id(), added);
+  auto next = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kDelaunay, {});
+  ASSERT_TRUE(next.ok());
+  EXPECT_NE(next->get(), first->get());
+  EXPECT_EQ((*next)->samples->size(), 9u);
+  EXPECT_EQ((*next)->through_reading_id, added.id);
+  EXPECT_EQ((*first)->samples->size(), 8u);
+  const double at[] = {30, 30, 90};
+  EXPECT_EQ((*next)->interpolator->Evaluate(at).vertices.at(0).id, added.id);
+  // The old snapshot still answers, from its own readings.
+  interp::Interpolation old = (*first)->interpolator->Evaluate(at);
+  for (const auto& v : old.vertices) EXPECT_NE(v.id, added.id);
+
+  // Another method or options are another index over the same readings.
+  interp::Options scaled;
+  scaled.axis_scale = {1, 1, 0.5};
+  auto other = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kDelaunay, scaled);
+  ASSERT_TRUE(other.ok());
+  EXPECT_NE(other->get(), next->get());
+  EXPECT_EQ((*other)->samples.get(), (*next)->samples.get());  // samples shared
+}
+
+TEST_F(IndexCacheTest, KeepsAtMostMaxSessionsEvictingTheLeastRecentlyUsed) {
+  SessionFixture a(*store_, 8);
+  FillGrid(a);
+  SessionFixture b(*store_, 8);
+  FillGrid(b);
+  IndexCache::Options options;
+  options.max_sessions = 1;
+  IndexCache cache(store_, options);
+  ASSERT_TRUE(cache.Get(a.id(), Quantity::kBrdf, interp::Method::kNearest, {}).ok());
+  ASSERT_TRUE(cache.Get(b.id(), Quantity::kBrdf, interp::Method::kNearest, {}).ok());
+  EXPECT_EQ(cache.stats().sessions, 1u);
+  EXPECT_EQ(cache.stats().evictions, 1u);
+  ASSERT_TRUE(cache.Get(a.id(), Quantity::kBrdf, interp::Method::kNearest, {}).ok());
+  EXPECT_EQ(cache.stats().loads, 3u);  // a was read from the store again
+  EXPECT_EQ(cache.stats().evictions, 2u);
+}
+
+TEST_F(IndexCacheTest, ErrorsNameTheProblem) {
+  IndexCache cache(store_);
+  EXPECT_EQ(cache.Get(4242, Quantity::kBrdf, interp::Method::kOctant, {}).status().code(),
+            StatusCode::kNotFound);
+  EXPECT_EQ(cache.stats().sessions, 0u);  // an unknown session is not kept
+
+  SessionFixture empty(*store_, 8);
+  auto none = cache.Get(empty.id(), Quantity::kBrdf, interp::Method::kOctant, {});
+  EXPECT_EQ(none.status().code(), StatusCode::kFailedPrecondition);
+
+  SessionFixture s(*store_, 9);
+  FillGrid(s);
+  s.AddSample({30, 0, 30, 90}, 0.5, /*with_reference=*/false);
+  interp::Options wrong;
+  wrong.axis_scale = {1, 1};
+  auto bad = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kOctant, wrong);
+  EXPECT_EQ(bad.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(bad.status().message().find("options.axis_scale"), std::string::npos);
+  // The sample without a reference has a radiance but no reflectance or BRDF.
+  auto radiance = cache.Get(s.id(), Quantity::kRadiance, interp::Method::kNearest, {});
+  auto brdf = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kNearest, {});
+  ASSERT_TRUE(radiance.ok() && brdf.ok());
+  EXPECT_EQ((*radiance)->samples->size(), 9u);
+  EXPECT_EQ((*brdf)->samples->size(), 8u);
+  EXPECT_EQ((*brdf)->skipped, 1u);
+  EXPECT_NE((*brdf)->skipped_detail.find("no reference"), std::string::npos);
+
+  SessionFixture aniso(*store_, 2, /*anisotropic=*/true);
+  aniso.AddReference(0);
+  aniso.AddDark();
+  interp::Options mirror;
+  mirror.mirror_phi = true;
+  auto sym = cache.Get(aniso.id(), Quantity::kBrdf, interp::Method::kOctant, mirror);
+  EXPECT_EQ(sym.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(sym.status().message().find("options.mirror_phi"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace brdf::daemon

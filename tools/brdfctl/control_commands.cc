@@ -1,0 +1,241 @@
+#include "tools/brdfctl/control_commands.h"
+
+#include "tools/brdfctl/exit_codes.h"
+#include "tools/brdfctl/json_output.h"
+#include "tools/brdfctl/plan_file.h"
+#include "tools/brdfctl/rpc_error.h"
+#include "tools/brdfctl/session_text.h"
+#include "tools/brdfctl/text_format.h"
+
+namespace brdf::ctl {
+namespace {
+
+int RpcFailed(CommandContext& ctx, const grpc::Status& status, const char* call) {
+  return ReportRpcError(ctx.err, status, call, ctx.client.options().address);
+}
+
+// After a verb: the session's new state in one line (or the reply as JSON).
+int PrintVerbResult(CommandContext& ctx, const google::protobuf::Message& reply,
+                    const v1::Session& session) {
+  if (ctx.json) {
+    PrintJsonLine(ctx.out, reply);
+  } else {
+    ctx.out << "session " << session.session_id() << ": " << StateName(session.state()) << "\n";
+    if (session.has_pending_prompt()) {
+      ctx.out << "  waiting for the operator: step " << session.pending_prompt().step_index()
+              << " (" << PromptKindName(session.pending_prompt().kind())
+              << "): " << session.pending_prompt().text() << "\n";
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int RunValidate(CommandContext& ctx, const std::string& plan_path) {
+  Result<v1::Plan> plan = ReadPlanFile(plan_path);
+  if (!plan.ok()) return ReportLocalError(ctx.err, plan.status());
+  v1::ValidatePlanRequest request;
+  *request.mutable_plan() = *plan;
+  v1::ValidatePlanResponse reply;
+  const grpc::Status status =
+      ctx.client.control().ValidatePlan(ctx.client.UnaryContext().get(), request, &reply);
+  if (!status.ok()) return RpcFailed(ctx, status, "ValidatePlan");
+  if (ctx.json) {
+    PrintJsonLine(ctx.out, reply);
+    return reply.valid() ? kExitOk : kExitInvalid;
+  }
+  if (reply.valid()) {
+    ctx.out << plan_path << ": valid\n";
+    if (reply.has_summary()) {
+      ctx.out << "  " << PlanSummaryText(reply.summary()) << "\n";
+    } else {
+      ctx.out << "  " << reply.step_count() << " steps, " << reply.operator_interventions()
+              << " operator actions, about " << Duration(reply.estimated_duration_s()) << "\n";
+    }
+    return kExitOk;
+  }
+  const int n = reply.problems_size();
+  ctx.out << plan_path << ": not valid, " << n << (n == 1 ? " problem" : " problems") << "\n";
+  for (const v1::PlanProblem& p : reply.problems()) {
+    ctx.out << "  " << (p.field_path().empty() ? "(plan)" : p.field_path()) << ": " << p.message()
+            << "\n";
+  }
+  return kExitInvalid;
+}
+
+int RunSubmit(CommandContext& ctx, const std::string& plan_path, bool start_now, bool quiet) {
+  Result<v1::Plan> plan = ReadPlanFile(plan_path);
+  if (!plan.ok()) return ReportLocalError(ctx.err, plan.status());
+  v1::SubmitPlanRequest request;
+  *request.mutable_plan() = *plan;
+  request.set_start_now(start_now);
+  v1::SubmitPlanResponse reply;
+  const grpc::Status status =
+      ctx.client.control().SubmitPlan(ctx.client.UnaryContext().get(), request, &reply);
+  if (!status.ok()) return RpcFailed(ctx, status, "SubmitPlan");
+  const v1::Session& s = reply.session();
+  if (ctx.json) {
+    PrintJsonLine(ctx.out, reply);
+  } else if (quiet) {
+    ctx.out << s.session_id() << "\n";
+  } else {
+    ctx.out << "submitted session " << s.session_id() << " \"" << s.name()
+            << "\": " << StateName(s.state()) << "\n";
+    if (s.has_summary()) ctx.out << "  " << PlanSummaryText(s.summary()) << "\n";
+    if (s.state() == v1::SESSION_STATE_QUEUED && !start_now) {
+      ctx.out << "  start it: brdfctl start " << s.session_id() << "\n";
+    }
+    ctx.out << "  follow it: brdfctl watch " << s.session_id() << "\n";
+  }
+  return kExitOk;
+}
+
+int RunStart(CommandContext& ctx, const std::string& session_id) {
+  v1::StartSessionRequest request;
+  request.set_session_id(session_id);
+  v1::StartSessionResponse reply;
+  const grpc::Status status =
+      ctx.client.control().StartSession(ctx.client.UnaryContext().get(), request, &reply);
+  if (!status.ok()) return RpcFailed(ctx, status, "StartSession");
+  return PrintVerbResult(ctx, reply, reply.session());
+}
+
+int RunPause(CommandContext& ctx, const std::string& session_id, bool immediate) {
+  v1::PauseSessionRequest request;
+  request.set_session_id(session_id);
+  request.set_mode(immediate ? v1::PAUSE_MODE_IMMEDIATE : v1::PAUSE_MODE_DEFERRED);
+  v1::PauseSessionResponse reply;
+  const grpc::Status status =
+      ctx.client.control().PauseSession(ctx.client.UnaryContext().get(), request, &reply);
+  if (!status.ok()) return RpcFailed(ctx, status, "PauseSession");
+  return PrintVerbResult(ctx, reply, reply.session());
+}
+
+int RunResume(CommandContext& ctx, const std::string& session_id) {
+  v1::ResumeSessionRequest request;
+  request.set_session_id(session_id);
+  v1::ResumeSessionResponse reply;
+  const grpc::Status status =
+      ctx.client.control().ResumeSession(ctx.client.UnaryContext().get(), request, &reply);
+  if (!status.ok()) return RpcFailed(ctx, status, "ResumeSession");
+  return PrintVerbResult(ctx, reply, reply.session());
+}
+
+int RunAbort(CommandContext& ctx, const std::string& session_id, const std::string& reason) {
+  v1::AbortSessionRequest request;
+  request.set_session_id(session_id);
+  request.set_reason(reason);
+  v1::AbortSessionResponse reply;
+  const grpc::Status status =
+      ctx.client.control().AbortSession(ctx.client.UnaryContext().get(), request, &reply);
+  if (!status.ok()) return RpcFailed(ctx, status, "AbortSession");
+  return PrintVerbResult(ctx, reply, reply.session());
+}
+
+int RunAnswer(CommandContext& ctx, const std::string& session_id, int step_index,
+              const std::string& note) {
+  v1::AnswerPromptRequest request;
+  request.set_session_id(session_id);
+  request.set_step_index(step_index);
+  request.set_note(note);
+  v1::AnswerPromptResponse reply;
+  const grpc::Status status =
+      ctx.client.control().AnswerPrompt(ctx.client.UnaryContext().get(), request, &reply);
+  if (!status.ok()) return RpcFailed(ctx, status, "AnswerPrompt");
+  return PrintVerbResult(ctx, reply, reply.session());
+}
+
+int RunGet(CommandContext& ctx, const std::string& session_id) {
+  v1::GetSessionRequest request;
+  request.set_session_id(session_id);
+  v1::Session reply;
+  const grpc::Status status =
+      ctx.client.control().GetSession(ctx.client.UnaryContext().get(), request, &reply);
+  if (!status.ok()) return RpcFailed(ctx, status, "GetSession");
+  if (ctx.json) {
+    PrintJsonLine(ctx.out, reply);
+  } else {
+    PrintSessionDetail(ctx.out, reply);
+  }
+  return kExitOk;
+}
+
+int RunList(CommandContext& ctx, const std::vector<std::string>& states, unsigned limit) {
+  v1::ListSessionsRequest request;
+  for (const std::string& name : states) {
+    v1::SessionState state{};
+    if (!ParseStateName(name, &state)) {
+      ctx.err << "brdfctl: --state " << name
+              << " is not a session state; use queued, running, pausing, paused, "
+                 "awaiting_operator, completed, aborted or failed\n";
+      return kExitInvalid;
+    }
+    request.add_states(state);
+  }
+  // Every page, merged into one reply (and one JSON object).
+  v1::ListSessionsResponse all;
+  for (;;) {
+    v1::ListSessionsResponse page;
+    const grpc::Status status =
+        ctx.client.control().ListSessions(ctx.client.UnaryContext().get(), request, &page);
+    if (!status.ok()) return RpcFailed(ctx, status, "ListSessions");
+    for (const v1::Session& s : page.sessions()) {
+      if (limit > 0 && static_cast<unsigned>(all.sessions_size()) >= limit) break;
+      *all.add_sessions() = s;
+    }
+    if (page.next_page_token().empty() ||
+        (limit > 0 && static_cast<unsigned>(all.sessions_size()) >= limit)) {
+      break;
+    }
+    request.set_page_token(page.next_page_token());
+  }
+  if (ctx.json) {
+    PrintJsonLine(ctx.out, all);
+    return kExitOk;
+  }
+  if (all.sessions().empty()) {
+    ctx.out << "no sessions" << (states.empty() ? "" : " in those states") << "\n";
+    return kExitOk;
+  }
+  for (const v1::Session& s : all.sessions()) ctx.out << SessionLine(s) << "\n";
+  return kExitOk;
+}
+
+int RunRig(CommandContext& ctx) {
+  v1::GetRigStatusRequest request;
+  v1::RigStatus reply;
+  const grpc::Status status =
+      ctx.client.control().GetRigStatus(ctx.client.UnaryContext().get(), request, &reply);
+  if (!status.ok()) return RpcFailed(ctx, status, "GetRigStatus");
+  if (ctx.json) {
+    PrintJsonLine(ctx.out, reply);
+    return kExitOk;
+  }
+  for (const v1::DeviceStatus& d : reply.devices()) {
+    ctx.out << d.name() << ": " << ConnectionStateName(d.state()) << "  " << d.model() << " at "
+            << d.address();
+    if (!d.detail().empty()) ctx.out << "  (" << d.detail() << ")";
+    ctx.out << "\n";
+  }
+  ctx.out << "meter serial: " << (reply.meter_serial().empty() ? "unknown" : reply.meter_serial())
+          << "\n";
+  ctx.out << "pose: "
+          << (reply.live_pose_valid() ? PoseText(reply.live_pose()) : std::string("not known yet"))
+          << "\n";
+  ctx.out << "detector arm: "
+          << (reply.detector_arm_motorized() ? "motorized" : "moved by the operator") << "\n";
+  for (const v1::AxisStatus& a : reply.axes()) {
+    if (!a.present()) continue;
+    ctx.out << "  " << a.name() << ": " << Num(a.position_deg(), 6) << "°"
+            << (a.moving() ? " moving" : "") << "  travel " << Num(a.min_deg()) << "…"
+            << Num(a.max_deg()) << "°";
+    if (a.alarm_code() != 0) ctx.out << "  ALARM " << a.alarm_code();
+    ctx.out << "\n";
+  }
+  ctx.out << "active session: "
+          << (reply.active_session_id().empty() ? "none" : reply.active_session_id()) << "\n";
+  return kExitOk;
+}
+
+}  // namespace brdf::ctl

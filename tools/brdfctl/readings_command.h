@@ -1,0 +1,24 @@
+// `brdfctl readings <id>`: a session's readings (Data.StreamReadings) in id order, one line each
+// (id, step, kind, pose, directions, quality, integration, label), or one JSON object per reading
+// with --json (with the spectrum). --follow keeps the stream open until the session ends.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tools/brdfctl/command_context.h"
+
+namespace brdf::ctl {
+
+struct ReadingsOptions {
+  std::string session_id;
+  bool follow = false;
+  std::vector<std::string> kinds;  // "sample", "reference", "dark"; empty: all
+  std::int64_t after_id = 0;
+  bool spectra = false;  // readable output: also print each spectrum
+};
+
+int RunReadings(CommandContext& ctx, const ReadingsOptions& options);
+
+}  // namespace brdf::ctl

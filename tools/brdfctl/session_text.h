@@ -1,0 +1,33 @@
+// Readable descriptions of sessions and of the things that happen to them (prompts, faults,
+// plan summaries), shared by the control commands and `watch`.
+#pragma once
+
+#include <ostream>
+#include <string>
+
+#include "brdf/v1/brdf.pb.h"
+
+namespace brdf::ctl {
+
+// "45/120 steps, 30/90 sample readings (37%)".
+std::string ProgressText(const v1::Progress& progress);
+
+// One line: "3  running  45/120 steps …  demo (reduced grid)".
+std::string SessionLine(const v1::Session& session);
+
+// Several lines: state, progress, ETA, pending prompt (with the answer command), last fault,
+// times, end reason, plan summary.
+void PrintSessionDetail(std::ostream& out, const v1::Session& session);
+
+// "prompt at step 7 (mount_white): <text>" and, on a second line, what the daemon assumes once
+// answered.
+void PrintPrompt(std::ostream& out, const v1::Prompt& prompt);
+
+// "fault at step 12 (attempt 3): timeout: <reason> — will retry" (or "— session paused").
+std::string FaultText(const v1::Fault& fault);
+
+// "120 steps: 90 sample, 12 reference, 6 dark readings; 12 operator actions; about 5:00
+// (at least 3:10)".
+std::string PlanSummaryText(const v1::PlanSummary& summary);
+
+}  // namespace brdf::ctl

@@ -1,0 +1,259 @@
+#include "tools/brdfctl/watch_command.h"
+
+#include <chrono>
+#include <iostream>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "tools/brdfctl/eta_calibrator.h"
+#include "tools/brdfctl/exit_codes.h"
+#include "tools/brdfctl/json_output.h"
+#include "tools/brdfctl/progress_line.h"
+#include "tools/brdfctl/prompt_hook.h"
+#include "tools/brdfctl/rpc_error.h"
+#include "tools/brdfctl/session_text.h"
+#include "tools/brdfctl/text_format.h"
+
+namespace brdf::ctl {
+namespace {
+
+bool Terminal(v1::SessionState s) {
+  return s == v1::SESSION_STATE_COMPLETED || s == v1::SESSION_STATE_ABORTED ||
+         s == v1::SESSION_STATE_FAILED;
+}
+
+class Watcher {
+ public:
+  Watcher(CommandContext& ctx, const WatchOptions& options)
+      : ctx_(ctx), options_(options), notes_(ctx.json ? ctx.err : ctx.out) {}
+
+  int Run() {
+    v1::WatchSessionRequest request;
+    request.set_session_id(options_.session_id);
+    auto context = ctx_.client.StreamContext();
+    auto reader = ctx_.client.control().WatchSession(context.get(), request);
+    v1::SessionEvent event;
+    while (reader->Read(&event)) {
+      const int exit_code = Handle(event);
+      if (exit_code != kExitOk) {
+        context->TryCancel();
+        ClearBar();
+        reader->Finish();
+        return exit_code;
+      }
+    }
+    const grpc::Status status = reader->Finish();
+    ClearBar();
+    if (!status.ok()) {
+      return ReportRpcError(ctx_.err, status, "WatchSession", ctx_.client.options().address);
+    }
+    return Finished();
+  }
+
+ private:
+  // Returns non-zero to stop watching with that exit status.
+  int Handle(const v1::SessionEvent& event) {
+    if (ctx_.json) PrintJsonLine(ctx_.out, event);
+    switch (event.event_case()) {
+      case v1::SessionEvent::kSnapshot: {
+        const v1::Session& s = event.snapshot();
+        state_ = s.state();
+        view_.state = StateName(s.state());
+        view_.done_steps = s.progress().done_steps();
+        view_.total_steps = s.progress().total_steps();
+        view_.eta_s = s.eta_s() > 0 ? s.eta_s() : -1;
+        view_.quality_code = s.last_quality_code();
+        Note("watching session " + s.session_id() + " \"" + s.name() + "\": " + view_.state + ", " +
+             ProgressText(s.progress()));
+        if (s.has_pending_prompt()) return OnPrompt(s.pending_prompt());
+        if (s.state() == v1::SESSION_STATE_PAUSED) {
+          return OnPaused(s.has_last_fault() ? s.last_fault().reason() : s.end_reason());
+        }
+        break;
+      }
+      case v1::SessionEvent::kStateChanged: {
+        const v1::StateChange& c = event.state_changed();
+        state_ = c.to();
+        view_.state = StateName(c.to());
+        if (!c.reason().empty()) end_reason_ = c.reason();
+        if (c.to() != v1::SESSION_STATE_RUNNING) eta_.Interrupt();
+        if (c.to() == v1::SESSION_STATE_PAUSED) return OnPaused(c.reason());
+        // Into and out of a prompt: the prompt and "confirmed" lines already say it.
+        const bool prompt_traffic = c.to() == v1::SESSION_STATE_AWAITING_OPERATOR ||
+                                    (c.from() == v1::SESSION_STATE_AWAITING_OPERATOR &&
+                                     c.to() == v1::SESSION_STATE_RUNNING);
+        if (!prompt_traffic) {
+          Note("state: " + StateName(c.from()) + " → " + StateName(c.to()) +
+               (c.reason().empty() ? "" : " (" + c.reason() + ")"));
+        }
+        break;
+      }
+      case v1::SessionEvent::kPrompt:
+        return OnPrompt(event.prompt());
+      case v1::SessionEvent::kStepCompleted:
+        OnStep(event.step_completed());
+        break;
+      case v1::SessionEvent::kFault:
+        Note(FaultText(event.fault()));
+        break;
+      default:
+        break;
+    }
+    DrawBar();
+    return kExitOk;
+  }
+
+  void OnStep(const v1::StepCompletion& step) {
+    view_.done_steps = step.progress().done_steps();
+    view_.total_steps = step.progress().total_steps();
+    const double now_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    eta_.OnStep(step.kind(), step.eta_s(), now_s);
+    view_.eta_s = eta_.Eta(step.eta_s());
+    if (step.quality_code() >= 0) view_.quality_code = step.quality_code();
+    if (step.reading_id() > 0 && !ctx_.json) FetchPose(step.reading_id());
+    if (options_.progress_bar || ctx_.json) return;
+    std::string line = "[" + std::to_string(view_.done_steps) + "/" +
+                       std::to_string(view_.total_steps) + "] step " +
+                       std::to_string(step.step_index()) + " " + StepKindName(step.kind());
+    if (step.reading_id() > 0) {
+      line += ": reading " + std::to_string(step.reading_id()) + ", quality " +
+              std::to_string(step.quality_code());
+      if (step.flagged()) line += " (flagged)";
+      if (view_.pose) line += ", " + PoseText(*view_.pose);
+    }
+    line += ", ETA " + Duration(view_.eta_s);
+    ctx_.out << line << std::endl;
+  }
+
+  // The pose of a reading that just landed: its id is known, so ask for the readings after id − 1
+  // (without follow, the stream sends what is stored and closes). Best effort: the display only.
+  void FetchPose(std::int64_t reading_id) {
+    v1::StreamReadingsRequest request;
+    request.set_session_id(options_.session_id);
+    request.set_after_id(reading_id - 1);
+    auto context = ctx_.client.UnaryContext();
+    auto reader = ctx_.client.data().StreamReadings(context.get(), request);
+    v1::Reading reading;
+    if (reader->Read(&reading) && reading.id() == reading_id) view_.pose = reading.pose();
+    context->TryCancel();
+    reader->Finish();
+  }
+
+  int OnPrompt(const v1::Prompt& prompt) {
+    const int step = prompt.step_index();
+    if (answered_.count(step) > 0 || declined_.count(step) > 0) return kExitOk;
+    ClearBar();
+    std::ostringstream text;
+    PrintPrompt(text, prompt);
+    notes_ << text.str();
+    bool confirm = options_.auto_confirm;
+    if (!confirm && options_.ask) {
+      notes_ << "Done? Confirm the prompt [y/N]: " << std::flush;
+      std::string answer;
+      if (!std::getline(std::cin, answer)) answer.clear();
+      confirm = answer == "y" || answer == "Y" || answer == "yes";
+    }
+    if (!confirm) {
+      declined_.insert(step);
+      notes_ << "  not confirmed; when done: brdfctl answer " << options_.session_id << " " << step
+             << std::endl;
+      DrawBar();
+      return kExitOk;
+    }
+    if (!options_.on_prompt.empty()) {
+      const Status hook = RunPromptHook(options_.on_prompt, options_.session_id, prompt);
+      if (!hook.ok()) {
+        ctx_.err << "brdfctl: " << hook.message() << "\n";
+        return kExitFailure;
+      }
+    }
+    v1::AnswerPromptRequest request;
+    request.set_session_id(options_.session_id);
+    request.set_step_index(step);
+    request.set_note(options_.auto_confirm ? "confirmed by brdfctl watch --auto-confirm"
+                                           : "confirmed in brdfctl watch");
+    v1::AnswerPromptResponse reply;
+    const grpc::Status status =
+        ctx_.client.control().AnswerPrompt(ctx_.client.UnaryContext().get(), request, &reply);
+    if (status.error_code() == grpc::StatusCode::FAILED_PRECONDITION) {
+      // Paused, aborted or answered elsewhere meanwhile; a prompt that is still due comes again.
+      notes_ << "  prompt at step " << step << " is no longer pending: " << status.error_message()
+             << std::endl;
+      DrawBar();
+      return kExitOk;
+    }
+    if (!status.ok()) {
+      return ReportRpcError(ctx_.err, status, "AnswerPrompt", ctx_.client.options().address);
+    }
+    answered_.insert(step);
+    notes_ << "  confirmed (step " << step << ")" << std::endl;
+    DrawBar();
+    return kExitOk;
+  }
+
+  int OnPaused(const std::string& reason) {
+    if (!options_.exit_on_pause) return kExitOk;
+    ClearBar();
+    ctx_.err << "brdfctl: session " << options_.session_id << " paused"
+             << (reason.empty() ? "" : ": " + reason) << "\n  resume it: brdfctl resume "
+             << options_.session_id << "\n";
+    return kExitNoResult;
+  }
+
+  int Finished() {
+    if (state_ == v1::SESSION_STATE_COMPLETED) {
+      Note("session " + options_.session_id + " completed: " + std::to_string(view_.done_steps) +
+           "/" + std::to_string(view_.total_steps) + " steps");
+      return kExitOk;
+    }
+    if (Terminal(state_)) {
+      ctx_.err << "brdfctl: session " << options_.session_id << " ended " << StateName(state_)
+               << (end_reason_.empty() ? "" : ": " + end_reason_) << "\n";
+      return kExitNoResult;
+    }
+    ctx_.err << "brdfctl: the watch stream of session " << options_.session_id
+             << " ended while the session was " << StateName(state_)
+             << "; the daemon may be shutting down (brdfctl get " << options_.session_id
+             << " shows where it is)\n";
+    return kExitFailure;
+  }
+
+  // A line above the progress bar (or on stderr with --json).
+  void Note(const std::string& line) {
+    ClearBar();
+    notes_ << line << std::endl;
+  }
+
+  void DrawBar() {
+    if (!options_.progress_bar || ctx_.json) return;
+    ctx_.out << "\r" << RenderProgressLine(view_, options_.width - 1) << "\x1b[K" << std::flush;
+    bar_shown_ = true;
+  }
+
+  void ClearBar() {
+    if (!bar_shown_) return;
+    ctx_.out << "\r\x1b[K" << std::flush;
+    bar_shown_ = false;
+  }
+
+  CommandContext& ctx_;
+  const WatchOptions& options_;
+  std::ostream& notes_;
+  ProgressView view_;
+  EtaCalibrator eta_;
+  v1::SessionState state_ = v1::SESSION_STATE_UNSPECIFIED;
+  std::string end_reason_;
+  std::set<int> answered_;
+  std::set<int> declined_;
+  bool bar_shown_ = false;
+};
+
+}  // namespace
+
+int RunWatch(CommandContext& ctx, const WatchOptions& options) {
+  return Watcher(ctx, options).Run();
+}
+
+}  // namespace brdf::ctl

@@ -1,0 +1,31 @@
+// `brdfctl watch <id>`: follows a session (WatchSession) until it ends.
+//   - On a terminal: a live progress line (progress_line.h) — done/total, ETA, the pose of the
+//     latest reading, its quality code — with state changes, prompts and faults printed above it.
+//   - Otherwise: one plain line per event. With --json: each SessionEvent as one JSON line.
+// At an operator prompt it stops and offers to confirm: "[y/N]" on a terminal; --auto-confirm
+// answers every prompt; without either it waits for someone to answer (`brdfctl answer`).
+// --on-prompt CMD runs before each confirmation (prompt_hook.h).
+// The ETA is the daemon's, rescaled to the pace the rig shows while watched (eta_calibrator.h).
+// Exit: 0 when the session completed, 4 when it ended aborted or failed (or paused, with
+// --exit-on-pause), else exit_codes.h.
+#pragma once
+
+#include <string>
+
+#include "tools/brdfctl/command_context.h"
+
+namespace brdf::ctl {
+
+struct WatchOptions {
+  std::string session_id;
+  bool auto_confirm = false;   // answer every prompt without asking
+  std::string on_prompt;       // shell command run before each confirmation; empty: none
+  bool exit_on_pause = false;  // stop watching (exit 4) when the session pauses (e.g. a fault)
+  bool progress_bar = false;   // redraw one progress line (stdout is a terminal, not --json)
+  bool ask = false;            // ask y/N on standard input (stdin and stdout are terminals)
+  int width = 80;              // terminal columns for the progress line
+};
+
+int RunWatch(CommandContext& ctx, const WatchOptions& options);
+
+}  // namespace brdf::ctl
