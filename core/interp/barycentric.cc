@@ -2,6 +2,12 @@
 
 #include <cmath>
 
+#include "core/interp/point_cloud.h"
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#endif
+
 namespace brdf::interp {
 namespace {
 
@@ -33,36 +39,57 @@ double Det(const std::array<const Column*, 4>& cols, int dims) {
 BarycentricWeights Barycentric(std::span<const double* const> vertices, const double* p, int dims) {
   BarycentricWeights out;
   std::array<Column, 4> edges{};
+  std::array<double, 4> len2{};
   Column r{};
-  double hadamard = 1.0;
   for (int k = 0; k < dims; ++k) {
-    double len2 = 0.0;
+    double sum = 0.0;
     for (int j = 0; j < dims; ++j) {
       edges[k][j] = vertices[k + 1][j] - vertices[0][j];
-      len2 += edges[k][j] * edges[k][j];
+      sum += edges[k][j] * edges[k][j];
     }
-    hadamard *= std::sqrt(len2);
+    len2[k] = sum;
   }
   for (int j = 0; j < dims; ++j) r[j] = p[j] - vertices[0][j];
 
   std::array<const Column*, 4> cols{&edges[0], &edges[1], &edges[2], &edges[3]};
   const double det = Det(cols, dims);
-  if (!(std::fabs(det) > kDegenerateRelativeVolume * hadamard)) return out;  // also NaN
+  // The degenerate test compares |det| with Hadamard's bound H = Π|e_k| (a product of square
+  // roots). H is within a few rounding errors of sqrt(P), P = Π|e_k|², so when det² clears
+  // (1e-12)²·P with a margin the answer is known without a root; only near the threshold, or
+  // where the squares could overflow or underflow, is H computed exactly as specified.
+  double product = 1.0;
+  for (int k = 0; k < dims; ++k) product *= len2[k];
+  const double abs_det = std::fabs(det);
+  const bool quick_range =
+      product > 1e-280 && product < 1e280 && abs_det > 1e-140 && abs_det < 1e140;
+  if (!(quick_range && det * det > kDegenerateRelativeVolume * kDegenerateRelativeVolume * product *
+                                       (1.0 + 1e-9))) {
+    double hadamard = 1.0;
+    for (int k = 0; k < dims; ++k) hadamard *= std::sqrt(len2[k]);
+    if (!(abs_det > kDegenerateRelativeVolume * hadamard)) return out;  // also NaN
+  }
 
+  // Cramer's rule. A weight below the tolerance decides "outside" at once: the later ones
+  // cannot change that. A numerator of the other sign than det and larger than 2·tolerance·|det|
+  // makes that weight < −tolerance whatever the rounding, without the division.
+  out.fit = SimplexFit::kOutside;
   std::array<double, kMaxSimplexVertices> lambda{};
   double sum_mu = 0.0;
   for (int k = 0; k < dims; ++k) {
     cols[k] = &r;
-    lambda[k + 1] = Det(cols, dims) / det;
+    const double numerator = Det(cols, dims);
     cols[k] = &edges[k];
+    if ((numerator < 0.0) != (det < 0.0) && numerator != 0.0 &&
+        std::fabs(numerator) > 2.0 * kEnclosingTolerance * abs_det) {
+      return out;
+    }
+    lambda[k + 1] = numerator / det;
+    if (!(lambda[k + 1] >= -kEnclosingTolerance)) return out;
     sum_mu += lambda[k + 1];
   }
   lambda[0] = 1.0 - sum_mu;
+  if (!(lambda[0] >= -kEnclosingTolerance)) return out;
 
-  out.fit = SimplexFit::kOutside;
-  for (int k = 0; k <= dims; ++k) {
-    if (!(lambda[k] >= -kEnclosingTolerance)) return out;
-  }
   double total = 0.0;
   for (int k = 0; k <= dims; ++k) {
     lambda[k] = lambda[k] > 0.0 ? lambda[k] : 0.0;
@@ -73,37 +100,98 @@ BarycentricWeights Barycentric(std::span<const double* const> vertices, const do
   return out;
 }
 
+namespace {
+
+// The blend of 4 or 5 vertex spectra, one band at a time: ((w0·s0 + w1·s1) + w2·s2) + …, the same
+// expression in every variant (the vector ones compute it for 4 or 8 bands at once, rounding each
+// product before it is added, exactly like the scalar code), so all give the same bits.
+template <int V>
+void BlendScalar(const double* w, const double* const* s, double* out, std::size_t first,
+                 std::size_t bands) {
+  for (std::size_t b = first; b < bands; ++b) {
+    double sum = RoundedProduct(w[0], s[0][b]);
+    for (int k = 1; k < V; ++k) sum = sum + RoundedProduct(w[k], s[k][b]);
+    out[b] = sum;
+  }
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+template <int V>
+__attribute__((target("avx2"))) void BlendAvx2(const double* w, const double* const* s, double* out,
+                                               std::size_t bands) {
+  __m256d wv[V];
+  for (int k = 0; k < V; ++k) wv[k] = _mm256_set1_pd(w[k]);
+  std::size_t b = 0;
+  for (; b + 4 <= bands; b += 4) {
+    __m256d sum = _mm256_mul_pd(wv[0], _mm256_loadu_pd(s[0] + b));
+    asm("" : "+x"(sum));
+    for (int k = 1; k < V; ++k) {
+      __m256d term = _mm256_mul_pd(wv[k], _mm256_loadu_pd(s[k] + b));
+      asm("" : "+x"(term));  // round the product: no fused multiply-add
+      sum = _mm256_add_pd(sum, term);
+    }
+    _mm256_storeu_pd(out + b, sum);
+  }
+  BlendScalar<V>(w, s, out, b, bands);
+}
+
+template <int V>
+__attribute__((target("avx512f"))) void BlendAvx512(const double* w, const double* const* s,
+                                                    double* out, std::size_t bands) {
+  __m512d wv[V];
+  for (int k = 0; k < V; ++k) wv[k] = _mm512_set1_pd(w[k]);
+  std::size_t b = 0;
+  for (; b + 8 <= bands; b += 8) {
+    __m512d sum = _mm512_mul_pd(wv[0], _mm512_loadu_pd(s[0] + b));
+    asm("" : "+v"(sum));
+    for (int k = 1; k < V; ++k) {
+      __m512d term = _mm512_mul_pd(wv[k], _mm512_loadu_pd(s[k] + b));
+      asm("" : "+v"(term));  // round the product: no fused multiply-add
+      sum = _mm512_add_pd(sum, term);
+    }
+    _mm512_storeu_pd(out + b, sum);
+  }
+  BlendScalar<V>(w, s, out, b, bands);
+}
+#endif
+
+using BlendFn = void (*)(const double*, const double* const*, double*, std::size_t);
+
+template <int V>
+BlendFn PickBlend() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  if (__builtin_cpu_supports("avx512f")) return &BlendAvx512<V>;
+  if (__builtin_cpu_supports("avx2")) return &BlendAvx2<V>;
+#endif
+  return [](const double* w, const double* const* s, double* out, std::size_t bands) {
+    BlendScalar<V>(w, s, out, 0, bands);
+  };
+}
+
+}  // namespace
+
 void BlendSpectra(std::span<const double> weights, std::span<const double* const> spectra,
                   std::span<double> out) {
   // One pass over all vertex spectra (their memory streams in parallel). Each band is summed as
   // ((w0·s0 + w1·s1) + w2·s2) + …, the same order for every vertex count.
+  static const BlendFn blend4 = PickBlend<4>();
+  static const BlendFn blend5 = PickBlend<5>();
   const std::size_t bands = out.size();
-  const double* s0 = spectra[0];
-  const double w0 = weights[0];
   switch (weights.size()) {
-    case 4: {
-      const double *s1 = spectra[1], *s2 = spectra[2], *s3 = spectra[3];
-      const double w1 = weights[1], w2 = weights[2], w3 = weights[3];
-      for (std::size_t b = 0; b < bands; ++b) {
-        out[b] = w0 * s0[b] + w1 * s1[b] + w2 * s2[b] + w3 * s3[b];
-      }
-      return;
-    }
-    case 5: {
-      const double *s1 = spectra[1], *s2 = spectra[2], *s3 = spectra[3], *s4 = spectra[4];
-      const double w1 = weights[1], w2 = weights[2], w3 = weights[3], w4 = weights[4];
-      for (std::size_t b = 0; b < bands; ++b) {
-        out[b] = w0 * s0[b] + w1 * s1[b] + w2 * s2[b] + w3 * s3[b] + w4 * s4[b];
-      }
-      return;
-    }
-    default:
-      for (std::size_t b = 0; b < bands; ++b) out[b] = w0 * s0[b];
+    case 4:
+      return blend4(weights.data(), spectra.data(), out.data(), bands);
+    case 5:
+      return blend5(weights.data(), spectra.data(), out.data(), bands);
+    default: {
+      const double* s0 = spectra[0];
+      const double w0 = weights[0];
+      for (std::size_t b = 0; b < bands; ++b) out[b] = RoundedProduct(w0, s0[b]);
       for (std::size_t k = 1; k < weights.size(); ++k) {
         const double w = weights[k];
         const double* s = spectra[k];
-        for (std::size_t b = 0; b < bands; ++b) out[b] += w * s[b];
+        for (std::size_t b = 0; b < bands; ++b) out[b] = out[b] + RoundedProduct(w, s[b]);
       }
+    }
   }
 }
 

@@ -6,7 +6,9 @@
 // (4D), in degrees. Pure: no I/O.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -92,6 +94,39 @@ class Interpolator {
   virtual int dims() const = 0;
   // query.size() == dims(). Thread-safe (const): many threads may evaluate at once.
   virtual Interpolation Evaluate(std::span<const double> query) const = 0;
+
+  // The same answer's status and spectrum only, for callers that need no provenance (batches,
+  // grids, rendering): the spectrum is written into `spectrum` (the sample set's bands() values)
+  // when the status is kOk and left untouched otherwise. Methods override it to answer without
+  // allocating; this default goes through Evaluate. Thread-safe like Evaluate.
+  virtual InterpStatus SpectrumAt(std::span<const double> query, std::span<double> spectrum) const {
+    Interpolation r = Evaluate(query);
+    if (r.status == InterpStatus::kOk) {
+      std::copy_n(r.spectrum.begin(), std::min(r.spectrum.size(), spectrum.size()),
+                  spectrum.begin());
+    }
+    return r.status;
+  }
+
+  // Many queries in one call, single thread, in order: n = statuses.size() queries (row-major,
+  // dims() coordinates each) answered as SpectrumAt would, statuses[i] and row i of `spectra`
+  // (n × bands values; rows of queries that are not kOk are set to NaN). Methods override it to
+  // overlap one query's memory traffic with the next one's search. The caller checks the sizes
+  // (EvaluateSpectraBatch in batch.h does, and spreads a batch over threads).
+  virtual void SpectraAt(std::span<const double> queries, std::span<InterpStatus> statuses,
+                         std::span<double> spectra) const {
+    const std::size_t n = statuses.size();
+    if (n == 0) return;
+    const auto d = static_cast<std::size_t>(dims());
+    const std::size_t bands = spectra.size() / n;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::span<double> row = spectra.subspan(i * bands, bands);
+      statuses[i] = SpectrumAt(queries.subspan(i * d, d), row);
+      if (statuses[i] != InterpStatus::kOk) {
+        std::fill(row.begin(), row.end(), std::numeric_limits<double>::quiet_NaN());
+      }
+    }
+  }
 };
 
 // Builds the index for `samples` (3D or 4D). Errors: wrong dims, empty set, bad options

@@ -2,50 +2,103 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <limits>
 #include <numeric>
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define BRDF_KD_X86 1
+#include <immintrin.h>
+#endif
 
 namespace brdf::interp {
 namespace {
 
-// Points per leaf (a leaf holds kLeafSize/2 … kLeafSize). Scanning a point is much cheaper than
-// deciding whether to visit a node (which bounds up to 2^dims orthants), so leaves are large.
-constexpr std::uint32_t kLeafSize = 32;
-
 // Lower bounds are shrunk by this factor before pruning. They are already never above the
-// computed distance of a point in the box (same rounded operations, monotone); the margin keeps
-// that true should a compiler contract the distance into fused multiply-adds.
+// computed distance of a point in the box (monotone rounded operations); the margin also covers
+// a different summation order and fused multiply-adds in the bound itself.
 constexpr double kBoundShrink = 1.0 - 1e-12;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-inline double Sq(double x) {
-  return x * x;
+// Extra coordinates after the last point, so that an 8-wide load at a leaf's last point stays
+// inside the arrays (the lanes past the leaf's end are masked out).
+constexpr std::size_t kPadding = 8;
+
+// max(a, b) without a branch (the compiler turns `a > b ? a : b` followed by a multiply into a
+// jump; the bound's three of them per box were the search's worst-predicted branches).
+inline double Max(double a, double b) {
+#ifdef BRDF_KD_X86
+  return _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(a), _mm_set_sd(b)));
+#else
+  return a > b ? a : b;
+#endif
 }
 
-// Bit o of PlusMask(j, D) is set when orthant o is on the + side of axis j.
-constexpr std::uint32_t PlusMask(int j, int dims) {
-  std::uint32_t m = 0;
-  for (int o = 0; o < (1 << dims); ++o) {
-    if ((o >> j) & 1) m |= 1u << o;
-  }
-  return m;
-}
-
+// Which sides of the query a box spans, as a pattern index `lt | ge << D`: bit j of lt is set
+// when the box has points with x_j < q_j (the − side of axis j), bit j of ge when it has points
+// with x_j >= q_j (the + side). kReach<D>[pattern] is the set of orthants the box reaches (bit o
+// for orthant o): those whose side on every axis the box spans.
 template <int D>
-constexpr std::array<std::uint32_t, D> PlusMasks() {
-  std::array<std::uint32_t, D> m{};
-  for (int j = 0; j < D; ++j) m[static_cast<std::size_t>(j)] = PlusMask(j, D);
-  return m;
+constexpr std::array<std::uint16_t, 1 << (2 * D)> MakeReach() {
+  std::array<std::uint16_t, 1 << (2 * D)> reach{};
+  for (int pattern = 0; pattern < (1 << (2 * D)); ++pattern) {
+    const int lt = pattern & ((1 << D) - 1), ge = pattern >> D;
+    unsigned mask = 0;
+    for (int o = 0; o < (1 << D); ++o) {
+      bool in = true;
+      for (int j = 0; j < D; ++j) in = in && (((o >> j) & 1) ? ((ge >> j) & 1) : ((lt >> j) & 1));
+      if (in) mask |= 1u << o;
+    }
+    reach[static_cast<std::size_t>(pattern)] = static_cast<std::uint16_t>(mask);
+  }
+  return reach;
 }
+template <int D>
+constexpr std::array<std::uint16_t, 1 << (2 * D)> kReach = MakeReach<D>();
 
 }  // namespace
 
 struct KdTree::OrthantBest {
-  std::array<double, kMaxOrthants> d2;
+  std::array<double, 4> q;              // the query (scaled)
+  std::array<double, kMaxOrthants> d2;  // per orthant: best squared distance so far
   std::array<std::uint32_t, kMaxOrthants> rank;
-  std::array<std::uint32_t, kMaxOrthants> pos;  // tree position of the best point
-  double worst;  // max of d2 over the orthants: a node farther than this cannot help any of them
+  std::array<std::uint32_t, kMaxOrthants> pos;  // the best point's position in tree order
+
+  // The orthants whose best is at least `bound` (bit o for orthant o): those a box at that
+  // distance could still improve.
+  template <int D>
+  unsigned Open(double bound) const {
+#ifdef BRDF_KD_X86
+    const __m128d b = _mm_set1_pd(bound);
+    unsigned mask = 0;
+#pragma GCC unroll 8
+    for (int o = 0; o < (1 << D); o += 2) {
+      const __m128d le = _mm_cmple_pd(b, _mm_loadu_pd(d2.data() + o));
+      mask |= static_cast<unsigned>(_mm_movemask_pd(le)) << o;
+    }
+    return mask;
+#else
+    unsigned mask = 0;
+    for (int o = 0; o < (1 << D); ++o) mask |= static_cast<unsigned>(bound <= d2[o]) << o;
+    return mask;
+#endif
+  }
+
+  // The exact rule of the brute-force scan: nearer wins; at the same distance, the lower rank.
+  // Without a branch: whether a candidate wins is a coin toss the predictor would lose.
+  bool Offer(std::size_t o, double dist2, std::uint32_t r, std::uint32_t at) {
+    const double bd = d2[o];
+    const std::uint32_t br = rank[o];
+    const bool better = (dist2 < bd) | ((dist2 == bd) & (r < br));
+    const std::uint64_t m = std::uint64_t{0} - static_cast<std::uint64_t>(better);
+    const auto m32 = static_cast<std::uint32_t>(m);
+    d2[o] = std::bit_cast<double>((std::bit_cast<std::uint64_t>(dist2) & m) |
+                                  (std::bit_cast<std::uint64_t>(bd) & ~m));
+    rank[o] = (r & m32) | (br & ~m32);
+    pos[o] = (at & m32) | (pos[o] & ~m32);
+    return better;
+  }
 };
 
 struct KdTree::NearestBest {
@@ -53,23 +106,217 @@ struct KdTree::NearestBest {
   std::uint32_t rank = kNoPoint;
 };
 
-KdTree::KdTree(const PointCloud& cloud) : dims_(cloud.dims) {
+// The leaf scans. Each computes, for every point of the leaf, its orthant (bit j set when
+// x_j >= q_j) and its squared distance ((0 + dx²) + dy²) + dz² (+ dw²), exactly as OrthantOf and
+// SquaredDistance do, and offers it to its orthant.
+template <int D>
+struct LeafKernels {
+  using Best = KdTree::OrthantBest;
+
+  // Portable: no data-dependent branch per point (the update is a masked select).
+  static bool Scalar(const KdTree& tree, std::uint32_t begin, std::uint32_t end, Best& best) {
+    const double* x[D];
+    for (int j = 0; j < D; ++j) x[j] = tree.axis_[static_cast<std::size_t>(j)].data();
+    double q[D];
+    for (int j = 0; j < D; ++j) q[j] = best.q[static_cast<std::size_t>(j)];
+    bool improved = false;
+    for (std::uint32_t pos = begin; pos < end; ++pos) {
+      unsigned o = 0;
+      double d2 = 0.0;
+#pragma GCC unroll 4
+      for (int j = 0; j < D; ++j) {
+        const double v = x[j][pos];
+        o |= static_cast<unsigned>(v >= q[j]) << j;
+        d2 += RoundedSquare(v - q[j]);
+      }
+      improved |= best.Offer(o, d2, tree.rank_[pos], pos);
+    }
+    return improved;
+  }
+
+#ifdef BRDF_KD_X86
+  // 4 points at a time; the bests of their orthants are gathered, and only a point at or below
+  // its orthant's best goes through the exact rule.
+  __attribute__((target("avx2"))) static bool Avx2(const KdTree& tree, std::uint32_t begin,
+                                                   std::uint32_t end, Best& best) {
+    __m256d q[D];
+    for (int j = 0; j < D; ++j) q[j] = _mm256_set1_pd(best.q[static_cast<std::size_t>(j)]);
+    bool improved = false;
+    for (std::uint32_t pos = begin; pos < end; pos += 4) {
+      __m256d d2 = _mm256_setzero_pd();
+      __m256i code = _mm256_setzero_si256();
+#pragma GCC unroll 4
+      for (int j = 0; j < D; ++j) {
+        const __m256d v = _mm256_loadu_pd(tree.axis_[static_cast<std::size_t>(j)].data() + pos);
+        const __m256d diff = _mm256_sub_pd(v, q[j]);
+        __m256d sq = _mm256_mul_pd(diff, diff);
+        asm("" : "+x"(sq));  // no fused multiply-add: round the square first
+        d2 = j == 0 ? sq : _mm256_add_pd(d2, sq);
+        const __m256i plus = _mm256_castpd_si256(_mm256_cmp_pd(v, q[j], _CMP_GE_OQ));
+        code = _mm256_or_si256(code, _mm256_and_si256(plus, _mm256_set1_epi64x(1 << j)));
+      }
+      const __m256d limit = _mm256_i64gather_pd(best.d2.data(), code, 8);
+      unsigned candidates =
+          static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(d2, limit, _CMP_LE_OQ)));
+      if (end - pos < 4) candidates &= (1u << (end - pos)) - 1u;
+      if (candidates == 0) continue;
+      alignas(32) double dist[4];
+      alignas(32) std::int64_t orthant[4];
+      _mm256_store_pd(dist, d2);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(orthant), code);
+      for (; candidates != 0; candidates &= candidates - 1) {
+        const int lane = std::countr_zero(candidates);
+        const std::uint32_t at = pos + static_cast<std::uint32_t>(lane);
+        improved |=
+            best.Offer(static_cast<std::size_t>(orthant[lane]), dist[lane], tree.rank_[at], at);
+      }
+    }
+    return improved;
+  }
+
+  // 8 points at a time; the orthants' bests sit in one (3D) or two (4D) registers and are
+  // permuted into place.
+  __attribute__((target("avx512f"))) static bool Avx512(const KdTree& tree, std::uint32_t begin,
+                                                        std::uint32_t end, Best& best) {
+    __m512d q[D];
+    for (int j = 0; j < D; ++j) q[j] = _mm512_set1_pd(best.q[static_cast<std::size_t>(j)]);
+    bool improved = false;
+    __m512d best_lo = _mm512_loadu_pd(best.d2.data());
+    __m512d best_hi = _mm512_loadu_pd(best.d2.data() + 8);
+    const __m512i lane_index = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
+    __m512i best_pos = _mm512_maskz_cvtepu32_epi64(
+        0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data())));
+    __m512i best_pos_hi = _mm512_maskz_cvtepu32_epi64(
+        0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data() + 8)));
+    for (std::uint32_t pos = begin; pos < end; pos += 8) {
+      __m512d d2 = _mm512_setzero_pd();
+      __m512i code = _mm512_setzero_si512();
+#pragma GCC unroll 4
+      for (int j = 0; j < D; ++j) {
+        const __m512d v = _mm512_loadu_pd(tree.axis_[static_cast<std::size_t>(j)].data() + pos);
+        const __m512d diff = _mm512_sub_pd(v, q[j]);
+        __m512d sq = _mm512_mul_pd(diff, diff);
+        asm("" : "+v"(sq));  // no fused multiply-add: round the square first
+        d2 = j == 0 ? sq : _mm512_add_pd(d2, sq);
+        const __mmask8 plus = _mm512_cmp_pd_mask(v, q[j], _CMP_GE_OQ);
+        code = _mm512_mask_or_epi64(code, plus, code, _mm512_set1_epi64(1 << j));
+      }
+      const __m512d limit = D == 3 ? _mm512_permutexvar_pd(code, best_lo)
+                                   : _mm512_permutex2var_pd(best_lo, code, best_hi);
+      // A point at its orthant's best distance is a candidate only when it is not that best
+      // point itself: the seeds are met again in their leaves, and each such meeting cost an
+      // unpredictable branch and a pass through the exact rule for nothing (Offer would keep
+      // the best: same distance, same rank). Empty orthants keep position kNoPoint, which no
+      // point has.
+      const __m512i best_at = D == 3 ? _mm512_permutexvar_epi64(code, best_pos)
+                                     : _mm512_permutex2var_epi64(best_pos, code, best_pos_hi);
+      const __m512i positions = _mm512_add_epi64(_mm512_set1_epi64(pos), lane_index);
+      unsigned candidates = _mm512_cmp_pd_mask(d2, limit, _CMP_LT_OQ) |
+                            _mm512_mask_cmpneq_epi64_mask(_mm512_cmp_pd_mask(d2, limit, _CMP_EQ_OQ),
+                                                          positions, best_at);
+      if (end - pos < 8) candidates &= (1u << (end - pos)) - 1u;
+      if (candidates == 0) continue;
+      alignas(64) double dist[8];
+      alignas(64) std::int64_t orthant[8];
+      _mm512_store_pd(dist, d2);
+      _mm512_store_si512(orthant, code);
+      for (; candidates != 0; candidates &= candidates - 1) {
+        const int lane = std::countr_zero(candidates);
+        const std::uint32_t at = pos + static_cast<std::uint32_t>(lane);
+        improved |=
+            best.Offer(static_cast<std::size_t>(orthant[lane]), dist[lane], tree.rank_[at], at);
+      }
+      best_lo = _mm512_loadu_pd(best.d2.data());
+      best_hi = _mm512_loadu_pd(best.d2.data() + 8);
+      best_pos = _mm512_maskz_cvtepu32_epi64(
+          0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data())));
+      best_pos_hi = _mm512_maskz_cvtepu32_epi64(
+          0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data() + 8)));
+    }
+    return improved;
+  }
+#endif
+};
+
+bool KdTree::Supported(Kernel kernel) {
+  switch (kernel) {
+    case Kernel::kBest:
+    case Kernel::kScalar:
+      return true;
+#ifdef BRDF_KD_X86
+    case Kernel::kAvx2:
+      return __builtin_cpu_supports("avx2");
+    case Kernel::kAvx512:
+      return __builtin_cpu_supports("avx512f");
+#else
+    case Kernel::kAvx2:
+    case Kernel::kAvx512:
+      return false;
+#endif
+  }
+  return false;
+}
+
+const char* KdTree::KernelName(Kernel kernel) {
+  switch (kernel) {
+    case Kernel::kBest:
+      return "best";
+    case Kernel::kScalar:
+      return "scalar";
+    case Kernel::kAvx2:
+      return "avx2";
+    case Kernel::kAvx512:
+      return "avx512";
+  }
+  return "unknown";
+}
+
+KdTree::KdTree(const PointCloud& cloud, Kernel kernel) : cloud_(&cloud), dims_(cloud.dims) {
+  if (kernel == Kernel::kBest) {
+    kernel = Supported(Kernel::kAvx512) ? Kernel::kAvx512
+             : Supported(Kernel::kAvx2) ? Kernel::kAvx2
+                                        : Kernel::kScalar;
+  }
+  if (!Supported(kernel)) kernel = Kernel::kScalar;
+  kernel_ = kernel;
+  // Wider kernels make points cheaper relative to deciding whether to visit a node (which is
+  // hard to predict), so their leaves are larger (measured with bench/).
+  leaf_size_ = kernel == Kernel::kAvx512 ? 96 : kernel == Kernel::kAvx2 ? 64 : 32;
+
+  const bool three = dims_ == 3;
+  switch (kernel) {
+#ifdef BRDF_KD_X86
+    case Kernel::kAvx512:
+      scan_ = three ? &LeafKernels<3>::Avx512 : &LeafKernels<4>::Avx512;
+      break;
+    case Kernel::kAvx2:
+      scan_ = three ? &LeafKernels<3>::Avx2 : &LeafKernels<4>::Avx2;
+      break;
+#endif
+    default:
+      scan_ = three ? &LeafKernels<3>::Scalar : &LeafKernels<4>::Scalar;
+  }
+
   const auto n = static_cast<std::uint32_t>(cloud.size());
   std::vector<std::uint32_t> order(n);
   std::iota(order.begin(), order.end(), 0u);
-  nodes_.reserve(2 * (n / kLeafSize) + 2);
-  Build(order, 0, n, cloud);
+  nodes_.reserve(2 * (n / (leaf_size_ / 2)) + 2);
+  Build(order, 0, n);
   const auto d = static_cast<std::size_t>(dims_);
-  points_.resize(static_cast<std::size_t>(n) * d);
-  for (std::size_t pos = 0; pos < n; ++pos) {
-    const auto src = cloud.scaled_point(order[pos]);
-    std::copy(src.begin(), src.end(), points_.begin() + static_cast<std::ptrdiff_t>(pos * d));
+  for (std::size_t j = 0; j < d; ++j) {
+    auto& a = axis_[j];
+    a.resize(n + kPadding);
+    for (std::size_t pos = 0; pos < n; ++pos) a[pos] = cloud.scaled[order[pos] * d + j];
+    std::fill(a.begin() + n, a.end(), a[n - 1]);
   }
   rank_ = std::move(order);
+  rank_.resize(n + kPadding, kNoPoint);
+  BuildSeeds();
 }
 
 std::uint32_t KdTree::Build(std::vector<std::uint32_t>& order, std::uint32_t begin,
-                            std::uint32_t end, const PointCloud& cloud) {
+                            std::uint32_t end) {
+  const PointCloud& cloud = *cloud_;
   const auto index = static_cast<std::uint32_t>(nodes_.size());
   nodes_.emplace_back();
   Node node{};
@@ -93,7 +340,7 @@ std::uint32_t KdTree::Build(std::vector<std::uint32_t>& order, std::uint32_t beg
   }
   const auto ua = static_cast<std::size_t>(axis);
   // A leaf when small, or when every point is the same (duplicates cannot be split apart).
-  if (end - begin <= kLeafSize || !(node.hi[ua] > node.lo[ua])) {
+  if (end - begin <= leaf_size_ || !(node.hi[ua] > node.lo[ua])) {
     nodes_[index] = node;
     return index;
   }
@@ -108,69 +355,41 @@ std::uint32_t KdTree::Build(std::vector<std::uint32_t>& order, std::uint32_t beg
   node.axis = static_cast<std::uint32_t>(axis);
   node.split = cloud.scaled[order[mid] * d + ua];
   nodes_[index] = node;
-  Build(order, begin, mid, cloud);
-  const std::uint32_t right = Build(order, mid, end, cloud);
+  Build(order, begin, mid);
+  const std::uint32_t right = Build(order, mid, end);
   nodes_[index].right = right;
   return index;
 }
 
 template <int D>
-void KdTree::VisitOrthants(std::uint32_t node_index, const double* p, OrthantBest& best) const {
-  static constexpr std::array<std::uint32_t, D> kPlus = PlusMasks<D>();
-  static constexpr int kOrthants = 1 << D;
+void KdTree::VisitOrthants(std::uint32_t node_index, OrthantBest& best) const {
   const Node& node = nodes_[node_index];
-  // Which orthants the box reaches, and its distance from p. On an axis where the box lies
-  // entirely on one side of p it reaches only that side, so this distance is also the bound for
-  // every orthant it reaches (the orthant's part of the box is as far as the whole box).
-  std::uint32_t reach = (1u << kOrthants) - 1u;
+  // The box's side pattern and its distance from the query. On an axis where the box lies
+  // entirely on one side of the query it reaches only that side, so the box's distance is also
+  // the bound for every orthant it reaches.
+  unsigned lt = 0, ge = 0;
   double bound = 0.0;
 #pragma GCC unroll 4
   for (int j = 0; j < D; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    const double lo = node.lo[uj], hi = node.hi[uj], q = p[j];
-    if (!(lo < q)) reach &= kPlus[uj];    // nothing on the − side
-    if (!(hi >= q)) reach &= ~kPlus[uj];  // nothing on the + side
-    bound += hi < q ? Sq(hi - q) : (lo > q ? Sq(lo - q) : 0.0);
+    const double lo = node.lo[uj], hi = node.hi[uj], q = best.q[uj];
+    lt |= static_cast<unsigned>(lo < q) << j;
+    ge |= static_cast<unsigned>(hi >= q) << j;
+    const double gap = Max(Max(lo - q, q - hi), 0.0);
+    bound += gap * gap;
   }
-  bound *= kBoundShrink;
-  // Farther than every orthant's best (once all have one): nothing to find here.
-  if (bound > best.worst) return;
-  bool worth = false;
-  for (std::uint32_t m = reach; m != 0; m &= m - 1) {
-    if (bound <= best.d2[static_cast<std::size_t>(std::countr_zero(m))]) {
-      worth = true;
-      break;
-    }
-  }
-  if (!worth) return;
+  if ((best.Open<D>(bound * kBoundShrink) & kReach<D>[lt | (ge << D)]) == 0) return;
 
   if (node.right == 0) {
-    bool improved = false;
-    for (std::uint32_t pos = node.begin; pos < node.end; ++pos) {
-      const double* x = points_.data() + static_cast<std::size_t>(pos) * D;
-      const auto o = static_cast<std::size_t>(OrthantOf<D>(x, p));
-      const double d2 = SquaredDistance<D>(x, p);
-      if (d2 < best.d2[o] || (d2 == best.d2[o] && rank_[pos] < best.rank[o])) {
-        best.d2[o] = d2;
-        best.rank[o] = rank_[pos];
-        best.pos[o] = pos;
-        improved = true;
-      }
-    }
-    if (improved) {
-      double worst = 0.0;
-      for (int o = 0; o < kOrthants; ++o)
-        worst = std::max(worst, best.d2[static_cast<std::size_t>(o)]);
-      best.worst = worst;
-    }
+    scan_(*this, node.begin, node.end, best);
     return;
   }
-  if (p[node.axis] < node.split) {
-    VisitOrthants<D>(node_index + 1, p, best);
-    VisitOrthants<D>(node.right, p, best);
+  if (best.q[node.axis] < node.split) {
+    VisitOrthants<D>(node_index + 1, best);
+    VisitOrthants<D>(node.right, best);
   } else {
-    VisitOrthants<D>(node.right, p, best);
-    VisitOrthants<D>(node_index + 1, p, best);
+    VisitOrthants<D>(node.right, best);
+    VisitOrthants<D>(node_index + 1, best);
   }
 }
 
@@ -181,15 +400,17 @@ void KdTree::VisitNearest(std::uint32_t node_index, const double* p, NearestBest
 #pragma GCC unroll 4
   for (int j = 0; j < D; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    const double q = p[j];
-    bound += q < node.lo[uj] ? Sq(node.lo[uj] - q) : (q > node.hi[uj] ? Sq(q - node.hi[uj]) : 0.0);
+    const double gap = Max(Max(node.lo[uj] - p[j], p[j] - node.hi[uj]), 0.0);
+    bound += gap * gap;
   }
   if (!(bound * kBoundShrink <= best.d2)) return;
 
   if (node.right == 0) {
     for (std::uint32_t pos = node.begin; pos < node.end; ++pos) {
-      const double* x = points_.data() + static_cast<std::size_t>(pos) * D;
-      const double d2 = SquaredDistance<D>(x, p);
+      double d2 = 0.0;
+#pragma GCC unroll 4
+      for (int j = 0; j < D; ++j)
+        d2 += RoundedSquare(axis_[static_cast<std::size_t>(j)][pos] - p[j]);
       const std::uint32_t r = rank_[pos];
       if (d2 < best.d2 || (d2 == best.d2 && r < best.rank)) {
         best.d2 = d2;
@@ -207,24 +428,92 @@ void KdTree::VisitNearest(std::uint32_t node_index, const double* p, NearestBest
   }
 }
 
-void KdTree::NearestPerOrthant(const double* p, OrthantWinners& winners) const {
-  OrthantBest best;
-  best.d2.fill(kInf);
-  best.rank.fill(kNoPoint);
-  best.pos.fill(0);
-  best.worst = kInf;
-  if (dims_ == 3) {
-    VisitOrthants<3>(0, p, best);
-  } else {
-    VisitOrthants<4>(0, p, best);
+void KdTree::BuildSeeds() {
+  // About two points per cell; a few thousand cells at most (3D: up to 32³, 4D: up to 12⁴).
+  const double n = static_cast<double>(rank_.size() - kPadding);
+  const int cap = dims_ == 3 ? 32 : 12;
+  seed_cells_ = std::clamp(static_cast<int>(std::lround(std::pow(n / 2.0, 1.0 / dims_))), 2, cap);
+  const auto d = static_cast<std::size_t>(dims_);
+  const Node& root = nodes_[0];
+  std::size_t cells = 1;
+  for (std::size_t j = 0; j < d; ++j) {
+    seed_lo_[j] = root.lo[j];
+    const double extent = root.hi[j] - root.lo[j];
+    seed_inv_[j] = extent > 0 ? seed_cells_ / extent : 0.0;
+    cells *= static_cast<std::size_t>(seed_cells_);
   }
   const std::size_t orthants = std::size_t{1} << dims_;
+  seeds_.assign(cells * orthants, kNoPoint);
+  std::array<double, 4> centre{};
+  for (std::size_t cell = 0; cell < cells; ++cell) {
+    std::size_t rest = cell;
+    for (std::size_t j = d; j-- > 0;) {
+      const auto k = static_cast<double>(rest % static_cast<std::size_t>(seed_cells_));
+      rest /= static_cast<std::size_t>(seed_cells_);
+      centre[j] = seed_inv_[j] > 0 ? seed_lo_[j] + (k + 0.5) / seed_inv_[j] : seed_lo_[j];
+    }
+    OrthantBest best;
+    best.q = centre;
+    best.d2.fill(kInf);
+    best.rank.fill(kNoPoint);
+    best.pos.fill(kNoPoint);
+    if (dims_ == 3) {
+      VisitOrthants<3>(0, best);
+    } else {
+      VisitOrthants<4>(0, best);
+    }
+    for (std::size_t o = 0; o < orthants; ++o) {
+      seeds_[cell * orthants + o] = best.rank[o] == kNoPoint ? kNoPoint : best.pos[o];
+    }
+  }
+}
+
+void KdTree::Seed(OrthantBest& best) const {
+  if (seeds_.empty()) return;
   const auto d = static_cast<std::size_t>(dims_);
+  std::size_t cell = 0;
+  for (std::size_t j = 0; j < d; ++j) {
+    const double f = (best.q[j] - seed_lo_[j]) * seed_inv_[j];
+    const int k = f > 0.0 ? static_cast<int>(std::min(f, static_cast<double>(seed_cells_ - 1))) : 0;
+    cell = cell * static_cast<std::size_t>(seed_cells_) + static_cast<std::size_t>(k);
+  }
+  const std::size_t orthants = std::size_t{1} << dims_;
+  const std::uint32_t* seed = seeds_.data() + cell * orthants;
+  for (std::size_t s = 0; s < orthants; ++s) {
+    const std::uint32_t pos = seed[s];
+    if (pos == kNoPoint) continue;
+    unsigned o = 0;
+    double d2 = 0.0;
+    for (std::size_t j = 0; j < d; ++j) {
+      const double v = axis_[j][pos];
+      o |= static_cast<unsigned>(v >= best.q[j]) << j;
+      d2 += RoundedSquare(v - best.q[j]);
+    }
+    best.Offer(o, d2, rank_[pos], pos);
+  }
+}
+
+void KdTree::NearestPerOrthant(const double* p, OrthantWinners& winners) const {
+  OrthantBest best;
+  const auto d = static_cast<std::size_t>(dims_);
+  std::copy(p, p + d, best.q.begin());
+  best.d2.fill(kInf);
+  best.rank.fill(kNoPoint);
+  best.pos.fill(kNoPoint);  // no point's position (the AVX-512 kernel compares positions)
+  Seed(best);
+  if (dims_ == 3) {
+    VisitOrthants<3>(0, best);
+  } else {
+    VisitOrthants<4>(0, best);
+  }
+  // The winners' coordinates from the per-axis arrays, whose lines the leaf scans just read.
+  const std::size_t orthants = std::size_t{1} << dims_;
   for (std::size_t o = 0; o < orthants; ++o) {
     winners.rank[o] = best.rank[o];
-    winners.scaled[o] = best.rank[o] == kNoPoint
-                            ? nullptr
-                            : points_.data() + static_cast<std::size_t>(best.pos[o]) * d;
+    winners.scaled[o] = nullptr;
+    if (best.rank[o] == kNoPoint) continue;
+    for (std::size_t j = 0; j < d; ++j) winners.coords[o][j] = axis_[j][best.pos[o]];
+    winners.scaled[o] = winners.coords[o].data();
   }
 }
 

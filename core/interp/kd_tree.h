@@ -1,11 +1,21 @@
 // The search index of the fast octant and nearest-neighbour methods: a k-d tree over a
 // PointCloud's scaled coordinates. One traversal finds the nearest point in every orthant around
-// the query at once (the octant method's step 2) — best-first into the nearer child, pruning a
-// subtree only when, for every orthant its box reaches, its lower-bound distance already exceeds
-// that orthant's best. The bounds are computed with the same rounded operations as the distances
-// (monotone, so never above the computed distance of a point in the box) and then shrunk by a
-// relative 1e-12, so pruning can never drop a point that the brute-force scan would pick: results,
-// ties included, are identical to the O(N) scan of octant_reference.h. Pure: no I/O.
+// the query at once (the octant method's step 2): nearer child first, a subtree pruned when, for
+// every orthant its box reaches, its lower-bound distance already exceeds that orthant's best.
+//
+// Exactness: the bounds are computed with rounded operations that never exceed the computed
+// distance of a point in the box, then shrunk by a relative 1e-12, so pruning never drops a point
+// the brute-force scan would pick. Every kernel computes a point's distance with SquaredDistance's
+// operations in SquaredDistance's order (no fused multiply-add), and ties go to the lower rank:
+// results, ties included, are identical to the O(N) scan of octant_reference.h.
+//
+// Speed: the points live in tree order as one array per axis, so a leaf is scanned several points
+// per instruction. A leaf kernel (chosen once, from what the CPU supports) computes distances and
+// orthants for 8 (AVX-512) or 4 (AVX2) points at a time and touches the per-orthant bests only
+// for the rare point that can improve one; a portable scalar kernel does the same without
+// branches. Pruning compares a box's distance with every orthant's best at once (one vector
+// compare) and keeps the orthants the box reaches (a table indexed by which sides of the query the
+// box spans). Pure: no I/O.
 #pragma once
 
 #include <array>
@@ -20,18 +30,35 @@ namespace brdf::interp {
 
 class KdTree {
  public:
-  // Copies the cloud's scaled points (3D or 4D, at least one) into tree order.
-  explicit KdTree(const PointCloud& cloud);
+  // How leaves are scanned. kBest picks the fastest the CPU supports; the others are for tests and
+  // benchmarks (a kernel the CPU lacks falls back to kScalar). All give identical results.
+  enum class Kernel { kBest, kScalar, kAvx2, kAvx512 };
+
+  // Indexes the cloud's scaled points (3D or 4D, at least one). Keeps a pointer to `cloud`, which
+  // must outlive the tree and not change.
+  explicit KdTree(const PointCloud& cloud, Kernel kernel = Kernel::kBest);
 
   int dims() const { return dims_; }
+  // The kernel in use (never kBest) and its name ("avx512", "avx2", "scalar").
+  Kernel kernel() const { return kernel_; }
+  static const char* KernelName(Kernel kernel);
+  // True when this CPU can run `kernel`.
+  static bool Supported(Kernel kernel);
 
   // For every orthant o around p (scaled space, OrthantOf numbering): the rank of the point nearest
   // to p in o, the lowest rank among points at the same distance, or kNoPoint when o holds no
-  // point; and a pointer to its coordinates in the tree's copy. p must be finite.
+  // point; and a pointer to its scaled coordinates in the cloud. p must be finite.
   void NearestPerOrthant(const double* p, OrthantWinners& winners) const;
 
   // The rank of the point nearest to p (the lowest rank among equals). p must be finite.
   std::uint32_t Nearest(const double* p) const;
+
+  // Nodes in the tree and points per leaf (for benchmarks).
+  std::size_t node_count() const { return nodes_.size(); }
+  std::uint32_t leaf_size() const { return leaf_size_; }
+
+  // The search state of one NearestPerOrthant call (public for the kernels in kd_tree.cc).
+  struct OrthantBest;
 
  private:
   struct Node {
@@ -43,20 +70,39 @@ class KdTree {
     std::uint32_t axis;   // split axis
     double split;         // points left have coordinate <= split, right >= split
   };
-  struct OrthantBest;
   struct NearestBest;
+  // Scans positions [begin, end) of a leaf into `best`; true when some orthant improved.
+  using LeafScan = bool (*)(const KdTree& tree, std::uint32_t begin, std::uint32_t end,
+                            OrthantBest& best);
 
-  std::uint32_t Build(std::vector<std::uint32_t>& order, std::uint32_t begin, std::uint32_t end,
-                      const PointCloud& cloud);
+  std::uint32_t Build(std::vector<std::uint32_t>& order, std::uint32_t begin, std::uint32_t end);
+  void BuildSeeds();
+  void Seed(OrthantBest& best) const;
   template <int D>
-  void VisitOrthants(std::uint32_t node, const double* p, OrthantBest& best) const;
+  void VisitOrthants(std::uint32_t node, OrthantBest& best) const;
   template <int D>
   void VisitNearest(std::uint32_t node, const double* p, NearestBest& best) const;
+  template <int D>
+  friend struct LeafKernels;
 
+  const PointCloud* cloud_;
   int dims_;
+  Kernel kernel_;
+  LeafScan scan_;
+  std::uint32_t leaf_size_;
   std::vector<Node> nodes_;
-  std::vector<double> points_;       // tree order, dims_ per point (scaled)
-  std::vector<std::uint32_t> rank_;  // tree position → rank in the cloud
+  // Scaled coordinates in tree order, one array per axis, padded with kPadding copies of the
+  // last point so that vector loads past a leaf's end stay inside the array.
+  std::array<std::vector<double>, 4> axis_;
+  std::vector<std::uint32_t> rank_;  // tree position → rank in the cloud (padded with kNoPoint)
+  // Seeds: a coarse grid over the points' bounding box, and for each cell the tree positions of
+  // the winners at the cell's centre (kNoPoint where none). A query first offers its cell's seeds,
+  // real points near its own winners, so that from the first leaf on only points that beat them
+  // go through the exact update (the answer cannot change: every point is still considered).
+  int seed_cells_ = 0;  // cells per axis
+  std::array<double, 4> seed_lo_{};
+  std::array<double, 4> seed_inv_{};  // cells per unit of each axis
+  std::vector<std::uint32_t> seeds_;
 };
 
 }  // namespace brdf::interp

@@ -1,5 +1,6 @@
 #include "core/interp/nearest.h"
 
+#include <algorithm>
 #include <array>
 
 #include "core/interp/kd_tree.h"
@@ -16,6 +17,17 @@ class NearestInterpolator final : public Interpolator {
 
   Method method() const override { return Method::kNearest; }
   int dims() const override { return cloud_.dims; }
+
+  InterpStatus SpectrumAt(std::span<const double> query,
+                          std::span<double> spectrum) const override {
+    const int d = cloud_.dims;
+    if (!ValidQuery(query, d)) return InterpStatus::kOutsideHull;
+    std::array<double, kMaxDims> p{};
+    cloud_.ScaleQuery(query, p);
+    const auto s = samples_->spectrum(cloud_.sample[tree_.Nearest(p.data())]);
+    std::copy_n(s.begin(), std::min(s.size(), spectrum.size()), spectrum.begin());
+    return InterpStatus::kOk;
+  }
 
   Interpolation Evaluate(std::span<const double> query) const override {
     const int d = cloud_.dims;
@@ -43,7 +55,7 @@ class NearestInterpolator final : public Interpolator {
 
  private:
   std::shared_ptr<const SampleSet> samples_;
-  PointCloud cloud_;
+  PointCloud cloud_;  // before tree_, which points into it
   KdTree tree_;
 };
 

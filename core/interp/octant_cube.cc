@@ -2,10 +2,16 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <vector>
 
 #include "core/interp/barycentric.h"
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define BRDF_CUBE_X86 1
+#include <immintrin.h>
+#endif
 
 namespace brdf::interp {
 namespace {
@@ -51,14 +57,6 @@ std::string Signs(int orthant, int dims) {
     out += (orthant >> j) & 1 ? "+" : "−";
   }
   return out + ")";
-}
-
-// Asks the memory system for every cache line of a spectrum, so the lines of all vertices arrive
-// in parallel instead of one stream after another.
-void PrefetchSpectrum(const double* spectrum, int bands) {
-  const char* p = reinterpret_cast<const char*>(spectrum);
-  const char* end = reinterpret_cast<const char*>(spectrum + bands);
-  for (; p < end; p += 64) __builtin_prefetch(p);
 }
 
 }  // namespace
@@ -132,31 +130,17 @@ Interpolation InvalidQueryAnswer(Method method, InterpStatus status, std::span<c
   return out;
 }
 
-Interpolation AssembleOctantAnswer(const PointCloud& cloud, const SampleSet& samples,
-                                   const OrthantWinners& winners,
-                                   std::span<const double> scaled_query) {
-  const int dims = cloud.dims;
+OctantBlend FindOctantBlend(const OrthantWinners& winners, std::span<const double> scaled_query,
+                            int dims) {
   const int orthants = 1 << dims;
-  Interpolation out;
-  out.method = Method::kOctant;
-
-  std::string empty;
-  for (int k = 0; k < orthants; ++k) {
-    // In 3D list empty octants in letter order (A … H), in 4D by number.
-    const int o = dims == 3 ? kOrthantOfLetter[static_cast<std::size_t>(k)] : k;
-    if (winners.rank[static_cast<std::size_t>(o)] != kNoPoint) continue;
-    empty += empty.empty() ? "" : ", ";
-    empty += OrthantName(o, dims);
+  OctantBlend out;
+  for (int o = 0; o < orthants; ++o) {
+    if (winners.rank[static_cast<std::size_t>(o)] == kNoPoint) out.empty_orthants |= 1u << o;
   }
-  if (!empty.empty()) {
-    out.status = InterpStatus::kEmptyOctant;
-    out.detail = "no sample in " + empty;
-    return out;
-  }
+  if (out.empty_orthants != 0) return out;
 
   const auto simplices = CubeSimplices(dims);
   const auto vertex_count = static_cast<std::size_t>(dims + 1);
-  int degenerate = 0;
   std::array<const double*, kMaxSimplexVertices> vertex_points{};
   for (std::size_t s = 0; s < simplices.size(); ++s) {
     for (std::size_t k = 0; k < vertex_count; ++k) {
@@ -164,39 +148,242 @@ Interpolation AssembleOctantAnswer(const PointCloud& cloud, const SampleSet& sam
     }
     const BarycentricWeights bw =
         Barycentric(std::span(vertex_points.data(), vertex_count), scaled_query.data(), dims);
-    if (bw.fit == SimplexFit::kDegenerate) ++degenerate;
+    if (bw.fit == SimplexFit::kDegenerate) ++out.degenerate;
     if (bw.fit != SimplexFit::kEncloses) continue;
-
-    // The vertex spectra are scattered over the sample set: start fetching all of them at once.
-    std::array<std::uint32_t, kMaxSimplexVertices> index{};
-    std::array<const double*, kMaxSimplexVertices> spectra{};
+    out.status = InterpStatus::kOk;
+    out.simplex = static_cast<int>(s);
     for (std::size_t k = 0; k < vertex_count; ++k) {
-      const std::uint32_t rank = winners.rank[static_cast<std::size_t>(simplices[s].corners[k])];
-      index[k] = cloud.sample[rank];
-      spectra[k] = samples.spectrum(index[k]).data();
-      PrefetchSpectrum(spectra[k], samples.bands());
+      out.rank[k] = winners.rank[static_cast<std::size_t>(simplices[s].corners[k])];
+      out.weight[k] = bw.weights[k];
     }
-    out.vertices.resize(vertex_count);
-    for (std::size_t k = 0; k < vertex_count; ++k) {
-      const std::uint32_t rank = winners.rank[static_cast<std::size_t>(simplices[s].corners[k])];
-      Vertex& v = out.vertices[k];
-      v.id = samples.id(index[k]);
-      v.index = index[k];
-      const auto p = cloud.point(rank);
-      v.coords.assign(p.begin(), p.end());
-      v.weight = bw.weights[k];
-    }
-    out.spectrum.resize(static_cast<std::size_t>(samples.bands()));
-    BlendSpectra(std::span(bw.weights.data(), vertex_count),
-                 std::span(spectra.data(), vertex_count), out.spectrum);
-    out.detail = SimplexName(static_cast<int>(s), dims);
     return out;
   }
   out.status = InterpStatus::kNoEnclosingSimplex;
-  out.detail = std::string("none of the ") + (dims == 3 ? "5 tetrahedra" : "24 Kuhn simplices") +
-               " of the nearest samples encloses the query";
-  if (degenerate > 0) out.detail += " (" + std::to_string(degenerate) + " of them flat)";
   return out;
+}
+
+#ifdef BRDF_CUBE_X86
+namespace {
+
+// a · b rounded before any addition (no fused multiply-add), 8 lanes.
+__attribute__((target("avx512f"))) inline __m512d Mul8(__m512d a, __m512d b) {
+  __m512d r = _mm512_mul_pd(a, b);
+  asm("" : "+v"(r));
+  return r;
+}
+
+// Det3 of barycentric.cc lane by lane: columns c0, c1, c2 (rows 0, 1, 2),
+// a(ei − fh) − b(di − fg) + c(dh − eg).
+__attribute__((target("avx512f"))) inline __m512d Det3x8(const __m512d* c0, const __m512d* c1,
+                                                         const __m512d* c2) {
+  const __m512d t0 = Mul8(c0[0], _mm512_sub_pd(Mul8(c1[1], c2[2]), Mul8(c2[1], c1[2])));
+  const __m512d t1 = Mul8(c1[0], _mm512_sub_pd(Mul8(c0[1], c2[2]), Mul8(c2[1], c0[2])));
+  const __m512d t2 = Mul8(c2[0], _mm512_sub_pd(Mul8(c0[1], c1[2]), Mul8(c1[1], c0[2])));
+  return _mm512_add_pd(_mm512_sub_pd(t0, t1), t2);
+}
+
+// Barycentric (barycentric.cc) for the five tetrahedra of kTetrahedra at once, lane t for
+// tetrahedron t (lanes 5–7 repeat tetrahedron 0 and are ignored). Every lane performs exactly
+// the scalar function's operations, in its order, each rounded (no fused multiply-add: the
+// products are pinned); the scalar function's early exits skip work whose outcome they already
+// know, so computing everything and reading the verdict at the end gives the same answer.
+__attribute__((target("avx512f"))) OctantBlend FindOctantBlend3Avx512(const OrthantWinners& winners,
+                                                                      const double* p) {
+  OctantBlend out;
+  // The winners' coordinates per axis, one lane per orthant.
+  alignas(64) double axis[3][8];
+  for (int o = 0; o < 8; ++o) {
+    const double* x = winners.scaled[static_cast<std::size_t>(o)];
+    for (int j = 0; j < 3; ++j) axis[j][o] = x[j];
+  }
+  __m512d x[3];
+  for (int j = 0; j < 3; ++j) x[j] = _mm512_load_pd(axis[j]);
+  // Vertex k of tetrahedron t: orthant kTetrahedra[t].corners[k].
+  const __m512i corner[4] = {
+      _mm512_set_epi64(0, 0, 0, 0, 3, 0, 0, 0),  // lanes 7..0
+      _mm512_set_epi64(1, 1, 1, 3, 5, 4, 3, 1),
+      _mm512_set_epi64(3, 3, 3, 5, 7, 5, 2, 3),
+      _mm512_set_epi64(5, 5, 5, 6, 6, 6, 6, 5),
+  };
+  __m512d v[4][3];
+  for (int k = 0; k < 4; ++k) {
+    for (int j = 0; j < 3; ++j) v[k][j] = _mm512_maskz_permutexvar_pd(0xFF, corner[k], x[j]);
+  }
+  const __m512d zero = _mm512_setzero_pd();
+  // Edges e_k = v_{k+1} − v_0 (columns), their squared lengths, r = p − v_0.
+  __m512d e[3][3];
+  __m512d len2[3];
+  __m512d r[3];
+  for (int k = 0; k < 3; ++k) {
+    __m512d sum = zero;
+    for (int j = 0; j < 3; ++j) {
+      e[k][j] = _mm512_sub_pd(v[k + 1][j], v[0][j]);
+      sum = _mm512_add_pd(sum, Mul8(e[k][j], e[k][j]));
+    }
+    len2[k] = sum;
+  }
+  for (int j = 0; j < 3; ++j) r[j] = _mm512_sub_pd(_mm512_set1_pd(p[j]), v[0][j]);
+  const __m512d det = Det3x8(e[0], e[1], e[2]);
+  // The degenerate test, as Barycentric does it.
+  const __m512d product = Mul8(Mul8(Mul8(_mm512_set1_pd(1.0), len2[0]), len2[1]), len2[2]);
+  const __m512d abs_det = _mm512_abs_pd(det);
+  const __mmask8 quick_range = _mm512_cmp_pd_mask(product, _mm512_set1_pd(1e-280), _CMP_GT_OQ) &
+                               _mm512_cmp_pd_mask(product, _mm512_set1_pd(1e280), _CMP_LT_OQ) &
+                               _mm512_cmp_pd_mask(abs_det, _mm512_set1_pd(1e-140), _CMP_GT_OQ) &
+                               _mm512_cmp_pd_mask(abs_det, _mm512_set1_pd(1e140), _CMP_LT_OQ);
+  constexpr double kSquaredLimit = kDegenerateRelativeVolume * kDegenerateRelativeVolume;
+  const __mmask8 quick_ok =
+      quick_range & _mm512_cmp_pd_mask(Mul8(det, det),
+                                       Mul8(Mul8(_mm512_set1_pd(kSquaredLimit), product),
+                                            _mm512_set1_pd(1.0 + 1e-9)),
+                                       _CMP_GT_OQ);
+  const __m512d hadamard = Mul8(Mul8(Mul8(_mm512_set1_pd(1.0), _mm512_maskz_sqrt_pd(0xFF, len2[0])),
+                                     _mm512_maskz_sqrt_pd(0xFF, len2[1])),
+                                _mm512_maskz_sqrt_pd(0xFF, len2[2]));
+  const __mmask8 exact_ok = _mm512_cmp_pd_mask(
+      abs_det, Mul8(_mm512_set1_pd(kDegenerateRelativeVolume), hadamard), _CMP_GT_OQ);
+  const auto flat = static_cast<unsigned>(static_cast<__mmask8>(~(quick_ok | exact_ok))) & 0x1Fu;
+  // Cramer's rule: μ_k = det(edges with e_k replaced by r) / det; outside when some weight is
+  // below −tolerance.
+  const __m512d tol = _mm512_set1_pd(-kEnclosingTolerance);
+  __m512d lambda[4];
+  __mmask8 inside = 0xFF;
+  __m512d sum_mu = zero;
+  for (int k = 0; k < 3; ++k) {
+    const __m512d* c0 = k == 0 ? r : e[0];
+    const __m512d* c1 = k == 1 ? r : e[1];
+    const __m512d* c2 = k == 2 ? r : e[2];
+    const __m512d numerator = Det3x8(c0, c1, c2);
+    // Barycentric's shortcut (a numerator of the other sign than det, larger than
+    // 2·tolerance·|det|, means outside), kept as it is for the rare inputs where rounding could
+    // make it disagree with the division.
+    const __mmask8 opposite =
+        static_cast<__mmask8>(_mm512_cmp_pd_mask(numerator, zero, _CMP_LT_OQ) ^
+                              _mm512_cmp_pd_mask(det, zero, _CMP_LT_OQ));
+    const __mmask8 shortcut =
+        opposite & _mm512_cmp_pd_mask(numerator, zero, _CMP_NEQ_UQ) &
+        _mm512_cmp_pd_mask(_mm512_abs_pd(numerator),
+                           Mul8(_mm512_set1_pd(2.0 * kEnclosingTolerance), abs_det), _CMP_GT_OQ);
+    lambda[k + 1] = _mm512_div_pd(numerator, det);
+    inside &= static_cast<__mmask8>(~shortcut) & _mm512_cmp_pd_mask(lambda[k + 1], tol, _CMP_GE_OQ);
+    sum_mu = _mm512_add_pd(sum_mu, lambda[k + 1]);
+  }
+  lambda[0] = _mm512_sub_pd(_mm512_set1_pd(1.0), sum_mu);
+  inside &= _mm512_cmp_pd_mask(lambda[0], tol, _CMP_GE_OQ);
+  const unsigned encloses = static_cast<unsigned>(inside) & ~flat & 0x1Fu;
+  if (encloses == 0) {
+    out.degenerate = std::popcount(flat);
+    out.status = InterpStatus::kNoEnclosingSimplex;
+    return out;
+  }
+  const int t = std::countr_zero(encloses);
+  out.degenerate = std::popcount(flat & ((1u << t) - 1u));
+  __m512d total = zero;
+  for (int k = 0; k < 4; ++k) {
+    lambda[k] = _mm512_max_pd(lambda[k], zero);  // lambda > 0 ? lambda : 0
+    total = _mm512_add_pd(total, lambda[k]);
+  }
+  alignas(64) double w[4][8];
+  for (int k = 0; k < 4; ++k) _mm512_store_pd(w[k], _mm512_div_pd(lambda[k], total));
+  out.status = InterpStatus::kOk;
+  out.simplex = t;
+  for (std::size_t k = 0; k < 4; ++k) {
+    out.rank[k] =
+        winners.rank[static_cast<std::size_t>(kTetrahedra[static_cast<std::size_t>(t)].corners[k])];
+    out.weight[k] = w[k][t];
+  }
+  return out;
+}
+
+}  // namespace
+#endif
+
+OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const double> scaled_query,
+                                int dims) {
+#ifdef BRDF_CUBE_X86
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
+  if (dims == 3 && avx512) {
+    std::uint32_t empty = 0;
+    for (int o = 0; o < 8; ++o) {
+      if (winners.rank[static_cast<std::size_t>(o)] == kNoPoint) empty |= 1u << o;
+    }
+    if (empty != 0) {
+      OctantBlend out;
+      out.empty_orthants = empty;
+      return out;
+    }
+    return FindOctantBlend3Avx512(winners, scaled_query.data());
+  }
+#endif
+  return FindOctantBlend(winners, scaled_query, dims);
+}
+
+void BlendOctantSpectrum(const PointCloud& cloud, const SampleSet& samples,
+                         const OctantBlend& blend, std::span<double> out) {
+  const auto vertex_count = static_cast<std::size_t>(cloud.dims + 1);
+  // The vertex spectra are scattered over the sample set: start fetching all of them at once.
+  std::array<const double*, kMaxSimplexVertices> spectra{};
+  for (std::size_t k = 0; k < vertex_count; ++k) {
+    spectra[k] = samples.spectrum(cloud.sample[blend.rank[k]]).data();
+    PrefetchSpectrum(std::span(spectra[k], static_cast<std::size_t>(samples.bands())));
+  }
+  BlendSpectra(std::span(blend.weight.data(), vertex_count),
+               std::span(spectra.data(), vertex_count), out);
+}
+
+Interpolation OctantInterpolation(const PointCloud& cloud, const SampleSet& samples,
+                                  const OctantBlend& blend) {
+  const int dims = cloud.dims;
+  Interpolation out;
+  out.method = Method::kOctant;
+  out.status = blend.status;
+  switch (blend.status) {
+    case InterpStatus::kOk:
+      break;
+    case InterpStatus::kEmptyOctant: {
+      std::string empty;
+      for (int k = 0; k < (1 << dims); ++k) {
+        // In 3D list empty octants in letter order (A … H), in 4D by number.
+        const int o = dims == 3 ? kOrthantOfLetter[static_cast<std::size_t>(k)] : k;
+        if ((blend.empty_orthants >> o & 1u) == 0) continue;
+        empty += empty.empty() ? "" : ", ";
+        empty += OrthantName(o, dims);
+      }
+      out.detail = "no sample in " + empty;
+      return out;
+    }
+    default:
+      out.detail = std::string("none of the ") +
+                   (dims == 3 ? "5 tetrahedra" : "24 Kuhn simplices") +
+                   " of the nearest samples encloses the query";
+      if (blend.degenerate > 0) {
+        out.detail += " (" + std::to_string(blend.degenerate) + " of them flat)";
+      }
+      return out;
+  }
+
+  const auto vertex_count = static_cast<std::size_t>(dims + 1);
+  out.spectrum.resize(static_cast<std::size_t>(samples.bands()));
+  BlendOctantSpectrum(cloud, samples, blend, out.spectrum);
+  out.vertices.resize(vertex_count);
+  for (std::size_t k = 0; k < vertex_count; ++k) {
+    const std::uint32_t rank = blend.rank[k];
+    const std::uint32_t index = cloud.sample[rank];
+    Vertex& v = out.vertices[k];
+    v.id = samples.id(index);
+    v.index = index;
+    const auto p = cloud.point(rank);
+    v.coords.assign(p.begin(), p.end());
+    v.weight = blend.weight[k];
+  }
+  out.detail = SimplexName(blend.simplex, dims);
+  return out;
+}
+
+Interpolation AssembleOctantAnswer(const PointCloud& cloud, const SampleSet& samples,
+                                   const OrthantWinners& winners,
+                                   std::span<const double> scaled_query) {
+  return OctantInterpolation(cloud, samples, FindOctantBlend(winners, scaled_query, cloud.dims));
 }
 
 }  // namespace brdf::interp

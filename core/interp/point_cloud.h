@@ -48,16 +48,35 @@ struct PointCloud {
   }
 };
 
-// Squared Euclidean distance in the cloud's scaled space, summed in axis order. Every search uses
-// this one definition, so "nearest" and "tie" mean the same thing bit for bit in all of them.
+// a * b, rounded to a double before anything is added to it: a compiler allowed to fuse
+// multiply-adds (-ffp-contract=fast with FMA available) must not fuse it into a sum, or two
+// computations of "the same" expression could differ in the last bit (a tie decided differently,
+// a blended band off by one ulp). Free on x86 and ARM (an empty asm pins the value).
+inline double RoundedProduct(double a, double b) {
+  double s = a * b;
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+  asm("" : "+x"(s));
+#elif defined(__GNUC__) && defined(__aarch64__)
+  asm("" : "+w"(s));
+#else
+  volatile double pinned = s;
+  s = pinned;
+#endif
+  return s;
+}
+inline double RoundedSquare(double d) {
+  return RoundedProduct(d, d);
+}
+
+// Squared Euclidean distance in the cloud's scaled space, ((0 + d0²) + d1²) + d2² (+ d3²): summed
+// in axis order. Every search uses this one definition (the vector kernels of kd_tree.cc compute
+// the same operations lane by lane), so "nearest" and "tie" mean the same thing bit for bit in
+// all of them.
 template <int D>
 inline double SquaredDistance(const double* a, const double* b) {
   double sum = 0.0;
 #pragma GCC unroll 4
-  for (int j = 0; j < D; ++j) {
-    const double d = a[j] - b[j];
-    sum += d * d;
-  }
+  for (int j = 0; j < D; ++j) sum += RoundedSquare(a[j] - b[j]);
   return sum;
 }
 inline double SquaredDistance(const double* a, const double* b, int dims) {

@@ -1,0 +1,225 @@
+// Micro-benchmarks of the interpolation index and blend (Google Benchmark), on the data sets of
+// bench/run.sh: the paper's rig grid (2,153 points), 50,000 uniform random points in
+// [0,90)×[0,90)×[0,360), and a 4D anisotropic set; 101-band analytic spectra (brdf-interp synth's
+// data: the same generators, the same seeds). Queries are uniform random in the data's box, in
+// random order, 4,096 of them cycled.
+//
+// Figures: items_per_second is queries (or builds, or blends) per second, one thread.
+#include <benchmark/benchmark.h>
+
+#include <array>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/interp/barycentric.h"
+#include "core/interp/kd_tree.h"
+#include "core/interp/octant.h"
+#include "core/interp/octant_cube.h"
+#include "core/interp/point_cloud.h"
+#include "core/wavelength_grid.h"
+#include "tools/brdf-interp/synthetic_samples.h"
+
+namespace brdf::interp {
+namespace {
+
+constexpr std::size_t kQueries = 4096;
+
+struct DataSet {
+  std::string name;
+  std::shared_ptr<SampleSet> samples;
+  PointCloud cloud;
+  std::vector<double> queries;  // kQueries × dims, already scaled (scale 1)
+};
+
+const DataSet& Data(const std::string& name) {
+  static std::map<std::string, std::unique_ptr<DataSet>> sets;
+  auto& slot = sets[name];
+  if (slot) return *slot;
+  interp_tool::SyntheticPoints points;
+  std::vector<double> hi;
+  if (name == "rig") {
+    points = interp_tool::PaperGridPoints().value();
+    hi = {90, 90, 180};
+  } else if (name == "random50k") {
+    points = interp_tool::RandomPoints(50000, 12, 3);
+    hi = {90, 90, 360};
+  } else {
+    points = interp_tool::RandomPoints(4000, 13, 4);
+    hi = {90, 360, 90, 360};
+  }
+  slot = std::make_unique<DataSet>();
+  slot->name = name;
+  slot->samples = interp_tool::SyntheticSamples(points, WavelengthGrid::Pr650());
+  slot->cloud = BuildPointCloud(*slot->samples, {}).value();
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  slot->queries.resize(kQueries * hi.size());
+  for (std::size_t i = 0; i < slot->queries.size(); ++i) {
+    slot->queries[i] = hi[i % hi.size()] * u(rng);
+  }
+  return *slot;
+}
+
+const char* const kSets[] = {"rig", "random50k", "aniso4d"};
+
+void BM_KdTreeBuild(benchmark::State& state, std::string set, KdTree::Kernel kernel) {
+  const DataSet& data = Data(set);
+  for (auto _ : state) {
+    KdTree tree(data.cloud, kernel);
+    benchmark::DoNotOptimize(tree.node_count());
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["points"] = static_cast<double>(data.cloud.size());
+}
+
+void BM_OrthantSearch(benchmark::State& state, std::string set, KdTree::Kernel kernel) {
+  const DataSet& data = Data(set);
+  const KdTree tree(data.cloud, kernel);
+  const auto d = static_cast<std::size_t>(data.cloud.dims);
+  OrthantWinners winners;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    tree.NearestPerOrthant(data.queries.data() + i * d, winners);
+    benchmark::DoNotOptimize(winners.rank[0]);
+    i = (i + 1) % kQueries;
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(KdTree::KernelName(tree.kernel()) + std::string(", leaf ") +
+                 std::to_string(tree.leaf_size()));
+}
+
+void BM_NearestSearch(benchmark::State& state, std::string set) {
+  const DataSet& data = Data(set);
+  const KdTree tree(data.cloud);
+  const auto d = static_cast<std::size_t>(data.cloud.dims);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(tree.Nearest(data.queries.data() + i * d));
+    i = (i + 1) % kQueries;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+// Steps 3–4 on real winners: the first enclosing simplex and its barycentric weights.
+void BM_FindBlend(benchmark::State& state, std::string set) {
+  const DataSet& data = Data(set);
+  const KdTree tree(data.cloud);
+  const auto d = static_cast<std::size_t>(data.cloud.dims);
+  std::vector<OrthantWinners> winners(kQueries);
+  for (std::size_t i = 0; i < kQueries; ++i) {
+    tree.NearestPerOrthant(data.queries.data() + i * d, winners[i]);
+  }
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const OctantBlend blend =
+        FindOctantBlend(winners[i], std::span(data.queries.data() + i * d, d), data.cloud.dims);
+    benchmark::DoNotOptimize(blend.weight[0]);
+    i = (i + 1) % kQueries;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+// The spectral blend alone: 4 (3D) or 5 (4D) vertex spectra of 101 bands, scattered in the set.
+void BM_BlendSpectra(benchmark::State& state, std::string set) {
+  const DataSet& data = Data(set);
+  const SampleSet& s = *data.samples;
+  const auto vertices = static_cast<std::size_t>(s.dims() + 1);
+  std::mt19937_64 rng(3);
+  std::vector<std::array<const double*, kMaxSimplexVertices>> picks(kQueries);
+  for (auto& p : picks) {
+    for (std::size_t k = 0; k < vertices; ++k) p[k] = s.spectrum(rng() % s.size()).data();
+  }
+  const std::array<double, kMaxSimplexVertices> weights = {0.1, 0.2, 0.3, 0.25, 0.15};
+  std::vector<double> out(static_cast<std::size_t>(s.bands()));
+  std::size_t i = 0;
+  for (auto _ : state) {
+    BlendSpectra(std::span(weights.data(), vertices), std::span(picks[i].data(), vertices), out);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+    i = (i + 1) % kQueries;
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(std::to_string(vertices) + " vertices × " + std::to_string(s.bands()) + " bands");
+}
+
+// One query end to end: the fast path (spectrum only) and the full answer with provenance.
+void BM_OctantQuery(benchmark::State& state, std::string set, bool full) {
+  const DataSet& data = Data(set);
+  const auto interp = OctantInterpolator::Create(data.samples).value();
+  const auto d = static_cast<std::size_t>(data.cloud.dims);
+  std::vector<double> out(static_cast<std::size_t>(data.samples->bands()));
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::span<const double> q(data.queries.data() + i * d, d);
+    if (full) {
+      benchmark::DoNotOptimize(interp->Evaluate(q));
+    } else {
+      benchmark::DoNotOptimize(interp->SpectrumAt(q, out));
+    }
+    i = (i + 1) % kQueries;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+void RegisterAll() {
+  const std::pair<KdTree::Kernel, const char*> kernels[] = {
+      {KdTree::Kernel::kAvx512, "avx512"},
+      {KdTree::Kernel::kAvx2, "avx2"},
+      {KdTree::Kernel::kScalar, "scalar"},
+  };
+  for (const char* set : kSets) {
+    for (const auto& [kernel, name] : kernels) {
+      if (!KdTree::Supported(kernel)) continue;
+      benchmark::RegisterBenchmark((std::string("KdTreeBuild/") + set + "/" + name).c_str(),
+                                   [set = std::string(set), kernel = kernel](benchmark::State& s) {
+                                     BM_KdTreeBuild(s, set, kernel);
+                                   });
+    }
+  }
+  for (const char* set : kSets) {
+    for (const auto& [kernel, name] : kernels) {
+      if (!KdTree::Supported(kernel)) continue;
+      benchmark::RegisterBenchmark((std::string("OrthantSearch/") + set + "/" + name).c_str(),
+                                   [set = std::string(set), kernel = kernel](benchmark::State& s) {
+                                     BM_OrthantSearch(s, set, kernel);
+                                   });
+    }
+  }
+  for (const char* set : kSets) {
+    benchmark::RegisterBenchmark(
+        (std::string("NearestSearch/") + set).c_str(),
+        [set = std::string(set)](benchmark::State& s) { BM_NearestSearch(s, set); });
+  }
+  for (const char* set : kSets) {
+    benchmark::RegisterBenchmark(
+        (std::string("FindBlend/") + set).c_str(),
+        [set = std::string(set)](benchmark::State& s) { BM_FindBlend(s, set); });
+  }
+  for (const char* set : {"rig", "aniso4d"}) {
+    benchmark::RegisterBenchmark(
+        (std::string("BlendSpectra/") + set).c_str(),
+        [set = std::string(set)](benchmark::State& s) { BM_BlendSpectra(s, set); });
+  }
+  for (const char* set : kSets) {
+    for (bool full : {false, true}) {
+      benchmark::RegisterBenchmark(
+          (std::string("OctantQuery/") + set + (full ? "/Evaluate" : "/SpectrumAt")).c_str(),
+          [set = std::string(set), full](benchmark::State& s) { BM_OctantQuery(s, set, full); });
+    }
+  }
+}
+
+}  // namespace
+}  // namespace brdf::interp
+
+int main(int argc, char** argv) {
+  brdf::interp::RegisterAll();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
