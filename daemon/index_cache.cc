@@ -173,6 +173,8 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
     announced = entry->announced_id;
   }
   bool appended = false;
+  const bool first_load = !entry->synced;
+  std::uint64_t read_now = 0;
   if (!entry->synced || announced > entry->through_id) {
     std::array<std::shared_ptr<interp::SampleSet>, kQuantityCount> next;
     auto add = [&](Quantity q, std::int64_t id, std::span<const double> coords,
@@ -198,6 +200,7 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
       Result<std::vector<storage::ReadingRecord>> page =
           store_->GetReadings(session, through, options_.page_size);
       if (!page.ok()) return page.status();
+      read_now += page->size();
       for (const storage::ReadingRecord& r : *page) {
         through = std::max(through, r.id);
         switch (r.kind) {
@@ -334,7 +337,7 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
       build.unlock();
       std::lock_guard lock(mu_);
       ++stats_.hits;
-      if (appended) ++stats_.loads;
+      CountLoad(appended, first_load, read_now);
       return hit;
     }
   }
@@ -417,10 +420,17 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
   {
     std::lock_guard lock(mu_);
     ++stats_.builds;
-    if (appended) ++stats_.loads;
+    CountLoad(appended, first_load, read_now);
     Evict(session);
   }
   return std::shared_ptr<const IndexSnapshot>(std::move(snapshot));
+}
+
+void IndexCache::CountLoad(bool appended, bool first_load, std::uint64_t readings_read) {
+  stats_.readings_read += readings_read;
+  if (!appended) return;
+  ++stats_.loads;
+  if (!first_load) ++stats_.appends;
 }
 
 void IndexCache::Evict(SessionId keep) {

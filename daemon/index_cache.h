@@ -76,12 +76,15 @@ class IndexCache {
   };
 
   struct Stats {
-    std::size_t sessions = 0;     // sessions cached now
-    std::size_t bytes = 0;        // estimated memory held now
-    std::uint64_t loads = 0;      // store reads that added readings (first load or append)
-    std::uint64_t builds = 0;     // indexes built
-    std::uint64_t hits = 0;       // queries answered from a cached index
-    std::uint64_t evictions = 0;  // sessions evicted
+    std::size_t sessions = 0;         // sessions cached now
+    std::size_t bytes = 0;            // estimated memory held now
+    std::uint64_t loads = 0;          // store reads that added readings (first load or append)
+    std::uint64_t appends = 0;        // of those, appends to samples already held (not first loads)
+    std::uint64_t readings_read = 0;  // readings fetched from the store, all sessions: an append
+                                      // reads only the readings after the last one it has
+    std::uint64_t builds = 0;         // indexes built
+    std::uint64_t hits = 0;           // queries answered from a cached index
+    std::uint64_t evictions = 0;      // sessions evicted
   };
 
   IndexCache(std::shared_ptr<storage::SessionStore> store, Options options);
@@ -110,6 +113,8 @@ class IndexCache {
  private:
   struct Entry;
   void Evict(SessionId keep);
+  // Counts a store read in stats_ (mu_ held).
+  void CountLoad(bool appended, bool first_load, std::uint64_t readings_read);
 
   std::shared_ptr<storage::SessionStore> store_;
   Options options_;

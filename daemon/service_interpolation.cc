@@ -248,9 +248,12 @@ grpc::Status InterpolationService::InterpolateBatch(
     return InvalidField("directions",
                         "empty; give 1 to " + std::to_string(kMaxBatchDirections) + " directions");
   if (n > kMaxBatchDirections) {
-    return InvalidField("directions", std::to_string(n) + " directions; at most " +
-                                          std::to_string(kMaxBatchDirections) +
-                                          " per batch (split the request)");
+    // A limit of the server, not a malformed request: RESOURCE_EXHAUSTED, as for an oversized
+    // message.
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        "directions: " + std::to_string(n) + " directions; at most " +
+                            std::to_string(kMaxBatchDirections) +
+                            " per InterpolateBatch (split the request into several batches)");
   }
   if (request->chunk_size() > kMaxChunkSize) {
     return InvalidField("chunk_size", std::to_string(request->chunk_size()) +

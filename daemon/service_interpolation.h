@@ -1,15 +1,23 @@
 // The Interpolation service (brdf.proto): spectra at directions that were not measured, from the
 // session's index (index_cache.h). Every request is checked before any work: angles finite and
 // in range (θ in [0, 90], φ in [−180, 360]), the direction's form set, enums known, options
-// positive, batches of 1 … kMaxBatchDirections directions with chunks of at most kMaxChunkSize.
+// positive, batches of 1 … kMaxBatchDirections directions with chunks of at most kMaxChunkSize
+// (service_common.h: 100,000 directions; chunks of 256 results by default, at most 1,024).
+// Errors name the field and, in a batch, the index: INVALID_ARGUMENT "directions[17].iso.phi:
+// must be a finite angle …" (NaN, ±inf, out of range, no direction set, an empty batch, an
+// unknown enum, a chunk_size over the limit); NOT_FOUND for an unknown session; RESOURCE_EXHAUSTED
+// for more than kMaxBatchDirections directions (or a request over kMaxReceiveMessageBytes, which
+// gRPC refuses before it reaches the service).
 // Isotropic sessions take `iso` directions (φ folded into [0, 180], exact for an isotropic
 // sample) or `four` (reduced to iso); anisotropic sessions take `four` only (φ wrapped into
 // (−180, 180], the range of the stored readings).
 //
 // A batch is answered from ONE snapshot of the index, so all its results see the same readings
 // even while the session goes on. Chunks are written with the synchronous writer, which blocks
-// while the client is slow to read (gRPC flow control): the server never buffers more than a
-// chunk or so per stream. A client that cancels stops the batch at the next chunk.
+// while the client is slow to read (gRPC flow control): each chunk is evaluated only once the
+// previous one has been taken by the transport, so the server holds about one chunk per stream
+// (plus what HTTP/2's flow-control window lets through), never the whole answer. A client that
+// cancels stops the batch at the next chunk.
 #pragma once
 
 #include "brdf/v1/brdf.grpc.pb.h"

@@ -40,8 +40,12 @@ struct RigDescription {
   double adaptive_integration_s = 2.0;  // expected integration when the plan says adaptive
   double min_integration_s = 0.010;     // the meter's shortest integration (lower bound)
   double reading_overhead_s = 0.5;      // command pacing and meter processing per reading
-  double move_settle_s = 0.25;          // in-position polling and settling per move
-  double operator_action_s = 30;        // one manual action (a prompt) by the operator
+  // The meter's own time per measurement beyond the integration (shutter, dark and processing
+  // inside M0), which nothing can overlap: part of the physical lower bound. 0 unless known for
+  // the instrument (pr650.md gives none; brdf-sim models 1.0 s: [optics.detector] overhead_s).
+  double meter_measure_overhead_s = 0;
+  double move_settle_s = 0.25;    // in-position polling and settling per move
+  double operator_action_s = 30;  // one manual action (a prompt) by the operator
 };
 
 }  // namespace brdf::plan

@@ -27,7 +27,8 @@ StepTime StepTimer::Advance(const Step& step) {
     const double integration_min =
         measurement_.adaptive() ? rig_.min_integration_s : measurement_.integration_ms / 1000.0;
     t.estimate_s = rig_.reading_overhead_s + integration * averages + rig_.meter_transfer_s;
-    t.lower_bound_s = integration_min * averages + rig_.meter_transfer_s;
+    t.lower_bound_s =
+        integration_min * averages + rig_.meter_measure_overhead_s + rig_.meter_transfer_s;
     after_reading_ = true;
   } else if (step.kind == v1::STEP_KIND_MOVE) {
     const double motion = MotionSeconds(stage_, step.pose);
@@ -47,6 +48,25 @@ StepTime StepTimer::Advance(const Step& step) {
   elapsed_.estimate_s += t.estimate_s;
   elapsed_.lower_bound_s += t.lower_bound_s;
   return t;
+}
+
+double PlanLowerBound(std::span<const Step> steps, const RigDescription& rig,
+                      const MeasurementChoice& measurement, bool pipelined) {
+  StepTimer timer(rig, measurement);
+  // Sequential: an empty pause between a reading and the move after it (a prompt's lower bound
+  // is 0) stops the move from hiding the transfer.
+  Step pause;
+  pause.kind = v1::STEP_KIND_PROMPT;
+  const Step* previous = nullptr;
+  for (const Step& s : steps) {
+    if (!pipelined && previous != nullptr && previous->is_reading() &&
+        s.kind == v1::STEP_KIND_MOVE) {
+      timer.Advance(pause);
+    }
+    timer.Advance(s);
+    previous = &s;
+  }
+  return timer.elapsed_lower_bound_s();
 }
 
 std::vector<StepTime> EstimateSteps(std::span<const Step> steps, const RigDescription& rig,

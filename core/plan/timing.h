@@ -5,7 +5,7 @@
 // The model, per step (times in seconds, RigDescription's parameters):
 //   reading (REFERENCE, DARK, SAMPLE):
 //     estimate    = reading_overhead_s + integration · averages + meter_transfer_s
-//     lower bound = integration_min · averages + meter_transfer_s
+//     lower bound = integration_min · averages + meter_measure_overhead_s + meter_transfer_s
 //     where integration is integration_ms / 1000, or adaptive_integration_s when adaptive
 //     (for the lower bound: min_integration_s, the meter's shortest, when adaptive).
 //   move: the motorized axes (α, β, and γ / δ when present) move at the same time, so
@@ -16,8 +16,11 @@
 //     the move once the meter has measured, while the spectrum comes down the serial line), so
 //     meter_transfer_s is taken off both: max(0, … − meter_transfer_s).
 //   prompt: estimate = operator_action_s; lower bound = 0 (operator time is not physics).
-// The lower bound therefore sums exactly what cannot overlap: integration, data transfer not
-// hidden behind motion, and motion not hidden behind a transfer. The rig starts at pose 0.
+// The lower bound therefore sums exactly what cannot overlap: integration and the meter's own
+// measuring time, data transfer not hidden behind motion, and motion not hidden behind a
+// transfer. The rig starts at pose 0. It is the bound for a pipelining executor; without
+// pipelining, PlanLowerBound(..., /*pipelined=*/false) adds the hidden part back (what a
+// sequential executor cannot beat), which is how the bench compares the two.
 #pragma once
 
 #include <span>
@@ -54,6 +57,12 @@ class StepTimer {
   bool after_reading_ = false;  // the previous step was a reading
   StepTime elapsed_;
 };
+
+// The physical lower bound of a whole list of steps, in seconds: the sum of StepTimer's
+// lower_bound_s when `pipelined`; else every move's full motion time (a move that waits for the
+// previous transfer to finish hides nothing behind it).
+double PlanLowerBound(std::span<const Step> steps, const RigDescription& rig,
+                      const MeasurementChoice& measurement, bool pipelined = true);
 
 // The time of every step of a list (StepTimer over the list).
 std::vector<StepTime> EstimateSteps(std::span<const Step> steps, const RigDescription& rig,

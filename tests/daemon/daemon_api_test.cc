@@ -362,7 +362,7 @@ TEST_F(DaemonApiTest, ChecksEveryArgumentAndNamesTheField) {
   request.set_chunk_size(0);
   request.clear_directions();
   for (int i = 0; i < 100001; ++i) request.add_directions()->mutable_iso()->set_theta_i(10);
-  expect(batch(request), StatusCode::INVALID_ARGUMENT, "100000");
+  expect(batch(request), StatusCode::RESOURCE_EXHAUSTED, "100000");
 
   // Oversize messages are refused by the transport (16 MiB limit).
   v1::AbortSessionRequest abort;

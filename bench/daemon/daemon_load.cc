@@ -1,0 +1,149 @@
+// bench_daemon_load: Interpolate latency and throughput against a running brdfd, from N concurrent
+// clients (each its own channel, i.e. its own HTTP/2 connection, as separate analysis programs
+// would be), each calling Interpolate back to back with a random direction for `--seconds`.
+// Latency is the client's: from the call to the answer, over loopback.
+//
+// With --recording SESSION the tool also reads that session's progress before and after the
+// window and prints how many steps it completed meanwhile (proof that it was recording).
+//
+// Output: one "key=value" line (bench/daemon/run.sh parses it).
+#include <grpcpp/grpcpp.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "brdf/v1/brdf.grpc.pb.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Options {
+  std::string address;
+  std::string token;
+  std::string session;
+  std::string recording;
+  int clients = 8;
+  double seconds = 10;
+  double warmup = 1;
+};
+
+void Authorize(grpc::ClientContext& context, const Options& o) {
+  if (!o.token.empty()) context.AddMetadata("authorization", "Bearer " + o.token);
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+}
+
+// Done steps of `session` (−1 when it cannot be read).
+long DoneSteps(const std::shared_ptr<grpc::Channel>& channel, const Options& o,
+               const std::string& session) {
+  auto stub = brdf::v1::Control::NewStub(channel);
+  grpc::ClientContext context;
+  Authorize(context, o);
+  brdf::v1::GetSessionRequest request;
+  request.set_session_id(session);
+  brdf::v1::Session response;
+  if (!stub->GetSession(&context, request, &response).ok()) return -1;
+  return static_cast<long>(response.progress().done_steps());
+}
+
+struct ClientResult {
+  std::vector<double> latencies_us;
+  long errors = 0;
+  std::string first_error;
+};
+
+void Client(const Options& o, int seed, Clock::time_point measure_from, Clock::time_point until,
+            ClientResult* out) {
+  grpc::ChannelArguments args;
+  args.SetInt("grpc.use_local_subchannel_pool", 1);  // a connection of its own
+  auto channel = grpc::CreateCustomChannel(o.address, grpc::InsecureChannelCredentials(), args);
+  auto stub = brdf::v1::Interpolation::NewStub(channel);
+  std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+  std::uniform_real_distribution<double> theta(0, 70);
+  std::uniform_real_distribution<double> phi(0, 180);
+  out->latencies_us.reserve(200000);
+  while (Clock::now() < until) {
+    brdf::v1::InterpolateRequest request;
+    request.set_session_id(o.session);
+    brdf::v1::IsoDirection* iso = request.mutable_direction()->mutable_iso();
+    iso->set_theta_i(theta(rng));
+    iso->set_theta_o(theta(rng));
+    iso->set_phi(phi(rng));
+    brdf::v1::InterpolateResponse response;
+    grpc::ClientContext context;
+    Authorize(context, o);
+    const Clock::time_point start = Clock::now();
+    const grpc::Status status = stub->Interpolate(&context, request, &response);
+    const Clock::time_point end = Clock::now();
+    if (start < measure_from) continue;  // warm-up: connections, the index's first build
+    if (!status.ok()) {
+      if (out->errors++ == 0) out->first_error = status.error_message();
+      continue;
+    }
+    out->latencies_us.push_back(std::chrono::duration<double, std::micro>(end - start).count());
+  }
+}
+
+double Percentile(std::vector<double>& sorted, double p) {
+  if (sorted.empty()) return 0;
+  const std::size_t i = std::min(sorted.size() - 1, static_cast<std::size_t>(p * sorted.size()));
+  return sorted[i];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app("bench_daemon_load: Interpolate latency and throughput from concurrent clients");
+  app.add_option("--address", o.address, "brdfd's host:port")->required();
+  app.add_option("--token", o.token, "bearer token (analyst is enough)");
+  app.add_option("--session", o.session, "session to interpolate")->required();
+  app.add_option("--recording", o.recording, "a session that records meanwhile (progress shown)");
+  app.add_option("--clients", o.clients, "concurrent clients")->check(CLI::Range(1, 256));
+  app.add_option("--seconds", o.seconds, "measurement window")->check(CLI::Range(0.1, 600.0));
+  app.add_option("--warmup", o.warmup, "seconds before the window")->check(CLI::Range(0.0, 60.0));
+  CLI11_PARSE(app, argc, argv);
+
+  auto control_channel = grpc::CreateChannel(o.address, grpc::InsecureChannelCredentials());
+  const Clock::time_point measure_from =
+      Clock::now() +
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.warmup));
+  const Clock::time_point until = measure_from + std::chrono::duration_cast<Clock::duration>(
+                                                     std::chrono::duration<double>(o.seconds));
+
+  std::vector<ClientResult> results(static_cast<std::size_t>(o.clients));
+  std::vector<std::thread> threads;
+  for (int i = 0; i < o.clients; ++i) {
+    threads.emplace_back(Client, std::cref(o), 1000 + i, measure_from, until,
+                         &results[static_cast<std::size_t>(i)]);
+  }
+  std::this_thread::sleep_until(measure_from);
+  const long before = o.recording.empty() ? -1 : DoneSteps(control_channel, o, o.recording);
+  for (std::thread& t : threads) t.join();
+  const long after = o.recording.empty() ? -1 : DoneSteps(control_channel, o, o.recording);
+
+  std::vector<double> all;
+  long errors = 0;
+  std::string first_error;
+  for (ClientResult& r : results) {
+    all.insert(all.end(), r.latencies_us.begin(), r.latencies_us.end());
+    if (r.errors > 0 && first_error.empty()) first_error = r.first_error;
+    errors += r.errors;
+  }
+  std::sort(all.begin(), all.end());
+  std::printf(
+      "interpolate clients=%d calls=%zu errors=%ld qps=%.0f p50_us=%.0f p90_us=%.0f p99_us=%.0f "
+      "p999_us=%.0f max_us=%.0f steps_recorded=%ld\n",
+      o.clients, all.size(), errors, static_cast<double>(all.size()) / o.seconds,
+      Percentile(all, 0.5), Percentile(all, 0.9), Percentile(all, 0.99), Percentile(all, 0.999),
+      all.empty() ? 0.0 : all.back(), before >= 0 && after >= 0 ? after - before : -1);
+  if (errors > 0) std::fprintf(stderr, "bench_daemon_load: first error: %s\n", first_error.c_str());
+  return all.empty() ? 1 : 0;
+}

@@ -1,0 +1,376 @@
+// The Interpolation service in process, over gRPC on loopback: a real SQLite store filled through
+// storage's API, the real IndexCache and InterpolationService behind a grpc::Server, and the
+// generated client stub. Checks that InterpolateBatch streams its answer chunk by chunk under the
+// client's flow control (a server interceptor counts the chunks the service has written), the
+// precise errors of both RPCs, and that the per-session index takes in new readings by appending
+// them (the cache's counters) instead of reading the session again.
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/support/server_interceptor.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <random>
+#include <thread>
+
+#include "brdf/v1/brdf.grpc.pb.h"
+#include "daemon/auth.h"
+#include "daemon/index_cache.h"
+#include "daemon/service_common.h"
+#include "daemon/service_interpolation.h"
+#include "storage/session_store.h"
+#include "tests/support/test_env.h"
+
+namespace brdf::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+
+// Counts the messages the service handlers have started to write (PRE_SEND_MESSAGE), all RPCs.
+class CountingInterceptor final : public grpc::experimental::Interceptor {
+ public:
+  explicit CountingInterceptor(std::atomic<int>& sent) : sent_(sent) {}
+  void Intercept(grpc::experimental::InterceptorBatchMethods* methods) override {
+    if (methods->QueryInterceptionHookPoint(
+            grpc::experimental::InterceptionHookPoints::PRE_SEND_MESSAGE)) {
+      ++sent_;
+    }
+    methods->Proceed();
+  }
+
+ private:
+  std::atomic<int>& sent_;
+};
+
+class CountingFactory final : public grpc::experimental::ServerInterceptorFactoryInterface {
+ public:
+  explicit CountingFactory(std::atomic<int>& sent) : sent_(sent) {}
+  grpc::experimental::Interceptor* CreateServerInterceptor(
+      grpc::experimental::ServerRpcInfo*) override {
+    return new CountingInterceptor(sent_);
+  }
+
+ private:
+  std::atomic<int>& sent_;
+};
+
+class InterpStreamTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto store = storage::SessionStore::Open(dir_.file("interp.db").string());
+    ASSERT_TRUE(store.ok()) << store.status().ToString();
+    store_ = std::move(*store);
+    cache_ = std::make_unique<IndexCache>(store_);
+    service_ = std::make_unique<InterpolationService>(*cache_, auth_, stopping_);
+
+    grpc::ServerBuilder builder;
+    int port = 0;
+    builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+    builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
+    builder.RegisterService(service_.get());
+    std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> creators;
+    creators.push_back(std::make_unique<CountingFactory>(sent_));
+    builder.experimental().SetInterceptorCreators(std::move(creators));
+    server_ = builder.BuildAndStart();
+    ASSERT_TRUE(server_ != nullptr && port > 0);
+    // No BDP probing: the stream's flow-control window stays at its initial 64 KiB, so a client
+    // that stops reading holds the server back after a few chunks.
+    grpc::ChannelArguments args;
+    args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+    args.SetMaxReceiveMessageSize(-1);
+    channel_ = grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(port),
+                                         grpc::InsecureChannelCredentials(), args);
+    stub_ = v1::Interpolation::NewStub(channel_);
+  }
+
+  void TearDown() override {
+    stopping_.Stop();
+    if (server_) server_->Shutdown(std::chrono::system_clock::now() + 2s);
+  }
+
+  // A session: a white reference, a dark, then `samples` sample readings at random directions
+  // (θi, θo in [0, 80], φ in [0, 180]) on the PR-650 grid. Returns its id.
+  std::int64_t MakeSession(int samples, int extra_steps = 0) {
+    storage::NewSession s;
+    s.name = "stream test";
+    s.plan_kind = "pose_list";
+    s.plan_json = R"({"poseList": {"poses": [{"alpha": 0, "beta": 0, "delta": 0}]}})";
+    s.created_by_role = "operator";
+    s.white_reflectance = 0.99;
+    std::vector<storage::StepRecord> steps;
+    for (int i = 0; i < samples + 2 + extra_steps; ++i) {
+      storage::StepRecord r;
+      r.step_index = i;
+      r.kind = i == 0   ? storage::StepKind::kReference
+               : i == 1 ? storage::StepKind::kDark
+                        : storage::StepKind::kSample;
+      steps.push_back(r);
+    }
+    Result<std::int64_t> id = store_->CreateSession(s, steps);
+    EXPECT_TRUE(id.ok()) << id.status().ToString();
+    EXPECT_TRUE(store_->SetSessionState(*id, SessionState::kRunning, "test").ok());
+    reference_ = Add(*id, storage::ReadingKind::kReference, {10, 0, 10, 180}, 1.0);
+    dark_ = Add(*id, storage::ReadingKind::kDark, {}, 0.001);
+    std::uniform_real_distribution<double> theta(0, 80);
+    std::uniform_real_distribution<double> phi(0, 180);
+    for (int i = 0; i < samples; ++i) {
+      Add(*id, storage::ReadingKind::kSample, {theta(rng_), 0, theta(rng_), phi(rng_)}, 0.1);
+    }
+    return *id;
+  }
+
+  // Stores a reading at the session's next step; returns it with its id.
+  storage::ReadingRecord AddReading(std::int64_t session, storage::ReadingKind kind,
+                                    const Directions& d, double level) {
+    storage::ReadingRecord r;
+    r.kind = kind;
+    r.directions = d;
+    r.grid = WavelengthGrid::Pr650();
+    r.spectrum.assign(static_cast<std::size_t>(r.grid.count), level);
+    if (kind == storage::ReadingKind::kSample) {
+      r.reference_reading_id = reference_;
+      r.dark_reading_id = dark_;
+    }
+    Result<std::int64_t> id = store_->CompleteStepWithReading(session, next_step_[session]++, r);
+    EXPECT_TRUE(id.ok()) << id.status().ToString();
+    r.id = id.ok() ? *id : 0;
+    r.session_id = session;
+    return r;
+  }
+  std::int64_t Add(std::int64_t session, storage::ReadingKind kind, const Directions& d,
+                   double level) {
+    return AddReading(session, kind, d, level).id;
+  }
+
+  static std::unique_ptr<grpc::ClientContext> Context(std::chrono::milliseconds deadline = 20s) {
+    auto c = std::make_unique<grpc::ClientContext>();
+    c->set_deadline(std::chrono::system_clock::now() + deadline);
+    return c;
+  }
+
+  static v1::DirectionQuery Iso(double theta_i, double theta_o, double phi) {
+    v1::DirectionQuery q;
+    q.mutable_iso()->set_theta_i(theta_i);
+    q.mutable_iso()->set_theta_o(theta_o);
+    q.mutable_iso()->set_phi(phi);
+    return q;
+  }
+
+  grpc::Status Single(const std::string& session, const v1::DirectionQuery& direction,
+                      v1::InterpolateResponse* response = nullptr) {
+    v1::InterpolateRequest request;
+    request.set_session_id(session);
+    *request.mutable_direction() = direction;
+    v1::InterpolateResponse ignored;
+    auto context = Context();
+    return stub_->Interpolate(context.get(), request, response ? response : &ignored);
+  }
+
+  // Runs a whole batch; the chunks through `chunks`.
+  grpc::Status Batch(const v1::InterpolateBatchRequest& request,
+                     std::vector<v1::InterpolateBatchChunk>* chunks = nullptr) {
+    auto context = Context();
+    auto reader = stub_->InterpolateBatch(context.get(), request);
+    v1::InterpolateBatchChunk chunk;
+    while (reader->Read(&chunk)) {
+      if (chunks != nullptr) chunks->push_back(chunk);
+    }
+    return reader->Finish();
+  }
+
+  testing::TempDir dir_{"interp-stream-test"};
+  std::shared_ptr<storage::SessionStore> store_;
+  std::unique_ptr<IndexCache> cache_;
+  Authenticator auth_{{}};
+  StopSignal stopping_;
+  std::unique_ptr<InterpolationService> service_;
+  std::atomic<int> sent_{0};
+  std::unique_ptr<grpc::Server> server_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::Interpolation::Stub> stub_;
+  std::mt19937_64 rng_{5};
+  std::map<std::int64_t, int> next_step_;
+  std::int64_t reference_ = 0;
+  std::int64_t dark_ = 0;
+};
+
+TEST_F(InterpStreamTest, BatchStreamsChunkByChunkUnderTheClientsFlowControl) {
+  const std::string session = std::to_string(MakeSession(300));
+  constexpr int kChunk = 64;
+  constexpr int kDirections = 200 * kChunk;  // 200 chunks of ~80 KB (101 bands + provenance)
+  v1::InterpolateBatchRequest request;
+  request.set_session_id(session);
+  request.set_chunk_size(kChunk);
+  std::uniform_real_distribution<double> theta(0, 80);
+  std::uniform_real_distribution<double> phi(0, 180);
+  std::vector<v1::DirectionQuery> asked;
+  for (int i = 0; i < kDirections; ++i) {
+    asked.push_back(Iso(theta(rng_), theta(rng_), phi(rng_)));
+    *request.add_directions() = asked.back();
+  }
+
+  auto context = Context(60s);
+  auto reader = stub_->InterpolateBatch(context.get(), request);
+  v1::InterpolateBatchChunk chunk;
+  ASSERT_TRUE(reader->Read(&chunk));
+  EXPECT_EQ(chunk.first_index(), 0u);
+  EXPECT_EQ(chunk.results_size(), kChunk);
+  // The client stops reading. The server must stop writing once the stream's window is full:
+  // its count of written chunks levels off far below the 200 of the answer (were the answer
+  // queued whole, it would reach 200 within milliseconds).
+  int seen = sent_.load();
+  for (int i = 0; i < 40; ++i) {  // ~2 s for a runaway server to show itself
+    std::this_thread::sleep_for(50ms);
+    seen = sent_.load();
+    if (seen >= kDirections / kChunk) break;
+  }
+  EXPECT_LT(seen, 40) << "the server wrote " << seen
+                      << " chunks while the client read one: it does not wait for flow control";
+
+  // Reading on: every result, in order, each chunk starting where the previous one ended.
+  int next = kChunk;
+  int chunks = 1;
+  while (reader->Read(&chunk)) {
+    ++chunks;
+    ASSERT_EQ(static_cast<int>(chunk.first_index()), next);
+    for (int i = 0; i < chunk.results_size(); ++i) {
+      const v1::InterpolationResult& r = chunk.results(i);
+      EXPECT_EQ(r.query().iso().theta_i(),
+                asked[static_cast<std::size_t>(next + i)].iso().theta_i());
+    }
+    next += chunk.results_size();
+  }
+  const grpc::Status finished = reader->Finish();
+  ASSERT_TRUE(finished.ok()) << finished.error_message();
+  EXPECT_EQ(next, kDirections);
+  EXPECT_EQ(chunks, kDirections / kChunk);
+  EXPECT_EQ(sent_.load(), kDirections / kChunk);
+
+  // The default chunk size, and a last chunk that is short.
+  v1::InterpolateBatchRequest small;
+  small.set_session_id(session);
+  const int n = static_cast<int>(kDefaultChunkSize) + 3;
+  for (int i = 0; i < n; ++i) *small.add_directions() = asked[static_cast<std::size_t>(i)];
+  std::vector<v1::InterpolateBatchChunk> got;
+  ASSERT_TRUE(Batch(small, &got).ok());
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0].results_size(), static_cast<int>(kDefaultChunkSize));
+  EXPECT_EQ(got[1].first_index(), kDefaultChunkSize);
+  EXPECT_EQ(got[1].results_size(), 3);
+}
+
+TEST_F(InterpStreamTest, ErrorsNameTheFieldAndTheIndex) {
+  const std::string session = std::to_string(MakeSession(40));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  auto expect = [](const grpc::Status& st, grpc::StatusCode code, const std::string& field) {
+    EXPECT_EQ(st.error_code(), code) << st.error_message();
+    EXPECT_EQ(st.error_message().rfind(field, 0), 0u)
+        << "'" << st.error_message() << "' does not start with " << field;
+  };
+
+  // Interpolate.
+  ASSERT_TRUE(Single(session, Iso(30, 30, 90)).ok());
+  expect(Single(session, Iso(nan, 30, 90)), grpc::StatusCode::INVALID_ARGUMENT,
+         "direction.iso.theta_i: must be a finite angle");
+  expect(Single(session, Iso(30, -inf, 90)), grpc::StatusCode::INVALID_ARGUMENT,
+         "direction.iso.theta_o: must be a finite angle");
+  expect(Single(session, Iso(30, 91, 90)), grpc::StatusCode::INVALID_ARGUMENT,
+         "direction.iso.theta_o: 91° is outside [0, 90]");
+  expect(Single(session, Iso(30, 30, 400)), grpc::StatusCode::INVALID_ARGUMENT,
+         "direction.iso.phi: 400° is outside");
+  expect(Single(session, v1::DirectionQuery()), grpc::StatusCode::INVALID_ARGUMENT,
+         "direction: no direction");
+  v1::DirectionQuery four;
+  four.mutable_four()->set_theta_i(20);
+  four.mutable_four()->set_phi_i(nan);
+  expect(Single(session, four), grpc::StatusCode::INVALID_ARGUMENT,
+         "direction.four.phi_i: must be a finite angle");
+  expect(Single("987654", Iso(30, 30, 90)), grpc::StatusCode::NOT_FOUND, "");
+  expect(Single("abc", Iso(30, 30, 90)), grpc::StatusCode::INVALID_ARGUMENT, "session_id");
+  EXPECT_NE(Single("987654", Iso(30, 30, 90)).error_message().find("987654"), std::string::npos);
+
+  // InterpolateBatch: the index of the offending direction, the first one wins.
+  const int sent_before = sent_.load();  // (the good Interpolate above sent its answer)
+  v1::InterpolateBatchRequest batch;
+  batch.set_session_id(session);
+  for (int i = 0; i < 10; ++i) *batch.add_directions() = Iso(10 + i, 20, 30);
+  ASSERT_TRUE(Batch(batch).ok());
+  v1::InterpolateBatchRequest bad = batch;
+  bad.mutable_directions(7)->mutable_iso()->set_phi(inf);
+  bad.mutable_directions(8)->mutable_iso()->set_theta_i(nan);
+  expect(Batch(bad), grpc::StatusCode::INVALID_ARGUMENT,
+         "directions[7].iso.phi: must be a finite angle");
+  bad = batch;
+  bad.mutable_directions(3)->mutable_iso()->set_theta_o(90.5);
+  expect(Batch(bad), grpc::StatusCode::INVALID_ARGUMENT, "directions[3].iso.theta_o: 90.5°");
+  bad = batch;
+  bad.mutable_directions(9)->clear_iso();
+  expect(Batch(bad), grpc::StatusCode::INVALID_ARGUMENT, "directions[9]: no direction");
+
+  v1::InterpolateBatchRequest empty;
+  empty.set_session_id(session);
+  expect(Batch(empty), grpc::StatusCode::INVALID_ARGUMENT, "directions: empty");
+
+  v1::InterpolateBatchRequest huge;
+  huge.set_session_id(session);
+  for (int i = 0; i < kMaxBatchDirections + 1; ++i) *huge.add_directions() = Iso(10, 20, 30);
+  expect(Batch(huge), grpc::StatusCode::RESOURCE_EXHAUSTED, "directions: 100001 directions");
+
+  v1::InterpolateBatchRequest chunky = batch;
+  chunky.set_chunk_size(kMaxChunkSize + 1);
+  expect(Batch(chunky), grpc::StatusCode::INVALID_ARGUMENT, "chunk_size");
+
+  v1::InterpolateBatchRequest unknown = batch;
+  unknown.set_session_id("987654");
+  expect(Batch(unknown), grpc::StatusCode::NOT_FOUND, "");
+  // Only the good batch wrote a chunk: every error comes before any work.
+  EXPECT_EQ(sent_.load(), sent_before + 1);
+}
+
+TEST_F(InterpStreamTest, NewReadingsAreAppendedToTheIndexNotReadAgain) {
+  const std::int64_t id = MakeSession(50, /*extra_steps=*/5);
+  const std::string session = std::to_string(id);
+  ASSERT_TRUE(Single(session, Iso(30, 30, 90)).ok());
+  const IndexCache::Stats first = cache_->stats();
+  EXPECT_EQ(first.loads, 1u);
+  EXPECT_EQ(first.appends, 0u);
+  EXPECT_EQ(first.readings_read, 52u);  // the reference, the dark and 50 samples
+
+  // Nothing new: answered from the same index, nothing read.
+  ASSERT_TRUE(Single(session, Iso(40, 20, 120)).ok());
+  EXPECT_EQ(cache_->stats().readings_read, first.readings_read);
+  EXPECT_EQ(cache_->stats().builds, first.builds);
+
+  // Two readings land, announced as the daemon's reading listener does; the very next query
+  // sees the new one at its direction, after reading just those two from the store.
+  const storage::ReadingRecord a =
+      AddReading(id, storage::ReadingKind::kSample, {33, 0, 44, 55}, 0.7);
+  cache_->OnReading(id, a);
+  const storage::ReadingRecord b =
+      AddReading(id, storage::ReadingKind::kSample, {63, 0, 14, 150}, 0.2);
+  cache_->OnReading(id, b);
+  v1::InterpolateRequest request;
+  request.set_session_id(session);
+  *request.mutable_direction() = Iso(33, 44, 55);
+  request.set_method(v1::INTERPOLATION_METHOD_NEAREST);
+  v1::InterpolateResponse response;
+  auto context = Context();
+  ASSERT_TRUE(stub_->Interpolate(context.get(), request, &response).ok());
+  ASSERT_EQ(response.result().vertices_size(), 1);
+  EXPECT_EQ(response.result().vertices(0).reading_id(), a.id);
+  const IndexCache::Stats after = cache_->stats();
+  EXPECT_EQ(after.readings_read, first.readings_read + 2);
+  EXPECT_EQ(after.loads, 2u);
+  EXPECT_EQ(after.appends, 1u);
+
+  // The octant index over the same readings: built once more, nothing read.
+  ASSERT_TRUE(Single(session, Iso(63, 14, 150)).ok());
+  EXPECT_EQ(cache_->stats().readings_read, after.readings_read);
+}
+
+}  // namespace
+}  // namespace brdf::daemon
