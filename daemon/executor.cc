@@ -74,6 +74,7 @@ struct Executor::Context {
   std::optional<Pose> stage_target;
   Pose stage_feedback;
   bool meter_configured = false;
+  bool meter_dark = false;  // the dark flag the meter was last configured with
   bool meter_recorded = false;
   int last_quality = -1;
   std::uint32_t next_move_first_attempt = 1;
@@ -412,6 +413,8 @@ Executor::Outcome Executor::RunReading(Context& c, int index, int& advanced) {
   drivers::MeasurementSettings settings;
   settings.integration_ms = static_cast<int>(c.settings.measurement.integration_ms);
   settings.averages = static_cast<int>(std::max<std::uint32_t>(1, c.settings.measurement.averages));
+  // A dark is weak by nature: the driver accepts its low-light codes instead of failing them.
+  settings.dark = step.kind == storage::StepKind::kDark;
 
   drivers::MeasurementOutcome outcome;
   drivers::SpectrumReport report;
@@ -455,9 +458,10 @@ Executor::Outcome Executor::RunReading(Context& c, int index, int& advanced) {
       if (rig.has_detector_arm) pose.delta = c.stage_feedback.delta;
     }
     return rig_.UseMeter(ctx, [&](drivers::Spectroradiometer& meter) -> Status {
-      if (!c.meter_configured || attempt > 1) {
+      if (!c.meter_configured || attempt > 1 || c.meter_dark != settings.dark) {
         BRDF_RETURN_IF_ERROR(meter.Configure(settings, ctx).WithContext("configuring the meter"));
         c.meter_configured = true;
+        c.meter_dark = settings.dark;
       }
       Result<drivers::MeasurementOutcome> measured = meter.Measure(ctx);
       if (!measured.ok()) {

@@ -65,6 +65,9 @@ int main(int argc, char** argv) {
   sigaddset(&stop_signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   signal(SIGPIPE, SIG_IGN);
+  // A file-size limit (ulimit -f, a quota) must not kill us in the middle of a session: ignored,
+  // a write past it fails with EFBIG, storage reports it and the session pauses.
+  signal(SIGXFSZ, SIG_IGN);
 
   std::string config_path;
   std::string log_level;

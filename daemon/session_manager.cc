@@ -39,8 +39,17 @@ Result<SessionId> ParseSessionId(const std::string& text, const std::string& fie
         return std::isdigit(static_cast<unsigned char>(ch));
       });
   if (!digits || std::stoll(text) <= 0) {
-    return InvalidArgument(field + ": \"" + text +
-                           "\" is not a session id (a positive number, as SubmitPlan returned it)");
+    // Echo at most a short, printable prefix: the message travels back in a gRPC trailer, and a
+    // hostile megabyte-long id must not make the error itself too large to deliver.
+    constexpr std::size_t kEchoBytes = 32;
+    std::string shown;
+    for (char ch : text.substr(0, kEchoBytes)) {
+      shown += std::isprint(static_cast<unsigned char>(ch)) ? ch : '?';
+    }
+    if (text.size() > kEchoBytes) shown += "...";
+    return InvalidArgument(field + ": \"" + shown + "\" (" + std::to_string(text.size()) +
+                           " bytes) is not a session id (a positive number, as SubmitPlan "
+                           "returned it)");
   }
   return static_cast<SessionId>(std::stoll(text));
 }
@@ -162,7 +171,15 @@ struct SessionManager::Impl final : public ExecutorHost {
     }
     if (*to == *from) return *to;  // idempotent (pause while paused, start while queued)
 
-    BRDF_RETURN_IF_ERROR(store.SetSessionState(id, *to, reason));
+    if (Status stored = store.SetSessionState(id, *to, reason); !stored.ok()) {
+      // The database refuses writes (disk full, read-only file). A pause must still happen: the
+      // executor has stopped, and a session left "running" with nothing running could never be
+      // resumed. It is kept in memory until a later transition writes the state; a crash
+      // meanwhile leaves "running" in the file, which recovery turns into paused anyway.
+      if (*to != SessionState::kPaused || stored.code() != StatusCode::kIoError) return stored;
+      spdlog::error("{}: paused, but the database did not record it: {}", SessionName(id),
+                    stored.ToString());
+    }
     l.state = *to;
     if (*to != SessionState::kAwaitingOperator) l.prompt.reset();
     if (*to == SessionState::kRunning) {

@@ -26,6 +26,9 @@ struct MeasurementSettings {
   int integration_ms = 0;       // 0 = adaptive (the meter chooses), else 10–6000 ms
   int averages = 1;             // 1–99 measurements averaged by the meter
   bool sync_to_source = false;  // sync integration to the lamp's flicker (uses F)
+  // A dark reading (shutter closed): weak-light quality codes are expected and accepted as they
+  // are, not adapted or failed (a PR-650 reports 10 or 18 on a dark).
+  bool dark = false;
 };
 
 // What happened during one measurement (the meter holds the data until transferred).

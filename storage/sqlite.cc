@@ -2,6 +2,7 @@
 
 #include <sqlite3.h>
 
+#include <cstring>
 #include <filesystem>
 #include <utility>
 
@@ -85,6 +86,20 @@ std::string DescribeSql(std::string_view sql) {
     }
   }
   return out;
+}
+
+// SQLite's message plus, for an I/O failure, what the operating system said ("No space left on
+// device", "File too large", "Operation not permitted"): "disk I/O error" alone does not tell the
+// operator whether to free space, lift a quota or remount.
+std::string WithSystemError(sqlite3* db, int rc, std::string message) {
+  const int primary = rc & 0xff;
+  if (primary != SQLITE_IOERR && primary != SQLITE_FULL && primary != SQLITE_READONLY &&
+      primary != SQLITE_CANTOPEN) {
+    return message;
+  }
+  const int err = sqlite3_system_errno(db);
+  if (err != 0) message += " (operating system: " + std::string(std::strerror(err)) + ")";
+  return message;
 }
 
 }  // namespace
@@ -365,7 +380,8 @@ Status Database::Exec(std::string_view sql) {
   char* message = nullptr;
   const int rc = sqlite3_exec(db_, s.c_str(), nullptr, nullptr, &message);
   if (rc == SQLITE_OK) return Status::Ok();
-  const std::string text = message != nullptr ? message : sqlite3_errstr(rc);
+  const std::string text =
+      WithSystemError(db_, rc, message != nullptr ? message : sqlite3_errstr(rc));
   sqlite3_free(message);
   return SqliteStatus(rc, path_, DescribeSql(s), text);
 }
@@ -399,7 +415,7 @@ bool Database::in_transaction() const {
 }
 
 Status Database::Error(int rc, std::string_view operation) const {
-  return SqliteStatus(rc, path_, operation, sqlite3_errmsg(db_));
+  return SqliteStatus(rc, path_, operation, WithSystemError(db_, rc, sqlite3_errmsg(db_)));
 }
 
 // --- Transaction

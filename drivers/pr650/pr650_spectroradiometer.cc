@@ -298,6 +298,7 @@ Status Pr650Spectroradiometer::Configure(const MeasurementSettings& settings,
   configured_.reset();
   BRDF_RETURN_IF_ERROR(SendSetup(fields, ctx));
   configured_ = fields;
+  dark_ = settings.dark;
   return Status::Ok();
 }
 
@@ -319,7 +320,7 @@ Result<MeasurementOutcome> Pr650Spectroradiometer::Measure(const CallContext& ct
 
     const SetupFields current = CurrentSetup();
     const pr650::MeasureLoopState state{current.integration_ms, current.sync, attempt,
-                                        options_.max_measure_attempts};
+                                        options_.max_measure_attempts, dark_};
     const pr650::QualityDecision decision =
         pr650::DecideQuality(options_.quality_policy, *code, state);
     if (!decision.note.empty()) {

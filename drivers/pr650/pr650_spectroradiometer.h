@@ -81,7 +81,8 @@ class Pr650Spectroradiometer final : public Spectroradiometer {
   bool port_seen_ = false;        // the port has opened before: a missing port has vanished
   bool lost_connection_ = false;  // the link went down under us (vs never connected)
 
-  std::optional<pr650::SetupFields> configured_;   // what Configure asked for
+  std::optional<pr650::SetupFields> configured_;  // what Configure asked for
+  bool dark_ = false;  // Configure's MeasurementSettings::dark: weak light is expected
   std::optional<pr650::SetupFields> meter_setup_;  // what the meter was last set to (S accepted)
   WavelengthGrid grid_ = WavelengthGrid::Pr650();  // from D120 once identified
   bool holds_measurement_ = false;

@@ -77,7 +77,15 @@ struct MeasureLoopState {
   bool sync = false;       // sync to source currently on
   int attempt = 1;         // measurements taken so far in this Measure call (1-based)
   int max_attempts = 4;    // bound on measurements per Measure call
+  // The measurement is a dark reading (shutter closed): weak light is what it is meant to see.
+  // Weak-light codes (IsLowLightCode) are then accepted as they are, without adapting the
+  // integration (a dark must keep the sample's integration to be subtracted from it) and without
+  // a flag, whatever the policy says for light readings.
+  bool low_light_expected = false;
 };
+
+// 10 (weak light signal) and 18 (low light level): the codes a dark reading is expected to earn.
+bool IsLowLightCode(int code);
 
 struct QualityDecision {
   enum class Kind {
@@ -92,7 +100,7 @@ struct QualityDecision {
   std::string note;            // what was decided and why, for the log and the reading
 };
 
-// Decides what to do about `code` under `policy`.
+// Decides what to do about `code` under `policy` (and state.low_light_expected, above).
 QualityDecision DecideQuality(const QualityPolicy& policy, int code, const MeasureLoopState& state);
 
 }  // namespace brdf::drivers::pr650

@@ -1,0 +1,470 @@
+// The fault campaign: each row of kMatrix below is a device or storage fault injected while a
+// session runs on the REAL daemon (brdfd as a process) driving the REAL drivers against brdf-sim,
+// with the fault set through the simulator's control unit (unit 100) or on the daemon process
+// itself (storage). The table reads as the daemon's promise about each fault:
+//
+//   recovers        the drivers and the executor retry it away: the session completes and is
+//                   never paused;
+//   pauses          the session pauses with the fault as its reason (the fault is named in the
+//                   session's last fault); once the fault is cleared, Resume completes it.
+//
+// Every row also checks what never changes: the daemon does not exit, no reading recorded before
+// the fault is lost or repeated, and at the end the database holds every planned step once with
+// exactly one reading per measuring step (tests/daemon/daemon_test_util.h, storage's own check).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <linux/fs.h>
+#include <sys/ioctl.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/daemon/daemon_test_rig.h"
+#include "tests/daemon/daemon_test_util.h"
+
+namespace brdf::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+// Three poses after a reference and a dark (prompts: mount the white, close the shutter, mount
+// the sample), so a fault can land on a reference, a dark, a sample or a move. Retries: three
+// attempts, a short backoff.
+constexpr const char* kFaultPlan = R"({
+  "name": "fault campaign",
+  "poseList": {"poses": [{"alpha": 0, "beta": 10, "delta": 40},
+                         {"alpha": 10, "beta": 40, "delta": 40},
+                         {"alpha": 20, "beta": 70, "delta": 40}]},
+  "reference": {"perDetectorPosition": true},
+  "dark": {"withEachReference": true},
+  "measurement": {"integrationMs": 200, "averages": 1},
+  "retry": {"maxAttempts": 3, "backoffMs": 100}
+})";
+
+// brdfd's configuration for the campaign: the daemon tests' one WITHOUT their quality-10
+// override (darks must pass on the default policy), and a meter measurement timeout that a
+// silent meter uses up quickly.
+std::string FaultConfigToml(const SimProcess& sim, const std::string& database) {
+  std::string toml = DaemonConfigToml(sim, database);
+  const std::string override_10 = "[meter.quality]\n\"10\" = \"accept_and_flag\"\n";
+  if (const auto at = toml.find(override_10); at != std::string::npos) {
+    toml.erase(at, override_10.size());
+  }
+  const std::string timeout = "measurement_timeout_ms = 3000";
+  if (const auto at = toml.find(timeout); at != std::string::npos) {
+    toml.replace(at, timeout.size(), "measurement_timeout_ms = 1500");
+  }
+  return toml;
+}
+
+enum class Expect { kRecovers, kPauses };
+
+// What a row does to the rig: the simulator's control unit, or the daemon's process.
+using Action = std::function<Status(DaemonRig&)>;
+
+struct FaultCase {
+  const char* name;    // the test's name
+  const char* fault;   // what goes wrong, in the lab's words
+  Expect expect;       // recovers or pauses (see the top of the file)
+  int after_readings;  // inject once this many readings are stored (0: before submitting)
+  Action inject;       //
+  Action clear;        // pauses: what makes the fault go away (nothing: it was one-shot)
+  const char* reason;  // pauses: a word the fault's reason must contain (case-insensitive)
+  int device_code;     // pauses: the fault's device code (−1: not checked)
+  // recovers: the injected fault fired (its "next N" counter ran down, its flag was consumed).
+  std::function<bool(DaemonRig&)> consumed;
+  // Extra checks on the readings (e.g. a flagged one), or nullptr.
+  std::function<void(const std::vector<v1::Reading>&)> check_readings;
+};
+
+// gtest prints a failing row by its name.
+void PrintTo(const FaultCase& c, std::ostream* out) {
+  *out << c.name;
+}
+
+// --- Actions ----------------------------------------------------------------------------------
+
+Action Serial(std::function<void(sim::SerialFaults&)> set) {
+  return [set](DaemonRig& rig) {
+    sim::SerialFaults f;
+    set(f);
+    return rig.sim_control().SetSerialFaults(f);
+  };
+}
+Action Modbus(std::function<void(sim::ModbusFaults&)> set) {
+  return [set](DaemonRig& rig) {
+    sim::ModbusFaults f;
+    set(f);
+    return rig.sim_control().SetModbusFaults(f);
+  };
+}
+Status ClearSerial(DaemonRig& rig) {
+  return rig.sim_control().SetSerialFaults({});
+}
+Status ClearModbus(DaemonRig& rig) {
+  return rig.sim_control().SetModbusFaults({});
+}
+
+// Waits (bounded) until the daemon reports the meter connected again (a vanished port is back).
+Status MeterBack(DaemonRig& rig) {
+  const auto until = std::chrono::steady_clock::now() + 30s;
+  while (std::chrono::steady_clock::now() < until) {
+    v1::GetRigStatusRequest request;
+    v1::RigStatus status;
+    if (rig.control().GetRigStatus(DaemonRig::Context().get(), request, &status).ok()) {
+      for (const auto& d : status.devices()) {
+        if (d.name() == "meter" && d.state() == v1::CONNECTION_STATE_CONNECTED) {
+          return Status::Ok();
+        }
+      }
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  return Timeout("the daemon did not report the meter connected within 30 s");
+}
+
+// Storage: a file-size limit of 0 bytes on the daemon process (prlimit): every write to the
+// database and its WAL fails with EFBIG, as on a full disk or an exhausted quota. brdfd ignores
+// SIGXFSZ, so the write fails instead of killing it.
+Status FileSizeLimit(DaemonRig& rig, rlim_t bytes) {
+  // Only the soft limit moves: raising a hard limit again would need CAP_SYS_RESOURCE.
+  rlimit limit{};
+  if (prlimit(rig.daemon()->pid(), RLIMIT_FSIZE, nullptr, &limit) != 0) {
+    return IoError("prlimit(RLIMIT_FSIZE) of brdfd: " + std::string(std::strerror(errno)));
+  }
+  limit.rlim_cur = bytes == RLIM_INFINITY ? limit.rlim_max : bytes;
+  if (prlimit(rig.daemon()->pid(), RLIMIT_FSIZE, &limit, nullptr) != 0) {
+    return IoError("prlimit(RLIMIT_FSIZE) on brdfd failed: " + std::string(std::strerror(errno)));
+  }
+  return Status::Ok();
+}
+
+// Storage: the database file and its WAL made immutable (FS_IMMUTABLE_FL, what chattr +i sets):
+// every write fails with EPERM even on brdfd's open descriptors, as on a filesystem remounted
+// read-only. Needs CAP_LINUX_IMMUTABLE and a filesystem that has the flag (kFailedPrecondition
+// when not: the row is skipped).
+Status SetImmutable(const std::string& path, bool on) {
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return IoError("open " + path + ": " + std::strerror(errno));
+  int flags = 0;
+  Status st = Status::Ok();
+  if (ioctl(fd, FS_IOC_GETFLAGS, &flags) != 0) {
+    st = FailedPrecondition("FS_IOC_GETFLAGS on " + path + ": " + std::strerror(errno));
+  } else {
+    flags = on ? (flags | FS_IMMUTABLE_FL) : (flags & ~FS_IMMUTABLE_FL);
+    if (ioctl(fd, FS_IOC_SETFLAGS, &flags) != 0) {
+      st = FailedPrecondition("FS_IOC_SETFLAGS on " + path + ": " + std::strerror(errno));
+    }
+  }
+  close(fd);
+  return st;
+}
+Status DatabaseReadOnly(DaemonRig& rig, bool on) {
+  BRDF_RETURN_IF_ERROR(SetImmutable(rig.database() + "-wal", on));
+  return SetImmutable(rig.database(), on);
+}
+
+// --- Checks -----------------------------------------------------------------------------------
+
+bool SerialConsumed(DaemonRig& rig) {
+  Result<sim::SerialFaults> f = rig.sim_control().SerialFaults();
+  return f.ok() && f->garbage_next == 0 && f->truncate_next == 0 && f->quality_count == 0 &&
+         f->vanish_seconds == 0;
+}
+bool ModbusConsumed(DaemonRig& rig) {
+  Result<sim::ModbusFaults> f = rig.sim_control().ModbusFaults();
+  return f.ok() && f->exception_count == 0 && f->late_count == 0 && !f->drop_connection &&
+         !f->alarm_mid_move && !f->stall;
+}
+
+std::function<void(const std::vector<v1::Reading>&)> SomeReading(int quality, bool flagged) {
+  return [quality, flagged](const std::vector<v1::Reading>& readings) {
+    const bool seen = std::any_of(readings.begin(), readings.end(), [&](const v1::Reading& r) {
+      return r.quality_code() == quality && r.flagged() == flagged;
+    });
+    EXPECT_TRUE(seen) << "no reading with quality code " << quality
+                      << (flagged ? " flagged" : " unflagged");
+  };
+}
+
+// --- The matrix -------------------------------------------------------------------------------
+
+const FaultCase kMatrix[] = {
+    // Serial line (PR-650).
+    {"SerialSilence", "the meter answers nothing (cable switch on XFER, not in remote mode)",
+     Expect::kPauses, 2, Serial([](auto& f) { f.silent = true; }), ClearSerial, "PR-650", -1,
+     nullptr, nullptr},
+    {"SerialGarbageOnce", "one reply is garbage bytes", Expect::kRecovers, 2,
+     Serial([](auto& f) { f.garbage_next = 1; }), nullptr, "", -1, SerialConsumed, nullptr},
+    {"SerialGarbageKeepsComing", "every reply is garbage", Expect::kPauses, 2,
+     Serial([](auto& f) { f.garbage_next = 1000; }), ClearSerial, "PR-650", -1, nullptr, nullptr},
+    {"SerialTruncatedReply", "one reply stops half-way", Expect::kRecovers, 2,
+     Serial([](auto& f) { f.truncate_next = 1; }), nullptr, "", -1, SerialConsumed, nullptr},
+    {"SerialPortVanishesBriefly", "the port vanishes during a D5 transfer, back after 0.1 s",
+     Expect::kRecovers, 2, Serial([](auto& f) { f.vanish_seconds = 5; }), nullptr, "", -1,
+     SerialConsumed, nullptr},
+    {"SerialPortVanishesForLong", "the port vanishes during a D5 transfer, back after 6 s",
+     Expect::kPauses, 2, Serial([](auto& f) { f.vanish_seconds = 300; }), MeterBack, "vanished", -1,
+     nullptr, nullptr},
+    // Quality codes, one per class of the default policy (drivers/pr650/quality_codes.h).
+    {"Quality18LowLightAcceptedFlagged", "quality 18 (low light): usable, flagged",
+     Expect::kRecovers, 0, Serial([](auto& f) {
+       f.quality_code = 18;
+       f.quality_count = 1;
+     }),
+     nullptr, "", -1, SerialConsumed, SomeReading(18, true)},
+    {"Quality19OverloadAdapted", "quality 19 (overload): integration halved, measured again",
+     Expect::kRecovers, 0, Serial([](auto& f) {
+       f.quality_code = 19;
+       f.quality_count = 1;
+     }),
+     nullptr, "", -1, SerialConsumed, nullptr},
+    {"Quality10WeakAdapted", "quality 10 (weak light) on a light reading: integration doubled",
+     Expect::kRecovers, 0, Serial([](auto& f) {
+       f.quality_code = 10;
+       f.quality_count = 1;
+     }),
+     nullptr, "", -1, SerialConsumed, nullptr},
+    {"Quality29Retried", "quality 29 (corrupted data): measured again", Expect::kRecovers, 0,
+     Serial([](auto& f) {
+       f.quality_code = 29;
+       f.quality_count = 1;
+     }),
+     nullptr, "", -1, SerialConsumed, nullptr},
+    {"Quality30RetriedThenFlagged", "quality 30 (noisy) on every try: accepted flagged",
+     Expect::kRecovers, 0, Serial([](auto& f) {
+       f.quality_code = 30;
+       f.quality_count = 4;
+     }),
+     nullptr, "", -1, SerialConsumed, SomeReading(30, true)},
+    {"Quality08SyncOffRetried", "quality 08 (sync lost): sync off, measured again",
+     Expect::kRecovers, 0, Serial([](auto& f) {
+       f.quality_code = 8;
+       f.quality_count = 1;
+     }),
+     nullptr, "", -1, SerialConsumed, nullptr},
+    {"Quality14Fails", "quality 14 (a failing code) on every try", Expect::kPauses, 2,
+     Serial([](auto& f) {
+       f.quality_code = 14;
+       f.quality_count = 1000;
+     }),
+     ClearSerial, "quality", 14, nullptr, nullptr},
+    {"QualityUnknownFails", "quality 42 (not in the reference)", Expect::kPauses, 2,
+     Serial([](auto& f) {
+       f.quality_code = 42;
+       f.quality_count = 1000;
+     }),
+     ClearSerial, "quality", 42, nullptr, nullptr},
+    // Modbus stage.
+    {"ModbusException02", "exception 02 (illegal data address) on every axis request",
+     Expect::kPauses, 2, Modbus([](auto& f) {
+       f.exception_code = 2;
+       f.exception_count = 1000;
+     }),
+     ClearModbus, "exception 2", 2, nullptr, nullptr},
+    {"ModbusException06Briefly", "exception 06 (busy) on the next two requests", Expect::kRecovers,
+     2, Modbus([](auto& f) {
+       f.exception_code = 6;
+       f.exception_count = 2;
+     }),
+     nullptr, "", -1, ModbusConsumed, nullptr},
+    {"ModbusException06KeepsComing", "exception 06 (busy) on every request", Expect::kPauses, 2,
+     Modbus([](auto& f) {
+       f.exception_code = 6;
+       f.exception_count = 1000;
+     }),
+     ClearModbus, "busy", 6, nullptr, nullptr},
+    {"ModbusLateReplies", "the next two replies come after the response timeout", Expect::kRecovers,
+     2, Modbus([](auto& f) {
+       f.late_reply_ms = 700;
+       f.late_count = 2;
+     }),
+     nullptr, "", -1, ModbusConsumed, nullptr},
+    {"ModbusDroppedConnection", "the TCP connection drops at the next request", Expect::kRecovers,
+     2, Modbus([](auto& f) { f.drop_connection = true; }), nullptr, "", -1, ModbusConsumed,
+     nullptr},
+    {"ModbusAlarmMidMove", "an axis raises an alarm half-way through the next move",
+     Expect::kRecovers, 2, Modbus([](auto& f) { f.alarm_mid_move = true; }), nullptr, "", -1,
+     ModbusConsumed, nullptr},
+    {"ModbusStall", "the next move never ends (MOVE stays set)", Expect::kRecovers, 2,
+     Modbus([](auto& f) { f.stall = true; }), nullptr, "", -1, ModbusConsumed, nullptr},
+    // Storage.
+    {"StorageDiskFull", "every database write fails (file-size limit: EFBIG, like a full disk)",
+     Expect::kPauses, 3, [](DaemonRig& rig) { return FileSizeLimit(rig, 0); },
+     [](DaemonRig& rig) { return FileSizeLimit(rig, RLIM_INFINITY); }, "disk I/O error", -1,
+     nullptr, nullptr},
+    {"StorageReadOnly", "the database file and its WAL become read-only (immutable)",
+     Expect::kPauses, 3, [](DaemonRig& rig) { return DatabaseReadOnly(rig, true); },
+     [](DaemonRig& rig) { return DatabaseReadOnly(rig, false); }, "disk I/O error", -1, nullptr,
+     nullptr},
+};
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  return s;
+}
+
+class FaultMatrixTest : public ::testing::TestWithParam<FaultCase> {
+ protected:
+  void SetUp() override {
+    Status sim = rig_.StartSim();
+    ASSERT_TRUE(sim.ok()) << sim.ToString();
+    Status daemon = rig_.StartDaemon(FaultConfigToml(rig_.sim(), rig_.database()));
+    ASSERT_TRUE(daemon.ok()) << daemon.ToString();
+  }
+
+  void TearDown() override {
+    if (cleanup_) (void)cleanup_(rig_);
+    if (op_) {
+      op_->Stop();
+      for (const std::string& e : op_->errors()) ADD_FAILURE() << "operator: " << e;
+    }
+    if (rig_.daemon() != nullptr) {
+      Result<int> code = rig_.StopDaemon();
+      EXPECT_TRUE(code.ok() && *code == 0)
+          << (code.ok() ? "exit code " + std::to_string(*code) : code.status().ToString());
+    }
+    if (HasFailure() || std::getenv("BRDF_TEST_SHOW_LOG") != nullptr) {
+      std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n----\n";
+    }
+  }
+
+  // The daemon process is still there (not exited, not a zombie) and answers.
+  void ExpectDaemonAlive() {
+    ASSERT_NE(rig_.daemon(), nullptr);
+    std::ifstream stat("/proc/" + std::to_string(rig_.daemon()->pid()) + "/stat");
+    std::string pid, comm, state;
+    stat >> pid >> comm >> state;
+    EXPECT_TRUE(stat && state != "Z" && state != "X") << "brdfd is gone (state " << state << ")";
+    v1::GetRigStatusRequest request;
+    v1::RigStatus status;
+    grpc::Status st = rig_.control().GetRigStatus(DaemonRig::Context().get(), request, &status);
+    EXPECT_TRUE(st.ok()) << "brdfd does not answer: " << st.error_message();
+  }
+
+  std::set<std::int64_t> ReadingIds(const std::string& id) {
+    Result<std::vector<v1::Reading>> r = rig_.Readings(id);
+    EXPECT_TRUE(r.ok()) << r.status().ToString();
+    std::set<std::int64_t> ids;
+    if (r.ok()) {
+      for (const auto& x : *r) ids.insert(x.id());
+    }
+    return ids;
+  }
+
+  DaemonRig rig_;
+  std::unique_ptr<GrpcOperator> op_;
+  Action cleanup_;
+};
+
+TEST_P(FaultMatrixTest, FaultIsRetriedOrPausesAndResumesWithoutLosingAReading) {
+  const FaultCase& c = GetParam();
+  SCOPED_TRACE(std::string(c.name) + ": " + c.fault);
+  cleanup_ = c.clear;  // a failed assertion must not leave the fault behind (e.g. immutable)
+
+  if (c.after_readings == 0) {
+    Status injected = c.inject(rig_);
+    ASSERT_TRUE(injected.ok()) << injected.ToString();
+  }
+  Result<v1::Session> submitted = rig_.Submit(kFaultPlan);
+  ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
+  const std::string id = submitted->session_id();
+  const std::int64_t sid = std::stoll(id);
+  const int planned = static_cast<int>(submitted->summary().sample_readings() +
+                                       submitted->summary().reference_readings() +
+                                       submitted->summary().dark_readings());
+  op_ = std::make_unique<GrpcOperator>(rig_, id);
+
+  if (c.after_readings > 0) {
+    const v1::Session s = rig_.WaitFor(
+        id,
+        [&](const v1::Session&) {
+          Result<DbSessionCounts> db = CountSession(rig_.database(), sid);
+          return db.ok() && db->readings >= c.after_readings;
+        },
+        60s);
+    Status injected = c.inject(rig_);
+    if (injected.code() == StatusCode::kFailedPrecondition) GTEST_SKIP() << injected.ToString();
+    ASSERT_TRUE(injected.ok()) << injected.ToString();
+  }
+
+  const auto stopped = [](const v1::Session& s) {
+    return s.state() == v1::SESSION_STATE_PAUSED || IsTerminal(s.state());
+  };
+  v1::Session s = rig_.WaitFor(id, stopped, 90s);
+  ExpectDaemonAlive();
+
+  if (c.expect == Expect::kRecovers) {
+    ASSERT_EQ(s.state(), v1::SESSION_STATE_COMPLETED) << "expected the fault to be retried away\n"
+                                                      << s.DebugString();
+    for (const auto& e : op_->events()) {
+      EXPECT_FALSE(e.has_state_changed() && e.state_changed().to() == v1::SESSION_STATE_PAUSED)
+          << "paused on the way: " << e.state_changed().reason();
+    }
+    EXPECT_TRUE(c.consumed(rig_)) << "the injected fault never fired";
+  } else {
+    ASSERT_EQ(s.state(), v1::SESSION_STATE_PAUSED) << s.DebugString();
+    ASSERT_TRUE(s.has_last_fault());
+    EXPECT_NE(Lower(s.last_fault().reason()).find(Lower(c.reason)), std::string::npos)
+        << "the pause does not name the fault: " << s.last_fault().reason();
+    EXPECT_FALSE(s.last_fault().will_retry());
+    if (c.device_code >= 0) {
+      EXPECT_EQ(s.last_fault().device_code(), c.device_code);
+    }
+    // What was recorded before the fault is all there, and stays there.
+    const std::set<std::int64_t> before = ReadingIds(id);
+    EXPECT_GE(static_cast<int>(before.size()), c.after_readings);
+    const Status cleared = c.clear(rig_);
+    ASSERT_TRUE(cleared.ok()) << cleared.ToString();
+    cleanup_ = nullptr;
+    ExpectDaemonAlive();
+
+    v1::ResumeSessionRequest resume;
+    resume.set_session_id(id);
+    v1::ResumeSessionResponse resumed;
+    grpc::Status st = rig_.control().ResumeSession(DaemonRig::Context().get(), resume, &resumed);
+    ASSERT_TRUE(st.ok()) << st.error_message();
+    s = rig_.WaitFor(id, stopped, 90s);
+    ASSERT_EQ(s.state(), v1::SESSION_STATE_COMPLETED) << s.DebugString();
+    const std::set<std::int64_t> after = ReadingIds(id);
+    EXPECT_TRUE(std::includes(after.begin(), after.end(), before.begin(), before.end()))
+        << "a reading recorded before the fault is gone";
+  }
+
+  // The end state: every reading of the plan, once; the database intact.
+  Result<std::vector<v1::Reading>> readings = rig_.Readings(id);
+  ASSERT_TRUE(readings.ok()) << readings.status().ToString();
+  EXPECT_EQ(static_cast<int>(readings->size()), planned);
+  if (c.check_readings) c.check_readings(*readings);
+  Result<DbSessionCounts> db = CountSession(rig_.database(), sid);
+  ASSERT_TRUE(db.ok()) << db.status().ToString();
+  EXPECT_EQ(db->state, "completed");
+  EXPECT_EQ(db->steps, db->total_steps);
+  EXPECT_EQ(db->steps_done, db->total_steps);
+  EXPECT_EQ(db->readings, planned);
+  EXPECT_EQ(db->duplicate_readings, 0);
+  EXPECT_EQ(db->orphan_readings, 0);
+  Result<std::string> problems = StorageProblems(rig_.database(), sid);
+  ASSERT_TRUE(problems.ok()) << problems.status().ToString();
+  EXPECT_EQ(*problems, "");
+  ExpectDaemonAlive();
+}
+
+INSTANTIATE_TEST_SUITE_P(Matrix, FaultMatrixTest, ::testing::ValuesIn(kMatrix),
+                         [](const ::testing::TestParamInfo<FaultCase>& row) {
+                           return std::string(row.param.name);
+                         });
+
+}  // namespace
+}  // namespace brdf::testing
