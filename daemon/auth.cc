@@ -1,5 +1,7 @@
 #include "daemon/auth.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdint>
@@ -93,12 +95,16 @@ grpc::Status Authenticator::Authorize(const grpc::ServerContextBase& context, Ac
         why = "the bearer token is not one of this daemon's tokens";
         break;
     }
+    // Never the token itself, not even a wrong one (it may be a real token of another system).
+    spdlog::debug("{}: refused a call from {}: {}", rpc, context.peer(), why);
     return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
                         std::string(rpc) + ": " + why +
                             "; send \"authorization: Bearer <token>\" with a token from the "
                             "daemon's [[auth.tokens]] (brdfctl: --token or $BRDF_TOKEN)");
   }
   if (access == Access::kControl && caller->role != Role::kOperator) {
+    spdlog::warn("{}: refused token \"{}\" (role {}) from {}: the call needs an operator", rpc,
+                 caller->name, RoleName(caller->role), context.peer());
     return grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
                         std::string(rpc) + ": token \"" + caller->name + "\" has the role " +
                             RoleName(caller->role) +

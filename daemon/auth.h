@@ -9,6 +9,10 @@
 // the lengths, never on where the first differing byte is, so response timing does not let a
 // client guess a token byte by byte.
 //
+// Refusals are logged without the token: PERMISSION_DENIED as a warning with the token's name,
+// the RPC and the peer; UNAUTHENTICATED at debug level (the peer and why), so that a scan cannot
+// flood the log.
+//
 // With no tokens configured the API is open: every caller is an operator named "anonymous" (the
 // configuration's documented mode for a daemon bound to localhost; main warns otherwise).
 #pragma once

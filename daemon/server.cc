@@ -1,11 +1,13 @@
 #include "daemon/server.h"
 
+#include <arpa/inet.h>
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/health_check_service_interface.h>
 #include <grpcpp/resource_quota.h>
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server_builder.h>
 #include <spdlog/spdlog.h>
+#include <sys/stat.h>
 
 #include <fstream>
 #include <sstream>
@@ -17,7 +19,11 @@ namespace {
 constexpr const char* kServiceNames[] = {"brdf.v1.Control", "brdf.v1.Data",
                                          "brdf.v1.Interpolation"};
 
-Result<std::string> ReadPem(const std::string& path, const std::string& key) {
+// Reads a PEM file and checks that it holds a block of the expected kind ("CERTIFICATE",
+// "PRIVATE KEY": also matches "EC PRIVATE KEY", "RSA PRIVATE KEY"). gRPC itself only says that
+// the port could not be opened when a file is not PEM, so the check here names the file.
+Result<std::string> ReadPem(const std::string& path, const std::string& key,
+                            const std::string& block) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     return ConfigurationError("config " + key + ": cannot read \"" + path +
@@ -28,7 +34,22 @@ Result<std::string> ReadPem(const std::string& path, const std::string& key) {
   if (text.str().empty()) {
     return ConfigurationError("config " + key + ": \"" + path + "\" is empty; give a PEM file");
   }
+  if (text.str().find(block + "-----") == std::string::npos) {
+    return ConfigurationError("config " + key + ": \"" + path + "\" holds no PEM \"" + block +
+                              "\" block; give a PEM file (-----BEGIN " + block + "-----)");
+  }
   return text.str();
+}
+
+// A private key others may read is a key others may copy.
+void WarnIfReadableByOthers(const std::string& path) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0 && (info.st_mode & (S_IRWXG | S_IRWXO)) != 0) {
+    spdlog::warn(
+        "the TLS private key {} is accessible to its group or others (mode {:o}); "
+        "chmod 600 it",
+        path, info.st_mode & 0777);
+  }
 }
 
 std::string HostOf(const std::string& listen) {
@@ -45,7 +66,18 @@ std::string HostOf(const std::string& listen) {
 bool IsLoopbackAddress(const std::string& listen) {
   if (listen.rfind("unix:", 0) == 0) return true;
   const std::string host = HostOf(listen);
-  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+  if (host == "localhost") return true;
+  // Literal addresses only: a host NAME such as "127.example.org" may resolve anywhere.
+  in_addr v4{};
+  if (::inet_pton(AF_INET, host.c_str(), &v4) == 1) {
+    return (ntohl(v4.s_addr) >> 24) == 127;
+  }
+  in6_addr v6{};
+  if (::inet_pton(AF_INET6, host.c_str(), &v6) == 1) {
+    if (IN6_IS_ADDR_LOOPBACK(&v6)) return true;
+    return IN6_IS_ADDR_V4MAPPED(&v6) && v6.s6_addr[12] == 127;  // ::ffff:127.x.y.z
+  }
+  return false;
 }
 
 Server::Server(SessionManager& manager, IndexCache& cache, const Authenticator& auth)
@@ -62,14 +94,16 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   std::shared_ptr<grpc::ServerCredentials> credentials;
   bool tls = false;
   if (config.tls.has_value()) {
-    Result<std::string> cert = ReadPem(config.tls->cert, "server.tls.cert");
+    Result<std::string> cert = ReadPem(config.tls->cert, "server.tls.cert", "CERTIFICATE");
     if (!cert.ok()) return cert.status();
-    Result<std::string> key = ReadPem(config.tls->key, "server.tls.key");
+    Result<std::string> key = ReadPem(config.tls->key, "server.tls.key", "PRIVATE KEY");
     if (!key.ok()) return key.status();
+    WarnIfReadableByOthers(config.tls->key);
     grpc::SslServerCredentialsOptions ssl(GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE);
     ssl.pem_key_cert_pairs.push_back({*key, *cert});
     if (!config.tls->client_ca.empty()) {
-      Result<std::string> ca = ReadPem(config.tls->client_ca, "server.tls.client_ca");
+      Result<std::string> ca =
+          ReadPem(config.tls->client_ca, "server.tls.client_ca", "CERTIFICATE");
       if (!ca.ok()) return ca.status();
       ssl.pem_root_certs = *ca;
       ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
@@ -105,14 +139,24 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   const bool unix_socket = config.listen.rfind("unix:", 0) == 0;
   if (!server->server_ || (!unix_socket && selected_port == 0)) {
     return IoError("cannot listen on " + config.listen +
-                   " (address in use, not allowed, or no such interface); change [server] "
-                   "listen or stop the process that holds it");
+                   (tls ? " with TLS (address in use, not allowed, no such interface, or the "
+                          "certificate and key in [server.tls] do not form a valid pair)"
+                        : " (address in use, not allowed, or no such interface)") +
+                   "; change [server] listen or stop the process that holds it");
   }
   server->tls_ = tls;
   server->port_ = selected_port;
   server->address_ = unix_socket ? config.listen
                                  : config.listen.substr(0, config.listen.rfind(':') + 1) +
                                        std::to_string(selected_port);
+  spdlog::info(
+      "limits: requests up to {} bytes (larger: RESOURCE_EXHAUSTED), InterpolateBatch up to {} "
+      "directions in chunks of up to {} results, notes up to {} bytes, pages up to {} sessions, "
+      "{} call threads{}",
+      kMaxReceiveMessageBytes, kMaxBatchDirections, kMaxChunkSize, kMaxNoteBytes, kMaxPageSize,
+      kMaxServerThreads,
+      tls ? (config.tls->client_ca.empty() ? "; TLS" : "; TLS, client certificates required")
+          : "; plaintext");
   if (grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService()) {
     health->SetServingStatus(true);
     for (const char* name : kServiceNames) health->SetServingStatus(name, true);

@@ -25,15 +25,18 @@ namespace brdf::daemon {
 
 inline constexpr int kMaxServerThreads = 256;
 
-// True for addresses only this machine can reach: 127.0.0.0/8, localhost, ::1, unix sockets.
+// True for addresses only this machine can reach: literal 127.0.0.0/8, ::1, ::ffff:127.x.y.z,
+// "localhost", unix sockets. Host names (other than localhost) and 0.0.0.0 / [::] are not.
 bool IsLoopbackAddress(const std::string& listen);
 
 class Server {
  public:
   // Builds the services and starts serving on config.listen (port 0: any free port; see
-  // address()). Errors: kConfigurationError when a TLS file cannot be read, kIoError when the
-  // address cannot be bound (in use, not allowed, no such interface). Logs a warning when a
-  // non-loopback address is served in plaintext. `manager`, `cache` and `auth` must outlive it.
+  // address()). Errors: kConfigurationError when a TLS file cannot be read or holds no PEM block
+  // of its kind, kIoError when the address cannot be bound (in use, not allowed, no such
+  // interface) or gRPC refuses the certificate/key pair. Logs a warning when a non-loopback
+  // address is served in plaintext or the TLS key is readable by others, and logs the limits
+  // (service_common.h) it enforces. `manager`, `cache` and `auth` must outlive it.
   static Result<std::unique_ptr<Server>> Start(const ServerConfig& config, SessionManager& manager,
                                                IndexCache& cache, const Authenticator& auth);
   // Shutdown(1 s) if not called before.

@@ -6,6 +6,7 @@
 
 #include "core/geometry.h"
 #include "daemon/engine_steps.h"
+#include "daemon/session_manager.h"
 
 namespace brdf::daemon {
 
@@ -46,6 +47,19 @@ grpc::Status ToGrpcStatus(const Status& status) {
 
 grpc::Status InvalidField(const std::string& field, const std::string& what) {
   return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, field + ": " + what);
+}
+
+grpc::Status ParseSessionIdField(const std::string& text, const std::string& field,
+                                 std::int64_t* id) {
+  if (text.size() > kMaxSessionIdBytes) {
+    return InvalidField(field, "is " + std::to_string(text.size()) +
+                                   " bytes long; a session id is a positive number of at most 18 "
+                                   "digits, as SubmitPlan returned it");
+  }
+  Result<SessionId> parsed = ParseSessionId(text, field);
+  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
+  *id = *parsed;
+  return grpc::Status::OK;
 }
 
 namespace {

@@ -32,6 +32,10 @@ inline constexpr std::uint32_t kDefaultChunkSize = 256;
 inline constexpr std::uint32_t kMaxChunkSize = 1024;
 // Free texts (abort reason, prompt note) are stored in the audit log; longer ones are refused.
 inline constexpr std::size_t kMaxNoteBytes = 4096;
+// A session id is a positive decimal number of at most 18 digits; ids and page tokens longer than
+// this are refused without being echoed back (an error message must stay small: gRPC carries it
+// in a trailer, which clients cap at a few KiB).
+inline constexpr std::size_t kMaxSessionIdBytes = 32;
 // ListSessions: default and largest page.
 inline constexpr std::uint32_t kDefaultPageSize = 100;
 inline constexpr std::uint32_t kMaxPageSize = 1000;
@@ -47,6 +51,12 @@ grpc::Status ToGrpcStatus(const Status& status);
 
 // INVALID_ARGUMENT "<field>: <what>".
 grpc::Status InvalidField(const std::string& field, const std::string& what);
+
+// A session id field ("session_id", "page_token") as a number: INVALID_ARGUMENT naming `field`
+// when it is empty, too long (kMaxSessionIdBytes: the value is not echoed) or not a positive
+// number. Never NOT_FOUND: whether the session exists is the caller's next question.
+grpc::Status ParseSessionIdField(const std::string& text, const std::string& field,
+                                 std::int64_t* id);
 
 // Checks a finite angle within [lo, hi]; the message names `field` and the range.
 Status CheckAngle(double value, double lo, double hi, const std::string& field);

@@ -21,10 +21,7 @@ namespace {
 
 // The session id of a request, or INVALID_ARGUMENT naming the field.
 grpc::Status ParseId(const std::string& text, SessionId* id) {
-  Result<SessionId> parsed = ParseSessionId(text, "session_id");
-  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
-  *id = *parsed;
-  return grpc::Status::OK;
+  return ParseSessionIdField(text, "session_id", id);
 }
 
 grpc::Status CheckNote(const std::string& text, const std::string& field) {
@@ -208,14 +205,18 @@ grpc::Status ControlService::ListSessions(grpc::ServerContext* context,
   // newest (highest id) first, so the next page holds the ids below it. Stable under inserts.
   std::optional<SessionId> before;
   if (!request->page_token().empty()) {
-    Result<SessionId> token = ParseSessionId(request->page_token(), "page_token");
-    if (!token.ok()) {
+    SessionId token = 0;
+    if (!ParseSessionIdField(request->page_token(), "page_token", &token).ok()) {
+      const std::string shown =
+          request->page_token().size() <= kMaxSessionIdBytes
+              ? "\"" + request->page_token() + "\""
+              : "the " + std::to_string(request->page_token().size()) + "-byte token given";
       return InvalidField("page_token",
-                          "\"" + request->page_token() +
-                              "\" is not a token this daemon gave out; pass next_page_token as "
-                              "it was returned, or leave it empty for the first page");
+                          shown +
+                              " is not a token this daemon gave out; pass next_page_token as it "
+                              "was returned, or leave it empty for the first page");
     }
-    before = *token;
+    before = token;
   }
   const std::uint32_t page_size =
       request->page_size() == 0 ? kDefaultPageSize : std::min(request->page_size(), kMaxPageSize);
