@@ -42,8 +42,10 @@ grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
       !st.ok()) {
     return st;
   }
-  Result<SessionId> id = ParseSessionId(request->session_id(), "session_id");
-  if (!id.ok()) return ToGrpcStatus(id.status());
+  SessionId id = 0;
+  if (grpc::Status st = ParseSessionIdField(request->session_id(), "session_id", &id); !st.ok()) {
+    return st;
+  }
   std::set<storage::ReadingKind> kinds;
   for (int i = 0; i < request->kinds_size(); ++i) {
     switch (request->kinds(i)) {
@@ -68,12 +70,12 @@ grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
   }
 
   storage::SessionStore& store = *manager_.store();
-  Result<storage::SessionRecord> session = store.GetSession(*id);
+  Result<storage::SessionRecord> session = store.GetSession(id);
   if (!session.ok()) return ToGrpcStatus(session.status());
 
   // Labels and averaging are fixed at submission: read them once.
   ReadingExtras extras;
-  if (Result<std::vector<storage::StepRecord>> steps = store.GetSteps(*id); steps.ok()) {
+  if (Result<std::vector<storage::StepRecord>> steps = store.GetSteps(id); steps.ok()) {
     for (const storage::StepRecord& step : *steps) extras.step_labels[step.step_index] = step.label;
   }
   if (Result<v1::Plan> plan = plan::ParsePlanJson(session->plan_json);
@@ -90,12 +92,12 @@ grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
     // reading after it, so an empty page then really is the end.
     bool ended = !request->follow();
     if (!ended) {
-      Result<storage::SessionRecord> now = store.GetSession(*id);
+      Result<storage::SessionRecord> now = store.GetSession(id);
       if (!now.ok()) return ToGrpcStatus(now.status());
       ended = IsTerminal(now->state);
     }
     const std::uint64_t generation = Generation();
-    Result<std::vector<storage::ReadingRecord>> page = store.GetReadings(*id, last, kPageSize);
+    Result<std::vector<storage::ReadingRecord>> page = store.GetReadings(id, last, kPageSize);
     if (!page.ok()) return ToGrpcStatus(page.status());
     for (const storage::ReadingRecord& r : *page) {
       last = r.id;

@@ -1,7 +1,8 @@
 // The Data service (brdf.proto): a session's readings, streamed in id order from the store, a
 // page at a time (memory bounded by one page whatever the session's size). With `follow` the
 // stream stays open and sends readings as they are committed (woken by a SessionManager reading
-// listener), until the session ends, the client cancels, or the daemon stops.
+// listener), until the session ends, the client cancels, or the daemon stops. Its exports to
+// files (Export) live in service_export.cc.
 #pragma once
 
 #include <condition_variable>
@@ -29,6 +30,11 @@ class DataService final : public v1::Data::Service {
   grpc::Status StreamReadings(grpc::ServerContext* context,
                               const v1::StreamReadingsRequest* request,
                               grpc::ServerWriter<v1::Reading>* writer) override;
+
+  // A session exported to a file (readings CSV, grid .npy/CSV, MERL .binary), streamed as
+  // progress, the file's bytes in chunks, then the report. Defined in service_export.cc.
+  grpc::Status Export(grpc::ServerContext* context, const v1::ExportRequest* request,
+                      grpc::ServerWriter<v1::ExportChunk>* writer) override;
 
  private:
   // Woken whenever any reading is committed; followers re-read the store then.

@@ -294,17 +294,27 @@ say "interpolating at θi ${query_theta_i}°, θo ${query_theta_o}°, φ ${query
   --phi "$query_phi" --explain --every 5 ||
   echo "quickstart: (no spectrum there; try other angles with brdfctl interpolate)"
 
-# --- figures (HOOK) ----------------------------------------------------------------------------
-# HOOK for the Python analysis client (issue 5, item 3): once clients/python/ provides it, this
-# writes the paper-style figures (Figure 7 sample points, Figure 8 interpolated spectrum, a polar
-# plot) of the demo session into $run/figures/. The script is called with the address, the
-# analyst token file and the session id.
+# --- figures -----------------------------------------------------------------------------------
+# The Python analysis client (clients/python) draws the paper-style figures of the demo session
+# into $run/figures/: Figure 7 (the readings in (α, β, δ) and (θi, θo, φ) with the query and its
+# enclosing tetrahedron), Figure 8 (the interpolated spectrum with its vertex spectra) at the
+# direction interpolated above, and a polar plot in the plane of incidence. It reads the analyst
+# token from its file. Debian's python3 (/usr/bin/python3) has numpy, matplotlib and grpcio;
+# another python3 first on PATH (a venv) may not.
 figures_script="$root/clients/python/examples/quickstart_figures.py"
+python=/usr/bin/python3
+[[ -x "$python" ]] || python=python3
+figures=""
 if [[ -f "$figures_script" ]]; then
   say "writing figures to $run/figures"
-  python3 "$figures_script" --address "$address" --token-file "$run/analyst.token" \
-    --session "$session" --out "$run/figures" ||
+  rm -f "$run/figures/fig7.png" "$run/figures/fig8.png" "$run/figures/polar.png"
+  if "$python" "$figures_script" --address "$address" --token-file "$run/analyst.token" \
+    --session "$session" --out "$run/figures" \
+    --query "$query_theta_i" "$query_theta_o" "$query_phi"; then
+    figures="$run/figures"
+  else
     echo "quickstart: the figures failed (the session and the daemon are fine)"
+  fi
 fi
 
 # --- what now ----------------------------------------------------------------------------------
@@ -332,9 +342,15 @@ example "brdfctl watch <id> --on-prompt \"brdfctl sim-mount from-prompt --modbus
   "live; y/N at prompts"
 example "brdfctl pause <id> [--immediate]; brdfctl resume <id>" "operator verbs"
 example "brdfctl abort <id> --reason \"lamp flickers\"" "stop for good (data kept)"
+example "brdfctl export $session csv -o demo.csv" "readings, units in the header"
+example "brdfctl export $session grid --steps 5 -o demo.npy" "regular grid (+ demo.npy.json)"
+example "brdfctl export $session merl -o demo.binary" "MERL BRDF file (RGB, D65)"
 cat <<EOF
 
 Files: $run/brdfd.toml (configuration), $run/brdfd.db (data),
-       $run/brdfd.log and $run/brdf-sim.log (logs)
+       $run/brdfd.log and $run/brdf-sim.log (logs)${figures:+
+Figures: $figures/fig7.png (Figure 7: samples, query, tetrahedron),
+         $figures/fig8.png (Figure 8: interpolated spectrum and its vertices),
+         $figures/polar.png (BRDF in the plane of incidence)}
 Stop both: deploy/quickstart.sh --stop
 EOF

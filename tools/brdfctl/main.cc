@@ -1,6 +1,7 @@
 // brdfctl: the command line for brdfd. Every API call is a subcommand (README.md):
 //   brdfctl validate|submit PLAN.json, start|pause|resume|abort|get|watch|readings ID,
-//   answer ID STEP, list, rig, interpolate ID --theta-i A --theta-o B --phi C
+//   answer ID STEP, list, rig, interpolate ID --theta-i A --theta-o B --phi C,
+//   export ID csv|grid|merl [-o FILE]
 // plus `sim-mount` for the simulated rig only. Address and token from --address/--token or
 // BRDF_ADDRESS/BRDF_TOKEN. Exit status: exit_codes.h.
 #include <sys/ioctl.h>
@@ -14,6 +15,7 @@
 #include "tools/brdfctl/client.h"
 #include "tools/brdfctl/control_commands.h"
 #include "tools/brdfctl/exit_codes.h"
+#include "tools/brdfctl/export_command.h"
 #include "tools/brdfctl/interpolate_command.h"
 #include "tools/brdfctl/readings_command.h"
 #include "tools/brdfctl/rpc_error.h"
@@ -201,6 +203,45 @@ int main(int argc, char** argv) {
   interpolate->add_option("--scale", interp.axis_scale, "per-axis distance multipliers a,b,c[,d]")
       ->delimiter(',');
 
+  ExportOptions export_options;
+  bool export_no_progress = false;
+  CLI::App* export_cmd = app.add_subcommand(
+      "export", "a session as a file: readings CSV, a regular grid (.npy or CSV), a MERL .binary");
+  add_id(export_cmd);
+  export_cmd->add_option("what", export_options.what, "csv, grid or merl")
+      ->required()
+      ->check(CLI::IsMember({"csv", "grid", "merl"}));
+  export_cmd->add_option("-o,--output", export_options.output,
+                         "the file (default: the daemon's name for it, e.g. "
+                         "session-1-grid-brdf.npy); - for standard output (csv)");
+  export_cmd
+      ->add_option("--quantity", export_options.quantity,
+                   "csv, grid: radiance, reflectance or brdf")
+      ->capture_default_str();
+  export_cmd->add_option("--format", export_options.format,
+                         "grid: npy or csv (default: from the file's extension, else npy)");
+  export_cmd
+      ->add_option("--steps", export_options.steps,
+                   "grid: dθi,dθo,dφ in degrees, or one for all (default 1: 90 × 90 × 180 cells)")
+      ->delimiter(',');
+  export_cmd->add_flag("--nodes", export_options.nodes,
+                       "grid: nodes 0, step, …, 90 (180) instead of the cells' centres");
+  export_cmd
+      ->add_option("--method", export_options.method, "octant (the paper's), delaunay, nearest")
+      ->capture_default_str();
+  export_cmd
+      ->add_option("--scale", export_options.axis_scale, "per-axis distance multipliers a,b,c")
+      ->delimiter(',');
+  export_cmd->add_flag("--mirror-phi", export_options.mirror_phi,
+                       "also use readings mirrored to −φ");
+  export_cmd->add_flag("--reciprocity", export_options.reciprocity,
+                       "grid: also use readings with θi and θo swapped (merl: always, see below)");
+  export_cmd->add_flag("--no-reciprocity", export_options.no_reciprocity,
+                       "merl: do not add the θi↔θo swapped readings");
+  export_cmd->add_flag("--exclude-flagged", export_options.exclude_flagged,
+                       "leave out readings the quality policy flagged");
+  export_cmd->add_flag("--no-progress", export_no_progress, "no progress line");
+
   std::string sim_target;
   std::string sim_modbus;
   int sim_unit = 100;
@@ -257,6 +298,12 @@ int main(int argc, char** argv) {
   if (readings->parsed()) {
     readings_options.session_id = session_id;
     return RunReadings(ctx, readings_options);
+  }
+  if (export_cmd->parsed()) {
+    export_options.session_id = session_id;
+    export_options.progress = !export_no_progress;
+    export_options.progress_tty = isatty(STDERR_FILENO) != 0;
+    return RunExport(ctx, export_options);
   }
   if (interpolate->parsed()) {
     interp.session_id = session_id;

@@ -8,9 +8,10 @@ must match the protobuf runtime installed next to the protoc that made them (Deb
 Where they go, first match wins:
   1. $BRDF_PY_STUBS (CMake's target brdf_python_stubs writes build/clients/python/stubs),
   2. ${XDG_CACHE_HOME:-~/.cache}/brdf_client/stubs.
-When the repository's proto/ is present the script is run on import: it is a no-op while the
-.proto files are unchanged and regenerates them when they change. Without proto/ (a copied
-client) the directory must already hold the stubs.
+When the repository's proto/ (or an installed share/brdfd/proto/, see deploy/CMakeLists.txt) is
+present the script is run on import: it is a no-op while the .proto files are unchanged and
+regenerates them when they change. Without proto/ (a copied client) the directory must already
+hold the stubs.
 """
 
 import os
@@ -32,8 +33,17 @@ def stubs_dir():
 
 
 def _proto_root():
+    """$BRDF_PROTO_ROOT, else the repository's proto/ (clients/python/brdf_client → ../../../proto),
+    else an installed layout's (cmake --install: share/brdfd/python/brdf_client →
+    share/brdfd/proto)."""
     explicit = os.environ.get("BRDF_PROTO_ROOT")
-    return pathlib.Path(explicit) if explicit else _PACKAGE_DIR.parent.parent.parent / "proto"
+    if explicit:
+        return pathlib.Path(explicit)
+    repository = _PACKAGE_DIR.parent.parent.parent / "proto"
+    installed = _PACKAGE_DIR.parent.parent / "proto"
+    if not (repository / "brdf" / "v1").is_dir() and (installed / "brdf" / "v1").is_dir():
+        return installed
+    return repository
 
 
 def _ensure_generated(out):

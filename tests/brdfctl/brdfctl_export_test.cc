@@ -1,0 +1,137 @@
+// `brdfctl export` as a user runs it: the built brdfctl against brdfd and brdf-sim (processes),
+// with an analyst token, on a small session measured once in the test. The files it writes are
+// checked on their own terms: the MERL file's size, the .npy loaded by NumPy (/usr/bin/python3),
+// whose NaN cells must be the count brdfctl reports, the CSV's rows.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "tests/brdfctl/ctl_test_rig.h"
+#include "tests/support/test_env.h"
+
+namespace brdf::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr const char* kPlan = R"({
+  "name": "export session",
+  "sampleRotation": {
+    "delta": {"start": 30, "stop": 45, "step": 15},
+    "alpha": {"start": 0, "stop": 20, "step": 10},
+    "beta": {"step": 10, "thetaMaxDeg": 40}
+  },
+  "reference": {"perDetectorPosition": true},
+  "dark": {"withEachReference": true}
+})";
+
+std::string Describe(const CommandResult& r) {
+  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out.substr(0, 4000) +
+         "\n--- stderr:\n" + r.err;
+}
+
+// Runs `command` with /bin/sh; its exit code and standard output.
+CommandResult RunShell(const std::string& command) {
+  CommandResult r;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return {-1, "", "popen failed: " + command};
+  char buffer[4096];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+    r.out.append(buffer, n);
+  const int status = ::pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+  return r;
+}
+
+class BrdfctlExportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const Status started = rig_.Start();
+    ASSERT_TRUE(started.ok()) << started.ToString();
+    const std::string plan = rig_.dir().file("plan.json").string();
+    std::ofstream(plan) << kPlan;
+    const CommandResult submit = Ctl({"submit", plan, "--start", "--quiet"}, kCtlOperatorToken);
+    ASSERT_EQ(submit.exit_code, 0) << Describe(submit);
+    id_ = Lines(submit.out).at(0);
+    const std::string ctl = *BrdfctlBinary();
+    const CommandResult watch =
+        Ctl({"watch", id_, "--auto-confirm", "--no-progress", "--on-prompt",
+             "'" + ctl + "' sim-mount from-prompt --modbus " + rig_.modbus()},
+            kCtlOperatorToken, 120s);
+    ASSERT_EQ(watch.exit_code, 0) << Describe(watch) << "\nbrdfd's log:\n" << rig_.log();
+  }
+
+  CommandResult Ctl(const std::vector<std::string>& args,
+                    const std::string& token = kCtlAnalystToken,
+                    std::chrono::milliseconds timeout = 150s) {
+    Result<CommandResult> r = rig_.Ctl(args, token, timeout);
+    EXPECT_TRUE(r.ok()) << r.status().ToString();
+    return r.ok() ? *r : CommandResult{-1, "", r.status().ToString()};
+  }
+
+  std::string Path(const std::string& name) const { return rig_.dir().file(name).string(); }
+
+  CtlRig rig_;
+  std::string id_;
+};
+
+TEST_F(BrdfctlExportTest, AnAnalystExportsMerlGridAndCsvFilesThatTheirReadersLoad) {
+  // MERL: the reference reader's size (three int32 dims, then 3 · 90 · 90 · 180 doubles).
+  const std::string merl = Path("session.binary");
+  const CommandResult m = Ctl({"export", id_, "merl", "-o", merl});
+  ASSERT_EQ(m.exit_code, 0) << Describe(m);
+  EXPECT_EQ(std::filesystem::file_size(merl), 90u * 90u * 180u * 3u * 8u + 12u);
+  EXPECT_FALSE(std::filesystem::exists(merl + ".partial"));
+  EXPECT_NE(m.err.find("export merl: "), std::string::npos) << "no progress line\n" << m.err;
+  EXPECT_NE(m.err.find("100%"), std::string::npos) << m.err;
+
+  // Grid as .npy: NumPy loads it; its NaN cells are the count brdfctl reports.
+  const std::string npy = Path("grid.npy");
+  const CommandResult g = Ctl({"export", id_, "grid", "--steps", "10,10,20", "-o", npy});
+  ASSERT_EQ(g.exit_code, 0) << Describe(g);
+  ASSERT_TRUE(std::filesystem::exists(npy + ".json"));
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(g.err, match, std::regex("NaN cells: ([0-9]+)"))) << g.err;
+  const std::string reported_nan = match[1];
+  const std::string script = Path("load_npy.py");
+  std::ofstream(script)
+      << "import json, sys, numpy as np\n"
+         "a = np.load(sys.argv[1])\n"
+         "d = json.load(open(sys.argv[1] + '.json'))\n"
+         "nan = np.isnan(a).all(axis=-1)\n"
+         "assert (np.isnan(a).any(axis=-1) == nan).all(), 'a cell is partly NaN'\n"
+         "print(a.dtype, *a.shape, int(nan.sum()), "
+         "int(np.isfinite(a).all(axis=-1).sum()))\n";
+  const CommandResult numpy = RunShell("/usr/bin/python3 '" + script + "' '" + npy + "' 2>&1");
+  ASSERT_EQ(numpy.exit_code, 0) << Describe(numpy);
+  EXPECT_EQ(Lines(numpy.out).at(0), "float64 9 9 9 101 " + reported_nan + " " +
+                                        std::to_string(729 - std::stoi(reported_nan)))
+      << numpy.out;
+
+  // Readings CSV to standard output: a '#' header, the column line, one row per sample reading.
+  const CommandResult c = Ctl({"export", id_, "csv", "-o", "-", "--no-progress"});
+  ASSERT_EQ(c.exit_code, 0) << Describe(c);
+  std::size_t rows = 0;
+  for (const std::string& line : Lines(c.out)) {
+    if (!line.empty() && line[0] != '#' && line.rfind("id,", 0) != 0) ++rows;
+  }
+  ASSERT_TRUE(std::regex_search(c.err, match, std::regex("([0-9]+) rows"))) << c.err;
+  EXPECT_EQ(std::to_string(rows), std::string(match[1]));
+  EXPECT_GT(rows, 10u);
+
+  // A grid step that does not divide 90° is the user's error (exit 2), and leaves no file.
+  const std::string bad = Path("bad.npy");
+  const CommandResult b = Ctl({"export", id_, "grid", "--steps", "7", "-o", bad});
+  EXPECT_EQ(b.exit_code, 2) << Describe(b);
+  EXPECT_FALSE(std::filesystem::exists(bad));
+  EXPECT_FALSE(std::filesystem::exists(bad + ".partial"));
+}
+
+}  // namespace
+}  // namespace brdf::testing
