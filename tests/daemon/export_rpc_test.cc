@@ -1,0 +1,334 @@
+// Data.Export over gRPC against a real brdfd and brdf-sim (processes): one small session is
+// measured once for the suite, then exported in each format. The checks are on the bytes the
+// client receives, parsed independently of the daemon's report (the CSV's rows, the .npy header
+// and its NaN cells, the MERL file's size and missing cells), and on the stream's contract:
+// progress that never decreases and ends at 1, data chunks in order without gaps and no larger
+// than asked, the report last with the byte count received.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/export/merl_layout.h"
+#include "core/export/merl_reader.h"
+#include "tests/daemon/daemon_test_rig.h"
+
+namespace brdf::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+// Two detector positions, three tilts, β every 10° within 40° of the normal: a small cloud of
+// (θi, θo, φ) readings, with a reference and a dark per detector position.
+constexpr const char* kExportPlan = R"({
+  "name": "export session",
+  "sampleRotation": {
+    "delta": {"start": 30, "stop": 45, "step": 15},
+    "alpha": {"start": 0, "stop": 20, "step": 10},
+    "beta": {"step": 10, "thetaMaxDeg": 40}
+  },
+  "reference": {"perDetectorPosition": true},
+  "dark": {"withEachReference": true},
+  "retry": {"maxAttempts": 2, "backoffMs": 0}
+})";
+
+// Everything one Export call delivered.
+struct ExportResult {
+  grpc::Status status;
+  std::vector<v1::ExportProgress> progress;
+  std::string file;
+  std::size_t chunks = 0;
+  std::size_t largest_chunk = 0;
+  std::optional<v1::ExportReport> report;
+  std::vector<std::string> contract_errors;  // order, offsets, messages after the report
+};
+
+std::vector<std::string> SplitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+class ExportRpcTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    rig_ = new DaemonRig();
+    if (Status st = rig_->StartSim({"--noise-scale", "0"}); !st.ok()) {
+      error_ = new std::string("brdf-sim: " + st.ToString());
+      return;
+    }
+    if (Status st = rig_->StartDaemon(); !st.ok()) {
+      error_ = new std::string("brdfd: " + st.ToString());
+      return;
+    }
+    Result<v1::Session> s = rig_->Submit(kExportPlan);
+    if (!s.ok()) {
+      error_ = new std::string("SubmitPlan: " + s.status().ToString());
+      return;
+    }
+    session_id_ = new std::string(s->session_id());
+    GrpcOperator op(*rig_, *session_id_);
+    const v1::Session done = rig_->WaitForState(*session_id_, v1::SESSION_STATE_COMPLETED, 90s);
+    op.Stop();
+    if (done.state() != v1::SESSION_STATE_COMPLETED) {
+      error_ = new std::string("the session did not complete: " + done.DebugString() +
+                               "\nbrdfd's log:\n" + rig_->log());
+    }
+  }
+  static void TearDownTestSuite() {
+    if (rig_ != nullptr && rig_->daemon() != nullptr) (void)rig_->StopDaemon();
+    delete rig_;
+    rig_ = nullptr;
+    delete error_;
+    error_ = nullptr;
+    delete session_id_;
+    session_id_ = nullptr;
+  }
+  void SetUp() override {
+    if (error_ != nullptr) GTEST_FAIL() << *error_;
+  }
+
+  static v1::ExportRequest Request(v1::ExportFormat format) {
+    v1::ExportRequest r;
+    r.set_session_id(*session_id_);
+    r.set_format(format);
+    return r;
+  }
+
+  // Runs the call to its end; `cancel_after` > 0 cancels it after that many messages.
+  static ExportResult Export(const v1::ExportRequest& request,
+                             const std::string& token = kAnalystToken, int cancel_after = 0) {
+    ExportResult out;
+    std::unique_ptr<grpc::ClientContext> context = DaemonRig::Context(token, 120s);
+    std::unique_ptr<grpc::ClientReader<v1::ExportChunk>> reader =
+        rig_->data().Export(context.get(), request);
+    v1::ExportChunk chunk;
+    double last_fraction = -1;
+    int messages = 0;
+    while (reader->Read(&chunk)) {
+      if (out.report) out.contract_errors.push_back("a message after the report");
+      if (chunk.has_progress()) {
+        if (chunk.progress().fraction() < last_fraction) {
+          out.contract_errors.push_back("progress went back to " +
+                                        std::to_string(chunk.progress().fraction()));
+        }
+        last_fraction = chunk.progress().fraction();
+        out.progress.push_back(chunk.progress());
+      } else if (chunk.has_data()) {
+        if (chunk.data().offset() != out.file.size()) {
+          out.contract_errors.push_back("chunk at offset " + std::to_string(chunk.data().offset()) +
+                                        " after " + std::to_string(out.file.size()) + " bytes");
+        }
+        out.file += chunk.data().content();
+        ++out.chunks;
+        out.largest_chunk = std::max(out.largest_chunk, chunk.data().content().size());
+      } else if (chunk.has_report()) {
+        out.report = chunk.report();
+      }
+      if (cancel_after > 0 && ++messages == cancel_after) context->TryCancel();
+    }
+    out.status = reader->Finish();
+    return out;
+  }
+
+  // The contract every successful export keeps.
+  static void ExpectCompleteStream(const ExportResult& r) {
+    ASSERT_TRUE(r.status.ok()) << r.status.error_message() << "\nbrdfd's log:\n" << rig_->log();
+    for (const std::string& e : r.contract_errors) ADD_FAILURE() << e;
+    ASSERT_TRUE(r.report.has_value()) << "no report";
+    EXPECT_EQ(r.report->bytes(), r.file.size());
+    ASSERT_FALSE(r.progress.empty());
+    EXPECT_EQ(r.progress.back().fraction(), 1.0);
+  }
+
+  static std::size_t SampleReadings() {
+    Result<std::vector<v1::Reading>> readings = rig_->Readings(*session_id_);
+    EXPECT_TRUE(readings.ok()) << readings.status().ToString();
+    if (!readings.ok()) return 0;
+    return static_cast<std::size_t>(
+        std::count_if(readings->begin(), readings->end(),
+                      [](const v1::Reading& r) { return r.kind() == v1::READING_KIND_SAMPLE; }));
+  }
+
+  static DaemonRig* rig_;
+  static std::string* error_;
+  static std::string* session_id_;
+};
+
+DaemonRig* ExportRpcTest::rig_ = nullptr;
+std::string* ExportRpcTest::error_ = nullptr;
+std::string* ExportRpcTest::session_id_ = nullptr;
+
+// An analyst may export; small chunks arrive in order; one row per sample reading (BRDF), one
+// per reading of any kind (radiance), after a '#' header that names the unit.
+TEST_F(ExportRpcTest, ReadingsCsvHasOneRowPerReadingInChunksOfTheAskedSize) {
+  const std::size_t samples = SampleReadings();
+  ASSERT_GT(samples, 10u);
+
+  v1::ExportRequest request = Request(v1::EXPORT_FORMAT_READINGS_CSV);
+  request.set_chunk_bytes(1000);
+  const ExportResult brdf = Export(request);
+  ExpectCompleteStream(brdf);
+  EXPECT_LE(brdf.largest_chunk, 1000u);
+  EXPECT_GE(brdf.chunks, brdf.file.size() / 1000);
+  EXPECT_EQ(brdf.report->file_name(), "session-" + *session_id_ + "-readings-brdf.csv");
+
+  std::size_t comments = 0, rows = 0;
+  bool unit_named = false;
+  for (const std::string& line : SplitLines(brdf.file)) {
+    if (line.rfind('#', 0) == 0) {
+      ++comments;
+      unit_named = unit_named || line.find("sr⁻¹") != std::string::npos;
+    } else {
+      ++rows;
+    }
+  }
+  EXPECT_GT(comments, 0u);
+  EXPECT_TRUE(unit_named) << "the header must name the BRDF's unit";
+  // One column header line, then the rows.
+  EXPECT_EQ(rows - 1, samples - brdf.report->skipped_readings());
+  EXPECT_EQ(brdf.report->rows(), rows - 1);
+
+  request.set_quantity(v1::QUANTITY_RADIANCE);
+  request.set_chunk_bytes(0);
+  const ExportResult radiance = Export(request);
+  ExpectCompleteStream(radiance);
+  Result<std::vector<v1::Reading>> all = rig_->Readings(*session_id_);
+  ASSERT_TRUE(all.ok());
+  EXPECT_EQ(radiance.report->rows(), all->size());
+}
+
+// The .npy has the shape the report gives, the byte size that shape implies, and exactly the
+// reported number of NaN cells (every band NaN in each); the CSV form agrees cell for cell.
+TEST_F(ExportRpcTest, GridNpyAndCsvHoldTheReportedShapeAndNanCells) {
+  v1::ExportRequest request = Request(v1::EXPORT_FORMAT_GRID_NPY);
+  request.set_step_theta_i(10);
+  request.set_step_theta_o(10);
+  request.set_step_phi(20);
+  const ExportResult npy = Export(request);
+  ExpectCompleteStream(npy);
+  const v1::ExportReport& report = *npy.report;
+  ASSERT_EQ(report.shape_size(), 4);
+  EXPECT_EQ(report.shape(0), 9u);
+  EXPECT_EQ(report.shape(1), 9u);
+  EXPECT_EQ(report.shape(2), 9u);
+  EXPECT_EQ(report.shape(3), 101u);
+  EXPECT_EQ(report.cells(), 729u);
+  EXPECT_EQ(report.filled_cells() + report.unfilled_cells(), report.cells());
+  EXPECT_GT(report.filled_cells(), 0u);
+  EXPECT_NE(report.description_json().find("sr"), std::string::npos);
+
+  // NPY 1.0: magic, version, little-endian uint16 header length, the header, then the doubles.
+  ASSERT_GT(npy.file.size(), 10u);
+  ASSERT_EQ(npy.file.compare(0, 6, "\x93NUMPY"), 0);
+  const std::size_t header_len =
+      static_cast<unsigned char>(npy.file[8]) + 256u * static_cast<unsigned char>(npy.file[9]);
+  const std::string header = npy.file.substr(10, header_len);
+  EXPECT_NE(header.find("'shape': (9, 9, 9, 101)"), std::string::npos) << header;
+  const std::size_t data_start = 10 + header_len;
+  ASSERT_EQ(npy.file.size(), data_start + 729u * 101u * 8u);
+  std::size_t nan_cells = 0;
+  for (std::size_t cell = 0; cell < 729; ++cell) {
+    std::size_t nan_bands = 0;
+    for (std::size_t b = 0; b < 101; ++b) {
+      double v = 0;
+      std::memcpy(&v, npy.file.data() + data_start + (cell * 101 + b) * 8, 8);
+      if (std::isnan(v)) ++nan_bands;
+    }
+    EXPECT_TRUE(nan_bands == 0 || nan_bands == 101) << "cell " << cell;
+    if (nan_bands == 101) ++nan_cells;
+  }
+  EXPECT_EQ(nan_cells, report.unfilled_cells());
+  std::uint64_t by_status = 0;
+  for (const auto& [name, count] : report.unfilled_by_status()) by_status += count;
+  EXPECT_EQ(by_status, report.unfilled_cells());
+
+  request.set_format(v1::EXPORT_FORMAT_GRID_CSV);
+  const ExportResult csv = Export(request);
+  ExpectCompleteStream(csv);
+  EXPECT_EQ(csv.report->unfilled_cells(), report.unfilled_cells());
+  std::size_t rows = 0, nan_rows = 0;
+  for (const std::string& line : SplitLines(csv.file)) {
+    if (line.empty() || line[0] == '#' || line.rfind("theta_i", 0) == 0) continue;
+    ++rows;
+    if (line.find(",nan") != std::string::npos) ++nan_rows;
+  }
+  EXPECT_EQ(rows, 729u);
+  EXPECT_EQ(nan_rows, report.unfilled_cells());
+}
+
+// The MERL file has MERL's size and dims, reads back with the reference reader's layout, and its
+// missing cells (−1) are exactly those the report counts as below the horizon or unfilled.
+TEST_F(ExportRpcTest, MerlFileHasMerlsSizeAndItsMissingCellsMatchTheReport) {
+  v1::ExportRequest request = Request(v1::EXPORT_FORMAT_MERL_BINARY);
+  request.mutable_options()->set_reciprocity(true);
+  request.set_chunk_bytes(256 * 1024);
+  const ExportResult merl = Export(request);
+  ExpectCompleteStream(merl);
+  ASSERT_EQ(merl.file.size(), 90u * 90u * 180u * 3u * 8u + 12u);
+  EXPECT_LE(merl.largest_chunk, 256u * 1024u);
+  std::int32_t dims[3] = {};
+  std::memcpy(dims, merl.file.data(), sizeof dims);
+  EXPECT_EQ(dims[0], 90);
+  EXPECT_EQ(dims[1], 90);
+  EXPECT_EQ(dims[2], 180);
+  Result<exports::MerlTable> table = exports::ParseMerl(merl.file);
+  ASSERT_TRUE(table.ok()) << table.status().ToString();
+  std::size_t missing = 0;
+  for (std::size_t i = 0; i < exports::kMerlCells; ++i) {
+    if (table->stored[i] < 0) ++missing;
+  }
+  const v1::ExportReport& report = *merl.report;
+  EXPECT_EQ(report.cells(), exports::kMerlCells);
+  EXPECT_EQ(missing, report.below_horizon_cells() + report.unfilled_cells());
+  EXPECT_EQ(report.filled_cells(), exports::kMerlCells - missing);
+  EXPECT_GT(report.filled_cells(), 0u);
+  EXPECT_EQ(report.file_name(), "session-" + *session_id_ + ".binary");
+}
+
+TEST_F(ExportRpcTest, BadRequestsFailWithTheCodeAndNameTheField) {
+  const ExportResult no_format = Export(Request(v1::EXPORT_FORMAT_UNSPECIFIED));
+  EXPECT_EQ(no_format.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(no_format.status.error_message().find("format"), std::string::npos);
+
+  v1::ExportRequest steps = Request(v1::EXPORT_FORMAT_GRID_NPY);
+  steps.set_step_theta_i(7);  // does not divide 90°
+  const ExportResult bad_steps = Export(steps);
+  EXPECT_EQ(bad_steps.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT)
+      << bad_steps.status.error_message();
+  EXPECT_TRUE(bad_steps.file.empty());
+
+  v1::ExportRequest merl_radiance = Request(v1::EXPORT_FORMAT_MERL_BINARY);
+  merl_radiance.set_quantity(v1::QUANTITY_RADIANCE);
+  EXPECT_EQ(Export(merl_radiance).status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  v1::ExportRequest unknown = Request(v1::EXPORT_FORMAT_READINGS_CSV);
+  unknown.set_session_id("987654");
+  EXPECT_EQ(Export(unknown).status.error_code(), grpc::StatusCode::NOT_FOUND);
+
+  EXPECT_EQ(Export(Request(v1::EXPORT_FORMAT_READINGS_CSV), "").status.error_code(),
+            grpc::StatusCode::UNAUTHENTICATED);
+}
+
+// A client that goes away mid-export stops it; the daemon keeps serving exports.
+TEST_F(ExportRpcTest, ACancelledExportEndsAndTheNextOneWorks) {
+  v1::ExportRequest request = Request(v1::EXPORT_FORMAT_MERL_BINARY);
+  const ExportResult cancelled = Export(request, kAnalystToken, /*cancel_after=*/2);
+  EXPECT_EQ(cancelled.status.error_code(), grpc::StatusCode::CANCELLED)
+      << cancelled.status.error_message();
+  EXPECT_FALSE(cancelled.report.has_value());
+
+  const ExportResult next = Export(Request(v1::EXPORT_FORMAT_READINGS_CSV));
+  ExpectCompleteStream(next);
+}
+
+}  // namespace
+}  // namespace brdf::testing
