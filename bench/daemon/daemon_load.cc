@@ -3,6 +3,10 @@
 // would be), each calling Interpolate back to back with a random direction for `--seconds`.
 // Latency is the client's: from the call to the answer, over loopback.
 //
+// --rate R paces each client at R calls/s on a fixed schedule (an analysis program's pace rather
+// than a saturating loop). Latency is then measured from each call's scheduled time, so a call that
+// starts late because the previous one was slow counts its wait (no coordinated omission).
+//
 // With --recording SESSION the tool also reads that session's progress before and after the
 // window and prints how many steps it completed meanwhile (proof that it was recording).
 //
@@ -33,6 +37,7 @@ struct Options {
   int clients = 8;
   double seconds = 10;
   double warmup = 1;
+  double rate = 0;  // calls/s per client; 0: back to back
 };
 
 void Authorize(grpc::ClientContext& context, const Options& o) {
@@ -69,7 +74,15 @@ void Client(const Options& o, int seed, Clock::time_point measure_from, Clock::t
   std::uniform_real_distribution<double> theta(0, 70);
   std::uniform_real_distribution<double> phi(0, 180);
   out->latencies_us.reserve(200000);
+  const bool paced = o.rate > 0;
+  const auto period =
+      paced
+          ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / o.rate))
+          : Clock::duration::zero();
+  // Clients start at staggered offsets so paced calls do not arrive in bursts of N.
+  Clock::time_point next = Clock::now() + period * (seed % 97) / 97;
   while (Clock::now() < until) {
+    if (paced) std::this_thread::sleep_until(next);
     brdf::v1::InterpolateRequest request;
     request.set_session_id(o.session);
     brdf::v1::IsoDirection* iso = request.mutable_direction()->mutable_iso();
@@ -79,7 +92,8 @@ void Client(const Options& o, int seed, Clock::time_point measure_from, Clock::t
     brdf::v1::InterpolateResponse response;
     grpc::ClientContext context;
     Authorize(context, o);
-    const Clock::time_point start = Clock::now();
+    const Clock::time_point start = paced ? next : Clock::now();
+    if (paced) next += period;
     const grpc::Status status = stub->Interpolate(&context, request, &response);
     const Clock::time_point end = Clock::now();
     if (start < measure_from) continue;  // warm-up: connections, the index's first build
@@ -109,6 +123,8 @@ int main(int argc, char** argv) {
   app.add_option("--clients", o.clients, "concurrent clients")->check(CLI::Range(1, 256));
   app.add_option("--seconds", o.seconds, "measurement window")->check(CLI::Range(0.1, 600.0));
   app.add_option("--warmup", o.warmup, "seconds before the window")->check(CLI::Range(0.0, 60.0));
+  app.add_option("--rate", o.rate, "calls/s per client on a fixed schedule (0: back to back)")
+      ->check(CLI::Range(0.0, 100000.0));
   CLI11_PARSE(app, argc, argv);
 
   auto control_channel = grpc::CreateChannel(o.address, grpc::InsecureChannelCredentials());
