@@ -2,7 +2,9 @@
 // (grpc.health.v1.Health: "" and each brdf.v1 service SERVING while up) and server reflection,
 // on the configured address, in plaintext or TLS ([server.tls]; client_ca → clients must present
 // a certificate). Synchronous API: each call runs on a thread of gRPC's pool, capped at
-// kMaxServerThreads (calls beyond it fail with RESOURCE_EXHAUSTED instead of piling up).
+// kMaxServerThreads (calls beyond it fail with RESOURCE_EXHAUSTED instead of piling up). One
+// exception, Interpolate, the call analysis clients make by the thousand: it is answered on gRPC's
+// callback API, on the thread that read the request (service_interpolation.h).
 #pragma once
 
 #include <grpcpp/server.h>

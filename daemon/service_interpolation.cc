@@ -198,32 +198,39 @@ grpc::Status SessionOf(const std::string& text, SessionId* id) {
 
 }  // namespace
 
-grpc::Status InterpolationService::Interpolate(grpc::ServerContext* context,
-                                               const v1::InterpolateRequest* request,
-                                               v1::InterpolateResponse* response) {
+grpc::ServerUnaryReactor* InterpolationService::Interpolate(grpc::CallbackServerContext* context,
+                                                            const v1::InterpolateRequest* request,
+                                                            v1::InterpolateResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  reactor->Finish(Answer(*context, *request, response));
+  return reactor;
+}
+
+grpc::Status InterpolationService::Answer(const grpc::ServerContextBase& context,
+                                          const v1::InterpolateRequest& request,
+                                          v1::InterpolateResponse* response) {
   Caller caller;
-  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "Interpolate", &caller);
-      !st.ok()) {
+  if (grpc::Status st = auth_.Authorize(context, Access::kRead, "Interpolate", &caller); !st.ok()) {
     return st;
   }
   SessionId id = 0;
-  if (grpc::Status st = SessionOf(request->session_id(), &id); !st.ok()) return st;
+  if (grpc::Status st = SessionOf(request.session_id(), &id); !st.ok()) return st;
   Settings settings;
   if (grpc::Status st =
-          ParseSettings(request->method(), request->quantity(), request->options(), &settings);
+          ParseSettings(request.method(), request.quantity(), request.options(), &settings);
       !st.ok()) {
     return st;
   }
-  if (grpc::Status st = CheckDirection(request->direction(), "direction"); !st.ok()) return st;
+  if (grpc::Status st = CheckDirection(request.direction(), "direction"); !st.ok()) return st;
 
   Result<std::shared_ptr<const IndexSnapshot>> index =
       cache_.Get(id, settings.quantity, settings.method, settings.options);
   if (!index.ok()) return ToGrpcStatus(index.status());
   std::array<double, 4> coords{};
-  if (grpc::Status st = ToCoords(request->direction(), **index, "direction", &coords); !st.ok()) {
+  if (grpc::Status st = ToCoords(request.direction(), **index, "direction", &coords); !st.ok()) {
     return st;
   }
-  Evaluate(request->direction(), coords, settings, **index, response->mutable_result());
+  Evaluate(request.direction(), coords, settings, **index, response->mutable_result());
   return grpc::Status::OK;
 }
 
