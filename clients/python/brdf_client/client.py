@@ -25,6 +25,7 @@ from . import names
 from ._stubs import brdf_pb2, brdf_pb2_grpc
 from .errors import BrdfError
 from .events import Event
+from .export import ExportResult, export_request
 from .interpolation import (InterpolationBatch, InterpolationResult, direction_query,
                             interpolation_options)
 from .plans import to_plan
@@ -320,6 +321,94 @@ class BrdfClient:
     def load_readings(self, session_id, kinds=None, timeout=None):
         """Every stored reading of the session (of `kinds`) as one ReadingSet."""
         return ReadingSet.concat(self.readings(session_id, kinds=kinds, timeout=timeout))
+
+    def export(self, session_id, fmt, path, *, quantity=None, method="octant", axis_scale=None,
+               mirror_phi=False, reciprocity=None, step_theta_i=0.0, step_theta_o=0.0,
+               step_phi=0.0, grid_nodes=False, exclude_flagged=False, chunk_bytes=0,
+               on_progress=None, timeout=None):
+        """Has the daemon export the session as a file and saves it at `path`; returns an
+        ExportResult (file name, bytes, summary, rows, cells, filled_cells, shape, ...).
+
+        fmt: "csv" (the readings, one row each), "grid" (the session's interpolator on a regular
+            (θi, θo, φ) grid: CSV when `path` ends in ".csv", else NumPy .npy, float64 of shape
+            (nθi, nθo, nφ, bands), NaN where the method cannot fill a cell), "merl" (a MERL
+            .binary, 90 × 90 × 180 linear sRGB, −1 where unfilled); or "grid_npy", "grid_csv".
+        path: the file; an existing folder: the daemon's file name (session-3-grid-brdf.npy, ...)
+            in it. The bytes go to `path`.partial, which is renamed to `path` only once the
+            report has arrived and the bytes are complete, so a failed or interrupted export never
+            leaves a truncated file (the partial file is removed).
+        quantity: csv and grids: "brdf" (sr⁻¹; None: the daemon's default, BRDF), "reflectance"
+            or "radiance" (csv: every reading, raw). MERL is always the BRDF.
+        method, axis_scale, mirror_phi: grids and MERL, as interpolate(). reciprocity: also use
+            the θi↔θo swapped readings; None: on for MERL (a cell stands for a pair of
+            directions and its swap alike, as `brdfctl export merl`), off otherwise.
+        step_theta_i, step_theta_o, step_phi: grids: degrees, dividing 90 (θ) or 180 (φ);
+            0: 1°. grid_nodes: sample 0, step, …, 90 (180) instead of the cells' centres.
+        exclude_flagged: leave out readings the quality policy flagged.
+        chunk_bytes: the daemon's largest data message; 0: 1 MiB.
+        on_progress(stage, fraction): called for each progress message ("loading readings",
+            "resampling", "building the MERL table", "sending", "done"; fraction in [0, 1],
+            never decreasing).
+        timeout: deadline of the whole export, seconds; None: none.
+
+        Raises BrdfError with the daemon's code and message (NOT_FOUND for an unknown session,
+        INVALID_ARGUMENT for bad steps or options, FAILED_PRECONDITION for a session without
+        usable readings), DATA_LOSS when the stream has a gap or its byte count disagrees with
+        the report, ValueError for a bad argument, OSError when the file cannot be written.
+        """
+        path = os.fspath(path)
+        if not path:
+            raise ValueError("give the file (or an existing folder) to save the export in")
+        into_folder = os.path.isdir(path)
+        request = export_request(session_id, fmt, "" if into_folder else path,
+                                 quantity=quantity, method=method, axis_scale=axis_scale,
+                                 mirror_phi=mirror_phi, reciprocity=reciprocity,
+                                 step_theta_i=step_theta_i, step_theta_o=step_theta_o,
+                                 step_phi=step_phi, grid_nodes=grid_nodes,
+                                 exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes)
+        partial = (os.path.join(path, f"brdf_client-export-{session_id}") if into_folder
+                   else path) + ".partial"
+        rpc = "Data.Export"
+
+        def broken(message):
+            return BrdfError(grpc.StatusCode.DATA_LOSS, f"{message}; export again", rpc)
+
+        call = self._data.Export(request, metadata=self._metadata, timeout=timeout)
+        received, report = 0, None
+        try:
+            with open(partial, "wb") as f:
+                try:
+                    for chunk in call:
+                        kind = chunk.WhichOneof("payload")
+                        if kind == "progress":
+                            if on_progress:
+                                on_progress(chunk.progress.stage, chunk.progress.fraction)
+                        elif kind == "data":
+                            if chunk.data.offset != received:
+                                raise broken(f"the daemon sent bytes at offset "
+                                             f"{chunk.data.offset} after {received} bytes")
+                            f.write(chunk.data.content)
+                            received += len(chunk.data.content)
+                        elif kind == "report":
+                            report = chunk.report
+                except grpc.RpcError as e:
+                    raise BrdfError.from_rpc_error(e, rpc) from None
+            if report is None:
+                raise broken(f"the stream ended without a report after {received} bytes")
+            if report.bytes != received:
+                raise broken(f"the report counts {report.bytes} bytes but {received} came")
+            # basename: the daemon names a file, never where it goes.
+            final = (os.path.join(path, os.path.basename(report.file_name)) if into_folder
+                     else path)
+            os.replace(partial, final)
+        except BaseException:
+            call.cancel()  # stops the daemon's work when we gave up early
+            try:
+                os.remove(partial)
+            except OSError:
+                pass  # never created (or already gone); the error that matters is re-raised
+            raise
+        return ExportResult.from_report(report, final, request.format)
 
     # --- Interpolation -------------------------------------------------------------------------
 

@@ -1,0 +1,142 @@
+"""Session exports (Data.Export): the request from Python arguments, and what an export produced.
+
+brdfd writes a session as a file — the readings as CSV, the session's interpolator on a regular
+(θi, θo, φ) grid as a NumPy .npy or CSV, or a MERL .binary — and streams it back: progress
+messages, the file's bytes in order, then a report. BrdfClient.export saves the bytes; this module
+builds the ExportRequest the way `brdfctl export` does (same words, same defaults) and turns the
+report into an ExportResult. The formats are described in tools/brdf-export/README.md.
+"""
+
+import dataclasses
+import json
+import os
+
+from . import names
+from ._stubs import brdf_pb2
+
+# What to export, in brdfctl's words ("grid" picks npy or CSV from the file name) and the
+# proto's (ExportFormat without its prefix).
+FORMATS = {
+    "csv": brdf_pb2.EXPORT_FORMAT_READINGS_CSV,
+    "readings_csv": brdf_pb2.EXPORT_FORMAT_READINGS_CSV,
+    "grid_npy": brdf_pb2.EXPORT_FORMAT_GRID_NPY,
+    "npy": brdf_pb2.EXPORT_FORMAT_GRID_NPY,
+    "grid_csv": brdf_pb2.EXPORT_FORMAT_GRID_CSV,
+    "merl": brdf_pb2.EXPORT_FORMAT_MERL_BINARY,
+    "merl_binary": brdf_pb2.EXPORT_FORMAT_MERL_BINARY,
+}
+GRID_FORMATS = frozenset((brdf_pb2.EXPORT_FORMAT_GRID_NPY, brdf_pb2.EXPORT_FORMAT_GRID_CSV))
+
+
+def format_name(value):
+    """ExportFormat number → "readings_csv", "grid_npy", "grid_csv", "merl_binary"."""
+    name = brdf_pb2.ExportFormat.Name(value)
+    return name[len("EXPORT_FORMAT_"):].lower()
+
+
+def export_format(fmt, path=""):
+    """`fmt` as an ExportFormat number.
+
+    fmt: "csv" (the readings), "grid" (the regular grid: CSV when `path` ends in ".csv", else
+    .npy), "merl"; or the proto's names "readings_csv", "grid_npy", "grid_csv", "merl_binary";
+    or an ExportFormat number. Anything else raises ValueError listing the accepted words.
+    """
+    if isinstance(fmt, str) and fmt.strip().lower() == "grid":
+        is_csv = os.fspath(path).lower().endswith(".csv")
+        return brdf_pb2.EXPORT_FORMAT_GRID_CSV if is_csv else brdf_pb2.EXPORT_FORMAT_GRID_NPY
+    if isinstance(fmt, str):
+        key = fmt.strip().lower().replace("-", "_")
+        if key not in FORMATS:
+            raise ValueError(f"unknown export format {fmt!r}; use csv, grid, merl (or "
+                             "readings_csv, grid_npy, grid_csv, merl_binary)")
+        return FORMATS[key]
+    value = int(fmt)
+    if value not in brdf_pb2.ExportFormat.values() or value == 0:
+        raise ValueError(f"unknown export format {fmt!r}; use csv, grid or merl")
+    return value
+
+
+def export_request(session_id, fmt, path="", *, quantity=None, method="octant",
+                   axis_scale=None, mirror_phi=False, reciprocity=None, step_theta_i=0.0,
+                   step_theta_o=0.0, step_phi=0.0, grid_nodes=False, exclude_flagged=False,
+                   chunk_bytes=0):
+    """The ExportRequest for BrdfClient.export's arguments (which document them).
+
+    As brdfctl: reciprocity None means on for MERL (a MERL cell stands for a pair of directions
+    and its swap alike) and off for the others. Grid steps on a non-grid export raise ValueError
+    rather than being silently ignored; the daemon checks the rest (INVALID_ARGUMENT).
+    """
+    value = export_format(fmt, path)
+    steps = (step_theta_i, step_theta_o, step_phi)
+    if value not in GRID_FORMATS and (any(steps) or grid_nodes):
+        raise ValueError(f"grid steps and grid_nodes are for grid exports, not "
+                         f"{format_name(value)}")
+    if reciprocity is None:
+        reciprocity = value == brdf_pb2.EXPORT_FORMAT_MERL_BINARY
+    options = brdf_pb2.InterpolationOptions(axis_scale=list(axis_scale or ()),
+                                            mirror_phi=mirror_phi, reciprocity=reciprocity)
+    return brdf_pb2.ExportRequest(
+        session_id=str(session_id), format=value,
+        quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"),
+        method=names.to_enum(method, names.METHODS, "method"), options=options,
+        step_theta_i=step_theta_i, step_theta_o=step_theta_o, step_phi=step_phi,
+        grid_nodes=grid_nodes, exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes)
+
+
+@dataclasses.dataclass
+class ExportResult:
+    """What an export produced (the daemon's ExportReport, and where the file went).
+
+    Attributes:
+      path:        the file written (the `path` given, or the daemon's file name in that folder).
+      format:      "readings_csv", "grid_npy", "grid_csv" or "merl_binary".
+      file_name:   the daemon's name for the file, e.g. "session-3-grid-brdf.npy".
+      bytes:       size of the file (checked against the bytes received).
+      summary:     one line, e.g. "16200 cells: 15012 ok, 1188 NaN (1100 empty_octant, …)".
+      rows:        readings CSV: rows written (readings; for reflectance and BRDF the sample
+                   readings that could be converted).
+      cells, filled_cells, unfilled_cells: grids and MERL: cells in the file, with a value,
+                   without one (NaN in a grid; −1 in a MERL file, below-horizon cells excluded).
+      unfilled_by_status: {"empty_octant": n, ...}: unfilled cells by why.
+      below_horizon_cells, clamped_cells: MERL: −1 cells below the surface; filled cells with a
+                   negative linear-sRGB component set to 0.
+      skipped_readings, first_skip_reason: sample readings left out, and why the first one was.
+      shape:       grid .npy: (nθi, nθo, nφ, bands); else ().
+      description: grid .npy: the axes, wavelengths, quantity, unit, method and counts (the
+                   report's description_json, parsed); else None.
+      warnings:    things to know, e.g. several dial positions γ folded together.
+    """
+
+    path: str
+    format: str
+    file_name: str
+    bytes: int
+    summary: str
+    rows: int = 0
+    cells: int = 0
+    filled_cells: int = 0
+    unfilled_cells: int = 0
+    unfilled_by_status: dict = dataclasses.field(default_factory=dict)
+    below_horizon_cells: int = 0
+    clamped_cells: int = 0
+    skipped_readings: int = 0
+    first_skip_reason: str = ""
+    shape: tuple = ()
+    description: dict = None
+    warnings: list = dataclasses.field(default_factory=list)
+
+    @classmethod
+    def from_report(cls, report, path, fmt):
+        """From a brdf_pb2.ExportReport, the saved file's path and the ExportFormat number."""
+        return cls(path=path, format=format_name(fmt), file_name=report.file_name,
+                   bytes=report.bytes, summary=report.summary, rows=report.rows,
+                   cells=report.cells, filled_cells=report.filled_cells,
+                   unfilled_cells=report.unfilled_cells,
+                   unfilled_by_status=dict(report.unfilled_by_status),
+                   below_horizon_cells=report.below_horizon_cells,
+                   clamped_cells=report.clamped_cells,
+                   skipped_readings=report.skipped_readings,
+                   first_skip_reason=report.first_skip_reason, shape=tuple(report.shape),
+                   description=(json.loads(report.description_json)
+                                if report.description_json else None),
+                   warnings=list(report.warnings))

@@ -1,0 +1,367 @@
+"""BrdfClient.export against a running brdfd driving brdf-sim (both started as processes).
+
+setUpClass runs test_live.py's small sample-rotation plan to completion (the operator's prompts
+answered on the simulator), then every test exports that session: the readings as CSV, a coarse
+regular grid as .npy and CSV, a MERL .binary, and the failures (unknown session, bad steps, a
+caller that gives up) that must leave no file behind. StreamChecks replaces the daemon by a
+server that sends broken streams (a gap, a wrong byte count, no report), which brdfd never does
+on purpose, to see the client refuse them. Exit code 77 (ctest: skipped) when brdfd
+or brdf-sim is not built.
+"""
+
+import concurrent.futures
+import csv
+import os
+import shutil
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
+sys.path.insert(0, HERE)
+
+import grpc  # noqa: E402
+
+import live_rig  # noqa: E402
+from brdf_client import BrdfClient, BrdfError, brdf_pb2, names  # noqa: E402
+from brdf_client._stubs import brdf_pb2_grpc  # noqa: E402
+from brdf_client.export import ExportResult  # noqa: E402
+from test_live import PLAN, PROMPT_ACTIONS  # noqa: E402
+
+MERL_BYTES = 90 * 90 * 180 * 3 * 8 + 12
+# A coarse grid keeps the test fast: 9 × 9 × 9 cell centres of 101 bands.
+GRID_STEPS = {"step_theta_i": 10.0, "step_theta_o": 10.0, "step_phi": 20.0}
+GRID_SHAPE = (9, 9, 9)
+
+
+class Progress:
+    """Records on_progress calls."""
+
+    def __init__(self):
+        self.calls = []
+
+    def __call__(self, stage, fraction):
+        self.calls.append((stage, fraction))
+
+    @property
+    def fractions(self):
+        return [f for _, f in self.calls]
+
+
+class GiveUp(Exception):
+    """Raised by a progress callback to abandon an export."""
+
+
+class LiveExport(unittest.TestCase):
+    rig = None
+    client = None
+    session_id = None
+    final = None
+    readings = None
+    out = None
+
+    @classmethod
+    def setUpClass(cls):
+        sim, daemon = live_rig.binaries()
+        cls.rig = live_rig.LiveRig(sim, daemon)
+        cls.rig.start()
+        cls.client = BrdfClient(cls.rig.address, cls.rig.operator_token)
+        cls.out = tempfile.mkdtemp(prefix="brdf_export_", dir=cls.rig.dir)
+        try:
+            cls.client.wait_ready(10)
+            cls.session_id = cls.client.submit_plan(PLAN, start_now=True).session_id
+            cls.final = cls.client.wait(cls.session_id, on_prompt=cls._act, timeout=180,
+                                        stop_states=("paused",))
+            if names.state_name(cls.final.state) != "completed":
+                raise AssertionError(f"session ended {names.state_name(cls.final.state)}: "
+                                     f"{cls.final.last_fault.reason or cls.final.end_reason}")
+            cls.readings = cls.client.load_readings(cls.session_id)
+        except Exception:
+            print(f"brdfd log:\n{cls.rig.log('brdfd')}\nbrdf-sim log:\n{cls.rig.log('sim')}",
+                  file=sys.stderr)
+            cls.tearDownClass()
+            raise
+
+    @classmethod
+    def _act(cls, prompt):
+        what = PROMPT_ACTIONS.get(names.prompt_kind_name(prompt.kind))
+        if what:
+            cls.rig.set_mounted(what)
+
+    @classmethod
+    def tearDownClass(cls):
+        if cls.client:
+            cls.client.close()
+        if cls.rig:
+            cls.rig.stop()
+            cls.rig.cleanup()
+
+    def path(self, name):
+        """A fresh path in a folder of this test's own, so that leftovers can be listed."""
+        folder = os.path.join(self.out, self.id().rsplit(".", 1)[-1])
+        shutil.rmtree(folder, ignore_errors=True)
+        os.makedirs(folder)
+        return os.path.join(folder, name)
+
+    def assertOnlyFile(self, path):
+        """`path` is the folder's one file: no .partial (or other) file was left beside it."""
+        folder = os.path.dirname(path)
+        self.assertEqual(os.listdir(folder), [os.path.basename(path)])
+
+    def assertProgress(self, progress):
+        f = progress.fractions
+        self.assertTrue(f, "no progress was reported")
+        self.assertTrue(all(0.0 <= x <= 1.0 for x in f), f)
+        self.assertTrue(all(b >= a for a, b in zip(f, f[1:])), f"fractions decrease: {f}")
+        self.assertEqual(f[-1], 1.0)
+        self.assertTrue(all(stage for stage, _ in progress.calls), progress.calls)
+
+    def assertCode(self, code, fn, *args, **kwargs):
+        with self.assertRaises(BrdfError) as caught:
+            fn(*args, **kwargs)
+        self.assertEqual(caught.exception.code, code, str(caught.exception))
+        self.assertEqual(caught.exception.method, "Data.Export")
+        self.assertTrue(caught.exception.message)
+        return caught.exception
+
+    # --- readings CSV -----------------------------------------------------------------------------
+
+    def read_csv(self, path):
+        """(column names, data rows) of a readings CSV ('#' lines are its documentation)."""
+        with open(path, encoding="utf-8", newline="") as f:
+            lines = [line for line in f if not line.startswith("#")]
+        rows = list(csv.reader(lines))
+        return rows[0], rows[1:]
+
+    def test_readings_csv_radiance_has_every_reading(self):
+        path = self.path("readings.csv")
+        progress = Progress()
+        r = self.client.export(self.session_id, "csv", path, quantity="radiance",
+                               on_progress=progress)
+        self.assertIsInstance(r, ExportResult)
+        self.assertEqual((r.path, r.format), (path, "readings_csv"))
+        self.assertEqual(r.file_name, f"session-{self.session_id}-readings-radiance.csv")
+        self.assertEqual(r.bytes, os.path.getsize(path))
+        self.assertOnlyFile(path)
+        self.assertProgress(progress)
+        header, rows = self.read_csv(path)
+        self.assertEqual(header[0], "id")
+        self.assertEqual(len(header), 15 + 101)
+        self.assertEqual(r.rows, len(self.readings))
+        self.assertEqual(len(rows), r.rows)
+        np.testing.assert_array_equal([int(row[0]) for row in rows], self.readings.ids)
+        self.assertIn(str(r.rows), r.summary)
+
+    def test_readings_csv_brdf_into_a_folder(self):
+        folder = os.path.dirname(self.path("unused"))
+        r = self.client.export(self.session_id, "csv", folder)
+        # A folder: the file takes the daemon's name; BRDF (the default) covers sample readings.
+        self.assertEqual(r.path, os.path.join(folder, r.file_name))
+        self.assertEqual(r.file_name, f"session-{self.session_id}-readings-brdf.csv")
+        self.assertOnlyFile(r.path)
+        _, rows = self.read_csv(r.path)
+        self.assertEqual(len(rows), r.rows)
+        self.assertEqual(r.rows + r.skipped_readings, self.final.summary.sample_readings)
+        samples = self.readings.of_kind("sample")
+        self.assertTrue(set(int(row[0]) for row in rows) <= set(samples.ids))
+
+    # --- regular grid -----------------------------------------------------------------------------
+
+    def test_grid_npy(self):
+        path = self.path("grid.npy")
+        progress = Progress()
+        r = self.client.export(self.session_id, "grid", path, on_progress=progress,
+                               chunk_bytes=64 * 1024, **GRID_STEPS)  # several data messages
+        self.assertGreater(r.bytes, 3 * 64 * 1024)
+        self.assertEqual(r.format, "grid_npy")
+        self.assertOnlyFile(path)
+        self.assertProgress(progress)
+        self.assertIn("resampling", [stage for stage, _ in progress.calls])
+        grid = np.load(path)
+        self.assertEqual(grid.dtype, np.float64)
+        self.assertEqual(grid.shape, GRID_SHAPE + (101,))
+        self.assertEqual(tuple(r.shape), grid.shape)
+        self.assertEqual(r.cells, int(np.prod(GRID_SHAPE)))
+        unfilled = np.isnan(grid).any(axis=-1)
+        self.assertTrue(np.array_equal(unfilled, np.isnan(grid).all(axis=-1)),
+                        "a cell is NaN in every band or in none")
+        self.assertEqual(int(unfilled.sum()), r.cells - r.filled_cells)
+        self.assertEqual(r.unfilled_cells, r.cells - r.filled_cells)
+        self.assertEqual(sum(r.unfilled_by_status.values()), r.unfilled_cells)
+        self.assertGreater(r.filled_cells, 0)
+        self.assertTrue(np.all(np.isfinite(grid[~unfilled])))
+        self.assertEqual(r.description["shape"], list(grid.shape))
+        self.assertEqual(r.description["nan_cells"], r.unfilled_cells)
+        self.assertEqual(r.description["quantity"], "brdf")
+
+    def test_grid_nodes_and_csv(self):
+        nodes = self.client.export(self.session_id, "grid", self.path("nodes.npy"),
+                                   grid_nodes=True, method="nearest", **GRID_STEPS)
+        self.assertEqual(np.load(nodes.path).shape, (10, 10, 10, 101))
+        self.assertEqual(nodes.filled_cells, nodes.cells)  # nearest fills every cell
+        path = self.path("grid.csv")
+        r = self.client.export(self.session_id, "grid", path, quantity="reflectance",
+                               **GRID_STEPS)
+        self.assertEqual((r.format, r.shape, r.description), ("grid_csv", (), None))
+        self.assertOnlyFile(path)
+        header, rows = self.read_csv(path)
+        self.assertEqual(header[:4], ["theta_i", "theta_o", "phi", "status"])
+        self.assertEqual(len(rows), r.cells)
+        self.assertEqual(sum(row[3] == "ok" for row in rows), r.filled_cells)
+
+    # --- MERL -------------------------------------------------------------------------------------
+
+    def test_merl_binary(self):
+        path = self.path("sample.binary")
+        progress = Progress()
+        r = self.client.export(self.session_id, "merl", path, on_progress=progress)
+        self.assertEqual((r.format, r.file_name), ("merl_binary", f"session-{self.session_id}"
+                                                                  ".binary"))
+        self.assertEqual(os.path.getsize(path), MERL_BYTES)
+        self.assertEqual(r.bytes, MERL_BYTES)
+        self.assertOnlyFile(path)
+        self.assertProgress(progress)
+        dims = np.fromfile(path, dtype="<i4", count=3)
+        np.testing.assert_array_equal(dims, [90, 90, 180])
+        table = np.fromfile(path, dtype="<f8", offset=12).reshape(3, -1)
+        self.assertEqual(r.cells, table.shape[1])
+        missing = table[0] == -1
+        self.assertTrue(np.array_equal(missing, np.all(table == -1, axis=0)))
+        self.assertEqual(int(missing.sum()), r.cells - r.filled_cells)
+        self.assertEqual(r.cells - r.filled_cells, r.unfilled_cells + r.below_horizon_cells)
+        self.assertGreater(r.filled_cells, 0)
+        self.assertTrue(np.all(table[:, ~missing] >= 0))
+
+    # --- failures leave no file -------------------------------------------------------------------
+
+    def test_unknown_session_is_not_found_and_leaves_nothing(self):
+        path = self.path("missing.csv")
+        e = self.assertCode(grpc.StatusCode.NOT_FOUND, self.client.export, "999999", "csv", path)
+        self.assertIn("999999", e.message)
+        self.assertEqual(os.listdir(os.path.dirname(path)), [])
+
+    def test_bad_step_is_invalid_argument_and_leaves_nothing(self):
+        path = self.path("bad.npy")
+        e = self.assertCode(grpc.StatusCode.INVALID_ARGUMENT, self.client.export,
+                            self.session_id, "grid", path, step_theta_i=7.0)
+        self.assertIn("7", e.message)
+        self.assertEqual(os.listdir(os.path.dirname(path)), [])
+
+    def test_caller_giving_up_removes_the_partial_file(self):
+        path = self.path("abandoned.npy")
+        written = []
+
+        def give_up(stage, _fraction):
+            if stage == "done":  # every byte is in the .partial file by now
+                written.append(os.path.getsize(path + ".partial"))
+                raise GiveUp()
+
+        with self.assertRaises(GiveUp):
+            self.client.export(self.session_id, "grid", path, on_progress=give_up, **GRID_STEPS)
+        self.assertTrue(written and written[0] > 0, written)
+        self.assertEqual(os.listdir(os.path.dirname(path)), [])
+        # A deadline that passes mid-export: the daemon's code, no file.
+        self.assertCode(grpc.StatusCode.DEADLINE_EXCEEDED, self.client.export, self.session_id,
+                        "merl", path, timeout=0.001)
+        self.assertEqual(os.listdir(os.path.dirname(path)), [])
+
+    def test_arguments_checked_before_calling(self):
+        path = self.path("never.csv")
+        with self.assertRaises(ValueError):
+            self.client.export(self.session_id, "csv", path, step_phi=10.0)
+        with self.assertRaises(ValueError):
+            self.client.export(self.session_id, "tiff", path)
+        with self.assertRaises(ValueError):
+            self.client.export(self.session_id, "grid", path, method="cubic")
+        self.assertEqual(os.listdir(os.path.dirname(path)), [])
+
+
+class ScriptedData(brdf_pb2_grpc.DataServicer):
+    """A Data service whose Export sends the chunks it is given, then fails with `abort` if set."""
+
+    def __init__(self):
+        self.chunks = []
+        self.abort = None
+
+    def Export(self, request, context):  # noqa: N802 (the gRPC method's name)
+        yield from self.chunks
+        if self.abort:
+            context.abort(*self.abort)
+
+
+def data(offset, content):
+    return brdf_pb2.ExportChunk(data=brdf_pb2.ExportData(offset=offset, content=content))
+
+
+def report(nbytes):
+    return brdf_pb2.ExportChunk(report=brdf_pb2.ExportReport(file_name="x.csv", bytes=nbytes,
+                                                             summary="2 rows", rows=2))
+
+
+class StreamChecks(unittest.TestCase):
+    """The client's checks of the stream itself, against a server that breaks the protocol."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.service = ScriptedData()
+        cls.server = grpc.server(concurrent.futures.ThreadPoolExecutor(max_workers=2))
+        brdf_pb2_grpc.add_DataServicer_to_server(cls.service, cls.server)
+        port = cls.server.add_insecure_port("127.0.0.1:0")
+        cls.server.start()
+        cls.client = BrdfClient(f"127.0.0.1:{port}", "")
+        cls.dir = tempfile.mkdtemp(prefix="brdf_export_stream_")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.client.close()
+        cls.server.stop(None)
+        shutil.rmtree(cls.dir, ignore_errors=True)
+
+    def export(self, chunks, abort=None):
+        self.service.chunks, self.service.abort = chunks, abort
+        for name in os.listdir(self.dir):
+            os.remove(os.path.join(self.dir, name))
+        return self.client.export("1", "csv", os.path.join(self.dir, "x.csv"), timeout=30)
+
+    def assertRefused(self, chunks, code, words, abort=None):
+        with self.assertRaises(BrdfError) as caught:
+            self.export(chunks, abort)
+        self.assertEqual(caught.exception.code, code, str(caught.exception))
+        self.assertIn(words, caught.exception.message)
+        self.assertEqual(os.listdir(self.dir), [])
+
+    def test_a_whole_stream_is_saved(self):
+        r = self.export([data(0, b"ab\n"), data(3, b"cd\n"), report(6)])
+        with open(r.path, "rb") as f:
+            self.assertEqual(f.read(), b"ab\ncd\n")
+        self.assertEqual((r.bytes, r.rows, r.file_name), (6, 2, "x.csv"))
+        self.assertEqual(os.listdir(self.dir), ["x.csv"])
+
+    def test_a_gap_is_data_loss(self):
+        self.assertRefused([data(0, b"ab\n"), data(4, b"cd\n"), report(7)],
+                           grpc.StatusCode.DATA_LOSS, "offset 4 after 3 bytes")
+
+    def test_a_wrong_byte_count_is_data_loss(self):
+        self.assertRefused([data(0, b"ab\n"), report(4)], grpc.StatusCode.DATA_LOSS,
+                           "counts 4 bytes but 3 came")
+
+    def test_no_report_is_data_loss(self):
+        self.assertRefused([data(0, b"ab\n")], grpc.StatusCode.DATA_LOSS, "without a report")
+
+    def test_a_failure_after_some_bytes_keeps_the_servers_code_and_message(self):
+        self.assertRefused([data(0, b"ab\n")], grpc.StatusCode.FAILED_PRECONDITION,
+                           "no usable readings",
+                           abort=(grpc.StatusCode.FAILED_PRECONDITION, "no usable readings"))
+
+
+if __name__ == "__main__":
+    sim_path, daemon_path = live_rig.binaries()
+    if not sim_path or not daemon_path:
+        print(f"skipped: brdf-sim or brdfd is not built in {live_rig.build_dir()} "
+              f"(brdf-sim: {sim_path}, brdfd: {daemon_path})")
+        sys.exit(77)
+    unittest.main()
