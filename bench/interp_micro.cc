@@ -1,13 +1,15 @@
 // Micro-benchmarks of the interpolation index and blend (Google Benchmark), on the data sets of
 // bench/run.sh: the paper's rig grid (2,153 points), 50,000 uniform random points in
 // [0,90)×[0,90)×[0,360), and a 4D anisotropic set; 101-band analytic spectra (brdf-interp synth's
-// data: the same generators, the same seeds). Queries are uniform random in the data's box, in
-// random order, 4,096 of them cycled.
+// data: the same generators, the same seeds). Queries: random rig poses for the rig grid (as
+// compare.py's), uniform random in the data's box for the others; random order, 4,096 cycled.
 //
 // Figures: items_per_second is queries (or builds, or blends) per second, one thread.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <random>
@@ -18,6 +20,7 @@
 #include "core/interp/kd_tree.h"
 #include "core/interp/octant.h"
 #include "core/interp/octant_cube.h"
+#include "core/interp/orthant_grid.h"
 #include "core/interp/point_cloud.h"
 #include "core/wavelength_grid.h"
 #include "tools/brdf-interp/synthetic_samples.h"
@@ -40,7 +43,7 @@ const DataSet& Data(const std::string& name) {
   if (slot) return *slot;
   interp_tool::SyntheticPoints points;
   std::vector<double> hi;
-  if (name == "rig") {
+  if (name == "rig" || name == "rig_mirror") {
     points = interp_tool::PaperGridPoints().value();
     hi = {90, 90, 180};
   } else if (name == "random50k") {
@@ -53,9 +56,33 @@ const DataSet& Data(const std::string& name) {
   slot = std::make_unique<DataSet>();
   slot->name = name;
   slot->samples = interp_tool::SyntheticSamples(points, WavelengthGrid::Pr650());
-  slot->cloud = BuildPointCloud(*slot->samples, {}).value();
+  Options options;
+  options.mirror_phi = name == "rig_mirror";  // the cloud doubles: (θi, θo, −φ) copies
+  slot->cloud = BuildPointCloud(*slot->samples, options).value();
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
+  if (name == "rig" || name == "rig_mirror") {
+    // Random rig poses, as compare.py's rig queries: α in [0, 70], β in [−175, 180], δ in
+    // [0, 146.25] degrees, converted to (θi, θo, φ) with geometry.md's closed forms.
+    constexpr double kRad = 3.14159265358979323846 / 180.0;
+    while (slot->queries.size() < kQueries * 3) {
+      const double a = 70.0 * u(rng) * kRad;
+      const double b = (-175.0 + 355.0 * u(rng)) * kRad;
+      const double dl = 146.25 * u(rng) * kRad;
+      const double ci = std::cos(a) * std::cos(b);
+      const double co = std::cos(a) * std::cos(b - dl);
+      const double ti = std::acos(std::clamp(ci, -1.0, 1.0)) / kRad;
+      const double to = std::acos(std::clamp(co, -1.0, 1.0)) / kRad;
+      if (ti > 89.999 || to > 89.999) continue;
+      double phi = 0.0;
+      if (ti > 1e-7 && to > 1e-7) {
+        const double c = (std::cos(dl) - ci * co) / (std::sin(ti * kRad) * std::sin(to * kRad));
+        phi = std::acos(std::clamp(c, -1.0, 1.0)) / kRad;
+      }
+      slot->queries.insert(slot->queries.end(), {ti, to, phi});
+    }
+    return *slot;
+  }
   slot->queries.resize(kQueries * hi.size());
   for (std::size_t i = 0; i < slot->queries.size(); ++i) {
     slot->queries[i] = hi[i % hi.size()] * u(rng);
@@ -68,16 +95,77 @@ const char* const kSets[] = {"rig", "random50k", "aniso4d"};
 void BM_KdTreeBuild(benchmark::State& state, std::string set, KdTree::Kernel kernel) {
   const DataSet& data = Data(set);
   for (auto _ : state) {
-    KdTree tree(data.cloud, kernel);
+    KdTree tree(data.cloud, kernel, KdTree::Search::kTree);
     benchmark::DoNotOptimize(tree.node_count());
   }
   state.SetItemsProcessed(state.iterations());
   state.counters["points"] = static_cast<double>(data.cloud.size());
 }
 
-void BM_OrthantSearch(benchmark::State& state, std::string set, KdTree::Kernel kernel) {
+// The grid shortcut of the octant search (orthant_grid.h): build time (tree and grid), size, and
+// how many of the benchmark's queries it answers (the rest walk the tree).
+void BM_GridBuild(benchmark::State& state, std::string set) {
   const DataSet& data = Data(set);
-  const KdTree tree(data.cloud, kernel);
+  // What a user of the shortcut pays: the tree and its grid.
+  for (auto _ : state) {
+    KdTree tree(data.cloud, KdTree::Kernel::kBest, KdTree::Search::kGridThenTree);
+    benchmark::DoNotOptimize(tree.grid().entries());
+  }
+  const KdTree tree(data.cloud, KdTree::Kernel::kBest, KdTree::Search::kGridThenTree);
+  const OrthantGrid& grid = tree.grid();
+  const auto d = static_cast<std::size_t>(data.cloud.dims);
+  std::size_t hits = 0;
+  for (std::size_t i = 0; i < kQueries; ++i) {
+    std::uint32_t begin = 0, count = 0, need = 0;
+    const double* q = data.queries.data() + i * d;
+    hits += d == 3 ? grid.Find<3>(q, begin, count, need) : grid.Find<4>(q, begin, count, need);
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["cells"] = static_cast<double>(grid.cell_count());
+  state.counters["listed%"] =
+      100.0 * static_cast<double>(grid.listed_cells()) / static_cast<double>(grid.cell_count());
+  state.counters["per_list"] =
+      static_cast<double>(grid.entries()) / static_cast<double>(grid.listed_cells());
+  state.counters["MB"] = static_cast<double>(grid.bytes()) / 1e6;
+  state.counters["hit%"] = 100.0 * static_cast<double>(hits) / kQueries;
+  state.counters["no_hole"] = static_cast<double>(grid.unlisted()[0]);
+  state.counters["no_far"] = static_cast<double>(grid.unlisted()[1]);
+  state.counters["no_long"] = static_cast<double>(grid.unlisted()[2]);
+}
+
+// The search on the queries the grid answers alone (its lists' scan, no tree).
+void BM_GridHits(benchmark::State& state, std::string set) {
+  const DataSet& data = Data(set);
+  const KdTree tree(data.cloud, KdTree::Kernel::kBest, KdTree::Search::kGridThenTree);
+  const auto d = static_cast<std::size_t>(data.cloud.dims);
+  std::vector<double> hits;
+  for (std::size_t i = 0; i < kQueries; ++i) {
+    std::uint32_t begin = 0, count = 0, need = 0;
+    const double* q = data.queries.data() + i * d;
+    if (d == 3 ? tree.grid().Find<3>(q, begin, count, need)
+               : tree.grid().Find<4>(q, begin, count, need)) {
+      hits.insert(hits.end(), q, q + d);
+    }
+  }
+  if (hits.empty()) {
+    state.SkipWithError("no query inside a listed cell");
+    return;
+  }
+  const std::size_t n = hits.size() / d;
+  OrthantWinners winners;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    tree.NearestPerOrthant(hits.data() + i * d, winners);
+    benchmark::DoNotOptimize(winners.rank[0]);
+    i = (i + 1) % n;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_OrthantSearch(benchmark::State& state, std::string set, KdTree::Kernel kernel,
+                      KdTree::Search search) {
+  const DataSet& data = Data(set);
+  const KdTree tree(data.cloud, kernel, search);
   const auto d = static_cast<std::size_t>(data.cloud.dims);
   OrthantWinners winners;
   std::size_t i = 0;
@@ -88,7 +176,8 @@ void BM_OrthantSearch(benchmark::State& state, std::string set, KdTree::Kernel k
   }
   state.SetItemsProcessed(state.iterations());
   state.SetLabel(KdTree::KernelName(tree.kernel()) + std::string(", leaf ") +
-                 std::to_string(tree.leaf_size()));
+                 std::to_string(tree.leaf_size()) +
+                 (search == KdTree::Search::kTree ? ", tree only" : ", grid then tree"));
 }
 
 void BM_NearestSearch(benchmark::State& state, std::string set) {
@@ -182,11 +271,23 @@ void RegisterAll() {
   for (const char* set : kSets) {
     for (const auto& [kernel, name] : kernels) {
       if (!KdTree::Supported(kernel)) continue;
-      benchmark::RegisterBenchmark((std::string("OrthantSearch/") + set + "/" + name).c_str(),
-                                   [set = std::string(set), kernel = kernel](benchmark::State& s) {
-                                     BM_OrthantSearch(s, set, kernel);
-                                   });
+      for (const auto search : {KdTree::Search::kGridThenTree, KdTree::Search::kTree}) {
+        const char* how = search == KdTree::Search::kTree ? "/tree" : "";
+        benchmark::RegisterBenchmark(
+            (std::string("OrthantSearch/") + set + "/" + name + how).c_str(),
+            [set = std::string(set), kernel = kernel, search](benchmark::State& s) {
+              BM_OrthantSearch(s, set, kernel, search);
+            });
+      }
     }
+  }
+  for (const char* set : {"rig", "rig_mirror", "random50k", "aniso4d"}) {
+    benchmark::RegisterBenchmark(
+        (std::string("GridBuild/") + set).c_str(),
+        [set = std::string(set)](benchmark::State& s) { BM_GridBuild(s, set); });
+    benchmark::RegisterBenchmark(
+        (std::string("GridHits/") + set).c_str(),
+        [set = std::string(set)](benchmark::State& s) { BM_GridHits(s, set); });
   }
   for (const char* set : kSets) {
     benchmark::RegisterBenchmark(

@@ -114,9 +114,10 @@ struct LeafKernels {
   using Best = KdTree::OrthantBest;
 
   // Portable: no data-dependent branch per point (the update is a masked select).
-  static bool Scalar(const KdTree& tree, std::uint32_t begin, std::uint32_t end, Best& best) {
+  static bool Scalar(const KdTree::Entries& tree, std::uint32_t begin, std::uint32_t end,
+                     Best& best) {
     const double* x[D];
-    for (int j = 0; j < D; ++j) x[j] = tree.axis_[static_cast<std::size_t>(j)].data();
+    for (int j = 0; j < D; ++j) x[j] = tree.axis[j];
     double q[D];
     for (int j = 0; j < D; ++j) q[j] = best.q[static_cast<std::size_t>(j)];
     bool improved = false;
@@ -129,15 +130,44 @@ struct LeafKernels {
         o |= static_cast<unsigned>(v >= q[j]) << j;
         d2 += RoundedSquare(v - q[j]);
       }
-      improved |= best.Offer(o, d2, tree.rank_[pos], pos);
+      improved |= best.Offer(o, d2, tree.rank[pos], pos);
     }
     return improved;
+  }
+
+  // Portable: a grid list (see ListAvx512), one point at a time.
+  static void ListScalar(const KdTree& tree, const std::uint32_t* entry, const double* block_gap,
+                         std::uint32_t blocks, unsigned need, Best& best) {
+    double q[D];
+    for (int j = 0; j < D; ++j) q[j] = best.q[static_cast<std::size_t>(j)];
+    double worst = kInf;
+    for (std::uint32_t b = 0; b < blocks; ++b) {
+      if (block_gap[b] > worst) break;
+      bool improved = false;
+      for (std::uint32_t k = 0; k < 8; ++k) {
+        const std::uint32_t pos = entry[std::size_t{b} * 8 + k];
+        unsigned o = 0;
+        double d2 = 0.0;
+#pragma GCC unroll 4
+        for (int j = 0; j < D; ++j) {
+          const double v = tree.axis_[static_cast<std::size_t>(j)][pos];
+          o |= static_cast<unsigned>(v >= q[j]) << j;
+          d2 += RoundedSquare(v - q[j]);
+        }
+        improved |= best.Offer(o, d2, tree.rank_[pos], pos);
+      }
+      if (!improved) continue;
+      worst = -kInf;  // orthants outside `need` are empty for every query of the cell
+      for (int o = 0; o < (1 << D); ++o) {
+        if ((need >> o) & 1u) worst = Max(worst, best.d2[static_cast<std::size_t>(o)]);
+      }
+    }
   }
 
 #ifdef BRDF_KD_X86
   // 4 points at a time; the bests of their orthants are gathered, and only a point at or below
   // its orthant's best goes through the exact rule.
-  __attribute__((target("avx2"))) static bool Avx2(const KdTree& tree, std::uint32_t begin,
+  __attribute__((target("avx2"))) static bool Avx2(const KdTree::Entries& tree, std::uint32_t begin,
                                                    std::uint32_t end, Best& best) {
     __m256d q[D];
     for (int j = 0; j < D; ++j) q[j] = _mm256_set1_pd(best.q[static_cast<std::size_t>(j)]);
@@ -147,7 +177,7 @@ struct LeafKernels {
       __m256i code = _mm256_setzero_si256();
 #pragma GCC unroll 4
       for (int j = 0; j < D; ++j) {
-        const __m256d v = _mm256_loadu_pd(tree.axis_[static_cast<std::size_t>(j)].data() + pos);
+        const __m256d v = _mm256_loadu_pd(tree.axis[j] + pos);
         const __m256d diff = _mm256_sub_pd(v, q[j]);
         __m256d sq = _mm256_mul_pd(diff, diff);
         asm("" : "+x"(sq));  // no fused multiply-add: round the square first
@@ -168,7 +198,7 @@ struct LeafKernels {
         const int lane = std::countr_zero(candidates);
         const std::uint32_t at = pos + static_cast<std::uint32_t>(lane);
         improved |=
-            best.Offer(static_cast<std::size_t>(orthant[lane]), dist[lane], tree.rank_[at], at);
+            best.Offer(static_cast<std::size_t>(orthant[lane]), dist[lane], tree.rank[at], at);
       }
     }
     return improved;
@@ -176,8 +206,9 @@ struct LeafKernels {
 
   // 8 points at a time; the orthants' bests sit in one (3D) or two (4D) registers and are
   // permuted into place.
-  __attribute__((target("avx512f"))) static bool Avx512(const KdTree& tree, std::uint32_t begin,
-                                                        std::uint32_t end, Best& best) {
+  __attribute__((target("avx512f"))) static bool Avx512(const KdTree::Entries& tree,
+                                                        std::uint32_t begin, std::uint32_t end,
+                                                        Best& best) {
     __m512d q[D];
     for (int j = 0; j < D; ++j) q[j] = _mm512_set1_pd(best.q[static_cast<std::size_t>(j)]);
     bool improved = false;
@@ -193,7 +224,7 @@ struct LeafKernels {
       __m512i code = _mm512_setzero_si512();
 #pragma GCC unroll 4
       for (int j = 0; j < D; ++j) {
-        const __m512d v = _mm512_loadu_pd(tree.axis_[static_cast<std::size_t>(j)].data() + pos);
+        const __m512d v = _mm512_loadu_pd(tree.axis[j] + pos);
         const __m512d diff = _mm512_sub_pd(v, q[j]);
         __m512d sq = _mm512_mul_pd(diff, diff);
         asm("" : "+v"(sq));  // no fused multiply-add: round the square first
@@ -224,7 +255,7 @@ struct LeafKernels {
         const int lane = std::countr_zero(candidates);
         const std::uint32_t at = pos + static_cast<std::uint32_t>(lane);
         improved |=
-            best.Offer(static_cast<std::size_t>(orthant[lane]), dist[lane], tree.rank_[at], at);
+            best.Offer(static_cast<std::size_t>(orthant[lane]), dist[lane], tree.rank[at], at);
       }
       best_lo = _mm512_loadu_pd(best.d2.data());
       best_hi = _mm512_loadu_pd(best.d2.data() + 8);
@@ -234,6 +265,79 @@ struct LeafKernels {
           0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data() + 8)));
     }
     return improved;
+  }
+  // A grid list (orthant_grid.h): tree positions, 8 per block, nearest blocks first. Stops at the
+  // first block whose bound exceeds the best of every orthant in `need`. 8 points at a time,
+  // their coordinates gathered from the tree's per-axis arrays (small: they stay in cache).
+  __attribute__((target("avx512f"))) static void ListAvx512(const KdTree& tree,
+                                                            const std::uint32_t* entry,
+                                                            const double* block_gap,
+                                                            std::uint32_t blocks, unsigned need,
+                                                            Best& best) {
+    __m512d q[D];
+    for (int j = 0; j < D; ++j) q[j] = _mm512_set1_pd(best.q[static_cast<std::size_t>(j)]);
+    __m512d best_lo = _mm512_loadu_pd(best.d2.data());
+    __m512d best_hi = _mm512_loadu_pd(best.d2.data() + 8);
+    __m512i best_pos = _mm512_maskz_cvtepu32_epi64(
+        0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data())));
+    __m512i best_pos_hi = _mm512_maskz_cvtepu32_epi64(
+        0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data() + 8)));
+    const auto need_lo = static_cast<__mmask8>(need & 0xFFu);
+    const auto need_hi = static_cast<__mmask8>(need >> 8);
+    double worst = kInf;
+    for (std::uint32_t b = 0; b < blocks; ++b) {
+      if (block_gap[b] > worst) break;
+      const std::uint32_t* at = entry + std::size_t{b} * 8;
+      const __m256i index = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(at));
+      __m512d d2 = _mm512_setzero_pd();
+      __m512i code = _mm512_setzero_si512();
+#pragma GCC unroll 4
+      for (int j = 0; j < D; ++j) {
+        const __m512d v =
+            _mm512_i32gather_pd(index, tree.axis_[static_cast<std::size_t>(j)].data(), 8);
+        const __m512d diff = _mm512_sub_pd(v, q[j]);
+        __m512d sq = _mm512_mul_pd(diff, diff);
+        asm("" : "+v"(sq));  // no fused multiply-add: round the square first
+        d2 = j == 0 ? sq : _mm512_add_pd(d2, sq);
+        const __mmask8 plus = _mm512_cmp_pd_mask(v, q[j], _CMP_GE_OQ);
+        code = _mm512_mask_or_epi64(code, plus, code, _mm512_set1_epi64(1 << j));
+      }
+      const __m512d limit = D == 3 ? _mm512_permutexvar_pd(code, best_lo)
+                                   : _mm512_permutex2var_pd(best_lo, code, best_hi);
+      // As in Avx512: a point equal to its orthant's best is a candidate only when it is not
+      // that point itself (lists repeat their last entry as padding).
+      const __m512i best_at = D == 3 ? _mm512_permutexvar_epi64(code, best_pos)
+                                     : _mm512_permutex2var_epi64(best_pos, code, best_pos_hi);
+      const __m512i positions = _mm512_cvtepu32_epi64(index);
+      unsigned candidates = _mm512_cmp_pd_mask(d2, limit, _CMP_LT_OQ) |
+                            _mm512_mask_cmpneq_epi64_mask(_mm512_cmp_pd_mask(d2, limit, _CMP_EQ_OQ),
+                                                          positions, best_at);
+      if (candidates == 0) continue;
+      alignas(64) double dist[8];
+      alignas(64) std::int64_t orthant[8];
+      _mm512_store_pd(dist, d2);
+      _mm512_store_si512(orthant, code);
+      // The exact rule point by point; the vector copies of the bests follow in registers
+      // (reloading them from the scalar stores would stall on store forwarding).
+      for (; candidates != 0; candidates &= candidates - 1) {
+        const int lane = std::countr_zero(candidates);
+        const std::uint32_t pos = at[lane];
+        const auto o = static_cast<unsigned>(orthant[lane]);
+        const bool better = best.Offer(o, dist[lane], tree.rank_[pos], pos);
+        const unsigned mask = static_cast<unsigned>(better) << o;
+        const __m512d d = _mm512_set1_pd(dist[lane]);
+        const __m512i p = _mm512_set1_epi64(pos);
+        best_lo = _mm512_mask_mov_pd(best_lo, static_cast<__mmask8>(mask), d);
+        best_pos = _mm512_mask_mov_epi64(best_pos, static_cast<__mmask8>(mask), p);
+        if (D == 4) {
+          best_hi = _mm512_mask_mov_pd(best_hi, static_cast<__mmask8>(mask >> 8), d);
+          best_pos_hi = _mm512_mask_mov_epi64(best_pos_hi, static_cast<__mmask8>(mask >> 8), p);
+        }
+      }
+      // Orthants outside `need` count as -inf (empty for every query of the cell).
+      worst = _mm512_mask_reduce_max_pd(need_lo, best_lo);
+      if (D == 4) worst = Max(worst, _mm512_mask_reduce_max_pd(need_hi, best_hi));
+    }
   }
 #endif
 };
@@ -271,7 +375,8 @@ const char* KdTree::KernelName(Kernel kernel) {
   return "unknown";
 }
 
-KdTree::KdTree(const PointCloud& cloud, Kernel kernel) : cloud_(&cloud), dims_(cloud.dims) {
+KdTree::KdTree(const PointCloud& cloud, Kernel kernel, Search search)
+    : cloud_(&cloud), dims_(cloud.dims) {
   if (kernel == Kernel::kBest) {
     kernel = Supported(Kernel::kAvx512) ? Kernel::kAvx512
              : Supported(Kernel::kAvx2) ? Kernel::kAvx2
@@ -296,6 +401,12 @@ KdTree::KdTree(const PointCloud& cloud, Kernel kernel) : cloud_(&cloud), dims_(c
     default:
       scan_ = three ? &LeafKernels<3>::Scalar : &LeafKernels<4>::Scalar;
   }
+  list_scan_ = three ? &LeafKernels<3>::ListScalar : &LeafKernels<4>::ListScalar;
+#ifdef BRDF_KD_X86
+  if (kernel == Kernel::kAvx512) {
+    list_scan_ = three ? &LeafKernels<3>::ListAvx512 : &LeafKernels<4>::ListAvx512;
+  }
+#endif
 
   const auto n = static_cast<std::uint32_t>(cloud.size());
   std::vector<std::uint32_t> order(n);
@@ -312,6 +423,13 @@ KdTree::KdTree(const PointCloud& cloud, Kernel kernel) : cloud_(&cloud), dims_(c
   rank_ = std::move(order);
   rank_.resize(n + kPadding, kNoPoint);
   BuildSeeds();
+  if (search == Search::kGridThenTree) {
+    std::vector<std::uint32_t> position_of(n);
+    for (std::uint32_t pos = 0; pos < n; ++pos) position_of[rank_[pos]] = pos;
+    grid_ = OrthantGrid(cloud, position_of, [this](const double* p, OrthantWinners& winners) {
+      NearestPerOrthant(p, winners);  // the grid is still empty: the tree answers
+    });
+  }
 }
 
 std::uint32_t KdTree::Build(std::vector<std::uint32_t>& order, std::uint32_t begin,
@@ -381,7 +499,9 @@ void KdTree::VisitOrthants(std::uint32_t node_index, OrthantBest& best) const {
   if ((best.Open<D>(bound * kBoundShrink) & kReach<D>[lt | (ge << D)]) == 0) return;
 
   if (node.right == 0) {
-    scan_(*this, node.begin, node.end, best);
+    const Entries entries{{axis_[0].data(), axis_[1].data(), axis_[2].data(), axis_[3].data()},
+                          rank_.data()};
+    scan_(entries, node.begin, node.end, best);
     return;
   }
   if (best.q[node.axis] < node.split) {
@@ -493,27 +613,46 @@ void KdTree::Seed(OrthantBest& best) const {
   }
 }
 
+template <int D>
+void KdTree::SearchOrthants(OrthantBest& best, OrthantWinners& winners) const {
+  constexpr std::size_t kOrthants = std::size_t{1} << D;
+  best.d2.fill(kInf);
+  best.rank.fill(kNoPoint);
+  best.pos.fill(kNoPoint);  // no point's position (the AVX-512 kernel compares positions)
+  std::uint32_t begin = 0, count = 0, need = 0;
+  if (grid_.Find<D>(best.q.data(), begin, count, need)) {
+    // The cell's list holds every possible winner, nearest to the cell first: one short scan, no
+    // tree.
+    list_scan_(*this, grid_.entry() + begin, grid_.block_gap() + begin / 8, count / 8, need, best);
+    for (std::size_t o = 0; o < kOrthants; ++o) {
+      winners.rank[o] = best.rank[o];
+      winners.scaled[o] = nullptr;
+      if (best.rank[o] == kNoPoint) continue;
+      for (std::size_t j = 0; j < D; ++j) winners.coords[o][j] = axis_[j][best.pos[o]];
+      winners.scaled[o] = winners.coords[o].data();
+    }
+    return;
+  }
+  Seed(best);
+  VisitOrthants<D>(0, best);
+  // The winners' coordinates from the per-axis arrays, whose lines the leaf scans just read.
+  for (std::size_t o = 0; o < kOrthants; ++o) {
+    winners.rank[o] = best.rank[o];
+    winners.scaled[o] = nullptr;
+    if (best.rank[o] == kNoPoint) continue;
+    for (std::size_t j = 0; j < D; ++j) winners.coords[o][j] = axis_[j][best.pos[o]];
+    winners.scaled[o] = winners.coords[o].data();
+  }
+}
+
 void KdTree::NearestPerOrthant(const double* p, OrthantWinners& winners) const {
   OrthantBest best;
   const auto d = static_cast<std::size_t>(dims_);
   std::copy(p, p + d, best.q.begin());
-  best.d2.fill(kInf);
-  best.rank.fill(kNoPoint);
-  best.pos.fill(kNoPoint);  // no point's position (the AVX-512 kernel compares positions)
-  Seed(best);
   if (dims_ == 3) {
-    VisitOrthants<3>(0, best);
+    SearchOrthants<3>(best, winners);
   } else {
-    VisitOrthants<4>(0, best);
-  }
-  // The winners' coordinates from the per-axis arrays, whose lines the leaf scans just read.
-  const std::size_t orthants = std::size_t{1} << dims_;
-  for (std::size_t o = 0; o < orthants; ++o) {
-    winners.rank[o] = best.rank[o];
-    winners.scaled[o] = nullptr;
-    if (best.rank[o] == kNoPoint) continue;
-    for (std::size_t j = 0; j < d; ++j) winners.coords[o][j] = axis_[j][best.pos[o]];
-    winners.scaled[o] = winners.coords[o].data();
+    SearchOrthants<4>(best, winners);
   }
 }
 

@@ -15,7 +15,14 @@
 // for the rare point that can improve one; a portable scalar kernel does the same without
 // branches. Pruning compares a box's distance with every orthant's best at once (one vector
 // compare) and keeps the orthants the box reaches (a table indexed by which sides of the query the
-// box spans). Pure: no I/O.
+// box spans).
+//
+// Shortcut (Search::kGridThenTree, opt-in): an OrthantGrid (orthant_grid.h) lists, for each
+// cell of a uniform grid, every point that can win an orthant for some query in the cell; a query
+// whose cell has a list scans it (tree positions: the points are gathered from the per-axis
+// arrays, same arithmetic as the leaf kernels) and skips the tree. Queries outside the grid, and
+// cells the grid could not bound, walk the tree. Same answers either way.
+// Pure: no I/O.
 #pragma once
 
 #include <array>
@@ -24,6 +31,7 @@
 #include <vector>
 
 #include "core/interp/octant_cube.h"
+#include "core/interp/orthant_grid.h"
 #include "core/interp/point_cloud.h"
 
 namespace brdf::interp {
@@ -34,9 +42,16 @@ class KdTree {
   // benchmarks (a kernel the CPU lacks falls back to kScalar). All give identical results.
   enum class Kernel { kBest, kScalar, kAvx2, kAvx512 };
 
+  // How NearestPerOrthant searches: the tree alone, or the grid's list first (see above). On the
+  // rig grid the grid makes the search about 2× faster, but tree + grid take about 100× the
+  // tree's build time (about 0.1 s; bench/README.md has the figures), so it is opt-in. Only 3D
+  // clouds of at most OrthantGrid::Options::max_points points get a grid.
+  enum class Search { kTree, kGridThenTree };
+
   // Indexes the cloud's scaled points (3D or 4D, at least one). Keeps a pointer to `cloud`, which
   // must outlive the tree and not change.
-  explicit KdTree(const PointCloud& cloud, Kernel kernel = Kernel::kBest);
+  explicit KdTree(const PointCloud& cloud, Kernel kernel = Kernel::kBest,
+                  Search search = Search::kTree);
 
   int dims() const { return dims_; }
   // The kernel in use (never kBest) and its name ("avx512", "avx2", "scalar").
@@ -56,9 +71,16 @@ class KdTree {
   // Nodes in the tree and points per leaf (for benchmarks).
   std::size_t node_count() const { return nodes_.size(); }
   std::uint32_t leaf_size() const { return leaf_size_; }
+  // The grid shortcut (empty with Search::kTree).
+  const OrthantGrid& grid() const { return grid_; }
 
   // The search state of one NearestPerOrthant call (public for the kernels in kd_tree.cc).
   struct OrthantBest;
+  // Points a leaf kernel scans: one array per axis and their ranks.
+  struct Entries {
+    const double* axis[4];
+    const std::uint32_t* rank;
+  };
 
  private:
   struct Node {
@@ -72,14 +94,19 @@ class KdTree {
   };
   struct NearestBest;
   // Scans positions [begin, end) of a leaf into `best`; true when some orthant improved.
-  using LeafScan = bool (*)(const KdTree& tree, std::uint32_t begin, std::uint32_t end,
+  using LeafScan = bool (*)(const Entries& entries, std::uint32_t begin, std::uint32_t end,
                             OrthantBest& best);
+  // Scans `blocks` blocks of 8 tree positions of a grid list (see OrthantGrid).
+  using ListScan = void (*)(const KdTree& tree, const std::uint32_t* entry, const double* block_gap,
+                            std::uint32_t blocks, unsigned need, OrthantBest& best);
 
   std::uint32_t Build(std::vector<std::uint32_t>& order, std::uint32_t begin, std::uint32_t end);
   void BuildSeeds();
   void Seed(OrthantBest& best) const;
   template <int D>
   void VisitOrthants(std::uint32_t node, OrthantBest& best) const;
+  template <int D>
+  void SearchOrthants(OrthantBest& best, OrthantWinners& winners) const;
   template <int D>
   void VisitNearest(std::uint32_t node, const double* p, NearestBest& best) const;
   template <int D>
@@ -89,6 +116,7 @@ class KdTree {
   int dims_;
   Kernel kernel_;
   LeafScan scan_;
+  ListScan list_scan_;
   std::uint32_t leaf_size_;
   std::vector<Node> nodes_;
   // Scaled coordinates in tree order, one array per axis, padded with kPadding copies of the
@@ -103,6 +131,7 @@ class KdTree {
   std::array<double, 4> seed_lo_{};
   std::array<double, 4> seed_inv_{};  // cells per unit of each axis
   std::vector<std::uint32_t> seeds_;
+  OrthantGrid grid_;
 };
 
 }  // namespace brdf::interp

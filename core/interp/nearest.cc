@@ -13,7 +13,9 @@ namespace {
 class NearestInterpolator final : public Interpolator {
  public:
   NearestInterpolator(std::shared_ptr<const SampleSet> samples, PointCloud cloud)
-      : samples_(std::move(samples)), cloud_(std::move(cloud)), tree_(cloud_) {}
+      : samples_(std::move(samples)),
+        cloud_(std::move(cloud)),
+        tree_(cloud_, KdTree::Kernel::kBest, KdTree::Search::kTree) {}
 
   Method method() const override { return Method::kNearest; }
   int dims() const override { return cloud_.dims; }
