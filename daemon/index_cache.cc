@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/geometry.h"
+#include "core/interp/octant.h"
 #include "core/plan/plan_json.h"
 #include "core/spectrum.h"
 
@@ -326,11 +327,26 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
         appended = true;
       }
     }
-    if (appended) entry->indexes.clear();  // built over fewer readings: stale
+    if (appended) {
+      // Indexes over fewer readings are stale. Octant ones stay, to be extended on their next
+      // query; the others are rebuilt then, so they need not be kept.
+      entry->indexes.remove_if([&](const auto& cached) {
+        const IndexSnapshot& index = *cached.second;
+        return index.method != interp::Method::kOctant &&
+               index.samples != entry->sets[static_cast<int>(index.quantity)];
+      });
+    }
   }
 
   const IndexKey key = MakeKey(quantity, method, options);
+  const int qi = static_cast<int>(quantity);
+  std::shared_ptr<const IndexSnapshot> stale;  // this key's index over fewer readings, if any
   for (auto it = entry->indexes.begin(); it != entry->indexes.end(); ++it) {
+    if (it->first == key && it->second->samples != entry->sets[qi]) {
+      stale = std::move(it->second);
+      entry->indexes.erase(it);
+      break;
+    }
     if (it->first == key) {
       std::shared_ptr<const IndexSnapshot> hit = it->second;
       entry->indexes.splice(entry->indexes.begin(), entry->indexes, it);
@@ -368,7 +384,6 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
                            std::to_string(session) + " is anisotropic");
   }
 
-  const int qi = static_cast<int>(quantity);
   const std::shared_ptr<const interp::SampleSet>& samples = entry->sets[qi];
   if (!samples || samples->size() == 0) {
     std::string message = "session " + std::to_string(session) + " has no sample reading with a " +
@@ -382,8 +397,26 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
     return FailedPrecondition(message);
   }
 
+  // Extend the stale octant index when there is one (it was made with this key's options); a
+  // fresh build otherwise, or if extending fails (it should not: the set only grew by Add).
+  std::unique_ptr<interp::Interpolator> extended;
+  bool extend_folded = false;
+  if (stale != nullptr) {
+    const auto* base = dynamic_cast<const interp::OctantInterpolator*>(stale->interpolator.get());
+    if (base != nullptr) {
+      Result<std::unique_ptr<interp::OctantInterpolator>> grown =
+          interp::OctantInterpolator::Extend(*base, samples);
+      if (grown.ok()) {
+        extend_folded = (*grown)->tail_size() == 0;
+        extended = std::move(grown).value();
+      }
+    }
+    stale.reset();
+  }
+  const bool was_extended = extended != nullptr && !extend_folded;
   Result<std::unique_ptr<interp::Interpolator>> made =
-      interp::MakeInterpolator(method, samples, options);
+      extended != nullptr ? Result<std::unique_ptr<interp::Interpolator>>(std::move(extended))
+                          : interp::MakeInterpolator(method, samples, options);
   if (!made.ok()) {
     return FailedPrecondition("session " + std::to_string(session) + ": cannot build the " +
                               interp::MethodName(method) + " index over its " +
@@ -419,7 +452,7 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
 
   {
     std::lock_guard lock(mu_);
-    ++stats_.builds;
+    ++(was_extended ? stats_.extends : stats_.builds);
     CountLoad(appended, first_load, read_now);
     Evict(session);
   }

@@ -18,7 +18,13 @@
 // set of readings even while new readings land. OnReading (registered as a SessionManager
 // reading listener; quick, never touches the store) only marks the session's samples stale; the
 // next Get reads the new readings from the store (only those after the last one it has: an
-// append, not a re-read), publishes new sample sets and rebuilds the requested index.
+// append, not a re-read) and publishes new sample sets. A new set is a copy of the old one that
+// shares its storage (interp::SampleSet's chunks) plus the new readings, so an append costs the
+// new readings, not the session. The octant index (the paper's method, the default) is then
+// extended, not rebuilt: interp::OctantInterpolator::Extend shares the old snapshot's search tree
+// and scans the new readings beside it (answers identical to a fresh build; it folds them into a
+// fresh tree now and then, which counts as a build). Delaunay and nearest-neighbour indexes are
+// rebuilt over the grown set on their next query. Older snapshots are never changed.
 //
 // Memory: the cache keeps at most Options::max_sessions sessions and about Options::max_bytes of
 // samples and indexes, evicting the least recently used session; each session keeps at most
@@ -82,7 +88,9 @@ class IndexCache {
     std::uint64_t appends = 0;        // of those, appends to samples already held (not first loads)
     std::uint64_t readings_read = 0;  // readings fetched from the store, all sessions: an append
                                       // reads only the readings after the last one it has
-    std::uint64_t builds = 0;         // indexes built
+    std::uint64_t builds = 0;         // indexes built from scratch (all their readings)
+    std::uint64_t extends = 0;        // octant indexes extended by the readings that landed
+                                      // (the search tree shared with the previous snapshot)
     std::uint64_t hits = 0;           // queries answered from a cached index
     std::uint64_t evictions = 0;      // sessions evicted
   };

@@ -74,9 +74,35 @@ Status SampleSet::Add(std::int64_t id, std::span<const double> coords,
   if (size() >= (std::size_t{1} << 29)) {
     return InvalidArgument(where + ": too many samples (the limit is 2^29)");
   }
-  ids_.push_back(id);
-  coords_.insert(coords_.end(), coords.begin(), coords.end());
-  values_.insert(values_.end(), spectrum.begin(), spectrum.end());
+  auto new_chunk = [this] {
+    auto chunk = std::make_shared<Chunk>();
+    chunk->ids.reserve(kChunkSamples);
+    chunk->coords.reserve(kChunkSamples * static_cast<std::size_t>(dims_));
+    chunk->values.reserve(kChunkSamples * static_cast<std::size_t>(bands_));
+    return chunk;
+  };
+  if (size_ % kChunkSamples == 0) {
+    chunks_.push_back(new_chunk());
+    coords_.push_back(nullptr);
+    values_.push_back(nullptr);
+  } else if (chunks_.back().use_count() > 1) {
+    // Another set (a copy, or the set this one was copied from) reads this chunk: write into a
+    // copy of it. Only this set can raise the count of a chunk it alone holds, so a count of 1
+    // means nobody else can see the write.
+    std::shared_ptr<Chunk> chunk = new_chunk();
+    const Chunk& shared = *chunks_.back();
+    chunk->ids.assign(shared.ids.begin(), shared.ids.end());
+    chunk->coords.assign(shared.coords.begin(), shared.coords.end());
+    chunk->values.assign(shared.values.begin(), shared.values.end());
+    chunks_.back() = std::move(chunk);
+  }
+  Chunk& chunk = *chunks_.back();
+  chunk.ids.push_back(id);
+  chunk.coords.insert(chunk.coords.end(), coords.begin(), coords.end());
+  chunk.values.insert(chunk.values.end(), spectrum.begin(), spectrum.end());
+  coords_.back() = chunk.coords.data();
+  values_.back() = chunk.values.data();
+  ++size_;
   return Status::Ok();
 }
 

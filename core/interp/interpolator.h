@@ -44,8 +44,16 @@ struct Options {
 
 // Scattered samples: N points of `dims` coordinates, each with a spectrum of `bands` values and
 // an id (a reading id, or a CSV row index). Order matters: ties go to the earlier sample.
+//
+// Storage comes in chunks of kChunkSamples samples, shared between copies: copying a set copies
+// one pointer per chunk, not the spectra, and Add on a copy writes into a chunk of its own (at
+// most the last, partly filled one is copied first), so the original never changes. That makes
+// "the readings so far plus one more" cheap while readers keep the set they had (the daemon's
+// snapshots). A sample's coordinates and spectrum are contiguous; two samples' need not be.
 class SampleSet {
  public:
+  static constexpr std::size_t kChunkSamples = 128;
+
   SampleSet(int dims, int bands) : dims_(dims), bands_(bands) {}
 
   // Appends a sample; coords.size() == dims, spectrum.size() == bands.
@@ -53,22 +61,41 @@ class SampleSet {
 
   int dims() const { return dims_; }
   int bands() const { return bands_; }
-  std::size_t size() const { return ids_.size(); }
-  std::int64_t id(std::size_t i) const { return ids_[i]; }
+  std::size_t size() const { return size_; }
+  std::int64_t id(std::size_t i) const {
+    return chunks_[i / kChunkSamples]->ids[i % kChunkSamples];
+  }
   std::span<const double> coords(std::size_t i) const {
-    return {coords_.data() + i * static_cast<std::size_t>(dims_), static_cast<std::size_t>(dims_)};
+    return {coords_[i / kChunkSamples] + (i % kChunkSamples) * static_cast<std::size_t>(dims_),
+            static_cast<std::size_t>(dims_)};
   }
   std::span<const double> spectrum(std::size_t i) const {
-    return {values_.data() + i * static_cast<std::size_t>(bands_),
+    return {values_[i / kChunkSamples] + (i % kChunkSamples) * static_cast<std::size_t>(bands_),
             static_cast<std::size_t>(bands_)};
+  }
+  // True when sample i of both sets is stored once, in memory both share (for tests and for
+  // callers that check that a set grew from another by Add).
+  bool SharesStorageWith(const SampleSet& other, std::size_t i) const {
+    return i < size_ && i < other.size_ &&
+           chunks_[i / kChunkSamples] == other.chunks_[i / kChunkSamples];
   }
 
  private:
+  // Up to kChunkSamples samples; its vectors are reserved in full when made, so they never move.
+  struct Chunk {
+    std::vector<std::int64_t> ids;
+    std::vector<double> coords;  // ids.size() * dims
+    std::vector<double> values;  // ids.size() * bands
+  };
+
   int dims_;
   int bands_;
-  std::vector<std::int64_t> ids_;
-  std::vector<double> coords_;  // size() * dims
-  std::vector<double> values_;  // size() * bands
+  std::size_t size_ = 0;
+  // Shared with copies; a chunk is written only while this set is its one owner.
+  std::vector<std::shared_ptr<Chunk>> chunks_;
+  // chunks_[c]->coords.data() and ->values.data(): one load less on the way to a spectrum.
+  std::vector<const double*> coords_;
+  std::vector<const double*> values_;
 };
 
 // One blended vertex of an answer.

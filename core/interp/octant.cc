@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "core/interp/barycentric.h"
 #include "core/interp/kd_tree.h"
@@ -11,9 +13,94 @@
 
 namespace brdf::interp {
 
+namespace {
+
+// The search tree over the first `cloud.size() / images` samples and the cloud it points into.
+// Immutable once built; shared by every interpolator extended from the one that built it.
+struct SearchIndex {
+  explicit SearchIndex(PointCloud c) : cloud(std::move(c)), tree(cloud) {}
+  SearchIndex(const SearchIndex&) = delete;
+  SearchIndex& operator=(const SearchIndex&) = delete;
+
+  PointCloud cloud;  // before `tree`, which points into it
+  KdTree tree;
+};
+
+}  // namespace
+
+// Ranks: every rank below is a rank in the cloud BuildPointCloud would make of all `total`
+// samples ("grown rank": image b of sample s has rank b · total + s). The tree's ranks are ranks
+// in its own cloud of `indexed` samples (b · indexed + s) and are translated on the way out.
 struct OctantInterpolator::Impl {
-  Impl(std::shared_ptr<const SampleSet> s, PointCloud c)
-      : samples(std::move(s)), cloud(std::move(c)), tree(cloud) {}
+  Impl(std::shared_ptr<const SampleSet> s, Options o, std::shared_ptr<const SearchIndex> i,
+       PointCloud t)
+      : samples(std::move(s)),
+        options(std::move(o)),
+        index(std::move(i)),
+        indexed(static_cast<std::uint32_t>(index->cloud.size() / ImageCount(options))),
+        total(static_cast<std::uint32_t>(samples->size())),
+        tail(std::move(t)) {
+    const std::size_t m = total - indexed;
+    tail_rank.resize(tail.size());
+    for (std::size_t k = 0; k < tail.size(); ++k) {
+      tail_rank[k] = static_cast<std::uint32_t>((k / m) * total + indexed + k % m);
+    }
+  }
+
+  // The SampleSet index of a grown rank.
+  std::uint32_t SampleOf(std::uint32_t rank) const {
+    return tail.size() == 0 ? index->cloud.sample[rank] : rank % total;
+  }
+  // The unscaled coordinates of a grown rank.
+  std::span<const double> PointOf(std::uint32_t rank) const {
+    if (tail.size() == 0) return index->cloud.point(rank);
+    const std::uint32_t image = rank / total;
+    const std::uint32_t s = rank % total;
+    if (s < indexed) return index->cloud.point(std::size_t{image} * indexed + s);
+    return tail.point(std::size_t{image} * (total - indexed) + (s - indexed));
+  }
+
+  // Step 2: the tree's winners, then the tail's points against them (exact distance, then rank).
+  template <int D>
+  void ScanTail(const double* p, OrthantWinners& winners) const {
+    constexpr int kOrthants = 1 << D;
+    std::array<double, kOrthants> best;
+    for (int o = 0; o < kOrthants; ++o) {
+      const auto u = static_cast<std::size_t>(o);
+      std::uint32_t& rank = winners.rank[u];
+      if (rank == kNoPoint) {
+        best[u] = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      best[u] = SquaredDistance<D>(winners.scaled[u], p);
+      std::uint32_t image = 0;
+      while (rank >= indexed) {
+        rank -= indexed;
+        image += total;
+      }
+      rank += image;
+    }
+    const double* x = tail.scaled.data();
+    for (std::size_t k = 0; k < tail.size(); ++k, x += D) {
+      const auto o = static_cast<std::size_t>(OrthantOf<D>(x, p));
+      const double dist = SquaredDistance<D>(x, p);
+      if (dist < best[o] || (dist == best[o] && tail_rank[k] < winners.rank[o])) {
+        best[o] = dist;
+        winners.rank[o] = tail_rank[k];
+        winners.scaled[o] = x;
+      }
+    }
+  }
+
+  void Search(const double* p, OrthantWinners& winners) const {
+    index->tree.NearestPerOrthant(p, winners);
+    if (tail.size() == 0) return;
+    if (tail.dims == 3) {
+      ScanTail<3>(p, winners);
+    } else {
+      ScanTail<4>(p, winners);
+    }
+  }
 
   // Steps 1–4 up to the blend: the query in scaled space, the winners, the simplex and weights.
   // False (and `blend` untouched) for an invalid query. `prefetch_all`: start fetching every
@@ -21,39 +108,58 @@ struct OctantInterpolator::Impl {
   // the chosen vertices' spectra are fetched, once the simplex is known (for a blend that comes
   // one query later, SpectraAt).
   bool Blend(std::span<const double> query, OctantBlend& blend, bool prefetch_all = true) const {
-    const int d = cloud.dims;
+    const int d = index->cloud.dims;
     if (!ValidQuery(query, d)) return false;
     std::array<double, kMaxDims> p{};
-    cloud.ScaleQuery(query, p);
+    index->cloud.ScaleQuery(query, p);
     OrthantWinners winners;
-    tree.NearestPerOrthant(p.data(), winners);
+    Search(p.data(), winners);
     // Start fetching the winners' spectra now: the blend uses 4 or 5 of them, and the fetch (from
     // main memory, for large sets) overlaps with the choice of the simplex.
     const int orthants = 1 << d;
     if (prefetch_all) {
       for (int o = 0; o < orthants; ++o) {
         const std::uint32_t rank = winners.rank[static_cast<std::size_t>(o)];
-        if (rank != kNoPoint) PrefetchSpectrum(samples->spectrum(cloud.sample[rank]));
+        if (rank != kNoPoint) PrefetchSpectrum(samples->spectrum(SampleOf(rank)));
       }
     }
     blend = FindOctantBlendFast(winners, std::span(p.data(), static_cast<std::size_t>(d)), d);
     if (!prefetch_all && blend.status == InterpStatus::kOk) {
       for (int k = 0; k <= d; ++k) {
-        PrefetchSpectrum(samples->spectrum(cloud.sample[blend.rank[static_cast<std::size_t>(k)]]));
+        PrefetchSpectrum(samples->spectrum(SampleOf(blend.rank[static_cast<std::size_t>(k)])));
       }
     }
     return true;
   }
 
-  // BlendOctantSpectrum for a blend whose spectra were prefetched already.
-  void BlendFetched(const OctantBlend& blend, std::span<double> out) const {
-    const auto vertex_count = static_cast<std::size_t>(cloud.dims + 1);
+  // BlendOctantSpectrum's numbers (BlendSpectra over the vertices in order) for a kOk blend whose
+  // ranks are grown ranks and whose spectra Blend prefetched already.
+  void BlendInto(const OctantBlend& blend, std::span<double> out) const {
+    const auto vertex_count = static_cast<std::size_t>(index->cloud.dims + 1);
     std::array<const double*, kMaxDims + 1> spectra{};
     for (std::size_t k = 0; k < vertex_count; ++k) {
-      spectra[k] = samples->spectrum(cloud.sample[blend.rank[k]]).data();
+      spectra[k] = samples->spectrum(SampleOf(blend.rank[k])).data();
     }
     BlendSpectra(std::span(blend.weight.data(), vertex_count),
                  std::span(spectra.data(), vertex_count), out);
+  }
+
+  // The complete answer of a blend (OctantInterpolation). With a tail, the grown cloud does not
+  // exist as one array: the answer is assembled over a cloud of just the blend's vertices.
+  Interpolation Answer(const OctantBlend& blend) const {
+    if (tail.size() == 0) return OctantInterpolation(index->cloud, *samples, blend);
+    PointCloud vertices;
+    vertices.dims = index->cloud.dims;
+    OctantBlend local = blend;
+    if (blend.status == InterpStatus::kOk) {
+      for (std::size_t k = 0; k <= static_cast<std::size_t>(vertices.dims); ++k) {
+        const std::span<const double> x = PointOf(blend.rank[k]);
+        vertices.coords.insert(vertices.coords.end(), x.begin(), x.end());
+        vertices.sample.push_back(SampleOf(blend.rank[k]));
+        local.rank[k] = static_cast<std::uint32_t>(k);
+      }
+    }
+    return OctantInterpolation(vertices, *samples, local);
   }
 
   // The part of a caller's buffer that receives the spectrum (never more than bands() values).
@@ -61,9 +167,14 @@ struct OctantInterpolator::Impl {
     return spectrum.first(std::min(spectrum.size(), static_cast<std::size_t>(samples->bands())));
   }
 
-  std::shared_ptr<const SampleSet> samples;
-  PointCloud cloud;  // before `tree`, which points into it
-  KdTree tree;
+  std::shared_ptr<const SampleSet> samples;  // all `total` samples
+  Options options;
+  std::shared_ptr<const SearchIndex> index;  // samples [0, indexed)
+  std::uint32_t indexed;
+  std::uint32_t total;
+  // The images of samples [indexed, total) (BuildPointCloudTail), and each one's grown rank.
+  PointCloud tail;
+  std::vector<std::uint32_t> tail_rank;
 };
 
 OctantInterpolator::OctantInterpolator(std::unique_ptr<const Impl> impl) : impl_(std::move(impl)) {}
@@ -74,16 +185,73 @@ Result<std::unique_ptr<OctantInterpolator>> OctantInterpolator::Create(
   if (samples == nullptr) return InvalidArgument("octant interpolator: no sample set (null)");
   Result<PointCloud> cloud = BuildPointCloud(*samples, options);
   if (!cloud.ok()) return cloud.status().WithContext("octant interpolator");
-  auto impl = std::make_unique<const Impl>(std::move(samples), std::move(cloud).value());
+  auto index = std::make_shared<const SearchIndex>(std::move(cloud).value());
+  PointCloud tail;
+  tail.dims = samples->dims();
+  auto impl =
+      std::make_unique<const Impl>(std::move(samples), options, std::move(index), std::move(tail));
   return std::unique_ptr<OctantInterpolator>(new OctantInterpolator(std::move(impl)));
 }
 
+Result<std::unique_ptr<OctantInterpolator>> OctantInterpolator::Extend(
+    const OctantInterpolator& base, std::shared_ptr<const SampleSet> grown, std::size_t max_tail) {
+  const Impl& b = *base.impl_;
+  if (grown == nullptr) return InvalidArgument("octant interpolator: no grown sample set (null)");
+  const std::string where = "octant interpolator: extending an index over " +
+                            std::to_string(b.total) + " samples to " +
+                            std::to_string(grown->size()) + ": ";
+  if (grown->dims() != b.samples->dims() || grown->bands() != b.samples->bands()) {
+    return InvalidArgument(where + "the grown set has " + std::to_string(grown->dims()) +
+                           " coordinates and " + std::to_string(grown->bands()) +
+                           " bands, the index " + std::to_string(b.samples->dims()) + " and " +
+                           std::to_string(b.samples->bands()) + "; build a new index instead");
+  }
+  if (grown->size() < b.total) {
+    return InvalidArgument(where + "the grown set has fewer samples; build a new index instead");
+  }
+  // A cheap check that `grown` continues base's set (a full one would cost what Extend saves).
+  const std::size_t last = b.total - 1;
+  if (!grown->SharesStorageWith(*b.samples, last)) {
+    const auto x = grown->coords(last);
+    const auto y = b.samples->coords(last);
+    if (grown->id(last) != b.samples->id(last) || !std::equal(x.begin(), x.end(), y.begin())) {
+      return InvalidArgument(where + "sample " + std::to_string(last) +
+                             " differs; the grown set must hold the index's samples first, in "
+                             "the same order: build a new index instead");
+    }
+  }
+  const std::size_t bound = max_tail > 0 ? max_tail : DefaultMaxTail(b.indexed);
+  if (grown->size() - b.indexed > bound) return Create(std::move(grown), b.options);
+
+  Result<PointCloud> tail = BuildPointCloudTail(*grown, b.options, b.indexed);
+  if (!tail.ok()) return tail.status().WithContext("octant interpolator");
+  auto impl =
+      std::make_unique<const Impl>(std::move(grown), b.options, b.index, std::move(tail).value());
+  return std::unique_ptr<OctantInterpolator>(new OctantInterpolator(std::move(impl)));
+}
+
+std::size_t OctantInterpolator::DefaultMaxTail(std::size_t indexed) {
+  return std::max<std::size_t>(32, indexed / 256);
+}
+
 int OctantInterpolator::dims() const {
-  return impl_->cloud.dims;
+  return impl_->index->cloud.dims;
 }
 
 int OctantInterpolator::bands() const {
   return impl_->samples->bands();
+}
+
+const Options& OctantInterpolator::options() const {
+  return impl_->options;
+}
+
+std::size_t OctantInterpolator::indexed_size() const {
+  return impl_->indexed;
+}
+
+std::size_t OctantInterpolator::tail_size() const {
+  return impl_->total - impl_->indexed;
 }
 
 Interpolation OctantInterpolator::Evaluate(std::span<const double> query) const {
@@ -91,7 +259,7 @@ Interpolation OctantInterpolator::Evaluate(std::span<const double> query) const 
   if (!impl_->Blend(query, blend)) {
     return InvalidQueryAnswer(Method::kOctant, InterpStatus::kEmptyOctant, query, dims());
   }
-  return OctantInterpolation(impl_->cloud, *impl_->samples, blend);
+  return impl_->Answer(blend);
 }
 
 InterpStatus OctantInterpolator::SpectrumAt(std::span<const double> query,
@@ -99,7 +267,7 @@ InterpStatus OctantInterpolator::SpectrumAt(std::span<const double> query,
   OctantBlend blend;
   if (!impl_->Blend(query, blend)) return InterpStatus::kEmptyOctant;
   if (blend.status == InterpStatus::kOk) {
-    BlendOctantSpectrum(impl_->cloud, *impl_->samples, blend, impl_->Bands(spectrum));
+    impl_->BlendInto(blend, impl_->Bands(spectrum));
   }
   return blend.status;
 }
@@ -125,7 +293,7 @@ void OctantInterpolator::SpectraAt(std::span<const double> queries,
     if (i > 0) {
       const std::span<double> row = spectra.subspan((i - 1) * bands, bands);
       if (previous.status == InterpStatus::kOk) {
-        impl.BlendFetched(previous, impl.Bands(row));
+        impl.BlendInto(previous, impl.Bands(row));
       } else {
         std::fill(row.begin(), row.end(), std::numeric_limits<double>::quiet_NaN());
       }
@@ -145,11 +313,11 @@ OctantResult OctantInterpolator::EvaluateInto(std::span<const double> query,
   out.status = blend.status;
   out.empty_orthants = blend.empty_orthants;
   if (blend.status != InterpStatus::kOk) return out;
-  BlendOctantSpectrum(impl_->cloud, *impl_->samples, blend, impl_->Bands(spectrum));
+  impl_->BlendInto(blend, impl_->Bands(spectrum));
   out.simplex = blend.simplex;
   out.vertex_count = dims() + 1;
   for (std::size_t k = 0; k < static_cast<std::size_t>(out.vertex_count); ++k) {
-    out.index[k] = impl_->cloud.sample[blend.rank[k]];
+    out.index[k] = impl_->SampleOf(blend.rank[k]);
     out.weight[k] = blend.weight[k];
   }
   return out;

@@ -44,10 +44,26 @@ Status ValidateOptions(const Options& options, int dims) {
   return Status::Ok();
 }
 
+std::size_t ImageCount(const Options& options) {
+  return 1 + (options.mirror_phi ? 1 : 0) + (options.reciprocity ? 1 : 0) +
+         (options.mirror_phi && options.reciprocity ? 1 : 0);
+}
+
 Result<PointCloud> BuildPointCloud(const SampleSet& samples, const Options& options) {
   BRDF_RETURN_IF_ERROR(ValidateOptions(options, samples.dims()));
   if (samples.size() == 0) {
     return InvalidArgument("the sample set is empty: interpolation needs at least one sample");
+  }
+  return BuildPointCloudTail(samples, options, 0);
+}
+
+Result<PointCloud> BuildPointCloudTail(const SampleSet& samples, const Options& options,
+                                       std::size_t first) {
+  BRDF_RETURN_IF_ERROR(ValidateOptions(options, samples.dims()));
+  if (first > samples.size()) {
+    return InvalidArgument("point cloud: samples from " + std::to_string(first) +
+                           " asked of a set of " + std::to_string(samples.size()) +
+                           "; the first sample must be within the set");
   }
   const int dims = samples.dims();
   const auto d = static_cast<std::size_t>(dims);
@@ -55,15 +71,14 @@ Result<PointCloud> BuildPointCloud(const SampleSet& samples, const Options& opti
   cloud.dims = dims;
   cloud.scale = options.axis_scale.empty() ? std::vector<double>(d, 1.0) : options.axis_scale;
 
-  const std::size_t copies = 1 + (options.mirror_phi ? 1 : 0) + (options.reciprocity ? 1 : 0) +
-                             (options.mirror_phi && options.reciprocity ? 1 : 0);
+  const std::size_t copies = ImageCount(options);
   const std::size_t n = samples.size();
-  cloud.coords.reserve(n * copies * d);
-  cloud.sample.reserve(n * copies);
+  cloud.coords.reserve((n - first) * copies * d);
+  cloud.sample.reserve((n - first) * copies);
 
   // One block per image; swap: θi ↔ θo, mirror: φ → −φ (0 − φ, so that φ = 0 stays +0).
   auto add_block = [&](bool swap, bool mirror) {
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = first; i < n; ++i) {
       const auto c = samples.coords(i);
       if (dims == 3) {
         cloud.coords.push_back(swap ? c[1] : c[0]);

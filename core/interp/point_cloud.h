@@ -86,4 +86,16 @@ inline double SquaredDistance(const double* a, const double* b, int dims) {
 // Errors: a SampleSet that is empty or not 3D/4D, and everything ValidateOptions rejects.
 Result<PointCloud> BuildPointCloud(const SampleSet& samples, const Options& options);
 
+// How many images of each sample the cloud holds (1 + one per symmetry copy): 1, 2 or 4.
+std::size_t ImageCount(const Options& options);
+
+// The part of BuildPointCloud(samples, options) that samples [first, samples.size()) contribute,
+// in the same layout (one block per image, each in sample order) with the same values bit for
+// bit; `sample` holds SampleSet indices (first, first + 1, …). Point k of the result is sample
+// first + k % m of image k / m (m = samples.size() − first), whose rank in the full cloud is
+// (k / m) · samples.size() + first + k % m. May be empty (first == samples.size()).
+// Errors: as BuildPointCloud, except that an empty range is not one; first > size() is.
+Result<PointCloud> BuildPointCloudTail(const SampleSet& samples, const Options& options,
+                                       std::size_t first);
+
 }  // namespace brdf::interp

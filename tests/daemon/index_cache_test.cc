@@ -5,9 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <bit>
 #include <cmath>
 #include <numbers>
+#include <random>
 
+#include "core/interp/octant.h"
 #include "storage/session_store.h"
 #include "tests/support/test_env.h"
 
@@ -175,6 +179,78 @@ TEST_F(IndexCacheTest, ReadersKeepTheirSnapshotWhileNewReadingsBuildTheNext) {
   ASSERT_TRUE(other.ok());
   EXPECT_NE(other->get(), next->get());
   EXPECT_EQ((*other)->samples.get(), (*next)->samples.get());  // samples shared
+}
+
+TEST_F(IndexCacheTest, ReadingsLandingOneByOneExtendTheOctantIndexWithFreshBuildAnswers) {
+  constexpr int kLanding = 30;
+  SessionFixture s(*store_, 8 + kLanding);
+  FillGrid(s);
+  IndexCache cache(store_);
+  interp::Options options;
+  options.mirror_phi = true;
+  options.reciprocity = true;
+  auto first = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kOctant, options);
+  ASSERT_TRUE(first.ok()) << first.status().ToString();
+  EXPECT_EQ(cache.stats().builds, 1u);
+  EXPECT_EQ(cache.stats().extends, 0u);
+
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> theta(15, 45), phi(50, 130), r(0.1, 0.9);
+  std::vector<std::array<double, 3>> queries;
+  for (int i = 0; i < 40; ++i) queries.push_back({theta(rng), theta(rng), phi(rng)});
+  std::shared_ptr<const IndexSnapshot> previous = *first;
+  for (int i = 0; i < kLanding; ++i) {
+    // Some readings repeat a pose already taken (exact duplicates: ties go to the earlier one).
+    const Directions d =
+        i % 5 == 4 ? Directions{20, 0, 40, 60} : Directions{theta(rng), 0, theta(rng), phi(rng)};
+    const storage::ReadingRecord added = s.AddSample(d, r(rng));
+    cache.OnReading(s.id(), added);
+    auto next = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kOctant, options);
+    ASSERT_TRUE(next.ok()) << next.status().ToString();
+    const IndexSnapshot& snap = **next;
+    ASSERT_EQ(snap.samples->size(), 9u + static_cast<std::size_t>(i));
+    EXPECT_EQ(snap.through_reading_id, added.id);
+    // An extend, not a build.
+    EXPECT_EQ(cache.stats().builds, 1u) << "reading " << i;
+    EXPECT_EQ(cache.stats().extends, static_cast<std::uint64_t>(i + 1));
+    // The previous snapshot is unchanged.
+    EXPECT_EQ(previous->samples->size(), 8u + static_cast<std::size_t>(i));
+
+    auto fresh = interp::OctantInterpolator::Create(snap.samples, options);
+    ASSERT_TRUE(fresh.ok()) << fresh.status().ToString();
+    for (const auto& q : queries) {
+      const interp::Interpolation a = snap.interpolator->Evaluate(q);
+      const interp::Interpolation b = (*fresh)->Evaluate(q);
+      ASSERT_EQ(a.status, b.status);
+      ASSERT_EQ(a.detail, b.detail);
+      ASSERT_EQ(a.vertices.size(), b.vertices.size());
+      for (std::size_t k = 0; k < a.vertices.size(); ++k) {
+        EXPECT_EQ(a.vertices[k].id, b.vertices[k].id);
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(a.vertices[k].weight),
+                  std::bit_cast<std::uint64_t>(b.vertices[k].weight));
+      }
+      ASSERT_EQ(a.spectrum.size(), b.spectrum.size());
+      for (std::size_t k = 0; k < a.spectrum.size(); ++k) {
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(a.spectrum[k]),
+                  std::bit_cast<std::uint64_t>(b.spectrum[k]));
+      }
+    }
+    previous = *next;
+  }
+  // The same readings read by a cache that never saw them land: the same answers.
+  IndexCache cold(store_);
+  auto rebuilt = cold.Get(s.id(), Quantity::kBrdf, interp::Method::kOctant, options);
+  ASSERT_TRUE(rebuilt.ok());
+  EXPECT_EQ(cold.stats().builds, 1u);
+  for (const auto& q : queries) {
+    const interp::Interpolation a = previous->interpolator->Evaluate(q);
+    const interp::Interpolation b = (*rebuilt)->interpolator->Evaluate(q);
+    ASSERT_EQ(a.status, b.status);
+    ASSERT_EQ(a.spectrum, b.spectrum);
+  }
+  // Other methods are rebuilt over the grown set.
+  ASSERT_TRUE(cache.Get(s.id(), Quantity::kBrdf, interp::Method::kNearest, {}).ok());
+  EXPECT_EQ(cache.stats().builds, 2u);
 }
 
 TEST_F(IndexCacheTest, KeepsAtMostMaxSessionsEvictingTheLeastRecentlyUsed) {
