@@ -44,8 +44,10 @@ esac
 logs="$build/sanitizer-logs"
 echo "sanitize: configuring $build (GCC, -fsanitize=$sanitize)"
 mkdir -p "$build"
+# -g1 (line tables, no local variables) is all the reports' file:line stacks need, and builds about
+# a fifth faster than -g on these gRPC- and gtest-heavy files.
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DBRDF_SANITIZE="$sanitize" -DBRDF_BUILD_BENCH=OFF -DBRDF_WERROR=OFF >"$build/configure.log" 2>&1 ||
   { cat "$build/configure.log" >&2; echo "sanitize: configure failed" >&2; exit 2; }
 
