@@ -284,6 +284,11 @@ struct LeafKernels {
         0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data() + 8)));
     const auto need_lo = static_cast<__mmask8>(need & 0xFFu);
     const auto need_hi = static_cast<__mmask8>(need >> 8);
+    // In locals: the stores into `best` below could alias the tree's members for the compiler,
+    // which would reload them for every block.
+    const double* axis[D];
+    for (int j = 0; j < D; ++j) axis[j] = tree.axis_[static_cast<std::size_t>(j)].data();
+    const std::uint32_t* rank = tree.rank_.data();
     double worst = kInf;
     for (std::uint32_t b = 0; b < blocks; ++b) {
       if (block_gap[b] > worst) break;
@@ -293,8 +298,7 @@ struct LeafKernels {
       __m512i code = _mm512_setzero_si512();
 #pragma GCC unroll 4
       for (int j = 0; j < D; ++j) {
-        const __m512d v =
-            _mm512_i32gather_pd(index, tree.axis_[static_cast<std::size_t>(j)].data(), 8);
+        const __m512d v = _mm512_i32gather_pd(index, axis[j], 8);
         const __m512d diff = _mm512_sub_pd(v, q[j]);
         __m512d sq = _mm512_mul_pd(diff, diff);
         asm("" : "+v"(sq));  // no fused multiply-add: round the square first
@@ -323,7 +327,7 @@ struct LeafKernels {
         const int lane = std::countr_zero(candidates);
         const std::uint32_t pos = at[lane];
         const auto o = static_cast<unsigned>(orthant[lane]);
-        const bool better = best.Offer(o, dist[lane], tree.rank_[pos], pos);
+        const bool better = best.Offer(o, dist[lane], rank[pos], pos);
         const unsigned mask = static_cast<unsigned>(better) << o;
         const __m512d d = _mm512_set1_pd(dist[lane]);
         const __m512i p = _mm512_set1_epi64(pos);

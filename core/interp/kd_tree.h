@@ -44,8 +44,9 @@ class KdTree {
 
   // How NearestPerOrthant searches: the tree alone, or the grid's list first (see above). On the
   // rig grid the grid makes the search about 2× faster, but tree + grid take about 100× the
-  // tree's build time (about 0.1 s; bench/README.md has the figures), so it is opt-in. Only 3D
-  // clouds of at most OrthantGrid::Options::max_points points get a grid.
+  // tree's build time (about 0.1 s; bench/README.md has the figures), so it is opt-in here;
+  // OctantInterpolator::Create opts in, its Extend's folds do not (octant.h). Only 3D clouds of
+  // at most OrthantGrid::Options::max_points points get a grid.
   enum class Search { kTree, kGridThenTree };
 
   // Indexes the cloud's scaled points (3D or 4D, at least one). Keeps a pointer to `cloud`, which

@@ -18,7 +18,8 @@ namespace {
 // The search tree over the first `cloud.size() / images` samples and the cloud it points into.
 // Immutable once built; shared by every interpolator extended from the one that built it.
 struct SearchIndex {
-  explicit SearchIndex(PointCloud c) : cloud(std::move(c)), tree(cloud) {}
+  SearchIndex(PointCloud c, KdTree::Search search)
+      : cloud(std::move(c)), tree(cloud, KdTree::Kernel::kBest, search) {}
   SearchIndex(const SearchIndex&) = delete;
   SearchIndex& operator=(const SearchIndex&) = delete;
 
@@ -181,11 +182,13 @@ OctantInterpolator::OctantInterpolator(std::unique_ptr<const Impl> impl) : impl_
 OctantInterpolator::~OctantInterpolator() = default;
 
 Result<std::unique_ptr<OctantInterpolator>> OctantInterpolator::Create(
-    std::shared_ptr<const SampleSet> samples, const Options& options) {
+    std::shared_ptr<const SampleSet> samples, const Options& options, Search search) {
   if (samples == nullptr) return InvalidArgument("octant interpolator: no sample set (null)");
   Result<PointCloud> cloud = BuildPointCloud(*samples, options);
   if (!cloud.ok()) return cloud.status().WithContext("octant interpolator");
-  auto index = std::make_shared<const SearchIndex>(std::move(cloud).value());
+  auto index = std::make_shared<const SearchIndex>(
+      std::move(cloud).value(),
+      search == Search::kTree ? KdTree::Search::kTree : KdTree::Search::kGridThenTree);
   PointCloud tail;
   tail.dims = samples->dims();
   auto impl =
@@ -221,7 +224,7 @@ Result<std::unique_ptr<OctantInterpolator>> OctantInterpolator::Extend(
     }
   }
   const std::size_t bound = max_tail > 0 ? max_tail : DefaultMaxTail(b.indexed);
-  if (grown->size() - b.indexed > bound) return Create(std::move(grown), b.options);
+  if (grown->size() - b.indexed > bound) return Create(std::move(grown), b.options, Search::kTree);
 
   Result<PointCloud> tail = BuildPointCloudTail(*grown, b.options, b.indexed);
   if (!tail.ok()) return tail.status().WithContext("octant interpolator");
@@ -236,6 +239,10 @@ std::size_t OctantInterpolator::DefaultMaxTail(std::size_t indexed) {
 
 int OctantInterpolator::dims() const {
   return impl_->index->cloud.dims;
+}
+
+OctantInterpolator::Search OctantInterpolator::search() const {
+  return impl_->index->tree.grid().empty() ? Search::kTree : Search::kGridThenTree;
 }
 
 int OctantInterpolator::bands() const {

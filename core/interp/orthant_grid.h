@@ -46,8 +46,10 @@ class OrthantGrid {
     // Longest list kept; a cell that needs more falls back to the tree.
     std::uint32_t max_list = 192;
     // A cell whose bound reaches farther than this many cell widths keeps no list (the build's
-    // enumeration would cost more than the list could save).
-    double max_reach = 16.0;
+    // enumeration would cost more than the list could save). On the rig grid 16 left 22 % of
+    // the cells without a list, near the data's edges, where the tree is slowest (an empty
+    // orthant cannot be pruned); 64 lists 99.6 % of them for 1.4× the build time.
+    double max_reach = 64.0;
     // Larger clouds get no grid: their lists would not stay in cache (the scan would wait for
     // memory, slower than the tree's walk) and the build would take seconds.
     std::size_t max_points = 16384;

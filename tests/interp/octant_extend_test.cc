@@ -300,6 +300,52 @@ TEST(OctantExtendTest, RejectsSetsThatDoNotContinueTheBase) {
   ExpectSameAnswers(**ok, *OctantInterpolator::Create(rebuilt).value(), Queries(3, 1), "rebuilt");
 }
 
+// Create searches with the grid shortcut where the cloud gets one (3D), the tree alone when asked
+// or in 4D; an extension keeps its base's index and a fold builds the tree alone (it runs while a
+// session records). Every combination answers exactly as the tree alone does.
+TEST(OctantExtendTest, CreateUsesTheGridAndFoldsBuildTheTreeAlone) {
+  const SpectrumFn fn = testing::AnalyticSpectrum(3);
+  const std::vector<Point> points = testing::PaperGrid();
+  auto set = std::make_shared<SampleSet>(3, static_cast<int>(fn(points[0]).size()));
+  for (std::size_t i = 0; i < 1500; ++i)
+    AddPoint(*set, points[i], fn, static_cast<std::int64_t>(i));
+  const auto grid = OctantInterpolator::Create(set).value();
+  const auto tree = OctantInterpolator::Create(set, {}, OctantInterpolator::Search::kTree).value();
+  EXPECT_EQ(grid->search(), OctantInterpolator::Search::kGridThenTree);
+  EXPECT_EQ(tree->search(), OctantInterpolator::Search::kTree);
+  // Random queries over the rig's range (the grid answers most), some outside the data.
+  const std::vector<Point> queries =
+      testing::RandomPoints(400, {-2.0, -2.0, -2.0}, {92.0, 92.0, 182.0}, 77);
+  ExpectSameAnswers(*grid, *tree, queries, "grid vs tree");
+
+  auto grown = std::make_shared<SampleSet>(*set);
+  for (std::size_t i = 1500; i < 1510; ++i)
+    AddPoint(*grown, points[i], fn, static_cast<std::int64_t>(i));
+  const auto extended = OctantInterpolator::Extend(*grid, grown).value();
+  EXPECT_EQ(extended->tail_size(), 10u);
+  EXPECT_EQ(extended->search(), OctantInterpolator::Search::kGridThenTree);
+  const auto grown_tree =
+      OctantInterpolator::Create(grown, {}, OctantInterpolator::Search::kTree).value();
+  ExpectSameAnswers(*extended, *grown_tree, queries, "extended grid vs tree");
+
+  auto folded_set = std::make_shared<SampleSet>(*grown);
+  for (std::size_t i = 1510; i < points.size(); ++i)
+    AddPoint(*folded_set, points[i], fn, static_cast<std::int64_t>(i));
+  const auto folded = OctantInterpolator::Extend(*extended, folded_set).value();
+  EXPECT_EQ(folded->tail_size(), 0u);
+  EXPECT_EQ(folded->search(), OctantInterpolator::Search::kTree);
+  ExpectSameAnswers(*folded, *OctantInterpolator::Create(folded_set).value(), queries,
+                    "folded vs grid");
+
+  // 4D clouds get no grid, whatever Create is asked.
+  const SpectrumFn fn4 = LinearSpectrum(4, 3);
+  auto set4 = std::make_shared<SampleSet>(4, 3);
+  const std::vector<Point> points4 = RandomPoints(300, 4, 5);
+  for (std::size_t i = 0; i < points4.size(); ++i)
+    AddPoint(*set4, points4[i], fn4, static_cast<std::int64_t>(i));
+  EXPECT_EQ(OctantInterpolator::Create(set4).value()->search(), OctantInterpolator::Search::kTree);
+}
+
 TEST(SampleSetChunksTest, CopiesShareStorageAndGrowIndependently) {
   const auto chunk = SampleSet::kChunkSamples;
   const std::size_t n = 2 * chunk + chunk / 2;  // two full chunks and a partial one
