@@ -3,6 +3,12 @@
 // would be), each calling Interpolate back to back with a random direction for `--seconds`.
 // Latency is the client's: from the call to the answer, over loopback.
 //
+// --api chooses the client side of gRPC. "callback" (the default): each client's next call is
+// started from the completion of the previous one, on the gRPC thread that read the answer, so a
+// call costs the load generator no thread wake-up (a wake-up per call on this 2-core machine costs
+// more CPU than the call itself, and that CPU is taken from brdfd). "sync": one blocking thread per
+// client (the simplest analysis program); needed for --rate.
+//
 // --rate R paces each client at R calls/s on a fixed schedule (an analysis program's pace rather
 // than a saturating loop). Latency is then measured from each call's scheduled time, so a call that
 // starts late because the previous one was slow counts its wait (no coordinated omission).
@@ -13,12 +19,14 @@
 // Output: one "key=value" line (bench/daemon/run.sh parses it).
 #include <absl/synchronization/mutex.h>
 #include <grpcpp/grpcpp.h>
+#include <grpcpp/support/client_callback.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <random>
 #include <string>
 #include <thread>
@@ -39,6 +47,7 @@ struct Options {
   double seconds = 10;
   double warmup = 1;
   double rate = 0;  // calls/s per client; 0: back to back
+  std::string api = "callback";
 };
 
 void Authorize(grpc::ClientContext& context, const Options& o) {
@@ -106,6 +115,81 @@ void Client(const Options& o, int seed, Clock::time_point measure_from, Clock::t
   }
 }
 
+// One client on gRPC's callback API: a closed loop of calls, the next started by the completion
+// of the previous one. The request and response messages are reused (gRPC parses into a cleared
+// message); the ClientContext cannot be, so each call has a new one.
+class CallbackClient {
+ public:
+  CallbackClient(const Options& o, int seed, Clock::time_point measure_from,
+                 Clock::time_point until, ClientResult* out)
+      : o_(o),
+        rng_(static_cast<std::uint64_t>(seed)),
+        measure_from_(measure_from),
+        until_(until),
+        out_(out) {
+    grpc::ChannelArguments args;
+    args.SetInt("grpc.use_local_subchannel_pool", 1);  // a connection of its own
+    stub_ = brdf::v1::Interpolation::NewStub(
+        grpc::CreateCustomChannel(o.address, grpc::InsecureChannelCredentials(), args));
+    out_->latencies_us.reserve(200000);
+    request_.set_session_id(o.session);
+  }
+
+  void Start() { Call(); }
+
+  // Blocks until the loop has ended (the window is over and the last call is back).
+  void Wait() {
+    absl::MutexLock lock(&mu_);
+    mu_.Await(absl::Condition(&done_));
+  }
+
+ private:
+  void Call() {
+    brdf::v1::IsoDirection* iso = request_.mutable_direction()->mutable_iso();
+    iso->set_theta_i(theta_(rng_));
+    iso->set_theta_o(theta_(rng_));
+    iso->set_phi(phi_(rng_));
+    context_ = std::make_unique<grpc::ClientContext>();
+    Authorize(*context_, o_);
+    start_ = Clock::now();
+    stub_->async()->Interpolate(context_.get(), &request_, &response_,
+                                [this](grpc::Status status) { Done(status); });
+  }
+
+  void Done(const grpc::Status& status) {
+    const Clock::time_point end = Clock::now();
+    if (start_ >= measure_from_) {  // before: warm-up (connections, the index's first build)
+      if (!status.ok()) {
+        if (out_->errors++ == 0) out_->first_error = status.error_message();
+      } else {
+        out_->latencies_us.push_back(
+            std::chrono::duration<double, std::micro>(end - start_).count());
+      }
+    }
+    if (end < until_) {
+      Call();
+      return;
+    }
+    absl::MutexLock lock(&mu_);
+    done_ = true;
+  }
+
+  const Options& o_;
+  std::unique_ptr<brdf::v1::Interpolation::Stub> stub_;
+  std::mt19937_64 rng_;
+  std::uniform_real_distribution<double> theta_{0, 70};
+  std::uniform_real_distribution<double> phi_{0, 180};
+  const Clock::time_point measure_from_;
+  const Clock::time_point until_;
+  ClientResult* out_;
+  brdf::v1::InterpolateRequest request_;
+  brdf::v1::InterpolateResponse response_;
+  std::unique_ptr<grpc::ClientContext> context_;
+  Clock::time_point start_;
+  absl::Mutex mu_;
+  bool done_ = false;
+};
+
 double Percentile(std::vector<double>& sorted, double p) {
   if (sorted.empty()) return 0;
   const std::size_t i = std::min(sorted.size() - 1, static_cast<std::size_t>(p * sorted.size()));
@@ -126,7 +210,13 @@ int main(int argc, char** argv) {
   app.add_option("--warmup", o.warmup, "seconds before the window")->check(CLI::Range(0.0, 60.0));
   app.add_option("--rate", o.rate, "calls/s per client on a fixed schedule (0: back to back)")
       ->check(CLI::Range(0.0, 100000.0));
+  app.add_option("--api", o.api, "gRPC client API: callback (default) or sync (needed for --rate)")
+      ->check(CLI::IsMember({"callback", "sync"}));
   CLI11_PARSE(app, argc, argv);
+  if (o.rate > 0 && o.api != "sync") {
+    std::fprintf(stderr, "bench_daemon_load: --rate needs --api sync\n");
+    return 2;
+  }
   // As brdfd does (daemon/server.cc): Debian's Abseil keeps absl::Mutex's debug-only deadlock
   // graph on, a cost on every lock gRPC takes that upstream release builds do not pay.
   absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
@@ -140,13 +230,21 @@ int main(int argc, char** argv) {
 
   std::vector<ClientResult> results(static_cast<std::size_t>(o.clients));
   std::vector<std::thread> threads;
+  std::vector<std::unique_ptr<CallbackClient>> callback_clients;
   for (int i = 0; i < o.clients; ++i) {
-    threads.emplace_back(Client, std::cref(o), 1000 + i, measure_from, until,
-                         &results[static_cast<std::size_t>(i)]);
+    ClientResult* out = &results[static_cast<std::size_t>(i)];
+    if (o.api == "sync") {
+      threads.emplace_back(Client, std::cref(o), 1000 + i, measure_from, until, out);
+    } else {
+      callback_clients.push_back(
+          std::make_unique<CallbackClient>(o, 1000 + i, measure_from, until, out));
+    }
   }
+  for (auto& c : callback_clients) c->Start();
   std::this_thread::sleep_until(measure_from);
   const long before = o.recording.empty() ? -1 : DoneSteps(control_channel, o, o.recording);
   for (std::thread& t : threads) t.join();
+  for (auto& c : callback_clients) c->Wait();
   const long after = o.recording.empty() ? -1 : DoneSteps(control_channel, o, o.recording);
 
   std::vector<double> all;
@@ -159,9 +257,10 @@ int main(int argc, char** argv) {
   }
   std::sort(all.begin(), all.end());
   std::printf(
-      "interpolate clients=%d calls=%zu errors=%ld qps=%.0f p50_us=%.0f p90_us=%.0f p99_us=%.0f "
+      "interpolate api=%s clients=%d calls=%zu errors=%ld qps=%.0f p50_us=%.0f p90_us=%.0f "
+      "p99_us=%.0f "
       "p999_us=%.0f max_us=%.0f steps_recorded=%ld\n",
-      o.clients, all.size(), errors, static_cast<double>(all.size()) / o.seconds,
+      o.api.c_str(), o.clients, all.size(), errors, static_cast<double>(all.size()) / o.seconds,
       Percentile(all, 0.5), Percentile(all, 0.9), Percentile(all, 0.99), Percentile(all, 0.999),
       all.empty() ? 0.0 : all.back(), before >= 0 && after >= 0 ? after - before : -1);
   if (errors > 0) std::fprintf(stderr, "bench_daemon_load: first error: %s\n", first_error.c_str());
