@@ -132,7 +132,20 @@ __attribute__((target("avx2"))) void BlendAvx2(const double* w, const double* co
     }
     _mm256_storeu_pd(out + b, sum);
   }
-  BlendScalar<V>(w, s, out, b, bands);
+  if (b == bands) return;
+  // The last 1–3 bands (101 = 25 · 4 + 1) with masked loads and stores, the same operations per
+  // lane: a scalar loop here waited on the last cache line of every spectrum in turn.
+  const __m256i lanes = _mm256_set_epi64x(3, 2, 1, 0);
+  const __m256i mask =
+      _mm256_cmpgt_epi64(_mm256_set1_epi64x(static_cast<long long>(bands - b)), lanes);
+  __m256d sum = _mm256_mul_pd(wv[0], _mm256_maskload_pd(s[0] + b, mask));
+  asm("" : "+x"(sum));
+  for (int k = 1; k < V; ++k) {
+    __m256d term = _mm256_mul_pd(wv[k], _mm256_maskload_pd(s[k] + b, mask));
+    asm("" : "+x"(term));
+    sum = _mm256_add_pd(sum, term);
+  }
+  _mm256_maskstore_pd(out + b, mask, sum);
 }
 
 template <int V>
@@ -151,7 +164,17 @@ __attribute__((target("avx512f"))) void BlendAvx512(const double* w, const doubl
     }
     _mm512_storeu_pd(out + b, sum);
   }
-  BlendScalar<V>(w, s, out, b, bands);
+  if (b == bands) return;
+  // The last 1–7 bands with masked loads and stores (see BlendAvx2).
+  const auto mask = static_cast<__mmask8>((1u << (bands - b)) - 1u);
+  __m512d sum = _mm512_mul_pd(wv[0], _mm512_maskz_loadu_pd(mask, s[0] + b));
+  asm("" : "+v"(sum));
+  for (int k = 1; k < V; ++k) {
+    __m512d term = _mm512_mul_pd(wv[k], _mm512_maskz_loadu_pd(mask, s[k] + b));
+    asm("" : "+v"(term));
+    sum = _mm512_add_pd(sum, term);
+  }
+  _mm512_mask_storeu_pd(out + b, mask, sum);
 }
 #endif
 

