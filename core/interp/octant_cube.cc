@@ -498,12 +498,34 @@ __attribute__((target("avx2"))) OctantBlend FindOctantBlend3Avx2(const OrthantWi
 }  // namespace
 #endif
 
-OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const double> scaled_query,
-                                int dims) {
+bool BlendKernelSupported(BlendKernel kernel) {
+  switch (kernel) {
+    case BlendKernel::kBest:
+    case BlendKernel::kScalar:
+      return true;
 #ifdef BRDF_CUBE_X86
-  static const bool avx512 = __builtin_cpu_supports("avx512f");
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (dims == 3 && (avx512 || avx2)) {
+    case BlendKernel::kAvx2:
+      return __builtin_cpu_supports("avx2");
+    case BlendKernel::kAvx512:
+      return __builtin_cpu_supports("avx512f");
+#else
+    case BlendKernel::kAvx2:
+    case BlendKernel::kAvx512:
+      return false;
+#endif
+  }
+  return false;
+}
+
+OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const double> scaled_query,
+                                int dims, BlendKernel kernel) {
+#ifdef BRDF_CUBE_X86
+  static const BlendKernel best = BlendKernelSupported(BlendKernel::kAvx512) ? BlendKernel::kAvx512
+                                  : BlendKernelSupported(BlendKernel::kAvx2) ? BlendKernel::kAvx2
+                                                                             : BlendKernel::kScalar;
+  if (kernel == BlendKernel::kBest) kernel = best;
+  if (!BlendKernelSupported(kernel)) kernel = BlendKernel::kScalar;
+  if (dims == 3 && kernel != BlendKernel::kScalar) {
     std::uint32_t empty = 0;
     for (int o = 0; o < 8; ++o) {
       if (winners.rank[static_cast<std::size_t>(o)] == kNoPoint) empty |= 1u << o;
@@ -513,9 +535,11 @@ OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const d
       out.empty_orthants = empty;
       return out;
     }
-    return avx512 ? FindOctantBlend3Avx512(winners, scaled_query.data())
-                  : FindOctantBlend3Avx2(winners, scaled_query.data());
+    return kernel == BlendKernel::kAvx512 ? FindOctantBlend3Avx512(winners, scaled_query.data())
+                                          : FindOctantBlend3Avx2(winners, scaled_query.data());
   }
+#else
+  (void)kernel;
 #endif
   return FindOctantBlend(winners, scaled_query, dims);
 }

@@ -100,8 +100,12 @@ OctantBlend FindOctantBlend(const OrthantWinners& winners, std::span<const doubl
 // Barycentric's order (no fused multiply-add), and the first that encloses the query is taken.
 // On random rig poses the AVX2 path takes about 0.4× the scalar time. What the indexed octant
 // method uses; the reference keeps FindOctantBlend.
+// `kernel` is for tests and benchmarks: kBest picks the widest the CPU supports; a kernel it
+// lacks falls back to kScalar (FindOctantBlend). All give the same blend.
+enum class BlendKernel { kBest, kScalar, kAvx2, kAvx512 };
+bool BlendKernelSupported(BlendKernel kernel);
 OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const double> scaled_query,
-                                int dims);
+                                int dims, BlendKernel kernel = BlendKernel::kBest);
 
 // The blended spectrum of a kOk blend: out[b] = Σ_k weight_k · spectrum_k[b] in vertex order
 // (BlendSpectra). out.size() == samples.bands().

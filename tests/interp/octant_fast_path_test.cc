@@ -255,9 +255,9 @@ OrthantWinners CubeWinners(const Point& q, double scale, std::mt19937_64& rng, b
   return w;
 }
 
-void ExpectSameBlend(const OrthantWinners& w, const Point& q) {
+void ExpectSameBlendWith(const OrthantWinners& w, const Point& q, BlendKernel kernel) {
   const OctantBlend want = FindOctantBlend(w, q, 3);
-  const OctantBlend got = FindOctantBlendFast(w, q, 3);
+  const OctantBlend got = FindOctantBlendFast(w, q, 3, kernel);
   ASSERT_EQ(got.status, want.status);
   EXPECT_EQ(got.empty_orthants, want.empty_orthants);
   EXPECT_EQ(got.simplex, want.simplex);
@@ -267,6 +267,15 @@ void ExpectSameBlend(const OrthantWinners& w, const Point& q) {
     EXPECT_EQ(std::bit_cast<std::uint64_t>(got.weight[k]),
               std::bit_cast<std::uint64_t>(want.weight[k]))
         << "weight " << k << ": " << got.weight[k] << " vs " << want.weight[k];
+  }
+}
+
+// Every blend kernel this CPU runs (AVX-512 and AVX2 both, where it has AVX-512).
+void ExpectSameBlend(const OrthantWinners& w, const Point& q) {
+  for (BlendKernel kernel : {BlendKernel::kBest, BlendKernel::kAvx2, BlendKernel::kAvx512}) {
+    if (!BlendKernelSupported(kernel)) continue;
+    SCOPED_TRACE(::testing::Message() << "blend kernel " << static_cast<int>(kernel));
+    ExpectSameBlendWith(w, q, kernel);
   }
 }
 
