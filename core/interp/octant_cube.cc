@@ -405,24 +405,14 @@ __attribute__((target("avx2"))) void Barycentric4(const __m256d (&v)[4][3], cons
 }
 
 // The cube of winners per axis: lo[j] holds coordinate j of orthants 0–3 (lane o), hi[j] of
-// orthants 4–7. Each winner is read with a masked load of its three coordinates (the fourth lane
-// is not touched: a winner may be the last point of an array).
+// orthants 4–7. Read one coordinate at a time: the search has just stored them one at a time, and
+// a wider load of several such stores would wait for them to reach the cache.
 __attribute__((target("avx2"))) inline void CubeAxes(const OrthantWinners& winners,
                                                      __m256d (&lo)[3], __m256d (&hi)[3]) {
-  const __m256i xyz = _mm256_set_epi64x(0, -1, -1, -1);
-  __m256d w[8];
-  for (std::size_t o = 0; o < 8; ++o) w[o] = _mm256_maskload_pd(winners.scaled[o], xyz);
-  // Two 4 × 4 transposes (the fourth row, lane 3 of every winner, is dropped).
-  for (int half = 0; half < 2; ++half) {
-    const __m256d* v = w + 4 * half;
-    const __m256d t0 = _mm256_unpacklo_pd(v[0], v[1]);  // x0 x1 z0 z1
-    const __m256d t1 = _mm256_unpackhi_pd(v[0], v[1]);  // y0 y1 .  .
-    const __m256d t2 = _mm256_unpacklo_pd(v[2], v[3]);  // x2 x3 z2 z3
-    const __m256d t3 = _mm256_unpackhi_pd(v[2], v[3]);  // y2 y3 .  .
-    __m256d(&out)[3] = half == 0 ? lo : hi;
-    out[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
-    out[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
-    out[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+  const auto& x = winners.scaled;
+  for (int j = 0; j < 3; ++j) {
+    lo[j] = _mm256_set_pd(x[3][j], x[2][j], x[1][j], x[0][j]);
+    hi[j] = _mm256_set_pd(x[7][j], x[6][j], x[5][j], x[4][j]);
   }
 }
 
