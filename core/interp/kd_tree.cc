@@ -106,6 +106,110 @@ struct KdTree::NearestBest {
   std::uint32_t rank = kNoPoint;
 };
 
+#ifdef BRDF_KD_X86
+// The per-orthant bests of a search held in AVX2 registers, for the AVX2 kernels: orthants
+// 4r … 4r + 3 in register r (squared distances, and tree positions widened to 64 bits; 2 + 2
+// registers in 3D, 4 + 4 in 4D). A lane's best is picked with a cross-lane permute (the orthant's
+// low two bits) and blends (its higher bits): a handful of one-cycle instructions where
+// vgatherqpd, which Zen 3 runs as many micro-ops, sat on the critical path of every 4 points.
+// The memory copy (OrthantBest) stays the exact record; the registers follow every update.
+template <int D>
+struct Avx2Bests {
+  static constexpr int kRegs = (1 << D) / 4;
+  __m256d d2[kRegs];
+  __m256i pos[kRegs];
+
+  __attribute__((target("avx2"), always_inline)) inline void Load(const KdTree::OrthantBest& best) {
+    for (int r = 0; r < kRegs; ++r) {
+      d2[r] = _mm256_loadu_pd(best.d2.data() + 4 * r);
+      pos[r] = _mm256_cvtepu32_epi64(
+          _mm_loadu_si128(reinterpret_cast<const __m128i*>(best.pos.data() + 4 * r)));
+    }
+  }
+
+  // Per lane, the orthant number (bit j from plus[j], the lane's x_j >= q_j mask).
+  __attribute__((target("avx2"), always_inline)) static inline __m256i Code(const __m256d* plus) {
+    __m256i code = _mm256_and_si256(_mm256_castpd_si256(plus[0]), _mm256_set1_epi64x(1));
+    for (int j = 1; j < D; ++j) {
+      code = _mm256_or_si256(
+          code, _mm256_and_si256(_mm256_castpd_si256(plus[j]), _mm256_set1_epi64x(1 << j)));
+    }
+    return code;
+  }
+
+  // The lanes (bit k for lane k) whose point is nearer than its orthant's best, or as near but
+  // not that very point (a best met again: the exact rule would keep it, so it is not a
+  // candidate; empty orthants have position kNoPoint, which no point has, and distance +inf).
+  __attribute__((target("avx2"), always_inline)) inline unsigned Candidates(
+      __m256d dist, const __m256d* plus, __m256i positions) const {
+    // The permute's index per 64-bit lane: 32-bit elements 2(o & 3) and 2(o & 3) + 1.
+    const __m256i index = _mm256_or_si256(
+        _mm256_set1_epi64x(std::int64_t{1} << 32),
+        _mm256_or_si256(
+            _mm256_and_si256(_mm256_castpd_si256(plus[0]), _mm256_set1_epi64x(0x0000000200000002)),
+            _mm256_and_si256(_mm256_castpd_si256(plus[1]),
+                             _mm256_set1_epi64x(0x0000000400000004))));
+    __m256d limit[kRegs];
+    __m256i at[kRegs];
+    for (int r = 0; r < kRegs; ++r) {
+      limit[r] = _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(d2[r]), index));
+      at[r] = _mm256_permutevar8x32_epi32(pos[r], index);
+    }
+    __m256d l = _mm256_blendv_pd(limit[0], limit[1], plus[2]);
+    __m256i a = _mm256_castpd_si256(
+        _mm256_blendv_pd(_mm256_castsi256_pd(at[0]), _mm256_castsi256_pd(at[1]), plus[2]));
+    if constexpr (D == 4) {
+      const __m256d l23 = _mm256_blendv_pd(limit[2], limit[3], plus[2]);
+      const __m256d a23 =
+          _mm256_blendv_pd(_mm256_castsi256_pd(at[2]), _mm256_castsi256_pd(at[3]), plus[2]);
+      l = _mm256_blendv_pd(l, l23, plus[3]);
+      a = _mm256_castpd_si256(_mm256_blendv_pd(_mm256_castsi256_pd(a), a23, plus[3]));
+    }
+    const __m256d below = _mm256_cmp_pd(dist, l, _CMP_LT_OQ);
+    const __m256d equal = _mm256_cmp_pd(dist, l, _CMP_EQ_OQ);
+    const __m256d same = _mm256_castsi256_pd(_mm256_cmpeq_epi64(positions, a));
+    return static_cast<unsigned>(
+        _mm256_movemask_pd(_mm256_or_pd(below, _mm256_andnot_pd(same, equal))));
+  }
+
+  // After OrthantBest::Offer: when the point won orthant o, the registers take its distance and
+  // position (no reload from memory: that would stall on store forwarding).
+  __attribute__((target("avx2"), always_inline)) inline void Update(bool better, unsigned o,
+                                                                    double dist, std::uint32_t at) {
+    // Orthant 16 is no orthant: a point that did not win changes nothing.
+    const auto target = static_cast<std::int64_t>(better ? o : 16u);
+    const __m256i which = _mm256_set1_epi64x(target);
+    const __m256d d = _mm256_set1_pd(dist);
+    const __m256d p = _mm256_castsi256_pd(_mm256_set1_epi64x(at));
+    for (int r = 0; r < kRegs; ++r) {
+      const __m256d m = _mm256_castsi256_pd(
+          _mm256_cmpeq_epi64(which, _mm256_set_epi64x(4 * r + 3, 4 * r + 2, 4 * r + 1, 4 * r)));
+      d2[r] = _mm256_blendv_pd(d2[r], d, m);
+      pos[r] = _mm256_castpd_si256(_mm256_blendv_pd(_mm256_castsi256_pd(pos[r]), p, m));
+    }
+  }
+
+  // Lane masks of the orthants in `need` (bit o for orthant o).
+  __attribute__((target("avx2"), always_inline)) static inline void NeedMask(unsigned need,
+                                                                             __m256d* keep) {
+    for (int r = 0; r < kRegs; ++r) {
+      const __m256i bits = _mm256_set1_epi64x(need >> (4 * r));
+      const __m256i lane = _mm256_set_epi64x(8, 4, 2, 1);
+      keep[r] = _mm256_castsi256_pd(_mm256_cmpeq_epi64(_mm256_and_si256(bits, lane), lane));
+    }
+  }
+
+  // The largest best among the orthants of `keep` (the others count as 0: bests are never
+  // negative, so this is the largest needed one whenever one is needed).
+  __attribute__((target("avx2"), always_inline)) inline double Worst(const __m256d* keep) const {
+    __m256d m = _mm256_and_pd(d2[0], keep[0]);
+    for (int r = 1; r < kRegs; ++r) m = _mm256_max_pd(m, _mm256_and_pd(d2[r], keep[r]));
+    const __m128d h = _mm_max_pd(_mm256_castpd256_pd128(m), _mm256_extractf128_pd(m, 1));
+    return _mm_cvtsd_f64(_mm_max_sd(h, _mm_unpackhi_pd(h, h)));
+  }
+};
+#endif
+
 // The leaf scans. Each computes, for every point of the leaf, its orthant (bit j set when
 // x_j >= q_j) and its squared distance ((0 + dx²) + dy²) + dz² (+ dw²), exactly as OrthantOf and
 // SquaredDistance do, and offers it to its orthant.
@@ -165,10 +269,56 @@ struct LeafKernels {
   }
 
 #ifdef BRDF_KD_X86
-  // 4 points at a time; the bests of their orthants are gathered, and only a point at or below
-  // its orthant's best goes through the exact rule.
+  // 4 points at a time, the bests in registers (Avx2Bests): only a point below its orthant's
+  // best, or at it but not that very point, goes through the exact rule.
   __attribute__((target("avx2"))) static bool Avx2(const KdTree::Entries& tree, std::uint32_t begin,
                                                    std::uint32_t end, Best& best) {
+    __m256d q[D];
+    for (int j = 0; j < D; ++j) q[j] = _mm256_set1_pd(best.q[static_cast<std::size_t>(j)]);
+    const double* axis[D];
+    for (int j = 0; j < D; ++j) axis[j] = tree.axis[j];
+    const std::uint32_t* rank = tree.rank;
+    Avx2Bests<D> bests;
+    bests.Load(best);
+    const __m256i lane_index = _mm256_set_epi64x(3, 2, 1, 0);
+    bool improved = false;
+    for (std::uint32_t pos = begin; pos < end; pos += 4) {
+      __m256d d2 = _mm256_setzero_pd();
+      __m256d plus[D];
+#pragma GCC unroll 4
+      for (int j = 0; j < D; ++j) {
+        const __m256d v = _mm256_loadu_pd(axis[j] + pos);
+        const __m256d diff = _mm256_sub_pd(v, q[j]);
+        __m256d sq = _mm256_mul_pd(diff, diff);
+        asm("" : "+x"(sq));  // no fused multiply-add: round the square first
+        d2 = j == 0 ? sq : _mm256_add_pd(d2, sq);
+        plus[j] = _mm256_cmp_pd(v, q[j], _CMP_GE_OQ);
+      }
+      const __m256i positions = _mm256_add_epi64(_mm256_set1_epi64x(pos), lane_index);
+      unsigned candidates = bests.Candidates(d2, plus, positions);
+      if (end - pos < 4) candidates &= (1u << (end - pos)) - 1u;
+      if (candidates == 0) continue;
+      alignas(32) double dist[4];
+      alignas(32) std::int64_t orthant[4];
+      _mm256_store_pd(dist, d2);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(orthant), Avx2Bests<D>::Code(plus));
+      for (; candidates != 0; candidates &= candidates - 1) {
+        const int lane = std::countr_zero(candidates);
+        const std::uint32_t at = pos + static_cast<std::uint32_t>(lane);
+        const auto o = static_cast<unsigned>(orthant[lane]);
+        const bool better = best.Offer(o, dist[lane], rank[at], at);
+        bests.Update(better, o, dist[lane], at);
+        improved |= better;
+      }
+    }
+    return improved;
+  }
+
+  // 4 points at a time; the bests of their orthants are gathered, and only a point at or below
+  // its orthant's best goes through the exact rule.
+  __attribute__((target("avx2"))) static bool Avx2Gather(const KdTree::Entries& tree,
+                                                         std::uint32_t begin, std::uint32_t end,
+                                                         Best& best) {
     __m256d q[D];
     for (int j = 0; j < D; ++j) q[j] = _mm256_set1_pd(best.q[static_cast<std::size_t>(j)]);
     bool improved = false;
@@ -202,6 +352,65 @@ struct LeafKernels {
       }
     }
     return improved;
+  }
+
+  // A grid list (see ListAvx512), 4 points at a time: their coordinates gathered from the tree's
+  // per-axis arrays, the bests in registers (Avx2Bests).
+  __attribute__((target("avx2"))) static void ListAvx2(const KdTree& tree,
+                                                       const std::uint32_t* entry,
+                                                       const double* block_gap,
+                                                       std::uint32_t blocks, unsigned need,
+                                                       Best& best) {
+    __m256d q[D];
+    for (int j = 0; j < D; ++j) q[j] = _mm256_set1_pd(best.q[static_cast<std::size_t>(j)]);
+    // In locals: the stores into `best` below could alias the tree's members for the compiler,
+    // which would reload them for every block.
+    const double* axis[D];
+    for (int j = 0; j < D; ++j) axis[j] = tree.axis_[static_cast<std::size_t>(j)].data();
+    const std::uint32_t* rank = tree.rank_.data();
+    Avx2Bests<D> bests;
+    bests.Load(best);
+    __m256d keep[Avx2Bests<D>::kRegs];
+    Avx2Bests<D>::NeedMask(need, keep);
+    double worst = kInf;
+    for (std::uint32_t b = 0; b < blocks; ++b) {
+      if (block_gap[b] > worst) break;
+      bool improved = false;
+#pragma GCC unroll 2
+      for (std::uint32_t half = 0; half < 2; ++half) {
+        const std::uint32_t* at = entry + std::size_t{b} * 8 + half * 4;
+        const __m128i index = _mm_loadu_si128(reinterpret_cast<const __m128i*>(at));
+        __m256d d2 = _mm256_setzero_pd();
+        __m256d plus[D];
+#pragma GCC unroll 4
+        for (int j = 0; j < D; ++j) {
+          const __m256d v = _mm256_i32gather_pd(axis[j], index, 8);
+          const __m256d diff = _mm256_sub_pd(v, q[j]);
+          __m256d sq = _mm256_mul_pd(diff, diff);
+          asm("" : "+x"(sq));  // no fused multiply-add: round the square first
+          d2 = j == 0 ? sq : _mm256_add_pd(d2, sq);
+          plus[j] = _mm256_cmp_pd(v, q[j], _CMP_GE_OQ);
+        }
+        // As in Avx2: a point equal to its orthant's best is a candidate only when it is not that
+        // point itself (lists repeat their last entry as padding).
+        unsigned candidates = bests.Candidates(d2, plus, _mm256_cvtepu32_epi64(index));
+        if (candidates == 0) continue;
+        alignas(32) double dist[4];
+        alignas(32) std::int64_t orthant[4];
+        _mm256_store_pd(dist, d2);
+        _mm256_store_si256(reinterpret_cast<__m256i*>(orthant), Avx2Bests<D>::Code(plus));
+        for (; candidates != 0; candidates &= candidates - 1) {
+          const int lane = std::countr_zero(candidates);
+          const std::uint32_t pos = at[lane];
+          const auto o = static_cast<unsigned>(orthant[lane]);
+          const bool better = best.Offer(o, dist[lane], rank[pos], pos);
+          bests.Update(better, o, dist[lane], pos);
+          improved |= better;
+        }
+      }
+      if (!improved) continue;
+      worst = bests.Worst(keep);
+    }
   }
 
   // 8 points at a time; the orthants' bests sit in one (3D) or two (4D) registers and are
@@ -399,7 +608,9 @@ KdTree::KdTree(const PointCloud& cloud, Kernel kernel, Search search)
       scan_ = three ? &LeafKernels<3>::Avx512 : &LeafKernels<4>::Avx512;
       break;
     case Kernel::kAvx2:
-      scan_ = three ? &LeafKernels<3>::Avx2 : &LeafKernels<4>::Avx2;
+      // 4D keeps the gather: its 16 bests would take 8 registers and 14 permutes and blends per
+      // 4 points (spilled; measured no faster than one vgatherqpd).
+      scan_ = three ? &LeafKernels<3>::Avx2 : &LeafKernels<4>::Avx2Gather;
       break;
 #endif
     default:
@@ -409,6 +620,8 @@ KdTree::KdTree(const PointCloud& cloud, Kernel kernel, Search search)
 #ifdef BRDF_KD_X86
   if (kernel == Kernel::kAvx512) {
     list_scan_ = three ? &LeafKernels<3>::ListAvx512 : &LeafKernels<4>::ListAvx512;
+  } else if (kernel == Kernel::kAvx2) {
+    list_scan_ = three ? &LeafKernels<3>::ListAvx2 : &LeafKernels<4>::ListAvx2;
   }
 #endif
 
