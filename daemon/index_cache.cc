@@ -73,10 +73,24 @@ std::size_t IndexBytes(const interp::SampleSet& set) {
   return set.size() * static_cast<std::size_t>(set.dims()) * sizeof(double) * 8;
 }
 
+// An index of a session, with the tick of its last query (least recently used first out).
+struct CachedIndex {
+  CachedIndex(IndexKey k, std::shared_ptr<const IndexSnapshot> i, std::uint64_t u)
+      : key(std::move(k)), index(std::move(i)), used(u) {}
+  IndexKey key;
+  std::shared_ptr<const IndexSnapshot> index;
+  mutable std::atomic<std::uint64_t> used;  // written by queries under Entry::state_mu shared
+};
+
 }  // namespace
 
 struct IndexCache::Entry {
-  std::mutex build_mu;  // guards everything below except announced_id and bytes
+  // Serialises store reads and builds; guards everything below except announced_id, bytes and
+  // used. state_mu guards synced, through_id, sets and indexes as well: they are written with
+  // both held (build_mu first), so the query fast path (FreshHit) reads them under state_mu
+  // shared alone, while a build goes on.
+  std::mutex build_mu;
+  mutable std::shared_mutex state_mu;
 
   bool loaded = false;  // session record read (plan kind, ρw)
   bool anisotropic = false;
@@ -90,25 +104,30 @@ struct IndexCache::Entry {
   std::array<std::shared_ptr<const interp::SampleSet>, kQuantityCount> sets;
   std::array<std::size_t, kQuantityCount> skipped{};
   std::array<std::string, kQuantityCount> skipped_detail;
-  std::list<std::pair<IndexKey, std::shared_ptr<const IndexSnapshot>>> indexes;  // MRU first
+  std::list<CachedIndex> indexes;
 
   std::atomic<std::size_t> bytes{0};
-  std::int64_t announced_id = 0;  // guarded by IndexCache::mu_: highest reading id reported
+  std::atomic<std::int64_t> announced_id{0};  // highest reading id reported (OnReading)
+  std::atomic<std::uint64_t> used{0};         // IndexCache::tick_ of the last query
 };
 
 IndexCache::IndexCache(std::shared_ptr<storage::SessionStore> store, Options options)
     : store_(std::move(store)), options_(options) {}
 
 void IndexCache::OnReading(SessionId session, const storage::ReadingRecord& reading) {
-  std::lock_guard lock(mu_);
+  std::shared_lock lock(mu_);
   auto it = entries_.find(session);
   if (it == entries_.end()) return;  // not cached: its first query reads everything anyway
-  it->second->announced_id = std::max(it->second->announced_id, reading.id);
+  std::atomic<std::int64_t>& announced = it->second->announced_id;
+  std::int64_t seen = announced.load();
+  while (seen < reading.id && !announced.compare_exchange_weak(seen, reading.id)) {
+  }
 }
 
 IndexCache::Stats IndexCache::stats() const {
-  std::lock_guard lock(mu_);
+  std::shared_lock lock(mu_);
   Stats s = stats_;
+  s.hits += hits_.load();
   s.sessions = entries_.size();
   s.bytes = 0;
   for (const auto& [id, e] : entries_) s.bytes += e->bytes.load();
@@ -134,25 +153,54 @@ Status LoadSession(storage::SessionStore& store, SessionId session, bool* anisot
 
 }  // namespace
 
+std::shared_ptr<const IndexSnapshot> IndexCache::FreshHit(SessionId session, Quantity quantity,
+                                                          interp::Method method,
+                                                          const interp::Options& options) {
+  std::shared_ptr<Entry> entry;
+  {
+    std::shared_lock lock(mu_);
+    auto it = entries_.find(session);
+    if (it == entries_.end()) return nullptr;
+    entry = it->second;
+  }
+  const std::uint64_t now = ++tick_;
+  entry->used.store(now, std::memory_order_relaxed);
+  // Read before the state: a reading announced from here on was committed after this query
+  // began, so an index that misses it is still an answer "over every reading committed so far".
+  const std::int64_t announced = entry->announced_id.load();
+  const IndexKey key = MakeKey(quantity, method, options);
+  const int qi = static_cast<int>(quantity);
+  std::shared_lock state(entry->state_mu);
+  if (!entry->synced || announced > entry->through_id) return nullptr;
+  for (const CachedIndex& cached : entry->indexes) {
+    if (cached.key == key) {
+      if (cached.index->samples != entry->sets[qi]) return nullptr;  // stale: extend or rebuild
+      cached.used.store(now, std::memory_order_relaxed);
+      hits_.fetch_add(1, std::memory_order_relaxed);
+      return cached.index;
+    }
+  }
+  return nullptr;
+}
+
 Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, Quantity quantity,
                                                              interp::Method method,
                                                              const interp::Options& options) {
+  if (std::shared_ptr<const IndexSnapshot> hit = FreshHit(session, quantity, method, options)) {
+    return hit;
+  }
   std::shared_ptr<Entry> entry;
   {
-    std::lock_guard lock(mu_);
+    std::unique_lock lock(mu_);
     std::shared_ptr<Entry>& slot = entries_[session];
     if (!slot) slot = std::make_shared<Entry>();
     entry = slot;
-    lru_.remove(session);
-    lru_.push_front(session);
   }
+  entry->used.store(++tick_, std::memory_order_relaxed);
   auto forget = [&] {  // an entry that never loaded (unknown session, store error) is not kept
-    std::lock_guard lock(mu_);
+    std::unique_lock lock(mu_);
     auto it = entries_.find(session);
-    if (it != entries_.end() && it->second == entry) {
-      entries_.erase(it);
-      lru_.remove(session);
-    }
+    if (it != entries_.end() && it->second == entry) entries_.erase(it);
   };
 
   std::unique_lock build(entry->build_mu);
@@ -168,11 +216,7 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
   const int dims = entry->anisotropic ? 4 : 3;
 
   // Read what landed since the last query (everything, the first time).
-  std::int64_t announced = 0;
-  {
-    std::lock_guard lock(mu_);
-    announced = entry->announced_id;
-  }
+  const std::int64_t announced = entry->announced_id.load();
   bool appended = false;
   const bool first_load = !entry->synced;
   std::uint64_t read_now = 0;
@@ -317,6 +361,7 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
       }
       if (static_cast<int>(page->size()) < options_.page_size) break;
     }
+    std::unique_lock state(entry->state_mu);
     entry->synced = true;
     entry->through_id = through;
     entry->skipped = skipped;
@@ -330,8 +375,8 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
     if (appended) {
       // Indexes over fewer readings are stale. Octant ones stay, to be extended on their next
       // query; the others are rebuilt then, so they need not be kept.
-      entry->indexes.remove_if([&](const auto& cached) {
-        const IndexSnapshot& index = *cached.second;
+      entry->indexes.remove_if([&](const CachedIndex& cached) {
+        const IndexSnapshot& index = *cached.index;
         return index.method != interp::Method::kOctant &&
                index.samples != entry->sets[static_cast<int>(index.quantity)];
       });
@@ -342,17 +387,18 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
   const int qi = static_cast<int>(quantity);
   std::shared_ptr<const IndexSnapshot> stale;  // this key's index over fewer readings, if any
   for (auto it = entry->indexes.begin(); it != entry->indexes.end(); ++it) {
-    if (it->first == key && it->second->samples != entry->sets[qi]) {
-      stale = std::move(it->second);
+    if (it->key == key && it->index->samples != entry->sets[qi]) {
+      stale = it->index;
+      std::unique_lock state(entry->state_mu);
       entry->indexes.erase(it);
       break;
     }
-    if (it->first == key) {
-      std::shared_ptr<const IndexSnapshot> hit = it->second;
-      entry->indexes.splice(entry->indexes.begin(), entry->indexes, it);
+    if (it->key == key) {
+      std::shared_ptr<const IndexSnapshot> hit = it->index;
+      it->used.store(++tick_, std::memory_order_relaxed);
       build.unlock();
-      std::lock_guard lock(mu_);
-      ++stats_.hits;
+      hits_.fetch_add(1, std::memory_order_relaxed);
+      std::unique_lock lock(mu_);
       CountLoad(appended, first_load, read_now);
       return hit;
     }
@@ -438,20 +484,27 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
   snapshot->samples = samples;
   snapshot->interpolator = std::shared_ptr<const interp::Interpolator>(std::move(*made));
 
-  entry->indexes.emplace_front(key, snapshot);
-  while (entry->indexes.size() > std::max<std::size_t>(1, options_.max_indexes_per_session)) {
-    entry->indexes.pop_back();
+  {
+    std::unique_lock state(entry->state_mu);
+    entry->indexes.emplace_back(key, snapshot, ++tick_);
+    while (entry->indexes.size() > std::max<std::size_t>(1, options_.max_indexes_per_session)) {
+      // The least recently queried one (the one just made has the newest tick).
+      entry->indexes.erase(std::min_element(entry->indexes.begin(), entry->indexes.end(),
+                                            [](const CachedIndex& a, const CachedIndex& b) {
+                                              return a.used.load() < b.used.load();
+                                            }));
+    }
   }
   std::size_t bytes = 0;
   for (const auto& set : entry->sets) {
     if (set) bytes += SetBytes(*set);
   }
-  for (const auto& [k, index] : entry->indexes) bytes += IndexBytes(*index->samples);
+  for (const CachedIndex& cached : entry->indexes) bytes += IndexBytes(*cached.index->samples);
   entry->bytes = bytes;
   build.unlock();
 
   {
-    std::lock_guard lock(mu_);
+    std::unique_lock lock(mu_);
     ++(was_extended ? stats_.extends : stats_.builds);
     CountLoad(appended, first_load, read_now);
     Evict(session);
@@ -472,11 +525,18 @@ void IndexCache::Evict(SessionId keep) {
     for (const auto& [id, e] : entries_) sum += e->bytes.load();
     return sum;
   };
-  while (!lru_.empty() && lru_.back() != keep &&
-         (entries_.size() > std::max<std::size_t>(1, options_.max_sessions) ||
-          total() > options_.max_bytes)) {
-    entries_.erase(lru_.back());
-    lru_.pop_back();
+  while (entries_.size() > std::max<std::size_t>(1, options_.max_sessions) ||
+         total() > options_.max_bytes) {
+    // The least recently queried session other than `keep`.
+    auto lru = entries_.end();
+    for (auto it = entries_.begin(); it != entries_.end(); ++it) {
+      if (it->first != keep &&
+          (lru == entries_.end() || it->second->used.load() < lru->second->used.load())) {
+        lru = it;
+      }
+    }
+    if (lru == entries_.end()) break;
+    entries_.erase(lru);
     ++stats_.evictions;
   }
 }

@@ -32,11 +32,13 @@
 // rebuilt from the store on its next query. Snapshots still held by readers stay valid.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <list>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <shared_mutex>
 #include <string>
 #include <vector>
 
@@ -120,17 +122,28 @@ class IndexCache {
 
  private:
   struct Entry;
+  // The cached, current index for this key when no reading landed since the session's last
+  // store read: the common query, answered under shared locks only (no store read, no build, no
+  // allocation), so concurrent queries never wait for each other. Null otherwise (the slow path
+  // in Get decides).
+  std::shared_ptr<const IndexSnapshot> FreshHit(SessionId session, Quantity quantity,
+                                                interp::Method method,
+                                                const interp::Options& options);
   void Evict(SessionId keep);
-  // Counts a store read in stats_ (mu_ held).
+  // Counts a store read in stats_ (mu_ held exclusively).
   void CountLoad(bool appended, bool first_load, std::uint64_t readings_read);
 
   std::shared_ptr<storage::SessionStore> store_;
   Options options_;
 
-  mutable std::mutex mu_;  // guards everything below (never held while building)
+  // Guards everything below (never held while building): shared to look an entry up, exclusive
+  // to add, evict or count. Recency is a tick per entry (Entry::used), not a list, so that a
+  // query only reads the map.
+  mutable std::shared_mutex mu_;
   std::map<SessionId, std::shared_ptr<Entry>> entries_;
-  std::list<SessionId> lru_;  // most recently used first
   Stats stats_;
+  std::atomic<std::uint64_t> hits_{0};  // Stats::hits (counted without mu_)
+  std::atomic<std::uint64_t> tick_{0};  // recency clock of entries and indexes
 };
 
 }  // namespace brdf::daemon

@@ -6,10 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <thread>
+#include <vector>
 
 #include "core/interp/octant.h"
 #include "storage/session_store.h"
@@ -268,6 +272,78 @@ TEST_F(IndexCacheTest, KeepsAtMostMaxSessionsEvictingTheLeastRecentlyUsed) {
   ASSERT_TRUE(cache.Get(a.id(), Quantity::kBrdf, interp::Method::kNearest, {}).ok());
   EXPECT_EQ(cache.stats().loads, 3u);  // a was read from the store again
   EXPECT_EQ(cache.stats().evictions, 2u);
+}
+
+// Queries of a current index take shared locks only (IndexCache::FreshHit); they must still see
+// every reading announced before they began, while other threads query and readings land.
+TEST_F(IndexCacheTest, ConcurrentQueriesSeeEveryReadingAnnouncedBeforeThemWhileReadingsLand) {
+  constexpr int kLanding = 40;
+  SessionFixture s(*store_, 8 + kLanding);
+  FillGrid(s);
+  IndexCache cache(store_);
+  ASSERT_TRUE(cache.Get(s.id(), Quantity::kBrdf, interp::Method::kOctant, {}).ok());
+  std::atomic<std::int64_t> announced{0};
+  std::atomic<bool> done{false};
+  std::atomic<long> queries{0};
+  std::atomic<long> stale{0};
+  std::atomic<long> failed{0};
+  std::vector<std::thread> readers;
+  for (int t = 0; t < 4; ++t) {
+    readers.emplace_back([&] {
+      while (!done.load()) {
+        const std::int64_t before = announced.load();
+        auto got = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kOctant, {});
+        if (!got.ok()) {
+          ++failed;
+          continue;
+        }
+        if ((*got)->through_reading_id < before) ++stale;
+        ++queries;
+      }
+    });
+  }
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> theta(15, 45), phi(50, 130);
+  std::int64_t last = 0;
+  for (int i = 0; i < kLanding; ++i) {
+    const storage::ReadingRecord added = s.AddSample({theta(rng), 0, theta(rng), phi(rng)}, 0.5);
+    cache.OnReading(s.id(), added);
+    announced.store(added.id);
+    last = added.id;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  done.store(true);
+  for (std::thread& t : readers) t.join();
+  EXPECT_EQ(failed.load(), 0);
+  EXPECT_EQ(stale.load(), 0);
+  EXPECT_GT(queries.load(), kLanding);
+  auto final_index = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kOctant, {});
+  ASSERT_TRUE(final_index.ok());
+  EXPECT_EQ((*final_index)->through_reading_id, last);
+  EXPECT_EQ((*final_index)->samples->size(), 8u + kLanding);
+  const IndexCache::Stats stats = cache.stats();
+  EXPECT_EQ(stats.builds + stats.extends + stats.hits, static_cast<std::uint64_t>(queries) + 2);
+}
+
+TEST_F(IndexCacheTest, KeepsAtMostMaxIndexesPerSessionDroppingTheLeastRecentlyQueried) {
+  SessionFixture s(*store_, 8);
+  FillGrid(s);
+  IndexCache::Options options;
+  options.max_indexes_per_session = 2;
+  IndexCache cache(store_, options);
+  auto get = [&](interp::Method m) { return cache.Get(s.id(), Quantity::kBrdf, m, {}); };
+  ASSERT_TRUE(get(interp::Method::kOctant).ok());
+  ASSERT_TRUE(get(interp::Method::kNearest).ok());
+  ASSERT_TRUE(get(interp::Method::kOctant).ok());  // a hit: octant is now the most recent
+  EXPECT_EQ(cache.stats().hits, 1u);
+  ASSERT_TRUE(get(interp::Method::kDelaunay).ok());  // a third index: nearest goes
+  EXPECT_EQ(cache.stats().builds, 3u);
+  ASSERT_TRUE(get(interp::Method::kOctant).ok());
+  EXPECT_EQ(cache.stats().hits, 2u);
+  EXPECT_EQ(cache.stats().builds, 3u);
+  ASSERT_TRUE(get(interp::Method::kNearest).ok());  // rebuilt
+  EXPECT_EQ(cache.stats().builds, 4u);
+  EXPECT_EQ(cache.stats().hits, 2u);
 }
 
 TEST_F(IndexCacheTest, ErrorsNameTheProblem) {
