@@ -5,6 +5,7 @@
 #include <cmath>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/geometry.h"
@@ -82,22 +83,22 @@ grpc::Status ParseSettings(int method, int quantity, const v1::InterpolationOpti
 
 // Ranges and finiteness, independent of the session. `field` is the DirectionQuery's path.
 grpc::Status CheckDirection(const v1::DirectionQuery& q, const std::string& field) {
-  auto check = [](double v, double lo, double hi, const std::string& f) {
-    return ToGrpcStatus(CheckAngle(v, lo, hi, f));
+  // The field's name is only put together for an error (a valid query costs no allocation).
+  auto check = [&field](double v, double lo, double hi, const char* suffix) {
+    if (std::isfinite(v) && v >= lo && v <= hi) return grpc::Status::OK;
+    return ToGrpcStatus(CheckAngle(v, lo, hi, field + suffix));
   };
   grpc::Status st;
   switch (q.direction_case()) {
     case v1::DirectionQuery::kIso:
-      if (st = check(q.iso().theta_i(), 0, 90, field + ".iso.theta_i"); !st.ok()) return st;
-      if (st = check(q.iso().theta_o(), 0, 90, field + ".iso.theta_o"); !st.ok()) return st;
-      return check(q.iso().phi(), kPhiMin, kPhiMax, field + ".iso.phi");
+      if (st = check(q.iso().theta_i(), 0, 90, ".iso.theta_i"); !st.ok()) return st;
+      if (st = check(q.iso().theta_o(), 0, 90, ".iso.theta_o"); !st.ok()) return st;
+      return check(q.iso().phi(), kPhiMin, kPhiMax, ".iso.phi");
     case v1::DirectionQuery::kFour:
-      if (st = check(q.four().theta_i(), 0, 90, field + ".four.theta_i"); !st.ok()) return st;
-      if (st = check(q.four().phi_i(), kPhiMin, kPhiMax, field + ".four.phi_i"); !st.ok()) {
-        return st;
-      }
-      if (st = check(q.four().theta_o(), 0, 90, field + ".four.theta_o"); !st.ok()) return st;
-      return check(q.four().phi_o(), kPhiMin, kPhiMax, field + ".four.phi_o");
+      if (st = check(q.four().theta_i(), 0, 90, ".four.theta_i"); !st.ok()) return st;
+      if (st = check(q.four().phi_i(), kPhiMin, kPhiMax, ".four.phi_i"); !st.ok()) return st;
+      if (st = check(q.four().theta_o(), 0, 90, ".four.theta_o"); !st.ok()) return st;
+      return check(q.four().phi_o(), kPhiMin, kPhiMax, ".four.phi_o");
     case v1::DirectionQuery::DIRECTION_NOT_SET:
       break;
   }
@@ -167,7 +168,7 @@ v1::InterpolationMethod ToProtoMethod(interp::Method m) {
 
 void Evaluate(const v1::DirectionQuery& query, const std::array<double, 4>& coords,
               const Settings& settings, const IndexSnapshot& index, v1::InterpolationResult* out) {
-  const interp::Interpolation r = index.interpolator->Evaluate(
+  interp::Interpolation r = index.interpolator->Evaluate(
       std::span<const double>(coords.data(), static_cast<std::size_t>(index.dims)));
   *out->mutable_query() = query;
   out->set_status(ToProtoStatus(r.status));
@@ -181,7 +182,7 @@ void Evaluate(const v1::DirectionQuery& query, const std::array<double, 4>& coor
     vertex->mutable_coords()->Add(v.coords.begin(), v.coords.end());
     vertex->set_weight(v.weight);
   }
-  std::string detail = r.detail;
+  std::string detail = std::move(r.detail);
   if (index.skipped > 0) {
     detail += (detail.empty() ? "" : "; ") + std::to_string(index.skipped) +
               " sample reading(s) of the session left out (first: " + index.skipped_detail + ")";
