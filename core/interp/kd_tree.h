@@ -12,9 +12,10 @@
 // Speed: the points live in tree order as one array per axis, so a leaf is scanned several points
 // per instruction. A leaf kernel (chosen once, from what the CPU supports) computes distances and
 // orthants for 8 (AVX-512) or 4 (AVX2) points at a time, compares each with its orthant's best
-// held in registers (permuted into place: no gather; the 4D AVX2 kernel still gathers, its 16
-// bests would not fit), and sends through the exact rule only the rare point below that best, or
-// at it but not that very point (a seed met again in its leaf). A portable scalar kernel does the
+// held in registers (permuted into place: no gather), and sends through the exact rule only the
+// rare point below that best, or at it but not that very point (a seed met again in its leaf).
+// The 4D AVX2 kernel gathers the bests instead (16 would take 8 registers: spilled, no faster)
+// and sends every point at or below its best. A portable scalar kernel does the
 // same without branches. Pruning compares a box's distance with every orthant's best at once (one
 // vector compare) and keeps the orthants the box reaches (a table indexed by which sides of the
 // query the box spans). The tree walk itself (hard-to-predict visits) and cache misses on large
