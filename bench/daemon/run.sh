@@ -143,10 +143,11 @@ for ((i = 0; i < 200; i++)); do
   if grep -q '^meter: connected' <<<"$rig" && grep -q '^stage: connected' <<<"$rig"; then break; fi
   sleep 0.1
 done
+# Long enough to go on recording through both windows (a) and (b): steps_recorded > 0 in each.
 cat >"$work/live-plan.json" <<'EOF'
 {"name": "bench: recording while queried",
- "sampleRotation": {"delta": {"start": 20, "stop": 60, "step": 20},
-                    "alpha": {"start": 0, "stop": 60, "step": 15}, "beta": {"step": 15}},
+ "sampleRotation": {"delta": {"start": 20, "stop": 60, "step": 10},
+                    "alpha": {"start": 0, "stop": 60, "step": 5}, "beta": {"step": 15}},
  "reference": {"perDetectorPosition": true},
  "measurement": {"integrationMs": 50, "averages": 1}}
 EOF
