@@ -864,8 +864,8 @@ void KdTree::SearchOrthants(OrthantBest& best, OrthantWinners& winners) const {
 
 void KdTree::NearestPerOrthant(const double* p, OrthantWinners& winners) const {
   OrthantBest best;
-  const auto d = static_cast<std::size_t>(dims_);
-  std::copy(p, p + d, best.q.begin());
+  // Coordinate by coordinate: std::copy of three doubles became a call to memmove.
+  best.q = {p[0], p[1], p[2], dims_ == 4 ? p[3] : 0.0};
   if (dims_ == 3) {
     SearchOrthants<3>(best, winners);
   } else {
