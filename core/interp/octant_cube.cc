@@ -338,20 +338,24 @@ struct FourTetrahedra {
   unsigned flat = 0;
   alignas(32) double lambda[4][4];  // [k][lane]
 };
-__attribute__((target("avx2"))) void Barycentric4(const __m256d (&v)[4][3], const double* p,
-                                                  FourTetrahedra& out) {
+__attribute__((target("avx2"), always_inline)) inline void Barycentric4(const __m256d (&v)[4][3],
+                                                                        const double* p,
+                                                                        FourTetrahedra& out) {
   const __m256d zero = _mm256_setzero_pd();
   __m256d e[3][3];
   __m256d len2[3];
   __m256d r[3];
+#pragma GCC unroll 4
   for (int k = 0; k < 3; ++k) {
     __m256d sum = zero;
+#pragma GCC unroll 4
     for (int j = 0; j < 3; ++j) {
       e[k][j] = _mm256_sub_pd(v[k + 1][j], v[0][j]);
       sum = _mm256_add_pd(sum, Mul4(e[k][j], e[k][j]));
     }
     len2[k] = sum;
   }
+#pragma GCC unroll 4
   for (int j = 0; j < 3; ++j) r[j] = _mm256_sub_pd(_mm256_set1_pd(p[j]), v[0][j]);
   const __m256d det = Det3x4(e[0], e[1], e[2]);
   // The degenerate test as Barycentric does it: the quick comparison of squares, and the exact
@@ -384,6 +388,7 @@ __attribute__((target("avx2"))) void Barycentric4(const __m256d (&v)[4][3], cons
   const __m256d shortcut_limit = Mul4(_mm256_set1_pd(2.0 * kEnclosingTolerance), abs_det);
   __m256d inside = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
   __m256d sum_mu = zero;
+#pragma GCC unroll 4
   for (int k = 0; k < 3; ++k) {
     const __m256d* c0 = k == 0 ? r : e[0];
     const __m256d* c1 = k == 1 ? r : e[1];
@@ -413,6 +418,7 @@ __attribute__((target("avx2"))) void Barycentric4(const __m256d (&v)[4][3], cons
 __attribute__((target("avx2"))) inline void CubeAxes(const OrthantWinners& winners,
                                                      __m256d (&lo)[3], __m256d (&hi)[3]) {
   const auto& x = winners.scaled;
+#pragma GCC unroll 4
   for (int j = 0; j < 3; ++j) {
     lo[j] = _mm256_set_pd(x[3][j], x[2][j], x[1][j], x[0][j]);
     hi[j] = _mm256_set_pd(x[7][j], x[6][j], x[5][j], x[4][j]);
@@ -444,6 +450,7 @@ __attribute__((target("avx2"))) OctantBlend FindOctantBlend3Avx2(const OrthantWi
   CubeAxes(winners, lo, hi);
   __m256d first[4][3];
   __m256d centre[4][3];
+#pragma GCC unroll 4
   for (int j = 0; j < 3; ++j) {
     first[0][j] = Pick<0, 0, 0, 3>(lo[j], hi[j]);
     first[1][j] = Pick<1, 3, 4, 5>(lo[j], hi[j]);
@@ -473,6 +480,7 @@ __attribute__((target("avx2"))) OctantBlend FindOctantBlend3Avx2(const OrthantWi
   const int lane = t == 4 ? 0 : t;
   double lambda[4];
   double total = 0.0;
+#pragma GCC unroll 4
   for (int k = 0; k < 4; ++k) {
     const double l = winner.lambda[k][lane];
     lambda[k] = l > 0.0 ? l : 0.0;
