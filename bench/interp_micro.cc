@@ -194,7 +194,7 @@ void BM_NearestSearch(benchmark::State& state, std::string set) {
 }
 
 // Steps 3–4 on real winners: the first enclosing simplex and its barycentric weights.
-void BM_FindBlend(benchmark::State& state, std::string set) {
+void BM_FindBlend(benchmark::State& state, std::string set, bool fast) {
   const DataSet& data = Data(set);
   const KdTree tree(data.cloud);
   const auto d = static_cast<std::size_t>(data.cloud.dims);
@@ -204,8 +204,9 @@ void BM_FindBlend(benchmark::State& state, std::string set) {
   }
   std::size_t i = 0;
   for (auto _ : state) {
-    const OctantBlend blend =
-        FindOctantBlend(winners[i], std::span(data.queries.data() + i * d, d), data.cloud.dims);
+    const std::span<const double> q(data.queries.data() + i * d, d);
+    const OctantBlend blend = fast ? FindOctantBlendFast(winners[i], q, data.cloud.dims)
+                                   : FindOctantBlend(winners[i], q, data.cloud.dims);
     benchmark::DoNotOptimize(blend.weight[0]);
     i = (i + 1) % kQueries;
   }
@@ -304,7 +305,10 @@ void RegisterAll() {
   for (const char* set : kSets) {
     benchmark::RegisterBenchmark(
         (std::string("FindBlend/") + set).c_str(),
-        [set = std::string(set)](benchmark::State& s) { BM_FindBlend(s, set); });
+        [set = std::string(set)](benchmark::State& s) { BM_FindBlend(s, set, false); });
+    benchmark::RegisterBenchmark(
+        (std::string("FindBlend/") + set + "/fast").c_str(),
+        [set = std::string(set)](benchmark::State& s) { BM_FindBlend(s, set, true); });
   }
   for (const char* set : {"rig", "aniso4d"}) {
     benchmark::RegisterBenchmark(
