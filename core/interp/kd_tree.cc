@@ -189,6 +189,44 @@ struct Avx2Bests {
     }
   }
 
+  // Squared distances ((0 + dx²) + dy²) + dz² (+ dw², each square rounded) and sides (plus[j]:
+  // x_j >= q_j) of the four points whose coordinates are v[j], lane by lane.
+  __attribute__((target("avx2"), always_inline)) static inline __m256d Measure(const __m256d* v,
+                                                                               const __m256d* q,
+                                                                               __m256d* plus) {
+    __m256d d2 = _mm256_setzero_pd();
+#pragma GCC unroll 4
+    for (int j = 0; j < D; ++j) {
+      const __m256d diff = _mm256_sub_pd(v[j], q[j]);
+      __m256d sq = _mm256_mul_pd(diff, diff);
+      asm("" : "+x"(sq));  // no fused multiply-add: round the square first
+      d2 = j == 0 ? sq : _mm256_add_pd(d2, sq);
+      plus[j] = _mm256_cmp_pd(v[j], q[j], _CMP_GE_OQ);
+    }
+    return d2;
+  }
+
+  // The exact rule (OrthantBest::Offer) for each lane of `candidates`, lane k being the point at
+  // tree position at[k]; the registers follow. True when some orthant improved.
+  __attribute__((target("avx2"), always_inline)) inline bool Offer(
+      unsigned candidates, __m256d dist2, const __m256d* plus, const std::uint32_t* at,
+      const std::uint32_t* rank, KdTree::OrthantBest& best) {
+    alignas(32) double dist[4];
+    alignas(32) std::int64_t orthant[4];
+    _mm256_store_pd(dist, dist2);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(orthant), Code(plus));
+    bool improved = false;
+    for (; candidates != 0; candidates &= candidates - 1) {
+      const int lane = std::countr_zero(candidates);
+      const std::uint32_t point = at[lane];
+      const auto o = static_cast<unsigned>(orthant[lane]);
+      const bool better = best.Offer(o, dist[lane], rank[point], point);
+      Update(better, o, dist[lane], point);
+      improved |= better;
+    }
+    return improved;
+  }
+
   // Lane masks of the orthants in `need` (bit o for orthant o).
   __attribute__((target("avx2"), always_inline)) static inline void NeedMask(unsigned need,
                                                                              __m256d* keep) {
@@ -283,33 +321,17 @@ struct LeafKernels {
     const __m256i lane_index = _mm256_set_epi64x(3, 2, 1, 0);
     bool improved = false;
     for (std::uint32_t pos = begin; pos < end; pos += 4) {
-      __m256d d2 = _mm256_setzero_pd();
-      __m256d plus[D];
+      __m256d v[D];
 #pragma GCC unroll 4
-      for (int j = 0; j < D; ++j) {
-        const __m256d v = _mm256_loadu_pd(axis[j] + pos);
-        const __m256d diff = _mm256_sub_pd(v, q[j]);
-        __m256d sq = _mm256_mul_pd(diff, diff);
-        asm("" : "+x"(sq));  // no fused multiply-add: round the square first
-        d2 = j == 0 ? sq : _mm256_add_pd(d2, sq);
-        plus[j] = _mm256_cmp_pd(v, q[j], _CMP_GE_OQ);
-      }
+      for (int j = 0; j < D; ++j) v[j] = _mm256_loadu_pd(axis[j] + pos);
+      __m256d plus[D];
+      const __m256d d2 = Avx2Bests<D>::Measure(v, q, plus);
       const __m256i positions = _mm256_add_epi64(_mm256_set1_epi64x(pos), lane_index);
       unsigned candidates = bests.Candidates(d2, plus, positions);
       if (end - pos < 4) candidates &= (1u << (end - pos)) - 1u;
       if (candidates == 0) continue;
-      alignas(32) double dist[4];
-      alignas(32) std::int64_t orthant[4];
-      _mm256_store_pd(dist, d2);
-      _mm256_store_si256(reinterpret_cast<__m256i*>(orthant), Avx2Bests<D>::Code(plus));
-      for (; candidates != 0; candidates &= candidates - 1) {
-        const int lane = std::countr_zero(candidates);
-        const std::uint32_t at = pos + static_cast<std::uint32_t>(lane);
-        const auto o = static_cast<unsigned>(orthant[lane]);
-        const bool better = best.Offer(o, dist[lane], rank[at], at);
-        bests.Update(better, o, dist[lane], at);
-        improved |= better;
-      }
+      const std::uint32_t at[4] = {pos, pos + 1, pos + 2, pos + 3};
+      improved |= bests.Offer(candidates, d2, plus, at, rank, best);
     }
     return improved;
   }
@@ -380,33 +402,16 @@ struct LeafKernels {
       for (std::uint32_t half = 0; half < 2; ++half) {
         const std::uint32_t* at = entry + std::size_t{b} * 8 + half * 4;
         const __m128i index = _mm_loadu_si128(reinterpret_cast<const __m128i*>(at));
-        __m256d d2 = _mm256_setzero_pd();
-        __m256d plus[D];
+        __m256d v[D];
 #pragma GCC unroll 4
-        for (int j = 0; j < D; ++j) {
-          const __m256d v = _mm256_i32gather_pd(axis[j], index, 8);
-          const __m256d diff = _mm256_sub_pd(v, q[j]);
-          __m256d sq = _mm256_mul_pd(diff, diff);
-          asm("" : "+x"(sq));  // no fused multiply-add: round the square first
-          d2 = j == 0 ? sq : _mm256_add_pd(d2, sq);
-          plus[j] = _mm256_cmp_pd(v, q[j], _CMP_GE_OQ);
-        }
+        for (int j = 0; j < D; ++j) v[j] = _mm256_i32gather_pd(axis[j], index, 8);
+        __m256d plus[D];
+        const __m256d d2 = Avx2Bests<D>::Measure(v, q, plus);
         // As in Avx2: a point equal to its orthant's best is a candidate only when it is not that
         // point itself (lists repeat their last entry as padding).
-        unsigned candidates = bests.Candidates(d2, plus, _mm256_cvtepu32_epi64(index));
+        const unsigned candidates = bests.Candidates(d2, plus, _mm256_cvtepu32_epi64(index));
         if (candidates == 0) continue;
-        alignas(32) double dist[4];
-        alignas(32) std::int64_t orthant[4];
-        _mm256_store_pd(dist, d2);
-        _mm256_store_si256(reinterpret_cast<__m256i*>(orthant), Avx2Bests<D>::Code(plus));
-        for (; candidates != 0; candidates &= candidates - 1) {
-          const int lane = std::countr_zero(candidates);
-          const std::uint32_t pos = at[lane];
-          const auto o = static_cast<unsigned>(orthant[lane]);
-          const bool better = best.Offer(o, dist[lane], rank[pos], pos);
-          bests.Update(better, o, dist[lane], pos);
-          improved |= better;
-        }
+        improved |= bests.Offer(candidates, d2, plus, at, rank, best);
       }
       if (!improved) continue;
       worst = bests.Worst(keep);
