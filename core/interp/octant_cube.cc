@@ -524,8 +524,12 @@ OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const d
   static const BlendKernel best = BlendKernelSupported(BlendKernel::kAvx512) ? BlendKernel::kAvx512
                                   : BlendKernelSupported(BlendKernel::kAvx2) ? BlendKernel::kAvx2
                                                                              : BlendKernel::kScalar;
-  if (kernel == BlendKernel::kBest) kernel = best;
-  if (!BlendKernelSupported(kernel)) kernel = BlendKernel::kScalar;
+  // kBest is what every query asks for: it needs no check beyond the one made once above.
+  if (kernel == BlendKernel::kBest) {
+    kernel = best;
+  } else if (!BlendKernelSupported(kernel)) {
+    kernel = BlendKernel::kScalar;
+  }
   if (dims == 3 && kernel != BlendKernel::kScalar) {
     std::uint32_t empty = 0;
     for (int o = 0; o < 8; ++o) {
