@@ -345,18 +345,12 @@ struct LeafKernels {
     for (int j = 0; j < D; ++j) q[j] = _mm256_set1_pd(best.q[static_cast<std::size_t>(j)]);
     bool improved = false;
     for (std::uint32_t pos = begin; pos < end; pos += 4) {
-      __m256d d2 = _mm256_setzero_pd();
-      __m256i code = _mm256_setzero_si256();
+      __m256d v[D];
 #pragma GCC unroll 4
-      for (int j = 0; j < D; ++j) {
-        const __m256d v = _mm256_loadu_pd(tree.axis[j] + pos);
-        const __m256d diff = _mm256_sub_pd(v, q[j]);
-        __m256d sq = _mm256_mul_pd(diff, diff);
-        asm("" : "+x"(sq));  // no fused multiply-add: round the square first
-        d2 = j == 0 ? sq : _mm256_add_pd(d2, sq);
-        const __m256i plus = _mm256_castpd_si256(_mm256_cmp_pd(v, q[j], _CMP_GE_OQ));
-        code = _mm256_or_si256(code, _mm256_and_si256(plus, _mm256_set1_epi64x(1 << j)));
-      }
+      for (int j = 0; j < D; ++j) v[j] = _mm256_loadu_pd(tree.axis[j] + pos);
+      __m256d plus[D];
+      const __m256d d2 = Avx2Bests<D>::Measure(v, q, plus);
+      const __m256i code = Avx2Bests<D>::Code(plus);
       const __m256d limit = _mm256_i64gather_pd(best.d2.data(), code, 8);
       unsigned candidates =
           static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(d2, limit, _CMP_LE_OQ)));
