@@ -37,6 +37,31 @@ struct DataSet {
   std::vector<double> queries;  // kQueries × dims, already scaled (scale 1)
 };
 
+// n random rig poses, as compare.py's rig queries: α in [0, 70], β in [−175, 180], δ in
+// [0, 146.25] degrees, converted to (θi, θo, φ) with geometry.md's closed forms; 3 per pose.
+std::vector<double> RigPoses(std::size_t n, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  constexpr double kRad = 3.14159265358979323846 / 180.0;
+  std::vector<double> out;
+  while (out.size() < n * 3) {
+    const double a = 70.0 * u(rng) * kRad;
+    const double b = (-175.0 + 355.0 * u(rng)) * kRad;
+    const double dl = 146.25 * u(rng) * kRad;
+    const double ci = std::cos(a) * std::cos(b);
+    const double co = std::cos(a) * std::cos(b - dl);
+    const double ti = std::acos(std::clamp(ci, -1.0, 1.0)) / kRad;
+    const double to = std::acos(std::clamp(co, -1.0, 1.0)) / kRad;
+    if (ti > 89.999 || to > 89.999) continue;
+    double phi = 0.0;
+    if (ti > 1e-7 && to > 1e-7) {
+      const double c = (std::cos(dl) - ci * co) / (std::sin(ti * kRad) * std::sin(to * kRad));
+      phi = std::acos(std::clamp(c, -1.0, 1.0)) / kRad;
+    }
+    out.insert(out.end(), {ti, to, phi});
+  }
+  return out;
+}
+
 const DataSet& Data(const std::string& name) {
   static std::map<std::string, std::unique_ptr<DataSet>> sets;
   auto& slot = sets[name];
@@ -62,25 +87,7 @@ const DataSet& Data(const std::string& name) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   if (name == "rig" || name == "rig_mirror") {
-    // Random rig poses, as compare.py's rig queries: α in [0, 70], β in [−175, 180], δ in
-    // [0, 146.25] degrees, converted to (θi, θo, φ) with geometry.md's closed forms.
-    constexpr double kRad = 3.14159265358979323846 / 180.0;
-    while (slot->queries.size() < kQueries * 3) {
-      const double a = 70.0 * u(rng) * kRad;
-      const double b = (-175.0 + 355.0 * u(rng)) * kRad;
-      const double dl = 146.25 * u(rng) * kRad;
-      const double ci = std::cos(a) * std::cos(b);
-      const double co = std::cos(a) * std::cos(b - dl);
-      const double ti = std::acos(std::clamp(ci, -1.0, 1.0)) / kRad;
-      const double to = std::acos(std::clamp(co, -1.0, 1.0)) / kRad;
-      if (ti > 89.999 || to > 89.999) continue;
-      double phi = 0.0;
-      if (ti > 1e-7 && to > 1e-7) {
-        const double c = (std::cos(dl) - ci * co) / (std::sin(ti * kRad) * std::sin(to * kRad));
-        phi = std::acos(std::clamp(c, -1.0, 1.0)) / kRad;
-      }
-      slot->queries.insert(slot->queries.end(), {ti, to, phi});
-    }
+    slot->queries = RigPoses(kQueries, rng);
     return *slot;
   }
   slot->queries.resize(kQueries * hi.size());
@@ -163,6 +170,46 @@ void BM_GridHits(benchmark::State& state, std::string set, bool hot) {
   state.SetItemsProcessed(state.iterations());
 }
 
+// The search as a large batch runs it (OctantInterpolator::SpectraAt): 50,000 random rig poses
+// grouped by grid cell, the queries of a cell up to `lanes` at a time through
+// KdTree::NearestPerOrthantInCell (lanes 1: one list scan per query, as NearestPerOrthant's grid
+// path). Only the queries the grid answers; items = queries. Counter: queries per call.
+void BM_CellGroups(benchmark::State& state, KdTree::Kernel kernel, int lanes) {
+  const DataSet& data = Data("rig");
+  const KdTree tree(data.cloud, kernel, KdTree::Search::kGridThenTree);
+  std::mt19937_64 rng(11);
+  const std::vector<double> poses = RigPoses(50000, rng);
+  std::map<std::uint32_t, std::vector<const double*>> by_cell;
+  for (std::size_t i = 0; i < poses.size(); i += 3) {
+    const std::uint32_t cell = tree.ListedCell(poses.data() + i);
+    if (cell != OrthantGrid::kNoCell) by_cell[cell].push_back(poses.data() + i);
+  }
+  struct Call {
+    std::uint32_t cell;
+    const double* const* queries;
+    int count;
+  };
+  std::vector<Call> calls;
+  std::size_t queries = 0;
+  for (const auto& [cell, list] : by_cell) {
+    for (std::size_t first = 0; first < list.size(); first += static_cast<std::size_t>(lanes)) {
+      const int count = static_cast<int>(std::min<std::size_t>(lanes, list.size() - first));
+      calls.push_back({cell, list.data() + first, count});
+      queries += static_cast<std::size_t>(count);
+    }
+  }
+  std::array<WinnerCube3, KdTree::kCellLanes> cubes;
+  for (auto _ : state) {
+    for (const Call& call : calls) {
+      tree.NearestPerOrthantInCell(call.cell, call.queries, call.count, cubes.data());
+      benchmark::DoNotOptimize(cubes[0].rank[0]);
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(queries));
+  state.counters["per_call"] = static_cast<double>(queries) / static_cast<double>(calls.size());
+  state.SetLabel(KdTree::KernelName(tree.kernel()));
+}
+
 void BM_OrthantSearch(benchmark::State& state, std::string set, KdTree::Kernel kernel,
                       KdTree::Search search) {
   const DataSet& data = Data(set);
@@ -194,7 +241,8 @@ void BM_NearestSearch(benchmark::State& state, std::string set) {
 }
 
 // Steps 3–4 on real winners: the first enclosing simplex and its barycentric weights.
-void BM_FindBlend(benchmark::State& state, std::string set, bool fast) {
+void BM_FindBlend(benchmark::State& state, std::string set, bool fast,
+                  BlendKernel kernel = BlendKernel::kBest) {
   const DataSet& data = Data(set);
   const KdTree tree(data.cloud);
   const auto d = static_cast<std::size_t>(data.cloud.dims);
@@ -205,7 +253,7 @@ void BM_FindBlend(benchmark::State& state, std::string set, bool fast) {
   std::size_t i = 0;
   for (auto _ : state) {
     const std::span<const double> q(data.queries.data() + i * d, d);
-    const OctantBlend blend = fast ? FindOctantBlendFast(winners[i], q, data.cloud.dims)
+    const OctantBlend blend = fast ? FindOctantBlendFast(winners[i], q, data.cloud.dims, kernel)
                                    : FindOctantBlend(winners[i], q, data.cloud.dims);
     benchmark::DoNotOptimize(blend.weight[0]);
     i = (i + 1) % kQueries;
@@ -297,6 +345,14 @@ void RegisterAll() {
   }
   benchmark::RegisterBenchmark("GridHitsHot/rig",
                                [](benchmark::State& s) { BM_GridHits(s, "rig", true); });
+  for (const auto& [kernel, name] : kernels) {
+    if (!KdTree::Supported(kernel)) continue;
+    for (int lanes : {1, KdTree::kCellLanes}) {
+      benchmark::RegisterBenchmark(
+          ("CellGroups/rig/" + std::string(name) + "/lanes" + std::to_string(lanes)).c_str(),
+          [kernel = kernel, lanes](benchmark::State& s) { BM_CellGroups(s, kernel, lanes); });
+    }
+  }
   for (const char* set : kSets) {
     benchmark::RegisterBenchmark(
         (std::string("NearestSearch/") + set).c_str(),
@@ -309,6 +365,14 @@ void RegisterAll() {
     benchmark::RegisterBenchmark(
         (std::string("FindBlend/") + set + "/fast").c_str(),
         [set = std::string(set)](benchmark::State& s) { BM_FindBlend(s, set, true); });
+  }
+  // The 3D vector kernels side by side (FindBlend/rig/fast runs the widest the CPU has).
+  for (BlendKernel kernel : {BlendKernel::kAvx2, BlendKernel::kAvx512}) {
+    if (!BlendKernelSupported(kernel)) continue;
+    const std::string name = kernel == BlendKernel::kAvx2 ? "avx2" : "avx512";
+    benchmark::RegisterBenchmark(("FindBlend/rig/" + name).c_str(), [kernel](benchmark::State& s) {
+      BM_FindBlend(s, "rig", true, kernel);
+    });
   }
   for (const char* set : {"rig", "aniso4d"}) {
     benchmark::RegisterBenchmark(

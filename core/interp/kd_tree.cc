@@ -6,6 +6,8 @@
 #include <limits>
 #include <numeric>
 
+#include "core/interp/kd_tree_cells.h"
+
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define BRDF_KD_X86 1
 #include <immintrin.h>
@@ -830,8 +832,22 @@ void KdTree::Seed(OrthantBest& best) const {
 }
 
 template <int D>
+void KdTree::FillWinners(const std::uint32_t* pos, OrthantWinners& winners) const {
+  // The coordinates from the per-axis arrays, whose lines the search just read.
+  for (std::size_t o = 0; o < (std::size_t{1} << D); ++o) {
+    winners.scaled[o] = nullptr;
+    if (pos[o] == kNoPoint) {
+      winners.rank[o] = kNoPoint;
+      continue;
+    }
+    winners.rank[o] = rank_[pos[o]];
+    for (std::size_t j = 0; j < D; ++j) winners.coords[o][j] = axis_[j][pos[o]];
+    winners.scaled[o] = winners.coords[o].data();
+  }
+}
+
+template <int D>
 void KdTree::SearchOrthants(OrthantBest& best, OrthantWinners& winners) const {
-  constexpr std::size_t kOrthants = std::size_t{1} << D;
   best.d2.fill(kInf);
   best.rank.fill(kNoPoint);
   best.pos.fill(kNoPoint);  // no point's position (the AVX-512 kernel compares positions)
@@ -840,25 +856,11 @@ void KdTree::SearchOrthants(OrthantBest& best, OrthantWinners& winners) const {
     // The cell's list holds every possible winner, nearest to the cell first: one short scan, no
     // tree.
     list_scan_(*this, grid_.entry() + begin, grid_.block_gap() + begin / 8, count / 8, need, best);
-    for (std::size_t o = 0; o < kOrthants; ++o) {
-      winners.rank[o] = best.rank[o];
-      winners.scaled[o] = nullptr;
-      if (best.rank[o] == kNoPoint) continue;
-      for (std::size_t j = 0; j < D; ++j) winners.coords[o][j] = axis_[j][best.pos[o]];
-      winners.scaled[o] = winners.coords[o].data();
-    }
-    return;
+  } else {
+    Seed(best);
+    VisitOrthants<D>(0, best);
   }
-  Seed(best);
-  VisitOrthants<D>(0, best);
-  // The winners' coordinates from the per-axis arrays, whose lines the leaf scans just read.
-  for (std::size_t o = 0; o < kOrthants; ++o) {
-    winners.rank[o] = best.rank[o];
-    winners.scaled[o] = nullptr;
-    if (best.rank[o] == kNoPoint) continue;
-    for (std::size_t j = 0; j < D; ++j) winners.coords[o][j] = axis_[j][best.pos[o]];
-    winners.scaled[o] = winners.coords[o].data();
-  }
+  FillWinners<D>(best.pos.data(), winners);
 }
 
 void KdTree::NearestPerOrthant(const double* p, OrthantWinners& winners) const {
@@ -869,6 +871,55 @@ void KdTree::NearestPerOrthant(const double* p, OrthantWinners& winners) const {
     SearchOrthants<3>(best, winners);
   } else {
     SearchOrthants<4>(best, winners);
+  }
+}
+
+std::uint32_t KdTree::ListedCell(const double* p) const {
+  return dims_ == 3 ? grid_.ListedCell<3>(p) : OrthantGrid::kNoCell;
+}
+
+void KdTree::NearestPerOrthantInCell(std::uint32_t cell, const double* const* queries, int count,
+                                     WinnerCube3* cubes) const {
+  static_assert(kCellLanes == interp::kCellLanes);
+  std::uint32_t begin = 0, entries = 0, need = 0;
+  grid_.List(cell, begin, entries, need);
+  const std::uint32_t* list = grid_.entry() + begin;
+  const double* gap = grid_.block_gap() + begin / 8;
+#ifdef BRDF_KD_X86
+  // A lone query scans faster on its own (ListAvx512 sends only its few candidates through the
+  // exact rule; the lanes of the cell kernel would stand mostly idle).
+  if (count > 1 && kernel_ == Kernel::kAvx512) {
+    const double* axis[3] = {axis_[0].data(), axis_[1].data(), axis_[2].data()};
+    CellListAvx512(axis, rank_.data(), list, gap, entries / 8, need, queries, count, cubes);
+    return;
+  }
+  if (count > 1 && kernel_ == Kernel::kAvx2 && rank_.size() - kPadding <= kCellAvx2Positions) {
+    const double* axis[3] = {axis_[0].data(), axis_[1].data(), axis_[2].data()};
+    for (int first = 0; first < count; first += kCellLanesAvx2) {
+      CellListAvx2(axis, rank_.data(), list, gap, entries / 8, need, queries + first,
+                   std::min(kCellLanesAvx2, count - first), cubes + first);
+    }
+    return;
+  }
+#endif
+  for (int k = 0; k < count; ++k) {
+    OrthantBest best;
+    best.q = {queries[k][0], queries[k][1], queries[k][2], 0.0};
+    best.d2.fill(kInf);
+    best.rank.fill(kNoPoint);
+    best.pos.fill(kNoPoint);
+    list_scan_(*this, list, gap, entries / 8, need, best);
+    WinnerCube3& cube = cubes[k];
+    cube.empty = 0;
+    for (std::size_t o = 0; o < 8; ++o) {
+      const std::uint32_t pos = best.pos[o];
+      if (pos == kNoPoint) {
+        cube.empty |= 1u << o;
+        continue;
+      }
+      cube.rank[o] = rank_[pos];
+      for (std::size_t j = 0; j < 3; ++j) cube.axis[j][o] = axis_[j][pos];
+    }
   }
 }
 

@@ -77,6 +77,19 @@ class KdTree {
   // The rank of the point nearest to p (the lowest rank among equals). p must be finite.
   std::uint32_t Nearest(const double* p) const;
 
+  // Batches (OctantInterpolator::SpectraAt) group their queries by grid cell, because the queries
+  // of one cell can share one scan of its list. ListedCell is p's cell (OrthantGrid::kNoCell when p
+  // is outside the grid or its cell has no list: search those with NearestPerOrthant).
+  // NearestPerOrthantInCell answers `count` (1 … kCellLanes) queries of one such cell at once,
+  // each as the cube of winners the vector blends read (octant_cube.h, WinnerCube3):
+  // with AVX-512, one query per vector lane, the list's entries broadcast to all lanes, no
+  // branch per entry (the kernel in kd_tree_cells.cc); elsewhere, and for a lone query, one list
+  // scan per query. The winners are NearestPerOrthant's, bit for bit, ties included.
+  static constexpr int kCellLanes = 8;
+  std::uint32_t ListedCell(const double* p) const;
+  void NearestPerOrthantInCell(std::uint32_t cell, const double* const* queries, int count,
+                               WinnerCube3* cubes) const;
+
   // Nodes in the tree and points per leaf (for benchmarks).
   std::size_t node_count() const { return nodes_.size(); }
   std::uint32_t leaf_size() const { return leaf_size_; }
@@ -116,6 +129,9 @@ class KdTree {
   void VisitOrthants(std::uint32_t node, OrthantBest& best) const;
   template <int D>
   void SearchOrthants(OrthantBest& best, OrthantWinners& winners) const;
+  // The winners at tree positions pos[o] (kNoPoint: orthant o is empty).
+  template <int D>
+  void FillWinners(const std::uint32_t* pos, OrthantWinners& winners) const;
   template <int D>
   void VisitNearest(std::uint32_t node, const double* p, NearestBest& best) const;
   template <int D>

@@ -136,13 +136,130 @@ struct OctantInterpolator::Impl {
   // BlendOctantSpectrum's numbers (BlendSpectra over the vertices in order) for a kOk blend whose
   // ranks are grown ranks and whose spectra Blend prefetched already.
   void BlendInto(const OctantBlend& blend, std::span<double> out) const {
+    std::array<std::uint32_t, kMaxDims + 1> sample{};
+    for (std::size_t k = 0; k <= static_cast<std::size_t>(index->cloud.dims); ++k) {
+      sample[k] = SampleOf(blend.rank[k]);
+    }
+    BlendSamples(blend.weight.data(), sample.data(), out);
+  }
+  // The same for dims + 1 vertices given as weights and SampleSet indices.
+  void BlendSamples(const double* weight, const std::uint32_t* sample,
+                    std::span<double> out) const {
     const auto vertex_count = static_cast<std::size_t>(index->cloud.dims + 1);
     std::array<const double*, kMaxDims + 1> spectra{};
-    for (std::size_t k = 0; k < vertex_count; ++k) {
-      spectra[k] = samples->spectrum(SampleOf(blend.rank[k])).data();
+    for (std::size_t k = 0; k < vertex_count; ++k) spectra[k] = samples->spectrum(sample[k]).data();
+    BlendSpectra(std::span(weight, vertex_count), std::span(spectra.data(), vertex_count), out);
+  }
+
+  // Batches: whether SpectraAt groups n queries by grid cell (SpectraByCell). Only a grid's
+  // lists can be shared, and only when the batch is large enough for its queries to meet in
+  // cells: below a quarter of a query per cell, sorting would cost more than the sharing saves.
+  bool GroupsByCell(std::size_t n) const {
+    const OrthantGrid& grid = index->tree.grid();
+    return tail.size() == 0 && index->cloud.dims == 3 && !grid.empty() &&
+           n * 4 >= grid.cell_count();
+  }
+
+  // SpectraAt for a batch whose queries meet in grid cells, in three passes: (1) the queries
+  // scaled and sorted by cell (a counting sort); (2) in cell order, the queries of a cell searched
+  // kCellLanes at a time with one scan of its list (KdTree::NearestPerOrthantInCell), the others
+  // with the tree, and each one's simplex chosen, into one cache line per query written in that
+  // order; (3) in query order, the spectra blended into the rows, which are written one after
+  // another, each query's vertex spectra fetched a few queries ahead. Writing the rows in cell
+  // order instead cost a cache miss per row (measured: about 0.1 µs per rig query).
+  // The same answers as query by query, bit for bit.
+  void SpectraByCell(std::span<const double> queries, std::span<InterpStatus> statuses,
+                     std::span<double> spectra, std::size_t bands) const {
+    const KdTree& tree = index->tree;
+    const std::size_t n = statuses.size();
+    const std::size_t cells = tree.grid().cell_count();
+    // Bucket `cells` holds the queries outside every list, `cells + 1` the invalid ones.
+    const auto no_list = static_cast<std::uint32_t>(cells);
+    const auto invalid = static_cast<std::uint32_t>(cells + 1);
+    // (1) Scale and sort.
+    std::vector<double> scaled(3 * n);
+    std::vector<std::uint32_t> bucket(n);
+    std::vector<std::uint32_t> start(cells + 3, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::span<const double> query = queries.subspan(3 * i, 3);
+      double* p = scaled.data() + 3 * i;
+      if (!ValidQuery(query, 3)) {
+        bucket[i] = invalid;
+      } else {
+        index->cloud.ScaleQuery(query, std::span(p, 3));
+        const std::uint32_t cell = tree.ListedCell(p);
+        bucket[i] = cell == OrthantGrid::kNoCell ? no_list : cell;
+      }
+      ++start[bucket[i] + 1];
     }
-    BlendSpectra(std::span(blend.weight.data(), vertex_count),
-                 std::span(spectra.data(), vertex_count), out);
+    for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+    std::vector<std::uint32_t> slot(n);  // query i is the slot[i]-th in cell order
+    std::vector<double> sorted(3 * n);   // the scaled queries in cell order
+    {
+      std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
+      for (std::size_t i = 0; i < n; ++i) {
+        slot[i] = next[bucket[i]]++;
+        std::copy_n(scaled.data() + 3 * i, 3, sorted.data() + 3 * std::size_t{slot[i]});
+      }
+    }
+
+    // (2) Search and choice of simplex.
+    constexpr int kLanes = KdTree::kCellLanes;
+    std::vector<Vertices> answer(n);
+    std::array<WinnerCube3, kLanes> cubes;
+    std::array<const double*, kLanes> p{};
+    for (std::uint32_t cell = 0; cell < no_list; ++cell) {
+      for (std::size_t first = start[cell]; first < start[cell + 1]; first += kLanes) {
+        const int count = static_cast<int>(std::min<std::size_t>(kLanes, start[cell + 1] - first));
+        for (int k = 0; k < count; ++k) p[k] = sorted.data() + 3 * (first + std::size_t(k));
+        tree.NearestPerOrthantInCell(cell, p.data(), count, cubes.data());
+        for (int k = 0; k < count; ++k)
+          answer[first + k] = Keep(FindOctantBlendFast(cubes[k], p[k]));
+      }
+    }
+    OrthantWinners winners;
+    for (std::size_t first = start[no_list]; first < start[invalid]; ++first) {
+      const double* q = sorted.data() + 3 * first;
+      tree.NearestPerOrthant(q, winners);
+      answer[first] = Keep(FindOctantBlendFast(winners, std::span(q, 3), 3));
+    }
+    // (3) The spectra.
+    constexpr std::size_t kAhead = 4;
+    auto prefetch = [&](std::size_t i) {
+      const Vertices& a = answer[slot[i]];
+      if (a.status != InterpStatus::kOk) return;
+      for (std::uint32_t s : a.sample) PrefetchSpectrum(samples->spectrum(s));
+    };
+    for (std::size_t i = 0; i < std::min(n, kAhead); ++i) prefetch(i);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i + 2 * kAhead < n) __builtin_prefetch(&answer[slot[i + 2 * kAhead]]);
+      if (i + kAhead < n) prefetch(i + kAhead);
+      const Vertices& a = answer[slot[i]];
+      statuses[i] = a.status;
+      const std::span<double> row = spectra.subspan(i * bands, bands);
+      if (a.status == InterpStatus::kOk) {
+        BlendSamples(a.weight.data(), a.sample.data(), Bands(row));
+      } else {
+        std::fill(row.begin(), row.end(), std::numeric_limits<double>::quiet_NaN());
+      }
+    }
+  }
+
+  // What SpectraByCell keeps of a 3D blend for its spectrum: one cache line.
+  struct alignas(64) Vertices {
+    std::array<double, 4> weight;
+    std::array<std::uint32_t, 4> sample;  // SampleSet indices
+    InterpStatus status = InterpStatus::kEmptyOctant;
+  };
+  Vertices Keep(const OctantBlend& blend) const {
+    Vertices v;
+    v.status = blend.status;
+    if (blend.status != InterpStatus::kOk) return v;
+    for (std::size_t k = 0; k < 4; ++k) {
+      v.weight[k] = blend.weight[k];
+      v.sample[k] = SampleOf(blend.rank[k]);
+    }
+    return v;
   }
 
   // The complete answer of a blend (OctantInterpolation). With a tail, the grown cloud does not
@@ -287,6 +404,10 @@ void OctantInterpolator::SpectraAt(std::span<const double> queries,
   const auto d = static_cast<std::size_t>(dims());
   const std::size_t bands = spectra.size() / n;
   const Impl& impl = *impl_;
+  if (impl.GroupsByCell(n)) {
+    impl.SpectraByCell(queries, statuses, spectra, bands);
+    return;
+  }
   // Query i is searched (its winners' spectra prefetched) before query i − 1 is blended.
   OctantBlend previous;
   for (std::size_t i = 0; i <= n; ++i) {

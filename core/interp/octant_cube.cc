@@ -201,17 +201,10 @@ __attribute__((target("avx512f"))) inline __m512d Det3x8(const __m512d* c0, cons
 // the scalar function's operations, in its order, each rounded (no fused multiply-add: the
 // products are pinned); the scalar function's early exits skip work whose outcome they already
 // know, so computing everything and reading the verdict at the end gives the same answer.
-__attribute__((target("avx512f"))) OctantBlend FindOctantBlend3Avx512(const OrthantWinners& winners,
-                                                                      const double* p) {
+// x[j]: coordinate j of the winners, lane o for orthant o; rank: the winners' ranks by orthant.
+__attribute__((target("avx512f"), always_inline)) inline OctantBlend Blend3Avx512(
+    const __m512d (&x)[3], const std::uint32_t* rank, const double* p) {
   OctantBlend out;
-  // The winners' coordinates per axis, one lane per orthant.
-  alignas(64) double axis[3][8];
-  for (int o = 0; o < 8; ++o) {
-    const double* x = winners.scaled[static_cast<std::size_t>(o)];
-    for (int j = 0; j < 3; ++j) axis[j][o] = x[j];
-  }
-  __m512d x[3];
-  for (int j = 0; j < 3; ++j) x[j] = _mm512_load_pd(axis[j]);
   // Vertex k of tetrahedron t: orthant kTetrahedra[t].corners[k].
   const __m512i corner[4] = {
       _mm512_set_epi64(0, 0, 0, 0, 3, 0, 0, 0),  // lanes 7..0
@@ -251,62 +244,92 @@ __attribute__((target("avx512f"))) OctantBlend FindOctantBlend3Avx512(const Orth
                                        Mul8(Mul8(_mm512_set1_pd(kSquaredLimit), product),
                                             _mm512_set1_pd(1.0 + 1e-9)),
                                        _CMP_GT_OQ);
-  const __m512d hadamard = Mul8(Mul8(Mul8(_mm512_set1_pd(1.0), _mm512_maskz_sqrt_pd(0xFF, len2[0])),
-                                     _mm512_maskz_sqrt_pd(0xFF, len2[1])),
-                                _mm512_maskz_sqrt_pd(0xFF, len2[2]));
-  const __mmask8 exact_ok = _mm512_cmp_pd_mask(
-      abs_det, Mul8(_mm512_set1_pd(kDegenerateRelativeVolume), hadamard), _CMP_GT_OQ);
+  // Hadamard's bound with its square roots only when the quick test left a tetrahedron open
+  // (rarely: square roots of 8 lanes are slow on some CPUs).
+  __mmask8 exact_ok = 0;
+  if ((quick_ok & 0x1Fu) != 0x1Fu) {
+    const __m512d hadamard =
+        Mul8(Mul8(Mul8(_mm512_set1_pd(1.0), _mm512_maskz_sqrt_pd(0xFF, len2[0])),
+                  _mm512_maskz_sqrt_pd(0xFF, len2[1])),
+             _mm512_maskz_sqrt_pd(0xFF, len2[2]));
+    exact_ok = _mm512_cmp_pd_mask(
+        abs_det, Mul8(_mm512_set1_pd(kDegenerateRelativeVolume), hadamard), _CMP_GT_OQ);
+  }
   const auto flat = static_cast<unsigned>(static_cast<__mmask8>(~(quick_ok | exact_ok))) & 0x1Fu;
   // Cramer's rule: μ_k = det(edges with e_k replaced by r) / det; outside when some weight is
-  // below −tolerance.
-  const __m512d tol = _mm512_set1_pd(-kEnclosingTolerance);
-  __m512d lambda[4];
-  __mmask8 inside = 0xFF;
-  __m512d sum_mu = zero;
+  // below −tolerance. The numerators for every lane; the divisions (slow for 8 lanes on some
+  // CPUs) only for the lanes Barycentric's shortcut leaves open: a numerator of the other sign
+  // than det, larger than 2·tolerance·|det|, means outside (kept as it is for the rare inputs
+  // where rounding could make it disagree with the division). Most tetrahedra of a cube are
+  // decided by it; about one lane per query is divided, in the scalar code's order.
+  alignas(64) double numerator[3][8];
+  __mmask8 cut = 0;
   for (int k = 0; k < 3; ++k) {
     const __m512d* c0 = k == 0 ? r : e[0];
     const __m512d* c1 = k == 1 ? r : e[1];
     const __m512d* c2 = k == 2 ? r : e[2];
-    const __m512d numerator = Det3x8(c0, c1, c2);
-    // Barycentric's shortcut (a numerator of the other sign than det, larger than
-    // 2·tolerance·|det|, means outside), kept as it is for the rare inputs where rounding could
-    // make it disagree with the division.
-    const __mmask8 opposite =
-        static_cast<__mmask8>(_mm512_cmp_pd_mask(numerator, zero, _CMP_LT_OQ) ^
-                              _mm512_cmp_pd_mask(det, zero, _CMP_LT_OQ));
-    const __mmask8 shortcut =
-        opposite & _mm512_cmp_pd_mask(numerator, zero, _CMP_NEQ_UQ) &
-        _mm512_cmp_pd_mask(_mm512_abs_pd(numerator),
-                           Mul8(_mm512_set1_pd(2.0 * kEnclosingTolerance), abs_det), _CMP_GT_OQ);
-    lambda[k + 1] = _mm512_div_pd(numerator, det);
-    inside &= static_cast<__mmask8>(~shortcut) & _mm512_cmp_pd_mask(lambda[k + 1], tol, _CMP_GE_OQ);
-    sum_mu = _mm512_add_pd(sum_mu, lambda[k + 1]);
+    const __m512d n = Det3x8(c0, c1, c2);
+    const __mmask8 opposite = static_cast<__mmask8>(_mm512_cmp_pd_mask(n, zero, _CMP_LT_OQ) ^
+                                                    _mm512_cmp_pd_mask(det, zero, _CMP_LT_OQ));
+    cut |= opposite & _mm512_cmp_pd_mask(n, zero, _CMP_NEQ_UQ) &
+           _mm512_cmp_pd_mask(_mm512_abs_pd(n),
+                              Mul8(_mm512_set1_pd(2.0 * kEnclosingTolerance), abs_det), _CMP_GT_OQ);
+    _mm512_store_pd(numerator[k], n);
   }
-  lambda[0] = _mm512_sub_pd(_mm512_set1_pd(1.0), sum_mu);
-  inside &= _mm512_cmp_pd_mask(lambda[0], tol, _CMP_GE_OQ);
-  const unsigned encloses = static_cast<unsigned>(inside) & ~flat & 0x1Fu;
-  if (encloses == 0) {
-    out.degenerate = std::popcount(flat);
-    out.status = InterpStatus::kNoEnclosingSimplex;
+  alignas(64) double determinant[8];
+  _mm512_store_pd(determinant, det);
+  double lambda[4];
+  for (unsigned open = ~(static_cast<unsigned>(cut) | flat) & 0x1Fu; open != 0; open &= open - 1) {
+    const int t = std::countr_zero(open);
+    double sum_mu = 0.0;
+    bool inside = true;
+#pragma GCC unroll 3
+    for (int k = 0; k < 3; ++k) {
+      lambda[k + 1] = numerator[k][t] / determinant[t];
+      inside = inside && lambda[k + 1] >= -kEnclosingTolerance;
+      sum_mu += lambda[k + 1];
+    }
+    lambda[0] = 1.0 - sum_mu;
+    if (!inside || !(lambda[0] >= -kEnclosingTolerance)) continue;
+    // The first tetrahedron that encloses p: weights as Barycentric computes them.
+    out.degenerate = std::popcount(flat & ((1u << t) - 1u));
+    double total = 0.0;
+#pragma GCC unroll 4
+    for (int k = 0; k < 4; ++k) {
+      lambda[k] = lambda[k] > 0.0 ? lambda[k] : 0.0;
+      total += lambda[k];
+    }
+    out.status = InterpStatus::kOk;
+    out.simplex = t;
+    for (std::size_t k = 0; k < 4; ++k) {
+      out.rank[k] = rank[kTetrahedra[static_cast<std::size_t>(t)].corners[k]];
+      out.weight[k] = lambda[k] / total;
+    }
     return out;
   }
-  const int t = std::countr_zero(encloses);
-  out.degenerate = std::popcount(flat & ((1u << t) - 1u));
-  __m512d total = zero;
-  for (int k = 0; k < 4; ++k) {
-    lambda[k] = _mm512_max_pd(lambda[k], zero);  // lambda > 0 ? lambda : 0
-    total = _mm512_add_pd(total, lambda[k]);
-  }
-  alignas(64) double w[4][8];
-  for (int k = 0; k < 4; ++k) _mm512_store_pd(w[k], _mm512_div_pd(lambda[k], total));
-  out.status = InterpStatus::kOk;
-  out.simplex = t;
-  for (std::size_t k = 0; k < 4; ++k) {
-    out.rank[k] =
-        winners.rank[static_cast<std::size_t>(kTetrahedra[static_cast<std::size_t>(t)].corners[k])];
-    out.weight[k] = w[k][t];
-  }
+  out.degenerate = std::popcount(flat);
+  out.status = InterpStatus::kNoEnclosingSimplex;
   return out;
+}
+
+__attribute__((target("avx512f"))) OctantBlend FindOctantBlend3Avx512(const OrthantWinners& winners,
+                                                                      const double* p) {
+  // The winners' coordinates per axis, one lane per orthant.
+  alignas(64) double axis[3][8];
+  for (int o = 0; o < 8; ++o) {
+    const double* x = winners.scaled[static_cast<std::size_t>(o)];
+    for (int j = 0; j < 3; ++j) axis[j][o] = x[j];
+  }
+  __m512d x[3];
+  for (int j = 0; j < 3; ++j) x[j] = _mm512_load_pd(axis[j]);
+  return Blend3Avx512(x, winners.rank.data(), p);
+}
+
+__attribute__((target("avx512f"))) OctantBlend FindOctantBlend3Avx512(const WinnerCube3& cube,
+                                                                      const double* p) {
+  const __m512d x[3] = {_mm512_load_pd(cube.axis[0].data()), _mm512_load_pd(cube.axis[1].data()),
+                        _mm512_load_pd(cube.axis[2].data())};
+  return Blend3Avx512(x, cube.rank.data(), p);
 }
 
 // a · b rounded before any addition (no fused multiply-add), 4 lanes.
@@ -442,12 +465,12 @@ __attribute__((target("avx2"))) inline __m256d Pick(__m256d lo, __m256d hi) {
 // central tetrahedron is the one that encloses most queries (60 % of random rig poses), so a
 // second pass only when the first four fail would be taken most of the time, behind a branch the
 // predictor cannot call. Weights as Barycentric computes them, for the winner alone.
-__attribute__((target("avx2"))) OctantBlend FindOctantBlend3Avx2(const OrthantWinners& winners,
-                                                                 const double* p) {
+// lo[j], hi[j]: coordinate j of the winners of orthants 0–3 and 4–7 (lane o mod 4); rank: the
+// winners' ranks by orthant.
+__attribute__((target("avx2"), always_inline)) inline OctantBlend Blend3Avx2(
+    const __m256d (&lo)[3], const __m256d (&hi)[3], const std::uint32_t* rank, const double* p) {
   // Vertex k of tetrahedron t is orthant kTetrahedra[t].corners[k] (the static_assert after
   // kTetrahedra): ABCF, ACDH, AEFH, CFGH in the lanes of `first`, ACFH in every lane of `centre`.
-  __m256d lo[3], hi[3];
-  CubeAxes(winners, lo, hi);
   __m256d first[4][3];
   __m256d centre[4][3];
 #pragma GCC unroll 4
@@ -489,11 +512,27 @@ __attribute__((target("avx2"))) OctantBlend FindOctantBlend3Avx2(const OrthantWi
   out.status = InterpStatus::kOk;
   out.simplex = t;
   for (std::size_t k = 0; k < 4; ++k) {
-    out.rank[k] =
-        winners.rank[static_cast<std::size_t>(kTetrahedra[static_cast<std::size_t>(t)].corners[k])];
+    out.rank[k] = rank[kTetrahedra[static_cast<std::size_t>(t)].corners[k]];
     out.weight[k] = lambda[k] / total;
   }
   return out;
+}
+
+__attribute__((target("avx2"))) OctantBlend FindOctantBlend3Avx2(const OrthantWinners& winners,
+                                                                 const double* p) {
+  __m256d lo[3], hi[3];
+  CubeAxes(winners, lo, hi);
+  return Blend3Avx2(lo, hi, winners.rank.data(), p);
+}
+
+__attribute__((target("avx2"))) OctantBlend FindOctantBlend3Avx2(const WinnerCube3& cube,
+                                                                 const double* p) {
+  __m256d lo[3], hi[3];
+  for (std::size_t j = 0; j < 3; ++j) {
+    lo[j] = _mm256_load_pd(cube.axis[j].data());
+    hi[j] = _mm256_load_pd(cube.axis[j].data() + 4);
+  }
+  return Blend3Avx2(lo, hi, cube.rank.data(), p);
 }
 
 }  // namespace
@@ -518,18 +557,45 @@ bool BlendKernelSupported(BlendKernel kernel) {
   return false;
 }
 
-OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const double> scaled_query,
-                                int dims, BlendKernel kernel) {
-#ifdef BRDF_CUBE_X86
+namespace {
+
+// The kernel a BlendKernel asks for on this CPU. kBest is what every query asks for: it needs no
+// check beyond the one made once here.
+BlendKernel KernelToRun(BlendKernel kernel) {
   static const BlendKernel best = BlendKernelSupported(BlendKernel::kAvx512) ? BlendKernel::kAvx512
                                   : BlendKernelSupported(BlendKernel::kAvx2) ? BlendKernel::kAvx2
                                                                              : BlendKernel::kScalar;
-  // kBest is what every query asks for: it needs no check beyond the one made once above.
-  if (kernel == BlendKernel::kBest) {
-    kernel = best;
-  } else if (!BlendKernelSupported(kernel)) {
-    kernel = BlendKernel::kScalar;
+  if (kernel == BlendKernel::kBest) return best;
+  return BlendKernelSupported(kernel) ? kernel : BlendKernel::kScalar;
+}
+
+}  // namespace
+
+OctantBlend FindOctantBlendFast(const WinnerCube3& cube, const double* scaled_query,
+                                BlendKernel kernel) {
+  if (cube.empty != 0) {
+    OctantBlend out;
+    out.empty_orthants = cube.empty;
+    return out;
   }
+  kernel = KernelToRun(kernel);
+#ifdef BRDF_CUBE_X86
+  if (kernel == BlendKernel::kAvx512) return FindOctantBlend3Avx512(cube, scaled_query);
+  if (kernel == BlendKernel::kAvx2) return FindOctantBlend3Avx2(cube, scaled_query);
+#endif
+  OrthantWinners winners;
+  for (std::size_t o = 0; o < 8; ++o) {
+    winners.rank[o] = cube.rank[o];
+    for (std::size_t j = 0; j < 3; ++j) winners.coords[o][j] = cube.axis[j][o];
+    winners.scaled[o] = winners.coords[o].data();
+  }
+  return FindOctantBlend(winners, std::span(scaled_query, 3), 3);
+}
+
+OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const double> scaled_query,
+                                int dims, BlendKernel kernel) {
+  kernel = KernelToRun(kernel);
+#ifdef BRDF_CUBE_X86
   if (dims == 3 && kernel != BlendKernel::kScalar) {
     std::uint32_t empty = 0;
     for (int o = 0; o < 8; ++o) {

@@ -107,6 +107,19 @@ bool BlendKernelSupported(BlendKernel kernel);
 OctantBlend FindOctantBlendFast(const OrthantWinners& winners, std::span<const double> scaled_query,
                                 int dims, BlendKernel kernel = BlendKernel::kBest);
 
+// A 3D cube of winners laid out as the vector kernels read it (what batches fill straight from
+// the search, KdTree::NearestPerOrthantInCell): lane o of axis[j] is coordinate j (scaled) of the
+// winner in orthant o, rank[o] its rank in the cloud; `empty` has bit o set when orthant o holds
+// no point (its lanes are not read).
+struct WinnerCube3 {
+  alignas(64) std::array<std::array<double, 8>, 3> axis;
+  std::array<std::uint32_t, 8> rank;
+  std::uint32_t empty = 0;
+};
+// FindOctantBlendFast for a cube in that layout: the same blend, bit for bit.
+OctantBlend FindOctantBlendFast(const WinnerCube3& cube, const double* scaled_query,
+                                BlendKernel kernel = BlendKernel::kBest);
+
 // The blended spectrum of a kOk blend: out[b] = Σ_k weight_k · spectrum_k[b] in vertex order
 // (BlendSpectra). out.size() == samples.bands().
 void BlendOctantSpectrum(const PointCloud& cloud, const SampleSet& samples,

@@ -87,23 +87,37 @@ class OrthantGrid {
   template <int D>
   bool Find(const double* q, std::uint32_t& begin, std::uint32_t& count,
             std::uint32_t& need) const {
+    const std::uint32_t cell = ListedCell<D>(q);
+    if (cell == kNoCell) return false;
+    List(cell, begin, count, need);
+    return true;
+  }
+
+  // Find in two steps, for batches that group their queries by cell: the cell whose list answers
+  // q (kNoCell when q is outside the grid or its cell has no list), then that cell's list.
+  static constexpr std::uint32_t kNoCell = 0xFFFFFFFFu;
+  template <int D>
+  std::uint32_t ListedCell(const double* q) const {
     std::size_t cell = 0;
 #pragma GCC unroll 4
     for (int j = 0; j < D; ++j) {
       const auto uj = static_cast<std::size_t>(j);
       const double f = (q[j] - lo_[uj]) * inv_[uj];
-      if (!(f >= 0.0 && f < static_cast<double>(count_[uj]))) return false;
+      if (!(f >= 0.0 && f < static_cast<double>(count_[uj]))) return kNoCell;
       const auto k = static_cast<std::size_t>(f);
       // The division above can round across a line: the lines themselves decide.
       const double* line = lines_[uj].data() + k;
-      if (q[j] < line[0] || q[j] >= line[1]) return false;
+      if (q[j] < line[0] || q[j] >= line[1]) return kNoCell;
       cell = cell * static_cast<std::size_t>(count_[uj]) + k;
     }
+    return span_[cell].count == kNoList ? kNoCell : static_cast<std::uint32_t>(cell);
+  }
+  void List(std::uint32_t cell, std::uint32_t& begin, std::uint32_t& count,
+            std::uint32_t& need) const {
     const Span s = span_[cell];
     begin = s.begin;
     count = s.count;
     need = s.need;
-    return s.count != kNoList;
   }
 
   // The list entries: positions (see the constructor), each list nearest to its cell first.

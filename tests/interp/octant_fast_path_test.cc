@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <random>
 
 #include "core/interp/kd_tree.h"
@@ -136,6 +137,46 @@ TEST(OctantFastPathTest, SpectraAtIsSpectrumAtQueryByQuery) {
   }
 }
 
+TEST(OctantFastPathTest, LargeBatchGroupedByCellIsSpectrumAtQueryByQuery) {
+  // A batch large enough for SpectraAt to group its queries by grid cell (a quarter of a query
+  // per cell or more): random queries in and around the data, runs of one repeated query (more
+  // than one group of lanes in a cell), the samples themselves (ties), queries outside the grid,
+  // invalid queries. Without and with mirroring in φ.
+  const auto grid = PaperGrid();
+  const auto samples = MakeSamples(grid, AnalyticSpectrum(3));
+  auto queries = RandomPoints(60000, {-5, -5, -5}, {95, 95, 185}, 32);
+  for (std::size_t k = 0; k < 2000; ++k) queries[k] = queries[k / 20 + 30000];
+  for (std::size_t k = 0; k < grid.size(); ++k) queries[2000 + k] = grid[k];
+  queries[7000] = {1, NAN, 1};
+  queries[7001] = {INFINITY, 1, 1};
+  queries[7002] = {-1e300, 1e300, 0};
+  std::vector<double> flat;
+  for (const Point& q : queries) flat.insert(flat.end(), q.begin(), q.end());
+  const auto bands = static_cast<std::size_t>(samples->bands());
+  for (const Options& options : {Options{}, Options{{1, 1, 0.5}, true, true}}) {
+    const auto interp = OctantInterpolator::Create(samples, options).value();
+    ASSERT_EQ(interp->search(), OctantInterpolator::Search::kGridThenTree);
+    std::vector<InterpStatus> status(queries.size());
+    std::vector<double> spectra(queries.size() * bands, -3.0);
+    interp->SpectraAt(flat, status, spectra);
+    std::size_t ok = 0;
+    for (std::size_t i = 0; i < queries.size(); ++i) {
+      std::vector<double> one(bands, -3.0);
+      ASSERT_EQ(status[i], interp->SpectrumAt(queries[i], one)) << i;
+      const std::vector<double> row(spectra.begin() + static_cast<std::ptrdiff_t>(i * bands),
+                                    spectra.begin() + static_cast<std::ptrdiff_t>((i + 1) * bands));
+      if (status[i] == InterpStatus::kOk) {
+        ++ok;
+        ASSERT_EQ(row, one) << i;
+      } else {
+        for (double v : row) ASSERT_TRUE(std::isnan(v)) << i;
+      }
+    }
+    EXPECT_GT(ok, queries.size() / 2);
+    EXPECT_EQ(status[7000], InterpStatus::kEmptyOctant);
+  }
+}
+
 TEST(NearestFastPathTest, SpectrumAtIsTheNearestSamplesSpectrum) {
   const auto points = RandomPoints(2000, {0, 0, 0}, {90, 90, 360}, 14);
   const auto samples = MakeSamples(points, LinearSpectrum(3, 3));
@@ -225,6 +266,73 @@ TEST(KdTreeKernelTest, EveryKernelFindsTheScansWinners) {
   }
 }
 
+// NearestPerOrthantInCell (several queries of one grid cell at once) against the scan, for
+// every kernel, groups of every size from 1 to kCellLanes.
+TEST(KdTreeKernelTest, QueriesOfACellTogetherFindTheScansWinners) {
+  struct Case {
+    const char* name;
+    std::vector<Point> points;
+    std::vector<Point> queries;
+  };
+  std::vector<Case> cases;
+  cases.push_back(
+      {"paper grid", PaperGrid(), RandomPoints(20000, {-5, -5, -5}, {95, 95, 185}, 41)});
+  // Ties everywhere: 3 copies of each lattice point, queries on the lattice and half-way.
+  std::vector<Point> lattice;
+  for (int copy = 0; copy < 3; ++copy) {
+    for (const Point& p : Lattice(3, 9)) lattice.push_back(p);
+  }
+  std::vector<Point> half;
+  for (int k = 0; k < 20000; ++k) {
+    half.push_back({0.5 * (k % 17) - 0.5, 0.5 * ((k / 17) % 17) - 0.5, 0.5 * ((k / 289) % 17)});
+  }
+  cases.push_back({"lattice with duplicates", lattice, half});
+  std::size_t grouped = 0;
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const auto samples = MakeSamples(c.points, LinearSpectrum(3, 1));
+    const PointCloud cloud = BuildPointCloud(*samples, {}).value();
+    for (KdTree::Kernel kernel :
+         {KdTree::Kernel::kScalar, KdTree::Kernel::kAvx2, KdTree::Kernel::kAvx512}) {
+      if (!KdTree::Supported(kernel)) continue;
+      SCOPED_TRACE(KdTree::KernelName(kernel));
+      const KdTree tree(cloud, kernel, KdTree::Search::kGridThenTree);
+      ASSERT_FALSE(tree.grid().empty());
+      std::map<std::uint32_t, std::vector<const double*>> by_cell;
+      for (const Point& q : c.queries) {
+        const std::uint32_t cell = tree.ListedCell(q.data());
+        if (cell != OrthantGrid::kNoCell) by_cell[cell].push_back(q.data());
+      }
+      std::size_t group_size = 1;  // cycles through 1 … kCellLanes
+      for (const auto& [cell, queries] : by_cell) {
+        for (std::size_t first = 0; first < queries.size(); first += group_size) {
+          const std::size_t count = std::min(group_size, queries.size() - first);
+          group_size = group_size % KdTree::kCellLanes + 1;
+          std::array<WinnerCube3, KdTree::kCellLanes> cubes;
+          tree.NearestPerOrthantInCell(cell, queries.data() + first, static_cast<int>(count),
+                                       cubes.data());
+          grouped += count > 1 ? count : 0;
+          for (std::size_t k = 0; k < count; ++k) {
+            const double* q = queries[first + k];
+            OrthantWinners want;
+            ScanWinners(cloud, q, want);
+            for (std::size_t o = 0; o < 8; ++o) {
+              SCOPED_TRACE(::testing::Message() << "query " << q[0] << ", " << q[1] << ", " << q[2]
+                                                << " in a group of " << count << ", orthant " << o);
+              ASSERT_EQ(((cubes[k].empty >> o) & 1u) != 0, want.rank[o] == kNoPoint);
+              if (want.rank[o] == kNoPoint) continue;
+              ASSERT_EQ(cubes[k].rank[o], want.rank[o]);
+              const auto p = cloud.scaled_point(want.rank[o]);
+              for (std::size_t j = 0; j < 3; ++j) ASSERT_EQ(cubes[k].axis[j][o], p[j]);
+            }
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(grouped, 10000u);  // most queries were answered in groups
+}
+
 TEST(KdTreeKernelTest, BestKernelIsSupportedAndNamed) {
   const auto samples =
       MakeSamples(RandomPoints(100, {0, 0, 0}, {1, 1, 1}, 3), LinearSpectrum(3, 1));
@@ -255,9 +363,7 @@ OrthantWinners CubeWinners(const Point& q, double scale, std::mt19937_64& rng, b
   return w;
 }
 
-void ExpectSameBlendWith(const OrthantWinners& w, const Point& q, BlendKernel kernel) {
-  const OctantBlend want = FindOctantBlend(w, q, 3);
-  const OctantBlend got = FindOctantBlendFast(w, q, 3, kernel);
+void ExpectSameBlendAs(const OctantBlend& got, const OctantBlend& want) {
   ASSERT_EQ(got.status, want.status);
   EXPECT_EQ(got.empty_orthants, want.empty_orthants);
   EXPECT_EQ(got.simplex, want.simplex);
@@ -270,9 +376,34 @@ void ExpectSameBlendWith(const OrthantWinners& w, const Point& q, BlendKernel ke
   }
 }
 
+// The same winners as a WinnerCube3 (the batch path's layout).
+WinnerCube3 CubeOf(const OrthantWinners& w) {
+  WinnerCube3 cube{};
+  for (std::size_t o = 0; o < 8; ++o) {
+    if (w.rank[o] == kNoPoint) {
+      cube.empty |= 1u << o;
+      continue;
+    }
+    cube.rank[o] = w.rank[o];
+    for (std::size_t j = 0; j < 3; ++j) cube.axis[j][o] = w.scaled[o][j];
+  }
+  return cube;
+}
+
+void ExpectSameBlendWith(const OrthantWinners& w, const Point& q, BlendKernel kernel) {
+  const OctantBlend want = FindOctantBlend(w, q, 3);
+  {
+    SCOPED_TRACE("OrthantWinners");
+    ExpectSameBlendAs(FindOctantBlendFast(w, q, 3, kernel), want);
+  }
+  SCOPED_TRACE("WinnerCube3");
+  ExpectSameBlendAs(FindOctantBlendFast(CubeOf(w), q.data(), kernel), want);
+}
+
 // Every blend kernel this CPU runs (AVX-512 and AVX2 both, where it has AVX-512).
 void ExpectSameBlend(const OrthantWinners& w, const Point& q) {
-  for (BlendKernel kernel : {BlendKernel::kBest, BlendKernel::kAvx2, BlendKernel::kAvx512}) {
+  for (BlendKernel kernel :
+       {BlendKernel::kBest, BlendKernel::kScalar, BlendKernel::kAvx2, BlendKernel::kAvx512}) {
     if (!BlendKernelSupported(kernel)) continue;
     SCOPED_TRACE(::testing::Message() << "blend kernel " << static_cast<int>(kernel));
     ExpectSameBlendWith(w, q, kernel);
