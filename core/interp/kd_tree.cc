@@ -806,17 +806,22 @@ void KdTree::BuildSeeds() {
   }
 }
 
-void KdTree::Seed(OrthantBest& best) const {
-  if (seeds_.empty()) return;
-  const auto d = static_cast<std::size_t>(dims_);
+std::uint32_t KdTree::SeedCell(const double* p) const {
   std::size_t cell = 0;
-  for (std::size_t j = 0; j < d; ++j) {
-    const double f = (best.q[j] - seed_lo_[j]) * seed_inv_[j];
+  for (std::size_t j = 0; j < static_cast<std::size_t>(dims_); ++j) {
+    const double f = (p[j] - seed_lo_[j]) * seed_inv_[j];
     const int k = f > 0.0 ? static_cast<int>(std::min(f, static_cast<double>(seed_cells_ - 1))) : 0;
     cell = cell * static_cast<std::size_t>(seed_cells_) + static_cast<std::size_t>(k);
   }
+  return static_cast<std::uint32_t>(cell);
+}
+
+void KdTree::Seed(OrthantBest& best) const {
+  if (seeds_.empty()) return;
+  const std::size_t cell = SeedCell(best.q.data());
   const std::size_t orthants = std::size_t{1} << dims_;
   const std::uint32_t* seed = seeds_.data() + cell * orthants;
+  const auto d = static_cast<std::size_t>(dims_);
   for (std::size_t s = 0; s < orthants; ++s) {
     const std::uint32_t pos = seed[s];
     if (pos == kNoPoint) continue;

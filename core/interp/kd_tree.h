@@ -87,6 +87,11 @@ class KdTree {
   // scan per query. The winners are NearestPerOrthant's, bit for bit, ties included.
   static constexpr int kCellLanes = 8;
   std::uint32_t ListedCell(const double* p) const;
+  // Without a grid, batches still sort their queries by the cell of the coarse seed grid (about
+  // two points per cell, kd_tree.cc): consecutive queries then walk the same part of the tree and
+  // read the same points. SeedCell(p) < seed_cell_count(); p must be finite.
+  std::uint32_t SeedCell(const double* p) const;
+  std::size_t seed_cell_count() const { return seeds_.size() >> dims_; }
   void NearestPerOrthantInCell(std::uint32_t cell, const double* const* queries, int count,
                                WinnerCube3* cubes) const;
 

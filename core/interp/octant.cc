@@ -151,28 +151,32 @@ struct OctantInterpolator::Impl {
     BlendSpectra(std::span(weight, vertex_count), std::span(spectra.data(), vertex_count), out);
   }
 
-  // Batches: whether SpectraAt groups n queries by grid cell (SpectraByCell). Only a grid's
-  // lists can be shared, and only when the batch is large enough for its queries to meet in
-  // cells: below a quarter of a query per cell, sorting would cost more than the sharing saves.
-  bool GroupsByCell(std::size_t n) const {
-    const OrthantGrid& grid = index->tree.grid();
-    return tail.size() == 0 && index->cloud.dims == 3 && !grid.empty() &&
-           n * 4 >= grid.cell_count();
+  // Batches: whether SpectraAt sorts n queries by cell (SpectraByCell): 3D, no tail, and a batch
+  // of at least a quarter of a query per cell (below that, sorting costs more than it saves).
+  // The cells are the grid's when the tree has one (their queries then share list scans), else
+  // the seed grid's (about two points per cell).
+  bool SortsByCell(std::size_t n) const {
+    const KdTree& tree = index->tree;
+    const std::size_t cells =
+        tree.grid().empty() ? tree.seed_cell_count() : tree.grid().cell_count();
+    return tail.size() == 0 && index->cloud.dims == 3 && n * 4 >= cells;
   }
 
-  // SpectraAt for a batch whose queries meet in grid cells, in three passes: (1) the queries
-  // scaled and sorted by cell (a counting sort); (2) in cell order, the queries of a cell searched
-  // kCellLanes at a time with one scan of its list (KdTree::NearestPerOrthantInCell), the others
-  // with the tree, and each one's simplex chosen, into one cache line per query written in that
-  // order; (3) in query order, the spectra blended into the rows, which are written one after
-  // another, each query's vertex spectra fetched a few queries ahead. Writing the rows in cell
-  // order instead cost a cache miss per row (measured: about 0.1 µs per rig query).
+  // SpectraAt for a batch whose queries meet in cells, in three passes: (1) the queries scaled
+  // and sorted by cell (a counting sort); (2) in cell order, the queries searched (with a grid,
+  // those of a cell kCellLanes at a time with one scan of its list, KdTree::
+  // NearestPerOrthantInCell; without one, one by one, the tree's paths and points still warm from
+  // the previous query) and each one's simplex chosen, into one cache line per query written in
+  // that order; (3) in query order, the spectra blended into the rows, which are written one
+  // after another, each query's vertex spectra fetched a few queries ahead. Writing the rows in
+  // cell order instead cost a cache miss per row (measured: about 0.1 µs per rig query).
   // The same answers as query by query, bit for bit.
   void SpectraByCell(std::span<const double> queries, std::span<InterpStatus> statuses,
                      std::span<double> spectra, std::size_t bands) const {
     const KdTree& tree = index->tree;
+    const bool lists = !tree.grid().empty();
     const std::size_t n = statuses.size();
-    const std::size_t cells = tree.grid().cell_count();
+    const std::size_t cells = lists ? tree.grid().cell_count() : tree.seed_cell_count();
     // Bucket `cells` holds the queries outside every list, `cells + 1` the invalid ones.
     const auto no_list = static_cast<std::uint32_t>(cells);
     const auto invalid = static_cast<std::uint32_t>(cells + 1);
@@ -187,7 +191,7 @@ struct OctantInterpolator::Impl {
         bucket[i] = invalid;
       } else {
         index->cloud.ScaleQuery(query, std::span(p, 3));
-        const std::uint32_t cell = tree.ListedCell(p);
+        const std::uint32_t cell = lists ? tree.ListedCell(p) : tree.SeedCell(p);
         bucket[i] = cell == OrthantGrid::kNoCell ? no_list : cell;
       }
       ++start[bucket[i] + 1];
@@ -208,7 +212,7 @@ struct OctantInterpolator::Impl {
     std::vector<Vertices> answer(n);
     std::array<WinnerCube3, kLanes> cubes;
     std::array<const double*, kLanes> p{};
-    for (std::uint32_t cell = 0; cell < no_list; ++cell) {
+    for (std::uint32_t cell = 0; cell < no_list && lists; ++cell) {
       for (std::size_t first = start[cell]; first < start[cell + 1]; first += kLanes) {
         const int count = static_cast<int>(std::min<std::size_t>(kLanes, start[cell + 1] - first));
         for (int k = 0; k < count; ++k) p[k] = sorted.data() + 3 * (first + std::size_t(k));
@@ -218,7 +222,7 @@ struct OctantInterpolator::Impl {
       }
     }
     OrthantWinners winners;
-    for (std::size_t first = start[no_list]; first < start[invalid]; ++first) {
+    for (std::size_t first = lists ? start[no_list] : 0; first < start[invalid]; ++first) {
       const double* q = sorted.data() + 3 * first;
       tree.NearestPerOrthant(q, winners);
       answer[first] = Keep(FindOctantBlendFast(winners, std::span(q, 3), 3));
@@ -404,7 +408,7 @@ void OctantInterpolator::SpectraAt(std::span<const double> queries,
   const auto d = static_cast<std::size_t>(dims());
   const std::size_t bands = spectra.size() / n;
   const Impl& impl = *impl_;
-  if (impl.GroupsByCell(n)) {
+  if (impl.SortsByCell(n)) {
     impl.SpectraByCell(queries, statuses, spectra, bands);
     return;
   }

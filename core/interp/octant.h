@@ -100,10 +100,11 @@ class OctantInterpolator final : public Interpolator {
   Interpolation Evaluate(std::span<const double> query) const override;
   InterpStatus SpectrumAt(std::span<const double> query, std::span<double> spectrum) const override;
   // Same answers as SpectrumAt, query by query, bit for bit. Pipelined: while one query's vertex
-  // spectra are on their way from memory, the next query is searched. A batch large enough that
-  // its queries meet in the grid's cells (a quarter of a query per cell or more: about 2,000 on
-  // the rig grid) is sorted by cell first, and the queries of a cell share one scan of its list
-  // (octant.cc, SpectraByCell).
+  // spectra are on their way from memory, the next query is searched. A 3D batch large enough
+  // that its queries meet in cells (a quarter of a query per cell or more: about 2,000 queries on
+  // the rig grid, 6,000 on 50,000 points) is sorted by cell first: the queries of a grid cell
+  // share one scan of its list, and without a grid, consecutive queries search the same part of
+  // the tree (octant.cc, SpectraByCell).
   void SpectraAt(std::span<const double> queries, std::span<InterpStatus> statuses,
                  std::span<double> spectra) const override;
   // Status, vertices and weights; the blended spectrum goes into `spectrum` when kOk (its first
