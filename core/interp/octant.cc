@@ -249,6 +249,33 @@ struct OctantInterpolator::Impl {
     }
   }
 
+  // SpectraAt query by query, pipelined: query i is searched (its winners' spectra prefetched)
+  // before query i − 1 is blended.
+  void SpectraOneByOne(std::span<const double> queries, std::span<InterpStatus> statuses,
+                       std::span<double> spectra, std::size_t bands) const {
+    const auto d = static_cast<std::size_t>(index->cloud.dims);
+    const std::size_t n = statuses.size();
+    OctantBlend previous;
+    for (std::size_t i = 0; i <= n; ++i) {
+      OctantBlend blend;
+      if (i < n) {
+        if (!Blend(queries.subspan(i * d, d), blend, /*prefetch_all=*/false)) {
+          blend.status = InterpStatus::kEmptyOctant;
+        }
+        statuses[i] = blend.status;
+      }
+      if (i > 0) {
+        const std::span<double> row = spectra.subspan((i - 1) * bands, bands);
+        if (previous.status == InterpStatus::kOk) {
+          BlendInto(previous, Bands(row));
+        } else {
+          std::fill(row.begin(), row.end(), std::numeric_limits<double>::quiet_NaN());
+        }
+      }
+      previous = blend;
+    }
+  }
+
   // What SpectraByCell keeps of a 3D blend for its spectrum: one cache line.
   struct alignas(64) Vertices {
     std::array<double, 4> weight;
@@ -408,30 +435,18 @@ void OctantInterpolator::SpectraAt(std::span<const double> queries,
   const auto d = static_cast<std::size_t>(dims());
   const std::size_t bands = spectra.size() / n;
   const Impl& impl = *impl_;
-  if (impl.SortsByCell(n)) {
-    impl.SpectraByCell(queries, statuses, spectra, bands);
-    return;
+  // Sorted batches go by windows, which bounds the sort's memory (about 100 bytes per query); a
+  // last window too short to sort goes query by query.
+  constexpr std::size_t kWindow = std::size_t{1} << 16;
+  std::size_t first = 0;
+  for (; first < n && impl.SortsByCell(std::min(kWindow, n - first)); first += kWindow) {
+    const std::size_t count = std::min(kWindow, n - first);
+    impl.SpectraByCell(queries.subspan(first * d, count * d), statuses.subspan(first, count),
+                       spectra.subspan(first * bands, count * bands), bands);
   }
-  // Query i is searched (its winners' spectra prefetched) before query i − 1 is blended.
-  OctantBlend previous;
-  for (std::size_t i = 0; i <= n; ++i) {
-    OctantBlend blend;
-    if (i < n) {
-      if (!impl.Blend(queries.subspan(i * d, d), blend, /*prefetch_all=*/false)) {
-        blend.status = InterpStatus::kEmptyOctant;
-      }
-      statuses[i] = blend.status;
-    }
-    if (i > 0) {
-      const std::span<double> row = spectra.subspan((i - 1) * bands, bands);
-      if (previous.status == InterpStatus::kOk) {
-        impl.BlendInto(previous, impl.Bands(row));
-      } else {
-        std::fill(row.begin(), row.end(), std::numeric_limits<double>::quiet_NaN());
-      }
-    }
-    previous = blend;
-  }
+  if (first >= n) return;
+  impl.SpectraOneByOne(queries.subspan(first * d), statuses.subspan(first),
+                       spectra.subspan(first * bands), bands);
 }
 
 OctantResult OctantInterpolator::EvaluateInto(std::span<const double> query,

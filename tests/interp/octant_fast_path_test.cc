@@ -167,9 +167,9 @@ TEST(OctantFastPathTest, LargeBatchSortedByCellIsSpectrumAtQueryByQuery) {
   // Batches large enough for SpectraAt to sort their queries by cell (a quarter of a query per
   // cell or more): random queries in and around the data, runs of one repeated query (more than
   // one group of lanes in a cell), the samples themselves (ties), queries outside the grid,
-  // invalid queries.
+  // invalid queries. 66,536 queries: a window of 65,536 sorted, then 1,000 too few to sort.
   const auto grid = PaperGrid();
-  auto queries = RandomPoints(60000, {-5, -5, -5}, {95, 95, 185}, 32);
+  auto queries = RandomPoints(66536, {-5, -5, -5}, {95, 95, 185}, 32);
   for (std::size_t k = 0; k < 2000; ++k) queries[k] = queries[k / 20 + 30000];
   for (std::size_t k = 0; k < grid.size(); ++k) queries[2000 + k] = grid[k];
   queries[7000] = {1, NAN, 1};
