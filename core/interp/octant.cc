@@ -152,7 +152,8 @@ struct OctantInterpolator::Impl {
   }
 
   // Batches: whether SpectraAt sorts n queries by cell (SpectraByCell): 3D, no tail, and a batch
-  // of at least a quarter of a query per cell (below that, sorting costs more than it saves).
+  // of at least a quarter of a query per cell. Measured on the rig grid (8,448 cells), sorted
+  // against query by query: 500 queries 4 % slower, 1,000 even, 2,000 13 % faster, 4,000 24 %.
   // The cells are the grid's when the tree has one (their queries then share list scans), else
   // the seed grid's (about two points per cell).
   bool SortsByCell(std::size_t n) const {
