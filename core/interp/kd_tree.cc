@@ -879,6 +879,14 @@ void KdTree::NearestPerOrthant(const double* p, OrthantWinners& winners) const {
   }
 }
 
+bool KdTree::OutsideBox(const double* p) const {
+  const Node& root = nodes_[0];
+  for (std::size_t j = 0; j < static_cast<std::size_t>(dims_); ++j) {
+    if (p[j] <= root.lo[j] || p[j] > root.hi[j]) return true;
+  }
+  return false;
+}
+
 std::uint32_t KdTree::ListedCell(const double* p) const {
   return dims_ == 3 ? grid_.ListedCell<3>(p) : OrthantGrid::kNoCell;
 }

@@ -77,6 +77,11 @@ class KdTree {
   // The rank of the point nearest to p (the lowest rank among equals). p must be finite.
   std::uint32_t Nearest(const double* p) const;
 
+  // True when p lies outside the points' bounding box on some axis j (p_j <= min_j: no point on
+  // the − side, or p_j > max_j: none on the + side), so that some orthant around p is certainly
+  // empty: NearestPerOrthant would report kNoPoint there. p must be finite.
+  bool OutsideBox(const double* p) const;
+
   // Batches (OctantInterpolator::SpectraAt) group their queries by grid cell, because the queries
   // of one cell can share one scan of its list. ListedCell is p's cell (OrthantGrid::kNoCell when p
   // is outside the grid or its cell has no list: search those with NearestPerOrthant).

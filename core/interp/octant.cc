@@ -178,9 +178,11 @@ struct OctantInterpolator::Impl {
     const bool lists = !tree.grid().empty();
     const std::size_t n = statuses.size();
     const std::size_t cells = lists ? tree.grid().cell_count() : tree.seed_cell_count();
-    // Bucket `cells` holds the queries outside every list, `cells + 1` the invalid ones.
+    // Bucket `cells` holds the queries outside every list; `cells + 1` those answered without a
+    // search (they keep kEmptyOctant): invalid ones, and those outside the points' box, where
+    // some orthant is certainly empty (on the rig, most of the queries outside the grid).
     const auto no_list = static_cast<std::uint32_t>(cells);
-    const auto invalid = static_cast<std::uint32_t>(cells + 1);
+    const auto unsearched = static_cast<std::uint32_t>(cells + 1);
     // (1) Scale and sort.
     std::vector<double> scaled(3 * n);
     std::vector<std::uint32_t> bucket(n);
@@ -188,12 +190,13 @@ struct OctantInterpolator::Impl {
     for (std::size_t i = 0; i < n; ++i) {
       const std::span<const double> query = queries.subspan(3 * i, 3);
       double* p = scaled.data() + 3 * i;
-      if (!ValidQuery(query, 3)) {
-        bucket[i] = invalid;
-      } else {
+      bucket[i] = unsearched;
+      if (ValidQuery(query, 3)) {
         index->cloud.ScaleQuery(query, std::span(p, 3));
-        const std::uint32_t cell = lists ? tree.ListedCell(p) : tree.SeedCell(p);
-        bucket[i] = cell == OrthantGrid::kNoCell ? no_list : cell;
+        if (!tree.OutsideBox(p)) {
+          const std::uint32_t cell = lists ? tree.ListedCell(p) : tree.SeedCell(p);
+          bucket[i] = cell == OrthantGrid::kNoCell ? no_list : cell;
+        }
       }
       ++start[bucket[i] + 1];
     }
@@ -223,7 +226,7 @@ struct OctantInterpolator::Impl {
       }
     }
     OrthantWinners winners;
-    for (std::size_t first = lists ? start[no_list] : 0; first < start[invalid]; ++first) {
+    for (std::size_t first = lists ? start[no_list] : 0; first < start[unsearched]; ++first) {
       const double* q = sorted.data() + 3 * first;
       tree.NearestPerOrthant(q, winners);
       answer[first] = Keep(FindOctantBlendFast(winners, std::span(q, 3), 3));
