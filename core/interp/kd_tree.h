@@ -138,6 +138,8 @@ class KdTree {
   template <int D>
   void VisitOrthants(std::uint32_t node, OrthantBest& best) const;
   template <int D>
+  void VisitOrthantsAvx2(std::uint32_t node, OrthantBest& best) const;
+  template <int D>
   void SearchOrthants(OrthantBest& best, OrthantWinners& winners) const;
   // The winners at tree positions pos[o] (kNoPoint: orthant o is empty).
   template <int D>
