@@ -737,47 +737,56 @@ void KdTree::VisitOrthants(std::uint32_t node_index, OrthantBest& best) const {
 // critical path. The sum of the squared gaps is formed in another order ((g0 + g2) + (g1 + g3));
 // kBoundShrink covers the difference, so the bound still never exceeds a point's distance.
 template <int D>
-__attribute__((target("avx2"))) void KdTree::VisitOrthantsAvx2(std::uint32_t node_index,
+__attribute__((target("avx2"))) void KdTree::VisitOrthantsAvx2(std::uint32_t root,
                                                                OrthantBest& best) const {
-  const Node& node = nodes_[node_index];
   const __m256d q = _mm256_loadu_pd(best.q.data());
-  const __m256d lo = _mm256_loadu_pd(node.lo.data());
-  const __m256d hi = _mm256_loadu_pd(node.hi.data());
-  __m256d gap =
-      _mm256_max_pd(_mm256_max_pd(_mm256_sub_pd(lo, q), _mm256_sub_pd(q, hi)), _mm256_setzero_pd());
-  // 3D: the fourth axis is unused (its box is empty: +inf … −inf).
-  if constexpr (D == 3) gap = _mm256_blend_pd(gap, _mm256_setzero_pd(), 0x8);
-  const __m256d square = _mm256_mul_pd(gap, gap);
-  const __m128d half = _mm_add_pd(_mm256_castpd256_pd128(square), _mm256_extractf128_pd(square, 1));
-  const double bound = _mm_cvtsd_f64(_mm_add_sd(half, _mm_unpackhi_pd(half, half)));
   constexpr unsigned kAxes = (1u << D) - 1u;
-  const unsigned lt =
-      static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(lo, q, _CMP_LT_OQ))) & kAxes;
-  const unsigned ge =
-      static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(hi, q, _CMP_GE_OQ))) & kAxes;
-  // The orthants whose best is at least the bound (OrthantBest::Open).
-  const __m256d b = _mm256_set1_pd(bound * kBoundShrink);
-  unsigned open = 0;
+  // Depth first, nearer child first, as VisitOrthants recurses: the farther child waits on a
+  // stack and is tested when it is taken, against the bests as they are then. (Iterative: the
+  // calls' prologues and epilogues were a good part of the recursive walk.)
+  // Every split halves its node's points, so a tree over fewer than 2^32 points is at most 32
+  // levels deep, and the stack holds at most one node per level.
+  std::uint32_t stack[64];
+  int top = 0;
+  std::uint32_t node_index = root;
+  for (;;) {
+    const Node& node = nodes_[node_index];
+    const __m256d lo = _mm256_loadu_pd(node.lo.data());
+    const __m256d hi = _mm256_loadu_pd(node.hi.data());
+    __m256d gap = _mm256_max_pd(_mm256_max_pd(_mm256_sub_pd(lo, q), _mm256_sub_pd(q, hi)),
+                                _mm256_setzero_pd());
+    // 3D: the fourth axis is unused (its box is empty: +inf … −inf).
+    if constexpr (D == 3) gap = _mm256_blend_pd(gap, _mm256_setzero_pd(), 0x8);
+    const __m256d square = _mm256_mul_pd(gap, gap);
+    const __m128d half =
+        _mm_add_pd(_mm256_castpd256_pd128(square), _mm256_extractf128_pd(square, 1));
+    const double bound = _mm_cvtsd_f64(_mm_add_sd(half, _mm_unpackhi_pd(half, half)));
+    const unsigned lt =
+        static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(lo, q, _CMP_LT_OQ))) & kAxes;
+    const unsigned ge =
+        static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(hi, q, _CMP_GE_OQ))) & kAxes;
+    // The orthants whose best is at least the bound (OrthantBest::Open).
+    const __m256d b = _mm256_set1_pd(bound * kBoundShrink);
+    unsigned open = 0;
 #pragma GCC unroll 4
-  for (int o = 0; o < (1 << D); o += 4) {
-    open |= static_cast<unsigned>(_mm256_movemask_pd(
-                _mm256_cmp_pd(b, _mm256_loadu_pd(best.d2.data() + o), _CMP_LE_OQ)))
-            << o;
-  }
-  if ((open & kReach<D>[lt | (ge << D)]) == 0) return;
-
-  if (node.right == 0) {
-    const Entries entries{{axis_[0].data(), axis_[1].data(), axis_[2].data(), axis_[3].data()},
-                          rank_.data()};
-    scan_(entries, node.begin, node.end, best);
-    return;
-  }
-  if (best.q[node.axis] < node.split) {
-    VisitOrthantsAvx2<D>(node_index + 1, best);
-    VisitOrthantsAvx2<D>(node.right, best);
-  } else {
-    VisitOrthantsAvx2<D>(node.right, best);
-    VisitOrthantsAvx2<D>(node_index + 1, best);
+    for (int o = 0; o < (1 << D); o += 4) {
+      open |= static_cast<unsigned>(_mm256_movemask_pd(
+                  _mm256_cmp_pd(b, _mm256_loadu_pd(best.d2.data() + o), _CMP_LE_OQ)))
+              << o;
+    }
+    if ((open & kReach<D>[lt | (ge << D)]) != 0) {
+      if (node.right != 0) {
+        const bool left_first = best.q[node.axis] < node.split;
+        stack[top++] = left_first ? node.right : node_index + 1;
+        node_index = left_first ? node_index + 1 : node.right;
+        continue;
+      }
+      const Entries entries{{axis_[0].data(), axis_[1].data(), axis_[2].data(), axis_[3].data()},
+                            rank_.data()};
+      scan_(entries, node.begin, node.end, best);
+    }
+    if (top == 0) return;
+    node_index = stack[--top];
   }
 }
 #endif
