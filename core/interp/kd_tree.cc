@@ -461,18 +461,24 @@ struct LeafKernels {
       alignas(64) std::int64_t orthant[8];
       _mm512_store_pd(dist, d2);
       _mm512_store_si512(orthant, code);
+      // The exact rule point by point; the vector copies of the bests follow in registers
+      // (reloading them from the scalar stores would stall on store forwarding).
       for (; candidates != 0; candidates &= candidates - 1) {
         const int lane = std::countr_zero(candidates);
         const std::uint32_t at = pos + static_cast<std::uint32_t>(lane);
-        improved |=
-            best.Offer(static_cast<std::size_t>(orthant[lane]), dist[lane], tree.rank[at], at);
+        const auto o = static_cast<unsigned>(orthant[lane]);
+        const bool better = best.Offer(o, dist[lane], tree.rank[at], at);
+        improved |= better;
+        const unsigned mask = static_cast<unsigned>(better) << o;
+        const __m512d d = _mm512_set1_pd(dist[lane]);
+        const __m512i p = _mm512_set1_epi64(at);
+        best_lo = _mm512_mask_mov_pd(best_lo, static_cast<__mmask8>(mask), d);
+        best_pos = _mm512_mask_mov_epi64(best_pos, static_cast<__mmask8>(mask), p);
+        if (D == 4) {
+          best_hi = _mm512_mask_mov_pd(best_hi, static_cast<__mmask8>(mask >> 8), d);
+          best_pos_hi = _mm512_mask_mov_epi64(best_pos_hi, static_cast<__mmask8>(mask >> 8), p);
+        }
       }
-      best_lo = _mm512_loadu_pd(best.d2.data());
-      best_hi = _mm512_loadu_pd(best.d2.data() + 8);
-      best_pos = _mm512_maskz_cvtepu32_epi64(
-          0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data())));
-      best_pos_hi = _mm512_maskz_cvtepu32_epi64(
-          0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data() + 8)));
     }
     return improved;
   }
