@@ -18,9 +18,10 @@
 // and sends every point at or below its best. A portable scalar kernel does the
 // same without branches. Pruning compares a box's distance with every orthant's best at once (one
 // vector compare) and keeps the orthants the box reaches (a table indexed by which sides of the
-// query the box spans). The tree walk itself (hard-to-predict visits) and cache misses on large
-// clouds cost about as much as the leaf scans (perf on 50,000 random points: leaves 38 %, walk
-// 32 %, seeding 12 %).
+// query the box spans). On CPUs with AVX2 the walk is iterative (an explicit stack, nearer child
+// first as in the recursion) and computes a box's distance and sides for all axes in one register.
+// The walk (hard-to-predict visits) still costs about as much as the leaf scans (perf on a sorted
+// batch over 50,000 random points, 2026-12-02: walk 14 %, leaves 13 % of all samples).
 //
 // Shortcut (Search::kGridThenTree, opt-in): an OrthantGrid (orthant_grid.h) lists, for each
 // cell of a uniform grid, every point that can win an orthant for some query in the cell; a query
