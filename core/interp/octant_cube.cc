@@ -179,6 +179,24 @@ OctantBlend FindOctantBlend(const OrthantWinners& winners, std::span<const doubl
 #ifdef BRDF_CUBE_X86
 namespace {
 
+// The blend of a query that tetrahedron t encloses, with the unclamped barycentric coordinates
+// lambda (vertex order), as Barycentric finishes it: negative ones clamped to 0, each divided by
+// their sum. rank: the winners' ranks by orthant.
+inline void SetEnclosed(int t, double (&lambda)[4], const std::uint32_t* rank, OctantBlend& out) {
+  double total = 0.0;
+#pragma GCC unroll 4
+  for (int k = 0; k < 4; ++k) {
+    lambda[k] = lambda[k] > 0.0 ? lambda[k] : 0.0;
+    total += lambda[k];
+  }
+  out.status = InterpStatus::kOk;
+  out.simplex = t;
+  for (std::size_t k = 0; k < 4; ++k) {
+    out.rank[k] = rank[kTetrahedra[static_cast<std::size_t>(t)].corners[k]];
+    out.weight[k] = lambda[k] / total;
+  }
+}
+
 // a · b rounded before any addition (no fused multiply-add), 8 lanes.
 __attribute__((target("avx512f"))) inline __m512d Mul8(__m512d a, __m512d b) {
   __m512d r = _mm512_mul_pd(a, b);
@@ -291,20 +309,9 @@ __attribute__((target("avx512f"), always_inline)) inline OctantBlend Blend3Avx51
     }
     lambda[0] = 1.0 - sum_mu;
     if (!inside || !(lambda[0] >= -kEnclosingTolerance)) continue;
-    // The first tetrahedron that encloses p: weights as Barycentric computes them.
+    // The first tetrahedron that encloses p.
     out.degenerate = std::popcount(flat & ((1u << t) - 1u));
-    double total = 0.0;
-#pragma GCC unroll 4
-    for (int k = 0; k < 4; ++k) {
-      lambda[k] = lambda[k] > 0.0 ? lambda[k] : 0.0;
-      total += lambda[k];
-    }
-    out.status = InterpStatus::kOk;
-    out.simplex = t;
-    for (std::size_t k = 0; k < 4; ++k) {
-      out.rank[k] = rank[kTetrahedra[static_cast<std::size_t>(t)].corners[k]];
-      out.weight[k] = lambda[k] / total;
-    }
+    SetEnclosed(t, lambda, rank, out);
     return out;
   }
   out.degenerate = std::popcount(flat);
@@ -502,19 +509,8 @@ __attribute__((target("avx2"), always_inline)) inline OctantBlend Blend3Avx2(
   const FourTetrahedra& winner = t == 4 ? fifth : four;
   const int lane = t == 4 ? 0 : t;
   double lambda[4];
-  double total = 0.0;
-#pragma GCC unroll 4
-  for (int k = 0; k < 4; ++k) {
-    const double l = winner.lambda[k][lane];
-    lambda[k] = l > 0.0 ? l : 0.0;
-    total += lambda[k];
-  }
-  out.status = InterpStatus::kOk;
-  out.simplex = t;
-  for (std::size_t k = 0; k < 4; ++k) {
-    out.rank[k] = rank[kTetrahedra[static_cast<std::size_t>(t)].corners[k]];
-    out.weight[k] = lambda[k] / total;
-  }
+  for (std::size_t k = 0; k < 4; ++k) lambda[k] = winner.lambda[k][lane];
+  SetEnclosed(t, lambda, rank, out);
   return out;
 }
 
