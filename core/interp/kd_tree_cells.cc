@@ -4,10 +4,11 @@
 // sends every entry that beats its orthant's best through the exact rule one by one; on the rig
 // grid that is ~15 entries per query, each an unpredictable branch, and most of the query's
 // time. Here the lanes hold up to 8 queries of the same cell instead: each list entry is
-// broadcast to all of them, and every lane keeps its own 8 orthant bests in 8 registers (one per
-// orthant, lane k = query k). An entry's distance and orthant per lane, the best of that orthant
-// picked by three levels of blends, one compare, and masked moves into the orthant registers:
-// no branch per entry, whatever the entry does to any lane.
+// broadcast to all of them, and every lane keeps its own 8 orthant bests: the distances in 8
+// registers (one per orthant, lane k = query k), the points' tree positions in an 8 × 8 array
+// beside them. An entry's distance and orthant per lane, the best of that orthant picked by three
+// levels of blends, one compare, and masked moves (distances) and masked stores (positions): no
+// branch per entry, whatever the entry does to any lane.
 //
 // Exactness: per lane the entries are offered in list order under the exact rule (nearer wins;
 // at the same distance, the lower rank: the rare equal distances go through a vector path of
