@@ -67,6 +67,14 @@ struct KdTree::OrthantBest {
   std::array<std::uint32_t, kMaxOrthants> rank;
   std::array<std::uint32_t, kMaxOrthants> pos;  // the best point's position in tree order
 
+  // No best yet in any orthant. Empty orthants keep position kNoPoint, which no point has (the
+  // AVX-512 kernels compare positions).
+  void Clear() {
+    d2.fill(kInf);
+    rank.fill(kNoPoint);
+    pos.fill(kNoPoint);
+  }
+
   // The orthants whose best is at least `bound` (bit o for orthant o): those a box at that
   // distance could still improve.
   template <int D>
@@ -858,9 +866,7 @@ void KdTree::BuildSeeds() {
     }
     OrthantBest best;
     best.q = centre;
-    best.d2.fill(kInf);
-    best.rank.fill(kNoPoint);
-    best.pos.fill(kNoPoint);
+    best.Clear();
     if (dims_ == 3) {
       VisitOrthants<3>(0, best);
     } else {
@@ -919,9 +925,7 @@ void KdTree::FillWinners(const std::uint32_t* pos, OrthantWinners& winners) cons
 
 template <int D>
 void KdTree::SearchOrthants(OrthantBest& best, OrthantWinners& winners) const {
-  best.d2.fill(kInf);
-  best.rank.fill(kNoPoint);
-  best.pos.fill(kNoPoint);  // no point's position (the AVX-512 kernel compares positions)
+  best.Clear();
   std::uint32_t begin = 0, count = 0, need = 0;
   if (grid_.Find<D>(best.q.data(), begin, count, need)) {
     // The cell's list holds every possible winner, nearest to the cell first: one short scan, no
@@ -972,16 +976,15 @@ void KdTree::NearestPerOrthantInCell(std::uint32_t cell, const double* const* qu
   grid_.List(cell, begin, entries, need);
   const std::uint32_t* list = grid_.entry() + begin;
   const double* gap = grid_.block_gap() + begin / 8;
+  const double* axis[3] = {axis_[0].data(), axis_[1].data(), axis_[2].data()};
 #ifdef BRDF_KD_X86
   // A lone query scans faster on its own (ListAvx512 sends only its few candidates through the
   // exact rule; the lanes of the cell kernel would stand mostly idle).
   if (count > 1 && kernel_ == Kernel::kAvx512) {
-    const double* axis[3] = {axis_[0].data(), axis_[1].data(), axis_[2].data()};
     CellListAvx512(axis, rank_.data(), list, gap, entries / 8, need, queries, count, cubes);
     return;
   }
   if (count > 1 && kernel_ == Kernel::kAvx2 && rank_.size() - kPadding <= kCellAvx2Positions) {
-    const double* axis[3] = {axis_[0].data(), axis_[1].data(), axis_[2].data()};
     for (int first = 0; first < count; first += kCellLanesAvx2) {
       CellListAvx2(axis, rank_.data(), list, gap, entries / 8, need, queries + first,
                    std::min(kCellLanesAvx2, count - first), cubes + first);
@@ -992,21 +995,10 @@ void KdTree::NearestPerOrthantInCell(std::uint32_t cell, const double* const* qu
   for (int k = 0; k < count; ++k) {
     OrthantBest best;
     best.q = {queries[k][0], queries[k][1], queries[k][2], 0.0};
-    best.d2.fill(kInf);
-    best.rank.fill(kNoPoint);
-    best.pos.fill(kNoPoint);
+    best.Clear();
     list_scan_(*this, list, gap, entries / 8, need, best);
-    WinnerCube3& cube = cubes[k];
-    cube.empty = 0;
-    for (std::size_t o = 0; o < 8; ++o) {
-      const std::uint32_t pos = best.pos[o];
-      if (pos == kNoPoint) {
-        cube.empty |= 1u << o;
-        continue;
-      }
-      cube.rank[o] = rank_[pos];
-      for (std::size_t j = 0; j < 3; ++j) cube.axis[j][o] = axis_[j][pos];
-    }
+    cubes[k].empty = 0;
+    for (std::size_t o = 0; o < 8; ++o) PutCubeWinner(axis, rank_.data(), best.pos[o], o, cubes[k]);
   }
 }
 

@@ -281,16 +281,12 @@ __attribute__((target("avx2"))) void CellListAvx2(const double* const* axis,
     _mm256_store_si256(reinterpret_cast<__m256i*>(keys[o]), key[o]);
   }
   for (int lane = 0; lane < count; ++lane) {
-    WinnerCube3& cube = cubes[lane];
-    cube.empty = 0;
+    cubes[lane].empty = 0;
     for (std::size_t o = 0; o < kOrthants; ++o) {
-      if (keys[o][lane] == kEmptyKey) {
-        cube.empty |= 1u << o;
-        continue;
-      }
-      const auto at = static_cast<std::uint32_t>(keys[o][lane] & kPositionMask);
-      cube.rank[o] = rank[at];
-      for (std::size_t j = 0; j < 3; ++j) cube.axis[j][o] = axis[j][at];
+      const std::int64_t held = keys[o][lane];
+      const auto at =
+          held == kEmptyKey ? kNoPoint : static_cast<std::uint32_t>(held & kPositionMask);
+      PutCubeWinner(axis, rank, at, o, cubes[lane]);
     }
   }
 }

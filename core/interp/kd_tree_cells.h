@@ -3,6 +3,7 @@
 // tree; kd_tree_cells.cc says how it works and why it gives the exact winners. Pure: no I/O.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "core/interp/octant_cube.h"
@@ -10,6 +11,18 @@
 namespace brdf::interp {
 
 inline constexpr int kCellLanes = 8;
+
+// Orthant o of `cube`: the winner at tree position `pos` (its coordinates from the per-axis
+// arrays, its rank), or empty when pos is kNoPoint. For kernels that end with positions.
+inline void PutCubeWinner(const double* const* axis, const std::uint32_t* rank, std::uint32_t pos,
+                          std::size_t o, WinnerCube3& cube) {
+  if (pos == kNoPoint) {
+    cube.empty |= 1u << o;
+    return;
+  }
+  cube.rank[o] = rank[pos];
+  for (std::size_t j = 0; j < 3; ++j) cube.axis[j][o] = axis[j][pos];
+}
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 // Scans a 3D cell's list (entries: tree positions, 8 per block; block_gap: per block, a lower

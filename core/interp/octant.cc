@@ -157,10 +157,12 @@ struct OctantInterpolator::Impl {
   // The cells are the grid's when the tree has one (their queries then share list scans), else
   // the seed grid's (about two points per cell).
   bool SortsByCell(std::size_t n) const {
+    return tail.size() == 0 && index->cloud.dims == 3 && n * 4 >= SortCells();
+  }
+  // The cells a batch is sorted by: the orthant grid's, or the seed grid's when there is none.
+  std::size_t SortCells() const {
     const KdTree& tree = index->tree;
-    const std::size_t cells =
-        tree.grid().empty() ? tree.seed_cell_count() : tree.grid().cell_count();
-    return tail.size() == 0 && index->cloud.dims == 3 && n * 4 >= cells;
+    return tree.grid().empty() ? tree.seed_cell_count() : tree.grid().cell_count();
   }
 
   // SpectraAt for a batch whose queries meet in cells, in three passes: (1) the queries scaled
@@ -177,7 +179,7 @@ struct OctantInterpolator::Impl {
     const KdTree& tree = index->tree;
     const bool lists = !tree.grid().empty();
     const std::size_t n = statuses.size();
-    const std::size_t cells = lists ? tree.grid().cell_count() : tree.seed_cell_count();
+    const std::size_t cells = SortCells();
     // Bucket `cells` holds the queries outside every list; `cells + 1` those answered without a
     // search (they keep kEmptyOctant): invalid ones, and those outside the points' box, where
     // some orthant is certainly empty (on the rig, most of the queries outside the grid).
