@@ -258,6 +258,60 @@ struct Avx2Bests {
 };
 #endif
 
+#ifdef BRDF_KD_X86
+// The per-orthant bests of a search held in AVX-512 registers, for the AVX-512 kernels: the
+// squared distances of orthants 0–7 in d2_lo and 8–15 in d2_hi (4D), their tree positions widened
+// to 64 bits in pos_lo and pos_hi; an orthant's best reaches a lane by a permute. The memory copy
+// (OrthantBest) stays the exact record; the registers follow every update (reloading them from
+// its scalar stores would stall on store forwarding).
+template <int D>
+struct Avx512Bests {
+  __m512d d2_lo, d2_hi;
+  __m512i pos_lo, pos_hi;
+
+  __attribute__((target("avx512f"), always_inline)) inline void Load(
+      const KdTree::OrthantBest& best) {
+    d2_lo = _mm512_loadu_pd(best.d2.data());
+    d2_hi = _mm512_loadu_pd(best.d2.data() + 8);
+    pos_lo = _mm512_maskz_cvtepu32_epi64(
+        0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data())));
+    pos_hi = _mm512_maskz_cvtepu32_epi64(
+        0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data() + 8)));
+  }
+
+  // The lanes (bit k for lane k) whose point (squared distance d2, orthant code, tree position)
+  // is nearer than its orthant's best, or as near but not that very point: the seeds are met
+  // again in their leaves (and lists repeat their last entry), and each such meeting would cost
+  // an unpredictable branch and a pass through the exact rule for nothing (Offer keeps the best:
+  // same distance, same rank). Empty orthants keep position kNoPoint, which no point has.
+  __attribute__((target("avx512f"), always_inline)) inline unsigned Candidates(
+      __m512d d2, __m512i code, __m512i positions) const {
+    const __m512d limit =
+        D == 3 ? _mm512_permutexvar_pd(code, d2_lo) : _mm512_permutex2var_pd(d2_lo, code, d2_hi);
+    const __m512i at = D == 3 ? _mm512_permutexvar_epi64(code, pos_lo)
+                              : _mm512_permutex2var_epi64(pos_lo, code, pos_hi);
+    return _mm512_cmp_pd_mask(d2, limit, _CMP_LT_OQ) |
+           _mm512_mask_cmpneq_epi64_mask(_mm512_cmp_pd_mask(d2, limit, _CMP_EQ_OQ), positions, at);
+  }
+
+  // After OrthantBest::Offer: when the point at tree position `at` won orthant o, the registers
+  // take its distance and position.
+  __attribute__((target("avx512f"), always_inline)) inline void Follow(bool better, unsigned o,
+                                                                       double dist,
+                                                                       std::uint32_t at) {
+    const unsigned mask = static_cast<unsigned>(better) << o;
+    const __m512d d = _mm512_set1_pd(dist);
+    const __m512i p = _mm512_set1_epi64(at);
+    d2_lo = _mm512_mask_mov_pd(d2_lo, static_cast<__mmask8>(mask), d);
+    pos_lo = _mm512_mask_mov_epi64(pos_lo, static_cast<__mmask8>(mask), p);
+    if (D == 4) {
+      d2_hi = _mm512_mask_mov_pd(d2_hi, static_cast<__mmask8>(mask >> 8), d);
+      pos_hi = _mm512_mask_mov_epi64(pos_hi, static_cast<__mmask8>(mask >> 8), p);
+    }
+  }
+};
+#endif
+
 // The leaf scans. Each computes, for every point of the leaf, its orthant (bit j set when
 // x_j >= q_j) and its squared distance ((0 + dx²) + dy²) + dz² (+ dw²), exactly as OrthantOf and
 // SquaredDistance do, and offers it to its orthant.
@@ -430,13 +484,9 @@ struct LeafKernels {
     __m512d q[D];
     for (int j = 0; j < D; ++j) q[j] = _mm512_set1_pd(best.q[static_cast<std::size_t>(j)]);
     bool improved = false;
-    __m512d best_lo = _mm512_loadu_pd(best.d2.data());
-    __m512d best_hi = _mm512_loadu_pd(best.d2.data() + 8);
+    Avx512Bests<D> bests;
+    bests.Load(best);
     const __m512i lane_index = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
-    __m512i best_pos = _mm512_maskz_cvtepu32_epi64(
-        0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data())));
-    __m512i best_pos_hi = _mm512_maskz_cvtepu32_epi64(
-        0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data() + 8)));
     for (std::uint32_t pos = begin; pos < end; pos += 8) {
       __m512d d2 = _mm512_setzero_pd();
       __m512i code = _mm512_setzero_si512();
@@ -450,19 +500,8 @@ struct LeafKernels {
         const __mmask8 plus = _mm512_cmp_pd_mask(v, q[j], _CMP_GE_OQ);
         code = _mm512_mask_or_epi64(code, plus, code, _mm512_set1_epi64(1 << j));
       }
-      const __m512d limit = D == 3 ? _mm512_permutexvar_pd(code, best_lo)
-                                   : _mm512_permutex2var_pd(best_lo, code, best_hi);
-      // A point at its orthant's best distance is a candidate only when it is not that best
-      // point itself: the seeds are met again in their leaves, and each such meeting cost an
-      // unpredictable branch and a pass through the exact rule for nothing (Offer would keep
-      // the best: same distance, same rank). Empty orthants keep position kNoPoint, which no
-      // point has.
-      const __m512i best_at = D == 3 ? _mm512_permutexvar_epi64(code, best_pos)
-                                     : _mm512_permutex2var_epi64(best_pos, code, best_pos_hi);
       const __m512i positions = _mm512_add_epi64(_mm512_set1_epi64(pos), lane_index);
-      unsigned candidates = _mm512_cmp_pd_mask(d2, limit, _CMP_LT_OQ) |
-                            _mm512_mask_cmpneq_epi64_mask(_mm512_cmp_pd_mask(d2, limit, _CMP_EQ_OQ),
-                                                          positions, best_at);
+      unsigned candidates = bests.Candidates(d2, code, positions);
       if (end - pos < 8) candidates &= (1u << (end - pos)) - 1u;
       if (candidates == 0) continue;
       alignas(64) double dist[8];
@@ -477,15 +516,7 @@ struct LeafKernels {
         const auto o = static_cast<unsigned>(orthant[lane]);
         const bool better = best.Offer(o, dist[lane], tree.rank[at], at);
         improved |= better;
-        const unsigned mask = static_cast<unsigned>(better) << o;
-        const __m512d d = _mm512_set1_pd(dist[lane]);
-        const __m512i p = _mm512_set1_epi64(at);
-        best_lo = _mm512_mask_mov_pd(best_lo, static_cast<__mmask8>(mask), d);
-        best_pos = _mm512_mask_mov_epi64(best_pos, static_cast<__mmask8>(mask), p);
-        if (D == 4) {
-          best_hi = _mm512_mask_mov_pd(best_hi, static_cast<__mmask8>(mask >> 8), d);
-          best_pos_hi = _mm512_mask_mov_epi64(best_pos_hi, static_cast<__mmask8>(mask >> 8), p);
-        }
+        bests.Follow(better, o, dist[lane], at);
       }
     }
     return improved;
@@ -500,12 +531,8 @@ struct LeafKernels {
                                                             Best& best) {
     __m512d q[D];
     for (int j = 0; j < D; ++j) q[j] = _mm512_set1_pd(best.q[static_cast<std::size_t>(j)]);
-    __m512d best_lo = _mm512_loadu_pd(best.d2.data());
-    __m512d best_hi = _mm512_loadu_pd(best.d2.data() + 8);
-    __m512i best_pos = _mm512_maskz_cvtepu32_epi64(
-        0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data())));
-    __m512i best_pos_hi = _mm512_maskz_cvtepu32_epi64(
-        0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(best.pos.data() + 8)));
+    Avx512Bests<D> bests;
+    bests.Load(best);
     const auto need_lo = static_cast<__mmask8>(need & 0xFFu);
     const auto need_hi = static_cast<__mmask8>(need >> 8);
     // In locals: the stores into `best` below could alias the tree's members for the compiler,
@@ -530,16 +557,8 @@ struct LeafKernels {
         const __mmask8 plus = _mm512_cmp_pd_mask(v, q[j], _CMP_GE_OQ);
         code = _mm512_mask_or_epi64(code, plus, code, _mm512_set1_epi64(1 << j));
       }
-      const __m512d limit = D == 3 ? _mm512_permutexvar_pd(code, best_lo)
-                                   : _mm512_permutex2var_pd(best_lo, code, best_hi);
-      // As in Avx512: a point equal to its orthant's best is a candidate only when it is not
-      // that point itself (lists repeat their last entry as padding).
-      const __m512i best_at = D == 3 ? _mm512_permutexvar_epi64(code, best_pos)
-                                     : _mm512_permutex2var_epi64(best_pos, code, best_pos_hi);
-      const __m512i positions = _mm512_cvtepu32_epi64(index);
-      unsigned candidates = _mm512_cmp_pd_mask(d2, limit, _CMP_LT_OQ) |
-                            _mm512_mask_cmpneq_epi64_mask(_mm512_cmp_pd_mask(d2, limit, _CMP_EQ_OQ),
-                                                          positions, best_at);
+      // Lists repeat their last entry as padding: it meets itself as its orthant's best.
+      unsigned candidates = bests.Candidates(d2, code, _mm512_cvtepu32_epi64(index));
       if (candidates == 0) continue;
       alignas(64) double dist[8];
       alignas(64) std::int64_t orthant[8];
@@ -551,20 +570,11 @@ struct LeafKernels {
         const int lane = std::countr_zero(candidates);
         const std::uint32_t pos = at[lane];
         const auto o = static_cast<unsigned>(orthant[lane]);
-        const bool better = best.Offer(o, dist[lane], rank[pos], pos);
-        const unsigned mask = static_cast<unsigned>(better) << o;
-        const __m512d d = _mm512_set1_pd(dist[lane]);
-        const __m512i p = _mm512_set1_epi64(pos);
-        best_lo = _mm512_mask_mov_pd(best_lo, static_cast<__mmask8>(mask), d);
-        best_pos = _mm512_mask_mov_epi64(best_pos, static_cast<__mmask8>(mask), p);
-        if (D == 4) {
-          best_hi = _mm512_mask_mov_pd(best_hi, static_cast<__mmask8>(mask >> 8), d);
-          best_pos_hi = _mm512_mask_mov_epi64(best_pos_hi, static_cast<__mmask8>(mask >> 8), p);
-        }
+        bests.Follow(best.Offer(o, dist[lane], rank[pos], pos), o, dist[lane], pos);
       }
       // Orthants outside `need` count as -inf (empty for every query of the cell).
-      worst = _mm512_mask_reduce_max_pd(need_lo, best_lo);
-      if (D == 4) worst = Max(worst, _mm512_mask_reduce_max_pd(need_hi, best_hi));
+      worst = _mm512_mask_reduce_max_pd(need_lo, bests.d2_lo);
+      if (D == 4) worst = Max(worst, _mm512_mask_reduce_max_pd(need_hi, bests.d2_hi));
     }
   }
 #endif
