@@ -227,6 +227,26 @@ void ScanWinners(const PointCloud& cloud, const double* p, OrthantWinners& w) {
   }
 }
 
+// 3 copies of each point of the 3D lattice of side × side × side unit steps (ties everywhere).
+std::vector<Point> TriplicatedLattice(int side) {
+  std::vector<Point> out;
+  for (int copy = 0; copy < 3; ++copy) {
+    for (const Point& p : Lattice(3, side)) out.push_back(p);
+  }
+  return out;
+}
+
+// n queries on the half-step lattice from −0.5, `steps` per axis (last axis from 0), in order:
+// on lattice points, on the planes between them, and half-way.
+std::vector<Point> HalfSteps(int steps, int n) {
+  std::vector<Point> out;
+  for (int k = 0; k < n; ++k) {
+    out.push_back({0.5 * (k % steps) - 0.5, 0.5 * ((k / steps) % steps) - 0.5,
+                   0.5 * ((k / (steps * steps)) % steps)});
+  }
+  return out;
+}
+
 TEST(KdTreeKernelTest, EveryKernelFindsTheScansWinners) {
   struct Case {
     const char* name;
@@ -240,15 +260,7 @@ TEST(KdTreeKernelTest, EveryKernelFindsTheScansWinners) {
   cases.push_back({"random 4D", RandomPoints(3000, {0, 0, 0, 0}, {90, 360, 90, 360}, 24),
                    RandomPoints(1000, {0, 0, 0, 0}, {90, 360, 90, 360}, 25)});
   // Ties everywhere and points on the splitting planes; 3 copies of each lattice point.
-  std::vector<Point> lattice;
-  for (int copy = 0; copy < 3; ++copy) {
-    for (const Point& p : Lattice(3, 7)) lattice.push_back(p);
-  }
-  std::vector<Point> half;
-  for (int k = 0; k < 2000; ++k) {
-    half.push_back({0.5 * (k % 15) - 0.5, 0.5 * ((k / 15) % 15) - 0.5, 0.5 * ((k / 225) % 15)});
-  }
-  cases.push_back({"lattice with duplicates", lattice, half});
+  cases.push_back({"lattice with duplicates", TriplicatedLattice(7), HalfSteps(15, 2000)});
   std::vector<Point> lattice4 = Lattice(4, 4);
   std::vector<Point> half4;
   for (int k = 0; k < 1000; ++k) {
@@ -298,15 +310,7 @@ TEST(KdTreeKernelTest, QueriesOfACellTogetherFindTheScansWinners) {
   cases.push_back(
       {"paper grid", PaperGrid(), RandomPoints(20000, {-5, -5, -5}, {95, 95, 185}, 41)});
   // Ties everywhere: 3 copies of each lattice point, queries on the lattice and half-way.
-  std::vector<Point> lattice;
-  for (int copy = 0; copy < 3; ++copy) {
-    for (const Point& p : Lattice(3, 9)) lattice.push_back(p);
-  }
-  std::vector<Point> half;
-  for (int k = 0; k < 20000; ++k) {
-    half.push_back({0.5 * (k % 17) - 0.5, 0.5 * ((k / 17) % 17) - 0.5, 0.5 * ((k / 289) % 17)});
-  }
-  cases.push_back({"lattice with duplicates", lattice, half});
+  cases.push_back({"lattice with duplicates", TriplicatedLattice(9), HalfSteps(17, 20000)});
   std::size_t grouped = 0;
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
