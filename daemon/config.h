@@ -24,6 +24,7 @@
 //   reply_timeout_ms = 2000             # short replies (B, D110, D120, D5)
 //   measurement_timeout_ms = 30000      # M0, S, F
 //   wake_attempts = 5                   # remote-mode wake-up tries before asking for a power cycle
+//   measure_with_spectrum = true        # M5 (one exchange per reading); false: M0 then D5
 //   [meter.quality]                     # overrides of the quality policy, by code
 //   "18" = "accept_and_flag"            # accept, accept_and_flag, retry, retry_then_flag,
 //   "30" = { action = "retry", accept_flagged_when_exhausted = true }  # adapt_integration,
@@ -95,6 +96,7 @@ struct MeterConfig {
   int reply_timeout_ms = 2000;
   int measurement_timeout_ms = 30000;
   int wake_attempts = 5;
+  bool measure_with_spectrum = true;
   // Rules that replace the driver's defaults for these quality codes (0–99).
   std::map<int, drivers::pr650::QualityRule> quality_overrides;
 };

@@ -25,6 +25,7 @@ drivers::Pr650Options MeterOptions(const MeterConfig& m) {
   o.reply_timeout = milliseconds(m.reply_timeout_ms);
   o.measurement_timeout = milliseconds(m.measurement_timeout_ms);
   o.wake_attempts = m.wake_attempts;
+  o.measure_with_spectrum = m.measure_with_spectrum;
   for (const auto& [code, rule] : m.quality_overrides) o.quality_policy.Set(code, rule);
   o.log = [](std::string_view line) { spdlog::debug("pr650: {}", line); };
   return o;

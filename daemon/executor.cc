@@ -463,30 +463,28 @@ Executor::Outcome Executor::RunReading(Context& c, int index, int& advanced) {
         c.meter_configured = true;
         c.meter_dark = settings.dark;
       }
-      Result<drivers::MeasurementOutcome> measured = meter.Measure(ctx);
-      if (!measured.ok()) {
-        if (measured.status().code() == StatusCode::kDeviceError) {
-          c.last_quality = measured.status().device_code();
-        }
-        return measured.status().WithContext("measuring (M0) at " + StepName(step));
-      }
-      outcome = *measured;
-      measurements += outcome.attempts;
-      c.last_quality = outcome.quality_code;
-      if (pipeline) {
-        // The meter holds the measurement: the stage may leave while the spectrum transfers.
+      // Called once the meter holds an accepted measurement, while its spectrum still streams in.
+      auto measured = [&](const drivers::MeasurementOutcome& done) {
+        c.last_quality = done.quality_code;
+        measurements += done.attempts;  // counted even if the transfer then fails
+        if (!pipeline) return;
+        // The stage may leave now: the measurement is taken, only its transfer is left.
         move.step_index = static_cast<int>(next);
         c.stage_target.reset();
         const Pose target = c.steps[next].pose;
         spdlog::debug("session {}: step {} moves while step {} transfers", session_, next, index);
         move.thread = std::thread(
             [this, &move, target, ctx] { move.result.emplace(MoveStage(target, ctx)); });
+      };
+      Result<drivers::MeasuredSpectrum> taken = meter.MeasureSpectrum(ctx, measured);
+      if (!taken.ok()) {
+        if (taken.status().code() == StatusCode::kDeviceError) {
+          c.last_quality = taken.status().device_code();
+        }
+        return taken.status().WithContext("measuring the spectrum of " + StepName(step));
       }
-      Result<drivers::SpectrumReport> spectrum = meter.TransferSpectrum(ctx);
-      if (!spectrum.ok()) {
-        return spectrum.status().WithContext("transferring the spectrum (D5) of " + StepName(step));
-      }
-      report = std::move(*spectrum);
+      outcome = taken->outcome;
+      report = std::move(taken->report);
       return Status::Ok();
     });
   });

@@ -1,12 +1,14 @@
 // A spectroradiometer, as the daemon sees it: connect, identify, configure, measure, transfer.
-// Measure and transfer are separate so the daemon can move the stage while the (slow, 9600-baud)
-// spectrum transfer streams. Knows nothing of plans, poses or storage.
+// The daemon moves the stage while the (slow, 9600-baud) spectrum transfer streams: MeasureSpectrum
+// tells it when the measurement is done and the transfer begins. Knows nothing of plans, poses or
+// storage.
 //
 // Threading: one instance is used by one thread at a time (the daemon's meter worker). Every call
 // takes a CallContext; it returns kTimeout at the deadline and kCancelled when cancelled, and never
 // blocks past either.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -48,6 +50,15 @@ struct SpectrumReport {
   double integrated = 0;  // the meter's integrated intensity line
 };
 
+// One accepted measurement and its spectrum.
+struct MeasuredSpectrum {
+  MeasurementOutcome outcome;
+  SpectrumReport report;
+};
+
+// Called once the measurement is final and accepted, before its spectrum has been transferred.
+using MeasuredCallback = std::function<void(const MeasurementOutcome&)>;
+
 class Spectroradiometer {
  public:
   virtual ~Spectroradiometer() = default;
@@ -67,6 +78,14 @@ class Spectroradiometer {
 
   // Transfers the spectrum of the last measurement.
   virtual Result<SpectrumReport> TransferSpectrum(const CallContext& ctx) = 0;
+
+  // Measure and TransferSpectrum in one call, with `measured` (if set) called on this thread in
+  // between: what has to wait only for the measurement, not its data (the stage's next move), can
+  // start then. A meter that sends the spectrum in the measurement's own reply (the PR-650's M5)
+  // overrides this to save an exchange; `measured` then runs as the reply's status line arrives.
+  // If the transfer fails after `measured` ran, the error is returned all the same.
+  virtual Result<MeasuredSpectrum> MeasureSpectrum(const CallContext& ctx,
+                                                   const MeasuredCallback& measured);
 };
 
 }  // namespace brdf::drivers

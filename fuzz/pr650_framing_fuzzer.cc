@@ -122,10 +122,24 @@ int FuzzPr650Framing(const std::uint8_t* data, std::size_t size) {
 
   ScriptedLink link(clock, std::move(chunks), cancel);
   const CallContext ctx(clock.Now() + deadline, cancel, clock);
-  const ReplyRequest request{"D5", lines, 2s};
+  ReplyRequest request{"M5", lines, 2s};
+  int first_lines = 0;
+  std::string first_line;
+  request.first_line = [&](std::string_view line) {
+    ++first_lines;
+    first_line = line;
+    BRDF_FUZZ_CHECK(!line.empty(), "the first line handed over is empty");
+    BRDF_FUZZ_CHECK(line.find_first_of("\r\n") == std::string_view::npos,
+                    "the first line handed over holds a line end");
+    (void)ParseSpectrumHeader(line, "M5");  // what the driver does with it
+  };
   const Result<std::string> r = ReadReply(link, request, framing, ctx);
+  BRDF_FUZZ_CHECK(first_lines <= 1, "the first line was handed over more than once");
 
   if (r.ok()) {
+    BRDF_FUZZ_CHECK(first_lines == 1, "a complete reply's first line was never handed over");
+    BRDF_FUZZ_CHECK(r->find(first_line) != std::string::npos,
+                    "the first line handed over is not in the reply");
     BRDF_FUZZ_CHECK(*r == link.delivered(), "the reply is not exactly the bytes delivered");
     BRDF_FUZZ_CHECK(EndsWithLineEnd(*r), "accepted a reply without a final line end");
     BRDF_FUZZ_CHECK(CountCompleteLines(*r) >= lines, "accepted a reply with too few lines");

@@ -35,6 +35,10 @@ struct Pr650Options {
 
   int accessory = 1;  // S field 1: 01 = the standard MS-75 lens
 
+  // A reading in one exchange: M5 (measure, then send the D5 report) instead of M0 then D5. Saves
+  // a command, a status reply and a quiet gap per reading; false for a meter that mishandles M5.
+  bool measure_with_spectrum = true;
+
   // Measurements per Measure call, including the quality policy's retries.
   int max_measure_attempts = 4;
   pr650::QualityPolicy quality_policy = pr650::QualityPolicy::Defaults();

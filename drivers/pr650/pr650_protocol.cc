@@ -369,40 +369,45 @@ Result<SpectralLayout> ParseLayoutReply(std::string_view reply) {
   return out;
 }
 
+Result<SpectrumHeader> ParseSpectrumHeader(std::string_view line, std::string_view command) {
+  const auto fields = SplitFields(line);
+  const std::optional<int> code = fields.size() == 2 ? ParseCode(fields[0]) : std::nullopt;
+  const std::optional<int> units = fields.size() == 2 ? ParseCode(fields[1]) : std::nullopt;
+  if (!code || !units || Trim(fields[1]).size() != 1) {
+    return LineError(command, 1, line, "\"qq,U\" (quality code, one-digit units code)");
+  }
+  return SpectrumHeader{*code, *units};
+}
+
 Result<SpectrumReply> ParseSpectrumReply(std::string_view reply,
-                                         std::optional<WavelengthGrid> expected) {
+                                         std::optional<WavelengthGrid> expected,
+                                         std::string_view command) {
   const std::vector<std::string> lines = SplitReplyLines(reply);
   if (lines.size() < 4) {
-    return LineCountError(kSpectrumCommand, lines.size(),
+    return LineCountError(command, lines.size(),
                           "a header, the integrated intensity and at least 2 bands", reply);
   }
   if (expected && lines.size() != SpectrumReplyLines(*expected)) {
-    return LineCountError(kSpectrumCommand, lines.size(),
+    return LineCountError(command, lines.size(),
                           std::to_string(SpectrumReplyLines(*expected)) + " (header, integrated, " +
                               std::to_string(expected->count) + " bands)",
                           reply);
   }
   for (std::size_t i = 0; i < lines.size(); ++i) {
     if (!AllPrintable(lines[i])) {
-      return LineError(kSpectrumCommand, i + 1, lines[i], "printable ASCII");
+      return LineError(command, i + 1, lines[i], "printable ASCII");
     }
   }
 
   SpectrumReply out;
-  const auto header = SplitFields(lines[0]);
-  const std::optional<int> code = header.size() == 2 ? ParseCode(header[0]) : std::nullopt;
-  const std::optional<int> units = header.size() == 2 ? ParseCode(header[1]) : std::nullopt;
-  if (!code || !units || Trim(header[1]).size() != 1) {
-    return LineError(kSpectrumCommand, 1, lines[0],
-                     "\"qq,U\" (quality code, one-digit units code)");
-  }
-  out.quality_code = *code;
-  out.units_code = *units;
+  Result<SpectrumHeader> header = ParseSpectrumHeader(lines[0], command);
+  if (!header.ok()) return header.status();
+  out.quality_code = header->quality_code;
+  out.units_code = header->units_code;
 
   const auto integrated = ParseNumber(lines[1]);
   if (!integrated) {
-    return LineError(kSpectrumCommand, 2, lines[1],
-                     "the integrated intensity as a number like 1.234E+01");
+    return LineError(command, 2, lines[1], "the integrated intensity as a number like 1.234E+01");
   }
   out.integrated = *integrated;
 
@@ -412,7 +417,7 @@ Result<SpectrumReply> ParseSpectrumReply(std::string_view reply,
     const std::optional<double> nm = fields.size() == 2 ? ParseNumber(fields[0]) : std::nullopt;
     const std::optional<double> value = fields.size() == 2 ? ParseNumber(fields[1]) : std::nullopt;
     if (!nm || !value) {
-      return LineError(kSpectrumCommand, i + 1, lines[i],
+      return LineError(command, i + 1, lines[i],
                        "\"wwww.,r.rrrEsee\" (wavelength in nm, spectral value)");
     }
     wavelengths.push_back(*nm);
@@ -421,12 +426,12 @@ Result<SpectrumReply> ParseSpectrumReply(std::string_view reply,
 
   const double step = wavelengths[1] - wavelengths[0];
   if (step <= 0) {
-    return LineError(kSpectrumCommand, 4, lines[3], "wavelengths increasing from line 3 on");
+    return LineError(command, 4, lines[3], "wavelengths increasing from line 3 on");
   }
   for (std::size_t i = 0; i < wavelengths.size(); ++i) {
     const double want = wavelengths[0] + step * static_cast<double>(i);
     if (std::abs(wavelengths[i] - want) > 0.01) {
-      return LineError(kSpectrumCommand, i + 3, lines[i + 2],
+      return LineError(command, i + 3, lines[i + 2],
                        "evenly spaced wavelengths (" + std::to_string(want) + " nm here)");
     }
   }
@@ -434,9 +439,10 @@ Result<SpectrumReply> ParseSpectrumReply(std::string_view reply,
   if (expected && (std::abs(expected->start_nm - out.grid.start_nm) > 0.01 ||
                    std::abs(expected->step_nm - out.grid.step_nm) > 0.01)) {
     return ProtocolError(
-        "PR-650 reply to D5 covers " + std::to_string(out.grid.start_nm) + " nm every " +
-        std::to_string(out.grid.step_nm) + " nm, but the meter's layout (D120) says " +
-        std::to_string(expected->start_nm) + " nm every " + std::to_string(expected->step_nm) +
+        "PR-650 reply to " + std::string(command) + " covers " + std::to_string(out.grid.start_nm) +
+        " nm every " + std::to_string(out.grid.step_nm) +
+        " nm, but the meter's layout (D120) says " + std::to_string(expected->start_nm) +
+        " nm every " + std::to_string(expected->step_nm) +
         " nm; re-identify the meter (D120) and retry");
   }
   return out;

@@ -40,6 +40,9 @@ std::string Printable(std::string_view bytes, std::size_t max_chars = 48);
 
 inline constexpr std::string_view kMeasureCommand = "M0";   // measure and hold, reply 000
 inline constexpr std::string_view kSpectrumCommand = "D5";  // spectrum of the last measurement
+// Measure, then send the D5 report: one exchange per reading instead of two (M1…M6 are "measure,
+// then send report n").
+inline constexpr std::string_view kMeasureSpectrumCommand = "M5";
 inline constexpr std::string_view kSerialNumberCommand = "D110";
 inline constexpr std::string_view kLayoutCommand = "D120";     // spectral layout
 inline constexpr std::string_view kFlickerCommand = "F";       // flicker frequency for sync
@@ -122,8 +125,18 @@ struct SpectralLayout {
 };
 Result<SpectralLayout> ParseLayoutReply(std::string_view reply);
 
+// The first line of a D5 (or M5) report, "qq,U": the measurement's quality code and the units
+// code. Read on its own so a driver can act on the quality before the bands have all arrived.
+struct SpectrumHeader {
+  int quality_code = 0;
+  int units_code = 0;
+};
+Result<SpectrumHeader> ParseSpectrumHeader(std::string_view line,
+                                           std::string_view command = kSpectrumCommand);
+
 // The D5 report: "qq,U", the integrated intensity, then one "wwww.,r.rrrEsee" line per band.
 // The bands must be evenly spaced and increasing; `expected`, when given, must match them.
+// `command` (D5 or M5) only names the reply in error messages.
 struct SpectrumReply {
   int quality_code = 0;
   int units_code = 0;
@@ -132,7 +145,8 @@ struct SpectrumReply {
   std::vector<double> values;  // one per band of `grid`
 };
 Result<SpectrumReply> ParseSpectrumReply(std::string_view reply,
-                                         std::optional<WavelengthGrid> expected = std::nullopt);
+                                         std::optional<WavelengthGrid> expected = std::nullopt,
+                                         std::string_view command = kSpectrumCommand);
 
 // Lines in a D5 report for `grid`: header, integrated intensity, one per band (the framing layer
 // waits for this many).

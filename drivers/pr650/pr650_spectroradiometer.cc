@@ -179,7 +179,8 @@ Status Pr650Spectroradiometer::DiscardLateReply(const CallContext& ctx) {
 }
 
 Result<std::string> Pr650Spectroradiometer::Exchange(std::string_view command, std::size_t lines,
-                                                     Duration timeout, const CallContext& ctx) {
+                                                     Duration timeout, const CallContext& ctx,
+                                                     const FirstLine& first_line) {
   if (!link_) return RequireConnected();
   Status status = DiscardLateReply(ctx);
   if (status.ok()) {
@@ -196,7 +197,7 @@ Result<std::string> Pr650Spectroradiometer::Exchange(std::string_view command, s
   }
   const auto sent_at = ctx.clock().Now();
   Result<std::string> reply =
-      status.ok() ? pr650::ReadReply(*link_, {command, lines, timeout}, framing_, ctx)
+      status.ok() ? pr650::ReadReply(*link_, {command, lines, timeout, first_line}, framing_, ctx)
                   : Result<std::string>(status);
   next_command_at_ = ctx.clock().Now() + options_.command_pacing;
   if (reply.ok()) return reply;
@@ -302,14 +303,67 @@ Status Pr650Spectroradiometer::Configure(const MeasurementSettings& settings,
   return Status::Ok();
 }
 
-Result<MeasurementOutcome> Pr650Spectroradiometer::Measure(const CallContext& ctx) {
+pr650::QualityDecision Pr650Spectroradiometer::Judge(int code, int attempt,
+                                                     std::vector<std::string>& notes) const {
+  const SetupFields current = CurrentSetup();
+  const pr650::MeasureLoopState state{current.integration_ms, current.sync, attempt,
+                                      options_.max_measure_attempts, dark_};
+  pr650::QualityDecision decision = pr650::DecideQuality(options_.quality_policy, code, state);
+  if (!decision.note.empty()) {
+    notes.push_back(decision.note);
+    Log("measurement " + std::to_string(attempt) + " on " + options_.port + ": " + decision.note);
+  }
+  return decision;
+}
+
+bool Pr650Spectroradiometer::Accepted(const pr650::QualityDecision& decision) {
+  using Kind = pr650::QualityDecision::Kind;
+  return decision.kind == Kind::kAccept || decision.kind == Kind::kAcceptFlagged;
+}
+
+MeasurementOutcome Pr650Spectroradiometer::Outcome(int code, const pr650::QualityDecision& decision,
+                                                   int attempt,
+                                                   const std::vector<std::string>& notes) const {
+  MeasurementOutcome outcome;
+  outcome.quality_code = code;
+  outcome.flagged = decision.kind == pr650::QualityDecision::Kind::kAcceptFlagged;
+  outcome.integration_ms = CurrentSetup().integration_ms;
+  outcome.attempts = attempt;
+  outcome.note = JoinNotes(notes);
+  return outcome;
+}
+
+Status Pr650Spectroradiometer::PrepareRemeasure(int code, const pr650::QualityDecision& decision,
+                                                int attempt, const std::vector<std::string>& notes,
+                                                const CallContext& ctx) {
+  if (decision.kind == pr650::QualityDecision::Kind::kFail) {
+    const pr650::QualityCodeInfo* info = pr650::FindQualityCode(code);
+    std::string hint = info && *info->hint ? info->hint : "see the PR-650 manual";
+    return DeviceError(code, "PR-650 on " + options_.port + " measurement failed after " +
+                                 std::to_string(attempt) + " attempt(s): " + JoinNotes(notes) +
+                                 "; " + hint);
+  }
+  const SetupFields current = CurrentSetup();
+  if (decision.new_integration_ms == current.integration_ms && decision.new_sync == current.sync) {
+    return Status::Ok();
+  }
+  SetupFields changed = current;
+  changed.integration_ms = decision.new_integration_ms;
+  changed.sync = decision.new_sync;
+  return SendSetup(changed, ctx);
+}
+
+Status Pr650Spectroradiometer::StartMeasuring(const CallContext& ctx) {
   BRDF_RETURN_IF_ERROR(RequireConnected());
   holds_measurement_ = false;
-  // Each Measure starts from the configured settings: an adaptation made for one pose (a halved
-  // integration time) does not carry into the next.
-  if (configured_ && meter_setup_ != configured_)
-    BRDF_RETURN_IF_ERROR(SendSetup(*configured_, ctx));
+  // Each measurement starts from the configured settings: an adaptation made for one pose (a
+  // halved integration time) does not carry into the next.
+  if (configured_ && meter_setup_ != configured_) return SendSetup(*configured_, ctx);
+  return Status::Ok();
+}
 
+Result<MeasurementOutcome> Pr650Spectroradiometer::Measure(const CallContext& ctx) {
+  BRDF_RETURN_IF_ERROR(StartMeasuring(ctx));
   std::vector<std::string> notes;
   for (int attempt = 1;; ++attempt) {
     Result<std::string> reply =
@@ -317,47 +371,12 @@ Result<MeasurementOutcome> Pr650Spectroradiometer::Measure(const CallContext& ct
     if (!reply.ok()) return WithSilenceHint(reply.status(), ctx);
     Result<int> code = pr650::ParseStatusReply(*reply, pr650::kMeasureCommand);
     if (!code.ok()) return code.status();
-
-    const SetupFields current = CurrentSetup();
-    const pr650::MeasureLoopState state{current.integration_ms, current.sync, attempt,
-                                        options_.max_measure_attempts, dark_};
-    const pr650::QualityDecision decision =
-        pr650::DecideQuality(options_.quality_policy, *code, state);
-    if (!decision.note.empty()) {
-      notes.push_back(decision.note);
-      Log("measurement " + std::to_string(attempt) + " on " + options_.port + ": " + decision.note);
+    const pr650::QualityDecision decision = Judge(*code, attempt, notes);
+    if (Accepted(decision)) {
+      holds_measurement_ = true;
+      return Outcome(*code, decision, attempt, notes);
     }
-
-    using Kind = pr650::QualityDecision::Kind;
-    switch (decision.kind) {
-      case Kind::kAccept:
-      case Kind::kAcceptFlagged: {
-        holds_measurement_ = true;
-        MeasurementOutcome outcome;
-        outcome.quality_code = *code;
-        outcome.flagged = decision.kind == Kind::kAcceptFlagged;
-        outcome.integration_ms = current.integration_ms;
-        outcome.attempts = attempt;
-        outcome.note = JoinNotes(notes);
-        return outcome;
-      }
-      case Kind::kRemeasure:
-        if (decision.new_integration_ms != current.integration_ms ||
-            decision.new_sync != current.sync) {
-          SetupFields changed = current;
-          changed.integration_ms = decision.new_integration_ms;
-          changed.sync = decision.new_sync;
-          BRDF_RETURN_IF_ERROR(SendSetup(changed, ctx));
-        }
-        break;
-      case Kind::kFail: {
-        const pr650::QualityCodeInfo* info = pr650::FindQualityCode(*code);
-        std::string hint = info && *info->hint ? info->hint : "see the PR-650 manual";
-        return DeviceError(*code, "PR-650 on " + options_.port + " measurement failed after " +
-                                      std::to_string(attempt) + " attempt(s): " + JoinNotes(notes) +
-                                      "; " + hint);
-      }
-    }
+    BRDF_RETURN_IF_ERROR(PrepareRemeasure(*code, decision, attempt, notes, ctx));
   }
 }
 
@@ -370,7 +389,12 @@ Result<SpectrumReport> Pr650Spectroradiometer::TransferSpectrum(const CallContex
   Result<std::string> reply = Exchange(pr650::kSpectrumCommand, pr650::SpectrumReplyLines(grid_),
                                        options_.reply_timeout, ctx);
   if (!reply.ok()) return WithSilenceHint(reply.status(), ctx);
-  Result<pr650::SpectrumReply> spectrum = pr650::ParseSpectrumReply(*reply, grid_);
+  return SpectrumFromReply(*reply, pr650::kSpectrumCommand);
+}
+
+Result<SpectrumReport> Pr650Spectroradiometer::SpectrumFromReply(std::string_view reply,
+                                                                 std::string_view command) const {
+  Result<pr650::SpectrumReply> spectrum = pr650::ParseSpectrumReply(reply, grid_, command);
   if (!spectrum.ok()) return spectrum.status();
   SpectrumReport report;
   report.grid = spectrum->grid;
@@ -379,6 +403,47 @@ Result<SpectrumReport> Pr650Spectroradiometer::TransferSpectrum(const CallContex
   report.units_code = spectrum->units_code;
   report.integrated = spectrum->integrated;
   return report;
+}
+
+Result<MeasuredSpectrum> Pr650Spectroradiometer::MeasureSpectrum(const CallContext& ctx,
+                                                                 const MeasuredCallback& measured) {
+  if (!options_.measure_with_spectrum) return Spectroradiometer::MeasureSpectrum(ctx, measured);
+  BRDF_RETURN_IF_ERROR(StartMeasuring(ctx));
+  constexpr std::string_view kCommand = pr650::kMeasureSpectrumCommand;
+  std::vector<std::string> notes;
+  for (int attempt = 1;; ++attempt) {
+    // The report's status line is the measurement's quality code: judge it as soon as it arrives,
+    // and let the caller go on (move the stage) while the bands stream in.
+    std::optional<int> code;
+    pr650::QualityDecision decision;
+    auto judge_status_line = [&](std::string_view line) {
+      Result<pr650::SpectrumHeader> header = pr650::ParseSpectrumHeader(line, kCommand);
+      if (!header.ok()) return;  // the whole reply's parse below says what is wrong
+      code = header->quality_code;
+      decision = Judge(*code, attempt, notes);
+      if (Accepted(decision) && measured) measured(Outcome(*code, decision, attempt, notes));
+    };
+    Result<std::string> reply = Exchange(kCommand, pr650::SpectrumReplyLines(grid_),
+                                         options_.measurement_timeout, ctx, judge_status_line);
+    const bool rejected = code.has_value() && !Accepted(decision);
+    if (!reply.ok()) {
+      // After a rejected measurement the meter may send its status line alone: the reader then
+      // reports a truncated reply, which is no error here (the policy measures again or fails).
+      if (!rejected || reply.status().code() != StatusCode::kProtocolError) {
+        return WithSilenceHint(reply.status(), ctx);
+      }
+    }
+    if (!rejected) {
+      Result<SpectrumReport> report = SpectrumFromReply(*reply, kCommand);
+      if (!report.ok()) return report.status();
+      if (!code.has_value()) {  // cannot happen: a parsed report has a status line
+        return ProtocolError("PR-650 reply to M5 on " + options_.port + " had no status line");
+      }
+      holds_measurement_ = true;
+      return MeasuredSpectrum{Outcome(*code, decision, attempt, notes), std::move(*report)};
+    }
+    BRDF_RETURN_IF_ERROR(PrepareRemeasure(*code, decision, attempt, notes, ctx));
+  }
 }
 
 }  // namespace brdf::drivers

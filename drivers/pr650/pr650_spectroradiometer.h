@@ -25,6 +25,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "drivers/pr650/pr650_options.h"
 #include "drivers/pr650/pr650_protocol.h"
@@ -52,6 +53,11 @@ class Pr650Spectroradiometer final : public Spectroradiometer {
   Status Configure(const MeasurementSettings& settings, const CallContext& ctx) override;
   Result<MeasurementOutcome> Measure(const CallContext& ctx) override;
   Result<SpectrumReport> TransferSpectrum(const CallContext& ctx) override;
+  // With options().measure_with_spectrum: one M5 exchange per attempt (the D5 report follows the
+  // measurement in its reply); `measured` runs when the report's status line is accepted.
+  // Otherwise M0 then D5, as Measure and TransferSpectrum.
+  Result<MeasuredSpectrum> MeasureSpectrum(const CallContext& ctx,
+                                           const MeasuredCallback& measured) override;
 
   const Pr650Options& options() const { return options_; }
 
@@ -61,12 +67,27 @@ class Pr650Spectroradiometer final : public Spectroradiometer {
   Status OpenWithRtsDrop(const CallContext& ctx);
   Status Wake(const CallContext& ctx);
   Status RequireConnected() const;
-  // Sends `command` and reads a reply of `lines` lines, the first byte within `timeout`.
+  using FirstLine = std::function<void(std::string_view)>;
+  // Sends `command` and reads a reply of `lines` lines, the first byte within `timeout`;
+  // `first_line` (if set) sees the reply's first line as soon as it is complete.
   Result<std::string> Exchange(std::string_view command, std::size_t lines, Duration timeout,
-                               const CallContext& ctx);
+                               const CallContext& ctx, const FirstLine& first_line = {});
   Status DiscardLateReply(const CallContext& ctx);
   Status SendSetup(const pr650::SetupFields& fields, const CallContext& ctx);
   pr650::SetupFields CurrentSetup() const;
+
+  // The measurement loop shared by Measure and MeasureSpectrum. StartMeasuring restores the
+  // configured setup; Judge applies the quality policy to attempt `attempt`'s code (logging its
+  // note); an accepted code becomes Outcome; otherwise PrepareRemeasure fails (kDeviceError) or
+  // changes the setup as the policy asks before the next attempt.
+  Status StartMeasuring(const CallContext& ctx);
+  pr650::QualityDecision Judge(int code, int attempt, std::vector<std::string>& notes) const;
+  static bool Accepted(const pr650::QualityDecision& decision);
+  MeasurementOutcome Outcome(int code, const pr650::QualityDecision& decision, int attempt,
+                             const std::vector<std::string>& notes) const;
+  Status PrepareRemeasure(int code, const pr650::QualityDecision& decision, int attempt,
+                          const std::vector<std::string>& notes, const CallContext& ctx);
+  Result<SpectrumReport> SpectrumFromReply(std::string_view reply, std::string_view command) const;
   void DropLink();
   // A "did not answer" timeout with what the operator can check.
   Status WithSilenceHint(const Status& status, const CallContext& ctx) const;

@@ -29,10 +29,17 @@ Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
   const auto first_deadline = clock.Now() + request.first_byte_timeout;
   std::string reply;
   auto last_byte = clock.Now();
+  bool first_line_seen = !request.first_line;
 
   auto append = [&](const std::string& bytes) -> Status {
     reply += bytes;
     last_byte = clock.Now();
+    if (!first_line_seen && CountCompleteLines(reply) > 0) {
+      first_line_seen = true;
+      const std::size_t begin = reply.find_first_not_of("\r\n");
+      request.first_line(
+          std::string_view(reply).substr(begin, reply.find_first_of("\r\n", begin) - begin));
+    }
     if (reply.size() > framing.max_reply_bytes) {
       return ProtocolError("PR-650 reply to " + command + " on " + link.port() + " exceeds " +
                            std::to_string(framing.max_reply_bytes) +

@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -31,6 +32,10 @@ struct ReplyRequest {
   std::string_view command;  // the command answered, for messages
   std::size_t lines = 1;     // complete lines that make the whole reply
   std::chrono::steady_clock::duration first_byte_timeout = std::chrono::seconds(2);
+  // Called once, as soon as the reply's first line is complete (without its line end), while the
+  // rest may still be on the wire: a report's status line can be acted on before its data has
+  // arrived (M5: the stage may leave once the measurement is known good).
+  std::function<void(std::string_view first_line)> first_line = nullptr;
 };
 
 // Reads one reply. Errors:

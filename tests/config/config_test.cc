@@ -33,6 +33,7 @@ TEST(ConfigTest, EmptyFileGivesTheDefaults) {
   EXPECT_FALSE(c.storage.database.empty());
   EXPECT_EQ(c.meter.baud, 9600);
   EXPECT_EQ(c.meter.pacing_ms, 100);
+  EXPECT_TRUE(c.meter.measure_with_spectrum);
   EXPECT_TRUE(c.meter.quality_overrides.empty());
   EXPECT_EQ(c.stage.transport, "tcp");
   EXPECT_EQ(c.stage.profile, "az");
@@ -67,6 +68,7 @@ quiet_gap_ms = 20
 reply_timeout_ms = 1500
 measurement_timeout_ms = 20000
 wake_attempts = 3
+measure_with_spectrum = false
 [meter.quality]
 18 = "fail"
 "30" = { action = "retry", accept_flagged_when_exhausted = true }
@@ -119,6 +121,7 @@ level = "debug"
   EXPECT_EQ(c.meter.baud, 19200);
   EXPECT_TRUE(c.meter.hardware_flow_control);
   EXPECT_EQ(c.meter.measurement_timeout_ms, 20000);
+  EXPECT_FALSE(c.meter.measure_with_spectrum);
   ASSERT_EQ(c.meter.quality_overrides.size(), 2u);
   EXPECT_EQ(c.meter.quality_overrides.at(18).action, drivers::pr650::QualityAction::kFail);
   EXPECT_EQ(c.meter.quality_overrides.at(30).action, drivers::pr650::QualityAction::kRetry);

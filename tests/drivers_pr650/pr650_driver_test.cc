@@ -22,64 +22,6 @@ using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using SteadyClock = std::chrono::steady_clock;
 
-class Pr650DriverTest : public ::testing::Test {
- protected:
-  void SetUp() override { StartEndpoint(FastEndpointOptions()); }
-
-  void StartEndpoint(const sim::Pr650EndpointOptions& options) {
-    endpoint_.reset();
-    endpoint_ = std::make_unique<sim::Pr650Endpoint>(backend_, control_, options);
-    ASSERT_TRUE(endpoint_->Start().ok());
-    options_ = FastDriverOptions(endpoint_->path(), log_);
-  }
-
-  std::unique_ptr<Pr650Spectroradiometer> Driver() {
-    return std::make_unique<Pr650Spectroradiometer>(options_);
-  }
-
-  // A connected driver with a fixed integration time.
-  std::unique_ptr<Pr650Spectroradiometer> Configured(int integration_ms) {
-    auto meter = Driver();
-    Status s = meter->Connect(Ctx());
-    EXPECT_TRUE(s.ok()) << s.ToString();
-    s = meter->Configure({integration_ms, 1, false}, Ctx());
-    EXPECT_TRUE(s.ok()) << s.ToString();
-    return meter;
-  }
-
-  void InjectQuality(int code, int count) {
-    control_.UpdateSerial([&](sim::SerialFaults& f) {
-      f.quality_code = code;
-      f.quality_count = count;
-      return 0;
-    });
-  }
-
-  std::vector<int> MeasuredIntegrations() const {
-    std::vector<int> out;
-    for (const auto& s : backend_.setups()) out.push_back(s.integration_ms);
-    return out;
-  }
-
-  FakeMeterBackend backend_;
-  sim::SimControl control_;
-  std::unique_ptr<sim::Pr650Endpoint> endpoint_;
-  LogCapture log_;
-  Pr650Options options_;
-};
-
-void ExpectSpectrumOf(const drivers::SpectrumReport& report, double level) {
-  const std::vector<double> want = FakeMeterBackend::Spectrum(level);
-  ASSERT_EQ(report.radiance.size(), want.size());
-  for (std::size_t i = 0; i < want.size(); ++i) {
-    // The meter prints 4 significant digits.
-    EXPECT_NEAR(report.radiance[i], want[i], want[i] * 6e-4) << "band " << i;
-  }
-  double integrated = 0;
-  for (double v : want) integrated += 4 * v;
-  EXPECT_NEAR(report.integrated, integrated, integrated * 6e-4);
-}
-
 // ---- each command path ------------------------------------------------------------------------
 
 TEST_F(Pr650DriverTest, ConnectIdentifyConfigureMeasureTransfer) {

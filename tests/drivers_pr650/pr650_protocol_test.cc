@@ -289,11 +289,31 @@ TEST(ParseSpectrumReply, MalformedReportsNameTheLine) {
       {"00,0\r\n", "1 line(s)"},
   };
   for (const Case& c : cases) {
-    auto r = ParseSpectrumReply(c.reply, WavelengthGrid::Pr650());
-    ASSERT_FALSE(r.ok()) << Printable(c.reply);
+    for (std::string_view command : {kSpectrumCommand, kMeasureSpectrumCommand}) {
+      auto r = ParseSpectrumReply(c.reply, WavelengthGrid::Pr650(), command);
+      ASSERT_FALSE(r.ok()) << Printable(c.reply);
+      EXPECT_EQ(r.status().code(), StatusCode::kProtocolError);
+      EXPECT_THAT(r.status().message(), HasSubstr("reply to " + std::string(command)));
+      EXPECT_THAT(r.status().message(), HasSubstr(c.expect_in_message)) << r.status().message();
+    }
+  }
+}
+
+TEST(ParseSpectrumHeader, QualityAndUnitsFromTheStatusLineAlone) {
+  auto h = ParseSpectrumHeader("18,0");
+  ASSERT_TRUE(h.ok()) << h.status().ToString();
+  EXPECT_EQ(h->quality_code, 18);
+  EXPECT_EQ(h->units_code, 0);
+  h = ParseSpectrumHeader("00,2", kMeasureSpectrumCommand);
+  ASSERT_TRUE(h.ok()) << h.status().ToString();
+  EXPECT_EQ(h->quality_code, 0);
+  EXPECT_EQ(h->units_code, 2);
+  for (std::string_view bad : {"", "00", "0a,0", "00,10", "00,0,1", "1.234E+01"}) {
+    auto r = ParseSpectrumHeader(bad, kMeasureSpectrumCommand);
+    ASSERT_FALSE(r.ok()) << bad;
     EXPECT_EQ(r.status().code(), StatusCode::kProtocolError);
-    EXPECT_THAT(r.status().message(), HasSubstr("D5"));
-    EXPECT_THAT(r.status().message(), HasSubstr(c.expect_in_message)) << r.status().message();
+    EXPECT_THAT(r.status().message(), HasSubstr("M5"));
+    EXPECT_THAT(r.status().message(), HasSubstr("qq,U"));
   }
 }
 

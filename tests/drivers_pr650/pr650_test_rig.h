@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "drivers/pr650/pr650_options.h"
+#include "drivers/pr650/pr650_spectroradiometer.h"
 #include "tools/brdf-sim/pr650_endpoint.h"
 #include "tools/brdf-sim/sim_shared.h"
 
@@ -146,6 +147,67 @@ inline int CountCommand(const sim::Pr650Endpoint& endpoint, const std::string& c
   int n = 0;
   for (const auto& c : endpoint.commands()) n += c == command ? 1 : 0;
   return n;
+}
+
+// A simulated meter on a pty (FakeMeterBackend optics, the sim's fault control) and the options for
+// a driver talking to it.
+class Pr650DriverTest : public ::testing::Test {
+ protected:
+  void SetUp() override { StartEndpoint(FastEndpointOptions()); }
+
+  void StartEndpoint(const sim::Pr650EndpointOptions& options) {
+    endpoint_.reset();
+    endpoint_ = std::make_unique<sim::Pr650Endpoint>(backend_, control_, options);
+    ASSERT_TRUE(endpoint_->Start().ok());
+    options_ = FastDriverOptions(endpoint_->path(), log_);
+  }
+
+  std::unique_ptr<drivers::Pr650Spectroradiometer> Driver() {
+    return std::make_unique<drivers::Pr650Spectroradiometer>(options_);
+  }
+
+  // A connected driver with a fixed integration time.
+  std::unique_ptr<drivers::Pr650Spectroradiometer> Configured(int integration_ms) {
+    auto meter = Driver();
+    Status s = meter->Connect(Ctx());
+    EXPECT_TRUE(s.ok()) << s.ToString();
+    s = meter->Configure({integration_ms, 1, false}, Ctx());
+    EXPECT_TRUE(s.ok()) << s.ToString();
+    return meter;
+  }
+
+  void InjectQuality(int code, int count) {
+    control_.UpdateSerial([&](sim::SerialFaults& f) {
+      f.quality_code = code;
+      f.quality_count = count;
+      return 0;
+    });
+  }
+
+  std::vector<int> MeasuredIntegrations() const {
+    std::vector<int> out;
+    for (const auto& s : backend_.setups()) out.push_back(s.integration_ms);
+    return out;
+  }
+
+  FakeMeterBackend backend_;
+  sim::SimControl control_;
+  std::unique_ptr<sim::Pr650Endpoint> endpoint_;
+  LogCapture log_;
+  drivers::Pr650Options options_;
+};
+
+// `report` holds FakeMeterBackend::Spectrum(level), to the meter's 4 printed digits.
+inline void ExpectSpectrumOf(const drivers::SpectrumReport& report, double level) {
+  const std::vector<double> want = FakeMeterBackend::Spectrum(level);
+  ASSERT_EQ(report.radiance.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    // The meter prints 4 significant digits.
+    EXPECT_NEAR(report.radiance[i], want[i], want[i] * 6e-4) << "band " << i;
+  }
+  double integrated = 0;
+  for (double v : want) integrated += 4 * v;
+  EXPECT_NEAR(report.integrated, integrated, integrated * 6e-4);
 }
 
 }  // namespace brdf::testing

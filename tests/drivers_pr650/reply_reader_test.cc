@@ -89,6 +89,25 @@ TEST(ReadReply, WaitsForAllExpectedLinesAcrossGapsLongerThanTheQuietGap) {
   EXPECT_EQ(*r, "00,0\r\n1.0E+00\r\n0380.,1.0E+00\r\n");
 }
 
+TEST(ReadReply, FirstLineIsSeenOnceWhileTheRestIsStillOnTheWay) {
+  // A blank line first (ignored), the status line in two pieces, then the data 150 ms later.
+  ScriptedLink link(
+      {{0ms, "\r\n1"}, {5ms, "8,0\r"}, {10ms, "\n1.0E+00\r\n"}, {150ms, "0380.,1.0E+00\r\n"}});
+  const auto start = SteadyClock::now();
+  std::vector<std::string> seen;
+  SteadyClock::duration seen_after{};
+  ReplyRequest request{"M5", 3, 1s};
+  request.first_line = [&](std::string_view line) {
+    seen.emplace_back(line);
+    seen_after = SteadyClock::now() - start;
+  };
+  auto r = ReadReply(link, request, Framing(30ms, 300ms), Ctx());
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(seen, std::vector<std::string>{"18,0"});
+  EXPECT_LT(seen_after, 140ms);  // before the last line, which arrives at 150 ms
+  EXPECT_GE(SteadyClock::now() - start, 150ms);
+}
+
 TEST(ReadReply, BytesWithinTheQuietGapBelongToTheReply) {
   ScriptedLink link({{0ms, "000\r\n"}, {10ms, "stray\r\n"}});
   auto r = ReadReply(link, {"M0", 1, 1s}, Framing(40ms), Ctx());

@@ -253,7 +253,12 @@ TEST(SimProcessTest, InjectedQualityCodeReachesTheMeterForTheNextMeasurementsOnl
   MeterPort meter(sim->pr650_path());
   ASSERT_EQ(meter.Ask("B0", 1), std::vector<std::string>{"000"});
   EXPECT_EQ(meter.Ask("M0", 1), std::vector<std::string>{"029"});
-  EXPECT_EQ(meter.Ask("M0", 1), std::vector<std::string>{"029"});
+  // M5 measures too (and counts down the fault); its reply is the D5 report, quality code first.
+  const auto m5 = meter.Ask("M5", 103);
+  ASSERT_EQ(m5.size(), 103u);
+  EXPECT_EQ(m5[0], "29,0");
+  EXPECT_EQ(SpectrumOf(m5).size(), 101u);
+  EXPECT_EQ(meter.Ask("M5", 103)[0], "00,0");
   EXPECT_EQ(meter.Ask("M0", 1), std::vector<std::string>{"000"});
   EXPECT_EQ((*control)->SerialFaults()->quality_count, 0);
 }

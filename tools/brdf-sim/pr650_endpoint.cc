@@ -212,43 +212,20 @@ void Pr650Endpoint::Handle(const std::string& command) {
     Reply({text});
     return;
   }
-  if (command == "M0") {
-    MeterSetup setup;
-    {
-      std::lock_guard lock(mu_);
-      setup = setup_;
-      measured_setups_.push_back(setup);
-    }
-    SimMeasurement m = backend_.Measure(setup);
-    const int forced = control_.UpdateSerial([](SerialFaults& f) {
-      if (f.quality_count <= 0) return -1;
-      --f.quality_count;
-      return f.quality_code;
-    });
-    if (forced >= 0) m.quality_code = forced;
-    if (!SleepReal(options_.time_scale.ToReal(std::max(0.0, m.duration_s)))) return;
-    {
-      std::lock_guard lock(mu_);
-      if (epoch != power_epoch_) return;  // switched off mid-measurement: no reply
-      last_ = Measurement{true, m.quality_code, m.integrated, std::move(m.radiance)};
+  if (command == "M0" || command == "M5") {
+    // M5 is M0 followed by the D5 report, in one reply.
+    if (!Measure(epoch)) return;
+    if (command == "M5") {
+      ReplySpectrum();
+      return;
     }
     char text[8];
-    std::snprintf(text, sizeof text, "%03d", std::clamp(m.quality_code, 0, 999));
+    std::snprintf(text, sizeof text, "%03d", std::clamp(LastQualityCode(), 0, 999));
     Reply({text});
     return;
   }
   if (command == "D5") {
-    Measurement last;
-    {
-      std::lock_guard lock(mu_);
-      last = last_;
-    }
-    const double vanish = control_.UpdateSerial([](SerialFaults& f) {
-      const double seconds = f.vanish_seconds;
-      f.vanish_seconds = 0;
-      return seconds;
-    });
-    Reply(Pr650SpectrumLines(last.quality_code, 0, last.integrated, last.radiance), vanish);
+    ReplySpectrum();
     return;
   }
   if (command == "D110") {
@@ -261,7 +238,47 @@ void Pr650Endpoint::Handle(const std::string& command) {
     Reply({Pr650LayoutLine()});
     return;
   }
-  // Unknown or unsupported (M1–M6, D1, D2, ...): the simulated meter does not answer.
+  // Unknown or unsupported (M1–M4, M6, D1, D2, ...): the simulated meter does not answer.
+}
+
+bool Pr650Endpoint::Measure(unsigned epoch) {
+  MeterSetup setup;
+  {
+    std::lock_guard lock(mu_);
+    setup = setup_;
+    measured_setups_.push_back(setup);
+  }
+  SimMeasurement m = backend_.Measure(setup);
+  const int forced = control_.UpdateSerial([](SerialFaults& f) {
+    if (f.quality_count <= 0) return -1;
+    --f.quality_count;
+    return f.quality_code;
+  });
+  if (forced >= 0) m.quality_code = forced;
+  if (!SleepReal(options_.time_scale.ToReal(std::max(0.0, m.duration_s)))) return false;
+  std::lock_guard lock(mu_);
+  if (epoch != power_epoch_) return false;  // switched off mid-measurement: no reply
+  last_ = Measurement{true, m.quality_code, m.integrated, std::move(m.radiance)};
+  return true;
+}
+
+int Pr650Endpoint::LastQualityCode() {
+  std::lock_guard lock(mu_);
+  return last_.quality_code;
+}
+
+void Pr650Endpoint::ReplySpectrum() {
+  Measurement last;
+  {
+    std::lock_guard lock(mu_);
+    last = last_;
+  }
+  const double vanish = control_.UpdateSerial([](SerialFaults& f) {
+    const double seconds = f.vanish_seconds;
+    f.vanish_seconds = 0;
+    return seconds;
+  });
+  Reply(Pr650SpectrumLines(last.quality_code, 0, last.integrated, last.radiance), vanish);
 }
 
 void Pr650Endpoint::Reply(std::vector<std::string> lines, double vanish_seconds) {

@@ -9,6 +9,8 @@
 //   M0                                                  a 3-digit status = the quality code ("000",
 //                                                       "018"), after the measurement's duration
 //   D5                                                  qq,U / integrated / 101 × "0380.,r.rrrEsee"
+//   M5                                                  M0's measurement, then the D5 report as
+//                                                       its reply (also after a bad quality code)
 //   D110                                                the serial number, blank-padded to 8
 //   D120                                                0101,008.0,0380.,0780.,004.
 //   anything else                                       no reply
@@ -19,10 +21,10 @@
 // counters are counted down through SimControl::UpdateSerial.
 //
 // The port path is a stable symlink to the current pty slave (path()). When the port "vanishes"
-// (SerialFaults::vanish_seconds, during the next D5) the pty is closed (a driver holding it sees a
-// hang-up, EIO), the link is removed, and after the pause a new pty is made and the link points at
-// it. The new pty usually has a different /dev/pts number, so drivers must open the link path, and
-// reopen it by name after a disconnect (the PR-650 driver does).
+// (SerialFaults::vanish_seconds, during the next D5 or M5 report) the pty is closed (a driver
+// holding it sees a hang-up, EIO), the link is removed, and after the pause a new pty is made and
+// the link points at it. The new pty usually has a different /dev/pts number, so drivers must open
+// the link path, and reopen it by name after a disconnect (the PR-650 driver does).
 #pragma once
 
 #include <atomic>
@@ -107,6 +109,12 @@ class Pr650Endpoint {
 
   void Run();
   void Handle(const std::string& command);
+  // Takes a measurement (its simulated duration in real time) into last_; false if stopped or
+  // switched off meanwhile (no reply then).
+  bool Measure(unsigned epoch);
+  int LastQualityCode();
+  // The D5 report of last_ (with the vanish fault, if armed).
+  void ReplySpectrum();
   // Sends `lines` as one reply (line ends, quirks and faults applied). `vanish_after`: for a D5
   // with the vanish fault, the number of bytes after which the port vanishes.
   void Reply(std::vector<std::string> lines, double vanish_seconds = 0);
