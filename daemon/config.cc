@@ -574,8 +574,9 @@ plan::RigDescription ToRigDescription(const Config& config) {
                     convention(s.delta)};
   // The D5 report is ~1,730 bytes; 10 bits per byte on the wire (8N1).
   rig.meter_transfer_s = 1730.0 * 10.0 / config.meter.baud;
-  // Two paced commands per reading (M0, D5) plus ~0.3 s of meter processing.
-  rig.reading_overhead_s = 2 * config.meter.pacing_ms / 1000.0 + 0.3;
+  // Paced commands per reading (M5; or M0 and D5) plus ~0.3 s of meter processing.
+  const int commands = config.meter.measure_with_spectrum ? 1 : 2;
+  rig.reading_overhead_s = commands * config.meter.pacing_ms / 1000.0 + 0.3;
   return rig;
 }
 

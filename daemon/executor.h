@@ -12,12 +12,14 @@
 //              Cancel (pause, abort, shutdown).
 //   reading    (reference, dark, sample) the stage must be where the last move before this step
 //              put it (on resume it is moved there first); Configure the meter per the plan's
-//              measurement settings, Measure (M0), TransferSpectrum (D5), directions from the pose
-//              (core/geometry; sample-fixed readings: the step's target), and one transaction with
-//              the reading (naming the session's latest reference and dark) and the done mark.
+//              measurement settings, MeasureSpectrum (PR-650: M5, or M0 then D5), directions from
+//              the pose (core/geometry; sample-fixed readings: the step's target), and one
+//              transaction with the reading (naming the session's latest reference and dark) and
+//              the done mark.
 //
 // Pipelining (Options::pipelining): when step k is a reading and step k+1 a move, the move starts
-// on a second thread as soon as M0 of step k has returned, while D5 transfers. Reading k is
+// on a second thread as soon as the meter has accepted the measurement of step k (MeasureSpectrum's
+// callback: M5's status line, or M0's reply), while the spectrum transfers. Reading k is
 // committed first, the move's done mark after it; a failed transfer waits for the move and moves
 // back before measuring again. Not done while a deferred pause is pending.
 //

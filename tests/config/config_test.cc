@@ -153,6 +153,12 @@ level = "debug"
   slow.meter.baud = 9600;
   EXPECT_NEAR(ToRigDescription(slow).meter_transfer_s, 2 * rig.meter_transfer_s, 1e-12);
   EXPECT_NEAR(ToRigDescription(slow).meter_transfer_s, 1.8, 0.05);  // pr650.md: ~1.8 s
+  // The estimate's per-reading overhead: one paced command with M5 (pacing_ms = 50), two with
+  // M0 then D5 (this file sets measure_with_spectrum = false).
+  EXPECT_NEAR(rig.reading_overhead_s, 0.3 + 2 * 0.050, 1e-12);
+  Config m5 = c;
+  m5.meter.measure_with_spectrum = true;
+  EXPECT_NEAR(ToRigDescription(m5).reading_overhead_s, 0.3 + 0.050, 1e-12);
 }
 
 TEST(ConfigTest, UnknownKeysAreRefusedByFullPath) {
