@@ -214,13 +214,14 @@ void Pr650Endpoint::Handle(const std::string& command) {
   }
   if (command == "M0" || command == "M5") {
     // M5 is M0 followed by the D5 report, in one reply.
-    if (!Measure(epoch)) return;
+    const std::optional<int> quality_code = Measure(epoch);
+    if (!quality_code.has_value()) return;
     if (command == "M5") {
       ReplySpectrum();
       return;
     }
     char text[8];
-    std::snprintf(text, sizeof text, "%03d", std::clamp(LastQualityCode(), 0, 999));
+    std::snprintf(text, sizeof text, "%03d", std::clamp(*quality_code, 0, 999));
     Reply({text});
     return;
   }
@@ -241,7 +242,7 @@ void Pr650Endpoint::Handle(const std::string& command) {
   // Unknown or unsupported (M1–M4, M6, D1, D2, ...): the simulated meter does not answer.
 }
 
-bool Pr650Endpoint::Measure(unsigned epoch) {
+std::optional<int> Pr650Endpoint::Measure(unsigned epoch) {
   MeterSetup setup;
   {
     std::lock_guard lock(mu_);
@@ -255,16 +256,11 @@ bool Pr650Endpoint::Measure(unsigned epoch) {
     return f.quality_code;
   });
   if (forced >= 0) m.quality_code = forced;
-  if (!SleepReal(options_.time_scale.ToReal(std::max(0.0, m.duration_s)))) return false;
+  if (!SleepReal(options_.time_scale.ToReal(std::max(0.0, m.duration_s)))) return std::nullopt;
   std::lock_guard lock(mu_);
-  if (epoch != power_epoch_) return false;  // switched off mid-measurement: no reply
+  if (epoch != power_epoch_) return std::nullopt;  // switched off mid-measurement: no reply
   last_ = Measurement{true, m.quality_code, m.integrated, std::move(m.radiance)};
-  return true;
-}
-
-int Pr650Endpoint::LastQualityCode() {
-  std::lock_guard lock(mu_);
-  return last_.quality_code;
+  return m.quality_code;
 }
 
 void Pr650Endpoint::ReplySpectrum() {

@@ -30,6 +30,7 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -109,10 +110,9 @@ class Pr650Endpoint {
 
   void Run();
   void Handle(const std::string& command);
-  // Takes a measurement (its simulated duration in real time) into last_; false if stopped or
-  // switched off meanwhile (no reply then).
-  bool Measure(unsigned epoch);
-  int LastQualityCode();
+  // Takes a measurement (its simulated duration in real time) into last_ and returns its quality
+  // code; nullopt if stopped or switched off meanwhile (no reply then).
+  std::optional<int> Measure(unsigned epoch);
   // The D5 report of last_ (with the vanish fault, if armed).
   void ReplySpectrum();
   // Sends `lines` as one reply (line ends, quirks and faults applied). `vanish_after`: for a D5
