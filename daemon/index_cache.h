@@ -118,17 +118,18 @@ class IndexCache {
                                                    interp::Method method,
                                                    const interp::Options& options);
 
+  // The cached, current index for these settings when no reading landed since the session's
+  // last store read: the common query, answered under shared locks only (no store read, no
+  // build, no allocation), so concurrent queries never wait for each other and a caller that
+  // must not block can ask. Null otherwise (then Get loads, extends or builds).
+  std::shared_ptr<const IndexSnapshot> FreshHit(SessionId session, Quantity quantity,
+                                                interp::Method method,
+                                                const interp::Options& options);
+
   Stats stats() const;
 
  private:
   struct Entry;
-  // The cached, current index for this key when no reading landed since the session's last
-  // store read: the common query, answered under shared locks only (no store read, no build, no
-  // allocation), so concurrent queries never wait for each other. Null otherwise (the slow path
-  // in Get decides).
-  std::shared_ptr<const IndexSnapshot> FreshHit(SessionId session, Quantity quantity,
-                                                interp::Method method,
-                                                const interp::Options& options);
   void Evict(SessionId keep);
   // Counts a store read in stats_ (mu_ held exclusively).
   void CountLoad(bool appended, bool first_load, std::uint64_t readings_read);

@@ -3,15 +3,16 @@
 #include <absl/synchronization/mutex.h>
 #include <arpa/inet.h>
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
-#include <grpcpp/health_check_service_interface.h>
 #include <grpcpp/resource_quota.h>
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server_builder.h>
 #include <spdlog/spdlog.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 namespace brdf::daemon {
 namespace {
@@ -81,10 +82,17 @@ bool IsLoopbackAddress(const std::string& listen) {
   return false;
 }
 
+int InterpolateLoopThreads(unsigned cores) {
+  return static_cast<int>(std::clamp(cores / 2, 1U, 8U));
+}
+
 Server::Server(SessionManager& manager, IndexCache& cache, const Authenticator& auth)
-    : control_(manager, auth, stopping_),
+    : health_(stopping_),
+      control_(manager, auth, stopping_),
       data_(manager, auth, stopping_),
-      interpolation_(cache, auth, stopping_) {}
+      interpolation_(cache, auth, stopping_),
+      interpolate_loop_(interpolation_,
+                        InterpolateLoopThreads(std::thread::hardware_concurrency())) {}
 
 Server::~Server() {
   Shutdown(std::chrono::seconds(1));
@@ -125,8 +133,7 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   // on: every lock gRPC takes records the lock in a global graph, about a tenth of the CPU of a
   // small call. Upstream release builds have it off; so do we (process-wide, before any call).
   absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
-  // Both must be set up before the builder is made.
-  grpc::EnableDefaultHealthCheckService(true);
+  // Set up before the builder is made. gRPC's own health service stays off: health_ serves it.
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
 
   std::unique_ptr<Server> server(new Server(manager, cache, auth));
@@ -137,9 +144,11 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   grpc::ResourceQuota quota("brdfd");
   quota.SetMaxThreads(kMaxServerThreads);
   builder.SetResourceQuota(quota);
+  builder.RegisterService(&server->health_);
   builder.RegisterService(&server->control_);
   builder.RegisterService(&server->data_);
   builder.RegisterService(&server->interpolation_);
+  server->interpolate_loop_.AddQueues(builder);
   server->server_ = builder.BuildAndStart();
   const bool unix_socket = config.listen.rfind("unix:", 0) == 0;
   if (!server->server_ || (!unix_socket && selected_port == 0)) {
@@ -149,6 +158,7 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
                         : " (address in use, not allowed, or no such interface)") +
                    "; change [server] listen or stop the process that holds it");
   }
+  server->interpolate_loop_.Start();
   server->tls_ = tls;
   server->port_ = selected_port;
   server->address_ = unix_socket ? config.listen
@@ -157,26 +167,24 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   spdlog::info(
       "limits: requests up to {} bytes (larger: RESOURCE_EXHAUSTED), InterpolateBatch up to {} "
       "directions in chunks of up to {} results, notes up to {} bytes, pages up to {} sessions, "
-      "{} call threads{}",
+      "{} call threads, Interpolate on {} loop thread(s){}",
       kMaxReceiveMessageBytes, kMaxBatchDirections, kMaxChunkSize, kMaxNoteBytes, kMaxPageSize,
-      kMaxServerThreads,
+      kMaxServerThreads, server->interpolate_loop_.threads(),
       tls ? (config.tls->client_ca.empty() ? "; TLS" : "; TLS, client certificates required")
           : "; plaintext");
-  if (grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService()) {
-    health->SetServingStatus(true);
-    for (const char* name : kServiceNames) health->SetServingStatus(name, true);
-  }
+  server->health_.SetServingStatus("", true);
+  for (const char* name : kServiceNames) server->health_.SetServingStatus(name, true);
   return server;
 }
 
 void Server::Shutdown(std::chrono::milliseconds grace) {
   if (shut_down_ || !server_) return;
   shut_down_ = true;
-  if (grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService()) {
-    health->SetServingStatus(false);
-  }
+  health_.SetServingStatus(false);
   stopping_.Stop();
+  interpolate_loop_.BeginShutdown();
   server_->Shutdown(std::chrono::system_clock::now() + grace);
+  interpolate_loop_.Stop();
   server_->Wait();
 }
 

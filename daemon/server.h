@@ -3,8 +3,9 @@
 // on the configured address, in plaintext or TLS ([server.tls]; client_ca → clients must present
 // a certificate). Synchronous API: each call runs on a thread of gRPC's pool, capped at
 // kMaxServerThreads (calls beyond it fail with RESOURCE_EXHAUSTED instead of piling up). One
-// exception, Interpolate, the call analysis clients make by the thousand: it is answered on gRPC's
-// callback API, on the thread that read the request (service_interpolation.h).
+// exception, Interpolate, the call analysis clients make by the thousand: it is answered by
+// brdfd's own loop threads on gRPC's completion-queue API (interpolate_loop.h), one per two
+// cores.
 #pragma once
 
 #include <grpcpp/server.h>
@@ -16,7 +17,9 @@
 #include "core/status.h"
 #include "daemon/auth.h"
 #include "daemon/config.h"
+#include "daemon/health_service.h"
 #include "daemon/index_cache.h"
+#include "daemon/interpolate_loop.h"
 #include "daemon/service_common.h"
 #include "daemon/service_control.h"
 #include "daemon/service_data.h"
@@ -26,6 +29,11 @@
 namespace brdf::daemon {
 
 inline constexpr int kMaxServerThreads = 256;
+
+// Interpolate's loop threads (interpolate_loop.h) on a machine with `cores` cores: one per two
+// cores, at least one, at most 8. Each keeps a core busy under load; the others are left to
+// gRPC's transport, the session and, on a shared machine, the clients.
+int InterpolateLoopThreads(unsigned cores);
 
 // True for addresses only this machine can reach: literal 127.0.0.0/8, ::1, ::ffff:127.x.y.z,
 // "localhost", unix sockets. Host names (other than localhost) and 0.0.0.0 / [::] are not.
@@ -59,9 +67,11 @@ class Server {
   Server(SessionManager& manager, IndexCache& cache, const Authenticator& auth);
 
   StopSignal stopping_;
+  HealthService health_;
   ControlService control_;
   DataService data_;
   InterpolationService interpolation_;
+  InterpolateLoop interpolate_loop_;  // after interpolation_, which it serves
   std::unique_ptr<grpc::Server> server_;
   std::string address_;
   int port_ = 0;

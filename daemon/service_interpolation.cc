@@ -199,17 +199,22 @@ grpc::Status SessionOf(const std::string& text, SessionId* id) {
 
 }  // namespace
 
-grpc::ServerUnaryReactor* InterpolationService::Interpolate(grpc::CallbackServerContext* context,
-                                                            const v1::InterpolateRequest* request,
-                                                            v1::InterpolateResponse* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  reactor->Finish(Answer(*context, *request, response));
-  return reactor;
+std::optional<grpc::Status> InterpolationService::AnswerIfReady(
+    const grpc::ServerContextBase& context, const v1::InterpolateRequest& request,
+    v1::InterpolateResponse* response) {
+  return Respond(context, request, response, /*may_load=*/false);
 }
 
 grpc::Status InterpolationService::Answer(const grpc::ServerContextBase& context,
                                           const v1::InterpolateRequest& request,
                                           v1::InterpolateResponse* response) {
+  return *Respond(context, request, response, /*may_load=*/true);
+}
+
+std::optional<grpc::Status> InterpolationService::Respond(const grpc::ServerContextBase& context,
+                                                          const v1::InterpolateRequest& request,
+                                                          v1::InterpolateResponse* response,
+                                                          bool may_load) {
   Caller caller;
   if (grpc::Status st = auth_.Authorize(context, Access::kRead, "Interpolate", &caller); !st.ok()) {
     return st;
@@ -224,14 +229,21 @@ grpc::Status InterpolationService::Answer(const grpc::ServerContextBase& context
   }
   if (grpc::Status st = CheckDirection(request.direction(), "direction"); !st.ok()) return st;
 
-  Result<std::shared_ptr<const IndexSnapshot>> index =
-      cache_.Get(id, settings.quantity, settings.method, settings.options);
-  if (!index.ok()) return ToGrpcStatus(index.status());
+  std::shared_ptr<const IndexSnapshot> index;
+  if (may_load) {
+    Result<std::shared_ptr<const IndexSnapshot>> loaded =
+        cache_.Get(id, settings.quantity, settings.method, settings.options);
+    if (!loaded.ok()) return ToGrpcStatus(loaded.status());
+    index = *std::move(loaded);
+  } else {
+    index = cache_.FreshHit(id, settings.quantity, settings.method, settings.options);
+    if (!index) return std::nullopt;
+  }
   std::array<double, 4> coords{};
-  if (grpc::Status st = ToCoords(request.direction(), **index, "direction", &coords); !st.ok()) {
+  if (grpc::Status st = ToCoords(request.direction(), *index, "direction", &coords); !st.ok()) {
     return st;
   }
-  Evaluate(request.direction(), coords, settings, **index, response->mutable_result());
+  Evaluate(request.direction(), coords, settings, *index, response->mutable_result());
   return grpc::Status::OK;
 }
 

@@ -20,6 +20,8 @@
 // cancels stops the batch at the next chunk.
 #pragma once
 
+#include <optional>
+
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/auth.h"
 #include "daemon/index_cache.h"
@@ -27,28 +29,36 @@
 
 namespace brdf::daemon {
 
-// Interpolate runs on gRPC's callback API: the answer takes microseconds, so it is computed on
-// the thread that read the request and finished there, with no hand-off to a call thread and back
-// (each hand-off is a thread wake-up, which on a loaded 2-core machine costs more than the
-// answer); this halved brdfd's CPU per call (bench/daemon). The one slow case, the first query
-// of a session whose index must be loaded and built, blocks that thread meanwhile (gRPC has
-// others). InterpolateBatch stays on the synchronous API: its writer blocks under flow control.
+// Interpolate is served on gRPC's completion-queue API by InterpolateLoop (interpolate_loop.h),
+// from threads of brdfd's own: the answer takes microseconds, so a loop thread computes it where
+// it took the request (AnswerIfReady) and only a query that must first load or extend the index
+// goes to a thread that may block (Answer). InterpolateBatch stays on the synchronous API: its
+// writer blocks under flow control.
 class InterpolationService final
-    : public v1::Interpolation::WithCallbackMethod_Interpolate<v1::Interpolation::Service> {
+    : public v1::Interpolation::WithAsyncMethod_Interpolate<v1::Interpolation::Service> {
  public:
   // All three must outlive the service.
   InterpolationService(IndexCache& cache, const Authenticator& auth, const StopSignal& stopping);
 
-  grpc::ServerUnaryReactor* Interpolate(grpc::CallbackServerContext* context,
-                                        const v1::InterpolateRequest* request,
-                                        v1::InterpolateResponse* response) override;
   grpc::Status InterpolateBatch(grpc::ServerContext* context,
                                 const v1::InterpolateBatchRequest* request,
                                 grpc::ServerWriter<v1::InterpolateBatchChunk>* writer) override;
 
- private:
+  // Interpolate's answer (or its error) when the cache holds a current index for the request
+  // (IndexCache::FreshHit): never reads the store nor builds. nullopt when the index must first be
+  // loaded, extended or built; then call Answer, which may take as long as that.
+  std::optional<grpc::Status> AnswerIfReady(const grpc::ServerContextBase& context,
+                                            const v1::InterpolateRequest& request,
+                                            v1::InterpolateResponse* response);
+  // Interpolate's answer, loading or extending the index first if need be.
   grpc::Status Answer(const grpc::ServerContextBase& context, const v1::InterpolateRequest& request,
                       v1::InterpolateResponse* response);
+
+ private:
+  // Both of the above; with `may_load` false, returns nullopt where it would load.
+  std::optional<grpc::Status> Respond(const grpc::ServerContextBase& context,
+                                      const v1::InterpolateRequest& request,
+                                      v1::InterpolateResponse* response, bool may_load);
 
   IndexCache& cache_;
   const Authenticator& auth_;

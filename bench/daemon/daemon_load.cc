@@ -3,11 +3,15 @@
 // would be), each calling Interpolate back to back with a random direction for `--seconds`.
 // Latency is the client's: from the call to the answer, over loopback.
 //
-// --api chooses the client side of gRPC. "callback" (the default): each client's next call is
-// started from the completion of the previous one, on the gRPC thread that read the answer, so a
-// call costs the load generator no thread wake-up (a wake-up per call on this 2-core machine costs
-// more CPU than the call itself, and that CPU is taken from brdfd). "sync": one blocking thread per
-// client (the simplest analysis program); needed for --rate.
+// --api chooses the client side of gRPC. "queue" (the default): all clients on one thread with
+// gRPC's completion-queue API, each client's next call started by that thread when the previous
+// one completes. The load generator then needs one core at most and never competes with itself
+// for the two this machine has (brdfd's Interpolate loop takes the other): a load generator of
+// several busy threads on the same cores as the server measures the scheduler's time slices
+// (4 ms ticks) rather than the server. "callback": gRPC's callback API, each next call started on
+// the gRPC thread that read the previous answer (gRPC runs two or more such threads: the
+// multi-threaded client). "sync": one blocking thread per client (the simplest analysis
+// program); needed for --rate.
 //
 // --rate R paces each client at R calls/s on a fixed schedule (an analysis program's pace rather
 // than a saturating loop). Latency is then measured from each call's scheduled time, so a call that
@@ -47,7 +51,7 @@ struct Options {
   double seconds = 10;
   double warmup = 1;
   double rate = 0;  // calls/s per client; 0: back to back
-  std::string api = "callback";
+  std::string api = "queue";
 };
 
 void Authorize(grpc::ClientContext& context, const Options& o) {
@@ -74,6 +78,28 @@ struct ClientResult {
   std::string first_error;
 };
 
+// A random direction of the benchmark's range (θi, θo in [0, 70], φ in [0, 180]) into `request`.
+void RandomDirection(std::mt19937_64& rng, brdf::v1::InterpolateRequest* request) {
+  std::uniform_real_distribution<double> theta(0, 70);
+  std::uniform_real_distribution<double> phi(0, 180);
+  brdf::v1::IsoDirection* iso = request->mutable_direction()->mutable_iso();
+  iso->set_theta_i(theta(rng));
+  iso->set_theta_o(theta(rng));
+  iso->set_phi(phi(rng));
+}
+
+// Counts a call that started at `start` and ended at `end`, unless it started in the warm-up
+// (connections, the index's first build).
+void Record(ClientResult* out, Clock::time_point measure_from, Clock::time_point start,
+            Clock::time_point end, const grpc::Status& status) {
+  if (start < measure_from) return;
+  if (!status.ok()) {
+    if (out->errors++ == 0) out->first_error = status.error_message();
+    return;
+  }
+  out->latencies_us.push_back(std::chrono::duration<double, std::micro>(end - start).count());
+}
+
 void Client(const Options& o, int seed, Clock::time_point measure_from, Clock::time_point until,
             ClientResult* out) {
   grpc::ChannelArguments args;
@@ -81,8 +107,6 @@ void Client(const Options& o, int seed, Clock::time_point measure_from, Clock::t
   auto channel = grpc::CreateCustomChannel(o.address, grpc::InsecureChannelCredentials(), args);
   auto stub = brdf::v1::Interpolation::NewStub(channel);
   std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
-  std::uniform_real_distribution<double> theta(0, 70);
-  std::uniform_real_distribution<double> phi(0, 180);
   out->latencies_us.reserve(200000);
   const bool paced = o.rate > 0;
   const auto period =
@@ -95,23 +119,14 @@ void Client(const Options& o, int seed, Clock::time_point measure_from, Clock::t
     if (paced) std::this_thread::sleep_until(next);
     brdf::v1::InterpolateRequest request;
     request.set_session_id(o.session);
-    brdf::v1::IsoDirection* iso = request.mutable_direction()->mutable_iso();
-    iso->set_theta_i(theta(rng));
-    iso->set_theta_o(theta(rng));
-    iso->set_phi(phi(rng));
+    RandomDirection(rng, &request);
     brdf::v1::InterpolateResponse response;
     grpc::ClientContext context;
     Authorize(context, o);
     const Clock::time_point start = paced ? next : Clock::now();
     if (paced) next += period;
     const grpc::Status status = stub->Interpolate(&context, request, &response);
-    const Clock::time_point end = Clock::now();
-    if (start < measure_from) continue;  // warm-up: connections, the index's first build
-    if (!status.ok()) {
-      if (out->errors++ == 0) out->first_error = status.error_message();
-      continue;
-    }
-    out->latencies_us.push_back(std::chrono::duration<double, std::micro>(end - start).count());
+    Record(out, measure_from, start, Clock::now(), status);
   }
 }
 
@@ -145,10 +160,7 @@ class CallbackClient {
 
  private:
   void Call() {
-    brdf::v1::IsoDirection* iso = request_.mutable_direction()->mutable_iso();
-    iso->set_theta_i(theta_(rng_));
-    iso->set_theta_o(theta_(rng_));
-    iso->set_phi(phi_(rng_));
+    RandomDirection(rng_, &request_);
     context_ = std::make_unique<grpc::ClientContext>();
     Authorize(*context_, o_);
     start_ = Clock::now();
@@ -158,14 +170,7 @@ class CallbackClient {
 
   void Done(const grpc::Status& status) {
     const Clock::time_point end = Clock::now();
-    if (start_ >= measure_from_) {  // before: warm-up (connections, the index's first build)
-      if (!status.ok()) {
-        if (out_->errors++ == 0) out_->first_error = status.error_message();
-      } else {
-        out_->latencies_us.push_back(
-            std::chrono::duration<double, std::micro>(end - start_).count());
-      }
-    }
+    Record(out_, measure_from_, start_, end, status);
     if (end < until_) {
       Call();
       return;
@@ -177,8 +182,6 @@ class CallbackClient {
   const Options& o_;
   std::unique_ptr<brdf::v1::Interpolation::Stub> stub_;
   std::mt19937_64 rng_;
-  std::uniform_real_distribution<double> theta_{0, 70};
-  std::uniform_real_distribution<double> phi_{0, 180};
   const Clock::time_point measure_from_;
   const Clock::time_point until_;
   ClientResult* out_;
@@ -188,6 +191,82 @@ class CallbackClient {
   Clock::time_point start_;
   absl::Mutex mu_;
   bool done_ = false;
+};
+
+// All clients on ONE thread with gRPC's completion-queue API: each client (its own channel) keeps
+// one call in flight, and the thread that takes a call's completion from the queue records it
+// and starts that client's next call. One thread does all the load generator's work, so on a
+// 2-core machine shared with brdfd it never competes with itself for a core (see --api).
+class QueueClients {
+ public:
+  QueueClients(const Options& o, Clock::time_point measure_from, Clock::time_point until,
+               std::vector<ClientResult>* results)
+      : o_(o), measure_from_(measure_from), until_(until) {
+    for (std::size_t i = 0; i < results->size(); ++i) {
+      auto client = std::make_unique<Client>();
+      grpc::ChannelArguments args;
+      args.SetInt("grpc.use_local_subchannel_pool", 1);  // a connection of its own
+      client->stub = brdf::v1::Interpolation::NewStub(
+          grpc::CreateCustomChannel(o.address, grpc::InsecureChannelCredentials(), args));
+      client->rng.seed(1000 + i);
+      client->out = &(*results)[i];
+      client->out->latencies_us.reserve(200000);
+      client->request.set_session_id(o.session);
+      clients_.push_back(std::move(client));
+    }
+  }
+
+  // Runs the closed loops until the window is over and every call is back.
+  void Run() {
+    int in_flight = 0;
+    for (auto& c : clients_) {
+      Call(*c);
+      ++in_flight;
+    }
+    void* tag = nullptr;
+    bool ok = false;
+    while (in_flight > 0 && queue_.Next(&tag, &ok)) {
+      Client& c = *static_cast<Client*>(tag);
+      const Clock::time_point end = Clock::now();
+      Record(c.out, measure_from_, c.start, end, c.status);
+      if (end < until_) {
+        Call(c);
+      } else {
+        --in_flight;
+      }
+    }
+    queue_.Shutdown();
+    while (queue_.Next(&tag, &ok)) {
+    }
+  }
+
+ private:
+  struct Client {
+    std::unique_ptr<brdf::v1::Interpolation::Stub> stub;
+    std::mt19937_64 rng;
+    ClientResult* out = nullptr;
+    brdf::v1::InterpolateRequest request;
+    brdf::v1::InterpolateResponse response;
+    std::unique_ptr<grpc::ClientContext> context;
+    std::unique_ptr<grpc::ClientAsyncResponseReader<brdf::v1::InterpolateResponse>> reader;
+    grpc::Status status;
+    Clock::time_point start;
+  };
+
+  void Call(Client& c) {
+    RandomDirection(c.rng, &c.request);
+    c.context = std::make_unique<grpc::ClientContext>();
+    Authorize(*c.context, o_);
+    c.start = Clock::now();
+    c.reader = c.stub->AsyncInterpolate(c.context.get(), c.request, &queue_);
+    c.reader->Finish(&c.response, &c.status, &c);
+  }
+
+  const Options& o_;
+  const Clock::time_point measure_from_;
+  const Clock::time_point until_;
+  grpc::CompletionQueue queue_;
+  std::vector<std::unique_ptr<Client>> clients_;
 };
 
 double Percentile(std::vector<double>& sorted, double p) {
@@ -210,8 +289,10 @@ int main(int argc, char** argv) {
   app.add_option("--warmup", o.warmup, "seconds before the window")->check(CLI::Range(0.0, 60.0));
   app.add_option("--rate", o.rate, "calls/s per client on a fixed schedule (0: back to back)")
       ->check(CLI::Range(0.0, 100000.0));
-  app.add_option("--api", o.api, "gRPC client API: callback (default) or sync (needed for --rate)")
-      ->check(CLI::IsMember({"callback", "sync"}));
+  app.add_option(
+         "--api", o.api,
+         "gRPC client API: queue (default: one thread), callback or sync (needed for --rate)")
+      ->check(CLI::IsMember({"callback", "sync", "queue"}));
   CLI11_PARSE(app, argc, argv);
   if (o.rate > 0 && o.api != "sync") {
     std::fprintf(stderr, "bench_daemon_load: --rate needs --api sync\n");
@@ -231,8 +312,13 @@ int main(int argc, char** argv) {
   std::vector<ClientResult> results(static_cast<std::size_t>(o.clients));
   std::vector<std::thread> threads;
   std::vector<std::unique_ptr<CallbackClient>> callback_clients;
+  std::unique_ptr<QueueClients> queue_clients;
+  if (o.api == "queue") {
+    queue_clients = std::make_unique<QueueClients>(o, measure_from, until, &results);
+  }
   for (int i = 0; i < o.clients; ++i) {
     ClientResult* out = &results[static_cast<std::size_t>(i)];
+    if (o.api == "queue") break;
     if (o.api == "sync") {
       threads.emplace_back(Client, std::cref(o), 1000 + i, measure_from, until, out);
     } else {
@@ -241,10 +327,13 @@ int main(int argc, char** argv) {
     }
   }
   for (auto& c : callback_clients) c->Start();
+  std::thread queue_thread;
+  if (queue_clients) queue_thread = std::thread([&] { queue_clients->Run(); });
   std::this_thread::sleep_until(measure_from);
   const long before = o.recording.empty() ? -1 : DoneSteps(control_channel, o, o.recording);
   for (std::thread& t : threads) t.join();
   for (auto& c : callback_clients) c->Wait();
+  if (queue_thread.joinable()) queue_thread.join();
   const long after = o.recording.empty() ? -1 : DoneSteps(control_channel, o, o.recording);
 
   std::vector<double> all;

@@ -2,7 +2,11 @@
 # Figures for a running daemon (issue 6, bench part 3), in one run of about three minutes:
 #   1. gRPC Interpolate latency (p50, p99) and throughput, 8 concurrent clients on loopback, while
 #      a session records against brdf-sim: (a) querying the recording session itself (its index
-#      takes in each new reading), (b) querying a completed 10,000-reading session meanwhile;
+#      takes in each new reading), (b) querying a completed 10,000-reading session meanwhile; the
+#      load generator drives its 8 clients (8 connections) from one thread (bench_daemon_load
+#      --api queue), so that on this 2-core machine it takes one core at most and brdfd the other;
+#      (c) as (a) with gRPC's multi-threaded callback client instead, for comparison: its busy
+#      threads and brdfd's outnumber the cores, and the tail is the scheduler's 4 ms ticks;
 #   2. session time against the physical lower bound, pipelining on and off (same plan, ≥ 500
 #      steps, brdf-sim in scaled time with its 9600-baud pacing; bench_session_time);
 #   3. readings ingested per second into SQLite (one transaction per reading, synchronous=FULL),
@@ -168,6 +172,10 @@ echo "   $load_live" >&2
 load_10k="$("$bin/bench_daemon_load" --address "$address" --token "$analyst_token" \
   --session 1 --recording "$live" --clients 8 --seconds "$load_seconds" --warmup 2)"
 echo "   $load_10k" >&2
+load_cb="$("$bin/bench_daemon_load" --address "$address" --token "$analyst_token" \
+  --session "$live" --recording "$live" --clients 8 --seconds "$load_seconds" --warmup 1 \
+  --api callback)"
+echo "   $load_cb" >&2
 "$ctl" abort "$live" --reason "bench done" >/dev/null 2>&1 || true
 stop_pid "$watch_pid"
 stop_pid "$live_pid"
@@ -213,11 +221,14 @@ echo
 echo "== brdfd under load (figures for a running daemon)"
 printf '%-58s %s\n' "figure" "value"
 printf '%-58s %s\n' "----------------------------------------------------------" "-----------------------------"
-for which in live 10k; do
+for which in live 10k callback; do
   line="$load_live"
-  label="Interpolate, 8 clients, querying the recording session"
-  if [[ $which == 10k ]]; then line="$load_10k"; label="Interpolate, 8 clients, a 10k-reading session"; fi
-  printf '%-58s %s\n' "$label: p50" "$(ms "$(field "$line" p50_us)")"
+  label="(a) Interpolate, 8 clients, the recording session: p50"
+  if [[ $which == 10k ]]; then line="$load_10k"; label="(b) Interpolate, 8 clients, a 10k-reading session: p50"; fi
+  if [[ $which == callback ]]; then
+    line="$load_cb"; label="(c) as (a), from gRPC's multi-threaded client: p50"
+  fi
+  printf '%-58s %s\n' "$label" "$(ms "$(field "$line" p50_us)")"
   printf '%-58s %s\n' "  p99 (target < 1 ms)" "$(ms "$(field "$line" p99_us)")"
   printf '%-58s %s\n' "  p99.9 / max" "$(ms "$(field "$line" p999_us)") / $(ms "$(field "$line" max_us)")"
   printf '%-58s %s\n' "  throughput" "$(field "$line" qps) calls/s ($(field "$line" calls) calls, $(field "$line" errors) errors)"

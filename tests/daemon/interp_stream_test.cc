@@ -1,9 +1,11 @@
 // The Interpolation service in process, over gRPC on loopback: a real SQLite store filled through
-// storage's API, the real IndexCache and InterpolationService behind a grpc::Server, and the
-// generated client stub. Checks that InterpolateBatch streams its answer chunk by chunk under the
-// client's flow control (a server interceptor counts the chunks the service has written), the
-// precise errors of both RPCs, and that the per-session index takes in new readings by appending
-// them (the cache's counters) instead of reading the session again.
+// storage's API, the real IndexCache and InterpolationService behind a grpc::Server with
+// Interpolate served by an InterpolateLoop, and the generated client stub. Checks that
+// InterpolateBatch streams its answer chunk by chunk under the client's flow control (a server
+// interceptor counts the chunks the service has written), the precise errors of both RPCs, that
+// the per-session index takes in new readings by appending them (the cache's counters) instead of
+// reading the session again, and the loop: concurrent calls while readings land (answered on the
+// loop or, after each new reading, in its slow lane), and a shutdown with calls in flight.
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/support/server_interceptor.h>
 #include <gtest/gtest.h>
@@ -19,6 +21,7 @@
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/auth.h"
 #include "daemon/index_cache.h"
+#include "daemon/interpolate_loop.h"
 #include "daemon/service_common.h"
 #include "daemon/service_interpolation.h"
 #include "storage/session_store.h"
@@ -71,11 +74,14 @@ class InterpStreamTest : public ::testing::Test {
     builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
     builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
     builder.RegisterService(service_.get());
+    loop_ = std::make_unique<InterpolateLoop>(*service_, 1);
+    loop_->AddQueues(builder);
     std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> creators;
     creators.push_back(std::make_unique<CountingFactory>(sent_));
     builder.experimental().SetInterceptorCreators(std::move(creators));
     server_ = builder.BuildAndStart();
     ASSERT_TRUE(server_ != nullptr && port > 0);
+    loop_->Start();
     // No BDP probing: the stream's flow-control window stays at its initial 64 KiB, so a client
     // that stops reading holds the server back after a few chunks.
     grpc::ChannelArguments args;
@@ -88,7 +94,9 @@ class InterpStreamTest : public ::testing::Test {
 
   void TearDown() override {
     stopping_.Stop();
+    loop_->BeginShutdown();
     if (server_) server_->Shutdown(std::chrono::system_clock::now() + 2s);
+    loop_->Stop();
   }
 
   // A session: a white reference, a dark, then `samples` sample readings at random directions
@@ -169,6 +177,20 @@ class InterpStreamTest : public ::testing::Test {
     return stub_->Interpolate(context.get(), request, response ? response : &ignored);
   }
 
+  // The reading the nearest-neighbour method answers with at `direction`; −1 when the call fails
+  // or does not answer with exactly one vertex.
+  std::int64_t NearestReadingAt(const std::string& session, const v1::DirectionQuery& direction) {
+    v1::InterpolateRequest request;
+    request.set_session_id(session);
+    *request.mutable_direction() = direction;
+    request.set_method(v1::INTERPOLATION_METHOD_NEAREST);
+    v1::InterpolateResponse response;
+    auto context = Context();
+    if (!stub_->Interpolate(context.get(), request, &response).ok()) return -1;
+    if (response.result().vertices_size() != 1) return -1;
+    return response.result().vertices(0).reading_id();
+  }
+
   // Runs a whole batch; the chunks through `chunks`.
   grpc::Status Batch(const v1::InterpolateBatchRequest& request,
                      std::vector<v1::InterpolateBatchChunk>* chunks = nullptr) {
@@ -187,6 +209,7 @@ class InterpStreamTest : public ::testing::Test {
   Authenticator auth_{{}};
   StopSignal stopping_;
   std::unique_ptr<InterpolationService> service_;
+  std::unique_ptr<InterpolateLoop> loop_;  // serves service_'s Interpolate
   std::atomic<int> sent_{0};
   std::unique_ptr<grpc::Server> server_;
   std::shared_ptr<grpc::Channel> channel_;
@@ -353,15 +376,7 @@ TEST_F(InterpStreamTest, NewReadingsAreAppendedToTheIndexNotReadAgain) {
   const storage::ReadingRecord b =
       AddReading(id, storage::ReadingKind::kSample, {63, 0, 14, 150}, 0.2);
   cache_->OnReading(id, b);
-  v1::InterpolateRequest request;
-  request.set_session_id(session);
-  *request.mutable_direction() = Iso(33, 44, 55);
-  request.set_method(v1::INTERPOLATION_METHOD_NEAREST);
-  v1::InterpolateResponse response;
-  auto context = Context();
-  ASSERT_TRUE(stub_->Interpolate(context.get(), request, &response).ok());
-  ASSERT_EQ(response.result().vertices_size(), 1);
-  EXPECT_EQ(response.result().vertices(0).reading_id(), a.id);
+  EXPECT_EQ(NearestReadingAt(session, Iso(33, 44, 55)), a.id);
   const IndexCache::Stats after = cache_->stats();
   EXPECT_EQ(after.readings_read, first.readings_read + 2);
   EXPECT_EQ(after.loads, 2u);
@@ -370,6 +385,87 @@ TEST_F(InterpStreamTest, NewReadingsAreAppendedToTheIndexNotReadAgain) {
   // The octant index over the same readings: built once more, nothing read.
   ASSERT_TRUE(Single(session, Iso(63, 14, 150)).ok());
   EXPECT_EQ(cache_->stats().readings_read, after.readings_read);
+}
+
+TEST_F(InterpStreamTest, ConcurrentCallsWhileReadingsLandAllSeeTheReadingsBeforeThem) {
+  const std::int64_t id = MakeSession(60, /*extra_steps=*/20);
+  const std::string session = std::to_string(id);
+  ASSERT_TRUE(Single(session, Iso(30, 30, 90)).ok());
+  std::atomic<bool> done{false};
+  std::atomic<int> answered{0};
+  std::vector<std::string> failures(4);
+  std::vector<std::thread> clients;
+  for (int c = 0; c < 4; ++c) {
+    clients.emplace_back([&, c] {
+      while (!done.load()) {
+        grpc::Status st = Single(session, Iso(10 + c * 10, 40, 20 * c));
+        if (!st.ok()) {
+          failures[c] = st.error_message();
+          return;
+        }
+        ++answered;
+      }
+    });
+  }
+  // Twenty readings land while the clients query: after each, the next query of the session
+  // goes to the slow lane (the index is extended), the ones after it are answered on the loop.
+  std::int64_t last_id = 0;
+  for (int i = 0; i < 20; ++i) {
+    const storage::ReadingRecord r =
+        AddReading(id, storage::ReadingKind::kSample, {5.0 + 3 * i, 0, 70.0 - 2 * i, 7.0 * i}, 0.5);
+    cache_->OnReading(id, r);
+    last_id = r.id;
+    std::this_thread::sleep_for(5ms);
+  }
+  done = true;
+  for (std::thread& t : clients) t.join();
+  for (const std::string& f : failures) EXPECT_EQ(f, "");
+  EXPECT_GT(answered.load(), 20);
+  // The next query sees the last reading: it is the nearest neighbour at its own direction.
+  EXPECT_EQ(NearestReadingAt(session, Iso(5 + 3 * 19, 70 - 2 * 19, 7 * 19)), last_id);
+  EXPECT_GE(cache_->stats().appends, 1u);
+}
+
+TEST_F(InterpStreamTest, ShutdownWithCallsInFlightEndsEveryCall) {
+  const std::string hot = std::to_string(MakeSession(40));
+  const std::string cold = std::to_string(MakeSession(2000));
+  ASSERT_TRUE(Single(hot, Iso(30, 30, 90)).ok());
+  // 64 calls at once: half on the session with an index (the loop), half on one whose index
+  // is not loaded yet (the slow lane, one after another behind the first load).
+  grpc::CompletionQueue queue;
+  struct Call {
+    grpc::ClientContext context;
+    v1::InterpolateResponse response;
+    grpc::Status status;
+    std::unique_ptr<grpc::ClientAsyncResponseReader<v1::InterpolateResponse>> reader;
+  };
+  std::vector<std::unique_ptr<Call>> calls;
+  for (int i = 0; i < 64; ++i) {
+    auto call = std::make_unique<Call>();
+    call->context.set_deadline(std::chrono::system_clock::now() + 20s);
+    v1::InterpolateRequest request;
+    request.set_session_id(i % 2 == 0 ? hot : cold);
+    *request.mutable_direction() = Iso(20 + i % 40, 30, 3 * i);
+    call->reader = stub_->AsyncInterpolate(&call->context, request, &queue);
+    call->reader->Finish(&call->response, &call->status, call.get());
+    calls.push_back(std::move(call));
+  }
+  TearDown();  // the daemon's shutdown order: no new calls, the server, then the loop
+  int ended = 0;
+  void* tag = nullptr;
+  bool ok = false;
+  while (ended < 64 && queue.Next(&tag, &ok)) {
+    ++ended;
+    const grpc::Status& st = static_cast<Call*>(tag)->status;
+    // Answered before the end, or ended by it; never left to run into its deadline.
+    EXPECT_TRUE(st.ok() || st.error_code() == grpc::StatusCode::CANCELLED ||
+                st.error_code() == grpc::StatusCode::UNAVAILABLE)
+        << st.error_code() << " " << st.error_message();
+  }
+  EXPECT_EQ(ended, 64);
+  queue.Shutdown();
+  while (queue.Next(&tag, &ok)) {
+  }
 }
 
 }  // namespace

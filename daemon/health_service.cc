@@ -1,0 +1,81 @@
+#include "daemon/health_service.h"
+
+namespace brdf::daemon {
+namespace {
+
+using grpc::health::v1::HealthCheckResponse;
+
+}  // namespace
+
+HealthService::HealthService(const StopSignal& stopping) : stopping_(stopping) {}
+
+void HealthService::SetServingStatus(const std::string& service, bool serving) {
+  {
+    std::lock_guard lock(mu_);
+    serving_[service] = serving;
+    ++version_;
+  }
+  changed_.notify_all();
+}
+
+void HealthService::SetServingStatus(bool serving) {
+  {
+    std::lock_guard lock(mu_);
+    for (auto& [name, value] : serving_) value = serving;
+    ++version_;
+  }
+  changed_.notify_all();
+}
+
+HealthService::Status HealthService::StatusLocked(const std::string& service) const {
+  auto it = serving_.find(service);
+  if (it == serving_.end()) return HealthCheckResponse::SERVICE_UNKNOWN;
+  return it->second ? HealthCheckResponse::SERVING : HealthCheckResponse::NOT_SERVING;
+}
+
+grpc::Status HealthService::Check(grpc::ServerContext* /*context*/,
+                                  const grpc::health::v1::HealthCheckRequest* request,
+                                  HealthCheckResponse* response) {
+  std::lock_guard lock(mu_);
+  const Status status = StatusLocked(request->service());
+  if (status == HealthCheckResponse::SERVICE_UNKNOWN) {
+    return {grpc::StatusCode::NOT_FOUND,
+            "health: no service \"" + request->service() +
+                "\"; ask for \"\" (the server) or brdf.v1.Control, brdf.v1.Data, "
+                "brdf.v1.Interpolation"};
+  }
+  response->set_status(status);
+  return grpc::Status::OK;
+}
+
+grpc::Status HealthService::Watch(grpc::ServerContext* context,
+                                  const grpc::health::v1::HealthCheckRequest* request,
+                                  grpc::ServerWriter<HealthCheckResponse>* writer) {
+  std::unique_lock lock(mu_);
+  std::uint64_t sent_version = version_;
+  Status sent = StatusLocked(request->service());
+  for (;;) {
+    HealthCheckResponse response;
+    response.set_status(sent);
+    lock.unlock();
+    if (!writer->Write(response)) return grpc::Status::OK;  // the client went away
+    lock.lock();
+    // Until the status changes (a new version may leave it as it was: not sent again).
+    for (;;) {
+      // A change first: at shutdown the NOT_SERVING set just before Stop() still goes out.
+      if (version_ != sent_version) {
+        sent_version = version_;
+        if (StatusLocked(request->service()) != sent) break;
+      }
+      if (context->IsCancelled()) return grpc::Status::OK;
+      if (stopping_.stopped()) {
+        return {grpc::StatusCode::UNAVAILABLE, "health: brdfd is shutting down"};
+      }
+      // The synchronous API has no wake-up for a client that went away: look now and then.
+      changed_.wait_for(lock, kStreamPollInterval);
+    }
+    sent = StatusLocked(request->service());
+  }
+}
+
+}  // namespace brdf::daemon

@@ -1,0 +1,51 @@
+// The standard health service (grpc.health.v1.Health, proto/grpc/health/v1/health.proto): Check
+// answers a service's status now, Watch streams it and each change. Known services: "" (the
+// server as a whole) and whatever SetServingStatus named. No token is needed (probes have none).
+//
+// brdfd serves this itself, on the synchronous API, rather than enabling gRPC's built-in health
+// service: that one runs on the callback API, whose threads (two or more, polling the same
+// connections as everyone) come with it, and on a 2-core machine they stood between Interpolate's
+// loop thread and its calls (interpolate_loop.h).
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+
+#include "daemon/service_common.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+
+namespace brdf::daemon {
+
+class HealthService final : public grpc::health::v1::Health::Service {
+ public:
+  // `stopping` ends Watch streams; it must outlive the service.
+  explicit HealthService(const StopSignal& stopping);
+
+  // Sets one service's status ("" is the server as a whole), waking its watchers.
+  void SetServingStatus(const std::string& service, bool serving);
+  // Sets every known service's status at once (shutdown: all NOT_SERVING).
+  void SetServingStatus(bool serving);
+
+  grpc::Status Check(grpc::ServerContext* context,
+                     const grpc::health::v1::HealthCheckRequest* request,
+                     grpc::health::v1::HealthCheckResponse* response) override;
+  grpc::Status Watch(grpc::ServerContext* context,
+                     const grpc::health::v1::HealthCheckRequest* request,
+                     grpc::ServerWriter<grpc::health::v1::HealthCheckResponse>* writer) override;
+
+ private:
+  using Status = grpc::health::v1::HealthCheckResponse::ServingStatus;
+  // The status of `service` (SERVICE_UNKNOWN when not known), mu_ held.
+  Status StatusLocked(const std::string& service) const;
+
+  const StopSignal& stopping_;
+  mutable std::mutex mu_;
+  std::condition_variable changed_;
+  std::map<std::string, bool> serving_;  // by service name
+  std::uint64_t version_ = 0;            // bumped at each change, for watchers
+};
+
+}  // namespace brdf::daemon

@@ -1,0 +1,82 @@
+// InterpolateLoop: the threads that serve Interpolate, the call analysis clients make by the
+// thousand, on gRPC's completion-queue (async) API.
+//
+// Why threads of our own: gRPC's callback API (where Interpolate ran before) runs calls on its
+// "nexting" threads, at least two however few the cores. Under a stream of calls they never
+// sleep, and with clients on the same two cores the busy threads outnumber the cores: the
+// scheduler then shares the cores out in whole ticks (4 ms at HZ=250), and a call whose next step
+// waits on a thread that is out of turn waits that long. That, not the answer (microseconds), was
+// the Interpolate tail (bench/daemon, README "Performance"). Here a loop thread polls its own
+// completion queue, so it reads a request, answers it and queues the reply itself: one busy
+// thread per loop, as many loops as `threads`.
+//
+// A loop never blocks on the store or an index build: a query whose index is current
+// (InterpolationService::AnswerIfReady) is answered on the spot; one that must first load,
+// extend or build the index (a session's first query, the first after a reading lands) goes to
+// the slow lane, one thread that answers such queries in arrival order, so the loops go on
+// answering every other query meanwhile.
+//
+// Lifecycle, with the grpc::Server it serves (server.cc):
+//   loop.AddQueues(builder); server = builder.BuildAndStart(); loop.Start();
+//   ... loop.BeginShutdown(); server->Shutdown(deadline); loop.Stop();
+#pragma once
+
+#include <grpcpp/server_builder.h>
+
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "daemon/service_interpolation.h"
+
+namespace brdf::daemon {
+
+class InterpolateLoop {
+ public:
+  // `service` must outlive the loop. threads ≥ 1.
+  InterpolateLoop(InterpolationService& service, int threads);
+  ~InterpolateLoop();  // Stop()
+  InterpolateLoop(const InterpolateLoop&) = delete;
+  InterpolateLoop& operator=(const InterpolateLoop&) = delete;
+
+  int threads() const { return threads_; }
+
+  // One completion queue per thread, added before the server is built.
+  void AddQueues(grpc::ServerBuilder& builder);
+  // After BuildAndStart: asks for the first calls and starts the threads.
+  void Start();
+  // Before grpc::Server::Shutdown: from here on no new call is asked for.
+  void BeginShutdown();
+  // After grpc::Server::Shutdown: the slow lane answers what it holds, the queues are shut down
+  // and drained, the threads joined. Idempotent.
+  void Stop();
+
+ private:
+  struct Call;
+
+  void Serve(grpc::ServerCompletionQueue* queue);
+  void SlowLane();
+  // Asks gRPC for the next Interpolate call on `queue` (nothing once BeginShutdown was called).
+  void Request(grpc::ServerCompletionQueue* queue);
+  static void Finish(Call* call, const grpc::Status& status);
+
+  InterpolationService& service_;
+  const int threads_;
+  std::vector<std::unique_ptr<grpc::ServerCompletionQueue>> queues_;
+  std::vector<std::thread> loops_;
+
+  std::mutex request_mu_;  // orders Request against BeginShutdown
+  bool closing_ = false;
+
+  std::mutex slow_mu_;
+  std::condition_variable slow_cv_;
+  std::deque<Call*> slow_;
+  bool slow_stop_ = false;
+  std::thread slow_lane_;
+  bool stopped_ = false;
+};
+
+}  // namespace brdf::daemon
