@@ -267,6 +267,26 @@ void ReadServer(TableReader& root, Config& c, Issues& issues) {
       c.server.listen = listen;
     }
   }
+  t.Int("interpolate_threads", c.server.interpolate_threads, 1, 64);
+  if (const toml::node* cpus = t.Node("interpolate_cpus")) {
+    const toml::array* list = cpus->as_array();
+    if (list == nullptr || list->empty()) {
+      t.Issue(*cpus, "interpolate_cpus", "must be a non-empty array of CPU numbers, e.g. [1]");
+    } else {
+      for (const toml::node& cpu : *list) {
+        const auto* n = cpu.as_integer();
+        if (n == nullptr || n->get() < 0 || n->get() >= kMaxCpuIndex) {
+          t.Issue(cpu, "interpolate_cpus",
+                  "holds " + (n ? std::to_string(n->get()) : std::string("a non-integer")) +
+                      "; give CPU numbers 0 … " + std::to_string(kMaxCpuIndex - 1) +
+                      " (as `nproc` and /proc/cpuinfo count them)");
+          c.server.interpolate_cpus.clear();
+          break;
+        }
+        c.server.interpolate_cpus.push_back(static_cast<int>(n->get()));
+      }
+    }
+  }
   if (const toml::table* tls_table = t.Table("tls")) {
     TableReader tls(tls_table, "server.tls", issues);
     TlsConfig cfg;

@@ -7,6 +7,8 @@
 //
 //   [server]
 //   listen = "127.0.0.1:50051"          # host:port (port 0: any free port) or "unix:/path"
+//   interpolate_threads = 1             # Interpolate's loop threads (default: one per 2 cores)
+//   interpolate_cpus = [1]              # pin them to these CPUs (default: not pinned)
 //   [server.tls]                        # optional; cert and key together; client_ca → mTLS
 //   cert = "/etc/brdfd/server.crt"
 //   key = "/etc/brdfd/server.key"
@@ -81,6 +83,11 @@ struct TlsConfig {
 struct ServerConfig {
   std::string listen = "127.0.0.1:50051";
   std::optional<TlsConfig> tls;  // unset: plaintext
+  // Interpolate's loop threads (daemon/interpolate_loop.h); 0: one per two cores (1–8).
+  int interpolate_threads = 0;
+  // CPUs the loop threads are pinned to, round robin (thread i on cpus[i % size]); empty: not
+  // pinned. Gives the loop a core of its own, away from clients and the session's threads.
+  std::vector<int> interpolate_cpus;
 };
 
 struct StorageConfig {
@@ -159,6 +166,8 @@ struct Config {
 inline constexpr std::size_t kMinTokenLength = 16;
 // Larger configuration files are refused unread.
 inline constexpr std::size_t kMaxConfigBytes = 1024 * 1024;
+// CPU numbers in [server] interpolate_cpus are below this (glibc's CPU_SETSIZE).
+inline constexpr int kMaxCpuIndex = 1024;
 
 // Parses TOML text. `source` names it in messages (the file's path). kConfigurationError listing
 // every problem, one per line, each with its line, key and reason.

@@ -2,8 +2,14 @@
 
 #include <grpcpp/server_context.h>
 #include <grpcpp/support/async_unary_call.h>
+#include <pthread.h>
+#include <sched.h>
+#include <spdlog/spdlog.h>
+#include <unistd.h>
 
+#include <cstring>
 #include <optional>
+#include <utility>
 
 namespace brdf::daemon {
 namespace {
@@ -11,6 +17,20 @@ namespace {
 // Calls asked for ahead on each queue: calls that arrive while the loop is busy are matched to
 // these at once rather than parked in gRPC's list of unmatched calls.
 constexpr int kRequestsAhead = 8;
+
+// Runs the calling thread on `cpu` only.
+void PinToCpu(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  if (int error = pthread_setaffinity_np(pthread_self(), sizeof(set), &set); error != 0) {
+    spdlog::warn(
+        "Interpolate loop: cannot pin to CPU {} ({}); it runs unpinned. Check [server] "
+        "interpolate_cpus against the CPUs brdfd may use (taskset -p {}, the service's "
+        "CPUAffinity)",
+        cpu, std::strerror(error), ::getpid());
+  }
+}
 
 }  // namespace
 
@@ -26,8 +46,8 @@ struct InterpolateLoop::Call {
   bool finishing = false;  // the reply is queued: the next event is its completion
 };
 
-InterpolateLoop::InterpolateLoop(InterpolationService& service, int threads)
-    : service_(service), threads_(threads < 1 ? 1 : threads) {}
+InterpolateLoop::InterpolateLoop(InterpolationService& service, int threads, std::vector<int> cpus)
+    : service_(service), threads_(threads < 1 ? 1 : threads), cpus_(std::move(cpus)) {}
 
 InterpolateLoop::~InterpolateLoop() {
   BeginShutdown();
@@ -43,8 +63,12 @@ void InterpolateLoop::Start() {
     for (int i = 0; i < kRequestsAhead; ++i) Request(queue.get());
   }
   slow_lane_ = std::thread([this] { SlowLane(); });
-  for (auto& queue : queues_) {
-    loops_.emplace_back([this, q = queue.get()] { Serve(q); });
+  for (std::size_t i = 0; i < queues_.size(); ++i) {
+    const int cpu = cpus_.empty() ? -1 : cpus_[i % cpus_.size()];
+    loops_.emplace_back([this, q = queues_[i].get(), cpu] {
+      if (cpu >= 0) PinToCpu(cpu);
+      Serve(q);
+    });
   }
 }
 

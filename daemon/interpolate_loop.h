@@ -36,8 +36,9 @@ namespace brdf::daemon {
 
 class InterpolateLoop {
  public:
-  // `service` must outlive the loop. threads ≥ 1.
-  InterpolateLoop(InterpolationService& service, int threads);
+  // `service` must outlive the loop. threads ≥ 1. With `cpus`, thread i runs on CPU
+  // cpus[i % cpus.size()] only (a thread that cannot be pinned logs a warning and runs unpinned).
+  InterpolateLoop(InterpolationService& service, int threads, std::vector<int> cpus = {});
   ~InterpolateLoop();  // Stop()
   InterpolateLoop(const InterpolateLoop&) = delete;
   InterpolateLoop& operator=(const InterpolateLoop&) = delete;
@@ -65,6 +66,7 @@ class InterpolateLoop {
 
   InterpolationService& service_;
   const int threads_;
+  const std::vector<int> cpus_;
   std::vector<std::unique_ptr<grpc::ServerCompletionQueue>> queues_;
   std::vector<std::thread> loops_;
 

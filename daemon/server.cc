@@ -6,6 +6,7 @@
 #include <grpcpp/resource_quota.h>
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server_builder.h>
+#include <sched.h>
 #include <spdlog/spdlog.h>
 #include <sys/stat.h>
 
@@ -63,6 +64,27 @@ std::string HostOf(const std::string& listen) {
   return host;
 }
 
+// Every CPU of [server] interpolate_cpus must be one brdfd may run on (its affinity mask: the
+// machine's CPUs, narrowed by taskset or the service's CPUAffinity).
+Status CheckCpusAvailable(const std::vector<int>& cpus) {
+  if (cpus.empty()) return Status::Ok();
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (::sched_getaffinity(0, sizeof(allowed), &allowed) != 0) return Status::Ok();  // cannot tell
+  std::string available;
+  for (int c = 0; c < CPU_SETSIZE; ++c) {
+    if (CPU_ISSET(c, &allowed)) available += (available.empty() ? "" : ", ") + std::to_string(c);
+  }
+  for (int cpu : cpus) {
+    if (cpu < 0 || cpu >= CPU_SETSIZE || !CPU_ISSET(cpu, &allowed)) {
+      return ConfigurationError("config server.interpolate_cpus: CPU " + std::to_string(cpu) +
+                                " is not one brdfd may run on (it may use CPUs " + available +
+                                "); fix [server] interpolate_cpus");
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 bool IsLoopbackAddress(const std::string& listen) {
@@ -86,13 +108,17 @@ int InterpolateLoopThreads(unsigned cores) {
   return static_cast<int>(std::clamp(cores / 2, 1U, 8U));
 }
 
-Server::Server(SessionManager& manager, IndexCache& cache, const Authenticator& auth)
+Server::Server(const ServerConfig& config, SessionManager& manager, IndexCache& cache,
+               const Authenticator& auth)
     : health_(stopping_),
       control_(manager, auth, stopping_),
       data_(manager, auth, stopping_),
       interpolation_(cache, auth, stopping_),
       interpolate_loop_(interpolation_,
-                        InterpolateLoopThreads(std::thread::hardware_concurrency())) {}
+                        config.interpolate_threads > 0
+                            ? config.interpolate_threads
+                            : InterpolateLoopThreads(std::thread::hardware_concurrency()),
+                        config.interpolate_cpus) {}
 
 Server::~Server() {
   Shutdown(std::chrono::seconds(1));
@@ -136,7 +162,8 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   // Set up before the builder is made. gRPC's own health service stays off: health_ serves it.
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
 
-  std::unique_ptr<Server> server(new Server(manager, cache, auth));
+  if (Status st = CheckCpusAvailable(config.interpolate_cpus); !st.ok()) return st;
+  std::unique_ptr<Server> server(new Server(config, manager, cache, auth));
   grpc::ServerBuilder builder;
   int selected_port = 0;
   builder.AddListeningPort(config.listen, credentials, &selected_port);

@@ -64,7 +64,8 @@ class Server {
   void Shutdown(std::chrono::milliseconds grace);
 
  private:
-  Server(SessionManager& manager, IndexCache& cache, const Authenticator& auth);
+  Server(const ServerConfig& config, SessionManager& manager, IndexCache& cache,
+         const Authenticator& auth);
 
   StopSignal stopping_;
   HealthService health_;

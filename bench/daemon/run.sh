@@ -4,9 +4,11 @@
 #      a session records against brdf-sim: (a) querying the recording session itself (its index
 #      takes in each new reading), (b) querying a completed 10,000-reading session meanwhile; the
 #      load generator drives its 8 clients (8 connections) from one thread (bench_daemon_load
-#      --api queue), so that on this 2-core machine it takes one core at most and brdfd the other;
-#      (c) as (a) with gRPC's multi-threaded callback client instead, for comparison: its busy
-#      threads and brdfd's outnumber the cores, and the tail is the scheduler's 4 ms ticks;
+#      --api queue) pinned to the first CPUs (taskset), brdfd's Interpolate loop is pinned to the
+#      last one ([server] interpolate_cpus): server and clients each on cores of their own, as
+#      when the clients run elsewhere; the session's threads run where the scheduler puts them;
+#      (c) as (a) with gRPC's multi-threaded callback client, not pinned, for comparison: its busy
+#      threads outnumber the cores, and the tail is the scheduler's 4 ms ticks;
 #   2. session time against the physical lower bound, pipelining on and off (same plan, ≥ 500
 #      steps, brdf-sim in scaled time with its 9600-baud pacing; bench_session_time);
 #   3. readings ingested per second into SQLite (one transaction per reading, synchronous=FULL),
@@ -71,11 +73,12 @@ wait_line() {
   return 1
 }
 
-# brdfd's configuration: $1 database, $2 meter port, $3 Modbus host:port.
+# brdfd's configuration: $1 database, $2 meter port, $3 Modbus host:port, $4 more [server] lines.
 write_config() {
   cat <<EOF
 [server]
 listen = "127.0.0.1:0"
+${4:-}
 [storage]
 database = "$1"
 [meter]
@@ -120,6 +123,16 @@ stop_pid() { kill -TERM "$1" 2>/dev/null || true; wait "$1" 2>/dev/null || true;
 kb() { awk -v k="$2:" '$1 == k { print $2 }' "/proc/$1/status"; }
 field() { tr ' ' '\n' <<<"$1" | awk -F= -v k="$2" '$1 == k { print $2 }'; }
 
+# Cores of their own for brdfd's Interpolate loop (the last CPU) and the load generator (the
+# others), when there are at least two.
+ncpu="$(nproc)"
+loop_pin=""
+client_pin=()
+if ((ncpu >= 2)); then
+  loop_pin="interpolate_cpus = [$((ncpu - 1))]"
+  client_pin=(taskset -c "0-$((ncpu - 2))")
+fi
+
 echo "brdfd daemon bench — $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) CPUs, build $build"
 echo "uptime at start: $(uptime)"
 
@@ -138,7 +151,7 @@ wait_line "$work/sim.out" '^ready' 20
 modbus="$(awk '$1 == "modbus-tcp" { print $2 }' "$work/sim.out")"
 pr650="$(awk '$1 == "pr650" { print $2 }' "$work/sim.out")"
 cp "$shm/s10k.db" "$work/live.db"
-write_config "$work/live.db" "$pr650" "$modbus" >"$work/live.toml"
+write_config "$work/live.db" "$pr650" "$modbus" "$loop_pin" >"$work/live.toml"
 start_brdfd "$work/live.toml" "$work/live.log"
 live_pid=$brdfd_pid
 export BRDF_ADDRESS="$address" BRDF_TOKEN="$operator_token"
@@ -166,10 +179,10 @@ for ((i = 0; i < 300; i++)); do
   if "$ctl" interpolate "$live" --theta-i 30 --theta-o 30 --phi 90 >/dev/null 2>&1; then break; fi
   sleep 0.1
 done
-load_live="$("$bin/bench_daemon_load" --address "$address" --token "$analyst_token" \
+load_live="$("${client_pin[@]}" "$bin/bench_daemon_load" --address "$address" --token "$analyst_token" \
   --session "$live" --recording "$live" --clients 8 --seconds "$load_seconds" --warmup 1)"
 echo "   $load_live" >&2
-load_10k="$("$bin/bench_daemon_load" --address "$address" --token "$analyst_token" \
+load_10k="$("${client_pin[@]}" "$bin/bench_daemon_load" --address "$address" --token "$analyst_token" \
   --session 1 --recording "$live" --clients 8 --seconds "$load_seconds" --warmup 2)"
 echo "   $load_10k" >&2
 load_cb="$("$bin/bench_daemon_load" --address "$address" --token "$analyst_token" \

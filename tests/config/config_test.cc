@@ -161,6 +161,28 @@ level = "debug"
   EXPECT_NEAR(ToRigDescription(m5).reading_overhead_s, 0.3 + 0.050, 1e-12);
 }
 
+TEST(ConfigTest, InterpolateLoopThreadsAndCpus) {
+  Result<Config> r = ParseConfig("[server]\ninterpolate_threads = 2\ninterpolate_cpus = [1, 0]\n");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->server.interpolate_threads, 2);
+  EXPECT_EQ(r->server.interpolate_cpus, (std::vector<int>{1, 0}));
+  Result<Config> defaults = ParseConfig("");
+  ASSERT_TRUE(defaults.ok());
+  EXPECT_EQ(defaults->server.interpolate_threads, 0);  // one per two cores
+  EXPECT_TRUE(defaults->server.interpolate_cpus.empty());
+
+  EXPECT_THAT(Refusal("[server]\ninterpolate_threads = 0\n"),
+              HasSubstr("server.interpolate_threads"));
+  EXPECT_THAT(Refusal("[server]\ninterpolate_cpus = []\n"),
+              HasSubstr("server.interpolate_cpus: must be a non-empty array of CPU numbers"));
+  EXPECT_THAT(Refusal("[server]\ninterpolate_cpus = 1\n"),
+              HasSubstr("server.interpolate_cpus: must be a non-empty array"));
+  EXPECT_THAT(Refusal("[server]\ninterpolate_cpus = [0, -1]\n"),
+              HasSubstr("server.interpolate_cpus: holds -1; give CPU numbers 0 … 1023"));
+  EXPECT_THAT(Refusal("[server]\ninterpolate_cpus = [\"1\"]\n"), HasSubstr("a non-integer"));
+  EXPECT_THAT(Refusal("[server]\ninterpolate_cpus = [4096]\n"), HasSubstr("holds 4096"));
+}
+
 TEST(ConfigTest, UnknownKeysAreRefusedByFullPath) {
   const std::string m = Refusal("[stage.axes.alpa]\nunit_id = 1\n");
   EXPECT_THAT(m, HasSubstr("unknown key stage.axes.alpa"));

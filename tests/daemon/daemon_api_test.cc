@@ -4,6 +4,7 @@
 #include <google/protobuf/wrappers.pb.h>
 #include <grpcpp/generic/generic_stub.h>
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include <chrono>
 #include <cmath>
@@ -25,11 +26,13 @@ using namespace std::chrono_literals;
 using grpc::StatusCode;
 
 // A configuration whose devices are absent: no such serial port, nothing on the Modbus port.
+// `server_keys`: more lines for [server].
 std::string AbsentDevicesToml(const std::string& database, int dead_port,
-                              const std::string& listen = "127.0.0.1:0") {
+                              const std::string& listen = "127.0.0.1:0",
+                              const std::string& server_keys = "") {
   std::ostringstream t;
   t << "[server]\nlisten = \"" << listen << "\"\n"
-    << "[storage]\ndatabase = \"" << database << "\"\n"
+    << server_keys << "[storage]\ndatabase = \"" << database << "\"\n"
     << "[meter]\nport = \"/dev/brdfd-test-no-such-port\"\n"
     << "[stage]\naddress = \"127.0.0.1:" << dead_port << "\"\nresponse_timeout_ms = 100\n"
     << "[[auth.tokens]]\nname = \"" << kOperatorName << "\"\ntoken = \"" << kOperatorToken
@@ -434,6 +437,51 @@ TEST(DaemonConfigTest, PlaintextOnANonLoopbackAddressIsServedWithAWarning) {
   Result<int> code = rig.StopDaemon();
   ASSERT_TRUE(code.ok());
   EXPECT_EQ(*code, 0);
+}
+
+TEST(DaemonConfigTest, InterpolateLoopPinnedToACpuServesAndAnUnusableCpuIsRefused) {
+  DaemonRig rig;
+  Result<int> dead = FreeTcpPort();
+  ASSERT_TRUE(dead.ok());
+  cpu_set_t allowed;
+  ASSERT_EQ(sched_getaffinity(0, sizeof(allowed), &allowed), 0);
+  int usable = 0;
+  while (!CPU_ISSET(usable, &allowed)) ++usable;
+  Status st = rig.StartDaemon(AbsentDevicesToml(
+      rig.database(), *dead, "127.0.0.1:0",
+      "interpolate_threads = 2\ninterpolate_cpus = [" + std::to_string(usable) + "]\n"));
+  ASSERT_TRUE(st.ok()) << st.ToString();
+  EXPECT_NE(rig.log().find("Interpolate on 2 loop thread(s)"), std::string::npos) << rig.log();
+  // An unknown session: the loop answered (NOT_FOUND from the slow lane's index load).
+  v1::InterpolateRequest request;
+  request.set_session_id("4242");
+  request.mutable_direction()->mutable_iso()->set_theta_i(30);
+  request.mutable_direction()->mutable_iso()->set_theta_o(30);
+  request.mutable_direction()->mutable_iso()->set_phi(90);
+  v1::InterpolateResponse response;
+  EXPECT_EQ(rig.interpolation()
+                .Interpolate(DaemonRig::Context(kAnalystToken).get(), request, &response)
+                .error_code(),
+            StatusCode::NOT_FOUND);
+  EXPECT_EQ(rig.log().find("cannot pin"), std::string::npos) << rig.log();
+  Result<int> code = rig.StopDaemon();
+  ASSERT_TRUE(code.ok());
+  EXPECT_EQ(*code, 0);
+
+  // A CPU brdfd may not run on: start-up fails, naming the key and the CPUs it may use.
+  TempDir dir("brdfd-cpus");
+  const std::string path = dir.file("cpus.toml").string();
+  {
+    std::ofstream out(path);
+    out << AbsentDevicesToml(dir.file("db.sqlite").string(), *dead, "127.0.0.1:0",
+                             "interpolate_cpus = [1023]\n");
+  }
+  Result<DaemonRun> run = RunBrdfd({"--config", path}, dir.file("log").string());
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_NE(run->exit_code, 0) << run->err;
+  EXPECT_NE(run->err.find("server.interpolate_cpus: CPU 1023 is not one brdfd may run on"),
+            std::string::npos)
+      << run->err;
 }
 
 }  // namespace
