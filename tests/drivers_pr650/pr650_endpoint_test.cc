@@ -9,6 +9,8 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <vector>
+
 #include "tests/drivers_pr650/pr650_test_rig.h"
 
 namespace brdf::testing {
@@ -37,11 +39,12 @@ class RawClient {
   bool ok() const { return fd_ >= 0; }
 
   // Sends `bytes` and returns everything that arrives until `quiet` passes without a byte (or
-  // `limit` overall). `hangup` is set when the port hung up.
+  // `limit` overall). `hangup` is set when the port hung up; `reads` holds each read's size.
   std::string Ask(const std::string& bytes, std::chrono::milliseconds quiet = 80ms,
                   std::chrono::milliseconds limit = 5s) {
     if (::write(fd_, bytes.data(), bytes.size()) != static_cast<ssize_t>(bytes.size())) return {};
     std::string out;
+    reads.clear();
     const auto end = SteadyClock::now() + limit;
     auto last = SteadyClock::now();
     while (SteadyClock::now() < end && SteadyClock::now() - last < quiet) {
@@ -51,6 +54,7 @@ class RawClient {
       const ssize_t n = ::read(fd_, buffer, sizeof buffer);
       if (n > 0) {
         out.append(buffer, static_cast<std::size_t>(n));
+        reads.push_back(static_cast<std::size_t>(n));
         last = SteadyClock::now();
       } else if (p.revents & (POLLHUP | POLLERR)) {
         hangup = true;
@@ -61,6 +65,7 @@ class RawClient {
   }
 
   bool hangup = false;
+  std::vector<std::size_t> reads;
 
  private:
   int fd_ = -1;
@@ -228,6 +233,29 @@ TEST_F(Pr650EndpointTest, RepliesArePacedAtTheSerialRate) {
   const std::string d5 = client_->Ask("D5\n", 60ms);
   EXPECT_EQ(d5.size(), 1734u);
   EXPECT_GE(SteadyClock::now() - start, 170ms);
+}
+
+TEST_F(Pr650EndpointTest, PacedRepliesReachThePortInFifoBursts) {
+  Start();  // fifo_bytes 14 (a 16550's receive FIFO): ~124 bursts for the D5 report
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  const auto start = SteadyClock::now();
+  EXPECT_EQ(client_->Ask("D5\n", 60ms).size(), 1734u);
+  EXPECT_GE(SteadyClock::now() - start, 170ms);  // the same pace on the wire
+  const std::vector<std::size_t> reads = client_->reads;
+  ASSERT_FALSE(reads.empty());
+  for (std::size_t i = 0; i + 1 < reads.size(); ++i) {
+    EXPECT_GE(reads[i], 14u) << "read " << i << " of " << reads.size();  // never a part burst
+  }
+  EXPECT_LE(reads.size(), 1734u / 14 + 1);
+
+  // Byte by byte: as many reads as the client can tell apart, far more than bursts.
+  endpoint_.reset();
+  sim::Pr650EndpointOptions options = FastEndpointOptions();
+  options.fifo_bytes = 1;
+  Start(options);
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  EXPECT_EQ(client_->Ask("D5\n", 60ms).size(), 1734u);
+  EXPECT_GT(client_->reads.size(), 1734u / 14 + 1);
 }
 
 TEST_F(Pr650EndpointTest, VanishingPortHangsUpAndComesBackAtTheSameLink) {

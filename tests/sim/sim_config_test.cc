@@ -39,6 +39,7 @@ TEST(SimConfigTest, DefaultsArePlausibleAndValid) {
   EXPECT_EQ(c.modbus_port, 0);
   EXPECT_TRUE(c.detector_arm);
   EXPECT_TRUE(c.pacing);
+  EXPECT_EQ(c.fifo_bytes, 14);  // a 16550 UART's receive FIFO
   EXPECT_EQ(c.mounted, MountedTarget::kSample);
   EXPECT_EQ(c.axes[kAlphaAxis].min_deg, 0);
   EXPECT_EQ(c.axes[kAlphaAxis].max_deg, 90);
@@ -48,18 +49,35 @@ TEST(SimConfigTest, DefaultsArePlausibleAndValid) {
 
 TEST(SimConfigTest, FlagsSetFields) {
   SimConfig c;
-  ASSERT_TRUE(
-      ParseLikeMain({"--time-scale", "50", "--seed", "9", "--modbus-port", "1502", "--rtu",
-                     "--no-detector-arm", "--no-pacing", "--wake-window", "2.5", "--anisotropic",
-                     "--mounted", "white", "--beta-home-speed", "40", "--gamma-min", "-90"},
-                    c)
-          .ok());
+  ASSERT_TRUE(ParseLikeMain({"--time-scale",
+                             "50",
+                             "--seed",
+                             "9",
+                             "--modbus-port",
+                             "1502",
+                             "--rtu",
+                             "--no-detector-arm",
+                             "--no-pacing",
+                             "--fifo-bytes",
+                             "1",
+                             "--wake-window",
+                             "2.5",
+                             "--anisotropic",
+                             "--mounted",
+                             "white",
+                             "--beta-home-speed",
+                             "40",
+                             "--gamma-min",
+                             "-90"},
+                            c)
+                  .ok());
   EXPECT_EQ(c.time_scale, 50);
   EXPECT_EQ(c.optics.seed, 9u);
   EXPECT_EQ(c.modbus_port, 1502);
   EXPECT_TRUE(c.rtu);
   EXPECT_FALSE(c.detector_arm);
   EXPECT_FALSE(c.pacing);
+  EXPECT_EQ(c.fifo_bytes, 1);
   EXPECT_EQ(c.wake_window_s, 2.5);
   EXPECT_TRUE(c.optics.anisotropic);
   EXPECT_EQ(c.mounted, MountedTarget::kWhite);
@@ -111,6 +129,7 @@ mounted = "dark"
 port = 1600
 [pr650]
 pacing = false
+fifo_bytes = 62
 [stage]
 detector_arm = false
 [stage.alpha]
@@ -131,6 +150,7 @@ color_temperature_k = 3000
   EXPECT_EQ(c.mounted, MountedTarget::kDark);
   EXPECT_EQ(c.modbus_port, 1600);
   EXPECT_FALSE(c.pacing);
+  EXPECT_EQ(c.fifo_bytes, 62);
   EXPECT_FALSE(c.detector_arm);
   EXPECT_EQ(c.axes[kAlphaAxis].home_speed_deg_s, 10);
   EXPECT_EQ(c.axes[kAlphaAxis].max_deg, 80);
@@ -174,8 +194,10 @@ TEST(SimConfigTest, ValidationRejectsImpossibleSettings) {
   EXPECT_TRUE(invalid([](SimConfig& c) { c.serial_faults.quality_code = 123; }));
   EXPECT_TRUE(invalid([](SimConfig& c) { c.optics.noise_scale = -1; }));
   EXPECT_TRUE(invalid([](SimConfig& c) { c.log_level = "loud"; }));
+  EXPECT_TRUE(invalid([](SimConfig& c) { c.fifo_bytes = 0; }));
   SimConfig c;
   EXPECT_FALSE(ParseLikeMain({"--mounted", "grey"}, c).ok());
+  EXPECT_FALSE(ParseLikeMain({"--fifo-bytes", "0"}, c).ok());
 }
 
 TEST(SimConfigTest, FindConfigPathAcceptsBothSpellings) {

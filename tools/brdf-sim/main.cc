@@ -53,6 +53,7 @@ Pr650EndpointOptions MeterOptionsFrom(const SimConfig& c) {
   o.time_scale = TimeScale{c.time_scale};
   o.wake_window_s = c.wake_window_s;
   o.pace_replies = c.pacing;
+  o.fifo_bytes = c.fifo_bytes;
   o.link_path = c.pr650_link;
   return o;
 }

@@ -330,13 +330,18 @@ bool Pr650Endpoint::WriteOut(const std::string& bytes) {
     // Never write across the end of the current piece.
     std::size_t chunk = std::min(bytes.size(), (sent / piece + 1) * piece) - sent;
     if (options_.pace_replies) {
-      // Send what is due by now (at least one byte), then wait for the next byte's time.
+      // Byte k (counting from 0) is due k byte-times after the start. The next burst leaves
+      // once its last byte is due; then everything due goes (more than a burst if late).
       const auto elapsed =
           std::chrono::duration_cast<std::chrono::nanoseconds>(SteadyClock::now() - start - paused);
-      const auto due =
-          static_cast<std::size_t>(options_.time_scale.ToSim(elapsed) / byte_sim_s) + 1;
-      if (due <= sent) {
-        SleepReal(std::chrono::microseconds(500));
+      const double elapsed_sim = options_.time_scale.ToSim(elapsed);
+      const auto due = static_cast<std::size_t>(elapsed_sim / byte_sim_s) + 1;
+      const std::size_t burst_end =
+          sent + std::min(chunk, static_cast<std::size_t>(std::max(options_.fifo_bytes, 1)));
+      if (due < burst_end) {
+        const double wait_sim = static_cast<double>(burst_end - 1) * byte_sim_s - elapsed_sim;
+        SleepReal(std::clamp<std::chrono::nanoseconds>(options_.time_scale.ToReal(wait_sim),
+                                                       std::chrono::microseconds(50), kSlice));
         continue;
       }
       chunk = std::min(chunk, due - sent);

@@ -64,6 +64,11 @@ struct Pr650EndpointOptions {
   // ~1.8 s simulated like the real meter; off: as fast as the pty takes them.
   bool pace_replies = false;
   int baud = 9600;
+  // With pace_replies: bytes reach the computer in bursts of this many, each once its last byte
+  // is due, as a UART's receive FIFO (a 16550 interrupts at 14) or a USB-serial adapter hands
+  // them over; the end of a reply (or piece) as soon as it is due. 1: byte by byte. The pace on
+  // the wire is the same; the reader (and this thread) wake once per burst instead of per byte.
+  int fifo_bytes = 14;
   // Where the stable port link goes; empty: a private temporary directory.
   std::string link_path;
   std::string serial_number = "60925301";

@@ -220,9 +220,11 @@ Status ReadTable(const TomlReader& r, const toml::table& root, SimConfig& c) {
   auto pr650 = r.Table(root, "", "pr650");
   if (!pr650.ok()) return pr650.status();
   if (const toml::table* p = *pr650) {
-    BRDF_RETURN_IF_ERROR(r.CheckKeys(*p, "pr650", {"pacing", "wake_window_s", "link"}));
+    BRDF_RETURN_IF_ERROR(
+        r.CheckKeys(*p, "pr650", {"pacing", "fifo_bytes", "wake_window_s", "link"}));
     BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "link", c.pr650_link));
     BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "pacing", c.pacing));
+    BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "fifo_bytes", c.fifo_bytes));
     BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "wake_window_s", c.wake_window_s));
   }
 
@@ -338,6 +340,10 @@ void AddRunFlags(CLI::App& app, SimConfig& c) {
   app.add_option("--manual-delta", c.manual_delta_deg,
                  "Without the arm: the detector angle δ the operator set, deg");
   app.add_flag("--pacing,!--no-pacing", c.pacing, "Pace PR-650 replies at 9600 baud");
+  app.add_option("--fifo-bytes", c.fifo_bytes,
+                 "With pacing: reply bytes reach the port in bursts of this many (a UART's "
+                 "receive FIFO; 1: byte by byte)")
+      ->check(CLI::Range(1, 4096));
   app.add_option("--wake-window", c.wake_window_s,
                  "Seconds after power-on within which the PR-650 accepts remote mode");
   app.add_option("--pr650-link", c.pr650_link,
@@ -419,6 +425,11 @@ Status ValidateConfig(const SimConfig& c) {
   if (c.modbus_host.empty()) return InvalidArgument("Modbus host is empty; use --modbus-host");
   if (!Finite(c.manual_delta_deg) || c.manual_delta_deg < 0 || c.manual_delta_deg > 180) {
     return InvalidArgument("manual detector angle must be 0–180 deg; fix --manual-delta");
+  }
+  if (c.fifo_bytes < 1 || c.fifo_bytes > 4096) {
+    return InvalidArgument(
+        "PR-650 fifo_bytes must be 1–4096 (14: a 16550 UART; 1: byte by byte); "
+        "fix [pr650] fifo_bytes or --fifo-bytes");
   }
   if (!Finite(c.wake_window_s) || c.wake_window_s < 0) {
     return InvalidArgument("wake window must be >= 0 s; fix --wake-window");

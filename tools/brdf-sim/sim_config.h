@@ -40,6 +40,7 @@ struct SimConfig {
   bool detector_arm = true;     // δ is a motorized axis (unit 4); false: the operator moves it
   double manual_delta_deg = 0;  // without the arm: where the operator put the detector (δ)
   bool pacing = true;           // pace PR-650 replies at 9600 baud
+  int fifo_bytes = 14;          // ... handed to the computer in bursts of this many (1: per byte)
   double wake_window_s = 5;     // the PR-650 enters remote mode only within this long of power-on
                                 // (simulated seconds; 0 = any time)
   std::string pr650_link;       // where the PR-650 port link goes (empty: a private temp dir)
