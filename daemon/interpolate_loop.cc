@@ -50,7 +50,6 @@ InterpolateLoop::InterpolateLoop(InterpolationService& service, int threads, std
     : service_(service), threads_(threads < 1 ? 1 : threads), cpus_(std::move(cpus)) {}
 
 InterpolateLoop::~InterpolateLoop() {
-  BeginShutdown();
   Stop();
 }
 
@@ -80,6 +79,7 @@ void InterpolateLoop::BeginShutdown() {
 void InterpolateLoop::Stop() {
   if (stopped_) return;
   stopped_ = true;
+  BeginShutdown();  // in case the caller did not: no call may be asked for on a closed queue
   {
     std::lock_guard lock(slow_mu_);
     slow_stop_ = true;
