@@ -78,6 +78,15 @@ struct ClientResult {
   std::string first_error;
 };
 
+// An Interpolation stub on a channel of its own (its own HTTP/2 connection, as a separate analysis
+// program would have).
+std::unique_ptr<brdf::v1::Interpolation::Stub> OwnConnectionStub(const std::string& address) {
+  grpc::ChannelArguments args;
+  args.SetInt("grpc.use_local_subchannel_pool", 1);
+  return brdf::v1::Interpolation::NewStub(
+      grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), args));
+}
+
 // A random direction of the benchmark's range (θi, θo in [0, 70], φ in [0, 180]) into `request`.
 void RandomDirection(std::mt19937_64& rng, brdf::v1::InterpolateRequest* request) {
   std::uniform_real_distribution<double> theta(0, 70);
@@ -102,10 +111,7 @@ void Record(ClientResult* out, Clock::time_point measure_from, Clock::time_point
 
 void Client(const Options& o, int seed, Clock::time_point measure_from, Clock::time_point until,
             ClientResult* out) {
-  grpc::ChannelArguments args;
-  args.SetInt("grpc.use_local_subchannel_pool", 1);  // a connection of its own
-  auto channel = grpc::CreateCustomChannel(o.address, grpc::InsecureChannelCredentials(), args);
-  auto stub = brdf::v1::Interpolation::NewStub(channel);
+  auto stub = OwnConnectionStub(o.address);
   std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
   out->latencies_us.reserve(200000);
   const bool paced = o.rate > 0;
@@ -142,10 +148,7 @@ class CallbackClient {
         measure_from_(measure_from),
         until_(until),
         out_(out) {
-    grpc::ChannelArguments args;
-    args.SetInt("grpc.use_local_subchannel_pool", 1);  // a connection of its own
-    stub_ = brdf::v1::Interpolation::NewStub(
-        grpc::CreateCustomChannel(o.address, grpc::InsecureChannelCredentials(), args));
+    stub_ = OwnConnectionStub(o.address);
     out_->latencies_us.reserve(200000);
     request_.set_session_id(o.session);
   }
@@ -204,10 +207,7 @@ class QueueClients {
       : o_(o), measure_from_(measure_from), until_(until) {
     for (std::size_t i = 0; i < results->size(); ++i) {
       auto client = std::make_unique<Client>();
-      grpc::ChannelArguments args;
-      args.SetInt("grpc.use_local_subchannel_pool", 1);  // a connection of its own
-      client->stub = brdf::v1::Interpolation::NewStub(
-          grpc::CreateCustomChannel(o.address, grpc::InsecureChannelCredentials(), args));
+      client->stub = OwnConnectionStub(o.address);
       client->rng.seed(1000 + i);
       client->out = &(*results)[i];
       client->out->latencies_us.reserve(200000);
@@ -315,15 +315,15 @@ int main(int argc, char** argv) {
   std::unique_ptr<QueueClients> queue_clients;
   if (o.api == "queue") {
     queue_clients = std::make_unique<QueueClients>(o, measure_from, until, &results);
-  }
-  for (int i = 0; i < o.clients; ++i) {
-    ClientResult* out = &results[static_cast<std::size_t>(i)];
-    if (o.api == "queue") break;
-    if (o.api == "sync") {
-      threads.emplace_back(Client, std::cref(o), 1000 + i, measure_from, until, out);
-    } else {
-      callback_clients.push_back(
-          std::make_unique<CallbackClient>(o, 1000 + i, measure_from, until, out));
+  } else {
+    for (int i = 0; i < o.clients; ++i) {
+      ClientResult* out = &results[static_cast<std::size_t>(i)];
+      if (o.api == "sync") {
+        threads.emplace_back(Client, std::cref(o), 1000 + i, measure_from, until, out);
+      } else {
+        callback_clients.push_back(
+            std::make_unique<CallbackClient>(o, 1000 + i, measure_from, until, out));
+      }
     }
   }
   for (auto& c : callback_clients) c->Start();
