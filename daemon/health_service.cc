@@ -39,10 +39,15 @@ grpc::Status HealthService::Check(grpc::ServerContext* /*context*/,
   std::lock_guard lock(mu_);
   const Status status = StatusLocked(request->service());
   if (status == HealthCheckResponse::SERVICE_UNKNOWN) {
+    std::string known;  // the services SetServingStatus named, "" (the server) first
+    for (const auto& entry : serving_) {
+      const std::string& name = entry.first;
+      known +=
+          (known.empty() ? "" : ", ") + (name.empty() ? std::string("\"\" (the server)") : name);
+    }
+    if (known.empty()) known = "none yet (brdfd is starting)";
     return {grpc::StatusCode::NOT_FOUND,
-            "health: no service \"" + request->service() +
-                "\"; ask for \"\" (the server) or brdf.v1.Control, brdf.v1.Data, "
-                "brdf.v1.Interpolation"};
+            "health: no service \"" + request->service() + "\"; ask for one of: " + known};
   }
   response->set_status(status);
   return grpc::Status::OK;

@@ -60,6 +60,9 @@ TEST_F(HealthServiceTest, CheckAnswersKnownServicesAndRefusesOthers) {
   const grpc::Status unknown = Check("no.such.Service", &response);
   EXPECT_EQ(unknown.error_code(), grpc::StatusCode::NOT_FOUND);
   EXPECT_NE(unknown.error_message().find("no.such.Service"), std::string::npos);
+  EXPECT_NE(unknown.error_message().find("ask for one of: \"\" (the server), brdf.v1.Control"),
+            std::string::npos)
+      << unknown.error_message();
   // Shutting down: every known service at once.
   health_.SetServingStatus(false);
   ASSERT_TRUE(Check("brdf.v1.Control", &response).ok());
