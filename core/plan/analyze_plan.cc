@@ -18,6 +18,10 @@ PlanAnalysis AnalyzePlan(const v1::Plan& plan, const RigDescription& rig) {
     return out;
   }
   std::vector<Step> steps = ExpandCheckedPlan(plan, rig, sink);
+  if (steps.empty() && sink.empty()) {
+    // Each method reports why it found nothing to do; this guards a method that does not.
+    sink.Add("", "the plan expands to no steps; give at least one pose or target to measure");
+  }
   if (steps.size() > static_cast<std::size_t>(kMaxSteps)) {
     sink.Add("", "the plan expands to more than " + std::to_string(kMaxSteps) +
                      " steps (the cap); use coarser steps, fewer targets, or split the plan");
