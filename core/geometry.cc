@@ -315,6 +315,15 @@ Result<std::vector<Pose>> ExpandSampleRotationGrid(const GridSpec& spec,
       }
     }
   }
+  if (poses.empty()) {
+    // E.g. α = 0, β every 90° and δ ≥ 90° leave the detector at grazing or below at every pose:
+    // a grid that would measure nothing is a mistake in the spec, not an empty answer.
+    return InvalidArgument(
+        "grid spec: no pose of the grid keeps both lamp and detector above the surface (θ < " +
+        Fmt(spec.theta_max_deg) + "°) with δ in [" + Fmt(spec.delta_start_deg) + "°, " +
+        Fmt(spec.delta_stop_deg) + "°] and α in [" + Fmt(spec.alpha_start_deg) + "°, " +
+        Fmt(spec.alpha_stop_deg) + "°]; lower δ (the lamp–detector angle) or widen the α range");
+  }
   return poses;
 }
 

@@ -119,6 +119,8 @@ Status ValidateGridSpec(const GridSpec& spec);
 
 // Expands the loops into poses (stage readings, via `convention`), in measurement order: γ
 // outermost (a manual dial, changed least often), then δ (the detector), then α, then β innermost.
+// kInvalidArgument for an invalid spec, and for one whose every pose leaves the lamp or the
+// detector at or beyond theta_max (nothing to measure).
 Result<std::vector<Pose>> ExpandSampleRotationGrid(const GridSpec& spec,
                                                    const HolderConvention& convention = {});
 

@@ -233,17 +233,6 @@ void ExpandSampleRotation(const v1::SampleRotation& rotation, const RigDescripti
     sink.Add("sampleRotation", grid.status().message());
     return;
   }
-  if (grid->empty()) {
-    // Every (δ, α, β) leaves the lamp or the detector at or beyond θmax (e.g. δ ≥ 90° with
-    // α = 0 puts the detector at grazing or below): a plan that would record nothing.
-    sink.Add("sampleRotation",
-             "no pose of the grid keeps both lamp and detector above the surface (θ < " +
-                 Deg(spec.theta_max_deg) + ") with δ in [" + Deg(spec.delta_start_deg) + ", " +
-                 Deg(spec.delta_stop_deg) + "] and α in [" + Deg(spec.alpha_start_deg) + ", " +
-                 Deg(spec.alpha_stop_deg) +
-                 "]; lower δ (the lamp–detector angle) or widen the α range");
-    return;
-  }
   // Rows of constant (γ, δ, α), β ascending, in geometry.h's order (γ, δ, α outermost first).
   struct Row {
     std::vector<Pose> poses;

@@ -343,6 +343,23 @@ TEST(GeometryTest, GridSpecValidationNamesTheField) {
   EXPECT_THAT(ValidateGridSpec(spec).message(), HasSubstr("gamma_deg"));
 }
 
+TEST(GeometryTest, GridWithNoValidPoseIsAnErrorNotAnEmptyList) {
+  GridSpec spec;  // the plan_json fuzzer's grid: the detector at grazing or below at every pose
+  spec.alpha_stop_deg = 0;
+  spec.beta_step_deg = 90;
+  spec.delta_start_deg = 90;
+  EXPECT_TRUE(ValidateGridSpec(spec).ok());
+  const Result<std::vector<Pose>> r = ExpandSampleRotationGrid(spec);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(r.status().message(), HasSubstr("no pose of the grid"));
+  EXPECT_THAT(r.status().message(), HasSubstr("δ in [90°, 150°] and α in [0°, 0°]"));
+  spec.delta_start_deg = 30;
+  const Result<std::vector<Pose>> lower = ExpandSampleRotationGrid(spec);
+  ASSERT_TRUE(lower.ok());
+  EXPECT_FALSE(lower->empty());
+}
+
 TEST(GeometryTest, DistinctPointsUseTolerance) {
   const std::vector<IsoDirection> pts = {
       {10, 20, 30}, {10 + 1e-10, 20, 30}, {10, 20, 30 + 1e-7}, {40, 20, 30}, {10, 20 - 1e-10, 30}};
