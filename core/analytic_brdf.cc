@@ -10,7 +10,7 @@ namespace {
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 
 // Unit vector in the sample frame for polar θ and azimuth φ (degrees): (sinθ cosφ, sinθ sinφ,
-// cosθ), the local frame (t, b, n) of ../shared/reference/geometry.md.
+// cosθ), the local frame (t, b, n) of docs/geometry.md ("Frames").
 struct Vec3 {
   double x, y, z;
 };

@@ -1,5 +1,5 @@
 // Rig kinematics: holder and detector pose ↔ incident/outgoing directions in the sample's frame,
-// exactly as fixed by ../shared/reference/geometry.md (read it first), plus the paper's
+// exactly as fixed by docs/geometry.md (read it first), plus the paper's
 // sample-rotation sampling loops. Pure; degrees in every interface.
 //
 // Two kinds of angles meet here. A Pose holds the stage readings (what the rotation stages are

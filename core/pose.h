@@ -1,5 +1,5 @@
 // The lab's vocabulary for where things are. Angles are in degrees everywhere in brdfd's
-// interfaces (radians only inside math). See ../shared/reference/geometry.md for the convention.
+// interfaces (radians only inside math). See docs/geometry.md for the convention.
 #pragma once
 
 namespace brdf {

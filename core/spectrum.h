@@ -1,5 +1,5 @@
 // Spectra on a wavelength grid, and the two quantities a session derives from raw readings
-// (../shared/reference/geometry.md, "Reflectance and BRDF"):
+// (docs/geometry.md, "Reflectance and BRDF"):
 //   reflectance R(λ) = (I(λ) − D(λ)) / (I0(λ) − D(λ))        (the paper's I/I0, D optional)
 //   BRDF        f(λ) = R(λ) · ρw(λ) / π · cos θi,ref / cos θi  (sr⁻¹)
 // where I is the sample's radiance at a pose, I0 the white standard's at the reference pose

@@ -9,7 +9,7 @@ namespace brdf::exports {
 std::vector<std::string> AngleConventionLines() {
   return {
       "angles in degrees; directions in the sample frame of brdfd's geometry convention "
-      "(shared/reference/geometry.md): θ from the surface normal, in [0, 90] above the surface;",
+      "(docs/geometry.md): θ from the surface normal, in [0, 90] above the surface;",
       "φ = |φo − φi| folded into [0, 180] is the relative azimuth of lamp and detector: "
       "180 = forward (specular) side, 0 = retro side; φ = 0 where θi or θo is 0",
   };

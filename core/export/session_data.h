@@ -1,5 +1,5 @@
 // A session's readings as the exports see them, and the quantities derived from them
-// (../shared/reference/geometry.md, "Reflectance and BRDF"). core/ does not depend on storage/, so
+// (docs/geometry.md, "Reflectance and BRDF"). core/ does not depend on storage/, so
 // the caller (brdf-export, a gRPC handler) copies storage's ReadingRecords into these plain values.
 //
 // The derivation matches the daemon's interpolation index (daemon/index_cache.h), so that an

@@ -1,5 +1,5 @@
 // The paper's octant method (Sun & Wang, "Interpolation"), made exact by
-// ../../../shared/reference/interpolation.md: around the query P, the nearest sample in each of
+// docs/interpolation.md ("Making it a function"): around the query P, the nearest sample in each of
 // the 2^dims orthants cut by the axis planes through P; the first simplex of the cube of winners
 // (3D: ABCF, ACDH, AEFH, CFGH, ACFH; 4D: the 24 Kuhn simplices) that encloses P; the vertex
 // spectra blended with P's barycentric weights. Everything happens in the scaled space of

@@ -2,7 +2,7 @@
 // found: how orthants are numbered and named, how the cube of winners is cut into simplices, and
 // how the answer is assembled from the winners. Both octant implementations (the brute-force
 // reference and the indexed one) end here, so they agree bit for bit whenever their searches
-// agree. See ../../../shared/reference/interpolation.md. Pure: no I/O.
+// agree. See docs/interpolation.md. Pure: no I/O.
 #pragma once
 
 #include <array>

@@ -1,6 +1,6 @@
 // Everything about talking to one PR-650 that an operator or a test may change: the port, the
 // link timing, the wake-up sequence and the quality policy. Defaults follow
-// /work/shared/reference/pr650.md; tests shrink the waits to run fast.
+// docs/pr650.md; tests shrink the waits to run fast.
 #pragma once
 
 #include <chrono>

@@ -1,5 +1,5 @@
 // The PR-650 remote-mode protocol as text: the commands the driver sends and a parser for every
-// reply it reads (see /work/shared/reference/pr650.md). Pure: no I/O, no clocks, no state, so it
+// reply it reads (see docs/pr650.md). Pure: no I/O, no clocks, no state, so it
 // can be unit-tested line by line and fuzzed.
 //
 // Every parser takes the whole reply as it came off the wire (line ends included) and either

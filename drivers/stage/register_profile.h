@@ -6,7 +6,7 @@
 //
 // Addresses are PDU addresses (0-based). Vendor manuals number holding registers from 1 ("40125"
 // is PDU address 124): subtract one when copying from a manual. See
-// ../shared/reference/stage-modbus.md for the default (AZ-like) map.
+// docs/stage-modbus.md for the default (AZ-like) map and the other two.
 //
 // Nothing here talks to a device; ValidateProfile / ValidateAxis reject a configuration that
 // cannot work, naming the field, before the driver touches the bus.

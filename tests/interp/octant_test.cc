@@ -1,6 +1,6 @@
 // Properties of the paper's octant method (core/interp/octant.h), checked on the paper's rig grid,
 // random sets, lattices and hand-built configurations. No snapshots: every expectation follows
-// from the method's definition in shared/reference/interpolation.md.
+// from the method's definition in docs/interpolation.md.
 #include "core/interp/octant.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 """A synthetic session for testing brdf_client's figure code without a daemon.
 
-Readings are made the way the rig makes them (shared/reference/geometry.md): holder poses of the
+Readings are made the way the rig makes them (docs/geometry.md): holder poses of the
 sample-rotation method → lamp and detector directions in the sample's frame; radiance of a
 virtual sample (Lambert + a Phong lobe) under a lamp, a white reference at normal incidence, and
 a dark reading. Interpolation answers come from tools/check/octant_reference.py, the independent

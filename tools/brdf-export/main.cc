@@ -14,7 +14,7 @@ namespace {
 using namespace brdf::export_tool;
 
 constexpr const char* kFooter = R"(
-Angles in degrees (geometry convention of shared/reference/geometry.md); radiance in
+Angles in degrees (geometry convention of docs/geometry.md); radiance in
 W·m⁻²·sr⁻¹·nm⁻¹, BRDF in sr⁻¹; every text export documents its units in '#' header lines.
 Files are written as OUT.partial and renamed when complete. Exit status: 0 done, 2 the request
 cannot work as given (bad value, unknown or empty session), 1 other failures (I/O, database).)";

@@ -1,5 +1,5 @@
 // The simulated PR-650 on a pseudo-terminal: a thread that speaks the meter's remote-mode protocol
-// (/work/shared/reference/pr650.md) byte for byte, asking a MeterBackend what it would measure.
+// (docs/pr650.md) byte for byte, asking a MeterBackend what it would measure.
 //
 //   commands (case-insensitive, ended by CR or LF)     replies (lines end CR LF)
 //   B0 … B3                                             000

@@ -1,5 +1,5 @@
 // One simulated stage drive (one axis, one unit id), modelled on an Oriental Motor AZ drive in
-// "direct data operation" (../../shared/reference/stage-modbus.md):
+// "direct data operation" (docs/stage-modbus.md, profile `az`):
 //
 //   0x0058–0x0069  operation data block (data no., type, position, speed, start rate, stop rate,
 //                  current, trigger, forwarding destination), 32-bit values, high word first;

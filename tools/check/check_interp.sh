@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Cross-checks brdf-interp against independent implementations:
 #   - the octant method (fast and --method octant-reference) against octant_reference.py, a NumPy
-#     implementation written from shared/reference/interpolation.md: every status, the vertex
+#     implementation written from docs/interpolation.md: every status, the vertex
 #     rows in order, weights and spectra to 1e-9, on the paper's grid (plain and with
 #     --mirror-phi --reciprocity --scale), random 3D and 4D sets, and an integer lattice (ties);
 #   - the Delaunay method against scipy.interpolate.LinearNDInterpolator on random 3D data in

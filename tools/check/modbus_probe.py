@@ -9,7 +9,7 @@ simulator's Modbus endpoint by hand:
   modbus_probe.py --port 5020 --reset 1           # pulse ALM-RST on unit 1
   modbus_probe.py --port 5020 --control-write 20 6 2   # control unit: exception 06 for the next 2
 
-Register map: the default AZ-like profile (shared/reference/stage-modbus.md): 32-bit values high
+Register map: the default AZ-like profile (docs/stage-modbus.md): 32-bit values high
 word first; operation block 0x0058 (type 0x005A, position 0x005C, speed 0x005E, trigger 0x0066);
 driver input command 0x007C; status 0x007E; alarm code 0x0080; feedback position 0x00CC.
 Exit status: 0 when every request was answered as expected, 1 otherwise.

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """An independent NumPy implementation of Sun & Wang's octant interpolation, written from
-shared/reference/interpolation.md (not from the C++), used by check_interp.sh to cross-check
+docs/interpolation.md (not from the C++), used by check_interp.sh to cross-check
 brdf-interp.
 
 The method, as pinned by interpolation.md:
