@@ -53,6 +53,9 @@ doc="$prefix/share/doc/brdfd"
 grep -q '^\[meter\]' "$doc/brdfd.example.toml" 2>/dev/null ||
   fail "share/doc/brdfd/brdfd.example.toml is missing"
 [[ -f "$doc/README.md" ]] || fail "share/doc/brdfd/README.md is missing"
+for page in README geometry interpolation pr650 stage-modbus; do
+  [[ -f "$doc/docs/$page.md" ]] || fail "share/doc/brdfd/docs/$page.md is missing"
+done
 
 py="$prefix/share/brdfd/python"
 for f in brdf_client/__init__.py brdf_client/client.py examples/quickstart_figures.py \
