@@ -49,8 +49,9 @@ struct IndexCache::Entry {
   std::atomic<std::uint64_t> used{0};         // IndexCache::tick_ of the last query
 };
 
-IndexCache::IndexCache(std::shared_ptr<storage::SessionStore> store, Options options)
-    : store_(std::move(store)), options_(options) {}
+IndexCache::IndexCache(std::shared_ptr<storage::SessionStore> store, Options options,
+                       PlanSource plans)
+    : store_(std::move(store)), options_(options), plans_(std::move(plans)) {}
 
 // --- Commit events ------------------------------------------------------------------------------
 
@@ -217,10 +218,17 @@ void IndexCache::Forget(SessionId session, const std::shared_ptr<Entry>& entry) 
 Status IndexCache::Load(Entry& entry, SessionId session, std::uint64_t* read) {
   Result<storage::SessionRecord> record = store_->GetSession(session);
   if (!record.ok()) return record.status();
-  Result<SessionPlan> plan = ParseSessionPlan(*record);
-  if (!plan.ok()) return plan.status();
-  IndexSamples samples(plan->plan.anisotropic(),
-                       record->white_reflectance.value_or(kWhiteStandardReflectance));
+  bool anisotropic = false;
+  if (plans_) {
+    Result<std::shared_ptr<const SessionPlan>> plan = plans_(session);
+    if (!plan.ok()) return plan.status();
+    anisotropic = (*plan)->plan.anisotropic();
+  } else {
+    Result<SessionPlan> plan = ParseSessionPlan(*record);
+    if (!plan.ok()) return plan.status();
+    anisotropic = plan->plan.anisotropic();
+  }
+  IndexSamples samples(anisotropic, record->white_reflectance.value_or(kWhiteStandardReflectance));
   std::int64_t through = 0;
   for (;;) {
     Result<std::vector<storage::ReadingRecord>> page =

@@ -42,6 +42,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <list>
 #include <map>
 #include <memory>
@@ -55,6 +56,7 @@
 #include "core/status.h"
 #include "core/wavelength_grid.h"
 #include "daemon/session_manager.h"
+#include "daemon/session_plan.h"
 #include "storage/records.h"
 #include "storage/session_store.h"
 
@@ -108,7 +110,13 @@ class IndexCache {
     std::uint64_t evictions = 0;        // sessions evicted
   };
 
-  IndexCache(std::shared_ptr<storage::SessionStore> store, Options options);
+  // Where the cache gets a session's plan (whether it is anisotropic): in brdfd the
+  // SessionManager's, parsed once (SessionManager::Plan). Without one, the cache parses the
+  // stored record on a first load (ParseSessionPlan), as a standalone cache must.
+  using PlanSource = std::function<Result<std::shared_ptr<const SessionPlan>>(SessionId)>;
+
+  IndexCache(std::shared_ptr<storage::SessionStore> store, Options options,
+             PlanSource plans = nullptr);
   explicit IndexCache(std::shared_ptr<storage::SessionStore> store)
       : IndexCache(std::move(store), Options()) {}
   IndexCache(const IndexCache&) = delete;
@@ -168,6 +176,7 @@ class IndexCache {
 
   std::shared_ptr<storage::SessionStore> store_;
   Options options_;
+  PlanSource plans_;
 
   // Guards everything below (never held while building): shared to look an entry up, exclusive
   // to add, evict or count. Recency is a tick per entry (Entry::used), not a list, so that a

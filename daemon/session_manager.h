@@ -55,6 +55,7 @@
 #include "core/status.h"
 #include "daemon/event_bus.h"
 #include "daemon/rig.h"
+#include "daemon/session_plan.h"
 #include "storage/records.h"
 #include "storage/session_store.h"
 
@@ -166,6 +167,11 @@ class SessionManager {
   Result<std::vector<v1::Session>> ListSessions(const std::vector<SessionState>& states = {}) const;
   // The rig's devices, live pose and meter serial, plus which session holds the rig.
   v1::RigStatus GetRigStatus() const;
+  // The session's plan, parsed once (at submission, or when the session is first loaded) and
+  // kept with the session (session_plan.h). kNotFound when there is no such session; kInternal
+  // "session N: its stored plan does not parse: …" (logged once) when its stored plan is
+  // unreadable.
+  Result<std::shared_ptr<const SessionPlan>> Plan(SessionId session) const;
 
   // --- Watching -------------------------------------------------------------------------------
 

@@ -6,8 +6,9 @@
 // A stored plan that no longer parses (a database edited by hand, a plan from a newer brdfd) is
 // reported one way: ParseSessionPlan's kInternal "session N: its stored plan does not parse:
 // <why>", logged once by the SessionManager when it loads the session. Whoever cannot work
-// without the plan returns that Status (the executor pauses the session with it as the reason;
-// the index cache answers it); whoever only shows the session shows it without the plan.
+// without the plan returns that Status (the executor stops, and the session fails with it as
+// the reason: measuring without the plan's settings is unsafe; the index cache answers it);
+// whoever only shows the session (GetSession, StreamReadings) shows it without the plan.
 #pragma once
 
 #include <cstdint>
