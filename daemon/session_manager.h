@@ -79,7 +79,9 @@ enum class PauseMode {
 // "17" → 17. kInvalidArgument naming `field` ("session_id") when the text is not a positive id.
 Result<SessionId> ParseSessionId(const std::string& text, const std::string& field = "session_id");
 
-// Called after a reading is committed: (session, the stored reading with its id).
+// Called after a reading is committed: (session, the stored reading with its id). The record is
+// the one the executor committed, complete for deriving from it (kind, pose, directions, grid,
+// spectrum, the reference and dark it names); only recorded_at is left 0 (the store's clock).
 using ReadingListener = std::function<void(SessionId, const storage::ReadingRecord&)>;
 
 class SessionManager {
