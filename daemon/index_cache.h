@@ -2,7 +2,8 @@
 // (session, quantity, method, options), built from the session's SAMPLE readings with
 // core/interp's MakeInterpolator.
 //
-// Quantities (core/spectrum.h, geometry.md "Reflectance and BRDF"), per sample reading I:
+// Quantities (core/readings/quantity.h, derived by core/readings/derive.h, the same derivation
+// the exports use), per sample reading I:
 //   radiance     I − D                                  (D: the dark the reading names, if any)
 //   reflectance  (I − D) / (I0 − D)                     (I0: the reference the reading names)
 //   BRDF         R · ρw / π · cos θi,ref / cos θi       (θi,ref: the reference reading's θi;
