@@ -7,7 +7,6 @@
 #include <utility>
 
 #include "core/geometry.h"
-#include "core/plan/plan_json.h"
 #include "core/plan/timing.h"
 #include "daemon/engine_steps.h"
 
@@ -134,16 +133,12 @@ void Executor::Run() {
   }
   c.steps = std::move(*steps);
 
-  Result<v1::Plan> plan = plan::ParsePlanJson(c.session.plan_json);
-  if (plan.ok()) {
-    c.settings = plan::ResolveSettings(*plan);
-  } else {
-    spdlog::warn(
-        "{}: stored plan does not parse ({}); using default measurement and retry "
-        "settings",
-        where, plan.status().ToString());
-    c.settings = plan::ResolveSettings(v1::Plan());
+  Result<std::shared_ptr<const SessionPlan>> plan = host_.Plan(session_);
+  if (!plan.ok()) {
+    Stop(c, -1, plan.status(), "reading the plan of " + where, false);
+    return;
   }
+  c.settings = (*plan)->settings;
   c.sample_fixed = c.session.plan_kind == "sample_fixed";
 
   const std::vector<plan::StepTime> times =

@@ -49,6 +49,7 @@
 #include "core/session_state.h"
 #include "core/status.h"
 #include "daemon/rig.h"
+#include "daemon/session_plan.h"
 #include "storage/records.h"
 #include "storage/session_store.h"
 
@@ -73,6 +74,9 @@ class ExecutorHost {
                              const storage::ReadingRecord* reading) = 0;
   // A step failed (will_retry tells whether the executor tries again).
   virtual void Fault(std::int64_t session, const v1::Fault& fault) = 0;
+  // The session's plan as the host keeps it (session_plan.h), or why it cannot be had (a stored
+  // plan that no longer parses: the run stops with that reason).
+  virtual Result<std::shared_ptr<const SessionPlan>> Plan(std::int64_t session) = 0;
 };
 
 class Executor {

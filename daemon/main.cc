@@ -134,7 +134,8 @@ int main(int argc, char** argv) {
                  recovered->size());
   }
 
-  IndexCache cache(store);
+  IndexCache cache(store, IndexCache::Options(),
+                   [&manager](SessionId session) { return manager.Plan(session); });
   const int cache_listener = manager.AddReadingListener(
       [&cache](SessionId session, const storage::ReadingRecord& reading) {
         cache.OnReading(session, reading);

@@ -49,6 +49,54 @@ grpc::Status InvalidField(const std::string& field, const std::string& what) {
   return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, field + ": " + what);
 }
 
+grpc::Status ParseQuantityField(int quantity, Quantity* out) {
+  switch (quantity) {
+    case v1::QUANTITY_UNSPECIFIED:
+    case v1::QUANTITY_BRDF:
+      *out = Quantity::kBrdf;
+      return grpc::Status::OK;
+    case v1::QUANTITY_RADIANCE:
+      *out = Quantity::kRadiance;
+      return grpc::Status::OK;
+    case v1::QUANTITY_REFLECTANCE:
+      *out = Quantity::kReflectance;
+      return grpc::Status::OK;
+    default:
+      return InvalidField("quantity", "unknown quantity " + std::to_string(quantity) +
+                                          "; use RADIANCE, REFLECTANCE or BRDF");
+  }
+}
+
+grpc::Status ParseMethodField(int method, interp::Method* out) {
+  switch (method) {
+    case v1::INTERPOLATION_METHOD_UNSPECIFIED:
+    case v1::INTERPOLATION_METHOD_OCTANT:
+      *out = interp::Method::kOctant;
+      return grpc::Status::OK;
+    case v1::INTERPOLATION_METHOD_DELAUNAY:
+      *out = interp::Method::kDelaunay;
+      return grpc::Status::OK;
+    case v1::INTERPOLATION_METHOD_NEAREST:
+      *out = interp::Method::kNearest;
+      return grpc::Status::OK;
+    default:
+      return InvalidField("method", "unknown interpolation method " + std::to_string(method) +
+                                        "; use OCTANT, DELAUNAY or NEAREST");
+  }
+}
+
+v1::Quantity ToProtoQuantity(Quantity quantity) {
+  switch (quantity) {
+    case Quantity::kRadiance:
+      return v1::QUANTITY_RADIANCE;
+    case Quantity::kReflectance:
+      return v1::QUANTITY_REFLECTANCE;
+    case Quantity::kBrdf:
+      break;
+  }
+  return v1::QUANTITY_BRDF;
+}
+
 grpc::Status ParseSessionIdField(const std::string& text, const std::string& field,
                                  std::int64_t* id) {
   if (text.size() > kMaxSessionIdBytes) {

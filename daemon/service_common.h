@@ -15,6 +15,8 @@
 #include <string>
 
 #include "brdf/v1/brdf.pb.h"
+#include "core/interp/interpolator.h"
+#include "core/readings/quantity.h"
 #include "core/status.h"
 #include "core/wavelength_grid.h"
 #include "storage/records.h"
@@ -57,6 +59,12 @@ grpc::Status InvalidField(const std::string& field, const std::string& what);
 // number. Never NOT_FOUND: whether the session exists is the caller's next question.
 grpc::Status ParseSessionIdField(const std::string& text, const std::string& field,
                                  std::int64_t* id);
+
+// The API's quantity (UNSPECIFIED: BRDF) and interpolation method (UNSPECIFIED: octant) as
+// brdfd's; INVALID_ARGUMENT naming "quantity" / "method" for a value the API does not have.
+grpc::Status ParseQuantityField(int quantity, Quantity* out);
+grpc::Status ParseMethodField(int method, interp::Method* out);
+v1::Quantity ToProtoQuantity(Quantity quantity);
 
 // Checks a finite angle within [lo, hi]; the message names `field` and the range.
 Status CheckAngle(double value, double lo, double hi, const std::string& field);

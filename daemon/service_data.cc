@@ -4,8 +4,6 @@
 #include <string>
 #include <vector>
 
-#include "core/plan/plan_json.h"
-
 namespace brdf::daemon {
 
 DataService::DataService(SessionManager& manager, const Authenticator& auth,
@@ -78,9 +76,9 @@ grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
   if (Result<std::vector<storage::StepRecord>> steps = store.GetSteps(id); steps.ok()) {
     for (const storage::StepRecord& step : *steps) extras.step_labels[step.step_index] = step.label;
   }
-  if (Result<v1::Plan> plan = plan::ParsePlanJson(session->plan_json);
-      plan.ok() && plan->measurement().averages() > 0) {
-    extras.averages = plan->measurement().averages();
+  if (Result<std::shared_ptr<const SessionPlan>> plan = manager_.Plan(id);
+      plan.ok() && (*plan)->plan.measurement().averages() > 0) {
+    extras.averages = (*plan)->plan.measurement().averages();
   }
 
   std::int64_t last = request->after_id();

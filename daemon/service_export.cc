@@ -6,9 +6,9 @@
 // Progress messages are interleaved; a client that goes away, or the daemon stopping, cancels
 // the export (its CancelToken) at the next progress report or chunk.
 //
-// The exports are the same code as brdf-export's (tools/brdf-export: the session conversion and
-// the CIE tables; core/export: the formats), so a file from the daemon and one from the tool are
-// the same bytes for the same session and options.
+// The exports are the same code as brdf-export's (storage/session_readings.h: the session;
+// data/cie_tables.h: the CIE tables; core/export: the formats), so a file from the daemon and one
+// from the tool are the same bytes for the same session and options.
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
@@ -31,8 +31,8 @@
 #include "core/export/spectral_rgb.h"
 #include "core/export/spectrum_source.h"
 #include "daemon/service_data.h"
-#include "tools/brdf-export/cie_tables.h"
-#include "tools/brdf-export/session_source.h"
+#include "data/cie_tables.h"
+#include "storage/session_readings.h"
 
 namespace brdf::daemon {
 namespace {
@@ -195,39 +195,11 @@ grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
                           "give one of READINGS_CSV, GRID_NPY, GRID_CSV, MERL_BINARY (got " +
                               std::to_string(r.format()) + ")");
   }
-  switch (r.quantity()) {
-    case v1::QUANTITY_UNSPECIFIED:
-    case v1::QUANTITY_BRDF:
-      out->quantity = exports::Quantity::kBrdf;
-      break;
-    case v1::QUANTITY_RADIANCE:
-      out->quantity = exports::Quantity::kRadiance;
-      break;
-    case v1::QUANTITY_REFLECTANCE:
-      out->quantity = exports::Quantity::kReflectance;
-      break;
-    default:
-      return InvalidField("quantity", "unknown quantity " + std::to_string(r.quantity()) +
-                                          "; use RADIANCE, REFLECTANCE or BRDF");
-  }
+  if (grpc::Status st = ParseQuantityField(r.quantity(), &out->quantity); !st.ok()) return st;
   if (r.format() == v1::EXPORT_FORMAT_MERL_BINARY && out->quantity != exports::Quantity::kBrdf) {
     return InvalidField("quantity", "a MERL file holds the BRDF; leave quantity unset or BRDF");
   }
-  switch (r.method()) {
-    case v1::INTERPOLATION_METHOD_UNSPECIFIED:
-    case v1::INTERPOLATION_METHOD_OCTANT:
-      out->method = interp::Method::kOctant;
-      break;
-    case v1::INTERPOLATION_METHOD_DELAUNAY:
-      out->method = interp::Method::kDelaunay;
-      break;
-    case v1::INTERPOLATION_METHOD_NEAREST:
-      out->method = interp::Method::kNearest;
-      break;
-    default:
-      return InvalidField("method", "unknown interpolation method " + std::to_string(r.method()) +
-                                        "; use OCTANT, DELAUNAY or NEAREST");
-  }
+  if (grpc::Status st = ParseMethodField(r.method(), &out->method); !st.ok()) return st;
   const v1::InterpolationOptions& o = r.options();
   if (o.axis_scale_size() != 0 && o.axis_scale_size() != 3) {
     return InvalidField("options.axis_scale",
@@ -370,7 +342,7 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
 
 Status ExportMerl(const exports::Session& session, const ExportSettings& s, const CallContext& ctx,
                   ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
-  Result<export_tool::CieTables> cie = export_tool::LoadCieTables(export_tool::kDefaultColordDir);
+  Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir);
   if (!cie.ok()) return cie.status();
   Result<SessionInterpolator> in = BuildInterpolator(session, exports::Quantity::kBrdf, s);
   if (!in.ok()) return in.status();
@@ -422,7 +394,7 @@ grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportR
 
   stream.Progress("loading readings", 0);
   Result<exports::Session> session =
-      export_tool::LoadSession(*manager_.store(), settings.session_id);
+      storage::LoadSessionReadings(*manager_.store(), settings.session_id);
   if (!session.ok()) return ToGrpcStatus(session.status());
   stream.Progress("loading readings", 0.05);
 

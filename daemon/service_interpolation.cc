@@ -25,45 +25,13 @@ constexpr double kPhiMax = 360;
 struct Settings {
   interp::Method method = interp::Method::kOctant;
   Quantity quantity = Quantity::kBrdf;
-  v1::Quantity proto_quantity = v1::QUANTITY_BRDF;
   interp::Options options;
 };
 
 grpc::Status ParseSettings(int method, int quantity, const v1::InterpolationOptions& options,
                            Settings* out) {
-  switch (method) {
-    case v1::INTERPOLATION_METHOD_UNSPECIFIED:
-    case v1::INTERPOLATION_METHOD_OCTANT:
-      out->method = interp::Method::kOctant;
-      break;
-    case v1::INTERPOLATION_METHOD_DELAUNAY:
-      out->method = interp::Method::kDelaunay;
-      break;
-    case v1::INTERPOLATION_METHOD_NEAREST:
-      out->method = interp::Method::kNearest;
-      break;
-    default:
-      return InvalidField("method", "unknown interpolation method " + std::to_string(method) +
-                                        "; use OCTANT, DELAUNAY or NEAREST");
-  }
-  switch (quantity) {
-    case v1::QUANTITY_UNSPECIFIED:
-    case v1::QUANTITY_BRDF:
-      out->quantity = Quantity::kBrdf;
-      out->proto_quantity = v1::QUANTITY_BRDF;
-      break;
-    case v1::QUANTITY_RADIANCE:
-      out->quantity = Quantity::kRadiance;
-      out->proto_quantity = v1::QUANTITY_RADIANCE;
-      break;
-    case v1::QUANTITY_REFLECTANCE:
-      out->quantity = Quantity::kReflectance;
-      out->proto_quantity = v1::QUANTITY_REFLECTANCE;
-      break;
-    default:
-      return InvalidField("quantity", "unknown quantity " + std::to_string(quantity) +
-                                          "; use RADIANCE, REFLECTANCE or BRDF");
-  }
+  if (grpc::Status st = ParseMethodField(method, &out->method); !st.ok()) return st;
+  if (grpc::Status st = ParseQuantityField(quantity, &out->quantity); !st.ok()) return st;
   if (options.axis_scale_size() > 4) {
     return InvalidField("options.axis_scale", "at most 4 values (one per axis), got " +
                                                   std::to_string(options.axis_scale_size()));
@@ -173,7 +141,7 @@ void Evaluate(const v1::DirectionQuery& query, const std::array<double, 4>& coor
   *out->mutable_query() = query;
   out->set_status(ToProtoStatus(r.status));
   out->set_method(ToProtoMethod(r.method));
-  out->set_quantity(settings.proto_quantity);
+  out->set_quantity(ToProtoQuantity(settings.quantity));
   *out->mutable_grid() = ToProtoGrid(index.grid);
   out->mutable_spectrum()->Add(r.spectrum.begin(), r.spectrum.end());
   for (const interp::Vertex& v : r.vertices) {

@@ -116,6 +116,11 @@ struct SessionManager::Impl final : public ExecutorHost {
     for (const ReadingListener& fn : to_call) fn(session, *reading);
   }
 
+  Result<std::shared_ptr<const SessionPlan>> Plan(std::int64_t session) override {
+    std::lock_guard lock(mu);
+    return PlanLocked(session, nullptr);
+  }
+
   void Fault(std::int64_t session, const v1::Fault& fault) override {
     std::lock_guard lock(mu);
     live[session].last_fault = fault;
@@ -206,6 +211,30 @@ struct SessionManager::Impl final : public ExecutorHost {
     return *to;
   }
 
+  // --- The session's plan -------------------------------------------------------------------
+
+  // The plan kept with the session, parsed from `record` (read from the store when null) the
+  // first time it is asked for. A plan that does not parse is logged once and kept as its Status.
+  Result<std::shared_ptr<const SessionPlan>> PlanLocked(SessionId id,
+                                                        const storage::SessionRecord* record) {
+    auto kept = plans.find(id);
+    if (kept != plans.end()) return kept->second;
+    Result<storage::SessionRecord> read = Internal("unset");
+    if (record == nullptr) {
+      read = store.GetSession(id);
+      if (!read.ok()) return read.status();
+      record = &*read;
+    }
+    Result<SessionPlan> parsed = ParseSessionPlan(*record);
+    if (!parsed.ok()) spdlog::error("{}", parsed.status().message());
+    Result<std::shared_ptr<const SessionPlan>> plan =
+        parsed.ok() ? Result<std::shared_ptr<const SessionPlan>>(
+                          std::make_shared<const SessionPlan>(std::move(*parsed)))
+                    : Result<std::shared_ptr<const SessionPlan>>(parsed.status());
+    plans.emplace(id, plan);
+    return plan;
+  }
+
   // --- The session as the API shows it ------------------------------------------------------
 
   Result<v1::Session> BuildLocked(SessionId id, bool with_plan) {
@@ -224,12 +253,12 @@ struct SessionManager::Impl final : public ExecutorHost {
     s.set_session_id(std::to_string(id));
     s.set_name(rec->name);
     s.set_state(ToProtoState(state));
-    v1::Plan plan;
-    if (Result<v1::Plan> parsed = plan::ParsePlanJson(rec->plan_json); parsed.ok()) {
-      plan = std::move(*parsed);
-    }
-    const plan::PlanSettings settings = plan::ResolveSettings(plan);
-    if (with_plan) *s.mutable_plan() = plan;
+    // A plan that no longer parses is shown as none (PlanLocked logged it once).
+    static const SessionPlan kNoPlan = MakeSessionPlan(v1::Plan());
+    Result<std::shared_ptr<const SessionPlan>> kept = PlanLocked(id, &*rec);
+    const SessionPlan& plan = kept.ok() ? **kept : kNoPlan;
+    const plan::PlanSettings& settings = plan.settings;
+    if (with_plan) *s.mutable_plan() = plan.plan;
 
     const std::vector<plan::Step> plan_steps = ToPlanSteps(*steps);
     *s.mutable_summary() = plan::ToProto(
@@ -386,11 +415,13 @@ struct SessionManager::Impl final : public ExecutorHost {
   std::condition_variable scheduler_cv;
   std::map<SessionId, Live> live;
   std::map<SessionId, v1::Session> terminal_cache;  // terminal sessions without their plan
-  std::deque<SessionId> queue;                      // started, waiting for the rig, in order
-  std::optional<SessionId> holder;                  // the session that holds the rig
-  std::optional<SessionId> launch;                  // a run to start once no run is alive
-  std::shared_ptr<Executor> current;                // the run alive (maybe winding down)
-  std::thread running_thread;                       // its thread
+  // Each session's plan, parsed once (PlanLocked), or why it does not parse.
+  std::map<SessionId, Result<std::shared_ptr<const SessionPlan>>> plans;
+  std::deque<SessionId> queue;        // started, waiting for the rig, in order
+  std::optional<SessionId> holder;    // the session that holds the rig
+  std::optional<SessionId> launch;    // a run to start once no run is alive
+  std::shared_ptr<Executor> current;  // the run alive (maybe winding down)
+  std::thread running_thread;         // its thread
   bool run_ended = false;
   bool shut_down = false;  // verbs refused
   bool stopping = false;   // the scheduler ends
@@ -508,6 +539,12 @@ Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor
   }
   Result<std::int64_t> id = store_->CreateSession(session, steps);
   if (!id.ok()) return id.status().WithContext("storing the new session");
+  {
+    std::lock_guard lock(impl_->mu);  // kept as submitted: never parsed back
+    impl_->plans.insert_or_assign(*id,
+                                  Result<std::shared_ptr<const SessionPlan>>(
+                                      std::make_shared<const SessionPlan>(MakeSessionPlan(plan))));
+  }
   impl_->Audit(actor, "session.submit", *id,
                "plan \"" + session.name + "\" (" + session.plan_kind + "), " +
                    std::to_string(steps.size()) + " steps, by " + Who(actor));
@@ -633,6 +670,11 @@ Result<std::vector<v1::Session>> SessionManager::ListSessions(
     out.push_back(std::move(*s));
   }
   return out;
+}
+
+Result<std::shared_ptr<const SessionPlan>> SessionManager::Plan(SessionId session) const {
+  std::lock_guard lock(impl_->mu);
+  return impl_->PlanLocked(session, nullptr);
 }
 
 v1::RigStatus SessionManager::GetRigStatus() const {

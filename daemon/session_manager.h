@@ -55,6 +55,7 @@
 #include "core/status.h"
 #include "daemon/event_bus.h"
 #include "daemon/rig.h"
+#include "daemon/session_plan.h"
 #include "storage/records.h"
 #include "storage/session_store.h"
 
@@ -78,7 +79,9 @@ enum class PauseMode {
 // "17" → 17. kInvalidArgument naming `field` ("session_id") when the text is not a positive id.
 Result<SessionId> ParseSessionId(const std::string& text, const std::string& field = "session_id");
 
-// Called after a reading is committed: (session, the stored reading with its id).
+// Called after a reading is committed: (session, the stored reading with its id). The record is
+// the one the executor committed, complete for deriving from it (kind, pose, directions, grid,
+// spectrum, the reference and dark it names); only recorded_at is left 0 (the store's clock).
 using ReadingListener = std::function<void(SessionId, const storage::ReadingRecord&)>;
 
 class SessionManager {
@@ -166,6 +169,11 @@ class SessionManager {
   Result<std::vector<v1::Session>> ListSessions(const std::vector<SessionState>& states = {}) const;
   // The rig's devices, live pose and meter serial, plus which session holds the rig.
   v1::RigStatus GetRigStatus() const;
+  // The session's plan, parsed once (at submission, or when the session is first loaded) and
+  // kept with the session (session_plan.h). kNotFound when there is no such session; kInternal
+  // "session N: its stored plan does not parse: …" (logged once) when its stored plan is
+  // unreadable.
+  Result<std::shared_ptr<const SessionPlan>> Plan(SessionId session) const;
 
   // --- Watching -------------------------------------------------------------------------------
 

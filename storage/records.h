@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/pose.h"
+#include "core/readings/reading.h"
 #include "core/session_state.h"
 #include "core/status.h"
 #include "core/wavelength_grid.h"
@@ -27,8 +28,8 @@ enum class StepKind { kMove, kPrompt, kReference, kDark, kSample };
 enum class StepState { kPending, kDone, kSkipped };
 
 // The reading a measuring step produced: I(λ) of the sample, I0(λ) of the white standard, or the
-// dark (ambient) D(λ).
-enum class ReadingKind { kSample, kReference, kDark };
+// dark (ambient) D(λ). core/readings' ReadingKind, stored as its word (ToString below).
+using ::brdf::ReadingKind;
 
 std::string_view ToString(SessionState state);  // SessionStateName
 std::string_view ToString(StepKind kind);

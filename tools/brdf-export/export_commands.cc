@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <filesystem>
 #include <sstream>
+#include <system_error>
 
 #include "core/analytic_brdf.h"
 #include "core/export/grid_text.h"
@@ -15,10 +17,10 @@
 #include "core/export/synthetic_session.h"
 #include "core/fit/fit.h"
 #include "core/fit/fit_report.h"
-#include "tools/brdf-export/cie_tables.h"
+#include "data/cie_tables.h"
+#include "storage/session_readings.h"
 #include "tools/brdf-export/output_file.h"
 #include "tools/brdf-export/progress_line.h"
-#include "tools/brdf-export/session_source.h"
 
 namespace brdf::export_tool {
 namespace {
@@ -33,6 +35,18 @@ int Fail(std::ostream& err, const char* command, const Status& st) {
     default:
       return kExitFailure;
   }
+}
+
+// Opens an EXISTING brdfd database (kNotFound naming the path when there is no file: the store
+// itself would create an empty one).
+Result<std::unique_ptr<storage::SessionStore>> OpenExistingStore(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return NotFound("no database at " + path +
+                    ": give the brdfd database file (the daemon's [storage] database setting, "
+                    "/var/lib/brdfd/brdfd.db by default)");
+  }
+  return storage::SessionStore::Open(path);
 }
 
 // An export runs without a deadline of its own; the CancelToken is there for API symmetry with
@@ -54,7 +68,7 @@ Result<exports::Session> LoadInput(const CommonOptions& c) {
   if (c.session_id < 0) return InvalidArgument("no session: give --session N");
   Result<std::unique_ptr<storage::SessionStore>> store = OpenExistingStore(c.db_path);
   if (!store.ok()) return store.status();
-  return LoadSession(**store, c.session_id);
+  return storage::LoadSessionReadings(**store, c.session_id);
 }
 
 Result<std::vector<double>> ParseNumbers(const std::string& text, const char* what) {
@@ -223,7 +237,7 @@ int RunMerl(const CommonOptions& c, const MerlOptions& o, std::ostream& out, std
   if (c.output == "-") {
     return Fail(err, "merl", InvalidArgument("a MERL .binary needs a file: give -o PATH.binary"));
   }
-  Result<CieTables> cie = LoadCieTables(o.colord_dir);
+  Result<data::CieTables> cie = data::LoadCieTables(o.colord_dir);
   if (!cie.ok()) return Fail(err, "merl", cie.status());
   Result<exports::Session> session = LoadInput(c);
   if (!session.ok()) return Fail(err, "merl", session.status());

@@ -1,9 +1,9 @@
-#include "tools/brdf-export/cie_tables.h"
+#include "data/cie_tables.h"
 
 #include <fstream>
 #include <sstream>
 
-namespace brdf::export_tool {
+namespace brdf::data {
 namespace {
 
 Result<SpectralTable> ReadTable(const std::string& path) {
@@ -36,4 +36,4 @@ Result<CieTables> LoadCieTables(const std::string& colord_dir) {
   return CieTables{std::move(*cmf), std::move(*d65)};
 }
 
-}  // namespace brdf::export_tool
+}  // namespace brdf::data

@@ -1,0 +1,51 @@
+// The lab's vocabulary for what the meter measured: a reading (sample I, white reference I0 or
+// dark D) with its pose, directions and spectrum, and a session's readings as one list. storage/
+// keeps them as ReadingRecords; the daemon's index, the exports, the fits and the tools all take
+// these plain values (storage/session_readings.h converts). Pure: no I/O.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/pose.h"
+#include "core/spectrum.h"
+
+namespace brdf {
+
+// What a reading measured: the sample I, the white standard I0, or the dark (ambient) D.
+enum class ReadingKind { kSample, kReference, kDark };
+const char* ReadingKindName(ReadingKind kind);  // "sample", "reference", "dark"
+
+// One reading as the session took it.
+struct Reading {
+  std::int64_t id = 0;
+  ReadingKind kind = ReadingKind::kSample;
+  Pose pose;               // the pose reached (stage readings, degrees)
+  Directions directions;   // θi φi θo φo in the sample frame (degrees)
+  Spectrum spectrum;       // radiance as the meter reported it, W·m⁻²·sr⁻¹·nm⁻¹
+  int quality_code = 0;    // the meter's quality code (0 = OK)
+  bool flagged = false;    // kept but flagged by the quality policy
+  int integration_ms = 0;  // 0 = adaptive
+  std::optional<std::int64_t> reference_id;  // the I0 this reading is divided by
+  std::optional<std::int64_t> dark_id;       // the D subtracted, when measured
+};
+
+// A session's readings, with what the derivation needs of the session itself.
+struct SessionReadings {
+  std::int64_t id = 0;
+  std::string name;
+  // ρw of the white standard; nullopt: the paper's RS-3, kWhiteStandardReflectance (0.99).
+  std::optional<double> white_reflectance;
+  std::vector<Reading> readings;  // in id order (the order they were taken)
+};
+
+// ρw as the session gives it, else kWhiteStandardReflectance.
+double WhiteReflectanceOf(const SessionReadings& session);
+
+// True when the sample readings were taken at more than one dial position γ: the session looks
+// anisotropic, and an isotropic reduction (grid, MERL, fits) folds its azimuths together.
+bool HasSeveralDialPositions(const SessionReadings& session);
+
+}  // namespace brdf

@@ -1,0 +1,40 @@
+#include "storage/session_readings.h"
+
+namespace brdf::storage {
+
+Reading ToReading(const ReadingRecord& r) {
+  Reading out;
+  out.id = r.id;
+  out.kind = r.kind;
+  out.pose = r.pose;
+  out.directions = r.directions;
+  out.spectrum = Spectrum{r.grid, r.spectrum};
+  out.quality_code = r.quality_code;
+  out.flagged = r.flagged;
+  out.integration_ms = r.integration_ms;
+  out.reference_id = r.reference_reading_id;
+  out.dark_id = r.dark_reading_id;
+  return out;
+}
+
+Result<SessionReadings> LoadSessionReadings(SessionStore& store, std::int64_t session_id) {
+  Result<SessionRecord> record = store.GetSession(session_id);
+  if (!record.ok()) {
+    if (record.status().code() == StatusCode::kNotFound) {
+      return NotFound("unknown session " + std::to_string(session_id) + " in " + store.path() +
+                      ": list the sessions with `brdfctl list`");
+    }
+    return record.status();
+  }
+  SessionReadings session;
+  session.id = record->id;
+  session.name = record->name;
+  session.white_reflectance = record->white_reflectance;
+  BRDF_RETURN_IF_ERROR(store.ForEachReading(session_id, [&](const ReadingRecord& r) {
+    session.readings.push_back(ToReading(r));
+    return Status::Ok();
+  }));
+  return session;
+}
+
+}  // namespace brdf::storage

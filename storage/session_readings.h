@@ -1,0 +1,25 @@
+// A stored session handed out as core/readings' values: the session record's ρw and name, and
+// every reading (sample, reference, dark) converted from its ReadingRecord. The exports (brdfd's
+// Data.Export, brdf-export) load whole sessions so; the daemon's interpolation index converts
+// each committed record as it lands. Read-only use of the store: only GetSession and
+// ForEachReading are called.
+#pragma once
+
+#include <cstdint>
+
+#include "core/readings/reading.h"
+#include "core/status.h"
+#include "storage/records.h"
+#include "storage/session_store.h"
+
+namespace brdf::storage {
+
+// One record as a Reading (what the derivation needs; the step, attempts, note, meter serial and
+// time stay in the record).
+Reading ToReading(const ReadingRecord& r);
+
+// The session and all its readings, in id order. kNotFound for an unknown session (naming it and
+// the database), and the store's errors.
+Result<SessionReadings> LoadSessionReadings(SessionStore& store, std::int64_t session_id);
+
+}  // namespace brdf::storage

@@ -1,0 +1,72 @@
+// core/readings' ReadingDeriver: readings folded one at a time give each sample's radiance,
+// reflectance and BRDF from the reference and dark it names, or say why not.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/readings/derive.h"
+
+namespace brdf {
+namespace {
+
+const WavelengthGrid kGrid{500, 100, 2};
+
+Reading Make(std::int64_t id, ReadingKind kind, Directions d, std::vector<double> values) {
+  Reading r;
+  r.id = id;
+  r.kind = kind;
+  r.directions = d;
+  r.spectrum = {kGrid, std::move(values)};
+  return r;
+}
+
+TEST(ReadingDeriver, SampleIsDividedByTheReferenceAndDarkItNames) {
+  ReadingDeriver deriver(0.95);
+  EXPECT_FALSE(deriver.Fold(Make(1, ReadingKind::kReference, {30, 0, 30, 180}, {2.0, 4.0})));
+  EXPECT_FALSE(deriver.Fold(Make(2, ReadingKind::kDark, {}, {0.5, 1.0})));
+  EXPECT_FALSE(deriver.grid().has_value());
+  Reading sample = Make(3, ReadingKind::kSample, {60, 0, 20, 90}, {1.1, 1.9});
+  sample.reference_id = 1;
+  sample.dark_id = 2;
+  std::optional<SampleQuantities> q = deriver.Fold(sample);
+  ASSERT_TRUE(q.has_value());
+  ASSERT_TRUE(q->has(Quantity::kRadiance) && q->has(Quantity::kReflectance) &&
+              q->has(Quantity::kBrdf));
+  EXPECT_DOUBLE_EQ(q->of(Quantity::kRadiance)[0], 0.6);
+  EXPECT_DOUBLE_EQ(q->of(Quantity::kReflectance)[1], 0.9 / 3.0);
+  const double ratio =
+      std::cos(30 * std::numbers::pi / 180) / std::cos(60 * std::numbers::pi / 180);
+  EXPECT_NEAR(q->of(Quantity::kBrdf)[0], 0.4 * 0.95 / std::numbers::pi * ratio, 1e-15);
+  ASSERT_TRUE(deriver.grid().has_value());
+  EXPECT_EQ(*deriver.grid(), kGrid);
+}
+
+TEST(ReadingDeriver, WhatCannotBeComputedSaysWhy) {
+  ReadingDeriver deriver(0.99);
+  Reading unknown_ref = Make(5, ReadingKind::kSample, {20, 0, 20, 90}, {1.0, 1.0});
+  unknown_ref.reference_id = 4;  // never folded
+  std::optional<SampleQuantities> q = deriver.Fold(unknown_ref);
+  ASSERT_TRUE(q.has_value());
+  EXPECT_TRUE(q->has(Quantity::kRadiance));
+  EXPECT_FALSE(q->has(Quantity::kBrdf));
+  EXPECT_EQ(q->reason(Quantity::kReflectance),
+            "reading 5: its reference reading 4 is not a reference reading of this session");
+
+  Reading no_ref = Make(6, ReadingKind::kSample, {20, 0, 20, 90}, {1.0, 1.0});
+  EXPECT_EQ(deriver.Fold(no_ref)->reason(Quantity::kBrdf),
+            "reading 6: it names no reference reading");
+
+  Reading other_grid = Make(7, ReadingKind::kSample, {20, 0, 20, 90}, {1.0, 1.0, 1.0});
+  other_grid.spectrum.grid = WavelengthGrid{500, 50, 3};
+  std::optional<SampleQuantities> g = deriver.Fold(other_grid);
+  EXPECT_FALSE(g->has(Quantity::kRadiance));
+  EXPECT_NE(g->reason(Quantity::kRadiance).find("wavelength grid differs"), std::string::npos);
+
+  Reading below = Make(8, ReadingKind::kSample, {95, 0, 20, 90}, {1.0, 1.0});
+  EXPECT_NE(deriver.Fold(below)->reason(Quantity::kRadiance).find("below the surface"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace brdf
