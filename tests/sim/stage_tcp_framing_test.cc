@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "tools/brdf-sim/stage_rtu_frame.h"
 #include "tools/brdf-sim/stage_simulator.h"
 
 namespace brdf::sim {
@@ -243,6 +244,12 @@ TEST_F(StageTcpFramingTest, InjectedException04BurstsThenTheDriveAnswers) {
   EXPECT_EQ(Ask(2, 1, kReadStatus), (Bytes{0x83, 0x04}));
   EXPECT_EQ(Ask(3, 1, kReadStatus)[0], 0x03);
   EXPECT_EQ(control_.modbus().exception_count, 0);
+}
+
+TEST(StageRtuFraming, AnFc08DiagnosisIsOneEightByteFrame) {
+  // slave 2, FC08, sub-function 0, data 0xA537, CRC: the AZ's diagnosis request on RS-485.
+  const Bytes frame{0x02, 0x08, 0x00, 0x00, 0xA5, 0x37};
+  EXPECT_EQ(RtuRequestLength(frame), 8);
 }
 
 TEST(StageFunctionCodes, ProfilesAndListsParse) {
