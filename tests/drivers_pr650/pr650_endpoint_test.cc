@@ -9,9 +9,14 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <vector>
 
+#include "core/wavelength_grid.h"
+#include "drivers/pr650/pr650_protocol.h"
 #include "tests/drivers_pr650/pr650_test_rig.h"
+#include "tools/brdf-sim/pr650_sim_protocol.h"
 
 namespace brdf::testing {
 namespace {
@@ -153,7 +158,7 @@ TEST_F(Pr650EndpointTest, SetupFieldsAreCheckedWithTheBadFieldPosition) {
 TEST_F(Pr650EndpointTest, UnknownCommandsGetNoReply) {
   Start();
   ASSERT_EQ(client_->Ask("B3\n"), "000\r\n");
-  EXPECT_EQ(client_->Ask("M1\n"), "");
+  EXPECT_EQ(client_->Ask("M4\n"), "");  // M1–M3 are answered since the simulator has reports 1–3
   EXPECT_EQ(client_->Ask("HELLO\n"), "");
   EXPECT_EQ(client_->Ask("B4\n"), "");
 }
@@ -189,8 +194,8 @@ TEST_F(Pr650EndpointTest, PowerCycleForgetsTheMeasurementAndSetup) {
   ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
   endpoint_->PowerCycle();
   ASSERT_EQ(client_->Ask("B3\n"), "000\r\n");
-  const std::string d5 = client_->Ask("D5\n");
-  EXPECT_THAT(d5, HasSubstr("0380.,0.000E+00\r\n"));
+  // No spectrum without a measurement since power-on (brdf-sim used to send one of zeros).
+  EXPECT_EQ(client_->Ask("D5\n"), std::string(sim::kNoMeasurementReply) + "\r\n");
   ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
   EXPECT_EQ(backend_.setups().back().integration_ms, 0);
 }
@@ -204,12 +209,27 @@ TEST_F(Pr650EndpointTest, SilentFaultAnswersNothing) {
 }
 
 TEST_F(Pr650EndpointTest, InjectedQualityLeadsM0AndD5AndCountsDown) {
-  Start();
+  // brdf-sim's older M0 reply, kept as an option: the quality code itself.
+  sim::Pr650EndpointOptions options = FastEndpointOptions();
+  options.m0_reply_is_quality = true;
+  Start(options);
   control_.set_serial({.quality_code = 19, .quality_count = 1});
   EXPECT_EQ(client_->Ask("M0\n"), "019\r\n");
   EXPECT_THAT(client_->Ask("D5\n"), StartsWith("19,0\r\n"));
   EXPECT_EQ(control_.serial().quality_count, 0);
   EXPECT_EQ(client_->Ask("M0\n"), "000\r\n");
+}
+
+TEST_F(Pr650EndpointTest, AsTheMeterM0Answers000AndTheQualityIsInTheReports) {
+  sim::Pr650EndpointOptions options = FastEndpointOptions();
+  options.m0_reply_is_quality = false;
+  options.pace_replies = false;
+  Start(options);
+  control_.set_serial({.quality_code = 18, .quality_count = 1});
+  EXPECT_EQ(client_->Ask("M0\n"), "000\r\n");  // what PsychoPy compares with
+  EXPECT_THAT(client_->Ask("D5\n"), StartsWith("18,0\r\n"));
+  EXPECT_THAT(client_->Ask("D1\n"), StartsWith("18,0,"));
+  EXPECT_THAT(client_->Ask("D2\n"), StartsWith("18,0,"));
 }
 
 TEST_F(Pr650EndpointTest, GarbageAndTruncationKeepTheReplysShapeOrCutIt) {
@@ -277,6 +297,116 @@ TEST_F(Pr650EndpointTest, VanishingPortHangsUpAndComesBackAtTheSameLink) {
   // The meter itself stayed on: still in remote mode, still holding its measurement.
   EXPECT_EQ(again.Ask("B3\n"), "000\r\n");
   EXPECT_EQ(again.Ask("D5\n").size(), 1734u);
+}
+
+// ---- the remote command set the open drivers use, read with brdfd's own parsers ---------------
+
+// The meter's own M0 reply (000), and replies as fast as the pty takes them: a whole report is
+// read in one Ask even on a loaded machine.
+sim::Pr650EndpointOptions MeterOptions() {
+  sim::Pr650EndpointOptions o = FastEndpointOptions();
+  o.m0_reply_is_quality = false;
+  o.pace_replies = false;
+  return o;
+}
+
+// The flat-ish test spectrum's colorimetry, as the simulated meter computes it.
+sim::Pr650Tristimulus TestSpectrumTristimulus() {
+  return sim::Pr650TristimulusOf(FakeMeterBackend::Spectrum(0.0123));
+}
+
+// Relative agreement at the meter's 4 significant digits.
+void ExpectNear4(double got, double want) {
+  EXPECT_NEAR(got, want, std::abs(want) * 6e-4) << "want " << want;
+}
+
+TEST_F(Pr650EndpointTest, M1AndD1ReportLuminanceAndXyThatBrdfdsParserReads) {
+  Start(MeterOptions());
+  const std::string m1 = client_->Ask("M1\n");
+  auto r = drivers::pr650::ParseColorimetryReply(m1);
+  ASSERT_TRUE(r.ok()) << r.status().ToString() << " in " << m1;
+  const sim::Pr650Tristimulus t = TestSpectrumTristimulus();
+  const double sum = t.X + t.Y + t.Z;
+  EXPECT_EQ(r->quality_code, 0);
+  EXPECT_EQ(r->units_code, 0);
+  ExpectNear4(r->luminance, t.Y);
+  EXPECT_NEAR(r->x, t.X / sum, 1e-4);
+  EXPECT_NEAR(r->y, t.Y / sum, 1e-4);
+  EXPECT_GT(r->luminance, 0);
+  EXPECT_EQ(client_->Ask("D1\n"), m1);      // the held measurement again
+  ASSERT_EQ(backend_.setups().size(), 1u);  // D1 does not measure
+}
+
+TEST_F(Pr650EndpointTest, M2AndD2ReportXyzThatBrdfdsParserReads) {
+  Start(MeterOptions());
+  const std::string m2 = client_->Ask("M2\n");
+  // The columns Psychtoolbox's PR650measxyz cuts: X at 6–14, Y at 16–24, Z at 26–34 (1-based).
+  ASSERT_EQ(m2.size(), 34u + 2u) << m2;
+  auto r = drivers::pr650::ParseTristimulusReply(m2);
+  ASSERT_TRUE(r.ok()) << r.status().ToString() << " in " << m2;
+  const sim::Pr650Tristimulus t = TestSpectrumTristimulus();
+  ExpectNear4(r->X, t.X);
+  ExpectNear4(r->Y, t.Y);
+  ExpectNear4(r->Z, t.Z);
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  auto again = drivers::pr650::ParseTristimulusReply(client_->Ask("D2\n"));
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->Y, r->Y);
+  EXPECT_EQ(backend_.setups().size(), 2u);
+}
+
+TEST_F(Pr650EndpointTest, M3ReportsLuminanceAndUPrimeVPrime) {
+  Start(MeterOptions());
+  const std::string m3 = client_->Ask("M3\n");
+  const sim::Pr650Tristimulus t = TestSpectrumTristimulus();
+  const double d = t.X + 15 * t.Y + 3 * t.Z;
+  char want[64];
+  std::snprintf(want, sizeof want, "00,0,%.3E,.%04ld,.%04ld\r\n", t.Y,
+                std::lround(4 * t.X / d * 1e4), std::lround(9 * t.Y / d * 1e4));
+  EXPECT_EQ(m3, want);
+}
+
+TEST_F(Pr650EndpointTest, M5IsTheMeasurementAndTheSpectrumInOneReply) {
+  Start(MeterOptions());
+  const std::string m5 = client_->Ask("M5\n");
+  auto r = drivers::pr650::ParseSpectrumReply(m5, WavelengthGrid::Pr650(), "M5");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->values.size(), 101u);
+  EXPECT_EQ(client_->Ask("D5\n"), m5);
+}
+
+TEST_F(Pr650EndpointTest, NoReportBeforeAMeasurement) {
+  Start(MeterOptions());
+  for (const char* report : {"D1\n", "D2\n", "D3\n", "D5\n"}) {
+    EXPECT_EQ(client_->Ask(report), std::string(sim::kNoMeasurementReply) + "\r\n") << report;
+  }
+  EXPECT_TRUE(backend_.setups().empty());
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  EXPECT_THAT(client_->Ask("D5\n"), StartsWith("00,0\r\n"));
+  // Switched off and on: the measurement is gone.
+  endpoint_->PowerCycle();
+  EXPECT_EQ(client_->Ask("D5\n"), std::string(sim::kNoMeasurementReply) + "\r\n");
+}
+
+TEST_F(Pr650EndpointTest, UndocumentedReportsAreNotAnswered) {
+  Start(MeterOptions());
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  for (const char* command : {"D4\n", "D6\n", "D201\n", "M4\n", "M6\n"}) {
+    EXPECT_EQ(client_->Ask(command), "") << command;
+  }
+  EXPECT_EQ(backend_.setups().size(), 1u);  // M4/M6 did not measure
+}
+
+TEST_F(Pr650EndpointTest, TheBareCrHeaderVariantRunsQualityIntoTheIntensityLine) {
+  sim::Pr650EndpointOptions options = MeterOptions();
+  options.quirks.d5_header_bare_cr = true;
+  Start(options);
+  ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
+  const std::string d5 = client_->Ask("D5\n");
+  EXPECT_THAT(d5, StartsWith("00,0\r"));
+  EXPECT_NE(d5[5], '\n');
+  auto r = drivers::pr650::ParseSpectrumReply(d5, WavelengthGrid::Pr650());
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
 }
 
 }  // namespace

@@ -53,7 +53,10 @@ TEST(Pr650WithBrdfSim, FullCycleThroughTheSimulatorProcess) {
 }
 
 TEST(Pr650WithBrdfSim, FaultFlagsReachTheDriver) {
-  auto sim = StartSim({"--serial-quality-code", "19", "--serial-quality-count", "1"});
+  // --pr650-m0-quality: the driver's Measure judges the quality from M0's reply, which the
+  // simulator, like the meter, otherwise answers with 000 (the quality is in the reports).
+  auto sim = StartSim(
+      {"--serial-quality-code", "19", "--serial-quality-count", "1", "--pr650-m0-quality"});
   ASSERT_NE(sim, nullptr);
   LogCapture log;
   drivers::Pr650Spectroradiometer meter(FastDriverOptions(sim->pr650_path(), log));

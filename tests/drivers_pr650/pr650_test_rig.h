@@ -86,10 +86,15 @@ class FakeMeterBackend final : public sim::MeterBackend {
 
 // Simulated time runs 10× faster than real time in these tests: the 5 s wake-up window is 0.5 s,
 // a 1.8 s D5 transfer 0.18 s.
+//
+// M0 answers with the quality code (brdf-sim's older reply, m0_reply_is_quality): the driver's
+// Measure still judges the quality from M0's reply, and these tests drive that path. The meter's
+// own "000" reply is tested in pr650_endpoint_test.cc and pr650_reports_test.cc.
 inline sim::Pr650EndpointOptions FastEndpointOptions() {
   sim::Pr650EndpointOptions o;
   o.time_scale.factor = 10;
   o.pace_replies = true;
+  o.m0_reply_is_quality = true;
   return o;
 }
 

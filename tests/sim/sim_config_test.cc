@@ -200,6 +200,50 @@ TEST(SimConfigTest, ValidationRejectsImpossibleSettings) {
   EXPECT_FALSE(ParseLikeMain({"--fifo-bytes", "0"}, c).ok());
 }
 
+TEST(SimConfigTest, DriveAndMeterSettingsFromTheFileAndFlags) {
+  SimConfig c;
+  EXPECT_EQ(StageFunctionCodes(c), (FunctionCodes{3, 6, 8, 16}));  // the AZ's by default
+  EXPECT_EQ(StageWordOrder(c), SimWordOrder::kHighFirst);
+  EXPECT_EQ(StageRampUnit(c), SimRampUnit::kKhzPerSecond);
+  EXPECT_FALSE(c.m0_reply_is_quality);
+  ASSERT_TRUE(LoadConfigString(R"([stage]
+function_codes = "moons"
+word_order = "lower_first"
+ramp_unit = "s"
+[pr650]
+d5_header_bare_cr = true
+m0_reply_is_quality = true
+)",
+                               "test.toml", c)
+                  .ok());
+  ASSERT_TRUE(ValidateConfig(c).ok());
+  EXPECT_EQ(StageFunctionCodes(c), (FunctionCodes{3, 4, 6, 16}));
+  EXPECT_EQ(StageWordOrder(c), SimWordOrder::kLowFirst);
+  EXPECT_EQ(StageRampUnit(c), SimRampUnit::kSeconds);
+  EXPECT_TRUE(c.d5_header_bare_cr);
+  EXPECT_TRUE(c.m0_reply_is_quality);
+
+  SimConfig f;
+  ASSERT_TRUE(ParseLikeMain({"--stage-function-codes", "3,16", "--stage-word-order", "lower_first",
+                             "--stage-ramp-unit", "ms_per_khz", "--pr650-bare-cr-header",
+                             "--pr650-m0-quality"},
+                            f)
+                  .ok());
+  EXPECT_EQ(StageFunctionCodes(f), (FunctionCodes{3, 16}));
+  EXPECT_EQ(StageRampUnit(f), SimRampUnit::kMsPerKhz);
+  EXPECT_TRUE(f.d5_header_bare_cr);
+
+  for (const auto& bad :
+       std::vector<std::vector<std::string>>{{"--stage-function-codes", "3,7"},
+                                             {"--stage-word-order", "middle_endian"},
+                                             {"--stage-ramp-unit", "rpm"}}) {
+    SimConfig b;
+    const Status s = ParseLikeMain(bad, b);
+    EXPECT_EQ(s.code(), StatusCode::kInvalidArgument) << bad[0];
+    EXPECT_NE(s.message().find(bad[0]), std::string::npos) << s.message();
+  }
+}
+
 TEST(SimConfigTest, FindConfigPathAcceptsBothSpellings) {
   const char* a[] = {"brdf-sim", "--seed", "1", "--config", "a.toml"};
   const char* b[] = {"brdf-sim", "--config=b.toml"};

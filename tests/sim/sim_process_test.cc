@@ -252,7 +252,9 @@ TEST(SimProcessTest, InjectedQualityCodeReachesTheMeterForTheNextMeasurementsOnl
   ASSERT_TRUE((*control)->SetSerialFaults(f).ok());
   MeterPort meter(sim->pr650_path());
   ASSERT_EQ(meter.Ask("B0", 1), std::vector<std::string>{"000"});
-  EXPECT_EQ(meter.Ask("M0", 1), std::vector<std::string>{"029"});
+  // As on the meter, M0 answers 000 and the quality is in the report.
+  EXPECT_EQ(meter.Ask("M0", 1), std::vector<std::string>{"000"});
+  EXPECT_EQ(meter.Ask("D5", 103)[0], "29,0");
   // M5 measures too (and counts down the fault); its reply is the D5 report, quality code first.
   const auto m5 = meter.Ask("M5", 103);
   ASSERT_EQ(m5.size(), 103u);
@@ -261,6 +263,15 @@ TEST(SimProcessTest, InjectedQualityCodeReachesTheMeterForTheNextMeasurementsOnl
   EXPECT_EQ(meter.Ask("M5", 103)[0], "00,0");
   EXPECT_EQ(meter.Ask("M0", 1), std::vector<std::string>{"000"});
   EXPECT_EQ((*control)->SerialFaults()->quality_count, 0);
+}
+
+TEST(SimProcessTest, TheOlderM0ReplyCarryingTheQualityIsAnOption) {
+  auto sim = StartSim({"--pr650-m0-quality", "--serial-quality-code", "18"});
+  ASSERT_NE(sim, nullptr);
+  MeterPort meter(sim->pr650_path());
+  ASSERT_EQ(meter.Ask("B0", 1), std::vector<std::string>{"000"});
+  EXPECT_EQ(meter.Ask("M0", 1), std::vector<std::string>{"018"});
+  EXPECT_EQ(meter.Ask("D5", 103)[0], "18,0");
 }
 
 std::vector<double> ParseTextTruth(const std::string& text) {

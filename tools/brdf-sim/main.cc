@@ -43,7 +43,10 @@ StageSimConfig StageConfigFrom(const SimConfig& c) {
     s.axes[i].min_deg = c.axes[i].min_deg;
     s.axes[i].max_deg = c.axes[i].max_deg;
     s.axes[i].home_speed_deg_s = c.axes[i].home_speed_deg_s;
+    s.axes[i].word_order = StageWordOrder(c);
+    s.axes[i].ramp_unit = StageRampUnit(c);
   }
+  s.drive_function_codes = StageFunctionCodes(c);
   s.axes[kDeltaAxis].present = c.detector_arm;
   return s;
 }
@@ -55,6 +58,8 @@ Pr650EndpointOptions MeterOptionsFrom(const SimConfig& c) {
   o.pace_replies = c.pacing;
   o.fifo_bytes = c.fifo_bytes;
   o.link_path = c.pr650_link;
+  o.quirks.d5_header_bare_cr = c.d5_header_bare_cr;
+  o.m0_reply_is_quality = c.m0_reply_is_quality;
   return o;
 }
 

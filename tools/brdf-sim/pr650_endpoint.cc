@@ -31,6 +31,11 @@ std::string Trim(const std::string& s) {
   return s.substr(first, last - first + 1);
 }
 
+// The reports brdf-sim answers: D1 (Y, x, y), D2 (X, Y, Z), D3 (Y, u', v'), D5 (spectrum).
+bool IsServedReport(int report) {
+  return report == 1 || report == 2 || report == 3 || report == 5;
+}
+
 // Junk of the same shape as the reply it replaces (same line count and lengths), so a driver
 // gets a complete-looking reply that does not parse: what a wrong baud rate or line noise gives.
 std::string Garble(const std::string& line, unsigned seed) {
@@ -212,21 +217,24 @@ void Pr650Endpoint::Handle(const std::string& command) {
     Reply({text});
     return;
   }
-  if (command == "M0" || command == "M5") {
-    // M5 is M0 followed by the D5 report, in one reply.
+  const bool two_chars = command.size() == 2;
+  const int digit = two_chars ? command[1] - '0' : -1;
+  if (two_chars && command[0] == 'M' && (digit == 0 || IsServedReport(digit))) {
+    // M0 measures and holds; Mn is M0 followed by report n, in one reply.
     const std::optional<int> quality_code = Measure(epoch);
     if (!quality_code.has_value()) return;
-    if (command == "M5") {
-      ReplySpectrum();
+    if (digit != 0) {
+      ReplyReport(digit);
       return;
     }
+    const int status = options_.m0_reply_is_quality ? std::clamp(*quality_code, 0, 999) : 0;
     char text[8];
-    std::snprintf(text, sizeof text, "%03d", std::clamp(*quality_code, 0, 999));
+    std::snprintf(text, sizeof text, "%03d", status);
     Reply({text});
     return;
   }
-  if (command == "D5") {
-    ReplySpectrum();
+  if (two_chars && command[0] == 'D' && IsServedReport(digit)) {
+    ReplyReport(digit);
     return;
   }
   if (command == "D110") {
@@ -239,7 +247,7 @@ void Pr650Endpoint::Handle(const std::string& command) {
     Reply({Pr650LayoutLine()});
     return;
   }
-  // Unknown or unsupported (M1–M4, M6, D1, D2, ...): the simulated meter does not answer.
+  // Unknown or undocumented (D4, D6, M4, M6, D201, ...): the simulated meter does not answer.
 }
 
 std::optional<int> Pr650Endpoint::Measure(unsigned epoch) {
@@ -263,18 +271,29 @@ std::optional<int> Pr650Endpoint::Measure(unsigned epoch) {
   return m.quality_code;
 }
 
-void Pr650Endpoint::ReplySpectrum() {
+void Pr650Endpoint::ReplyReport(int report) {
   Measurement last;
   {
     std::lock_guard lock(mu_);
     last = last_;
+  }
+  if (!last.valid) {
+    Reply({kNoMeasurementReply});
+    return;
+  }
+  constexpr int kUnitsRadiance = 0;
+  if (report != 5) {
+    Reply({Pr650ColorimetryLine(report, last.quality_code, kUnitsRadiance,
+                                Pr650TristimulusOf(last.radiance))});
+    return;
   }
   const double vanish = control_.UpdateSerial([](SerialFaults& f) {
     const double seconds = f.vanish_seconds;
     f.vanish_seconds = 0;
     return seconds;
   });
-  Reply(Pr650SpectrumLines(last.quality_code, 0, last.integrated, last.radiance), vanish);
+  Reply(Pr650SpectrumLines(last.quality_code, kUnitsRadiance, last.integrated, last.radiance),
+        vanish);
 }
 
 void Pr650Endpoint::Reply(std::vector<std::string> lines, double vanish_seconds) {

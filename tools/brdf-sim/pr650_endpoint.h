@@ -6,15 +6,23 @@
 //   S<acc1>,<acc2>,<acc3>,<acc4>,<sync>,<integ>,<avg>,<units>   pp (00 ok, 01–08 bad field, 09 too
 //                                                       many fields, 50 accessory not fitted)
 //   F                                                   qq,freq  ("00,100.0")
-//   M0                                                  a 3-digit status = the quality code ("000",
-//                                                       "018"), after the measurement's duration
+//   M0                                                  000 once the measurement is done (its
+//                                                       quality is in the reports); with
+//                                                       m0_reply_is_quality the quality code
+//                                                       itself ("018"), brdf-sim's older reply
+//   D1                                                  qq,U,Y.YYYEsee,.xxxx,.yyyy  (Y, x, y)
+//   D2                                                  qq,U,X.XXXEsee,Y.YYYEsee,Z.ZZZEsee
+//   D3                                                  qq,U,Y.YYYEsee,.uuuu,.vvvv  (Y, u', v')
 //   D5                                                  qq,U / integrated / 101 × "0380.,r.rrrEsee"
-//   M5                                                  M0's measurement, then the D5 report as
+//   M1, M2, M3, M5                                      a measurement, then report 1, 2, 3 or 5 as
 //                                                       its reply (also after a bad quality code)
 //   D110                                                the serial number, blank-padded to 8
 //   D120                                                0101,008.0,0380.,0780.,004.
-//   anything else                                       no reply
+//   anything else (D4, D6, M4, M6, D201, ...)           no reply: no source documents them
 //
+// A report asked for before any measurement since power-on (D1–D3, D5) is answered with the
+// status line "-1" alone (kNoMeasurementReply), the value the open programs treat as "no data";
+// the meter never sends a spectrum it has not measured.
 // Remote mode starts only if the first command arrives within wake_window_s (simulated) of
 // power-on (Start or PowerCycle); otherwise the meter stays in stand-alone mode and answers
 // nothing until power-cycled. Faults come from SimControl::serial() at each command; the "next N"
@@ -46,7 +54,8 @@ namespace brdf::sim {
 struct Pr650WireQuirks {
   enum class LineEnding { kCrLf, kLf, kCr };
   LineEnding line_ending = LineEnding::kCrLf;
-  // D5 header and integrated line run together with a bare CR ("00,0\r1.234E+01\r\n").
+  // D5 header and integrated line run together with a bare CR ("00,0\r1.234E+01\r\n"), as one
+  // quoted manual line shows.
   bool d5_header_bare_cr = false;
   // > 0: replies leave in pieces of this many bytes, piece_gap apart (real time).
   int piece_bytes = 0;
@@ -73,8 +82,14 @@ struct Pr650EndpointOptions {
   std::string link_path;
   std::string serial_number = "60925301";
   double flicker_hz = 100.0;  // what F reports (a 50 Hz mains lamp flickers at 100 Hz)
+  // M0 answers with the quality code ("018") instead of the meter's "000": what brdf-sim did
+  // before it followed the meter, for drivers that judge the quality from M0's reply.
+  bool m0_reply_is_quality = false;
   Pr650WireQuirks quirks;
 };
+
+// The reply to a report asked for before any measurement.
+inline constexpr const char* kNoMeasurementReply = "-1";
 
 class Pr650Endpoint {
  public:
@@ -118,8 +133,9 @@ class Pr650Endpoint {
   // Takes a measurement (its simulated duration in real time) into last_ and returns its quality
   // code; nullopt if stopped or switched off meanwhile (no reply then).
   std::optional<int> Measure(unsigned epoch);
-  // The D5 report of last_ (with the vanish fault, if armed).
-  void ReplySpectrum();
+  // Report 1, 2, 3 or 5 of last_ (the D5 report with the vanish fault, if armed), or
+  // kNoMeasurementReply when there is none.
+  void ReplyReport(int report);
   // Sends `lines` as one reply (line ends, quirks and faults applied). `vanish_after`: for a D5
   // with the vanish fault, the number of bytes after which the port vanishes.
   void Reply(std::vector<std::string> lines, double vanish_seconds = 0);

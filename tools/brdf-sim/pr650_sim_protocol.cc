@@ -1,5 +1,6 @@
 #include "tools/brdf-sim/pr650_sim_protocol.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -48,6 +49,69 @@ std::vector<std::string> Pr650SpectrumLines(int quality_code, int units_code, do
     lines.emplace_back(text);
   }
   return lines;
+}
+
+namespace {
+
+// One lobe of the Wyman–Sloan–Shirley fit: a Gaussian with different widths either side of μ.
+double Lobe(double nm, double mu, double sigma_below, double sigma_above) {
+  const double t = (nm - mu) / (nm < mu ? sigma_below : sigma_above);
+  return std::exp(-0.5 * t * t);
+}
+
+// "qq,U," for the colorimetric reports.
+std::string ReportHead(int quality_code, int units_code) {
+  char text[16];
+  std::snprintf(text, sizeof text, "%02d,%d,", quality_code, units_code);
+  return text;
+}
+
+// A chromaticity coordinate as the meter prints it: ".xxxx".
+std::string Coordinate(double value) {
+  const long scaled = std::lround(std::clamp(value, 0.0, 0.9999) * 10000);
+  char text[16];
+  std::snprintf(text, sizeof text, ".%04ld", scaled);
+  return text;
+}
+
+}  // namespace
+
+Pr650Tristimulus Pr650TristimulusOf(const std::vector<double>& radiance) {
+  constexpr double kLumensPerWatt = 683.0;
+  Pr650Tristimulus t;
+  for (std::size_t i = 0; i < radiance.size() && i < static_cast<std::size_t>(kPr650Bands); ++i) {
+    const double nm = kPr650FirstNm + kPr650StepNm * static_cast<double>(i);
+    const double x_bar = 1.056 * Lobe(nm, 599.8, 37.9, 31.0) + 0.362 * Lobe(nm, 442.0, 16.0, 26.7) -
+                         0.065 * Lobe(nm, 501.1, 20.4, 26.2);
+    const double y_bar = 0.821 * Lobe(nm, 568.8, 46.9, 40.5) + 0.286 * Lobe(nm, 530.9, 16.3, 31.1);
+    const double z_bar = 1.217 * Lobe(nm, 437.0, 11.8, 36.0) + 0.681 * Lobe(nm, 459.0, 26.0, 13.8);
+    const double w = kLumensPerWatt * radiance[i] * kPr650StepNm;
+    t.X += w * x_bar;
+    t.Y += w * y_bar;
+    t.Z += w * z_bar;
+  }
+  return t;
+}
+
+std::string Pr650ColorimetryLine(int report, int quality_code, int units_code,
+                                 const Pr650Tristimulus& xyz) {
+  const double sum = xyz.X + xyz.Y + xyz.Z;
+  const double uv_denominator = xyz.X + 15 * xyz.Y + 3 * xyz.Z;
+  const std::string head = ReportHead(quality_code, units_code);
+  switch (report) {
+    case 1:
+      return head + FormatPr650Number(xyz.Y) + "," + Coordinate(sum > 0 ? xyz.X / sum : 0) + "," +
+             Coordinate(sum > 0 ? xyz.Y / sum : 0);
+    case 2:
+      return head + FormatPr650Number(xyz.X) + "," + FormatPr650Number(xyz.Y) + "," +
+             FormatPr650Number(xyz.Z);
+    case 3:
+      return head + FormatPr650Number(xyz.Y) + "," +
+             Coordinate(uv_denominator > 0 ? 4 * xyz.X / uv_denominator : 0) + "," +
+             Coordinate(uv_denominator > 0 ? 9 * xyz.Y / uv_denominator : 0);
+    default:
+      return {};
+  }
 }
 
 std::string Pr650LayoutLine() {

@@ -26,6 +26,24 @@ std::string FormatPr650Number(double value);
 std::vector<std::string> Pr650SpectrumLines(int quality_code, int units_code, double integrated,
                                             const std::vector<double>& radiance);
 
+// CIE 1931 tristimulus values of a spectral radiance on the PR-650 grid (W·m⁻²·sr⁻¹·nm⁻¹ in,
+// cd/m² for Y out: 683 lm/W × Σ L(λ) ȳ(λ) × 4 nm). The colour-matching functions are the
+// multi-lobe Gaussian fit of Wyman, Sloan & Shirley (JCGT 2(2), 2013), within a few percent of the
+// CIE tables: a simulated meter needs plausible colorimetry, not a calibration.
+struct Pr650Tristimulus {
+  double X = 0, Y = 0, Z = 0;
+};
+Pr650Tristimulus Pr650TristimulusOf(const std::vector<double>& radiance);
+
+// The colorimetric reports, one line each, as the open PR-650 programs parse them:
+//   1  "qq,U,Y.YYYEsee,.xxxx,.yyyy"      luminance and CIE 1931 x, y
+//   2  "qq,U,X.XXXEsee,Y.YYYEsee,Z.ZZZEsee"  tristimulus values
+//   3  "qq,U,Y.YYYEsee,.uuuu,.vvvv"      luminance and CIE 1976 u', v'
+// Chromaticities are 4 decimals with no leading 0; black (X + Y + Z = 0) gives .0000. `report` is
+// 1, 2 or 3; any other number returns an empty string.
+std::string Pr650ColorimetryLine(int report, int quality_code, int units_code,
+                                 const Pr650Tristimulus& xyz);
+
 // The D120 layout line: "0101,008.0,0380.,0780.,004.".
 std::string Pr650LayoutLine();
 

@@ -220,8 +220,11 @@ Status ReadTable(const TomlReader& r, const toml::table& root, SimConfig& c) {
   auto pr650 = r.Table(root, "", "pr650");
   if (!pr650.ok()) return pr650.status();
   if (const toml::table* p = *pr650) {
-    BRDF_RETURN_IF_ERROR(
-        r.CheckKeys(*p, "pr650", {"pacing", "fifo_bytes", "wake_window_s", "link"}));
+    BRDF_RETURN_IF_ERROR(r.CheckKeys(*p, "pr650",
+                                     {"pacing", "fifo_bytes", "wake_window_s", "link",
+                                      "d5_header_bare_cr", "m0_reply_is_quality"}));
+    BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "d5_header_bare_cr", c.d5_header_bare_cr));
+    BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "m0_reply_is_quality", c.m0_reply_is_quality));
     BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "link", c.pr650_link));
     BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "pacing", c.pacing));
     BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "fifo_bytes", c.fifo_bytes));
@@ -231,8 +234,13 @@ Status ReadTable(const TomlReader& r, const toml::table& root, SimConfig& c) {
   auto stage = r.Table(root, "", "stage");
   if (!stage.ok()) return stage.status();
   if (const toml::table* s = *stage) {
-    BRDF_RETURN_IF_ERROR(r.CheckKeys(
-        *s, "stage", {"detector_arm", "manual_delta_deg", "alpha", "beta", "gamma", "delta"}));
+    BRDF_RETURN_IF_ERROR(
+        r.CheckKeys(*s, "stage",
+                    {"detector_arm", "manual_delta_deg", "function_codes", "word_order",
+                     "ramp_unit", "alpha", "beta", "gamma", "delta"}));
+    BRDF_RETURN_IF_ERROR(r.Read(*s, "stage", "ramp_unit", c.stage_ramp_unit));
+    BRDF_RETURN_IF_ERROR(r.Read(*s, "stage", "function_codes", c.stage_function_codes));
+    BRDF_RETURN_IF_ERROR(r.Read(*s, "stage", "word_order", c.stage_word_order));
     BRDF_RETURN_IF_ERROR(r.Read(*s, "stage", "detector_arm", c.detector_arm));
     BRDF_RETURN_IF_ERROR(r.Read(*s, "stage", "manual_delta_deg", c.manual_delta_deg));
     for (std::size_t i = 0; i < kAxisNames.size(); ++i) {
@@ -348,6 +356,16 @@ void AddRunFlags(CLI::App& app, SimConfig& c) {
                  "Seconds after power-on within which the PR-650 accepts remote mode");
   app.add_option("--pr650-link", c.pr650_link,
                  "Path of the PR-650 port symlink (default: in a private temp directory)");
+  app.add_flag("--pr650-bare-cr-header", c.d5_header_bare_cr,
+               "End the D5 header line \"qq,U\" with a bare CR (a quoted manual's variant)");
+  app.add_flag("--pr650-m0-quality", c.m0_reply_is_quality,
+               "M0 answers the quality code (\"018\") instead of the meter's \"000\"");
+  app.add_option("--stage-function-codes", c.stage_function_codes,
+                 "Function codes the drives answer: az (3,6,8,16), leadshine, moons, or a list");
+  app.add_option("--stage-word-order", c.stage_word_order,
+                 "32-bit values in two registers: upper_first (AZ default) or lower_first");
+  app.add_option("--stage-ramp-unit", c.stage_ramp_unit,
+                 "Unit of the drives' ramp rates: khz_per_s (AZ default), s or ms_per_khz");
   app.add_flag("--anisotropic", c.optics.anisotropic, "Mount the brushed (anisotropic) sample");
   const std::map<std::string, MountedTarget> targets = {{"sample", MountedTarget::kSample},
                                                         {"white", MountedTarget::kWhite},
@@ -376,7 +394,7 @@ void AddRunFlags(CLI::App& app, SimConfig& c) {
                  "Fault: the pty vanishes during the next D5, back after S seconds");
   ModbusFaults& m = c.modbus_faults;
   app.add_option("--modbus-exception-code", m.exception_code,
-                 "Fault: reply with this exception (2 or 6) ...");
+                 "Fault: reply with this exception (2, 4 busy, 6) ...");
   app.add_option("--modbus-exception-count", m.exception_count,
                  "... to the next N requests (default 1 when a code is given)");
   app.add_option("--modbus-late-reply-ms", m.late_reply_ms,
@@ -411,6 +429,30 @@ void AddTruthFlags(CLI::App& truth, TruthQuery& q) {
   phi->excludes(phi_i)->excludes(phi_o);
   truth.add_flag("--anisotropic", q.anisotropic, "The brushed (anisotropic) sample");
   truth.add_flag("--json", q.json, "Print JSON instead of two columns");
+}
+
+FunctionCodes StageFunctionCodes(const SimConfig& c) {
+  std::string error;
+  return ParseFunctionCodes(c.stage_function_codes, &error).value_or(kServedFunctionCodes);
+}
+
+SimWordOrder StageWordOrder(const SimConfig& c) {
+  return c.stage_word_order == "lower_first" ? SimWordOrder::kLowFirst : SimWordOrder::kHighFirst;
+}
+
+namespace {
+const std::map<std::string, SimRampUnit>& RampUnits() {
+  static const std::map<std::string, SimRampUnit> units = {
+      {"khz_per_s", SimRampUnit::kKhzPerSecond},
+      {"s", SimRampUnit::kSeconds},
+      {"ms_per_khz", SimRampUnit::kMsPerKhz}};
+  return units;
+}
+}  // namespace
+
+SimRampUnit StageRampUnit(const SimConfig& c) {
+  const auto it = RampUnits().find(c.stage_ramp_unit);
+  return it == RampUnits().end() ? SimRampUnit::kKhzPerSecond : it->second;
 }
 
 Status ValidateConfig(const SimConfig& c) {
@@ -459,7 +501,22 @@ Status ValidateConfig(const SimConfig& c) {
     return InvalidArgument("Modbus fault counts and delays must be >= 0");
   }
   if (m.exception_code < 0 || m.exception_code > 255) {
-    return InvalidArgument("Modbus fault exception code must be 0–255 (usually 2 or 6)");
+    return InvalidArgument("Modbus fault exception code must be 0–255 (usually 2, 4 or 6)");
+  }
+  std::string error;
+  if (!ParseFunctionCodes(c.stage_function_codes, &error)) {
+    return InvalidArgument("stage function codes '" + c.stage_function_codes + "': " + error +
+                           "; fix [stage] function_codes or --stage-function-codes");
+  }
+  if (c.stage_word_order != "upper_first" && c.stage_word_order != "lower_first") {
+    return InvalidArgument("stage word order '" + c.stage_word_order +
+                           "' is unknown; use upper_first or lower_first ([stage] word_order, "
+                           "--stage-word-order)");
+  }
+  if (RampUnits().count(c.stage_ramp_unit) == 0) {
+    return InvalidArgument("stage ramp unit '" + c.stage_ramp_unit +
+                           "' is unknown; use khz_per_s, s or ms_per_khz ([stage] ramp_unit, "
+                           "--stage-ramp-unit)");
   }
   const OpticsConfig& o = c.optics;
   if (!Finite(o.noise_scale) || o.noise_scale < 0) {

@@ -11,6 +11,8 @@
 #include "core/status.h"
 #include "tools/brdf-sim/optics.h"
 #include "tools/brdf-sim/sim_shared.h"
+#include "tools/brdf-sim/stage_pdu.h"
+#include "tools/brdf-sim/stage_sim_axis.h"
 
 namespace CLI {
 class App;
@@ -44,6 +46,16 @@ struct SimConfig {
   double wake_window_s = 5;     // the PR-650 enters remote mode only within this long of power-on
                                 // (simulated seconds; 0 = any time)
   std::string pr650_link;       // where the PR-650 port link goes (empty: a private temp dir)
+  bool d5_header_bare_cr = false;    // D5's "qq,U" ended by a bare CR (a quoted manual's variant)
+  bool m0_reply_is_quality = false;  // M0 answers the quality code, not the meter's 000
+
+  // The axis drives, set as on an AZ drive: which function codes they answer (a profile name,
+  // "az", "leadshine", "moons", or a list "3,6,8,16"), and how a 32-bit value lies over two
+  // registers ("upper_first", the AZ default, or "lower_first"), and the unit of the ramp rates
+  // in the operation block ("khz_per_s", the AZ default, "s" or "ms_per_khz").
+  std::string stage_function_codes = "az";
+  std::string stage_word_order = "upper_first";
+  std::string stage_ramp_unit = "khz_per_s";
 
   std::array<AxisSettings, 4> axes = {{
       // home speed, min, max
@@ -93,6 +105,11 @@ void FinishFlags(CLI::App& app, SimConfig& config);
 
 // Registers `truth`'s flags on its subcommand, bound to `query`.
 void AddTruthFlags(CLI::App& truth, TruthQuery& query);
+
+// The drives' settings as the stage simulator takes them (ValidateConfig has checked them).
+FunctionCodes StageFunctionCodes(const SimConfig& config);
+SimWordOrder StageWordOrder(const SimConfig& config);
+SimRampUnit StageRampUnit(const SimConfig& config);
 
 // Checks ranges: time scale > 0, port 0–65535, speeds > 0, min < max, and so on.
 Status ValidateConfig(const SimConfig& config);

@@ -30,6 +30,8 @@ int RtuRequestLength(std::span<const std::uint8_t> bytes) {
     case 0x05:
     case 0x06:
       return 8;  // slave, fc, address(2), count/value(2), crc(2)
+    case 0x08:
+      return 8;  // slave, fc, sub-function(2), one data word (the AZ's diagnosis form), crc(2)
     case 0x0F:
     case 0x10:
       if (bytes.size() < 7) return 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace brdf::sim {
@@ -9,17 +10,6 @@ namespace brdf::sim {
 using namespace sim_axis;  // NOLINT(google-build-using-namespace): this file's register names
 
 namespace {
-
-// 32-bit values are stored high word first (AZ "upper word first").
-std::int32_t Join(std::uint16_t high, std::uint16_t low) {
-  return static_cast<std::int32_t>((static_cast<std::uint32_t>(high) << 16) | low);
-}
-std::uint16_t High(std::int32_t v) {
-  return static_cast<std::uint16_t>(static_cast<std::uint32_t>(v) >> 16);
-}
-std::uint16_t Low(std::int32_t v) {
-  return static_cast<std::uint16_t>(static_cast<std::uint32_t>(v) & 0xFFFFu);
-}
 
 bool InBlock(std::uint32_t a) {
   return a >= kBlockStart && a < kBlockStart + kBlockWords;
@@ -32,7 +22,57 @@ bool Readable(std::uint32_t a) {
          a == kFeedback + 1u || a == kFeedbackAlt || a == kFeedbackAlt + 1u;
 }
 
+// The speed profile of a move of `distance` counts (>= 0) at `speed` with the given acceleration
+// and deceleration (counts/s², +inf: at once): a trapezoid, or a triangle when the move is too
+// short to reach the speed.
+struct SpeedProfile {
+  double peak = 0;    // counts/s
+  double t_up = 0;    // s, ramping up
+  double t_run = 0;   // s, at the peak speed
+  double t_down = 0;  // s, ramping down
+  double total() const { return t_up + t_run + t_down; }
+};
+
+SpeedProfile ProfileOf(double distance, double speed, double accel, double decel) {
+  SpeedProfile p;
+  if (distance <= 0 || speed <= 0) return p;
+  p.peak = speed;
+  if (speed * speed * (0.5 / accel + 0.5 / decel) > distance) {
+    p.peak = std::sqrt(2 * distance / (1 / accel + 1 / decel));
+  }
+  p.t_up = p.peak / accel;
+  p.t_down = p.peak / decel;
+  p.t_run = std::max(0.0, (distance - 0.5 * p.peak * (p.t_up + p.t_down)) / p.peak);
+  return p;
+}
+
+// Distance covered `t` seconds into that move.
+double Travelled(double distance, double speed, double accel, double decel, double t) {
+  const SpeedProfile p = ProfileOf(distance, speed, accel, decel);
+  if (t <= 0 || p.peak <= 0) return 0;
+  if (t < p.t_up) return 0.5 * accel * t * t;
+  if (t < p.t_up + p.t_run) return 0.5 * p.peak * p.t_up + p.peak * (t - p.t_up);
+  if (t < p.total()) return distance - 0.5 * decel * (p.total() - t) * (p.total() - t);
+  return distance;
+}
+
+double MoveDuration(double distance, double speed, double accel, double decel) {
+  return ProfileOf(distance, speed, accel, decel).total();
+}
+
 }  // namespace
+
+std::int32_t SimAxis::Join(std::uint16_t first, std::uint16_t second) const {
+  const bool high_first = config_.word_order == SimWordOrder::kHighFirst;
+  const std::uint32_t high = high_first ? first : second;
+  const std::uint32_t low = high_first ? second : first;
+  return static_cast<std::int32_t>((high << 16) | low);
+}
+
+std::uint16_t SimAxis::WordOf(std::uint32_t value, std::uint32_t offset) const {
+  const bool upper = (offset == 0) == (config_.word_order == SimWordOrder::kHighFirst);
+  return static_cast<std::uint16_t>(upper ? value >> 16 : value & 0xFFFFu);
+}
 
 SimAxis::SimAxis(SimAxisConfig config, SimControl& control, std::function<double()> now_s)
     : config_(std::move(config)),
@@ -48,7 +88,7 @@ void SimAxis::Advance(double now) const {
   Motion& m = motion_;
   if (!m.moving || m.stalled) return;
   const double distance = std::abs(m.target_counts - m.start_counts);
-  const double end_s = m.start_s + distance / m.speed;
+  const double end_s = m.start_s + MoveDuration(distance, m.speed, m.accel, m.decel);
   if (m.alarm_at_s >= 0 && now >= m.alarm_at_s && m.alarm_at_s < end_s) {
     m.start_counts = std::round(CountsAt(m.alarm_at_s));  // a drive rests on whole counts
     m.moving = false;
@@ -67,8 +107,9 @@ void SimAxis::Advance(double now) const {
 double SimAxis::CountsAt(double now) const {
   const Motion& m = motion_;
   if (!m.moving || m.stalled) return m.start_counts;
-  const double travelled = std::max(0.0, now - m.start_s) * m.speed;
   const double distance = m.target_counts - m.start_counts;
+  const double travelled =
+      Travelled(std::abs(distance), m.speed, m.accel, m.decel, std::max(0.0, now - m.start_s));
   if (travelled >= std::abs(distance)) return m.target_counts;
   return m.start_counts + std::copysign(travelled, distance);
 }
@@ -104,26 +145,23 @@ std::uint32_t SimAxis::StatusWord() const {
 
 std::uint16_t SimAxis::RegisterAt(std::uint16_t a, double now) const {
   if (InBlock(a)) return block_[a - kBlockStart];
-  const auto feedback = static_cast<std::int32_t>(std::lround(CountsAt(now)));
+  const auto feedback = static_cast<std::uint32_t>(std::lround(CountsAt(now)));
   switch (a) {
     case kInputCommand:
-      return High(static_cast<std::int32_t>(input_command_));
     case kInputCommand + 1:
-      return Low(static_cast<std::int32_t>(input_command_));
+      return WordOf(input_command_, a - kInputCommand);
     case kStatus:
-      return High(static_cast<std::int32_t>(StatusWord()));
     case kStatus + 1:
-      return Low(static_cast<std::int32_t>(StatusWord()));
+      return WordOf(StatusWord(), a - kStatus);
     case kAlarmCode:
-      return High(alarm_code_);
     case kAlarmCode + 1:
-      return Low(alarm_code_);
+      return WordOf(static_cast<std::uint32_t>(alarm_code_), a - kAlarmCode);
     case kFeedback:
-    case kFeedbackAlt:
-      return High(feedback);
     case kFeedback + 1:
+      return WordOf(feedback, a - kFeedback);
+    case kFeedbackAlt:
     case kFeedbackAlt + 1:
-      return Low(feedback);
+      return WordOf(feedback, a - kFeedbackAlt);
     default:
       return 0;
   }
@@ -185,12 +223,9 @@ std::uint8_t SimAxis::WriteRegisters(std::uint16_t address, std::span<const std:
   }
 
   // The driver input command: act on rising edges.
-  std::uint16_t high = High(static_cast<std::int32_t>(input_command_));
-  std::uint16_t low = Low(static_cast<std::int32_t>(input_command_));
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    (address + i == kInputCommand ? high : low) = values[i];
-  }
-  const auto command = static_cast<std::uint32_t>(Join(high, low));
+  std::uint16_t words[2] = {WordOf(input_command_, 0), WordOf(input_command_, 1)};
+  for (std::size_t i = 0; i < values.size(); ++i) words[address + i - kInputCommand] = values[i];
+  const auto command = static_cast<std::uint32_t>(Join(words[0], words[1]));
   const std::uint32_t rising = command & ~input_command_;
   input_command_ = command;
   if ((rising & kAlarmReset) != 0) {
@@ -227,21 +262,42 @@ void SimAxis::StartOperation(double now) {
     alarm_code_ = kAlarmOvertravel;
     return;
   }
-  Begin(now, target, BlockInt32(kSpeed), true);
+  const double speed = BlockInt32(kSpeed);
+  Begin(now, target, speed, RampAcceleration(kStartRate, speed), RampAcceleration(kStopRate, speed),
+        true);
+}
+
+double SimAxis::RampAcceleration(std::uint16_t address, double speed) const {
+  const double value = BlockInt32(address) * 0.001;  // registers hold thousandths of the unit
+  if (value <= 0) return std::numeric_limits<double>::infinity();
+  switch (config_.ramp_unit) {
+    case SimRampUnit::kKhzPerSecond:
+      return value * 1000;  // kHz/s = 1000 counts/s²
+    case SimRampUnit::kSeconds:
+      return speed / value;  // standstill to speed in `value` s
+    case SimRampUnit::kMsPerKhz:
+      return 1000 / (value * 0.001);  // 1 kHz in `value` ms
+  }
+  return std::numeric_limits<double>::infinity();
 }
 
 void SimAxis::StartHoming(double now) {
   if (alarm_ || (input_command_ & kStop) != 0) return;
+  constexpr double kAtOnce = std::numeric_limits<double>::infinity();
   Begin(now, config_.zero_offset_counts,
-        std::max(1.0, config_.home_speed_deg_s * config_.counts_per_degree), false);
+        std::max(1.0, config_.home_speed_deg_s * config_.counts_per_degree), kAtOnce, kAtOnce,
+        false);
 }
 
-void SimAxis::Begin(double now, double target_counts, double speed, bool take_faults) {
+void SimAxis::Begin(double now, double target_counts, double speed, double accel, double decel,
+                    bool take_faults) {
   Motion m;
   m.start_counts = std::round(CountsAt(now));
   m.start_s = now;
   m.target_counts = target_counts;
   m.speed = speed;
+  m.accel = accel;
+  m.decel = decel;
   bool alarm_mid_move = false;
   if (take_faults) {
     control_.UpdateModbus([&](ModbusFaults& f) {
@@ -251,7 +307,8 @@ void SimAxis::Begin(double now, double target_counts, double speed, bool take_fa
       f.stall = false;
     });
   }
-  const double duration = std::abs(target_counts - m.start_counts) / speed;
+  const double duration =
+      MoveDuration(std::abs(target_counts - m.start_counts), speed, accel, decel);
   m.moving = duration > 0 || m.stalled;
   ++moves_started_;
   if (alarm_mid_move) {

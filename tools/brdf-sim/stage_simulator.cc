@@ -115,7 +115,7 @@ StageReply StageSimulator::Handle(std::uint8_t unit, std::span<const std::uint8_
     return reply;
   }
   std::lock_guard l(mu_);
-  reply.pdu = ServePdu(pdu, *axis);
+  reply.pdu = ServePdu(pdu, *axis, config_.drive_function_codes);
   return reply;
 }
 

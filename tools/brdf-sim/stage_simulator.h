@@ -5,9 +5,9 @@
 // are now, on the simulator's scaled clock.
 //
 // Injected Modbus faults (SimControl::modbus(), consumed as they fire, axis unit ids only):
-// exception 02/06 for the next N requests, replies held back by late_reply_ms for the next N
-// requests, a dropped TCP connection, an alarm half-way through the next move, a stall where MOVE
-// never clears.
+// exception 02/04/06 (any code) for the next N requests, replies held back by late_reply_ms for the
+// next N requests, a dropped TCP connection, an alarm half-way through the next move, a stall where
+// MOVE never clears.
 #pragma once
 
 #include <array>
@@ -34,6 +34,9 @@ struct StageSimConfig {
   // motorized detector arm.
   std::array<SimAxisConfig, 4> axes = DefaultAxes();
   int control_unit_id = control_map::kDefaultUnitId;
+  // What the axis drives answer; any other function code is exception 01 (the control unit
+  // answers everything brdf-sim serves).
+  FunctionCodes drive_function_codes = *DocumentedFunctionCodes("az");
   TimeScale time_scale;
 
   bool serve_tcp = true;

@@ -19,7 +19,10 @@ namespace {
 
 using SteadyClock = std::chrono::steady_clock;
 
-constexpr int kMbapLength = 7;
+constexpr std::size_t kMbapLength = 7;       // transaction, protocol, length, unit id
+constexpr std::size_t kMbapHeaderBytes = 6;  // what the length field does not count
+constexpr std::size_t kMinLength = 2;        // unit id + function code
+constexpr std::size_t kMaxLength = 254;      // unit id + the 253-byte PDU maximum
 
 }  // namespace
 
@@ -34,8 +37,6 @@ bool StageTcpEndpoint::Start(const std::string& host, int port, std::string* err
              modbus_strerror(errno);
     return false;
   }
-  // A client that sends half a request must not stall the others for long.
-  modbus_set_byte_timeout(ctx_, 0, 200'000);
   listen_fd_ = modbus_tcp_listen(ctx_, 16);
   if (listen_fd_ < 0) {
     *error = "stage simulator: cannot listen on " + host + ":" + std::to_string(port) + ": " +
@@ -141,39 +142,58 @@ void StageTcpEndpoint::CloseClient(int fd) {
 }
 
 void StageTcpEndpoint::Receive(int fd) {
-  std::uint8_t request[MODBUS_TCP_MAX_ADU_LENGTH];
-  modbus_set_socket(ctx_, fd);
-  const int rc = modbus_receive(ctx_, request);
-  if (rc <= kMbapLength) {  // closed by the peer, a broken or half request
-    CloseClient(fd);
+  Client& client = clients_[fd];
+  std::uint8_t buffer[1024];
+  const ssize_t n = ::recv(fd, buffer, sizeof buffer, MSG_DONTWAIT);
+  if (n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) {
+    CloseClient(fd);  // closed by the peer, or broken
     return;
   }
-  const std::uint8_t unit = request[6];
-  const StageReply reply =
-      dispatcher_.Handle(unit,
-                         std::span<const std::uint8_t>(request + kMbapLength,
-                                                       static_cast<std::size_t>(rc - kMbapLength)),
-                         StageTransport::kTcp);
-  switch (reply.kind) {
-    case StageReply::Kind::kDrop:
-      CloseClient(fd);
-      return;
-    case StageReply::Kind::kSilent:
-      return;
-    case StageReply::Kind::kReply:
-      break;
-  }
-  std::vector<std::uint8_t> frame{request[0], request[1], 0, 0};  // transaction id, protocol 0
-  const auto length = static_cast<std::uint16_t>(reply.pdu.size() + 1);
-  frame.push_back(static_cast<std::uint8_t>(length >> 8));
-  frame.push_back(static_cast<std::uint8_t>(length & 0xFF));
-  frame.push_back(unit);
-  frame.insert(frame.end(), reply.pdu.begin(), reply.pdu.end());
+  if (n < 0) return;
+  client.input.insert(client.input.end(), buffer, buffer + n);
+  if (!ServeFramed(client)) CloseClient(fd);
+}
 
-  Client& client = clients_[fd];
-  auto due = SteadyClock::now() + reply.delay;
-  if (!client.queue.empty()) due = std::max(due, client.queue.back().due);
-  client.queue.push_back({due, std::move(frame)});
+bool StageTcpEndpoint::ServeFramed(Client& client) {
+  std::size_t at = 0;
+  bool keep = true;
+  while (keep && client.input.size() - at >= kMbapLength) {
+    const std::uint8_t* h = client.input.data() + at;
+    const std::size_t length = static_cast<std::size_t>((h[4] << 8) | h[5]);
+    if (length < kMinLength || length > kMaxLength) {
+      keep = false;  // cannot be framed: no function code, or longer than any PDU
+      break;
+    }
+    const std::size_t adu_size = kMbapHeaderBytes + length;
+    if (client.input.size() - at < adu_size) break;  // the rest is still on its way
+    const std::span<const std::uint8_t> adu(h, adu_size);
+    at += adu_size;
+    const std::uint16_t protocol = static_cast<std::uint16_t>((h[2] << 8) | h[3]);
+    if (protocol != 0) continue;  // not Modbus: dropped without a reply (Modbus TCP spec)
+    const StageReply reply =
+        dispatcher_.Handle(adu[6], adu.subspan(kMbapLength), StageTransport::kTcp);
+    switch (reply.kind) {
+      case StageReply::Kind::kDrop:
+        keep = false;
+        break;
+      case StageReply::Kind::kSilent:
+        break;
+      case StageReply::Kind::kReply: {
+        std::vector<std::uint8_t> frame{adu[0], adu[1], 0, 0};  // transaction id, protocol 0
+        const auto reply_length = static_cast<std::uint16_t>(reply.pdu.size() + 1);
+        frame.push_back(static_cast<std::uint8_t>(reply_length >> 8));
+        frame.push_back(static_cast<std::uint8_t>(reply_length & 0xFF));
+        frame.push_back(adu[6]);  // unit id
+        frame.insert(frame.end(), reply.pdu.begin(), reply.pdu.end());
+        auto due = SteadyClock::now() + reply.delay;
+        if (!client.queue.empty()) due = std::max(due, client.queue.back().due);
+        client.queue.push_back({due, std::move(frame)});
+        break;
+      }
+    }
+  }
+  client.input.erase(client.input.begin(), client.input.begin() + static_cast<std::ptrdiff_t>(at));
+  return keep;
 }
 
 void StageTcpEndpoint::SendDue() {

@@ -1,9 +1,19 @@
 // The stage simulator's Modbus TCP endpoint: listens on host:port with libmodbus
-// (modbus_new_tcp + modbus_tcp_listen; port 0 picks a free port), serves several clients from one
-// thread with select(), reads each request with modbus_receive and dispatches it on its unit id
-// (byte 6 of the MBAP header) through a StageDispatcher, so every unit id has its own registers.
-// Replies are framed here (MBAP + PDU) so that an injected delay holds back only that client's
-// replies, in order, while the other clients are served.
+// (modbus_new_tcp + modbus_tcp_listen; port 0 picks a free port) and serves several clients from
+// one thread with select().
+//
+// Requests are framed by the MBAP header, as the Modbus TCP specification says, never by a byte
+// count inside the PDU: transaction id (2 bytes), protocol id (2, 0 = Modbus), length (2: the
+// unit id plus the PDU), unit id (1), then `length - 1` PDU bytes. So a malformed PDU inside a
+// well-framed ADU is answered with an exception (stage_pdu.h) and the next request on the
+// connection is read from the right place, with its own transaction id and unit. An ADU whose
+// protocol id is not 0 is read past and dropped without a reply. A length outside 2–254 (no
+// function code, or more than the 253-byte PDU maximum) means the stream can no longer be framed
+// (there is no start marker to resync on): the connection is closed, as a real gateway does.
+// Each request is dispatched on its unit id through a StageDispatcher (every unit id has its own
+// registers); replies are framed here (the request's transaction id and unit id, protocol 0) so
+// that an injected delay holds back only that client's replies, in order, while the other clients
+// are served.
 #pragma once
 
 #include <modbus.h>
@@ -13,6 +23,7 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -40,12 +51,16 @@ class StageTcpEndpoint {
     std::vector<std::uint8_t> bytes;
   };
   struct Client {
-    std::deque<Outgoing> queue;  // in order; each due no earlier than the one before
+    std::vector<std::uint8_t> input;  // bytes received, not yet a whole ADU
+    std::deque<Outgoing> queue;       // in order; each due no earlier than the one before
   };
 
   void Run();
   void Accept();
   void Receive(int fd);
+  // Serves every whole ADU at the front of the client's input; false when the connection must
+  // close (an unframeable length, or a dropped-connection fault).
+  bool ServeFramed(Client& client);
   void SendDue();
   void CloseClient(int fd);
 
