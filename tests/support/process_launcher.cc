@@ -125,8 +125,15 @@ Result<std::unique_ptr<ChildProcess>> ChildProcess::Launch(const std::string& wh
     ::dup2(out_pipe[1], STDOUT_FILENO);
     if (err_pipe[1] >= 0) ::dup2(err_pipe[1], STDERR_FILENO);
     if (log_fd >= 0) ::dup2(log_fd, STDERR_FILENO);
+    if (options.stdout_with_stderr) ::dup2(STDERR_FILENO, STDOUT_FILENO);
     if (own_env) {
-      ::execve(argv[0], argv.data(), envp.data());
+      if (options.search_path) {
+        ::execvpe(argv[0], argv.data(), envp.data());
+      } else {
+        ::execve(argv[0], argv.data(), envp.data());
+      }
+    } else if (options.search_path) {
+      ::execvp(argv[0], argv.data());
     } else {
       ::execv(argv[0], argv.data());
     }

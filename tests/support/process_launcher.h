@@ -43,8 +43,10 @@ struct LaunchOptions {
   std::vector<std::string> args;  // without the program name
   enum class Stderr { kInherit, kPipe, kAppendToFile };
   Stderr stderr_to = Stderr::kInherit;
-  std::string stderr_path;  // with kAppendToFile
+  std::string stderr_path;          // with kAppendToFile
+  bool stdout_with_stderr = false;  // stdout goes where stderr goes (e.g. the same log file)
   bool stdin_from_null = false;
+  bool search_path = false;  // the binary is a name looked up on $PATH (execvp)
   // The environment: the test's own, less `unset_env` (names), plus `set_env`.
   std::vector<std::string> unset_env;
   EnvVars set_env;
