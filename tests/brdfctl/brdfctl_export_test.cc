@@ -13,6 +13,7 @@
 #include <string>
 
 #include "tests/brdfctl/ctl_test_rig.h"
+#include "tests/support/plan_fixtures.h"
 #include "tests/support/test_env.h"
 
 namespace brdf::testing {
@@ -20,16 +21,7 @@ namespace {
 
 using namespace std::chrono_literals;
 
-constexpr const char* kPlan = R"({
-  "name": "export session",
-  "sampleRotation": {
-    "delta": {"start": 30, "stop": 45, "step": 15},
-    "alpha": {"start": 0, "stop": 20, "step": 10},
-    "beta": {"step": 10, "thetaMaxDeg": 40}
-  },
-  "reference": {"perDetectorPosition": true},
-  "dark": {"withEachReference": true}
-})";
+const std::string kPlan = plans::InterpolationGrid().Name("export session");
 
 std::string Describe(const CommandResult& r) {
   return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out.substr(0, 4000) +

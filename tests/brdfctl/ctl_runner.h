@@ -1,5 +1,6 @@
-// Runs the built brdfctl as a child process, the way a user or a script does: arguments, extra
-// environment variables, standard input closed; returns its exit code and everything it printed.
+// Runs the built brdfctl as a child process (tests/support/process_launcher.h), the way a user or a
+// script does: arguments, extra environment variables, standard input closed; returns its exit code
+// and everything it printed.
 //
 // The binary is $BRDF_BUILD_DIR/tools/brdfctl/brdfctl (brdf_add_test sets BRDF_BUILD_DIR);
 // $BRDFCTL_BINARY overrides the path.
@@ -11,17 +12,15 @@
 #include <vector>
 
 #include "core/status.h"
-#include "tests/support/sim_process.h"
+#include "tests/support/process_launcher.h"
 
 namespace brdf::testing {
 
 Result<std::string> BrdfctlBinary();
 
-// Environment entries ("NAME", "value") set for the child on top of the test's own environment;
-// BRDF_ADDRESS and BRDF_TOKEN are removed first, so a test only sees what it passes.
-using EnvVars = std::vector<std::pair<std::string, std::string>>;
-
-// Runs brdfctl to completion within `timeout` (then kills it and returns kTimeout).
+// Runs brdfctl to completion within `timeout` (then kills it and returns kTimeout). `env` is set
+// for the child on top of the test's own environment; BRDF_ADDRESS and BRDF_TOKEN are removed
+// first, so a test only sees what it passes.
 Result<CommandResult> RunBrdfctl(const std::vector<std::string>& args, const EnvVars& env = {},
                                  std::chrono::milliseconds timeout = std::chrono::seconds(30));
 

@@ -4,6 +4,8 @@
 #include <sstream>
 #include <thread>
 
+#include "tests/support/sim_rig.h"
+
 namespace brdf::testing {
 
 using namespace std::chrono_literals;
@@ -22,15 +24,10 @@ std::string CtlRig::modbus() const {
 
 Status CtlRig::Start() {
   if (dir_.path().empty()) return IoError("no temporary directory: " + dir_.error());
-  Result<std::unique_ptr<SimProcess>> sim =
-      SimProcess::Start({"--time-scale", "50", "--seed", "3", "--modbus-port", "0", "--wake-window",
-                         "0", "--no-pacing", "--log-level", "warn"});
+  Result<SimRig> sim = StartSimRig(/*seed=*/3);
   if (!sim.ok()) return sim.status();
-  sim_ = std::move(*sim);
-  Result<std::unique_ptr<ModbusControl>> control =
-      ModbusControl::Connect(sim_->modbus_host(), sim_->modbus_port(), sim_->control_unit());
-  if (!control.ok()) return control.status();
-  sim_control_ = std::move(*control);
+  sim_ = std::move(sim->sim);
+  sim_control_ = std::move(sim->control);
 
   // Like deploy/quickstart.sh's configuration, with the meter's timings shortened for 50×.
   std::ostringstream toml;

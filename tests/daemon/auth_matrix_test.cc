@@ -18,6 +18,7 @@
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/daemon/daemon_test_util.h"
 #include "tests/daemon/raw_call.h"
+#include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
 namespace {
@@ -50,10 +51,7 @@ const std::map<std::string, Needs>& Classification() {
   return table;
 }
 
-constexpr const char* kSmallPlan = R"({
-  "name": "queued",
-  "poseList": {"poses": [{"alpha": 0, "beta": 10, "delta": 40}]}
-})";
+const std::string kSmallPlan = plans::OnePose();
 
 // A token of the right shape that no daemon here knows.
 constexpr const char* kStrangerToken = "zz-stranger-7d41c09e5ab2f386";

@@ -18,6 +18,7 @@
 #include "core/plan/plan_json.h"
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/daemon/daemon_test_util.h"
+#include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
 namespace {
@@ -42,10 +43,7 @@ std::string AbsentDevicesToml(const std::string& database, int dead_port,
   return t.str();
 }
 
-constexpr const char* kSmallPlan = R"({
-  "name": "queued",
-  "poseList": {"poses": [{"alpha": 0, "beta": 10, "delta": 40}]}
-})";
+const std::string kSmallPlan = plans::OnePose();
 
 class DaemonApiTest : public ::testing::Test {
  protected:

@@ -21,6 +21,7 @@
 #include "core/analytic_brdf.h"
 #include "core/geometry.h"
 #include "tests/daemon/daemon_test_rig.h"
+#include "tests/support/plan_fixtures.h"
 #include "tools/brdf-sim/optics.h"
 
 namespace brdf::testing {
@@ -30,17 +31,7 @@ using namespace std::chrono_literals;
 
 // Two detector positions, three tilts, β every 10° while lamp and detector stay within 40° of
 // the normal: a small 3D cloud of (θi, θo, φ) readings. Darks with each reference.
-constexpr const char* kGridPlan = R"({
-  "name": "interpolation grid",
-  "sampleRotation": {
-    "delta": {"start": 30, "stop": 45, "step": 15},
-    "alpha": {"start": 0, "stop": 20, "step": 10},
-    "beta": {"step": 10, "thetaMaxDeg": 40}
-  },
-  "reference": {"perDetectorPosition": true},
-  "dark": {"withEachReference": true},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
+const std::string kGridPlan = plans::InterpolationGrid().Retry(2, 0);
 
 // A measured BRDF vs the truth at the reading's directions: the meter prints 4 significant
 // digits (%.3E: ≤ 0.05 % per value, in I, I0 and D), and the stage's position is quantised to

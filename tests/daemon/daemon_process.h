@@ -1,4 +1,5 @@
-// Runs the built brdfd as a child process for the daemon's integration tests: starts it with a
+// Runs the built brdfd as a child process (tests/support/process_launcher.h) for the daemon's
+// integration tests: starts it with a
 // configuration file, waits for its one stdout line "brdfd listening on <address>", and stops it
 // with SIGTERM (a clean shutdown, exit code returned) or SIGKILL (a crash). Its stderr (the log)
 // goes to a file, shown by log() when a test fails.
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "core/status.h"
+#include "tests/support/process_launcher.h"
 
 namespace brdf::testing {
 
@@ -35,7 +37,7 @@ class DaemonProcess {
 
   // "127.0.0.1:43123", as brdfd printed it.
   const std::string& address() const { return address_; }
-  pid_t pid() const { return pid_; }
+  pid_t pid() const { return child_ ? child_->pid() : -1; }
 
   // SIGTERM, then waits up to `timeout`; the exit code (128 + signal when killed by one).
   // kTimeout (after a SIGKILL) when it did not exit in time.
@@ -49,8 +51,7 @@ class DaemonProcess {
  private:
   DaemonProcess() = default;
 
-  pid_t pid_ = -1;
-  int stdout_fd_ = -1;
+  std::unique_ptr<ChildProcess> child_;
   std::string address_;
   std::string log_path_;
 };

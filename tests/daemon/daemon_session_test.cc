@@ -17,6 +17,7 @@
 #include "storage/session_store.h"
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/daemon/daemon_test_util.h"
+#include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
 namespace {
@@ -25,54 +26,19 @@ using namespace std::chrono_literals;
 
 // Two detector positions, two tilts, β every 45° (within the default margin); a dark with each
 // reference, so the operator mounts the white, closes the shutter and mounts the sample per δ.
-constexpr const char* kRotationPlan = R"({
-  "name": "small rotation",
-  "sampleRotation": {
-    "delta": {"start": 22.5, "stop": 45, "step": 22.5},
-    "alpha": {"start": 0, "stop": 20, "step": 20},
-    "beta": {"step": 45}
-  },
-  "reference": {"perDetectorPosition": true},
-  "dark": {"withEachReference": true},
-  "measurement": {"integrationMs": 200, "averages": 1},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
+const std::string kRotationPlan = plans::SmallRotation();
 
 // Readings long enough (40 averages × 200 ms + 1 s overhead = 9 simulated seconds, ~0.18 s real)
 // to be caught in the middle by an immediate pause. (A long integration instead would overload
 // the detector near the highlight.)
-constexpr const char* kSlowPlan = R"({
-  "name": "slow readings",
-  "sampleRotation": {
-    "delta": {"start": 30, "stop": 30, "step": 10},
-    "alpha": {"start": 0, "stop": 10, "step": 10},
-    "beta": {"step": 30}
-  },
-  "measurement": {"integrationMs": 200, "averages": 40},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
+const std::string kSlowPlan =
+    plans::SlowRotation(/*alpha_stop=*/10, /*beta_step=*/30, /*averages=*/40);
 
-constexpr const char* kFixedPlan = R"({
-  "name": "sample fixed",
-  "sampleFixed": {
-    "targets": [
-      {"thetaI": 0, "thetaO": 45, "phi": 180, "label": "0/45"},
-      {"thetaI": 30, "thetaO": 30, "phi": 180, "label": "specular 30"},
-      {"thetaI": 20, "thetaO": 50, "phi": 90, "label": "side"}
-    ]
-  },
-  "reference": {"perDetectorPosition": true},
-  "measurement": {"integrationMs": 200, "averages": 1},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
+const std::string kFixedPlan =
+    plans::SampleFixed({{0, 45, 180, "0/45"}, {30, 30, 180, "specular 30"}, {20, 50, 90, "side"}},
+                       /*reference_per_detector_position=*/true);
 
-constexpr const char* kTinyPlan = R"({
-  "name": "tiny pose list",
-  "poseList": {"poses": [{"alpha": 0, "beta": 10, "delta": 40},
-                         {"alpha": 10, "beta": 20, "delta": 40}]},
-  "measurement": {"integrationMs": 100, "averages": 1},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
+const std::string kTinyPlan = plans::TinyPoseList();
 
 std::int64_t IdOf(const v1::Session& s) {
   return std::stoll(s.session_id());
@@ -109,7 +75,7 @@ class DaemonSessionTest : public ::testing::Test {
     return *operators_.back();
   }
 
-  v1::Session SubmitAndWatch(const char* plan) {
+  v1::Session SubmitAndWatch(const std::string& plan) {
     Result<v1::Session> s = rig_.Submit(plan);
     EXPECT_TRUE(s.ok()) << s.status().ToString();
     if (!s.ok()) return {};

@@ -10,17 +10,6 @@ namespace brdf::testing {
 
 using namespace std::chrono_literals;
 
-std::vector<std::string> FastSimArgs(const std::vector<std::string>& extra) {
-  std::vector<std::string> args = {"--time-scale",  std::to_string(kTimeScale),
-                                   "--seed",        "11",
-                                   "--modbus-port", "0",
-                                   "--wake-window", "0",
-                                   "--no-pacing",   "--log-level",
-                                   "warn"};
-  args.insert(args.end(), extra.begin(), extra.end());
-  return args;
-}
-
 std::string DaemonConfigToml(const SimProcess& sim, const std::string& database) {
   std::ostringstream t;
   t << "[server]\n"
@@ -78,13 +67,10 @@ DaemonRig::~DaemonRig() {
 
 Status DaemonRig::StartSim(const std::vector<std::string>& extra) {
   if (dir_.path().empty()) return IoError("no temporary directory: " + dir_.error());
-  Result<std::unique_ptr<SimProcess>> sim = SimProcess::Start(FastSimArgs(extra));
-  if (!sim.ok()) return sim.status();
-  sim_ = std::move(*sim);
-  Result<std::unique_ptr<ModbusControl>> control =
-      ModbusControl::Connect(sim_->modbus_host(), sim_->modbus_port(), sim_->control_unit());
-  if (!control.ok()) return control.status();
-  sim_control_ = std::move(*control);
+  Result<SimRig> rig = StartSimRig(/*seed=*/11, extra);
+  if (!rig.ok()) return rig.status();
+  sim_ = std::move(rig->sim);
+  sim_control_ = std::move(rig->control);
   return Status::Ok();
 }
 

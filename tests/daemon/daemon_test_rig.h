@@ -25,17 +25,15 @@
 #include "tests/daemon/daemon_process.h"
 #include "tests/support/modbus_control.h"
 #include "tests/support/sim_process.h"
+#include "tests/support/sim_rig.h"
 #include "tests/support/test_env.h"
 
 namespace brdf::testing {
 
-inline constexpr double kTimeScale = 50;
+inline constexpr double kTimeScale = kSimTimeScale;
 inline constexpr const char* kOperatorToken = "op-token-2f9c61d0a7b34e58";
 inline constexpr const char* kAnalystToken = "an-token-93be07c4d1a24f6e";
 inline constexpr const char* kOperatorName = "test-operator";
-
-// brdf-sim's flags for a fast, deterministic rig (no 9600-baud pacing, no wake window).
-std::vector<std::string> FastSimArgs(const std::vector<std::string>& extra = {});
 
 // The TOML configuration of a brdfd driving `sim` with the database at `database`: listen on
 // 127.0.0.1:0, short meter and stage timings, a motorized detector arm, an operator and an
@@ -50,7 +48,8 @@ class DaemonRig {
   DaemonRig();
   ~DaemonRig();
 
-  // Starts brdf-sim with FastSimArgs(extra) and connects to its control unit.
+  // Starts brdf-sim (tests/support/sim_rig.h, seed 11, then `extra`) and connects to its
+  // control unit.
   Status StartSim(const std::vector<std::string>& extra = {});
   // Writes the configuration (DaemonConfigToml unless `toml` is given) and starts brdfd on it;
   // builds the channel and the stubs. May be called again after StopDaemon/KillDaemon: the same

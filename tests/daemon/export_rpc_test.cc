@@ -19,6 +19,7 @@
 #include "core/export/merl_layout.h"
 #include "core/export/merl_reader.h"
 #include "tests/daemon/daemon_test_rig.h"
+#include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
 namespace {
@@ -27,17 +28,7 @@ using namespace std::chrono_literals;
 
 // Two detector positions, three tilts, β every 10° within 40° of the normal: a small cloud of
 // (θi, θo, φ) readings, with a reference and a dark per detector position.
-constexpr const char* kExportPlan = R"({
-  "name": "export session",
-  "sampleRotation": {
-    "delta": {"start": 30, "stop": 45, "step": 15},
-    "alpha": {"start": 0, "stop": 20, "step": 10},
-    "beta": {"step": 10, "thetaMaxDeg": 40}
-  },
-  "reference": {"perDetectorPosition": true},
-  "dark": {"withEachReference": true},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
+const std::string kExportPlan = plans::InterpolationGrid().Name("export session").Retry(2, 0);
 
 // Everything one Export call delivered.
 struct ExportResult {

@@ -15,6 +15,7 @@
 #include "daemon/service_common.h"
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/daemon/raw_call.h"
+#include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
 namespace {
@@ -27,10 +28,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 const std::string kOperatorHeader = std::string("Bearer ") + kOperatorToken;
 
-constexpr const char* kSmallPlan = R"({
-  "name": "queued",
-  "poseList": {"poses": [{"alpha": 0, "beta": 10, "delta": 40}]}
-})";
+const std::string kSmallPlan = plans::OnePose();
 
 // Protobuf wire format: a varint, and an unknown field number no message of ours uses.
 std::string Varint(std::uint64_t v) {

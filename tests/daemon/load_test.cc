@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "tests/daemon/daemon_test_rig.h"
+#include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
 namespace {
@@ -30,16 +31,10 @@ constexpr auto kWarmUp = 2s;  // not measured: gRPC's pools and the index fill u
 constexpr long kMaxRssGrowthKb = 16 * 1024;
 
 // Long enough to keep recording for the whole test (468 sample readings); aborted at the end.
-constexpr const char* kLongPlan = R"({
-  "name": "load test",
-  "sampleRotation": {
-    "delta": {"start": 30, "stop": 30, "step": 10},
-    "alpha": {"start": 0, "stop": 60, "step": 5},
-    "beta": {"step": 10}
-  },
-  "measurement": {"integrationMs": 100, "averages": 1},
-  "retry": {"maxAttempts": 3, "backoffMs": 0}
-})";
+const std::string kLongPlan = PlanFixture("load test")
+                                  .SampleRotation({30, 30, 10}, {0, 60, 5}, 10)
+                                  .Measurement(100, 1)
+                                  .Retry(3, 0);
 
 // VmRSS of `pid` in kB; -1 when it cannot be read (the process is gone).
 long RssKb(pid_t pid) {

@@ -3,19 +3,15 @@
 // 127.0.0.1 signed by it, a client certificate signed by it, and a second ("rogue") CA with a
 // client certificate of its own. brdfd runs as a process without devices; the clients are the
 // generated stubs over TLS channels and brdfctl with --tls/--ca/--cert/--key.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
-#include <thread>
 
 #include "tests/daemon/daemon_test_rig.h"
+#include "tests/support/process_launcher.h"
 
 namespace brdf::testing {
 namespace {
@@ -27,32 +23,14 @@ using grpc::StatusCode;
 // could not be run, -1 when it did not finish within `timeout` (it is then killed).
 int RunProgram(const std::vector<std::string>& argv, const std::string& log,
                std::chrono::milliseconds timeout = 30s) {
-  std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) return 127;
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    if (fd >= 0) {
-      ::dup2(fd, STDOUT_FILENO);
-      ::dup2(fd, STDERR_FILENO);
-    }
-    ::execvp(args[0], args.data());
-    ::_exit(127);
-  }
-  const auto until = std::chrono::steady_clock::now() + timeout;
-  for (;;) {
-    int status = 0;
-    const pid_t r = ::waitpid(pid, &status, WNOHANG);
-    if (r == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    if (std::chrono::steady_clock::now() >= until) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      return -1;
-    }
-    std::this_thread::sleep_for(10ms);
-  }
+  LaunchOptions options(std::vector<std::string>(argv.begin() + 1, argv.end()));
+  options.stderr_to = LaunchOptions::Stderr::kAppendToFile;
+  options.stderr_path = log;
+  options.stdout_with_stderr = true;
+  options.search_path = true;
+  Result<CommandResult> run = RunToCompletion(argv[0], argv[0], options, timeout);
+  if (run.ok()) return run->exit_code;
+  return run.status().code() == brdf::StatusCode::kTimeout ? -1 : 127;
 }
 
 std::string ReadFile(const std::string& path) {

@@ -1,11 +1,11 @@
-// What the engine tests stand on: a real brdf-sim process (tests/support SimProcess), the real
-// PR-650 and Modbus stage drivers talking to it, a real SQLite file in a temporary directory,
-// and an "operator" that answers the session's prompts the way a person would: it mounts the
-// white standard, the sample or closes the shutter on the simulator (its control unit), then
-// answers the prompt.
+// What the engine tests stand on: the in-process fake meter and stage behind the driver
+// interfaces (tests/support/fake_rig.h), a real SQLite file in a temporary directory, and an
+// "operator" that answers the session's prompts the way a person would: it mounts the white
+// standard, the sample or closes the shutter on the fake bench, then answers the prompt. The
+// real drivers and their wire protocols are exercised against brdf-sim elsewhere (tests/sim,
+// tests/drivers_*, tests/daemon, tests/faults).
 //
-// Simulated time runs kTimeScale times faster (the meter's integrations and the stage's moves);
-// the drivers run on real time with short timeouts.
+// Simulated time runs kTimeScale times faster (the meter's integrations and the stage's moves).
 #pragma once
 
 #include <atomic>
@@ -22,22 +22,12 @@
 #include "daemon/rig.h"
 #include "daemon/session_manager.h"
 #include "storage/session_store.h"
-#include "tests/support/modbus_control.h"
-#include "tests/support/sim_process.h"
+#include "tests/support/fake_rig.h"
 #include "tests/support/test_env.h"
 
 namespace brdf::testing {
 
 inline constexpr double kTimeScale = 50;
-
-// brdf-sim's flags for a fast, deterministic rig (no 9600-baud pacing, no wake window).
-std::vector<std::string> FastSimArgs(const std::vector<std::string>& extra = {});
-
-// The rig as the sim builds it by default: α/β plus a motorized detector arm (δ), γ as a dial.
-plan::RigDescription SimRigDescription();
-
-// The real drivers pointed at `sim`, with timeouts shrunk for the tests.
-std::shared_ptr<daemon::Rig> MakeSimRig(const SimProcess& sim);
 
 daemon::SessionManager::Options ManagerOptions(bool pipelining = true);
 
@@ -45,11 +35,11 @@ daemon::SessionManager::Options ManagerOptions(bool pipelining = true);
 v1::Plan PlanFromJson(const std::string& json);
 
 // Acts as the operator on one session: watches it (SessionManager::Subscribe) and answers every
-// prompt after doing what it asks on the simulator. Keeps every event it saw. Runs on its own
+// prompt after doing what it asks on the fake bench. Keeps every event it saw. Runs on its own
 // thread until the session ends or Stop().
 class Operator {
  public:
-  Operator(daemon::SessionManager& manager, ModbusControl& control, daemon::SessionId session,
+  Operator(daemon::SessionManager& manager, FakeBench& bench, daemon::SessionId session,
            bool answer_prompts = true);
   ~Operator();
 
@@ -65,7 +55,7 @@ class Operator {
   void Run();
 
   daemon::SessionManager& manager_;
-  ModbusControl& control_;
+  FakeBench& bench_;
   daemon::SessionId session_;
   std::atomic<bool> answering_;
   std::atomic<bool> stop_{false};

@@ -1,6 +1,6 @@
 // kill -9 in the middle of a session: a child process runs the engine (store, rig, manager, an
-// operator answering prompts) against brdf-sim and is killed with SIGKILL once part of the plan
-// is done. A new manager on the same database recovers the session as paused at its first
+// operator answering prompts) on the fake meter and stage and is killed with SIGKILL once part of
+// the plan is done. A new manager on the same database recovers the session as paused at its first
 // unfinished step; resuming completes it, and every step is in the database exactly once.
 #include <gtest/gtest.h>
 #include <poll.h>
@@ -16,45 +16,35 @@
 #include "daemon/session_manager.h"
 #include "storage/session_store.h"
 #include "tests/engine/engine_test_rig.h"
+#include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
 namespace {
 
 using namespace std::chrono_literals;
 
-constexpr const char* kPlan = R"({
-  "name": "to be interrupted",
-  "sampleRotation": {
-    "delta": {"start": 20, "stop": 40, "step": 20},
-    "alpha": {"start": 0, "stop": 20, "step": 20},
-    "beta": {"step": 45}
-  },
-  "measurement": {"integrationMs": 1000, "averages": 1},
-  "retry": {"maxAttempts": 3, "backoffMs": 0}
-})";
+const std::string kPlan = PlanFixture("to be interrupted")
+                              .SampleRotation({20, 40, 20}, {0, 20, 20}, 45)
+                              .Measurement(1000, 1)
+                              .Retry(3, 0);
 
 // The child: runs the session until it is killed. Writes the session id to `fd`.
-[[noreturn]] void RunChild(const SimProcess& sim, const std::string& db, int fd) {
+[[noreturn]] void RunChild(const std::string& db, int fd) {
   auto store = storage::SessionStore::Open(db);
   if (!store.ok()) ::_exit(10);
-  auto control = ModbusControl::Connect(sim.modbus_host(), sim.modbus_port(), sim.control_unit());
-  if (!control.ok()) ::_exit(11);
-  std::shared_ptr<daemon::Rig> rig = MakeSimRig(sim);
-  if (rig == nullptr) ::_exit(12);
-  daemon::SessionManager manager(std::move(*store), rig, ManagerOptions());
+  FakeRig fake = MakeFakeRig();
+  daemon::SessionManager manager(std::move(*store), fake.rig, ManagerOptions());
   auto plan = plan::ParsePlanJson(kPlan);
   if (!plan.ok()) ::_exit(13);
   auto session = manager.SubmitPlan(*plan, kTestOperator, /*start_now=*/true);
   if (!session.ok()) ::_exit(14);
   const daemon::SessionId id = IdOf(*session);
   if (::write(fd, &id, sizeof id) != static_cast<ssize_t>(sizeof id)) ::_exit(15);
-  Operator op(manager, **control, id);
+  Operator op(manager, *fake.bench, id);
   for (;;) ::pause();  // until SIGKILL
 }
 
 TEST(RestartRecoveryTest, KilledMidSessionComesBackPausedAndResumesWithoutLossOrDuplicate) {
-  auto sim = SimProcess::Start(FastSimArgs());
-  ASSERT_TRUE(sim.ok()) << sim.status().ToString();
   TempDir dir("brdf-engine-restart");
   const std::string db = dir.file("brdfd.db").string();
 
@@ -65,7 +55,7 @@ TEST(RestartRecoveryTest, KilledMidSessionComesBackPausedAndResumesWithoutLossOr
   ASSERT_GE(child, 0) << std::strerror(errno);
   if (child == 0) {
     ::close(fds[0]);
-    RunChild(**sim, db, fds[1]);
+    RunChild(db, fds[1]);
   }
   ::close(fds[1]);
   struct ChildGuard {
@@ -123,10 +113,8 @@ TEST(RestartRecoveryTest, KilledMidSessionComesBackPausedAndResumesWithoutLossOr
   EXPECT_EQ(before->readings, done_readings);
 
   // A new daemon on the same database.
-  auto control =
-      ModbusControl::Connect((*sim)->modbus_host(), (*sim)->modbus_port(), (*sim)->control_unit());
-  ASSERT_TRUE(control.ok()) << control.status().ToString();
-  daemon::SessionManager manager(store, MakeSimRig(**sim), ManagerOptions());
+  FakeRig fake = MakeFakeRig();
+  daemon::SessionManager manager(store, fake.rig, ManagerOptions());
   auto recovered = manager.Recover();
   ASSERT_TRUE(recovered.ok()) << recovered.status().ToString();
   EXPECT_EQ(*recovered, std::vector<daemon::SessionId>{id});
@@ -141,7 +129,7 @@ TEST(RestartRecoveryTest, KilledMidSessionComesBackPausedAndResumesWithoutLossOr
   ASSERT_TRUE(record.ok());
   EXPECT_EQ(record->state_reason, storage::kRecoveredReason);
 
-  Operator op(manager, **control, id);
+  Operator op(manager, *fake.bench, id);
   auto resumed = manager.Resume(id, kTestOperator);
   ASSERT_TRUE(resumed.ok()) << resumed.status().ToString();
   const v1::Session finished = WaitForSession(manager, id, [](const v1::Session& s) {

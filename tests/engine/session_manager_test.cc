@@ -1,6 +1,7 @@
-// Sessions end to end on the engine: SessionManager → Executor → Rig → the real PR-650 and Modbus
-// stage drivers → a real brdf-sim process, with a real SQLite file. The test plays the operator
-// (tests/engine/engine_test_rig.h).
+// Sessions end to end on the engine: SessionManager → Executor → Rig → the in-process fake meter
+// and stage (tests/support/fake_rig.h), with a real SQLite file. The test plays the operator
+// (tests/engine/engine_test_rig.h). The same sessions on the real drivers and brdf-sim run in
+// tests/daemon/daemon_session_test.cc.
 #include "daemon/session_manager.h"
 
 #include <gtest/gtest.h>
@@ -18,6 +19,7 @@
 #include "drivers/stage/modbus_stage.h"
 #include "storage/session_store.h"
 #include "tests/engine/engine_test_rig.h"
+#include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
 namespace {
@@ -27,50 +29,14 @@ using daemon::PauseMode;
 using daemon::SessionId;
 
 // Two detector positions, two tilts, β every 45°; a dark with each reference.
-constexpr const char* kRotationPlan = R"({
-  "name": "small rotation",
-  "sampleRotation": {
-    "delta": {"start": 22.5, "stop": 45, "step": 22.5},
-    "alpha": {"start": 0, "stop": 20, "step": 20},
-    "beta": {"step": 45}
-  },
-  "reference": {"perDetectorPosition": true},
-  "dark": {"withEachReference": true},
-  "measurement": {"integrationMs": 200, "averages": 1},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
-
+const std::string kRotationPlan = plans::SmallRotation();
 // Readings that take long enough (~20 simulated seconds, ~0.4 s real) to pause in the middle.
-constexpr const char* kSlowPlan = R"({
-  "name": "slow readings",
-  "sampleRotation": {
-    "delta": {"start": 30, "stop": 30, "step": 10},
-    "alpha": {"start": 0, "stop": 0, "step": 10},
-    "beta": {"step": 60}
-  },
-  "measurement": {"integrationMs": 200, "averages": 99},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
-
-constexpr const char* kFixedPlan = R"({
-  "name": "sample fixed",
-  "sampleFixed": {
-    "targets": [
-      {"thetaI": 0, "thetaO": 45, "phi": 180, "label": "0/45"},
-      {"thetaI": 30, "thetaO": 30, "phi": 180, "label": "specular 30"}
-    ]
-  },
-  "reference": {"perDetectorPosition": false},
-  "measurement": {"integrationMs": 200, "averages": 1},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
-
-constexpr const char* kTinyPlan = R"({
-  "name": "tiny pose list",
-  "poseList": {"poses": [{"alpha": 0, "beta": 10, "delta": 40}, {"alpha": 10, "beta": 20, "delta": 40}]},
-  "measurement": {"integrationMs": 100, "averages": 1},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
+const std::string kSlowPlan = plans::SlowRotation(/*alpha_stop=*/0, /*beta_step=*/60,
+                                                  /*averages=*/99);
+const std::string kFixedPlan =
+    plans::SampleFixed({{0, 45, 180, "0/45"}, {30, 30, 180, "specular 30"}},
+                       /*reference_per_detector_position=*/false);
+const std::string kTinyPlan = plans::TinyPoseList();
 
 bool Terminal(const v1::Session& s) {
   return s.state() == v1::SESSION_STATE_COMPLETED || s.state() == v1::SESSION_STATE_ABORTED ||
@@ -81,21 +47,14 @@ class EngineTest : public ::testing::Test {
  protected:
   void SetUp() override { Open(true); }
 
-  void Open(bool pipelining, const std::vector<std::string>& extra_sim_args = {}) {
+  void Open(bool pipelining) {
     Close();
-    auto sim = SimProcess::Start(FastSimArgs(extra_sim_args));
-    ASSERT_TRUE(sim.ok()) << sim.status().ToString();
-    sim_ = std::move(*sim);
-    auto control =
-        ModbusControl::Connect(sim_->modbus_host(), sim_->modbus_port(), sim_->control_unit());
-    ASSERT_TRUE(control.ok()) << control.status().ToString();
-    control_ = std::move(*control);
     ASSERT_FALSE(dir_.path().empty()) << dir_.error();
     auto store = storage::SessionStore::Open(dir_.file("brdfd.db").string());
     ASSERT_TRUE(store.ok()) << store.status().ToString();
     store_ = std::move(*store);
-    rig_ = MakeSimRig(*sim_);
-    ASSERT_NE(rig_, nullptr);
+    fake_ = MakeFakeRig();
+    rig_ = fake_.rig;
     manager_ = std::make_unique<daemon::SessionManager>(store_, rig_, ManagerOptions(pipelining));
     listener_ = manager_->AddReadingListener([this](SessionId, const storage::ReadingRecord& r) {
       std::lock_guard lock(listened_mu_);
@@ -108,9 +67,8 @@ class EngineTest : public ::testing::Test {
     if (manager_) manager_->Shutdown(5s);
     manager_.reset();
     rig_.reset();
+    fake_ = FakeRig();
     store_.reset();
-    control_.reset();
-    sim_.reset();
   }
 
   void TearDown() override {
@@ -120,14 +78,14 @@ class EngineTest : public ::testing::Test {
     Close();
   }
 
-  SessionId Submit(const char* json, bool start_now = true) {
+  SessionId Submit(const std::string& json, bool start_now = true) {
     Result<v1::Session> s = manager_->SubmitPlan(PlanFromJson(json), kTestOperator, start_now);
     EXPECT_TRUE(s.ok()) << s.status().ToString();
     return s.ok() ? IdOf(*s) : 0;
   }
 
   Operator& Watch(SessionId id, bool answer = true) {
-    operators_.push_back(std::make_unique<Operator>(*manager_, *control_, id, answer));
+    operators_.push_back(std::make_unique<Operator>(*manager_, *fake_.bench, id, answer));
     return *operators_.back();
   }
 
@@ -204,8 +162,7 @@ class EngineTest : public ::testing::Test {
   }
 
   TempDir dir_{"brdf-engine-test"};
-  std::unique_ptr<SimProcess> sim_;
-  std::unique_ptr<ModbusControl> control_;
+  FakeRig fake_;
   std::shared_ptr<storage::SessionStore> store_;
   std::shared_ptr<daemon::Rig> rig_;
   std::unique_ptr<daemon::SessionManager> manager_;
@@ -282,9 +239,9 @@ TEST_F(EngineTest, SampleFixedPlanWaitsForEachPromptAndUsesTheTargets) {
     std::this_thread::sleep_for(50ms);
     EXPECT_EQ(manager_->GetSession(id)->state(), v1::SESSION_STATE_AWAITING_OPERATOR);
     if (prompt.kind() == v1::PROMPT_KIND_MOUNT_WHITE) {
-      ASSERT_TRUE(control_->SetMounted(sim::MountedTarget::kWhite).ok());
+      fake_.bench->SetMounted(FakeTarget::kWhite);
     } else if (prompt.kind() == v1::PROMPT_KIND_MOUNT_SAMPLE) {
-      ASSERT_TRUE(control_->SetMounted(sim::MountedTarget::kSample).ok());
+      fake_.bench->SetMounted(FakeTarget::kSample);
     }
     auto ok = manager_->AnswerPrompt(id, prompt.step_index(), "done", kTestOperator);
     ASSERT_TRUE(ok.ok()) << ok.status().ToString();
@@ -431,10 +388,10 @@ TEST_F(EngineTest, AbortKeepsTheDataAndIsFinal) {
 TEST_F(EngineTest, DeviceFaultThatSurvivesRetriesPausesWithTheFaultThenResumeCompletes) {
   // Quality code 14 fails every measurement it hits (until the operator clears it); the plan
   // allows 2 attempts per step.
-  sim::SerialFaults faults;
-  faults.quality_code = 14;
-  faults.quality_count = 1000;
-  ASSERT_TRUE(control_->SetSerialFaults(faults).ok());
+  FakeFaults faults;
+  faults.fail_next = 1000;
+  faults.failure = DeviceError(14, "fake meter: measurement failed with quality code 14");
+  fake_.meter_faults->Set(faults);
   const SessionId id = Submit(kTinyPlan);
   Operator& op = Watch(id);
   v1::Session s = WaitForSession(*manager_, id, [](const v1::Session& x) {
@@ -452,7 +409,7 @@ TEST_F(EngineTest, DeviceFaultThatSurvivesRetriesPausesWithTheFaultThenResumeCom
   EXPECT_NE(record->state_reason.find("14"), std::string::npos) << record->state_reason;
   ExpectIntact(id);
 
-  ASSERT_TRUE(control_->SetSerialFaults(sim::SerialFaults()).ok());  // the operator fixes it
+  fake_.meter_faults->Set(FakeFaults());  // the operator fixes it
   ASSERT_TRUE(manager_->Resume(id, kTestOperator).ok());
   const v1::Session done = WaitDone(id);
   ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED);

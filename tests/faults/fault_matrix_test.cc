@@ -32,6 +32,7 @@
 
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/daemon/daemon_test_util.h"
+#include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
 namespace {
@@ -41,16 +42,12 @@ using namespace std::chrono_literals;
 // Three poses after a reference and a dark (prompts: mount the white, close the shutter, mount
 // the sample), so a fault can land on a reference, a dark, a sample or a move. Retries: three
 // attempts, a short backoff.
-constexpr const char* kFaultPlan = R"({
-  "name": "fault campaign",
-  "poseList": {"poses": [{"alpha": 0, "beta": 10, "delta": 40},
-                         {"alpha": 10, "beta": 40, "delta": 40},
-                         {"alpha": 20, "beta": 70, "delta": 40}]},
-  "reference": {"perDetectorPosition": true},
-  "dark": {"withEachReference": true},
-  "measurement": {"integrationMs": 200, "averages": 1},
-  "retry": {"maxAttempts": 3, "backoffMs": 100}
-})";
+const std::string kFaultPlan = PlanFixture("fault campaign")
+                                   .PoseList({{0, 10, 40}, {10, 40, 40}, {20, 70, 40}})
+                                   .Reference(true)
+                                   .DarkWithEachReference()
+                                   .Measurement(200, 1)
+                                   .Retry(3, 100);
 
 // brdfd's configuration for the campaign: the daemon tests' one WITHOUT their quality-10
 // override (darks must pass on the default policy), and a meter measurement timeout that a

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/status.h"
+#include "tests/support/process_launcher.h"
 
 namespace brdf::testing {
 
@@ -39,7 +40,7 @@ class SimProcess {
   int control_unit() const { return control_unit_; }
   // Every line printed before (and including) "ready", in order.
   const std::vector<std::string>& startup_lines() const { return lines_; }
-  pid_t pid() const { return pid_; }
+  pid_t pid() const { return child_ ? child_->pid() : -1; }
 
   // Sends SIGTERM and waits up to `timeout` for the exit; returns the exit code (128 + signal
   // number when killed by a signal). After the timeout the child is killed and the result is
@@ -50,21 +51,13 @@ class SimProcess {
   SimProcess() = default;
   Status ParseLine(const std::string& line);
 
-  pid_t pid_ = -1;
-  int stdout_fd_ = -1;
+  std::unique_ptr<ChildProcess> child_;
   std::string pr650_path_;
   std::string modbus_host_;
   int modbus_port_ = 0;
   std::string rtu_path_;
   int control_unit_ = 0;
   std::vector<std::string> lines_;
-};
-
-// What a short-lived command printed.
-struct CommandResult {
-  int exit_code = 0;  // 128 + signal number when killed by a signal
-  std::string out;
-  std::string err;
 };
 
 // Runs brdf-sim with `args` to completion (for subcommands like `truth`), within `timeout`.
