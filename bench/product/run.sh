@@ -135,6 +135,14 @@ PY
 
 med() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { printf "%.2f", (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f×", a / b }'; }
+# The median over the repetitions of scipy's time ÷ ours in the same repetition: $1, $2 names of
+# the two arrays (each repetition's pair ran back to back, under the same load).
+pair_ratio() {
+  local -n a="$1" b="$2"
+  local i
+  for i in "${!a[@]}"; do awk -v x="${a[$i]}" -v y="${b[$i]}" 'BEGIN { print x / y }'; done |
+    sort -g | awk '{ v[NR] = $1 } END { printf "%.2f×", (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+}
 echo
 echo "== product operations end to end, 50,000-reading session (medians of $reps, interleaved)"
 printf '%-62s %s\n' "figure" "value"
@@ -142,13 +150,13 @@ printf '%-62s %s\n' "grid 1°×1°×2° (729,000 cells × 101 bands), brdfctl ex
 printf '%-62s %s\n' "  the same, --method delaunay" "$(med "${g_del[@]}") s (all: ${g_del[*]})"
 printf '%-62s %s\n' "  scipy LinearNDInterpolator, same samples and cells, to .npy" "$(med "${g_scipy[@]}") s (all: ${g_scipy[*]})"
 printf '%-62s %s\n' "    of which triangulation + interpolation + .npy" "$(med "${g_scipy_c[@]}") s (all: ${g_scipy_c[*]})"
-printf '%-62s %s\n' "  scipy ÷ ours: octant, delaunay" "$(ratio "$(med "${g_scipy[@]}")" "$(med "${g_oct[@]}")"), $(ratio "$(med "${g_scipy[@]}")" "$(med "${g_del[@]}")")"
-printf '%-62s %s\n' "  scipy without reading its CSV ÷ ours: octant, delaunay" "$(ratio "$(med "${g_scipy_c[@]}")" "$(med "${g_oct[@]}")"), $(ratio "$(med "${g_scipy_c[@]}")" "$(med "${g_del[@]}")")"
+printf '%-62s %s\n' "  scipy ÷ ours: octant, delaunay" "$(ratio "$(med "${g_scipy[@]}")" "$(med "${g_oct[@]}")"), $(ratio "$(med "${g_scipy[@]}")" "$(med "${g_del[@]}")") (median of each repetition's: $(pair_ratio g_scipy g_oct), $(pair_ratio g_scipy g_del))"
+printf '%-62s %s\n' "  scipy without reading its CSV ÷ ours: octant, delaunay" "$(ratio "$(med "${g_scipy_c[@]}")" "$(med "${g_oct[@]}")"), $(ratio "$(med "${g_scipy_c[@]}")" "$(med "${g_del[@]}")") (per repetition: $(pair_ratio g_scipy_c g_oct), $(pair_ratio g_scipy_c g_del))"
 printf '%-62s %s\n' "InterpolateBatch, 100,000 directions over gRPC, octant" "$(med "${b_oct[@]}") s (all: ${b_oct[*]})"
 printf '%-62s %s\n' "  the same, delaunay" "$(med "${b_del[@]}") s (all: ${b_del[*]})"
 printf '%-62s %s\n' "  scipy LinearNDInterpolator, same samples and directions" "$(med "${b_scipy[@]}") s (all: ${b_scipy[*]})"
 printf '%-62s %s\n' "    of which triangulation + interpolation" "$(med "${b_scipy_c[@]}") s (all: ${b_scipy_c[*]})"
-printf '%-62s %s\n' "  scipy ÷ ours: octant, delaunay" "$(ratio "$(med "${b_scipy[@]}")" "$(med "${b_oct[@]}")"), $(ratio "$(med "${b_scipy[@]}")" "$(med "${b_del[@]}")")"
-printf '%-62s %s\n' "  scipy without reading its CSV ÷ ours: octant, delaunay" "$(ratio "$(med "${b_scipy_c[@]}")" "$(med "${b_oct[@]}")"), $(ratio "$(med "${b_scipy_c[@]}")" "$(med "${b_del[@]}")")"
+printf '%-62s %s\n' "  scipy ÷ ours: octant, delaunay" "$(ratio "$(med "${b_scipy[@]}")" "$(med "${b_oct[@]}")"), $(ratio "$(med "${b_scipy[@]}")" "$(med "${b_del[@]}")") (median of each repetition's: $(pair_ratio b_scipy b_oct), $(pair_ratio b_scipy b_del))"
+printf '%-62s %s\n' "  scipy without reading its CSV ÷ ours: octant, delaunay" "$(ratio "$(med "${b_scipy_c[@]}")" "$(med "${b_oct[@]}")"), $(ratio "$(med "${b_scipy_c[@]}")" "$(med "${b_del[@]}")") (per repetition: $(pair_ratio b_scipy_c b_oct), $(pair_ratio b_scipy_c b_del))"
 printf '%-62s %s\n' "  our delaunay vs scipy's answers" "$check"
 echo "uptime at end: $(uptime)"
