@@ -2,7 +2,9 @@
 # The interpolation benchmarks, in one run: Google Benchmark micro-benchmarks of the index and
 # the blend, then our interpolation against scipy on the same data and queries (compare.py),
 # the octant answers checked against the O(N) reference, and the 90×90×180 grid on 1 and 2
-# threads. Prints the figures and their ratios; takes a few minutes on 2 cores.
+# threads. Prints the figures and their ratios; takes a few minutes on 2 cores. Then the daemon's
+# figures (bench/daemon/run.sh) and the product operations end to end against scipy
+# (bench/product/run.sh, about ten minutes more).
 #
 # Usage: bench/run.sh [BUILD_DIR]      (default: $BRDF_BENCH_BUILD, then build-bench)
 #   Configures and builds bench_interp_micro, bench_interp_driver and brdf-interp there (-j2)
@@ -62,4 +64,6 @@ echo "uptime at end: $(uptime)"
 if [[ "${BENCH_KEEP:-0}" == 1 ]]; then echo "data and results.json kept in $work"; fi
 if [[ $status -ne 0 ]]; then echo "bench: MISMATCHES against the reference (see above)"; fi
 echo; "$here/daemon/run.sh" "$build" || echo "bench: the daemon figures (bench/daemon/run.sh) failed; see above"
+echo; BENCH_REPS=3 "$here/product/run.sh" "$build" ||
+  echo "bench: the product figures (bench/product/run.sh) failed; see above"
 exit $status

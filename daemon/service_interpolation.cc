@@ -134,10 +134,9 @@ v1::InterpolationMethod ToProtoMethod(interp::Method m) {
   return v1::INTERPOLATION_METHOD_UNSPECIFIED;
 }
 
-void Evaluate(const v1::DirectionQuery& query, const std::array<double, 4>& coords,
-              const Settings& settings, const IndexSnapshot& index, v1::InterpolationResult* out) {
-  interp::Interpolation r = index.interpolator->Evaluate(
-      std::span<const double>(coords.data(), static_cast<std::size_t>(index.dims)));
+// One answer as the API gives it.
+void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const Settings& settings,
+              const IndexSnapshot& index, v1::InterpolationResult* out) {
   *out->mutable_query() = query;
   out->set_status(ToProtoStatus(r.status));
   out->set_method(ToProtoMethod(r.method));
@@ -156,6 +155,14 @@ void Evaluate(const v1::DirectionQuery& query, const std::array<double, 4>& coor
               " sample reading(s) of the session left out (first: " + index.skipped_detail + ")";
   }
   out->set_detail(std::move(detail));
+}
+
+void Evaluate(const v1::DirectionQuery& query, const std::array<double, 4>& coords,
+              const Settings& settings, const IndexSnapshot& index, v1::InterpolationResult* out) {
+  ToResult(query,
+           index.interpolator->Evaluate(
+               std::span<const double>(coords.data(), static_cast<std::size_t>(index.dims))),
+           settings, index, out);
 }
 
 grpc::Status SessionOf(const std::string& text, SessionId* id) {
@@ -264,41 +271,53 @@ grpc::Status InterpolationService::InterpolateBatch(
       cache_.Get(id, settings.quantity, settings.method, settings.options);
   if (!got.ok()) return ToGrpcStatus(got.status());
   const IndexSnapshot& index = **got;
-  std::vector<std::array<double, 4>> coords(static_cast<std::size_t>(n));
+  const auto d = static_cast<std::size_t>(index.dims);
+  std::vector<double> coords(static_cast<std::size_t>(n) * d);  // row-major, the index's dims
   for (int i = 0; i < n; ++i) {
+    std::array<double, 4> at{};
     if (grpc::Status st =
-            ToCoords(request->directions(i), index, "directions[" + std::to_string(i) + "]",
-                     &coords[static_cast<std::size_t>(i)]);
+            ToCoords(request->directions(i), index, "directions[" + std::to_string(i) + "]", &at);
         !st.ok()) {
       return st;
     }
+    std::copy_n(at.begin(), d, coords.begin() + static_cast<std::ptrdiff_t>(i * d));
   }
 
-  for (int first = 0; first < n; first += chunk) {
+  // The whole batch in one EvaluateEach (the octant method sorts it by cell), its answers
+  // streamed chunk by chunk as they come, in order.
+  grpc::Status outcome = grpc::Status::OK;
+  v1::InterpolateBatchChunk out;
+  auto start_chunk = [&](int first) {
     if (context->IsCancelled()) {
-      return grpc::Status(grpc::StatusCode::CANCELLED,
-                          "InterpolateBatch: cancelled by the client after " +
-                              std::to_string(first) + " of " + std::to_string(n) + " results");
+      outcome = grpc::Status(grpc::StatusCode::CANCELLED,
+                             "InterpolateBatch: cancelled by the client after " +
+                                 std::to_string(first) + " of " + std::to_string(n) + " results");
+      return false;
     }
     if (stopping_.stopped()) {
-      return grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                          "InterpolateBatch: the daemon is shutting down after " +
-                              std::to_string(first) + " of " + std::to_string(n) +
-                              " results; ask again for the rest once it is back");
+      outcome = grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                             "InterpolateBatch: the daemon is shutting down after " +
+                                 std::to_string(first) + " of " + std::to_string(n) +
+                                 " results; ask again for the rest once it is back");
+      return false;
     }
-    v1::InterpolateBatchChunk out;
+    out.Clear();
     out.set_first_index(static_cast<std::uint32_t>(first));
-    const int last = std::min(n, first + chunk);
-    for (int i = first; i < last; ++i) {
-      Evaluate(request->directions(i), coords[static_cast<std::size_t>(i)], settings, index,
-               out.add_results());
-    }
+    return true;
+  };
+  index.interpolator->EvaluateEach(coords, [&](std::size_t k, interp::Interpolation&& answer) {
+    const int i = static_cast<int>(k);
+    if (i % chunk == 0 && !start_chunk(i)) return false;
+    ToResult(request->directions(i), std::move(answer), settings, index, out.add_results());
+    if (out.results_size() < chunk && i + 1 < n) return true;
     // Blocks while the client is slow to read (flow control); false: the client went away.
     if (!writer->Write(out)) {
-      return grpc::Status(grpc::StatusCode::CANCELLED, "InterpolateBatch: the client went away");
+      outcome = grpc::Status(grpc::StatusCode::CANCELLED, "InterpolateBatch: the client went away");
+      return false;
     }
-  }
-  return grpc::Status::OK;
+    return true;
+  });
+  return outcome;
 }
 
 }  // namespace brdf::daemon

@@ -20,6 +20,15 @@
 // With --recording SESSION the tool also reads that session's progress before and after the
 // window and prints how many steps it completed meanwhile (proof that it was recording).
 //
+// --noop (queue API): every other call of each client is the no-op instead of an Interpolate, so
+// that both see the same load in the same window, and the line adds the no-op's percentiles and
+// p99_ratio = Interpolate p99 ÷ no-op p99 (absolute times on a shared machine do not hold; the
+// ratio does). The no-op is an Interpolate of the same session with no direction: brdfd's
+// Interpolate loop reads it, authorizes the token, parses it and answers INVALID_ARGUMENT before
+// any index lookup, so it travels Interpolate's own path (the completion-queue loop thread, the
+// same connections) minus the interpolation. A separate RPC (grpc.health.v1 Check) would be
+// served by other threads (the synchronous API's pool) and measure another path.
+//
 // Output: one "key=value" line (bench/daemon/run.sh parses it).
 #include <absl/synchronization/mutex.h>
 #include <grpcpp/grpcpp.h>
@@ -52,6 +61,7 @@ struct Options {
   double warmup = 1;
   double rate = 0;  // calls/s per client; 0: back to back
   std::string api = "queue";
+  bool noop = false;  // every other call of each client the no-op (--noop)
 };
 
 void Authorize(grpc::ClientContext& context, const Options& o) {
@@ -202,16 +212,20 @@ class CallbackClient {
 // 2-core machine shared with brdfd it never competes with itself for a core (see --api).
 class QueueClients {
  public:
+  // With `noop_results` (one per client, or null), every other call is the no-op (--noop).
   QueueClients(const Options& o, Clock::time_point measure_from, Clock::time_point until,
-               std::vector<ClientResult>* results)
+               std::vector<ClientResult>* results, std::vector<ClientResult>* noop_results)
       : o_(o), measure_from_(measure_from), until_(until) {
     for (std::size_t i = 0; i < results->size(); ++i) {
       auto client = std::make_unique<Client>();
+      client->noop_out = noop_results == nullptr ? nullptr : &(*noop_results)[i];
+      if (client->noop_out != nullptr) client->noop_out->latencies_us.reserve(200000);
       client->stub = OwnConnectionStub(o.address);
       client->rng.seed(1000 + i);
       client->out = &(*results)[i];
       client->out->latencies_us.reserve(200000);
       client->request.set_session_id(o.session);
+      client->noop_request.set_session_id(o.session);
       clients_.push_back(std::move(client));
     }
   }
@@ -228,7 +242,16 @@ class QueueClients {
     while (in_flight > 0 && queue_.Next(&tag, &ok)) {
       Client& c = *static_cast<Client*>(tag);
       const Clock::time_point end = Clock::now();
-      Record(c.out, measure_from_, c.start, end, c.status);
+      if (c.noop) {
+        // The no-op's expected answer is the refusal; anything else is an error.
+        const grpc::Status st = c.status.error_code() == grpc::StatusCode::INVALID_ARGUMENT
+                                    ? grpc::Status::OK
+                                    : grpc::Status(grpc::StatusCode::UNKNOWN,
+                                                   "no-op answered " + c.status.error_message());
+        Record(c.noop_out, measure_from_, c.start, end, st);
+      } else {
+        Record(c.out, measure_from_, c.start, end, c.status);
+      }
       if (end < until_) {
         Call(c);
       } else {
@@ -245,7 +268,10 @@ class QueueClients {
     std::unique_ptr<brdf::v1::Interpolation::Stub> stub;
     std::mt19937_64 rng;
     ClientResult* out = nullptr;
+    ClientResult* noop_out = nullptr;  // --noop only
+    bool noop = false;                 // the call in flight is the no-op
     brdf::v1::InterpolateRequest request;
+    brdf::v1::InterpolateRequest noop_request;  // the session, no direction
     brdf::v1::InterpolateResponse response;
     std::unique_ptr<grpc::ClientContext> context;
     std::unique_ptr<grpc::ClientAsyncResponseReader<brdf::v1::InterpolateResponse>> reader;
@@ -254,11 +280,13 @@ class QueueClients {
   };
 
   void Call(Client& c) {
-    RandomDirection(c.rng, &c.request);
+    c.noop = c.noop_out != nullptr && !c.noop;
+    if (!c.noop) RandomDirection(c.rng, &c.request);
     c.context = std::make_unique<grpc::ClientContext>();
     Authorize(*c.context, o_);
     c.start = Clock::now();
-    c.reader = c.stub->AsyncInterpolate(c.context.get(), c.request, &queue_);
+    c.reader =
+        c.stub->AsyncInterpolate(c.context.get(), c.noop ? c.noop_request : c.request, &queue_);
     c.reader->Finish(&c.response, &c.status, &c);
   }
 
@@ -293,7 +321,14 @@ int main(int argc, char** argv) {
          "--api", o.api,
          "gRPC client API: queue (default: one thread), callback or sync (needed for --rate)")
       ->check(CLI::IsMember({"callback", "sync", "queue"}));
+  app.add_flag("--noop", o.noop,
+               "every other call the no-op (an Interpolate refused before any work; queue API): "
+               "adds its percentiles and p99_ratio");
   CLI11_PARSE(app, argc, argv);
+  if (o.noop && o.api != "queue") {
+    std::fprintf(stderr, "bench_daemon_load: --noop needs --api queue\n");
+    return 2;
+  }
   if (o.rate > 0 && o.api != "sync") {
     std::fprintf(stderr, "bench_daemon_load: --rate needs --api sync\n");
     return 2;
@@ -310,11 +345,13 @@ int main(int argc, char** argv) {
                                                      std::chrono::duration<double>(o.seconds));
 
   std::vector<ClientResult> results(static_cast<std::size_t>(o.clients));
+  std::vector<ClientResult> noop_results(o.noop ? results.size() : 0);
   std::vector<std::thread> threads;
   std::vector<std::unique_ptr<CallbackClient>> callback_clients;
   std::unique_ptr<QueueClients> queue_clients;
   if (o.api == "queue") {
-    queue_clients = std::make_unique<QueueClients>(o, measure_from, until, &results);
+    queue_clients = std::make_unique<QueueClients>(o, measure_from, until, &results,
+                                                   o.noop ? &noop_results : nullptr);
   } else {
     for (int i = 0; i < o.clients; ++i) {
       ClientResult* out = &results[static_cast<std::size_t>(i)];
@@ -336,22 +373,47 @@ int main(int argc, char** argv) {
   if (queue_thread.joinable()) queue_thread.join();
   const long after = o.recording.empty() ? -1 : DoneSteps(control_channel, o, o.recording);
 
-  std::vector<double> all;
-  long errors = 0;
-  std::string first_error;
-  for (ClientResult& r : results) {
-    all.insert(all.end(), r.latencies_us.begin(), r.latencies_us.end());
-    if (r.errors > 0 && first_error.empty()) first_error = r.first_error;
-    errors += r.errors;
+  // All clients' latencies, sorted; errors counted and the first one kept.
+  struct Merged {
+    std::vector<double> latencies_us;
+    long errors = 0;
+    std::string first_error;
+  };
+  auto merge = [](std::vector<ClientResult>& from) {
+    Merged m;
+    for (ClientResult& r : from) {
+      m.latencies_us.insert(m.latencies_us.end(), r.latencies_us.begin(), r.latencies_us.end());
+      if (r.errors > 0 && m.first_error.empty()) m.first_error = r.first_error;
+      m.errors += r.errors;
+    }
+    std::sort(m.latencies_us.begin(), m.latencies_us.end());
+    return m;
+  };
+  Merged interpolate = merge(results);
+  Merged noop = merge(noop_results);
+  std::vector<double>& all = interpolate.latencies_us;
+  const long errors = interpolate.errors + noop.errors;
+  const std::string first_error =
+      interpolate.first_error.empty() ? noop.first_error : interpolate.first_error;
+  std::string noop_fields;
+  if (o.noop) {
+    const double noop_p99 = Percentile(noop.latencies_us, 0.99);
+    char buffer[256];
+    std::snprintf(buffer, sizeof buffer,
+                  " noop_calls=%zu noop_errors=%ld noop_p50_us=%.0f noop_p99_us=%.0f "
+                  "p99_ratio=%.3f",
+                  noop.latencies_us.size(), noop.errors, Percentile(noop.latencies_us, 0.5),
+                  noop_p99, noop_p99 > 0 ? Percentile(all, 0.99) / noop_p99 : 0.0);
+    noop_fields = buffer;
   }
-  std::sort(all.begin(), all.end());
   std::printf(
       "interpolate api=%s clients=%d calls=%zu errors=%ld qps=%.0f p50_us=%.0f p90_us=%.0f "
       "p99_us=%.0f "
-      "p999_us=%.0f max_us=%.0f steps_recorded=%ld\n",
-      o.api.c_str(), o.clients, all.size(), errors, static_cast<double>(all.size()) / o.seconds,
-      Percentile(all, 0.5), Percentile(all, 0.9), Percentile(all, 0.99), Percentile(all, 0.999),
-      all.empty() ? 0.0 : all.back(), before >= 0 && after >= 0 ? after - before : -1);
+      "p999_us=%.0f max_us=%.0f steps_recorded=%ld%s\n",
+      o.api.c_str(), o.clients, all.size(), interpolate.errors,
+      static_cast<double>(all.size()) / o.seconds, Percentile(all, 0.5), Percentile(all, 0.9),
+      Percentile(all, 0.99), Percentile(all, 0.999), all.empty() ? 0.0 : all.back(),
+      before >= 0 && after >= 0 ? after - before : -1, noop_fields.c_str());
   if (errors > 0) std::fprintf(stderr, "bench_daemon_load: first error: %s\n", first_error.c_str());
-  return all.empty() ? 1 : 0;
+  return all.empty() || (o.noop && noop.latencies_us.empty()) ? 1 : 0;
 }

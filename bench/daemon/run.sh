@@ -14,7 +14,9 @@
 #   3. readings ingested per second into SQLite (one transaction per reading, synchronous=FULL),
 #      on the disk of the temporary folder;
 #   4. peak RSS (VmHWM) of brdfd holding a 10,000- and a 50,000-reading session after loading and
-#      querying them (sessions written through storage/ by bench_storage, not measured for hours).
+#      querying them (sessions written through storage/ by bench_storage, not measured for hours);
+#      (d) on the 10k one, nothing pinned: Interpolate p99 ÷ a no-op's p99, both driven by the same
+#      8 clients in the same window (bench_daemon_load --noop: every other call the no-op).
 # Prints a table at the end. Called by bench/run.sh; runnable alone.
 #
 # Usage: bench/daemon/run.sh [BUILD_DIR]    (default: $BRDF_BENCH_BUILD, then build-bench)
@@ -223,6 +225,14 @@ for n in 10k 50k; do
     --session 1 --clients 2 --seconds 2 --warmup 0)"
   rss_peak[$n]="$(kb "$brdfd_pid" VmHWM)"
   rss_now[$n]="$(kb "$brdfd_pid" VmRSS)"
+  if [[ $n == 10k ]]; then
+    # (d) Interpolate p99 ÷ the no-op's p99, both from the same 8 clients in the same window,
+    # nothing pinned (this brdfd has no interpolate_cpus): the ratio holds where absolute times
+    # on a shared machine do not.
+    load_ratio="$("$bin/bench_daemon_load" --address "$address" --token "$analyst_token" \
+      --session 1 --clients 8 --seconds "$load_seconds" --warmup 1 --noop)"
+    echo "   (d) $load_ratio" >&2
+  fi
   echo "   $n: idle ${rss_idle[$n]} kB, after loading+querying: VmHWM ${rss_peak[$n]} kB, VmRSS ${rss_now[$n]} kB ($mem_load)" >&2
   stop_pid "$brdfd_pid"
 done
@@ -247,6 +257,9 @@ for which in live 10k callback; do
   printf '%-58s %s\n' "  throughput" "$(field "$line" qps) calls/s ($(field "$line" calls) calls, $(field "$line" errors) errors)"
   printf '%-58s %s\n' "  steps the session recorded meanwhile" "$(field "$line" steps_recorded)"
 done
+printf '%-58s %s\n' "(d) Interpolate ÷ no-op p99, 8 clients, 10k session, unpinned" "$(field "$load_ratio" p99_ratio) (goal ≤ 1.5)"
+printf '%-58s %s\n' "  Interpolate p50 / p99" "$(ms "$(field "$load_ratio" p50_us)") / $(ms "$(field "$load_ratio" p99_us)") ($(field "$load_ratio" calls) calls)"
+printf '%-58s %s\n' "  no-op (Interpolate refused before any work) p50 / p99" "$(ms "$(field "$load_ratio" noop_p50_us)") / $(ms "$(field "$load_ratio" noop_p99_us)") ($(field "$load_ratio" noop_calls) calls)"
 for line in "$on_line" "$off_line"; do
   mode="$(field "$line" pipelining)"
   printf '%-58s %s\n' "session, pipelining $mode: steps / sample readings" "$(field "$line" steps) / $(field "$line" samples)"

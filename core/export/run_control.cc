@@ -44,6 +44,14 @@ constexpr std::size_t kChunk = 256;
 Status ParallelFor(std::size_t count, unsigned threads, const CallContext& ctx,
                    ProgressReporter* progress, std::size_t progress_base, const char* what,
                    const std::function<void(std::size_t begin, std::size_t end)>& body) {
+  return ParallelForChunks(count, kChunk, threads, ctx, progress, progress_base, what, body);
+}
+
+Status ParallelForChunks(std::size_t count, std::size_t chunk, unsigned threads,
+                         const CallContext& ctx, ProgressReporter* progress,
+                         std::size_t progress_base, const char* what,
+                         const std::function<void(std::size_t begin, std::size_t end)>& body) {
+  chunk = std::max<std::size_t>(1, chunk);
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
   std::atomic<bool> stop{false};
@@ -58,17 +66,17 @@ Status ParallelFor(std::size_t count, unsigned threads, const CallContext& ctx,
   auto work = [&](bool report) {
     for (;;) {
       if (should_stop()) return;
-      const std::size_t begin = next.fetch_add(kChunk, std::memory_order_relaxed);
+      const std::size_t begin = next.fetch_add(chunk, std::memory_order_relaxed);
       if (begin >= count) return;
-      const std::size_t end = std::min(count, begin + kChunk);
+      const std::size_t end = std::min(count, begin + chunk);
       body(begin, end);
       const std::size_t now = done.fetch_add(end - begin, std::memory_order_relaxed) + end - begin;
       if (report && progress != nullptr) progress->Report(progress_base + now);
     }
   };
 
-  const unsigned n = std::max(
-      1u, std::min<unsigned>(threads, static_cast<unsigned>((count + kChunk - 1) / kChunk)));
+  const unsigned n =
+      std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>((count + chunk - 1) / chunk)));
   std::vector<std::thread> workers;
   workers.reserve(n - 1);
   for (unsigned t = 1; t < n; ++t) workers.emplace_back(work, false);

@@ -56,4 +56,12 @@ Status ParallelFor(std::size_t count, unsigned threads, const CallContext& ctx,
                    ProgressReporter* progress, std::size_t progress_base, const char* what,
                    const std::function<void(std::size_t begin, std::size_t end)>& body);
 
+// ParallelFor with chunks of `chunk` indices (at least 1) instead of the default 256: for bodies
+// that answer a chunk as one batch (SpectrumSource::Spectra), which needs thousands of cells to
+// sort them by interpolation cell. Progress and cancellation then come once per chunk.
+Status ParallelForChunks(std::size_t count, std::size_t chunk, unsigned threads,
+                         const CallContext& ctx, ProgressReporter* progress,
+                         std::size_t progress_base, const char* what,
+                         const std::function<void(std::size_t begin, std::size_t end)>& body);
+
 }  // namespace brdf::exports

@@ -3,8 +3,11 @@
 // tests and the synthetic demo, a known analytic BRDF.
 #pragma once
 
+#include <concepts>
 #include <functional>
 #include <span>
+#include <type_traits>
+#include <utility>
 
 #include "core/analytic_brdf.h"
 #include "core/interp/interpolator.h"
@@ -13,12 +16,43 @@
 
 namespace brdf::exports {
 
-// Writes one value per band into `out` (out.size() = bands) and returns kOk, or returns why there
-// is no value (and leaves `out` alone). Called from many threads at once: must be thread-safe.
-using SpectrumSource =
-    std::function<interp::InterpStatus(const IsoDirection& at, std::span<double> out)>;
+// Answers one direction, or many at once. Called from many threads at once: must be thread-safe.
+class SpectrumSource {
+ public:
+  // Writes one value per band into `out` (out.size() = bands) and returns kOk, or returns why
+  // there is no value (and leaves `out` alone).
+  using One = std::function<interp::InterpStatus(const IsoDirection& at, std::span<double> out)>;
+  // n = statuses.size() directions, row-major (θi, θo, φ) in `directions`; statuses[i] and row i
+  // of `spectra` (n × bands values) as One would give them, except that a row whose status is not
+  // kOk holds NaN. Interpolator::SpectraAt's contract: what lets a 3D octant interpolator sort a
+  // large batch by cell (octant.h) instead of answering query by query.
+  using Many =
+      std::function<void(std::span<const double> directions,
+                         std::span<interp::InterpStatus> statuses, std::span<double> spectra)>;
 
-// Asks a 3D interpolator. The interpolator must outlive the source.
+  // From a callable answering one direction (a lambda, a One); Spectra then asks it one by one.
+  template <typename F>
+  requires(
+      !std::same_as<std::remove_cvref_t<F>, SpectrumSource> &&
+      std::is_invocable_r_v<interp::InterpStatus, const F&, const IsoDirection&, std::span<double>>)
+      SpectrumSource(F one)
+      : one_(std::move(one)) {}  // NOLINT(google-explicit-constructor)
+  SpectrumSource(One one, Many many) : one_(std::move(one)), many_(std::move(many)) {}
+
+  interp::InterpStatus operator()(const IsoDirection& at, std::span<double> out) const {
+    return one_(at, out);
+  }
+  // Many's contract; directions.size() == 3 × statuses.size(), spectra.size() a multiple of it.
+  void Spectra(std::span<const double> directions, std::span<interp::InterpStatus> statuses,
+               std::span<double> spectra) const;
+
+ private:
+  One one_;
+  Many many_;  // empty: one by one through one_
+};
+
+// Asks a 3D interpolator: one direction by SpectrumAt, many by SpectraAt (the sorted batch path
+// of the octant method). The interpolator must outlive the source.
 SpectrumSource InterpolatorSource(const interp::Interpolator& interpolator);
 
 // Evaluates an analytic BRDF (sr⁻¹) on `grid` at CanonicalDirections(at); always kOk.

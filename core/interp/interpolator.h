@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <span>
@@ -133,6 +134,20 @@ class Interpolator {
                   spectrum.begin());
     }
     return r.status;
+  }
+
+  // Receives answer `index` of an EvaluateEach; returns false to stop the batch there.
+  using TakeAnswer = std::function<bool(std::size_t index, Interpolation&& answer)>;
+  // Full answers (with provenance) for queries.size() / dims() queries (row-major), single
+  // thread, each the answer Evaluate gives, handed to `take` in query order as they are ready, so
+  // the caller can stream them without holding all of them; stops when `take` returns false.
+  // Methods override it to answer a large batch faster (the octant method sorts it by cell); this
+  // default calls Evaluate query by query.
+  virtual void EvaluateEach(std::span<const double> queries, const TakeAnswer& take) const {
+    const auto d = static_cast<std::size_t>(dims());
+    for (std::size_t i = 0; i < queries.size() / d; ++i) {
+      if (!take(i, Evaluate(queries.subspan(i * d, d)))) return;
+    }
   }
 
   // Many queries in one call, single thread, in order: n = statuses.size() queries (row-major,

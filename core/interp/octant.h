@@ -107,6 +107,13 @@ class OctantInterpolator final : public Interpolator {
   // the tree (octant.cc, SpectraByCell).
   void SpectraAt(std::span<const double> queries, std::span<InterpStatus> statuses,
                  std::span<double> spectra) const override;
+  // Evaluate's answers, bit for bit, in query order; a 3D batch of 65,536 queries or a remainder
+  // large enough to sort (as for SpectraAt) is sorted and searched by cell first, its answers
+  // then assembled in query order (octant.cc). What brdfd's InterpolateBatch calls.
+  void EvaluateEach(std::span<const double> queries, const TakeAnswer& take) const override;
+  // Queries answered so far by the cell-sorted passes of SpectraAt and EvaluateEach, over this
+  // interpolator's life (relaxed counter): how tests tell that a product path takes them.
+  std::uint64_t sorted_queries() const;
   // Status, vertices and weights; the blended spectrum goes into `spectrum` when kOk (its first
   // bands() values; a shorter buffer gets the first bands only), untouched otherwise. Same numbers
   // as Evaluate, bit for bit. Thread-safe.

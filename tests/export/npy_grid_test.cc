@@ -12,6 +12,7 @@
 #include "core/export/npy_writer.h"
 #include "core/export/regular_grid.h"
 #include "core/export/synthetic_session.h"
+#include "core/interp/octant.h"
 #include "export_test_util.h"
 
 namespace brdf::exports {
@@ -232,6 +233,36 @@ TEST_F(InterpolatedGrid, ParallelIsBitIdenticalToSerialAndMatchesTheInterpolator
       }
     }
   }
+}
+
+TEST_F(InterpolatedGrid, InterpolatorSourceSortsItsBatchesWithTheOneByOneAnswers) {
+  // The export's product path: an octant interpolator's cells go through SpectraAt in batches
+  // large enough to sort by cell, and the grid is the one a source asking cell by cell makes.
+  const auto* octant = dynamic_cast<const interp::OctantInterpolator*>(interpolator_.get());
+  ASSERT_NE(octant, nullptr);
+  Result<RegularGrid> grid = MakeRegularGrid(1, 2, 2, GridPlacement::kCellCentres);
+  ASSERT_TRUE(grid.ok());
+  const interp::Interpolator& in = *interpolator_;
+  const SpectrumSource one_by_one = [&in](const IsoDirection& at, std::span<double> out) {
+    const double q[3] = {at.theta_i, at.theta_o, at.phi};
+    return in.SpectrumAt(q, out);
+  };
+  MemoryGrid batched, single;
+  ASSERT_TRUE(ResampleOnGrid(InterpolatorSource(in), *grid, bands_, RunControl{2, {}},
+                             LongContext(), batched)
+                  .ok());
+  const std::uint64_t sorted = octant->sorted_queries();
+  EXPECT_GT(sorted, grid->cells() * 9 / 10);  // all but a window's short last batch
+  ASSERT_TRUE(
+      ResampleOnGrid(one_by_one, *grid, bands_, RunControl{2, {}}, LongContext(), single).ok());
+  EXPECT_EQ(octant->sorted_queries(), sorted);
+  EXPECT_EQ(batched.statuses(), single.statuses());
+  ASSERT_EQ(batched.values().size(), single.values().size());
+  EXPECT_EQ(std::memcmp(batched.values().data(), single.values().data(),
+                        batched.values().size() * sizeof(double)),
+            0);
+  EXPECT_GT(batched.report().filled, 0u);
+  EXPECT_GT(batched.report().nan_cells, 0u);
 }
 
 TEST_F(InterpolatedGrid, ProgressRisesToOneAndCancellationStopsTheRun) {

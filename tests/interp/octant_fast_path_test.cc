@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <span>
 
 #include "core/interp/kd_tree.h"
 #include "core/interp/nearest.h"
@@ -194,6 +195,59 @@ TEST(OctantFastPathTest, LargeBatchSortedByCellIsSpectrumAtQueryByQuery) {
     for (std::size_t k = 0; k < 1000; ++k) around[k] = points[k];
     around[1000] = {NAN, 1, 1};
     ExpectSpectraAtIsSpectrumAt(*interp, around);
+  }
+}
+
+void ExpectSameAnswer(const Interpolation& got, const Interpolation& want) {
+  ASSERT_EQ(got.status, want.status);
+  EXPECT_EQ(got.method, want.method);
+  EXPECT_EQ(got.spectrum, want.spectrum);
+  EXPECT_EQ(got.detail, want.detail);
+  ASSERT_EQ(got.vertices.size(), want.vertices.size());
+  for (std::size_t k = 0; k < want.vertices.size(); ++k) {
+    EXPECT_EQ(got.vertices[k].id, want.vertices[k].id);
+    EXPECT_EQ(got.vertices[k].index, want.vertices[k].index);
+    EXPECT_EQ(got.vertices[k].coords, want.vertices[k].coords);
+    EXPECT_EQ(got.vertices[k].weight, want.vertices[k].weight);
+  }
+}
+
+TEST(OctantFastPathTest, EvaluateEachSortsLargeBatchesAndIsEvaluateBitForBit) {
+  // InterpolateBatch's path: full answers with provenance, a large batch sorted by cell, handed
+  // over in query order. 70,000 queries: a window of 65,536 sorted, then 4,464 (sorted if that
+  // is a quarter of a query per cell of the grid); samples (ties), invalid queries and
+  // queries outside the data (Evaluate's own answers, with their empty orthants named).
+  const auto grid = PaperGrid();
+  auto queries = RandomPoints(70000, {-5, -5, -5}, {95, 95, 185}, 41);
+  for (std::size_t k = 0; k < grid.size(); ++k) queries[k] = grid[k];
+  queries[5000] = {1, NAN, 1};
+  queries[5001] = {-1e300, 1e300, 0};
+  std::vector<double> flat;
+  for (const Point& q : queries) flat.insert(flat.end(), q.begin(), q.end());
+  const auto samples = MakeSamples(grid, AnalyticSpectrum(3));
+  for (const Options& options : {Options{}, Options{{1, 1, 0.5}, true, true}}) {
+    const auto interp = OctantInterpolator::Create(samples, options).value();
+    std::size_t next = 0;
+    interp->EvaluateEach(flat, [&](std::size_t i, Interpolation&& answer) {
+      EXPECT_EQ(i, next++);
+      ExpectSameAnswer(answer, interp->Evaluate(queries[i]));
+      return !::testing::Test::HasFatalFailure();
+    });
+    EXPECT_EQ(next, queries.size());
+    const std::uint64_t sorted = interp->sorted_queries();
+    EXPECT_TRUE(sorted == 65536 || sorted == queries.size()) << sorted;
+
+    // A batch too small to sort goes query by query (the counter stays), with the same answers.
+    const std::span<const double> few = std::span<const double>(flat).first(3 * 100);
+    interp->EvaluateEach(few, [&](std::size_t i, Interpolation&& answer) {
+      ExpectSameAnswer(answer, interp->Evaluate(queries[i]));
+      return true;
+    });
+    EXPECT_EQ(interp->sorted_queries(), sorted);
+    // `take` returning false stops the batch.
+    std::size_t taken = 0;
+    interp->EvaluateEach(flat, [&](std::size_t i, Interpolation&&) { return ++taken, i < 9; });
+    EXPECT_EQ(taken, 10u);
   }
 }
 
