@@ -55,6 +55,9 @@
 
 namespace brdf::daemon {
 
+struct ReadingRequest;  // engine_reading_step.h
+class PipelinedMove;
+
 // What the executor needs from whoever runs it (the SessionManager). Called on the executor's
 // thread.
 class ExecutorHost {
@@ -119,15 +122,25 @@ class Executor {
 
   Outcome RunMove(Context& c, int index, std::uint32_t first_attempt);
   Outcome RunPrompt(Context& c, int index);
-  // Returns how many steps were completed (1, or 2 with a pipelined move) through `advanced`.
+  // A reading step (engine_reading_step.h's handlers, then CommitReading and, when a move was
+  // pipelined, FinishPipelinedMove). Returns how many steps were completed (1, or 2 with a
+  // pipelined move) through `advanced`.
   Outcome RunReading(Context& c, int index, int& advanced);
+  // What measuring step `index` needs: its pose, where the stage must be, the meter's settings,
+  // and the next step's move when it may be pipelined (pipelining on, the next step a pending
+  // move, the session running).
+  ReadingRequest PlanReading(const Context& c, int index);
+  // The commit: the reading and the step's done mark in one transaction; then `reading` carries
+  // its id, the session's latest reference / dark follow it, and the host hears of the completed
+  // step with the reading. The store's error otherwise (nothing changed).
+  Status CommitReading(Context& c, int index, storage::ReadingRecord& reading);
+  // After the reading before it is committed: waits for the pipelined move; on success writes
+  // its done mark (advanced = 2), on failure reports a fault and leaves the move for the loop to
+  // run again as its second attempt, or stops when it may not be retried.
+  Outcome FinishPipelinedMove(Context& c, PipelinedMove& move, int& advanced);
 
-  // Moves the motorized axes to `pose`; returns the stage's feedback pose after the move (the
-  // commanded pose when the feedback cannot be read).
-  Result<Pose> MoveStage(const Pose& pose, const CallContext& ctx);
-  // Clears the alarms of the axes that report one (before retrying a failed move).
-  void ResetAlarms(const CallContext& ctx);
-  // Runs `attempt` per the plan's retry policy; publishes a fault per failed attempt.
+  // Runs `attempt` per the plan's retry policy (RunWithRetry); publishes a fault per failed
+  // attempt.
   Status WithRetry(Context& c, int index, std::uint32_t first_attempt,
                    const std::function<Status(std::uint32_t attempt)>& attempt);
   // Commits a move's or prompt's done mark and publishes the completion.
