@@ -1,10 +1,12 @@
-// Resampling a session onto a regular grid over (θi, θo, φ), the form array tools want: every cell
-// asks a SpectrumSource (the session's interpolator) for its spectrum, in parallel, and the cells
+// Resampling a session onto a regular grid over (θi, θo, φ), the form array tools want: the cells
+// ask a SpectrumSource (the session's interpolator) for their spectra in batches of thousands
+// (SpectrumSource::Spectra, which the octant method sorts by cell), in parallel, and the cells
 // it cannot fill (an empty octant, outside the hull) hold NaN and are counted per status.
 //
 // The work goes slice by slice (one θi value at a time, C order θi, θo, φ, band) to a GridSink,
 // so that a 1° grid of 101 bands (90 × 90 × 180 × 101 doubles, 1.2 GB) never has to sit in
-// memory: the .npy and CSV writers stream it out.
+// memory: the .npy and CSV writers stream it out. Slices are computed a window of at least 65,536
+// cells at a time (1° × 1° × 2°, 101 bands: 8 slices, 52 MB) before they go to the sink.
 #pragma once
 
 #include <cstddef>
