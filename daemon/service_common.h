@@ -8,13 +8,12 @@
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <map>
-#include <mutex>
 #include <string>
 
 #include "brdf/v1/brdf.pb.h"
+#include "core/mutex.h"
 #include "core/status.h"
 #include "core/wavelength_grid.h"
 #include "storage/records.h"
@@ -83,8 +82,8 @@ class StopSignal {
 
  private:
   std::atomic<bool> stopped_{false};
-  mutable std::mutex mu_;
-  mutable std::condition_variable cv_;
+  mutable Mutex mu_;
+  mutable CondVar cv_;
 };
 
 }  // namespace brdf::daemon
