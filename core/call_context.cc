@@ -26,22 +26,22 @@ const Clock& Clock::Real() {
 
 void CancelToken::Cancel(std::string reason) {
   {
-    std::lock_guard lock(state_->mu);
+    MutexLock lock(state_->mu);
     if (state_->cancelled.load()) return;
     state_->reason = std::move(reason);
     state_->cancelled.store(true, std::memory_order_release);
   }
-  state_->cv.notify_all();
+  state_->cv.NotifyAll();
 }
 
 std::string CancelToken::reason() const {
-  std::lock_guard lock(state_->mu);
+  MutexLock lock(state_->mu);
   return state_->reason;
 }
 
 bool CancelToken::WaitFor(std::chrono::steady_clock::duration d) const {
-  std::unique_lock lock(state_->mu);
-  return state_->cv.wait_for(lock, d, [&] { return state_->cancelled.load(); });
+  MutexLock lock(state_->mu);
+  return state_->cv.WaitFor(state_->mu, d, [&] { return state_->cancelled.load(); });
 }
 
 CallContext CallContext::WithTimeout(std::chrono::steady_clock::duration timeout,

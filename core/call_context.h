@@ -5,12 +5,11 @@
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <memory>
-#include <mutex>
 #include <string>
 
 #include "core/clock.h"
+#include "core/mutex.h"
 
 namespace brdf {
 
@@ -29,9 +28,9 @@ class CancelToken {
  private:
   struct State {
     std::atomic<bool> cancelled{false};
-    mutable std::mutex mu;
-    mutable std::condition_variable cv;
-    std::string reason;
+    mutable Mutex mu;
+    mutable CondVar cv;
+    std::string reason GUARDED_BY(mu);
   };
   std::shared_ptr<State> state_;
 };

@@ -22,7 +22,7 @@ EventSubscription::EventSubscription(std::size_t capacity)
 
 void EventSubscription::Push(v1::SessionEvent event, bool last) {
   {
-    std::lock_guard lock(mu_);
+    MutexLock lock(mu_);
     if (closed_ || closing_) return;
     if (queue_.size() >= capacity_) {
       queue_.pop_front();
@@ -31,12 +31,12 @@ void EventSubscription::Push(v1::SessionEvent event, bool last) {
     queue_.push_back(std::move(event));
     if (last) closing_ = true;
   }
-  cv_.notify_all();
+  cv_.NotifyAll();
 }
 
 std::optional<v1::SessionEvent> EventSubscription::Next(std::chrono::steady_clock::duration wait,
                                                         const CancelToken* cancel) {
-  std::unique_lock lock(mu_);
+  MutexLock lock(mu_);
   const auto until = std::chrono::steady_clock::now() + wait;
   // With a cancel token, wake up now and then to look at it (the token has its own condition
   // variable, which cannot wake this one).
@@ -51,7 +51,7 @@ std::optional<v1::SessionEvent> EventSubscription::Next(std::chrono::steady_cloc
     if (now >= until) return std::nullopt;
     auto step = until - now;
     if (cancel != nullptr) step = std::min<std::chrono::steady_clock::duration>(step, kCancelPoll);
-    cv_.wait_for(lock, step);
+    cv_.WaitFor(mu_, step);
   }
   if (queue_.empty()) return std::nullopt;
   v1::SessionEvent event = std::move(queue_.front());
@@ -61,28 +61,28 @@ std::optional<v1::SessionEvent> EventSubscription::Next(std::chrono::steady_cloc
 }
 
 bool EventSubscription::ended() const {
-  std::lock_guard lock(mu_);
+  MutexLock lock(mu_);
   return closed_;
 }
 
 std::uint64_t EventSubscription::dropped() const {
-  std::lock_guard lock(mu_);
+  MutexLock lock(mu_);
   return dropped_;
 }
 
 void EventSubscription::Close() {
   {
-    std::lock_guard lock(mu_);
+    MutexLock lock(mu_);
     closed_ = true;
     queue_.clear();
   }
-  cv_.notify_all();
+  cv_.NotifyAll();
 }
 
 EventBus::EventBus(std::size_t queue_capacity) : capacity_(queue_capacity) {}
 
 std::uint64_t EventBus::Publish(std::int64_t session, v1::SessionEvent event, bool terminal) {
-  std::lock_guard lock(mu_);
+  MutexLock lock(mu_);
   Channel& channel = channels_[session];
   event.set_session_id(std::to_string(session));
   event.set_sequence(++channel.sequence);
@@ -105,7 +105,7 @@ std::shared_ptr<EventSubscription> EventBus::Subscribe(std::int64_t session,
                                                        const OpeningFn& opening,
                                                        bool already_ended) {
   auto sub = std::make_shared<EventSubscription>(capacity_);
-  std::lock_guard lock(mu_);
+  MutexLock lock(mu_);
   Channel& channel = channels_[session];
   Opening first = opening();
   v1::SessionEvent snapshot;
@@ -128,7 +128,7 @@ std::shared_ptr<EventSubscription> EventBus::Subscribe(std::int64_t session,
 }
 
 std::size_t EventBus::SubscriberCount(std::int64_t session) const {
-  std::lock_guard lock(mu_);
+  MutexLock lock(mu_);
   auto it = channels_.find(session);
   if (it == channels_.end()) return 0;
   std::size_t n = 0;

@@ -11,18 +11,17 @@
 #pragma once
 
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <vector>
 
 #include "brdf/v1/brdf.pb.h"
 #include "core/call_context.h"
+#include "core/mutex.h"
 
 namespace brdf::daemon {
 
@@ -50,12 +49,13 @@ class EventSubscription {
   void Push(v1::SessionEvent event, bool last);
 
   const std::size_t capacity_;
-  mutable std::mutex mu_;
-  std::condition_variable cv_;
-  std::deque<v1::SessionEvent> queue_;
-  bool closing_ = false;  // the terminal event is queued: end once the queue drains
-  bool closed_ = false;   // Close() or the terminal event was read
-  std::uint64_t dropped_ = 0;
+  mutable Mutex mu_;
+  CondVar cv_;
+  std::deque<v1::SessionEvent> queue_ GUARDED_BY(mu_);
+  // The terminal event is queued: end once the queue drains.
+  bool closing_ GUARDED_BY(mu_) = false;
+  bool closed_ GUARDED_BY(mu_) = false;  // Close() or the terminal event was read
+  std::uint64_t dropped_ GUARDED_BY(mu_) = 0;
 };
 
 class EventBus {
@@ -91,8 +91,8 @@ class EventBus {
   };
 
   const std::size_t capacity_;
-  mutable std::mutex mu_;
-  std::map<std::int64_t, Channel> channels_;
+  mutable Mutex mu_;
+  std::map<std::int64_t, Channel> channels_ GUARDED_BY(mu_);
 };
 
 }  // namespace brdf::daemon

@@ -59,19 +59,19 @@ Executor::~Executor() = default;
 void Executor::Cancel(const std::string& reason) {
   cancel_.Cancel(reason);
   {
-    std::lock_guard lock(answer_mu_);
+    MutexLock lock(answer_mu_);
     wake_ = true;
   }
-  answer_cv_.notify_all();
+  answer_cv_.NotifyAll();
 }
 
 void Executor::Answered(int step_index) {
   {
-    std::lock_guard lock(answer_mu_);
+    MutexLock lock(answer_mu_);
     answered_step_ = step_index;
     wake_ = true;
   }
-  answer_cv_.notify_all();
+  answer_cv_.NotifyAll();
 }
 
 CallContext Executor::DeviceContext() const {
@@ -258,14 +258,14 @@ Executor::Outcome Executor::RunPrompt(Context& c, int index) {
   v1::Prompt prompt = ToPrompt(step);
   *prompt.mutable_raised_at() = NowTimestamp();
   {
-    std::lock_guard lock(answer_mu_);
+    MutexLock lock(answer_mu_);
     answered_step_.reset();
   }
   Result<SessionState> state = host_.RaisePrompt(session_, prompt);
   if (!state.ok() || *state != SessionState::kAwaitingOperator) return Outcome::kStop;
   {
-    std::unique_lock lock(answer_mu_);
-    answer_cv_.wait(lock, [&] {
+    MutexLock lock(answer_mu_);
+    answer_cv_.Wait(answer_mu_, [&]() REQUIRES(answer_mu_) {
       return cancel_.cancelled() || (answered_step_.has_value() && *answered_step_ == index);
     });
   }

@@ -33,11 +33,9 @@
 #pragma once
 
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,6 +43,7 @@
 #include "brdf/v1/brdf.pb.h"
 #include "core/call_context.h"
 #include "core/clock.h"
+#include "core/mutex.h"
 #include "core/plan/plan_settings.h"
 #include "core/session_state.h"
 #include "core/status.h"
@@ -161,10 +160,10 @@ class Executor {
   Options options_;
   CancelToken cancel_;
 
-  std::mutex answer_mu_;
-  std::condition_variable answer_cv_;
-  std::optional<int> answered_step_;
-  bool wake_ = false;  // Cancel() or Answered() happened
+  Mutex answer_mu_;
+  CondVar answer_cv_;
+  std::optional<int> answered_step_ GUARDED_BY(answer_mu_);
+  bool wake_ GUARDED_BY(answer_mu_) = false;  // Cancel() or Answered() happened
 };
 
 }  // namespace brdf::daemon

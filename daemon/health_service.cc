@@ -11,20 +11,20 @@ HealthService::HealthService(const StopSignal& stopping) : stopping_(stopping) {
 
 void HealthService::SetServingStatus(const std::string& service, bool serving) {
   {
-    std::lock_guard lock(mu_);
+    MutexLock lock(mu_);
     serving_[service] = serving;
     ++version_;
   }
-  changed_.notify_all();
+  changed_.NotifyAll();
 }
 
 void HealthService::SetServingStatus(bool serving) {
   {
-    std::lock_guard lock(mu_);
+    MutexLock lock(mu_);
     for (auto& [name, value] : serving_) value = serving;
     ++version_;
   }
-  changed_.notify_all();
+  changed_.NotifyAll();
 }
 
 HealthService::Status HealthService::StatusLocked(const std::string& service) const {
@@ -36,7 +36,7 @@ HealthService::Status HealthService::StatusLocked(const std::string& service) co
 grpc::Status HealthService::Check(grpc::ServerContext* /*context*/,
                                   const grpc::health::v1::HealthCheckRequest* request,
                                   HealthCheckResponse* response) {
-  std::lock_guard lock(mu_);
+  MutexLock lock(mu_);
   const Status status = StatusLocked(request->service());
   if (status == HealthCheckResponse::SERVICE_UNKNOWN) {
     std::string known;  // the services SetServingStatus named, "" (the server) first
@@ -56,15 +56,15 @@ grpc::Status HealthService::Check(grpc::ServerContext* /*context*/,
 grpc::Status HealthService::Watch(grpc::ServerContext* context,
                                   const grpc::health::v1::HealthCheckRequest* request,
                                   grpc::ServerWriter<HealthCheckResponse>* writer) {
-  std::unique_lock lock(mu_);
+  MutexLock lock(mu_);
   std::uint64_t sent_version = version_;
   Status sent = StatusLocked(request->service());
   for (;;) {
     HealthCheckResponse response;
     response.set_status(sent);
-    lock.unlock();
+    lock.Unlock();
     if (!writer->Write(response)) return grpc::Status::OK;  // the client went away
-    lock.lock();
+    lock.Lock();
     // Until the status changes (a new version may leave it as it was: not sent again).
     for (;;) {
       // A change first: at shutdown the NOT_SERVING set just before Stop() still goes out.
@@ -77,7 +77,7 @@ grpc::Status HealthService::Watch(grpc::ServerContext* context,
         return {grpc::StatusCode::UNAVAILABLE, "health: brdfd is shutting down"};
       }
       // The synchronous API has no wake-up for a client that went away: look now and then.
-      changed_.wait_for(lock, kStreamPollInterval);
+      changed_.WaitFor(mu_, kStreamPollInterval);
     }
     sent = StatusLocked(request->service());
   }

@@ -8,12 +8,11 @@
 // loop thread and its calls (interpolate_loop.h).
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <map>
-#include <mutex>
 #include <string>
 
+#include "core/mutex.h"
 #include "daemon/service_common.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 
@@ -39,13 +38,13 @@ class HealthService final : public grpc::health::v1::Health::Service {
  private:
   using Status = grpc::health::v1::HealthCheckResponse::ServingStatus;
   // The status of `service` (SERVICE_UNKNOWN when not known), mu_ held.
-  Status StatusLocked(const std::string& service) const;
+  Status StatusLocked(const std::string& service) const REQUIRES(mu_);
 
   const StopSignal& stopping_;
-  mutable std::mutex mu_;
-  std::condition_variable changed_;
-  std::map<std::string, bool> serving_;  // by service name
-  std::uint64_t version_ = 0;            // bumped at each change, for watchers
+  mutable Mutex mu_;
+  CondVar changed_;
+  std::map<std::string, bool> serving_ GUARDED_BY(mu_);  // by service name
+  std::uint64_t version_ GUARDED_BY(mu_) = 0;            // bumped at each change, for watchers
 };
 
 }  // namespace brdf::daemon

@@ -72,7 +72,7 @@ void InterpolateLoop::Start() {
 }
 
 void InterpolateLoop::BeginShutdown() {
-  std::lock_guard lock(request_mu_);
+  MutexLock lock(request_mu_);
   closing_ = true;
 }
 
@@ -81,10 +81,10 @@ void InterpolateLoop::Stop() {
   stopped_ = true;
   BeginShutdown();  // in case the caller did not: no call may be asked for on a closed queue
   {
-    std::lock_guard lock(slow_mu_);
+    MutexLock lock(slow_mu_);
     slow_stop_ = true;
   }
-  slow_cv_.notify_all();
+  slow_cv_.NotifyAll();
   // The slow lane first: its replies complete on the queues, which must still be open.
   if (slow_lane_.joinable()) slow_lane_.join();
   for (auto& queue : queues_) queue->Shutdown();
@@ -99,12 +99,13 @@ void InterpolateLoop::Stop() {
   loops_.clear();
   // Left behind only if a loop handed a call over after the slow lane had stopped (the server's
   // shutdown should have settled every call by then): released unanswered.
+  MutexLock lock(slow_mu_);
   for (Call* call : slow_) delete call;
   slow_.clear();
 }
 
 void InterpolateLoop::Request(grpc::ServerCompletionQueue* queue) {
-  std::lock_guard lock(request_mu_);
+  MutexLock lock(request_mu_);
   if (closing_) return;
   auto* call = new Call(queue);
   service_.RequestInterpolate(&call->context, &call->request, &call->responder, queue, queue, call);
@@ -136,10 +137,10 @@ void InterpolateLoop::Serve(grpc::ServerCompletionQueue* queue) {
       continue;
     }
     {
-      std::lock_guard lock(slow_mu_);
+      MutexLock lock(slow_mu_);
       slow_.push_back(call);
     }
-    slow_cv_.notify_one();
+    slow_cv_.NotifyOne();
   }
 }
 
@@ -147,8 +148,8 @@ void InterpolateLoop::SlowLane() {
   for (;;) {
     Call* call = nullptr;
     {
-      std::unique_lock lock(slow_mu_);
-      slow_cv_.wait(lock, [this] { return slow_stop_ || !slow_.empty(); });
+      MutexLock lock(slow_mu_);
+      slow_cv_.Wait(slow_mu_, [this]() REQUIRES(slow_mu_) { return slow_stop_ || !slow_.empty(); });
       if (slow_.empty()) return;  // stopping, and nothing left to answer
       call = slow_.front();
       slow_.pop_front();

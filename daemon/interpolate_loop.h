@@ -23,13 +23,12 @@
 
 #include <grpcpp/server_builder.h>
 
-#include <condition_variable>
 #include <deque>
 #include <memory>
-#include <mutex>
 #include <thread>
 #include <vector>
 
+#include "core/mutex.h"
 #include "daemon/service_interpolation.h"
 
 namespace brdf::daemon {
@@ -70,13 +69,13 @@ class InterpolateLoop {
   std::vector<std::unique_ptr<grpc::ServerCompletionQueue>> queues_;
   std::vector<std::thread> loops_;
 
-  std::mutex request_mu_;  // orders Request against BeginShutdown
-  bool closing_ = false;
+  Mutex request_mu_;  // orders Request against BeginShutdown
+  bool closing_ GUARDED_BY(request_mu_) = false;
 
-  std::mutex slow_mu_;
-  std::condition_variable slow_cv_;
-  std::deque<Call*> slow_;
-  bool slow_stop_ = false;
+  Mutex slow_mu_;
+  CondVar slow_cv_;
+  std::deque<Call*> slow_ GUARDED_BY(slow_mu_);
+  bool slow_stop_ GUARDED_BY(slow_mu_) = false;
   std::thread slow_lane_;
   bool stopped_ = false;
 };

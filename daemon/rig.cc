@@ -156,7 +156,7 @@ Rig::~Rig() {
 }
 
 void Rig::Start() {
-  std::lock_guard lock(thread_mu_);
+  MutexLock lock(thread_mu_);
   if (supervisor_.joinable()) return;
   stopping_ = false;
   supervisor_cancel_ = CancelToken();
@@ -165,11 +165,11 @@ void Rig::Start() {
 
 void Rig::Stop() {
   {
-    std::lock_guard lock(thread_mu_);
+    MutexLock lock(thread_mu_);
     stopping_ = true;
     supervisor_cancel_.Cancel("the daemon is shutting down");
   }
-  wake_.notify_all();
+  wake_.NotifyAll();
   if (supervisor_.joinable()) supervisor_.join();
   // Close the devices once their users are done with them.
   if (meter_) {
@@ -180,23 +180,23 @@ void Rig::Stop() {
     std::unique_lock lock(stage_mu_);
     stage_->Disconnect();
   }
-  std::lock_guard lock(status_mu_);
+  MutexLock lock(status_mu_);
   if (meter_) SetConnection(status_.meter, DeviceConnection::kDisconnected);
   if (stage_) SetConnection(status_.stage, DeviceConnection::kDisconnected);
 }
 
 RigStatus Rig::GetStatus() const {
-  std::lock_guard lock(status_mu_);
+  MutexLock lock(status_mu_);
   return status_;
 }
 
 std::optional<drivers::MeterIdentity> Rig::meter_identity() const {
-  std::lock_guard lock(status_mu_);
+  MutexLock lock(status_mu_);
   return identity_;
 }
 
 void Rig::SetManualDelta(double delta_deg) {
-  std::lock_guard lock(status_mu_);
+  MutexLock lock(status_mu_);
   status_.manual_delta_deg = delta_deg;
 }
 
@@ -217,7 +217,7 @@ std::chrono::milliseconds Rig::BackoffAfter(int failed_attempts) const {
 }
 
 void Rig::NoteMeterResult(const Status& status, bool connecting) {
-  std::lock_guard lock(status_mu_);
+  MutexLock lock(status_mu_);
   DeviceHealth& h = status_.meter;
   if (status.ok()) {
     h.failed_attempts = 0;
@@ -236,7 +236,7 @@ void Rig::NoteMeterResult(const Status& status, bool connecting) {
 }
 
 void Rig::NoteStageResult(const Status& status, bool connecting) {
-  std::lock_guard lock(status_mu_);
+  MutexLock lock(status_mu_);
   DeviceHealth& h = status_.stage;
   if (status.ok()) {
     h.failed_attempts = 0;
@@ -256,15 +256,17 @@ void Rig::NoteStageResult(const Status& status, bool connecting) {
 }
 
 Status Rig::ConnectMeterLocked(const CallContext& ctx) {
+  std::string address;
   {
-    std::lock_guard lock(status_mu_);
+    MutexLock lock(status_mu_);
     SetConnection(status_.meter, DeviceConnection::kConnecting);
+    address = status_.meter.address;
   }
   Status st = meter_->Connect(ctx);
   if (st.ok()) {
     Result<drivers::MeterIdentity> id = meter_->Identify(ctx);
     if (id.ok()) {
-      std::lock_guard lock(status_mu_);
+      MutexLock lock(status_mu_);
       identity_ = *id;
       status_.meter_serial = id->serial_number;
       status_.meter_grid = id->grid;
@@ -276,26 +278,28 @@ Status Rig::ConnectMeterLocked(const CallContext& ctx) {
   }
   NoteMeterResult(st, /*connecting=*/true);
   if (st.ok()) {
-    spdlog::info("meter connected ({}, serial {})", status_.meter.address,
+    spdlog::info("meter connected ({}, serial {})", address,
                  meter_identity() ? meter_identity()->serial_number : "?");
   } else if (st.code() != StatusCode::kCancelled) {
-    spdlog::warn("meter on {} not connected: {}", status_.meter.address, st.ToString());
+    spdlog::warn("meter on {} not connected: {}", address, st.ToString());
   }
   return st;
 }
 
 Status Rig::ConnectStageLocked(const CallContext& ctx) {
+  std::string address;
   {
-    std::lock_guard lock(status_mu_);
+    MutexLock lock(status_mu_);
     SetConnection(status_.stage, DeviceConnection::kConnecting);
+    address = status_.stage.address;
   }
   if (stage_reset_requested_.exchange(false) || stage_->connected()) stage_->Disconnect();
   const Status st = stage_->Connect(ctx);
   NoteStageResult(st, /*connecting=*/true);
   if (st.ok()) {
-    spdlog::info("stage connected ({})", status_.stage.address);
+    spdlog::info("stage connected ({})", address);
   } else if (st.code() != StatusCode::kCancelled) {
-    spdlog::warn("stage on {} not connected: {}", status_.stage.address, st.ToString());
+    spdlog::warn("stage on {} not connected: {}", address, st.ToString());
   }
   return st;
 }
@@ -370,7 +374,7 @@ void Rig::PollPose() {
       CallContext::WithTimeout(std::max(options_.pose_poll_interval, milliseconds(1000)),
                                supervisor_cancel_, *options_.clock));
   if (pose.ok()) {
-    std::lock_guard status_lock(status_mu_);
+    MutexLock status_lock(status_mu_);
     status_.live_pose = *pose;
     status_.updated_at = std::chrono::system_clock::now();
     if (status_.stage.connection != DeviceConnection::kConnected &&
@@ -385,13 +389,13 @@ void Rig::PollPose() {
 void Rig::Supervise() {
   for (;;) {
     {
-      std::lock_guard lock(thread_mu_);
+      MutexLock lock(thread_mu_);
       if (stopping_) return;
     }
     const auto now = steady_clock::now();
     steady_clock::time_point meter_at, stage_at;
     {
-      std::lock_guard lock(status_mu_);
+      MutexLock lock(status_mu_);
       meter_at = next_meter_attempt_;
       stage_at = next_stage_attempt_;
     }
@@ -402,7 +406,7 @@ void Rig::Supervise() {
     // Sleep until the next poll or connection attempt, whichever comes first.
     auto wait = options_.pose_poll_interval;
     {
-      std::lock_guard lock(status_mu_);
+      MutexLock lock(status_mu_);
       const auto after = steady_clock::now();
       if (meter_ && status_.meter.connection != DeviceConnection::kConnected) {
         wait = std::min(wait, std::chrono::duration_cast<milliseconds>(std::max(
@@ -414,8 +418,8 @@ void Rig::Supervise() {
       }
     }
     wait = std::max(wait, milliseconds(10));
-    std::unique_lock lock(thread_mu_);
-    wake_.wait_for(lock, wait, [this] { return stopping_; });
+    MutexLock lock(thread_mu_);
+    wake_.WaitFor(thread_mu_, wait, [this]() REQUIRES(thread_mu_) { return stopping_; });
     if (stopping_) return;
   }
 }

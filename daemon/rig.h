@@ -15,10 +15,8 @@
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -26,6 +24,7 @@
 #include "brdf/v1/brdf.pb.h"
 #include "core/call_context.h"
 #include "core/clock.h"
+#include "core/mutex.h"
 #include "core/plan/rig_description.h"
 #include "core/pose.h"
 #include "core/status.h"
@@ -136,7 +135,7 @@ class Rig {
   // Records the outcome of a call or connection attempt in the device's health.
   void NoteMeterResult(const Status& status, bool connecting);
   void NoteStageResult(const Status& status, bool connecting);
-  void SetConnection(DeviceHealth& health, DeviceConnection connection);  // status_mu_ held
+  void SetConnection(DeviceHealth& health, DeviceConnection connection) REQUIRES(status_mu_);
   std::chrono::milliseconds BackoffAfter(int failed_attempts) const;
 
   plan::RigDescription description_;
@@ -150,15 +149,15 @@ class Rig {
   DeviceGate stage_mu_;
   std::atomic<bool> stage_reset_requested_{false};  // the link failed under a call: reconnect
 
-  mutable std::mutex status_mu_;  // guards everything below
-  RigStatus status_;
-  std::optional<drivers::MeterIdentity> identity_;
-  std::chrono::steady_clock::time_point next_meter_attempt_{};
-  std::chrono::steady_clock::time_point next_stage_attempt_{};
+  mutable Mutex status_mu_;
+  RigStatus status_ GUARDED_BY(status_mu_);
+  std::optional<drivers::MeterIdentity> identity_ GUARDED_BY(status_mu_);
+  std::chrono::steady_clock::time_point next_meter_attempt_ GUARDED_BY(status_mu_){};
+  std::chrono::steady_clock::time_point next_stage_attempt_ GUARDED_BY(status_mu_){};
 
-  std::mutex thread_mu_;
-  std::condition_variable wake_;
-  bool stopping_ = false;
+  Mutex thread_mu_;
+  CondVar wake_;
+  bool stopping_ GUARDED_BY(thread_mu_) = false;
   std::thread supervisor_;
   CancelToken supervisor_cancel_;
 };

@@ -179,15 +179,15 @@ v1::Reading ToProtoReading(const storage::ReadingRecord& r, const ReadingExtras&
 
 void StopSignal::Stop() {
   {
-    std::lock_guard lock(mu_);
+    MutexLock lock(mu_);
     stopped_ = true;
   }
-  cv_.notify_all();
+  cv_.NotifyAll();
 }
 
 bool StopSignal::WaitFor(std::chrono::steady_clock::duration d) const {
-  std::unique_lock lock(mu_);
-  return cv_.wait_for(lock, d, [this] { return stopped_.load(); });
+  MutexLock lock(mu_);
+  return cv_.WaitFor(mu_, d, [this] { return stopped_.load(); });
 }
 
 }  // namespace brdf::daemon

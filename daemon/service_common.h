@@ -8,14 +8,13 @@
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <map>
-#include <mutex>
 #include <string>
 
 #include "brdf/v1/brdf.pb.h"
 #include "core/interp/interpolator.h"
+#include "core/mutex.h"
 #include "core/readings/quantity.h"
 #include "core/status.h"
 #include "core/wavelength_grid.h"
@@ -91,8 +90,8 @@ class StopSignal {
 
  private:
   std::atomic<bool> stopped_{false};
-  mutable std::mutex mu_;
-  mutable std::condition_variable cv_;
+  mutable Mutex mu_;
+  mutable CondVar cv_;
 };
 
 }  // namespace brdf::daemon

@@ -11,10 +11,10 @@ DataService::DataService(SessionManager& manager, const Authenticator& auth,
     : manager_(manager), auth_(auth), stopping_(stopping) {
   listener_ = manager_.AddReadingListener([this](SessionId, const storage::ReadingRecord&) {
     {
-      std::lock_guard lock(mu_);
+      MutexLock lock(mu_);
       ++generation_;
     }
-    cv_.notify_all();
+    cv_.NotifyAll();
   });
 }
 
@@ -23,13 +23,13 @@ DataService::~DataService() {
 }
 
 std::uint64_t DataService::Generation() const {
-  std::lock_guard lock(mu_);
+  MutexLock lock(mu_);
   return generation_;
 }
 
 void DataService::WaitForReading(std::uint64_t seen, std::chrono::steady_clock::duration d) const {
-  std::unique_lock lock(mu_);
-  cv_.wait_for(lock, d, [&] { return generation_ != seen || stopping_.stopped(); });
+  MutexLock lock(mu_);
+  cv_.WaitFor(mu_, d, [&]() REQUIRES(mu_) { return generation_ != seen || stopping_.stopped(); });
 }
 
 grpc::Status DataService::StreamReadings(grpc::ServerContext* context,

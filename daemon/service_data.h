@@ -5,12 +5,11 @@
 // files (Export) live in service_export.cc.
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <memory>
-#include <mutex>
 
 #include "brdf/v1/brdf.grpc.pb.h"
+#include "core/mutex.h"
 #include "daemon/auth.h"
 #include "daemon/service_common.h"
 #include "daemon/session_manager.h"
@@ -46,9 +45,9 @@ class DataService final : public v1::Data::Service {
   const StopSignal& stopping_;
   int listener_ = 0;
 
-  mutable std::mutex mu_;
-  mutable std::condition_variable cv_;
-  std::uint64_t generation_ = 0;  // guarded by mu_
+  mutable Mutex mu_;
+  mutable CondVar cv_;
+  std::uint64_t generation_ GUARDED_BY(mu_) = 0;
 };
 
 }  // namespace brdf::daemon

@@ -4,12 +4,12 @@
 
 #include <algorithm>
 #include <cctype>
-#include <condition_variable>
 #include <deque>
 #include <map>
 #include <thread>
 #include <utility>
 
+#include "core/mutex.h"
 #include "core/plan/plan_json.h"
 #include "core/plan/plan_proto.h"
 #include "core/plan/plan_settings.h"
@@ -75,18 +75,18 @@ struct SessionManager::Impl final : public ExecutorHost {
 
   Result<SessionState> ApplyEvent(std::int64_t session, SessionEvent event,
                                   const std::string& reason) override {
-    std::lock_guard lock(mu);
+    MutexLock lock(mu);
     return TransitionLocked(session, event, reason);
   }
 
   SessionState CurrentState(std::int64_t session) override {
-    std::lock_guard lock(mu);
+    MutexLock lock(mu);
     Result<SessionState> s = StateLocked(session);
     return s.ok() ? *s : SessionState::kFailed;
   }
 
   Result<SessionState> RaisePrompt(std::int64_t session, const v1::Prompt& prompt) override {
-    std::lock_guard lock(mu);
+    MutexLock lock(mu);
     Result<SessionState> next = TransitionLocked(session, SessionEvent::kPrompt,
                                                  "waiting for the operator: " + prompt.text());
     if (next.ok() && *next == SessionState::kAwaitingOperator) {
@@ -101,7 +101,7 @@ struct SessionManager::Impl final : public ExecutorHost {
   void StepCompleted(std::int64_t session, const v1::StepCompletion& completion,
                      const storage::ReadingRecord* reading) override {
     {
-      std::lock_guard lock(mu);
+      MutexLock lock(mu);
       if (reading != nullptr) live[session].last_quality = reading->quality_code;
       v1::SessionEvent event;
       *event.mutable_step_completed() = completion;
@@ -110,19 +110,19 @@ struct SessionManager::Impl final : public ExecutorHost {
     if (reading == nullptr) return;
     std::vector<ReadingListener> to_call;
     {
-      std::lock_guard lock(listeners_mu);
+      MutexLock lock(listeners_mu);
       for (const auto& [handle, fn] : listeners) to_call.push_back(fn);
     }
     for (const ReadingListener& fn : to_call) fn(session, *reading);
   }
 
   Result<std::shared_ptr<const SessionPlan>> Plan(std::int64_t session) override {
-    std::lock_guard lock(mu);
+    MutexLock lock(mu);
     return PlanLocked(session, nullptr);
   }
 
   void Fault(std::int64_t session, const v1::Fault& fault) override {
-    std::lock_guard lock(mu);
+    MutexLock lock(mu);
     live[session].last_fault = fault;
     if (fault.last_quality_code() >= 0) live[session].last_quality = fault.last_quality_code();
     v1::SessionEvent event;
@@ -132,7 +132,7 @@ struct SessionManager::Impl final : public ExecutorHost {
 
   // --- State --------------------------------------------------------------------------------
 
-  Result<SessionState> StateLocked(SessionId id) {
+  Result<SessionState> StateLocked(SessionId id) REQUIRES(mu) {
     Live& l = live[id];
     if (l.state.has_value()) return *l.state;
     Result<storage::SessionRecord> rec = store.GetSession(id);
@@ -145,14 +145,15 @@ struct SessionManager::Impl final : public ExecutorHost {
   }
 
   // The rig is free for `id` when nobody holds it (or `id` does) and no session waits before it.
-  bool RigFreeFor(SessionId id) const {
+  bool RigFreeFor(SessionId id) const REQUIRES(mu) {
     if (holder.has_value() && *holder != id) return false;
     return queue.empty() || queue.front() == id;
   }
 
   // The one place where a session's state changes: core/session_state.h's table, then the store,
   // then the watchers.
-  Result<SessionState> TransitionLocked(SessionId id, SessionEvent event, std::string reason) {
+  Result<SessionState> TransitionLocked(SessionId id, SessionEvent event, std::string reason)
+      REQUIRES(mu) {
     Result<SessionState> from = StateLocked(id);
     if (!from.ok()) return from.status();
     Result<SessionState> to = NextState(*from, event, RigFreeFor(id));
@@ -207,7 +208,7 @@ struct SessionManager::Impl final : public ExecutorHost {
     spdlog::info("{}: {} -> {} ({}){}", SessionName(id), SessionStateName(*from),
                  SessionStateName(*to), SessionEventName(event),
                  reason.empty() ? "" : ": " + reason);
-    scheduler_cv.notify_all();
+    scheduler_cv.NotifyAll();
     return *to;
   }
 
@@ -216,7 +217,8 @@ struct SessionManager::Impl final : public ExecutorHost {
   // The plan kept with the session, parsed from `record` (read from the store when null) the
   // first time it is asked for. A plan that does not parse is logged once and kept as its Status.
   Result<std::shared_ptr<const SessionPlan>> PlanLocked(SessionId id,
-                                                        const storage::SessionRecord* record) {
+                                                        const storage::SessionRecord* record)
+      REQUIRES(mu) {
     auto kept = plans.find(id);
     if (kept != plans.end()) return kept->second;
     Result<storage::SessionRecord> read = Internal("unset");
@@ -237,7 +239,7 @@ struct SessionManager::Impl final : public ExecutorHost {
 
   // --- The session as the API shows it ------------------------------------------------------
 
-  Result<v1::Session> BuildLocked(SessionId id, bool with_plan) {
+  Result<v1::Session> BuildLocked(SessionId id, bool with_plan) REQUIRES(mu) {
     if (!with_plan) {
       auto cached = terminal_cache.find(id);
       if (cached != terminal_cache.end()) return cached->second;
@@ -328,7 +330,7 @@ struct SessionManager::Impl final : public ExecutorHost {
     Status st;
     Result<v1::Session> out = Internal("unset");
     {
-      std::lock_guard lock(mu);
+      MutexLock lock(mu);
       if (shut_down) {
         st = FailedPrecondition("the daemon is shutting down; try again after it restarts");
       } else {
@@ -344,7 +346,7 @@ struct SessionManager::Impl final : public ExecutorHost {
   // --- Runs ---------------------------------------------------------------------------------
 
   // Starts an executor for `id` (scheduler thread, mu held, no other run alive).
-  void LaunchLocked(SessionId id) {
+  void LaunchLocked(SessionId id) REQUIRES(mu) {
     Executor::Options options;
     options.pipelining = owner.options_.pipelining;
     options.clock = owner.options_.clock;
@@ -352,26 +354,26 @@ struct SessionManager::Impl final : public ExecutorHost {
     current = executor;
     running_thread = std::thread([this, executor] {
       executor->Run();
-      std::lock_guard lock(mu);
+      MutexLock lock(mu);
       if (current == executor) current.reset();
       run_ended = true;
-      scheduler_cv.notify_all();
+      scheduler_cv.NotifyAll();
     });
   }
 
   void Schedule() {
-    std::unique_lock lock(mu);
+    MutexLock lock(mu);
     for (;;) {
-      scheduler_cv.wait(lock, [this] {
+      scheduler_cv.Wait(mu, [this]() REQUIRES(mu) {
         return stopping || run_ended || (!current && launch.has_value()) ||
                (!holder.has_value() && !queue.empty() && !shut_down);
       });
       if (run_ended) {
         run_ended = false;
         std::thread finished = std::move(running_thread);
-        lock.unlock();
+        lock.Unlock();
         if (finished.joinable()) finished.join();
-        lock.lock();
+        lock.Lock();
       }
       if (stopping && !current) return;
       if (!holder.has_value() && !queue.empty() && !shut_down) {
@@ -401,9 +403,9 @@ struct SessionManager::Impl final : public ExecutorHost {
 
   // After a verb made `id` running: a new run starts once the previous one (if any, e.g. one
   // winding down after an immediate pause) has ended.
-  void EnsureRunLocked(SessionId id) {
+  void EnsureRunLocked(SessionId id) REQUIRES(mu) {
     launch = id;
-    scheduler_cv.notify_all();
+    scheduler_cv.NotifyAll();
   }
 
   SessionManager& owner;
@@ -411,25 +413,27 @@ struct SessionManager::Impl final : public ExecutorHost {
   Rig& rig;
   EventBus bus;
 
-  std::mutex mu;
-  std::condition_variable scheduler_cv;
-  std::map<SessionId, Live> live;
-  std::map<SessionId, v1::Session> terminal_cache;  // terminal sessions without their plan
+  Mutex mu;
+  CondVar scheduler_cv;
+  std::map<SessionId, Live> live GUARDED_BY(mu);
+  // Terminal sessions without their plan.
+  std::map<SessionId, v1::Session> terminal_cache GUARDED_BY(mu);
   // Each session's plan, parsed once (PlanLocked), or why it does not parse.
-  std::map<SessionId, Result<std::shared_ptr<const SessionPlan>>> plans;
-  std::deque<SessionId> queue;        // started, waiting for the rig, in order
-  std::optional<SessionId> holder;    // the session that holds the rig
-  std::optional<SessionId> launch;    // a run to start once no run is alive
-  std::shared_ptr<Executor> current;  // the run alive (maybe winding down)
-  std::thread running_thread;         // its thread
-  bool run_ended = false;
-  bool shut_down = false;  // verbs refused
-  bool stopping = false;   // the scheduler ends
+  std::map<SessionId, Result<std::shared_ptr<const SessionPlan>>> plans GUARDED_BY(mu);
+  std::deque<SessionId> queue GUARDED_BY(mu);        // started, waiting for the rig, in order
+  std::optional<SessionId> holder GUARDED_BY(mu);    // the session that holds the rig
+  std::optional<SessionId> launch GUARDED_BY(mu);    // a run to start once no run is alive
+  std::shared_ptr<Executor> current GUARDED_BY(mu);  // the run alive (maybe winding down)
+  // Its thread: set and taken under mu; joined by Shutdown once the scheduler has ended.
+  std::thread running_thread;
+  bool run_ended GUARDED_BY(mu) = false;
+  bool shut_down GUARDED_BY(mu) = false;  // verbs refused
+  bool stopping GUARDED_BY(mu) = false;   // the scheduler ends
   std::thread scheduler;
 
-  std::mutex listeners_mu;
-  std::map<int, ReadingListener> listeners;
-  int next_listener = 1;
+  Mutex listeners_mu;
+  std::map<int, ReadingListener> listeners GUARDED_BY(listeners_mu);
+  int next_listener GUARDED_BY(listeners_mu) = 1;
 };
 
 SessionManager::SessionManager(std::shared_ptr<storage::SessionStore> store,
@@ -448,7 +452,7 @@ Result<std::vector<SessionId>> SessionManager::Recover() {
   Result<std::vector<std::int64_t>> ids = store_->RecoverInterruptedSessions();
   if (!ids.ok()) return ids.status();
   {
-    std::lock_guard lock(impl_->mu);
+    MutexLock lock(impl_->mu);
     for (SessionId id : *ids) impl_->live[id].state = SessionState::kPaused;
     if (!ids->empty() && !impl_->holder.has_value()) impl_->holder = ids->front();
   }
@@ -465,7 +469,7 @@ Result<std::vector<SessionId>> SessionManager::Recover() {
 
 void SessionManager::Shutdown(std::chrono::milliseconds timeout) {
   Impl& m = *impl_;
-  std::unique_lock lock(m.mu);
+  MutexLock lock(m.mu);
   if (m.stopping) return;
   m.shut_down = true;
   m.queue.clear();  // nothing new starts; waiting sessions stay QUEUED in the store
@@ -483,7 +487,7 @@ void SessionManager::Shutdown(std::chrono::milliseconds timeout) {
         m.current->Cancel("daemon shutting down");
     }
   }
-  if (!m.scheduler_cv.wait_for(lock, timeout, [&m] { return !m.current; })) {
+  if (!m.scheduler_cv.WaitFor(m.mu, timeout, [&m]() REQUIRES(m.mu) { return !m.current; })) {
     // The step did not finish in time: cancel it (resume redoes it).
     const SessionId id = m.current->session();
     spdlog::warn("{}: step still running at shutdown after {} ms; cancelling it", SessionName(id),
@@ -491,11 +495,11 @@ void SessionManager::Shutdown(std::chrono::milliseconds timeout) {
     (void)m.TransitionLocked(id, SessionEvent::kPauseImmediate,
                              "daemon shutting down (step in progress cancelled; resume redoes it)");
     m.current->Cancel("daemon shutting down");
-    m.scheduler_cv.wait(lock, [&m] { return !m.current; });
+    m.scheduler_cv.Wait(m.mu, [&m]() REQUIRES(m.mu) { return !m.current; });
   }
   m.stopping = true;
-  m.scheduler_cv.notify_all();
-  lock.unlock();
+  m.scheduler_cv.NotifyAll();
+  lock.Unlock();
   if (m.scheduler.joinable()) m.scheduler.join();
   if (m.running_thread.joinable()) m.running_thread.join();
   rig_->Stop();
@@ -534,13 +538,13 @@ Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor
   steps.reserve(analysis.steps.size());
   for (const plan::Step& step : analysis.steps) steps.push_back(ToStepRecord(step));
   {
-    std::lock_guard lock(impl_->mu);
+    MutexLock lock(impl_->mu);
     if (impl_->shut_down) return FailedPrecondition("the daemon is shutting down; submit later");
   }
   Result<std::int64_t> id = store_->CreateSession(session, steps);
   if (!id.ok()) return id.status().WithContext("storing the new session");
   {
-    std::lock_guard lock(impl_->mu);  // kept as submitted: never parsed back
+    MutexLock lock(impl_->mu);  // kept as submitted: never parsed back
     impl_->plans.insert_or_assign(*id,
                                   Result<std::shared_ptr<const SessionPlan>>(
                                       std::make_shared<const SessionPlan>(MakeSessionPlan(plan))));
@@ -553,21 +557,23 @@ Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor
 }
 
 Result<v1::Session> SessionManager::Start(SessionId session, const Actor& actor) {
-  return impl_->Verb(session, actor, "session.start", "started by " + Who(actor), [&]() -> Status {
-    Result<SessionState> to =
-        impl_->TransitionLocked(session, SessionEvent::kStart, "started by " + Who(actor));
-    if (!to.ok()) return to.status();
-    if (*to == SessionState::kRunning) impl_->EnsureRunLocked(session);
-    return Status::Ok();
-  });
+  return impl_->Verb(session, actor, "session.start", "started by " + Who(actor),
+                     [&]() REQUIRES(impl_->mu) -> Status {
+                       Result<SessionState> to = impl_->TransitionLocked(
+                           session, SessionEvent::kStart, "started by " + Who(actor));
+                       if (!to.ok()) return to.status();
+                       if (*to == SessionState::kRunning) impl_->EnsureRunLocked(session);
+                       return Status::Ok();
+                     });
 }
 
 Result<v1::Session> SessionManager::Pause(SessionId session, PauseMode mode, const Actor& actor) {
   const bool immediate = mode == PauseMode::kImmediate;
   const std::string reason =
       std::string("paused (") + (immediate ? "immediate" : "deferred") + ") by " + Who(actor);
-  return impl_->Verb(session, actor, "session.pause", reason, [&]() -> Status {
+  return impl_->Verb(session, actor, "session.pause", reason, [&]() REQUIRES(impl_->mu) -> Status {
     Impl& m = *impl_;
+    m.mu.AssertHeld();  // the same mutex, under another name
     Result<SessionState> from = m.StateLocked(session);
     if (!from.ok()) return from.status();
     if (!immediate) m.live[session].pause_reason = reason;
@@ -583,26 +589,28 @@ Result<v1::Session> SessionManager::Pause(SessionId session, PauseMode mode, con
 }
 
 Result<v1::Session> SessionManager::Resume(SessionId session, const Actor& actor) {
-  return impl_->Verb(session, actor, "session.resume", "resumed by " + Who(actor), [&]() -> Status {
-    Result<SessionState> from = impl_->StateLocked(session);
-    if (!from.ok()) return from.status();
-    Result<SessionState> to =
-        impl_->TransitionLocked(session, SessionEvent::kResume, "resumed by " + Who(actor));
-    if (!to.ok()) return to.status();
-    // From pausing, the run is still in its step and simply goes on.
-    if (*to == SessionState::kRunning && *from != SessionState::kPausing) {
-      impl_->EnsureRunLocked(session);
-    }
-    return Status::Ok();
-  });
+  return impl_->Verb(session, actor, "session.resume", "resumed by " + Who(actor),
+                     [&]() REQUIRES(impl_->mu) -> Status {
+                       Result<SessionState> from = impl_->StateLocked(session);
+                       if (!from.ok()) return from.status();
+                       Result<SessionState> to = impl_->TransitionLocked(
+                           session, SessionEvent::kResume, "resumed by " + Who(actor));
+                       if (!to.ok()) return to.status();
+                       // From pausing, the run is still in its step and simply goes on.
+                       if (*to == SessionState::kRunning && *from != SessionState::kPausing) {
+                         impl_->EnsureRunLocked(session);
+                       }
+                       return Status::Ok();
+                     });
 }
 
 Result<v1::Session> SessionManager::Abort(SessionId session, const std::string& reason,
                                           const Actor& actor) {
   const std::string why =
       "aborted by " + Who(actor) + (reason.empty() ? std::string() : ": " + reason);
-  return impl_->Verb(session, actor, "session.abort", why, [&]() -> Status {
+  return impl_->Verb(session, actor, "session.abort", why, [&]() REQUIRES(impl_->mu) -> Status {
     Impl& m = *impl_;
+    m.mu.AssertHeld();  // the same mutex, under another name
     Result<SessionState> to = m.TransitionLocked(session, SessionEvent::kAbort, why);
     if (!to.ok()) return to.status();
     if (m.current && m.current->session() == session) m.current->Cancel(why);
@@ -615,42 +623,44 @@ Result<v1::Session> SessionManager::AnswerPrompt(SessionId session, int step_ind
                                                  const std::string& note, const Actor& actor) {
   const std::string detail = "answered the prompt of step " + std::to_string(step_index) + " by " +
                              Who(actor) + (note.empty() ? "" : ": " + note);
-  return impl_->Verb(session, actor, "session.answer_prompt", detail, [&]() -> Status {
-    Impl& m = *impl_;
-    Result<SessionState> state = m.StateLocked(session);
-    if (!state.ok()) return state.status();
-    const std::optional<v1::Prompt>& open = m.live[session].prompt;
-    if (*state != SessionState::kAwaitingOperator || !open.has_value()) {
-      return FailedPrecondition(SessionName(session) + " has no open prompt (it is " +
-                                SessionStateName(*state) + "); nothing to answer");
-    }
-    if (open->step_index() != step_index) {
-      return FailedPrecondition(SessionName(session) + ": the open prompt is step " +
-                                std::to_string(open->step_index()) + ", not step " +
-                                std::to_string(step_index) + " (\"" + open->text() +
-                                "\"); answer the open prompt");
-    }
-    BRDF_RETURN_IF_ERROR(
-        m.store.CompleteStep(session, step_index)
-            .WithContext("recording the answer to step " + std::to_string(step_index)));
-    const v1::Prompt answered = *open;
-    Result<SessionState> to = m.TransitionLocked(session, SessionEvent::kAnswer, detail);
-    if (!to.ok()) return to.status();
-    if (answered.kind() == v1::PROMPT_KIND_RELOCATE_DETECTOR ||
-        answered.kind() == v1::PROMPT_KIND_RELOCATE_LAMP_AND_DETECTOR) {
-      m.rig.SetManualDelta(answered.pose().delta());
-    }
-    if (m.current && m.current->session() == session && !m.current->cancelled()) {
-      m.current->Answered(step_index);
-    } else {
-      m.EnsureRunLocked(session);  // no run waits on this prompt: start one at the next step
-    }
-    return Status::Ok();
-  });
+  return impl_->Verb(
+      session, actor, "session.answer_prompt", detail, [&]() REQUIRES(impl_->mu) -> Status {
+        Impl& m = *impl_;
+        m.mu.AssertHeld();  // the same mutex, under another name
+        Result<SessionState> state = m.StateLocked(session);
+        if (!state.ok()) return state.status();
+        const std::optional<v1::Prompt>& open = m.live[session].prompt;
+        if (*state != SessionState::kAwaitingOperator || !open.has_value()) {
+          return FailedPrecondition(SessionName(session) + " has no open prompt (it is " +
+                                    SessionStateName(*state) + "); nothing to answer");
+        }
+        if (open->step_index() != step_index) {
+          return FailedPrecondition(SessionName(session) + ": the open prompt is step " +
+                                    std::to_string(open->step_index()) + ", not step " +
+                                    std::to_string(step_index) + " (\"" + open->text() +
+                                    "\"); answer the open prompt");
+        }
+        BRDF_RETURN_IF_ERROR(
+            m.store.CompleteStep(session, step_index)
+                .WithContext("recording the answer to step " + std::to_string(step_index)));
+        const v1::Prompt answered = *open;
+        Result<SessionState> to = m.TransitionLocked(session, SessionEvent::kAnswer, detail);
+        if (!to.ok()) return to.status();
+        if (answered.kind() == v1::PROMPT_KIND_RELOCATE_DETECTOR ||
+            answered.kind() == v1::PROMPT_KIND_RELOCATE_LAMP_AND_DETECTOR) {
+          m.rig.SetManualDelta(answered.pose().delta());
+        }
+        if (m.current && m.current->session() == session && !m.current->cancelled()) {
+          m.current->Answered(step_index);
+        } else {
+          m.EnsureRunLocked(session);  // no run waits on this prompt: start one at the next step
+        }
+        return Status::Ok();
+      });
 }
 
 Result<v1::Session> SessionManager::GetSession(SessionId session) const {
-  std::lock_guard lock(impl_->mu);
+  MutexLock lock(impl_->mu);
   return impl_->BuildLocked(session, /*with_plan=*/true);
 }
 
@@ -659,7 +669,7 @@ Result<std::vector<v1::Session>> SessionManager::ListSessions(
   Result<std::vector<storage::SessionRecord>> records = store_->ListSessions();
   if (!records.ok()) return records.status();
   std::vector<v1::Session> out;
-  std::lock_guard lock(impl_->mu);
+  MutexLock lock(impl_->mu);
   for (auto it = records->rbegin(); it != records->rend(); ++it) {
     const SessionState state = impl_->live[it->id].state.value_or(it->state);
     if (!states.empty() && std::find(states.begin(), states.end(), state) == states.end()) {
@@ -673,20 +683,20 @@ Result<std::vector<v1::Session>> SessionManager::ListSessions(
 }
 
 Result<std::shared_ptr<const SessionPlan>> SessionManager::Plan(SessionId session) const {
-  std::lock_guard lock(impl_->mu);
+  MutexLock lock(impl_->mu);
   return impl_->PlanLocked(session, nullptr);
 }
 
 v1::RigStatus SessionManager::GetRigStatus() const {
   v1::RigStatus status = ToProto(rig_->GetStatus());
-  std::lock_guard lock(impl_->mu);
+  MutexLock lock(impl_->mu);
   if (impl_->holder.has_value()) status.set_active_session_id(std::to_string(*impl_->holder));
   return status;
 }
 
 Result<std::shared_ptr<EventSubscription>> SessionManager::Subscribe(SessionId session) {
   Impl& m = *impl_;
-  std::lock_guard lock(m.mu);  // no event can fall between the snapshot and the queue
+  MutexLock lock(m.mu);  // no event can fall between the snapshot and the queue
   Result<SessionState> state = m.StateLocked(session);
   if (!state.ok()) return state.status();
   Result<v1::Session> snapshot = m.BuildLocked(session, /*with_plan=*/true);
@@ -702,14 +712,14 @@ Result<std::shared_ptr<EventSubscription>> SessionManager::Subscribe(SessionId s
 }
 
 int SessionManager::AddReadingListener(ReadingListener listener) {
-  std::lock_guard lock(impl_->listeners_mu);
+  MutexLock lock(impl_->listeners_mu);
   const int handle = impl_->next_listener++;
   impl_->listeners.emplace(handle, std::move(listener));
   return handle;
 }
 
 void SessionManager::RemoveReadingListener(int handle) {
-  std::lock_guard lock(impl_->listeners_mu);
+  MutexLock lock(impl_->listeners_mu);
   impl_->listeners.erase(handle);
 }
 

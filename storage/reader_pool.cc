@@ -16,7 +16,7 @@ ReaderPool::ReaderPool(std::string path, OpenOptions options, std::size_t max_id
 
 Result<ReaderPool::Lease> ReaderPool::Acquire() {
   {
-    std::lock_guard<std::mutex> lock(mu_);
+    MutexLock lock(mu_);
     if (!idle_.empty()) {
       std::unique_ptr<Database> db = std::move(idle_.back());
       idle_.pop_back();
@@ -31,7 +31,7 @@ Result<ReaderPool::Lease> ReaderPool::Acquire() {
 void ReaderPool::Return(std::unique_ptr<Database> db) {
   // A connection left inside a transaction (a bug) would pin an old snapshot; drop it instead.
   if (db->in_transaction()) return;
-  std::lock_guard<std::mutex> lock(mu_);
+  MutexLock lock(mu_);
   if (idle_.size() < max_idle_) idle_.push_back(std::move(db));
 }
 

@@ -7,10 +7,10 @@
 
 #include <cstddef>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
+#include "core/mutex.h"
 #include "core/status.h"
 #include "storage/sqlite.h"
 
@@ -46,8 +46,8 @@ class ReaderPool {
   std::string path_;
   OpenOptions options_;
   std::size_t max_idle_;
-  std::mutex mu_;
-  std::vector<std::unique_ptr<Database>> idle_;  // guarded by mu_
+  Mutex mu_;
+  std::vector<std::unique_ptr<Database>> idle_ GUARDED_BY(mu_);
 };
 
 }  // namespace brdf::storage

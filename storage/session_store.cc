@@ -282,7 +282,7 @@ Result<std::int64_t> SessionStore::CreateSession(const NewSession& session,
   }
   const UnixSeconds now = Now();
 
-  std::lock_guard<std::mutex> lock(write_mu_);
+  MutexLock lock(write_mu_);
   Database& db = *writer_;
   BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
   {
@@ -338,7 +338,7 @@ Status SessionStore::SetSessionState(std::int64_t session, SessionState state, s
       "setting " + SessionName(session) + " to " + std::string(ToString(state));
   const UnixSeconds now = Now();
 
-  std::lock_guard<std::mutex> lock(write_mu_);
+  MutexLock lock(write_mu_);
   Database& db = *writer_;
   BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
   BRDF_STORAGE_ASSIGN_OR_RETURN(SessionState current, SessionStateOf(db, session));
@@ -380,7 +380,7 @@ Status SessionStore::SetSessionState(std::int64_t session, SessionState state, s
 
 Status SessionStore::SetSessionMeterSerial(std::int64_t session, const std::string& meter_serial) {
   const std::string what = "recording the meter serial of " + SessionName(session);
-  std::lock_guard<std::mutex> lock(write_mu_);
+  MutexLock lock(write_mu_);
   Database& db = *writer_;
   BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
                                 db.Prepare("UPDATE sessions SET meter_serial = ? WHERE id = ?"));
@@ -416,7 +416,7 @@ Result<std::vector<SessionRecord>> SessionStore::ListSessions() {
 
 Result<std::vector<std::int64_t>> SessionStore::RecoverInterruptedSessions() {
   const std::string what = "pausing sessions interrupted by a restart";
-  std::lock_guard<std::mutex> lock(write_mu_);
+  MutexLock lock(write_mu_);
   Database& db = *writer_;
   BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
   constexpr std::string_view kInterrupted = "('running', 'pausing', 'awaiting_operator')";
@@ -483,7 +483,7 @@ Result<std::int64_t> SessionStore::CompleteStepWithReading(std::int64_t session,
   const std::vector<std::uint8_t> blob = EncodeSpectrum(reading.spectrum);
   const UnixSeconds recorded_at = reading.recorded_at != 0 ? reading.recorded_at : Now();
 
-  std::lock_guard<std::mutex> lock(write_mu_);
+  MutexLock lock(write_mu_);
   Database& db = *writer_;
   BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
   BRDF_STORAGE_ASSIGN_OR_RETURN(SessionState state, SessionStateOf(db, session));
@@ -579,7 +579,7 @@ Status SessionStore::MarkStepFinished(std::int64_t session, int step_index, Step
                            StepName(session, step_index);
   const UnixSeconds now = Now();
 
-  std::lock_guard<std::mutex> lock(write_mu_);
+  MutexLock lock(write_mu_);
   Database& db = *writer_;
   BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
   BRDF_STORAGE_ASSIGN_OR_RETURN(SessionState session_state, SessionStateOf(db, session));
@@ -683,7 +683,7 @@ Status SessionStore::RecordDevice(const DeviceRecord& device) {
     return InvalidArgument(what + ": a device needs a kind and a model");
   }
   const UnixSeconds first_seen = device.first_seen != 0 ? device.first_seen : Now();
-  std::lock_guard<std::mutex> lock(write_mu_);
+  MutexLock lock(write_mu_);
   BRDF_STORAGE_ASSIGN_OR_RETURN(
       Statement st,
       writer_->Prepare("INSERT INTO devices (session_id, kind, model, serial, first_seen) "
@@ -718,7 +718,7 @@ Status SessionStore::AppendAudit(const AuditRecord& entry) {
     return InvalidArgument(what + ": an audit entry needs an actor and an action");
   }
   const UnixSeconds at = entry.at != 0 ? entry.at : Now();
-  std::lock_guard<std::mutex> lock(write_mu_);
+  MutexLock lock(write_mu_);
   BRDF_STORAGE_ASSIGN_OR_RETURN(
       Statement st, writer_->Prepare("INSERT INTO audit (at, role, actor, action, session_id, "
                                      "detail) VALUES (?, ?, ?, ?, ?, ?)"));

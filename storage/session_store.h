@@ -23,11 +23,11 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/mutex.h"
 #include "core/status.h"
 #include "storage/reader_pool.h"
 #include "storage/records.h"
@@ -169,8 +169,8 @@ class SessionStore {
 
   std::string path_;
   Options options_;
-  std::mutex write_mu_;
-  std::unique_ptr<Database> writer_;  // guarded by write_mu_
+  Mutex write_mu_;
+  std::unique_ptr<Database> writer_ PT_GUARDED_BY(write_mu_);
   std::unique_ptr<ReaderPool> readers_;
 };
 

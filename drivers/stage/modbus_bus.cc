@@ -38,10 +38,11 @@ struct ModbusBus::Job {
   CancelToken cancel;
   std::atomic<bool> abandoned{false};
 
-  std::mutex mu;
-  std::condition_variable cv;
-  bool done = false;
-  Status status;
+  Mutex mu;
+  CondVar cv;
+  bool done GUARDED_BY(mu) = false;
+  Status status GUARDED_BY(mu);
+  // Written by the owner thread before it sets `done`, read by the caller after.
   std::vector<std::uint16_t> data;
 
   // "unit 2: reading 4 registers at 0x007E"
@@ -321,10 +322,10 @@ ModbusBus::~ModbusBus() {
 }
 
 Status ModbusBus::Open(const CallContext& ctx) {
-  std::lock_guard lifecycle(lifecycle_mu_);
+  MutexLock lifecycle(lifecycle_mu_);
   if (open_.load()) return Status::Ok();
   {
-    std::lock_guard l(mu_);
+    MutexLock l(mu_);
     running_ = true;
     stopping_ = false;
   }
@@ -341,20 +342,20 @@ Status ModbusBus::Open(const CallContext& ctx) {
 }
 
 void ModbusBus::Close() {
-  std::lock_guard lifecycle(lifecycle_mu_);
+  MutexLock lifecycle(lifecycle_mu_);
   open_.store(false);
   StopThread();
 }
 
 void ModbusBus::StopThread() {
   {
-    std::lock_guard l(mu_);
+    MutexLock l(mu_);
     if (!running_) return;
     stopping_ = true;
   }
-  cv_.notify_all();
+  cv_.NotifyAll();
   if (thread_.joinable()) thread_.join();
-  std::lock_guard l(mu_);
+  MutexLock l(mu_);
   running_ = false;
 }
 
@@ -396,7 +397,7 @@ Result<std::vector<std::uint16_t>> ModbusBus::Submit(const std::shared_ptr<Job>&
   job->cancel = ctx.cancel();
   job->deadline = SteadyClock::now() + ctx.remaining();
   {
-    std::lock_guard l(mu_);
+    MutexLock l(mu_);
     if (!running_ || stopping_) {
       return Disconnected(description_ + " " + job->What() +
                           ": the bus is not open; call Connect first");
@@ -407,9 +408,9 @@ Result<std::vector<std::uint16_t>> ModbusBus::Submit(const std::shared_ptr<Job>&
       queue_.push_back(job);
     }
   }
-  cv_.notify_all();
+  cv_.NotifyAll();
 
-  std::unique_lock l(job->mu);
+  MutexLock l(job->mu);
   while (!job->done) {
     if (ctx.cancelled()) {
       job->abandoned.store(true);
@@ -423,7 +424,7 @@ Result<std::vector<std::uint16_t>> ModbusBus::Submit(const std::shared_ptr<Job>&
                      "silent");
     }
     // Short slices: the caller's clock may be scaled, and cancel tokens cannot wake this wait.
-    job->cv.wait_for(l, milliseconds(2));
+    job->cv.WaitFor(job->mu, milliseconds(2));
   }
   if (!job->status.ok()) return job->status;
   return std::move(job->data);
@@ -434,8 +435,8 @@ void ModbusBus::Run() {
   while (true) {
     std::shared_ptr<Job> job;
     {
-      std::unique_lock l(mu_);
-      cv_.wait(l, [&] { return stopping_ || !queue_.empty(); });
+      MutexLock l(mu_);
+      cv_.Wait(mu_, [&]() REQUIRES(mu_) { return stopping_ || !queue_.empty(); });
       if (stopping_) break;
       job = queue_.front();
       queue_.pop_front();
@@ -444,25 +445,25 @@ void ModbusBus::Run() {
     Status status =
         job->kind == Job::Kind::kConnect ? link.Connect(*job, true) : link.Execute(*job);
     {
-      std::lock_guard jl(job->mu);
+      MutexLock jl(job->mu);
       job->status = std::move(status);
       job->done = true;
     }
-    job->cv.notify_all();
+    job->cv.NotifyAll();
   }
   link.Destroy();
   std::deque<std::shared_ptr<Job>> left;
   {
-    std::lock_guard l(mu_);
+    MutexLock l(mu_);
     left.swap(queue_);
   }
   for (auto& job : left) {
     {
-      std::lock_guard jl(job->mu);
+      MutexLock jl(job->mu);
       job->status = Disconnected(description_ + " " + job->What() + ": the bus was closed");
       job->done = true;
     }
-    job->cv.notify_all();
+    job->cv.NotifyAll();
   }
 }
 

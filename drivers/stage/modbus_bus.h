@@ -28,17 +28,16 @@
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <thread>
 #include <variant>
 #include <vector>
 
 #include "core/call_context.h"
+#include "core/mutex.h"
 #include "core/status.h"
 
 namespace brdf::drivers::stage {
@@ -113,11 +112,11 @@ class ModbusBus {
   const std::string description_;
   std::atomic<bool> open_{false};
 
-  std::mutex lifecycle_mu_;  // serializes Open/Close
-  std::mutex mu_;            // guards queue_ and running_; stopping_ is set under it
-  std::condition_variable cv_;
-  std::deque<std::shared_ptr<Job>> queue_;
-  bool running_ = false;
+  Mutex lifecycle_mu_;  // serializes Open/Close
+  Mutex mu_;            // guards queue_ and running_; stopping_ is set under it
+  CondVar cv_;
+  std::deque<std::shared_ptr<Job>> queue_ GUARDED_BY(mu_);
+  bool running_ GUARDED_BY(mu_) = false;
   std::atomic<bool> stopping_{false};  // also read by the owner thread while it waits or retries
   std::thread thread_;
 };
