@@ -70,6 +70,10 @@ void CheckResponse(std::span<const std::uint8_t> request, const std::vector<std:
     BRDF_FUZZ_CHECK(
         resp.size() == 5 && std::equal(resp.begin() + 1, resp.end(), request.begin() + 1),
         "FC16 answer does not repeat address and count: " + where);
+  } else if (fc == modbus::kDiagnostics) {
+    // FC08 sub-function 0 (return query data) echoes the request; no other sub-function answers.
+    BRDF_FUZZ_CHECK(std::equal(request.begin(), request.end(), resp.begin(), resp.end()),
+                    "FC08 not echoed: " + where);
   } else {
     InvariantFailed("success", __FILE__, __LINE__, "unknown function answered: " + where);
   }
