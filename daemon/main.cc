@@ -3,6 +3,7 @@
 //   brdfd --config /etc/brdfd/brdfd.toml [--log-level L] [--shutdown-timeout S]
 //
 // Start-up: configuration (a bad file exits 2, naming every bad key and why), logging to stderr,
+// one owner (a database, listen address or meter port another process holds exits 2, naming it),
 // the SQLite store, recovery of sessions a dead daemon was driving (they come back paused), the
 // rig (devices connect in the background: an absent device shows as disconnected and is
 // retried, the API is up meanwhile), then the gRPC server. Once serving it prints exactly one
@@ -30,9 +31,11 @@
 #include "daemon/auth.h"
 #include "daemon/config.h"
 #include "daemon/index_cache.h"
+#include "daemon/one_owner.h"
 #include "daemon/rig.h"
 #include "daemon/server.h"
 #include "daemon/session_manager.h"
+#include "drivers/exclusive_open.h"
 #include "storage/session_store.h"
 
 #ifdef BRDF_HAVE_SYSTEMD
@@ -43,7 +46,8 @@ namespace {
 
 constexpr int kExitOk = 0;
 constexpr int kExitFailure = 1;        // the store, the address or recovery failed
-constexpr int kExitConfiguration = 2;  // a bad command line or configuration file
+constexpr int kExitConfiguration = 2;  // a bad command line or configuration file, or
+                                       // another process owns the database, address or meter
 
 void Notify([[maybe_unused]] const std::string& state) {
 #ifdef BRDF_HAVE_SYSTEMD
@@ -104,6 +108,22 @@ int main(int argc, char** argv) {
                config.stage.transport == "rtu" ? config.stage.device : config.stage.host,
                config.stage.port);
 
+  // One owner: refuse, before touching anything, a database, address or meter port that another
+  // process holds (daemon/one_owner.h). The database lock is held until exit.
+  Result<std::unique_ptr<DatabaseLock>> database_lock =
+      DatabaseLock::Acquire(config.storage.database);
+  if (!database_lock.ok()) {
+    std::fprintf(stderr, "brdfd: %s\n", database_lock.status().message().c_str());
+    return kExitConfiguration;
+  }
+  for (const Status& owned : {CheckListenAddressFree(config.server.listen),
+                              drivers::CheckDeviceFree(config.meter.port)}) {
+    if (!owned.ok()) {
+      std::fprintf(stderr, "brdfd: %s\n", owned.message().c_str());
+      return kExitConfiguration;
+    }
+  }
+
   Result<std::unique_ptr<storage::SessionStore>> opened =
       storage::SessionStore::Open(config.storage.database);
   if (!opened.ok()) {
@@ -159,6 +179,11 @@ int main(int argc, char** argv) {
   if (!server.ok()) {
     spdlog::critical("{}", server.status().ToString());
     manager.RemoveReadingListener(cache_listener);
+    // Taken since the check above: still one owner per address.
+    if (Status owned = CheckListenAddressFree(config.server.listen); !owned.ok()) {
+      std::fprintf(stderr, "brdfd: %s\n", owned.message().c_str());
+      return kExitConfiguration;
+    }
     return kExitFailure;
   }
   spdlog::info("serving on {} ({})", (*server)->address(), (*server)->tls() ? "TLS" : "plaintext");

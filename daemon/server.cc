@@ -167,6 +167,9 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   grpc::ServerBuilder builder;
   int selected_port = 0;
   builder.AddListeningPort(config.listen, credentials, &selected_port);
+  // One daemon per address: without SO_REUSEPORT a second brdfd's bind fails instead of sharing
+  // the port (and answering some of the first one's calls).
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
   grpc::ResourceQuota quota("brdfd");
   quota.SetMaxThreads(kMaxServerThreads);

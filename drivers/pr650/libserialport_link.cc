@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "drivers/exclusive_open.h"
 #include "drivers/pr650/fd_io.h"
 
 namespace brdf::drivers::pr650 {
@@ -73,6 +74,12 @@ Status LibSerialPortLink::Open(bool seen_before) {
     sp_free_port(port);
     return ConfigurationError("cannot set " + name + " to " + std::to_string(settings_.baud) +
                               " baud 8N1 (" + why + "): check that it is a serial port");
+  }
+  // One owner: a port another brdfd (or any program holding its lock) uses is refused, naming it.
+  if (Status owned = LockDeviceExclusively(fd, name); !owned.ok()) {
+    sp_close(port);
+    sp_free_port(port);
+    return owned;
   }
   // The waits in fd_io poll the handle and expect reads and writes never to block.
   const int flags = ::fcntl(fd, F_GETFL);

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "drivers/exclusive_open.h"
 #include "drivers/pr650/fd_io.h"
 
 namespace brdf::drivers::pr650 {
@@ -68,6 +69,11 @@ Status TermiosLink::Open(bool seen_before) {
     return ConfigurationError("serial port " + settings_.port +
                               " is not a terminal device: check the port name in the "
                               "configuration");
+  }
+  // One owner: a port another brdfd (or any program holding its lock) uses is refused, naming it.
+  if (Status owned = LockDeviceExclusively(fd, settings_.port); !owned.ok()) {
+    ::close(fd);
+    return owned;
   }
   termios t{};
   if (::tcgetattr(fd, &t) != 0) {
