@@ -33,6 +33,34 @@ Result<SessionState> ParseSessionState(const std::string& name) {
   return InvalidArgument("unknown session state '" + name + "'");
 }
 
+const char* SessionEventVerb(SessionEvent e) {
+  switch (e) {
+    case SessionEvent::kStart:
+      return "start";
+    case SessionEvent::kPauseDeferred:
+      return "pause";
+    case SessionEvent::kPauseImmediate:
+      return "pause (immediately)";
+    case SessionEvent::kResume:
+      return "resume";
+    case SessionEvent::kAbort:
+      return "abort";
+    case SessionEvent::kAnswer:
+      return "answer a prompt of";
+    case SessionEvent::kPrompt:
+      return "prompt the operator in";
+    case SessionEvent::kStepDone:
+      return "complete a step of";
+    case SessionEvent::kFault:
+      return "record a fault in";
+    case SessionEvent::kFinish:
+      return "finish";
+    case SessionEvent::kError:
+      return "fail";
+  }
+  return "change";
+}
+
 const char* SessionEventName(SessionEvent e) {
   switch (e) {
     case SessionEvent::kStart:
@@ -141,7 +169,7 @@ Result<SessionState> NextState(SessionState from, SessionEvent event, bool rig_f
     case S::kFailed:
       break;
   }
-  return FailedPrecondition(std::string("cannot ") + SessionEventName(event) +
+  return FailedPrecondition(std::string("cannot ") + SessionEventVerb(event) +
                             " a session that is " + SessionStateName(from));
 }
 

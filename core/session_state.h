@@ -50,6 +50,9 @@ enum class SessionEvent {
 const char* SessionStateName(SessionState s);  // "queued", "running", ..., "awaiting_operator"
 Result<SessionState> ParseSessionState(const std::string& name);
 const char* SessionEventName(SessionEvent e);  // "start", "pause_deferred", ...
+// The event as the operator says it, for messages: "pause", "pause (immediately)", "resume",
+// "answer a prompt of" (read as "cannot <verb> a session that is paused").
+const char* SessionEventVerb(SessionEvent e);
 
 bool IsTerminal(SessionState s);
 

@@ -63,6 +63,7 @@ struct SessionManager::Impl final : public ExecutorHost {
     std::optional<v1::Fault> last_fault;
     int last_quality = -1;
     std::string pause_reason;  // why a deferred pause was asked (used when it takes effect)
+    std::string reason;        // why it is in `state` (what the store holds, also when it failed)
   };
 
   Impl(SessionManager& owner_in, storage::SessionStore& store_in, Rig& rig_in)
@@ -163,14 +164,22 @@ struct SessionManager::Impl final : public ExecutorHost {
       reason = l.pause_reason.empty() ? "paused after the step in progress" : l.pause_reason;
     }
     if (*to == SessionState::kQueued && !holder.has_value()) {
-      reason = "waiting for the rig (" + std::to_string(queue.size()) + " session(s) before it)";
+      reason = "waiting for the rig (" + std::to_string(queue.size()) +
+               " session(s) before it); it starts by itself when the rig is free";
     } else if (*to == SessionState::kQueued) {
-      reason = "waiting for the rig (" + SessionName(*holder) + " holds it)";
+      const Result<SessionState> holding = StateLocked(*holder);
+      const bool held_paused = holding.ok() && *holding == SessionState::kPaused;
+      reason = "waiting for the rig (" + SessionName(*holder) +
+               (held_paused ? " holds it, paused: it frees the rig once it ends, so resume or "
+                              "abort it"
+                            : " holds it") +
+               "); it starts by itself when the rig is free";
     }
     if (*to == SessionState::kQueued && *from == SessionState::kQueued &&
         std::find(queue.begin(), queue.end(), id) == queue.end()) {
       // Started while the rig is busy: the session joins the queue (state unchanged).
       BRDF_RETURN_IF_ERROR(store.SetSessionState(id, *to, reason));
+      live[id].reason = reason;
       queue.push_back(id);
       spdlog::info("{}: queued ({})", SessionName(id), reason);
       return *to;
@@ -187,6 +196,7 @@ struct SessionManager::Impl final : public ExecutorHost {
                     stored.ToString());
     }
     l.state = *to;
+    l.reason = reason;
     if (*to != SessionState::kAwaitingOperator) l.prompt.reset();
     if (*to == SessionState::kRunning) {
       holder = id;
@@ -287,7 +297,8 @@ struct SessionManager::Impl final : public ExecutorHost {
     progress->set_total_steps(static_cast<std::uint32_t>(rec->total_steps));
     progress->set_done_samples(done_samples);
     progress->set_total_samples(samples);
-    s.set_eta_s(IsTerminal(state) ? 0 : eta);
+    // A queued session has no running ETA: it has not started (or waits for another session).
+    s.set_eta_s(IsTerminal(state) || state == SessionState::kQueued ? 0 : eta);
     const bool never_started = state == SessionState::kQueued && !rec->started_at.has_value();
     s.set_current_step(never_started || IsTerminal(state) ? -1 : first_pending);
     if (state == SessionState::kAwaitingOperator && l.prompt.has_value()) {
@@ -300,6 +311,10 @@ struct SessionManager::Impl final : public ExecutorHost {
     if (rec->finished_at.has_value()) *s.mutable_finished_at() = ToTimestamp(*rec->finished_at);
     if (state == SessionState::kAborted || state == SessionState::kFailed) {
       s.set_end_reason(rec->state_reason);
+    }
+    if (state == SessionState::kQueued || state == SessionState::kPaused ||
+        state == SessionState::kPausing || IsTerminal(state)) {
+      s.set_state_reason(l.state.has_value() && !l.reason.empty() ? l.reason : rec->state_reason);
     }
     if (IsTerminal(state) && !with_plan) terminal_cache[id] = s;
     return s;

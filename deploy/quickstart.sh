@@ -177,7 +177,29 @@ operator_token="$(cat "$run/operator.token")"
 analyst_token="$(cat "$run/analyst.token")"
 umask 022
 
-# Each demo starts from an empty database; the previous one is kept once.
+# Each demo starts from an empty database; the previous one is kept once (brdfd.previous.db,
+# replaced by the next run). A database with an unfinished session (queued, running, paused,
+# waiting for the operator: e.g. after a crash or --stop) is never replaced: it is kept under a
+# name of its own, which no later run touches, and the script says how to carry on with it.
+unfinished_sessions() {
+  sqlite3 -readonly "$1" "SELECT group_concat(id || ' (' || state || ')', ', ') FROM sessions
+    WHERE state IN ('queued', 'running', 'pausing', 'paused', 'awaiting_operator');" 2>/dev/null
+}
+if [[ -f "$run/brdfd.db" ]]; then
+  unfinished="$(unfinished_sessions "$run/brdfd.db" || true)"
+  if [[ -n "$unfinished" ]]; then
+    kept="$run/brdfd.kept-$(date +%Y%m%d-%H%M%S).db"
+    for suffix in "" -wal -shm; do
+      if [[ -f "$run/brdfd.db$suffix" ]]; then mv -f "$run/brdfd.db$suffix" "$kept$suffix"; fi
+    done
+    say "the previous database holds unfinished session(s) $unfinished: kept as $kept"
+    cat <<EOF
+  This run starts a new database; nothing deletes the kept one. To carry on with those sessions
+  instead: deploy/quickstart.sh --stop, set database = "$kept" in $run/brdfd.toml,
+  start brdfd again on it (README, "Starting brdfd again") and brdfctl resume <id>.
+EOF
+  fi
+fi
 for suffix in "" -wal -shm; do
   if [[ -f "$run/brdfd.db$suffix" ]]; then mv -f "$run/brdfd.db$suffix" "$run/brdfd.previous.db$suffix"; fi
 done
@@ -328,6 +350,7 @@ Talk to the daemon (operator token; $run/analyst.token holds a read-only one):
   export BRDF_ADDRESS=$address
   export BRDF_TOKEN=\$(cat $run/operator.token)
   export PATH="$build/tools/brdfctl:\$PATH"
+  export BRDF_SIM_MODBUS=$modbus   # the simulator's Modbus address (clients/python/README.md)
 
 EOF
 example "brdfctl list" "sessions, newest first"

@@ -58,7 +58,7 @@ Result<IntegrityReport> SessionStore::CheckSession(std::int64_t session) {
         db.Prepare("SELECT total_steps, done_steps, state FROM sessions WHERE id = ?"));
     st.Bind(1, session);
     BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
-    if (!row) return NotFound("no session " + std::to_string(session) + " in " + path_);
+    if (!row) return NotFound("no session " + std::to_string(session) + " in the database");
     report.total_steps = st.Int(0);
     report.done_steps_recorded = st.Int(1);
     state = st.Text(2);

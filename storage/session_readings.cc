@@ -21,7 +21,7 @@ Result<SessionReadings> LoadSessionReadings(SessionStore& store, std::int64_t se
   Result<SessionRecord> record = store.GetSession(session_id);
   if (!record.ok()) {
     if (record.status().code() == StatusCode::kNotFound) {
-      return NotFound("unknown session " + std::to_string(session_id) + " in " + store.path() +
+      return NotFound("unknown session " + std::to_string(session_id) +
                       ": list the sessions with `brdfctl list`");
     }
     return record.status();

@@ -121,7 +121,7 @@ Result<SessionState> SessionStateOf(Database& db, std::int64_t session) {
                                 db.Prepare("SELECT state FROM sessions WHERE id = ?"));
   st.Bind(1, session);
   BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
-  if (!row) return NotFound("no " + SessionName(session) + " in " + db.path());
+  if (!row) return NotFound("no " + SessionName(session) + " in the database");
   return FromColumn(ParseSessionState(st.Text(0)), db.path(), SessionName(session));
 }
 
@@ -386,7 +386,7 @@ Status SessionStore::SetSessionMeterSerial(std::int64_t session, const std::stri
                                 db.Prepare("UPDATE sessions SET meter_serial = ? WHERE id = ?"));
   st.Bind(1, meter_serial).Bind(2, session);
   BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
-  if (db.changes() == 0) return NotFound("no " + SessionName(session) + " in " + path_);
+  if (db.changes() == 0) return NotFound("no " + SessionName(session) + " in the database");
   return Status::Ok();
 }
 
@@ -396,7 +396,7 @@ Result<SessionRecord> SessionStore::GetSession(std::int64_t session) {
                                                           " FROM sessions WHERE id = ?"));
   st.Bind(1, session);
   BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
-  if (!row) return NotFound("no " + SessionName(session) + " in " + path_);
+  if (!row) return NotFound("no " + SessionName(session) + " in the database");
   return ReadSession(st, path_);
 }
 
@@ -647,7 +647,7 @@ Result<ReadingRecord> SessionStore::GetReading(std::int64_t reading_id) {
                                                           " FROM readings WHERE id = ?"));
   st.Bind(1, reading_id);
   BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
-  if (!row) return NotFound("no reading " + S(reading_id) + " in " + path_);
+  if (!row) return NotFound("no reading " + S(reading_id) + " in the database");
   return ReadReading(st, path_);
 }
 

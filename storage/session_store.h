@@ -37,7 +37,8 @@ namespace brdf::storage {
 
 // The reason RecoverInterruptedSessions gives the sessions it pauses.
 inline constexpr std::string_view kRecoveredReason =
-    "daemon restarted (previous run ended without a clean shutdown)";
+    "recovered after a restart: the daemon stopped without a clean shutdown while this session "
+    "ran; paused at its first unfinished step (resume it to go on)";
 
 // What CheckSession found. ok() when `problems` is empty.
 struct IntegrityReport {

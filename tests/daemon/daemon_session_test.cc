@@ -467,9 +467,15 @@ TEST_F(DaemonSessionTest, KillNineMidSessionRestartResumeLosesAndDuplicatesNothi
   ASSERT_TRUE(restarted.ok()) << restarted.ToString();
   v1::Session recovered = *rig_.Get(id);
   EXPECT_EQ(recovered.state(), v1::SESSION_STATE_PAUSED);
+  // It says it was recovered and why it is paused, in the API as in the database.
+  EXPECT_NE(recovered.state_reason().find("recovered after a restart"), std::string::npos)
+      << recovered.state_reason();
+  EXPECT_NE(recovered.state_reason().find("resume it to go on"), std::string::npos)
+      << recovered.state_reason();
   Result<DbSessionCounts> parked = CountSession(rig_.database(), sid);
   ASSERT_TRUE(parked.ok());
-  EXPECT_NE(parked->state_reason.find("restarted"), std::string::npos) << parked->state_reason;
+  EXPECT_NE(parked->state_reason.find("recovered after a restart"), std::string::npos)
+      << parked->state_reason;
   EXPECT_EQ(parked->readings, before->readings);
 
   Watch(id);

@@ -21,6 +21,7 @@ int PrintVerbResult(CommandContext& ctx, const google::protobuf::Message& reply,
     PrintJsonLine(ctx.out, reply);
   } else {
     ctx.out << "session " << session.session_id() << ": " << StateName(session.state()) << "\n";
+    if (!session.state_reason().empty()) ctx.out << "  " << session.state_reason() << "\n";
     if (session.has_pending_prompt()) {
       ctx.out << "  waiting for the operator: step " << session.pending_prompt().step_index()
               << " (" << PromptKindName(session.pending_prompt().kind())
@@ -83,6 +84,10 @@ int RunSubmit(CommandContext& ctx, const std::string& plan_path, bool start_now,
     ctx.out << "submitted session " << s.session_id() << " \"" << s.name()
             << "\": " << StateName(s.state()) << "\n";
     if (s.has_summary()) ctx.out << "  " << PlanSummaryText(s.summary()) << "\n";
+    // Started while another session holds the rig: which one, and that it starts by itself.
+    if (s.state() == v1::SESSION_STATE_QUEUED && start_now && !s.state_reason().empty()) {
+      ctx.out << "  " << s.state_reason() << "\n";
+    }
     if (s.state() == v1::SESSION_STATE_QUEUED && !start_now) {
       ctx.out << "  start it: brdfctl start " << s.session_id() << "\n";
     }

@@ -150,6 +150,9 @@ int main(int argc, char** argv) {
   watch->add_option("--on-prompt", watch_options.on_prompt,
                     "shell command run before confirming a prompt; sees BRDF_PROMPT_KIND, "
                     "BRDF_PROMPT_STEP, BRDF_PROMPT_TEXT, BRDF_SESSION_ID, BRDF_PROMPT_DELTA …");
+  bool force_ask = false;
+  watch->add_flag("--ask", force_ask,
+                  "ask y/N for each prompt on standard input even when it is not a terminal");
   watch->add_flag("--no-progress", no_progress, "plain lines even on a terminal");
   watch->add_flag("--exit-on-pause", watch_options.exit_on_pause,
                   "stop watching (exit 4) when the session pauses, e.g. after a device fault");
@@ -291,7 +294,8 @@ int main(int argc, char** argv) {
     watch_options.session_id = session_id;
     const bool tty_out = isatty(STDOUT_FILENO) != 0;
     watch_options.progress_bar = tty_out && !json && !no_progress;
-    watch_options.ask = tty_out && isatty(STDIN_FILENO) != 0 && !watch_options.auto_confirm;
+    watch_options.ask =
+        (force_ask || (tty_out && isatty(STDIN_FILENO) != 0)) && !watch_options.auto_confirm;
     watch_options.width = TerminalWidth();
     return RunWatch(ctx, watch_options);
   }

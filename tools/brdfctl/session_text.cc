@@ -61,6 +61,9 @@ std::string FaultText(const v1::Fault& f) {
 void PrintSessionDetail(std::ostream& out, const v1::Session& s) {
   out << "session " << s.session_id() << "  \"" << s.name() << "\"\n";
   out << "  state        " << StateName(s.state()) << "\n";
+  if (!s.state_reason().empty() && s.state_reason() != s.end_reason()) {
+    out << "  why          " << s.state_reason() << "\n";
+  }
   out << "  progress     " << ProgressText(s.progress()) << "\n";
   if (s.eta_s() > 0) out << "  ETA          " << Duration(s.eta_s()) << "\n";
   if (s.current_step() >= 0) out << "  step         " << s.current_step() << "\n";

@@ -1,10 +1,17 @@
 #include "tools/brdfctl/watch_command.h"
 
+#include <poll.h>
+#include <unistd.h>
+
 #include <chrono>
+#include <condition_variable>
+#include <deque>
 #include <iostream>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "tools/brdfctl/eta_calibrator.h"
 #include "tools/brdfctl/exit_codes.h"
@@ -28,23 +35,49 @@ class Watcher {
   Watcher(CommandContext& ctx, const WatchOptions& options)
       : ctx_(ctx), options_(options), notes_(ctx.json ? ctx.err : ctx.out) {}
 
+  // The stream is read on its own thread into a queue, so that a question waiting for the
+  // operator's answer never hides what the session does meanwhile (a pause, an abort, the prompt
+  // answered elsewhere withdraw it).
   int Run() {
     v1::WatchSessionRequest request;
     request.set_session_id(options_.session_id);
     auto context = ctx_.client.StreamContext();
     auto reader = ctx_.client.control().WatchSession(context.get(), request);
-    v1::SessionEvent event;
-    while (reader->Read(&event)) {
-      const int exit_code = Handle(event);
-      if (exit_code != kExitOk) {
-        context->TryCancel();
-        ClearBar();
-        reader->Finish();
-        return exit_code;
+    std::thread pump([&] {
+      v1::SessionEvent event;
+      while (reader->Read(&event)) {
+        std::lock_guard<std::mutex> lock(queue_mu_);
+        queue_.push_back(event);
+        queue_cv_.notify_one();
       }
+      std::lock_guard<std::mutex> lock(queue_mu_);
+      stream_ended_ = true;
+      queue_cv_.notify_one();
+    });
+    int exit_code = kExitOk;
+    for (;;) {
+      std::optional<v1::SessionEvent> event;
+      bool ended = false;
+      {
+        std::unique_lock<std::mutex> lock(queue_mu_);
+        queue_cv_.wait_for(lock, std::chrono::milliseconds(question_ ? 50 : 500),
+                           [this] { return !queue_.empty() || stream_ended_; });
+        if (!queue_.empty()) {
+          event = std::move(queue_.front());
+          queue_.pop_front();
+        } else {
+          ended = stream_ended_;
+        }
+      }
+      if (event) exit_code = Handle(*event);
+      if (exit_code == kExitOk && question_) exit_code = PollAnswer();
+      if (exit_code != kExitOk || ended) break;
     }
+    if (exit_code != kExitOk) context->TryCancel();
+    pump.join();
     const grpc::Status status = reader->Finish();
     ClearBar();
+    if (exit_code != kExitOk) return exit_code;
     if (!status.ok()) {
       return ReportRpcError(ctx_.err, status, "WatchSession", ctx_.client.options().address);
     }
@@ -64,11 +97,13 @@ class Watcher {
         view_.total_steps = s.progress().total_steps();
         view_.eta_s = s.eta_s() > 0 ? s.eta_s() : -1;
         view_.quality_code = s.last_quality_code();
-        Note("watching session " + s.session_id() + " \"" + s.name() + "\": " + view_.state + ", " +
+        Note("watching session " + s.session_id() + " \"" + s.name() + "\": " + view_.state +
+             (s.state_reason().empty() ? "" : " (" + s.state_reason() + ")") + ", " +
              ProgressText(s.progress()));
         if (s.has_pending_prompt()) return OnPrompt(s.pending_prompt());
         if (s.state() == v1::SESSION_STATE_PAUSED) {
-          return OnPaused(s.has_last_fault() ? s.last_fault().reason() : s.end_reason());
+          const int paused = OnPaused(s.state_reason());
+          if (paused != kExitOk) return paused;
         }
         break;
       }
@@ -78,14 +113,19 @@ class Watcher {
         view_.state = StateName(c.to());
         if (!c.reason().empty()) end_reason_ = c.reason();
         if (c.to() != v1::SESSION_STATE_RUNNING) eta_.Interrupt();
-        if (c.to() == v1::SESSION_STATE_PAUSED) return OnPaused(c.reason());
-        // Into and out of a prompt: the prompt and "confirmed" lines already say it.
+        if (c.to() == v1::SESSION_STATE_QUEUED) view_.eta_s = -1;  // no running ETA while queued
+        if (c.from() == v1::SESSION_STATE_AWAITING_OPERATOR) WithdrawQuestion(c);
+        // Into and out of a prompt we answered: the prompt and "confirmed" lines already say it.
         const bool prompt_traffic = c.to() == v1::SESSION_STATE_AWAITING_OPERATOR ||
                                     (c.from() == v1::SESSION_STATE_AWAITING_OPERATOR &&
                                      c.to() == v1::SESSION_STATE_RUNNING);
         if (!prompt_traffic) {
           Note("state: " + StateName(c.from()) + " → " + StateName(c.to()) +
                (c.reason().empty() ? "" : " (" + c.reason() + ")"));
+        }
+        if (c.to() == v1::SESSION_STATE_PAUSED) {
+          const int paused = OnPaused(c.reason());
+          if (paused != kExitOk) return paused;
         }
         break;
       }
@@ -144,24 +184,75 @@ class Watcher {
   int OnPrompt(const v1::Prompt& prompt) {
     const int step = prompt.step_index();
     if (answered_.count(step) > 0 || declined_.count(step) > 0) return kExitOk;
+    if (question_ && question_->step_index() == step) return kExitOk;
     ClearBar();
     std::ostringstream text;
     PrintPrompt(text, prompt);
     notes_ << text.str();
-    bool confirm = options_.auto_confirm;
-    if (!confirm && options_.ask) {
+    open_prompt_ = step;
+    if (options_.auto_confirm) return Confirm(prompt);
+    if (options_.ask) {
+      // Asked, not waited for: the answer is read between events (PollAnswer).
       notes_ << "Done? Confirm the prompt [y/N]: " << std::flush;
-      std::string answer;
-      if (!std::getline(std::cin, answer)) answer.clear();
-      confirm = answer == "y" || answer == "Y" || answer == "yes";
-    }
-    if (!confirm) {
-      declined_.insert(step);
-      notes_ << "  not confirmed; when done: brdfctl answer " << options_.session_id << " " << step
-             << std::endl;
-      DrawBar();
+      question_ = prompt;
+      answer_.clear();
       return kExitOk;
     }
+    Decline(step);
+    return kExitOk;
+  }
+
+  // Reads what the operator typed so far (without blocking); a full line answers the question.
+  int PollAnswer() {
+    pollfd in{STDIN_FILENO, POLLIN, 0};
+    while (question_ && ::poll(&in, 1, 0) > 0) {
+      char buffer[256];
+      const ssize_t n = ::read(STDIN_FILENO, buffer, sizeof buffer);
+      const bool eof = n <= 0;
+      if (!eof) answer_.append(buffer, static_cast<size_t>(n));
+      const size_t newline = answer_.find('\n');
+      if (!eof && newline == std::string::npos) continue;
+      const std::string line = answer_.substr(0, newline);
+      const v1::Prompt prompt = *question_;
+      question_.reset();
+      answer_.clear();
+      if (line == "y" || line == "Y" || line == "yes") return Confirm(prompt);
+      Decline(prompt.step_index());
+      if (eof) break;
+    }
+    return kExitOk;
+  }
+
+  // The session left awaiting_operator (paused, aborted, answered elsewhere): an open question
+  // about its prompt is withdrawn, and neither answered nor its --on-prompt hook run.
+  void WithdrawQuestion(const v1::StateChange& change) {
+    if (!open_prompt_) return;
+    const int step = *open_prompt_;
+    open_prompt_.reset();
+    if (answered_.count(step) > 0) return;
+    const bool asked = question_.has_value();
+    question_.reset();
+    answer_.clear();
+    if (asked) notes_ << "\n";
+    const std::string why = change.to() == v1::SESSION_STATE_RUNNING
+                                ? "answered elsewhere"
+                                : "the session is now " + StateName(change.to()) +
+                                      (change.reason().empty() ? "" : " (" + change.reason() + ")");
+    Note("  prompt at step " + std::to_string(step) + " withdrawn: " + why +
+         (asked ? "; not confirmed" : "") +
+         (change.to() == v1::SESSION_STATE_RUNNING ? "" : "; it comes again on resume"));
+    declined_.erase(step);  // a prompt that is due again is shown again
+  }
+
+  void Decline(int step) {
+    declined_.insert(step);
+    notes_ << "  not confirmed; when done: brdfctl answer " << options_.session_id << " " << step
+           << std::endl;
+    DrawBar();
+  }
+
+  int Confirm(const v1::Prompt& prompt) {
+    const int step = prompt.step_index();
     if (!options_.on_prompt.empty()) {
       const Status hook = RunPromptHook(options_.on_prompt, options_.session_id, prompt);
       if (!hook.ok()) {
@@ -247,6 +338,13 @@ class Watcher {
   std::string end_reason_;
   std::set<int> answered_;
   std::set<int> declined_;
+  std::optional<int> open_prompt_;      // the prompt shown and not answered by us
+  std::optional<v1::Prompt> question_;  // asked [y/N], the answer not read yet
+  std::string answer_;                  // what the operator typed so far
+  std::mutex queue_mu_;
+  std::condition_variable queue_cv_;
+  std::deque<v1::SessionEvent> queue_;  // read from the stream, not handled yet
+  bool stream_ended_ = false;
   bool bar_shown_ = false;
 };
 

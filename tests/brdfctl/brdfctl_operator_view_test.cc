@@ -1,0 +1,155 @@
+// What the operator sees is true (issue 20, item 4), with brdfctl, brdfd and brdf-sim as real
+// processes: `brdfctl watch` shows the pause and its reason while a prompt question is open, and
+// withdraws the question (the answer typed afterwards neither answers the prompt nor runs the
+// --on-prompt hook); a session started while another holds the rig says which one and that it
+// starts by itself, and shows no ETA; refusals use the operator's words and no server paths.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <thread>
+
+#include "tests/brdfctl/ctl_test_rig.h"
+
+namespace brdf::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::string SourceDir() {
+#ifdef BRDF_TEST_SOURCE_DIR
+  return BRDF_TEST_SOURCE_DIR;
+#else
+  const char* dir = std::getenv("BRDF_SOURCE_DIR");
+  return dir != nullptr ? dir : ".";
+#endif
+}
+
+std::string Describe(const CommandResult& r) {
+  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "\n--- stderr:\n" +
+         r.err;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Polls until `pred` holds (true) or `timeout` passes (false).
+bool Eventually(const std::function<bool()>& pred, std::chrono::milliseconds timeout = 20s) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < end) {
+    if (pred()) return true;
+    std::this_thread::sleep_for(50ms);
+  }
+  return pred();
+}
+
+class OperatorViewTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const Status started = rig_.Start();
+    ASSERT_TRUE(started.ok()) << started.ToString();
+  }
+  void TearDown() override {
+    if (HasFailure()) std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n";
+  }
+  CommandResult Ctl(const std::vector<std::string>& args) {
+    Result<CommandResult> r = rig_.Ctl(args);
+    EXPECT_TRUE(r.ok()) << r.status().ToString();
+    return r.ok() ? *r : CommandResult{-1, "", r.status().ToString()};
+  }
+  std::string SubmitDemo() {
+    const CommandResult r =
+        Ctl({"submit", SourceDir() + "/examples/plans/demo.json", "--start", "--quiet"});
+    EXPECT_EQ(r.exit_code, 0) << Describe(r);
+    return Lines(r.out).empty() ? "" : Lines(r.out)[0];
+  }
+  CtlRig rig_;
+};
+
+TEST_F(OperatorViewTest, WatchWithdrawsTheQuestionWhenTheSessionPausesAndShowsWhy) {
+  const std::string id = SubmitDemo();
+  ASSERT_FALSE(id.empty());
+  // The demo's first step asks for the white standard: brdfctl asks y/N on its standard input (a
+  // FIFO the test writes), its output goes to a file.
+  const std::string fifo = rig_.dir().file("answers").string();
+  const std::string out = rig_.dir().file("watch.out").string();
+  const std::string marker = rig_.dir().file("hook-ran").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string ctl = *BrdfctlBinary();
+  LaunchOptions watch({"-c", "exec '" + ctl + "' watch " + id + " --ask --no-progress " +
+                                 "--on-prompt 'touch " + marker + "' < " + fifo + " > " + out +
+                                 " 2>&1"});
+  watch.set_env = rig_.Env();
+  Result<std::unique_ptr<ChildProcess>> watcher = ChildProcess::Launch("sh", "/bin/sh", watch);
+  ASSERT_TRUE(watcher.ok()) << watcher.status().ToString();
+  const int answers = ::open(fifo.c_str(), O_WRONLY);  // the shell opens the other end
+  ASSERT_GE(answers, 0);
+
+  ASSERT_TRUE(Eventually([&] { return ReadText(out).find("[y/N]") != std::string::npos; }))
+      << ReadText(out);
+  // The operator pauses the session from elsewhere while the question is open.
+  const CommandResult paused = Ctl({"pause", id, "--immediate"});
+  ASSERT_EQ(paused.exit_code, 0) << Describe(paused);
+  ASSERT_TRUE(Eventually([&] { return ReadText(out).find("withdrawn") != std::string::npos; }))
+      << ReadText(out);
+  const std::string shown = ReadText(out);
+  EXPECT_NE(shown.find("withdrawn: the session is now paused"), std::string::npos) << shown;
+  EXPECT_NE(shown.find("state: awaiting_operator → paused ("), std::string::npos) << shown;
+
+  // The answer typed now is to a question no longer asked: no hook, no answer.
+  ASSERT_EQ(::write(answers, "y\n", 2), 2);
+  std::this_thread::sleep_for(700ms);
+  EXPECT_FALSE(std::filesystem::exists(marker)) << ReadText(out);
+  const CommandResult got = Ctl({"get", id});
+  EXPECT_NE(got.out.find("state        paused"), std::string::npos) << Describe(got);
+  EXPECT_NE(got.out.find("why          "), std::string::npos) << Describe(got);
+
+  // A second session started now waits: it says for whom, that it starts by itself, no ETA.
+  const CommandResult second =
+      Ctl({"submit", SourceDir() + "/examples/plans/demo.json", "--start"});
+  ASSERT_EQ(second.exit_code, 0) << Describe(second);
+  EXPECT_NE(second.out.find(": queued"), std::string::npos) << Describe(second);
+  EXPECT_NE(second.out.find("waiting for the rig (session " + id + " holds it, paused"),
+            std::string::npos)
+      << Describe(second);
+  EXPECT_NE(second.out.find("it starts by itself when the rig is free"), std::string::npos)
+      << Describe(second);
+  const CommandResult list = Ctl({"list", "--state", "queued"});
+  ASSERT_EQ(list.exit_code, 0) << Describe(list);
+  ASSERT_EQ(Lines(list.out).size(), 1u) << Describe(list);
+  EXPECT_EQ(list.out.find("ETA"), std::string::npos) << Describe(list);
+
+  // Refusals in the operator's words: no internal verb names, no server paths.
+  const CommandResult abort = Ctl({"abort", id, "--reason", "test over"});
+  ASSERT_EQ(abort.exit_code, 0) << Describe(abort);
+  const CommandResult again = Ctl({"pause", id});
+  EXPECT_NE(again.exit_code, 0) << Describe(again);
+  EXPECT_NE(again.err.find("cannot pause a session that is aborted"), std::string::npos)
+      << Describe(again);
+  EXPECT_EQ(again.err.find("pause_deferred"), std::string::npos) << Describe(again);
+  const CommandResult missing = Ctl({"get", "987654"});
+  EXPECT_EQ(missing.exit_code, 1) << Describe(missing);
+  EXPECT_EQ(missing.err.find(rig_.dir().path().string()), std::string::npos) << Describe(missing);
+  EXPECT_EQ(missing.err.find(".db"), std::string::npos) << Describe(missing);
+
+  // The watch follows the abort to its end.
+  ::close(answers);
+  EXPECT_EQ((*watcher)->WaitUntil(std::chrono::steady_clock::now() + 20s), 4) << ReadText(out);
+  EXPECT_NE(ReadText(out).find("ended aborted: aborted by ctl-operator (operator): test over"),
+            std::string::npos)
+      << ReadText(out);
+  EXPECT_FALSE(std::filesystem::exists(marker));
+}
+
+}  // namespace
+}  // namespace brdf::testing
