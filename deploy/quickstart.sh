@@ -296,7 +296,7 @@ fi
 
 plan="$root/examples/plans/demo.json"
 say "validating and submitting $plan"
-"$ctl" validate "$plan"
+"$ctl" validate "$plan" --time-scale "$time_scale"
 session="$("$ctl" submit "$plan" --start --quiet)"
 echo "quickstart: session $session started"
 

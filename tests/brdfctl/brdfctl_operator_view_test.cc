@@ -22,15 +22,6 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::string SourceDir() {
-#ifdef BRDF_TEST_SOURCE_DIR
-  return BRDF_TEST_SOURCE_DIR;
-#else
-  const char* dir = std::getenv("BRDF_SOURCE_DIR");
-  return dir != nullptr ? dir : ".";
-#endif
-}
-
 std::string Describe(const CommandResult& r) {
   return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "\n--- stderr:\n" +
          r.err;

@@ -21,15 +21,6 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::string SourceDir() {
-#ifdef BRDF_TEST_SOURCE_DIR
-  return BRDF_TEST_SOURCE_DIR;
-#else
-  const char* dir = std::getenv("BRDF_SOURCE_DIR");
-  return dir != nullptr ? dir : ".";
-#endif
-}
-
 // Parses one line of --json output strictly (unknown fields refused), as the type it claims to be.
 template <typename Message>
 std::optional<Message> ParseJson(const std::string& line) {

@@ -1,8 +1,18 @@
 #include "tests/brdfctl/ctl_runner.h"
 
+#include <cstdlib>
 #include <sstream>
 
 namespace brdf::testing {
+
+std::string SourceDir() {
+#ifdef BRDF_TEST_SOURCE_DIR
+  return BRDF_TEST_SOURCE_DIR;
+#else
+  const char* dir = std::getenv("BRDF_SOURCE_DIR");
+  return dir != nullptr ? dir : ".";
+#endif
+}
 
 Result<std::string> BrdfctlBinary() {
 #ifdef BRDF_TEST_BUILD_DIR

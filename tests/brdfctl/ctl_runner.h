@@ -18,6 +18,9 @@ namespace brdf::testing {
 
 Result<std::string> BrdfctlBinary();
 
+// The repository's root (compiled in; $BRDF_SOURCE_DIR otherwise), for examples/plans/.
+std::string SourceDir();
+
 // Runs brdfctl to completion within `timeout` (then kills it and returns kTimeout). `env` is set
 // for the child on top of the test's own environment; BRDF_ADDRESS and BRDF_TOKEN are removed
 // first, so a test only sees what it passes.

@@ -33,7 +33,7 @@ int PrintVerbResult(CommandContext& ctx, const google::protobuf::Message& reply,
 
 }  // namespace
 
-int RunValidate(CommandContext& ctx, const std::string& plan_path) {
+int RunValidate(CommandContext& ctx, const std::string& plan_path, double time_scale) {
   Result<v1::Plan> plan = ReadPlanFile(plan_path);
   if (!plan.ok()) return ReportLocalError(ctx.err, plan.status());
   v1::ValidatePlanRequest request;
@@ -49,7 +49,7 @@ int RunValidate(CommandContext& ctx, const std::string& plan_path) {
   if (reply.valid()) {
     ctx.out << plan_path << ": valid\n";
     if (reply.has_summary()) {
-      ctx.out << "  " << PlanSummaryText(reply.summary()) << "\n";
+      ctx.out << "  " << PlanSummaryText(reply.summary(), time_scale) << "\n";
     } else {
       ctx.out << "  " << reply.step_count() << " steps, " << reply.operator_interventions()
               << " operator actions, about " << Duration(reply.estimated_duration_s()) << "\n";

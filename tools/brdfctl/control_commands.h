@@ -12,7 +12,8 @@ namespace brdf::ctl {
 
 // ValidatePlan on a plan file: the summary when valid (exit 0); otherwise every problem with its
 // JSON field path (exit 2). A file that does not parse is reported locally (exit 2).
-int RunValidate(CommandContext& ctx, const std::string& plan_path);
+// `time_scale`: the estimate for a rig that runs that many times faster (brdf-sim --time-scale).
+int RunValidate(CommandContext& ctx, const std::string& plan_path, double time_scale = 1.0);
 
 // SubmitPlan (start_now with --start). `quiet`: print only the new session's id.
 int RunSubmit(CommandContext& ctx, const std::string& plan_path, bool start_now, bool quiet);

@@ -89,6 +89,12 @@ int main(int argc, char** argv) {
       "check a plan file against the rig: every problem with its field path, or the "
       "step count and duration");
   validate->add_option("plan", plan_path, "plan JSON file (- for standard input)")->required();
+  double time_scale = 1.0;
+  validate
+      ->add_option("--time-scale", time_scale,
+                   "estimate for a simulated rig this many times faster (brdf-sim "
+                   "--time-scale; the quick start's is 8)")
+      ->check(CLI::Range(0.001, 1e6));
 
   bool start_now = false;
   bool quiet = false;
@@ -280,7 +286,7 @@ int main(int argc, char** argv) {
   if (!client.ok()) return ReportLocalError(std::cerr, client.status());
   CommandContext ctx{**client, json, std::cout, std::cerr};
 
-  if (validate->parsed()) return RunValidate(ctx, plan_path);
+  if (validate->parsed()) return RunValidate(ctx, plan_path, time_scale);
   if (submit->parsed()) return RunSubmit(ctx, plan_path, start_now, quiet);
   if (start->parsed()) return RunStart(ctx, session_id);
   if (pause->parsed()) return RunPause(ctx, session_id, immediate);

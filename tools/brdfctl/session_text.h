@@ -28,6 +28,10 @@ std::string FaultText(const v1::Fault& fault);
 
 // "120 steps: 90 sample, 12 reference, 6 dark readings; 12 operator actions; about 5:00
 // (at least 3:10)".
-std::string PlanSummaryText(const v1::PlanSummary& summary);
+// The estimate is split in two: the rig's time (readings and moves; divided by `time_scale` for a
+// simulated rig that runs that many times faster, e.g. brdf-sim --time-scale 8) and the operator's
+// manual actions (about core/plan's operator_action_s each on a real rig; a script answering
+// them on brdf-sim takes about none).
+std::string PlanSummaryText(const v1::PlanSummary& summary, double time_scale = 1.0);
 
 }  // namespace brdf::ctl
