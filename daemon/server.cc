@@ -12,11 +12,18 @@
 
 #include <algorithm>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <thread>
 
+#include "daemon/token_gate.h"
+
 namespace brdf::daemon {
 namespace {
+
+// The control plane's threads (control_loop.h): one answers while the other may wait on the
+// store (SubmitPlan's commit).
+constexpr int kControlThreads = 2;
 
 // The services by their full names, for the health service's per-service status.
 constexpr const char* kServiceNames[] = {"brdf.v1.Control", "brdf.v1.Data",
@@ -110,10 +117,12 @@ int InterpolateLoopThreads(unsigned cores) {
 
 Server::Server(const ServerConfig& config, SessionManager& manager, IndexCache& cache,
                const Authenticator& auth)
-    : health_(stopping_),
-      control_(manager, auth, stopping_),
-      data_(manager, auth, stopping_),
-      interpolation_(cache, auth, stopping_),
+    : streams_(config, auth.enabled()),
+      control_loop_(kControlThreads),
+      health_(stopping_, streams_),
+      control_(manager, auth, stopping_, streams_),
+      data_(manager, auth, stopping_, streams_),
+      interpolation_(cache, auth, stopping_, streams_),
       interpolate_loop_(interpolation_,
                         config.interpolate_threads > 0
                             ? config.interpolate_threads
@@ -146,7 +155,9 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
     credentials = grpc::SslServerCredentials(ssl);
     tls = true;
   } else {
-    credentials = grpc::InsecureServerCredentials();
+    // Plaintext as gRPC's xDS credentials with the insecure fallback (no xDS server here, so
+    // plaintext is all they do): unlike InsecureServerCredentials() they take the token gate.
+    credentials = grpc::XdsServerCredentials(grpc::InsecureServerCredentials());
     if (!IsLoopbackAddress(config.listen)) {
       spdlog::warn(
           "serving {} in PLAINTEXT on a non-loopback address: bearer tokens and data cross the "
@@ -166,16 +177,20 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   std::unique_ptr<Server> server(new Server(config, manager, cache, auth));
   grpc::ServerBuilder builder;
   int selected_port = 0;
+  credentials->SetAuthMetadataProcessor(std::make_shared<TokenGate>(auth));
   builder.AddListeningPort(config.listen, credentials, &selected_port);
   builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
   grpc::ResourceQuota quota("brdfd");
-  quota.SetMaxThreads(kMaxServerThreads);
+  quota.SetMaxThreads(ServerThreadCap(config));
   builder.SetResourceQuota(quota);
   builder.RegisterService(&server->health_);
   builder.RegisterService(&server->control_);
   builder.RegisterService(&server->data_);
   builder.RegisterService(&server->interpolation_);
   server->interpolate_loop_.AddQueues(builder);
+  server->health_.ServeOn(server->control_loop_);
+  server->control_.ServeOn(server->control_loop_);
+  server->control_loop_.AddQueue(builder);
   server->server_ = builder.BuildAndStart();
   const bool unix_socket = config.listen.rfind("unix:", 0) == 0;
   if (!server->server_ || (!unix_socket && selected_port == 0)) {
@@ -186,6 +201,7 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
                    "; change [server] listen or stop the process that holds it");
   }
   server->interpolate_loop_.Start();
+  server->control_loop_.Start();
   server->tls_ = tls;
   server->port_ = selected_port;
   server->address_ = unix_socket ? config.listen
@@ -194,9 +210,13 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   spdlog::info(
       "limits: requests up to {} bytes (larger: RESOURCE_EXHAUSTED), InterpolateBatch up to {} "
       "directions in chunks of up to {} results, notes up to {} bytes, pages up to {} sessions, "
-      "{} call threads, Interpolate on {} loop thread(s){}",
+      "open streams up to {} per token, {} analyst, {} operator, {} without a token (a stream "
+      "not read for {} s is cancelled), {} call threads, control plane on {} thread(s), "
+      "Interpolate on {} loop thread(s){}",
       kMaxReceiveMessageBytes, kMaxBatchDirections, kMaxChunkSize, kMaxNoteBytes, kMaxPageSize,
-      kMaxServerThreads, server->interpolate_loop_.threads(),
+      config.max_streams_per_token, config.max_streams_analyst, config.max_streams_operator,
+      config.max_streams_unauthenticated, config.stream_stall_timeout_s, ServerThreadCap(config),
+      server->control_loop_.threads(), server->interpolate_loop_.threads(),
       tls ? (config.tls->client_ca.empty() ? "; TLS" : "; TLS, client certificates required")
           : "; plaintext");
   server->health_.SetServingStatus("", true);
@@ -210,8 +230,10 @@ void Server::Shutdown(std::chrono::milliseconds grace) {
   health_.SetServingStatus(false);
   stopping_.Stop();
   interpolate_loop_.BeginShutdown();
+  control_loop_.BeginShutdown();
   server_->Shutdown(std::chrono::system_clock::now() + grace);
   interpolate_loop_.Stop();
+  control_loop_.Stop();
   server_->Wait();
 }
 

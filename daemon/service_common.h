@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 
 #include "brdf/v1/brdf.pb.h"
 #include "core/interp/interpolator.h"
@@ -49,6 +50,11 @@ inline constexpr std::chrono::milliseconds kStreamPollInterval{200};
 // kTimeout → DEADLINE_EXCEEDED, kCancelled → CANCELLED, device errors → UNAVAILABLE, kInternal
 // and kConfigurationError → INTERNAL. The message is kept as it is.
 grpc::Status ToGrpcStatus(const Status& status);
+
+// A client's string as an error message may quote it: at most `max` bytes, each byte outside
+// printable ASCII as '?', a longer one cut and marked ("abc... (102400 bytes)"). gRPC carries
+// an error message in a trailer, which clients cap at a few KiB.
+std::string PrintablePrefix(std::string_view text, std::size_t max = 64);
 
 // INVALID_ARGUMENT "<field>: <what>".
 grpc::Status InvalidField(const std::string& field, const std::string& what);

@@ -14,8 +14,25 @@
 namespace brdf::daemon {
 
 ControlService::ControlService(SessionManager& manager, const Authenticator& auth,
-                               const StopSignal& stopping)
-    : manager_(manager), auth_(auth), stopping_(stopping) {}
+                               const StopSignal& stopping, StreamRegistry& streams)
+    : manager_(manager), auth_(auth), stopping_(stopping), streams_(streams) {}
+
+void ControlService::ServeOn(ControlLoop& loop) {
+  // Each method's async request (RequestX) and its handler (X), by name.
+#define BRDF_CONTROL_METHOD(Name, Req, Resp)                                                    \
+  loop.Add<v1::Req, v1::Resp>(                                                                  \
+      [this](grpc::ServerContext* c, v1::Req* r, grpc::ServerAsyncResponseWriter<v1::Resp>* w,  \
+             grpc::ServerCompletionQueue* q, void* tag) { Request##Name(c, r, w, q, q, tag); }, \
+      [this](grpc::ServerContext* c, const v1::Req* r, v1::Resp* out) { return Name(c, r, out); })
+  BRDF_CONTROL_METHOD(SubmitPlan, SubmitPlanRequest, SubmitPlanResponse);
+  BRDF_CONTROL_METHOD(StartSession, StartSessionRequest, StartSessionResponse);
+  BRDF_CONTROL_METHOD(PauseSession, PauseSessionRequest, PauseSessionResponse);
+  BRDF_CONTROL_METHOD(ResumeSession, ResumeSessionRequest, ResumeSessionResponse);
+  BRDF_CONTROL_METHOD(AbortSession, AbortSessionRequest, AbortSessionResponse);
+  BRDF_CONTROL_METHOD(AnswerPrompt, AnswerPromptRequest, AnswerPromptResponse);
+  BRDF_CONTROL_METHOD(GetRigStatus, GetRigStatusRequest, RigStatus);
+#undef BRDF_CONTROL_METHOD
+}
 
 namespace {
 
@@ -260,6 +277,9 @@ grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
       !st.ok()) {
     return st;
   }
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  if (grpc::Status st = streams_.Open(*context, &caller, "WatchSession", &slot); !st.ok())
+    return st;
   SessionId id = 0;
   if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
   Result<std::shared_ptr<EventSubscription>> subscribed = manager_.Subscribe(id);
@@ -277,7 +297,7 @@ grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
     std::optional<v1::SessionEvent> event =
         sub->Next(stopping ? std::chrono::milliseconds(0) : kStreamPollInterval);
     if (event.has_value()) {
-      if (!writer->Write(*event)) {
+      if (!slot->Write(writer, *event)) {
         sub->Close();
         return grpc::Status(grpc::StatusCode::CANCELLED, "WatchSession: the client went away");
       }

@@ -1,0 +1,52 @@
+#include "daemon/control_loop.h"
+
+namespace brdf::daemon {
+
+ControlLoop::ControlLoop(int threads) : threads_(threads < 1 ? 1 : threads) {}
+
+ControlLoop::~ControlLoop() {
+  Stop();
+}
+
+void ControlLoop::AddQueue(grpc::ServerBuilder& builder) {
+  queue_ = builder.AddCompletionQueue();
+}
+
+bool ControlLoop::AskIfOpen(const std::function<void()>& ask) {
+  MutexLock lock(request_mu_);
+  if (closing_) return false;
+  ask();
+  return true;
+}
+
+void ControlLoop::Start() {
+  for (auto& method : methods_) method->Ask();
+  for (int i = 0; i < threads_; ++i) loops_.emplace_back([this] { Serve(); });
+}
+
+void ControlLoop::BeginShutdown() {
+  MutexLock lock(request_mu_);
+  closing_ = true;
+}
+
+void ControlLoop::Stop() {
+  if (stopped_) return;
+  stopped_ = true;
+  BeginShutdown();
+  if (!queue_) return;
+  queue_->Shutdown();
+  if (loops_.empty()) Serve();  // never started: drain the queue here
+  for (std::thread& loop : loops_) loop.join();
+  loops_.clear();
+}
+
+void ControlLoop::Serve() {
+  void* tag = nullptr;
+  bool ok = false;
+  while (queue_->Next(&tag, &ok)) {
+    auto* call = static_cast<Call*>(tag);
+    if (!call->Proceed(ok)) delete call;
+  }
+}
+
+}  // namespace brdf::daemon
