@@ -123,8 +123,11 @@ grpc::Status ControlService::PauseSession(grpc::ServerContext* context,
       return InvalidField("mode", "unknown pause mode " + std::to_string(request->mode()) +
                                       "; use PAUSE_MODE_DEFERRED or PAUSE_MODE_IMMEDIATE");
   }
+  Result<v1::Session> before = manager_.GetSession(id);
   Result<v1::Session> session = manager_.Pause(id, mode, caller.ToActor());
   if (!session.ok()) return ToGrpcStatus(session.status());
+  response->set_already_paused(before.ok() && before->state() == v1::SESSION_STATE_PAUSED &&
+                               session->state() == v1::SESSION_STATE_PAUSED);
   *response->mutable_session() = std::move(*session);
   return grpc::Status::OK;
 }
