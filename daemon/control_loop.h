@@ -8,7 +8,10 @@
 // PauseSession failed with "Server Threadpool Exhausted" (issue 20). Here the control calls are
 // read from their own completion queue by their own threads, so whatever the streams hold, a
 // control call waits only for the control calls ahead of it. The streams are capped besides
-// (stream_registry.h), so the synchronous pool is never exhausted either.
+// (stream_registry.h), so the synchronous pool is never exhausted either. The threads ask for nice
+// -5 (CAP_SYS_NICE or RLIMIT_NICE: the systemd unit's LimitNICE=-5; else they stay at 0) and the
+// streams' work runs at +10: with the cores busy (Interpolate clients, exports), a control call
+// still gets one at once (bench/daemon/control_plane.sh).
 //
 // Each method is added with Add() before the server is built, from a service that marked it
 // async (WithAsyncMethod_X) and a handler with the synchronous signature (the service's own

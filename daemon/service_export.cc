@@ -386,7 +386,9 @@ grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportR
     return st;
   }
   std::unique_ptr<StreamRegistry::Slot> slot;
-  if (grpc::Status st = streams_.Open(*context, &caller, "Export", &slot); !st.ok()) return st;
+  if (grpc::Status st = streams_.Open(*context, &caller, "Export", &slot, /*computes=*/true);
+      !st.ok())
+    return st;
   ExportSettings settings;
   if (grpc::Status st = ParseRequest(*request, &settings); !st.ok()) return st;
 

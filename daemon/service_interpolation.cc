@@ -231,7 +231,9 @@ grpc::Status InterpolationService::InterpolateBatch(
     return st;
   }
   std::unique_ptr<StreamRegistry::Slot> slot;
-  if (grpc::Status st = streams_.Open(*context, &caller, "InterpolateBatch", &slot); !st.ok())
+  if (grpc::Status st =
+          streams_.Open(*context, &caller, "InterpolateBatch", &slot, /*computes=*/true);
+      !st.ok())
     return st;
   SessionId id = 0;
   if (grpc::Status st = SessionOf(request->session_id(), &id); !st.ok()) return st;

@@ -1,6 +1,9 @@
 #include "daemon/stream_registry.h"
 
 #include <spdlog/spdlog.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
 
@@ -9,6 +12,16 @@ namespace {
 
 // Room beyond the stream caps in the synchronous pool: the analysts' unary calls and the pollers.
 constexpr int kUnaryThreads = 64;
+
+// A stream's work runs at this nice value (lower priority than the control plane's and
+// Interpolate's threads, which stay at 0). Going back to 0 afterwards needs CAP_SYS_NICE or
+// RLIMIT_NICE; without them the pool thread stays at this value, which only slows the analysts'
+// calls it serves later, never the control plane.
+constexpr int kWorkNice = 10;
+
+void SetThreadNice(int nice) {
+  (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), nice);
+}
 
 std::int64_t NowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -46,7 +59,8 @@ int ServerThreadCap(const ServerConfig& config) {
 StreamRegistry::StreamRegistry(const ServerConfig& config, bool tokens_configured)
     : limits_(config),
       per_token_(tokens_configured),
-      stall_timeout_(std::chrono::seconds(config.stream_stall_timeout_s)) {
+      stall_timeout_(std::chrono::seconds(config.stream_stall_timeout_s)),
+      work_permits_(static_cast<int>(std::max(1U, std::thread::hardware_concurrency() / 2))) {
   watchdog_ = std::thread([this] { Watchdog(); });
 }
 
@@ -60,45 +74,70 @@ StreamRegistry::~StreamRegistry() {
 }
 
 grpc::Status StreamRegistry::Open(grpc::ServerContextBase& context, const Caller* caller,
-                                  std::string_view rpc, std::unique_ptr<Slot>* slot) {
-  MutexLock lock(mu_);
-  auto entry = std::make_unique<Entry>();
-  entry->context = &context;
-  entry->rpc = std::string(rpc);
-  if (caller == nullptr) {
-    if (unauthenticated_open_ >= limits_.max_streams_unauthenticated) {
-      return CapReached(rpc, "calls without a token", limits_.max_streams_unauthenticated,
-                        "max_streams_unauthenticated");
-    }
-    ++unauthenticated_open_;
-    entry->who = "a client without a token";
-  } else {
-    const bool op = caller->role == Role::kOperator;
-    int& role_open = op ? operator_open_ : analyst_open_;
-    const int role_cap = op ? limits_.max_streams_operator : limits_.max_streams_analyst;
-    if (per_token_) {
-      const int held = per_token_open_.count(caller->name) ? per_token_open_[caller->name] : 0;
-      if (held >= limits_.max_streams_per_token) {
-        return CapReached(rpc, "token \"" + caller->name + "\"", limits_.max_streams_per_token,
-                          "max_streams_per_token");
+                                  std::string_view rpc, std::unique_ptr<Slot>* slot,
+                                  bool computes) {
+  {
+    MutexLock lock(mu_);
+    auto entry = std::make_unique<Entry>();
+    entry->context = &context;
+    entry->rpc = std::string(rpc);
+    if (caller == nullptr) {
+      if (unauthenticated_open_ >= limits_.max_streams_unauthenticated) {
+        return CapReached(rpc, "calls without a token", limits_.max_streams_unauthenticated,
+                          "max_streams_unauthenticated");
       }
+      ++unauthenticated_open_;
+      entry->who = "a client without a token";
+    } else {
+      const bool op = caller->role == Role::kOperator;
+      int& role_open = op ? operator_open_ : analyst_open_;
+      const int role_cap = op ? limits_.max_streams_operator : limits_.max_streams_analyst;
+      if (per_token_) {
+        const int held = per_token_open_.count(caller->name) ? per_token_open_[caller->name] : 0;
+        if (held >= limits_.max_streams_per_token) {
+          return CapReached(rpc, "token \"" + caller->name + "\"", limits_.max_streams_per_token,
+                            "max_streams_per_token");
+        }
+      }
+      if (role_open >= role_cap) {
+        return CapReached(rpc, std::string(op ? "operator" : "analyst") + " tokens together",
+                          role_cap, op ? "max_streams_operator" : "max_streams_analyst");
+      }
+      ++role_open;
+      if (per_token_) ++per_token_open_[caller->name];
+      entry->who = "token \"" + caller->name + "\"";
+      entry->token = caller->name;
+      entry->role = caller->role;
+      entry->authenticated = true;
     }
-    if (role_open >= role_cap) {
-      return CapReached(rpc, std::string(op ? "operator" : "analyst") + " tokens together",
-                        role_cap, op ? "max_streams_operator" : "max_streams_analyst");
-    }
-    ++role_open;
-    if (per_token_) ++per_token_open_[caller->name];
-    entry->who = "token \"" + caller->name + "\"";
-    entry->token = caller->name;
-    entry->role = caller->role;
-    entry->authenticated = true;
+    const std::uint64_t id = next_id_++;
+    Entry* raw = entry.get();
+    entries_.emplace(id, std::move(entry));
+    slot->reset(new Slot(this, id, raw, computes));
   }
-  const std::uint64_t id = next_id_++;
-  Entry* raw = entry.get();
-  entries_.emplace(id, std::move(entry));
-  slot->reset(new Slot(this, id, raw));
+  if (computes) (*slot)->holding_ = AcquireWork(context);
   return grpc::Status::OK;
+}
+
+bool StreamRegistry::AcquireWork(const grpc::ServerContextBase& context) {
+  MutexLock lock(work_mu_);
+  while (working_ >= work_permits_) {
+    // The synchronous API has no wake-up for a cancelled call: look now and then.
+    if (context.IsCancelled()) return false;
+    work_cv_.WaitFor(work_mu_, std::chrono::milliseconds(100));
+  }
+  ++working_;
+  SetThreadNice(kWorkNice);
+  return true;
+}
+
+void StreamRegistry::ReleaseWork() {
+  SetThreadNice(0);
+  {
+    MutexLock lock(work_mu_);
+    --working_;
+  }
+  work_cv_.NotifyOne();
 }
 
 void StreamRegistry::Release(std::uint64_t id) {
@@ -144,15 +183,23 @@ void StreamRegistry::Watchdog() {
 }
 
 StreamRegistry::Slot::~Slot() {
+  Close();
   registry_->Release(id_);
 }
 
+void StreamRegistry::Slot::Close() {
+  if (holding_) registry_->ReleaseWork();
+  holding_ = false;
+}
+
 void StreamRegistry::Slot::BeginWrite() {
+  Close();
   entry_->write_since_ns.store(NowNs());
 }
 
 void StreamRegistry::Slot::EndWrite() {
   entry_->write_since_ns.store(0);
+  if (computes_) holding_ = registry_->AcquireWork(*entry_->context);
 }
 
 }  // namespace brdf::daemon

@@ -9,6 +9,12 @@
 // synchronous pool, which server.cc sizes above the caps' sum (ServerThreadCap): the streams
 // cannot exhaust it, and the control plane is not on it at all (control_loop.h).
 //
+// Bounded work: a stream that computes what it sends (Export, InterpolateBatch: opened with
+// `computes`) works only while it holds one of a few work permits (one per two cores), and gives
+// its permit back while a write waits for the client. A thousand exports then take turns on the
+// cores instead of all running at once, and at a lower CPU priority (nice 10) than the control
+// plane's threads and Interpolate's loop, which get a core when they need one.
+//
 // Stall deadline (stream_stall_timeout_s): a stream writes through its Slot; a write that has
 // waited that long (the client read nothing meanwhile: HTTP/2 flow control holds the message)
 // gets the call cancelled by the registry's watchdog thread, so the write fails, the handler
@@ -57,16 +63,20 @@ class StreamRegistry {
       EndWrite();
       return ok;
     }
+    // Releases the work permit (if any) before it goes away.
+    void Close();
 
    private:
     friend class StreamRegistry;
-    Slot(StreamRegistry* registry, std::uint64_t id, Entry* entry)
-        : registry_(registry), id_(id), entry_(entry) {}
-    void BeginWrite();
-    void EndWrite();
+    Slot(StreamRegistry* registry, std::uint64_t id, Entry* entry, bool computes)
+        : registry_(registry), id_(id), entry_(entry), computes_(computes) {}
+    void BeginWrite();  // gives the work permit back
+    void EndWrite();    // takes a work permit again
     StreamRegistry* registry_;
     std::uint64_t id_;
     Entry* entry_;
+    const bool computes_;
+    bool holding_ = false;  // a work permit
   };
 
   // `tokens_configured`: false when the API is open (auth disabled): no per-token cap. Starts
@@ -77,9 +87,13 @@ class StreamRegistry {
   StreamRegistry& operator=(const StreamRegistry&) = delete;
 
   // Admits a stream of `rpc` for `caller` (nullptr: a call without a token) on `context`: OK with
-  // *slot set, or RESOURCE_EXHAUSTED naming the cap that is full and its configuration key.
+  // *slot set, or RESOURCE_EXHAUSTED naming the cap that is full and its configuration key. With
+  // `computes`, waits for a work permit first (returns without one if the call is cancelled).
   grpc::Status Open(grpc::ServerContextBase& context, const Caller* caller, std::string_view rpc,
-                    std::unique_ptr<Slot>* slot);
+                    std::unique_ptr<Slot>* slot, bool computes = false);
+
+  // Work permits: one per two cores, at least one.
+  int work_permits() const { return work_permits_; }
 
   // Streams open now, and streams cancelled for not reading since the start.
   int open() const;
@@ -87,6 +101,9 @@ class StreamRegistry {
 
  private:
   void Release(std::uint64_t id);
+  // Waits for a work permit (false: `context` was cancelled meanwhile); gives one back.
+  bool AcquireWork(const grpc::ServerContextBase& context);
+  void ReleaseWork();
   void Watchdog();
 
   const ServerConfig limits_;
@@ -103,6 +120,10 @@ class StreamRegistry {
   int operator_open_ GUARDED_BY(mu_) = 0;
   int unauthenticated_open_ GUARDED_BY(mu_) = 0;
   std::atomic<std::uint64_t> stalled_{0};
+  const int work_permits_;
+  Mutex work_mu_;
+  CondVar work_cv_;
+  int working_ GUARDED_BY(work_mu_) = 0;
   std::thread watchdog_;
 };
 
