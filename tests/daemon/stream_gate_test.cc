@@ -198,6 +198,38 @@ TEST_F(StreamGateTest, PausingAPausedSessionSaysSo) {
   op.Stop();
 }
 
+TEST_F(StreamGateTest, AStreamItsClientStopsReadingIsCancelledAfterTheStallTimeout) {
+  Start("stream_stall_timeout_s = 1\n");
+  Result<v1::Session> s = rig_.Submit(
+      PlanFixture("stall").SampleRotation({30, 30, 10}, {0, 60, 5}, 10).Measurement(100, 1));
+  ASSERT_TRUE(s.ok()) << s.status().ToString();
+  GrpcOperator op(rig_, s->session_id());
+  const v1::Session recorded = rig_.WaitFor(
+      s->session_id(), [](const v1::Session& x) { return x.progress().done_samples() >= 2; },
+      45s);
+  ASSERT_GE(recorded.progress().done_samples(), 2u) << rig_.log();
+  // ~24 MB of answers: far more than HTTP/2's windows hold while the client reads nothing.
+  v1::InterpolateBatchRequest batch;
+  batch.set_session_id(s->session_id());
+  for (int d = 0; d < 20000; ++d) {
+    v1::IsoDirection* at = batch.add_directions()->mutable_iso();
+    at->set_theta_i(30);
+    at->set_theta_o(10 + d % 60);
+    at->set_phi(d % 180);
+  }
+  auto context = DaemonRig::Context(kAnalystToken, 60s);
+  auto reader = rig_.interpolation().InterpolateBatch(context.get(), batch);
+  std::this_thread::sleep_for(4s);  // the stall timeout (1 s) and the watchdog's round
+  int results = 0;
+  v1::InterpolateBatchChunk chunk;
+  while (reader->Read(&chunk)) results += chunk.results_size();
+  const grpc::Status ended = reader->Finish();
+  EXPECT_EQ(ended.error_code(), StatusCode::CANCELLED) << ended.error_message();
+  EXPECT_LT(results, 20000);
+  EXPECT_NE(rig_.log().find("its client read nothing for 1 s"), std::string::npos) << rig_.log();
+  op.Stop();
+}
+
 TEST_F(StreamGateTest, TheDocumentedCapsAreTheServers) {
   Start("");
   const std::string id = QueuedSession();
