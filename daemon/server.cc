@@ -2,7 +2,6 @@
 
 #include <absl/synchronization/mutex.h>
 #include <arpa/inet.h>
-#include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/resource_quota.h>
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server_builder.h>
@@ -28,6 +27,15 @@ constexpr int kControlThreads = 2;
 // The services by their full names, for the health service's per-service status.
 constexpr const char* kServiceNames[] = {"brdf.v1.Control", "brdf.v1.Data",
                                          "brdf.v1.Interpolation"};
+
+// Every service the server registers, for reflection's list_services.
+std::vector<std::string> ServedServices() {
+  std::vector<std::string> names(std::begin(kServiceNames), std::end(kServiceNames));
+  names.push_back("grpc.health.v1.Health");
+  names.push_back("grpc.reflection.v1.ServerReflection");
+  names.push_back("grpc.reflection.v1alpha.ServerReflection");
+  return names;
+}
 
 // Reads a PEM file and checks that it holds a block of the expected kind ("CERTIFICATE",
 // "PRIVATE KEY": also matches "EC PRIVATE KEY", "RSA PRIVATE KEY"). gRPC itself only says that
@@ -127,7 +135,9 @@ Server::Server(const ServerConfig& config, SessionManager& manager, IndexCache& 
                         config.interpolate_threads > 0
                             ? config.interpolate_threads
                             : InterpolateLoopThreads(std::thread::hardware_concurrency()),
-                        config.interpolate_cpus) {}
+                        config.interpolate_cpus),
+      reflection_v1_(ServedServices(), streams_),
+      reflection_v1alpha_(ServedServices(), streams_) {}
 
 Server::~Server() {
   Shutdown(std::chrono::seconds(1));
@@ -170,8 +180,6 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   // on: every lock gRPC takes records the lock in a global graph, about a tenth of the CPU of a
   // small call. Upstream release builds have it off; so do we (process-wide, before any call).
   absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
-  // Set up before the builder is made. gRPC's own health service stays off: health_ serves it.
-  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
 
   if (Status st = CheckCpusAvailable(config.interpolate_cpus); !st.ok()) return st;
   std::unique_ptr<Server> server(new Server(config, manager, cache, auth));
@@ -187,6 +195,8 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   builder.RegisterService(&server->control_);
   builder.RegisterService(&server->data_);
   builder.RegisterService(&server->interpolation_);
+  builder.RegisterService(&server->reflection_v1_);
+  builder.RegisterService(&server->reflection_v1alpha_);
   server->interpolate_loop_.AddQueues(builder);
   server->health_.ServeOn(server->control_loop_);
   server->control_.ServeOn(server->control_loop_);

@@ -1,5 +1,6 @@
 // The gRPC server: the Control, Data and Interpolation services, the standard health service
-// (grpc.health.v1.Health: "" and each brdf.v1 service SERVING while up) and server reflection,
+// (grpc.health.v1.Health: "" and each brdf.v1 service SERVING while up) and server reflection
+// (grpc.reflection.v1 and v1alpha, reflection_service.h),
 // on the configured address, in plaintext or TLS ([server.tls]; client_ca → clients must present
 // a certificate). Every call passes the token gate first (token_gate.h: the bearer token is
 // checked from the metadata, before the request is read). Three sets of threads answer:
@@ -24,6 +25,7 @@
 #include "daemon/health_service.h"
 #include "daemon/index_cache.h"
 #include "daemon/interpolate_loop.h"
+#include "daemon/reflection_service.h"
 #include "daemon/service_common.h"
 #include "daemon/service_control.h"
 #include "daemon/service_data.h"
@@ -78,6 +80,8 @@ class Server {
   DataService data_;
   InterpolationService interpolation_;
   InterpolateLoop interpolate_loop_;  // after interpolation_, which it serves
+  ReflectionV1Service reflection_v1_;
+  ReflectionV1AlphaService reflection_v1alpha_;
   std::unique_ptr<grpc::Server> server_;
   std::string address_;
   int port_ = 0;
