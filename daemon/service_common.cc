@@ -42,7 +42,17 @@ grpc::Status ToGrpcStatus(const Status& status) {
       code = StatusCode::INTERNAL;
       break;
   }
-  return grpc::Status(code, status.message());
+  return grpc::Status(code, BoundedMessage(status.message()));
+}
+
+std::string BoundedMessage(std::string message) {
+  if (message.size() <= kMaxErrorMessageBytes) return message;
+  std::size_t cut = kMaxErrorMessageBytes - 32;
+  // Not inside a UTF-8 sequence: back up over continuation bytes (10xxxxxx).
+  while (cut > 0 && (static_cast<unsigned char>(message[cut]) & 0xC0) == 0x80) --cut;
+  const std::size_t full = message.size();
+  message.resize(cut);
+  return message + "... (" + std::to_string(full) + " bytes)";
 }
 
 std::string PrintablePrefix(std::string_view text, std::size_t max) {
@@ -58,7 +68,7 @@ std::string PrintablePrefix(std::string_view text, std::size_t max) {
 }
 
 grpc::Status InvalidField(const std::string& field, const std::string& what) {
-  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, field + ": " + what);
+  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, BoundedMessage(field + ": " + what));
 }
 
 grpc::Status ParseQuantityField(int quantity, Quantity* out) {

@@ -229,7 +229,7 @@ grpc::Status ControlService::ListSessions(grpc::ServerContext* context,
     if (!ParseSessionIdField(request->page_token(), "page_token", &token).ok()) {
       const std::string shown =
           request->page_token().size() <= kMaxSessionIdBytes
-              ? "\"" + request->page_token() + "\""
+              ? "\"" + PrintablePrefix(request->page_token(), kMaxSessionIdBytes) + "\""
               : "the " + std::to_string(request->page_token().size()) + "-byte token given";
       return InvalidField("page_token",
                           shown +

@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "daemon/service_common.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/support/plan_fixtures.h"
@@ -113,6 +114,23 @@ TEST_F(StreamGateTest, UnauthenticatedLargeRequestsAreRefusedBeforeTheyAreRead) 
   std::cout << "8 unauthenticated 15 MiB calls: VmRSS " << before << " kB → " << after << " kB\n";
 }
 
+TEST(ErrorTextTest, ClientStringsAreQuotedShortAndPrintableAndMessagesBounded) {
+  EXPECT_EQ(daemon::PrintablePrefix("brdf.v1.Control"), "brdf.v1.Control");
+  EXPECT_EQ(daemon::PrintablePrefix(std::string("a\x01\nb", 4)), "a??b");
+  EXPECT_EQ(daemon::PrintablePrefix(std::string(100, 'x'), 8), "xxxxxxxx... (100 bytes)");
+  const std::string short_message = "θi: out of range";
+  EXPECT_EQ(daemon::BoundedMessage(short_message), short_message);
+  std::string long_message;
+  while (long_message.size() < 5000) long_message += "θ";  // two bytes each
+  const std::string bounded = daemon::BoundedMessage(long_message);
+  EXPECT_LE(bounded.size(), daemon::kMaxErrorMessageBytes);
+  EXPECT_NE(bounded.find("(5000 bytes)"), std::string::npos) << bounded;
+  EXPECT_EQ(bounded.rfind("θ... (", std::string::npos) + std::string("θ... (").size() +
+                std::string("5000 bytes)").size(),
+            bounded.size())
+      << "cut at a character boundary";
+}
+
 TEST_F(StreamGateTest, ErrorsQuoteAShortPrintablePrefixOfAClientsString) {
   Start("");
   auto health = grpc::health::v1::Health::NewStub(rig_.channel());
@@ -205,8 +223,7 @@ TEST_F(StreamGateTest, AStreamItsClientStopsReadingIsCancelledAfterTheStallTimeo
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   GrpcOperator op(rig_, s->session_id());
   const v1::Session recorded = rig_.WaitFor(
-      s->session_id(), [](const v1::Session& x) { return x.progress().done_samples() >= 2; },
-      45s);
+      s->session_id(), [](const v1::Session& x) { return x.progress().done_samples() >= 2; }, 45s);
   ASSERT_GE(recorded.progress().done_samples(), 2u) << rig_.log();
   // ~24 MB of answers: far more than HTTP/2's windows hold while the client reads nothing.
   v1::InterpolateBatchRequest batch;
