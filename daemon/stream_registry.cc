@@ -13,11 +13,11 @@ namespace {
 // Room beyond the stream caps in the synchronous pool: the analysts' unary calls and the pollers.
 constexpr int kUnaryThreads = 64;
 
-// A stream's work runs at this nice value (lower priority than the control plane's and
-// Interpolate's threads, which stay at 0). Going back to 0 afterwards needs CAP_SYS_NICE or
+// A stream's thread runs at this nice value while the stream is open (lower priority than the
+// control plane's threads, at -5 or 0, and Interpolate's loop, at 0). Going back to 0 afterwards needs CAP_SYS_NICE or
 // RLIMIT_NICE; without them the pool thread stays at this value, which only slows the analysts'
 // calls it serves later, never the control plane.
-constexpr int kWorkNice = 10;
+constexpr int kStreamNice = 10;
 
 void SetThreadNice(int nice) {
   (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), nice);
@@ -115,6 +115,7 @@ grpc::Status StreamRegistry::Open(grpc::ServerContextBase& context, const Caller
     entries_.emplace(id, std::move(entry));
     slot->reset(new Slot(this, id, raw, computes));
   }
+  SetThreadNice(kStreamNice);
   if (computes) (*slot)->holding_ = AcquireWork(context);
   return grpc::Status::OK;
 }
@@ -127,12 +128,10 @@ bool StreamRegistry::AcquireWork(const grpc::ServerContextBase& context) {
     work_cv_.WaitFor(work_mu_, std::chrono::milliseconds(100));
   }
   ++working_;
-  SetThreadNice(kWorkNice);
   return true;
 }
 
 void StreamRegistry::ReleaseWork() {
-  SetThreadNice(0);
   {
     MutexLock lock(work_mu_);
     --working_;
@@ -185,6 +184,7 @@ void StreamRegistry::Watchdog() {
 StreamRegistry::Slot::~Slot() {
   Close();
   registry_->Release(id_);
+  SetThreadNice(0);
 }
 
 void StreamRegistry::Slot::Close() {

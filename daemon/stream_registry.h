@@ -12,8 +12,9 @@
 // Bounded work: a stream that computes what it sends (Export, InterpolateBatch: opened with
 // `computes`) works only while it holds one of a few work permits (one per two cores), and gives
 // its permit back while a write waits for the client. A thousand exports then take turns on the
-// cores instead of all running at once, and at a lower CPU priority (nice 10) than the control
-// plane's threads and Interpolate's loop, which get a core when they need one.
+// cores instead of all running at once. Every stream's thread runs at nice 10 while the stream is
+// open (back to 0 after), below the control plane's threads and Interpolate's loop, which get a
+// core when they need one.
 //
 // Stall deadline (stream_stall_timeout_s): a stream writes through its Slot; a write that has
 // waited that long (the client read nothing meanwhile: HTTP/2 flow control holds the message)
