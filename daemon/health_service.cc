@@ -70,8 +70,9 @@ grpc::Status HealthService::Watch(grpc::ServerContext* context,
                                   const grpc::health::v1::HealthCheckRequest* request,
                                   grpc::ServerWriter<HealthCheckResponse>* writer) {
   std::unique_ptr<StreamRegistry::Slot> slot;
-  if (grpc::Status st = streams_.Open(*context, nullptr, "health Watch", &slot); !st.ok())
+  if (grpc::Status st = streams_.Open(*context, nullptr, "health Watch", &slot); !st.ok()) {
     return st;
+  }
   MutexLock lock(mu_);
   std::uint64_t sent_version = version_;
   Status sent = StatusLocked(request->service());

@@ -281,8 +281,9 @@ grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
     return st;
   }
   std::unique_ptr<StreamRegistry::Slot> slot;
-  if (grpc::Status st = streams_.Open(*context, &caller, "WatchSession", &slot); !st.ok())
+  if (grpc::Status st = streams_.Open(*context, &caller, "WatchSession", &slot); !st.ok()) {
     return st;
+  }
   SessionId id = 0;
   if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
   Result<std::shared_ptr<EventSubscription>> subscribed = manager_.Subscribe(id);

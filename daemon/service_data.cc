@@ -41,8 +41,9 @@ grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
     return st;
   }
   std::unique_ptr<StreamRegistry::Slot> slot;
-  if (grpc::Status st = streams_.Open(*context, &caller, "StreamReadings", &slot); !st.ok())
+  if (grpc::Status st = streams_.Open(*context, &caller, "StreamReadings", &slot); !st.ok()) {
     return st;
+  }
   SessionId id = 0;
   if (grpc::Status st = ParseSessionIdField(request->session_id(), "session_id", &id); !st.ok()) {
     return st;

@@ -14,9 +14,9 @@ namespace {
 constexpr int kUnaryThreads = 64;
 
 // A stream's thread runs at this nice value while the stream is open (lower priority than the
-// control plane's threads, at -5 or 0, and Interpolate's loop, at 0). Going back to 0 afterwards needs CAP_SYS_NICE or
-// RLIMIT_NICE; without them the pool thread stays at this value, which only slows the analysts'
-// calls it serves later, never the control plane.
+// control plane's threads, at -5 or 0, and Interpolate's loop, at 0). Going back to 0 afterwards
+// needs CAP_SYS_NICE or RLIMIT_NICE; without them the pool thread stays at this value, which only
+// slows the analysts' calls it serves later, never the control plane.
 constexpr int kStreamNice = 10;
 
 void SetThreadNice(int nice) {
