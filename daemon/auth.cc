@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <utility>
 
+#include "daemon/service_common.h"
+
 namespace brdf::daemon {
 
 bool ConstantTimeEquals(std::string_view a, std::string_view b) {
@@ -80,7 +82,11 @@ grpc::Status Authenticator::Authorize(const grpc::ServerContextBase& context, Ac
   const auto& metadata = context.client_metadata();
   auto it = metadata.find("authorization");
   if (it != metadata.end()) header = std::string_view(it->second.data(), it->second.size());
+  return Check(header, access, rpc, context.peer(), caller);
+}
 
+grpc::Status Authenticator::Check(std::string_view header, Access access, std::string_view rpc,
+                                  std::string_view peer, Caller* caller) const {
   AuthFailure failure = AuthFailure::kNone;
   if (!Identify(header, caller, &failure)) {
     std::string why;
@@ -96,7 +102,7 @@ grpc::Status Authenticator::Authorize(const grpc::ServerContextBase& context, Ac
         break;
     }
     // Never the token itself, not even a wrong one (it may be a real token of another system).
-    spdlog::debug("{}: refused a call from {}: {}", rpc, context.peer(), why);
+    spdlog::debug("{}: refused a call from {}: {}", rpc, peer.empty() ? "a client" : peer, why);
     return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
                         std::string(rpc) + ": " + why +
                             "; send \"authorization: Bearer <token>\" with a token from the "
@@ -104,13 +110,34 @@ grpc::Status Authenticator::Authorize(const grpc::ServerContextBase& context, Ac
   }
   if (access == Access::kControl && caller->role != Role::kOperator) {
     spdlog::warn("{}: refused token \"{}\" (role {}) from {}: the call needs an operator", rpc,
-                 caller->name, RoleName(caller->role), context.peer());
+                 caller->name, RoleName(caller->role), peer.empty() ? "a client" : peer);
     return grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
                         std::string(rpc) + ": token \"" + caller->name + "\" has the role " +
                             RoleName(caller->role) +
                             ", which may only read; this call needs an operator token");
   }
   return grpc::Status::OK;
+}
+
+std::optional<Access> MethodAccess(std::string_view path) {
+  auto starts = [&](std::string_view prefix) { return path.substr(0, prefix.size()) == prefix; };
+  if (starts("/grpc.health.v1.Health/") || starts("/grpc.reflection.")) return std::nullopt;
+  static constexpr std::string_view kControlVerbs[] = {"SubmitPlan",   "StartSession",
+                                                       "PauseSession", "ResumeSession",
+                                                       "AbortSession", "AnswerPrompt"};
+  if (starts("/brdf.v1.Control/")) {
+    const std::string_view method = path.substr(std::string_view("/brdf.v1.Control/").size());
+    for (std::string_view verb : kControlVerbs) {
+      if (method == verb) return Access::kControl;
+    }
+  }
+  return Access::kRead;
+}
+
+std::string MethodName(std::string_view path) {
+  const std::size_t slash = path.rfind('/');
+  std::string_view name = slash == std::string_view::npos ? path : path.substr(slash + 1);
+  return PrintablePrefix(name, 64);
 }
 
 }  // namespace brdf::daemon

@@ -20,6 +20,7 @@
 #include <grpcpp/server_context.h>
 #include <grpcpp/support/status.h>
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -51,6 +52,15 @@ struct Caller {
   Actor ToActor() const { return Actor{RoleName(role), name}; }
 };
 
+// What the method at `path` (":path", "/brdf.v1.Control/PauseSession") needs: nullopt for the
+// calls open to everyone (grpc.health.v1.Health, grpc.reflection.*), kControl for Control's
+// mutating verbs, kRead for every other method, known or not.
+std::optional<Access> MethodAccess(std::string_view path);
+
+// The method's name for messages: what follows the last '/' of `path`, at most 64 printable
+// characters ("PauseSession").
+std::string MethodName(std::string_view path);
+
 // True when a and b hold the same bytes. Runs over max(|a|, |b|) bytes without an early exit.
 bool ConstantTimeEquals(std::string_view a, std::string_view b);
 
@@ -74,6 +84,10 @@ class Authenticator {
   // PERMISSION_DENIED (an analyst on a control call). `rpc` names the call in the message.
   grpc::Status Authorize(const grpc::ServerContextBase& context, Access access,
                          std::string_view rpc, Caller* caller) const;
+  // The same check on an "authorization" value (`header`, empty: none) for a call from `peer`
+  // (for the log; may be empty). Authorize and the token gate (token_gate.h) both use it.
+  grpc::Status Check(std::string_view header, Access access, std::string_view rpc,
+                     std::string_view peer, Caller* caller) const;
 
  private:
   std::vector<TokenConfig> tokens_;

@@ -268,6 +268,11 @@ void ReadServer(TableReader& root, Config& c, Issues& issues) {
     }
   }
   t.Int("interpolate_threads", c.server.interpolate_threads, 1, 64);
+  t.Int("max_streams_per_token", c.server.max_streams_per_token, 1, 100000);
+  t.Int("max_streams_analyst", c.server.max_streams_analyst, 0, 100000);
+  t.Int("max_streams_operator", c.server.max_streams_operator, 1, 100000);
+  t.Int("max_streams_unauthenticated", c.server.max_streams_unauthenticated, 0, 100000);
+  t.Int("stream_stall_timeout_s", c.server.stream_stall_timeout_s, 1, 86400);
   if (const toml::node* cpus = t.Node("interpolate_cpus")) {
     const toml::array* list = cpus->as_array();
     if (list == nullptr || list->empty()) {

@@ -88,6 +88,16 @@ struct ServerConfig {
   // CPUs the loop threads are pinned to, round robin (thread i on cpus[i % size]); empty: not
   // pinned. Gives the loop a core of its own, away from clients and the session's threads.
   std::vector<int> interpolate_cpus;
+  // Open streams (WatchSession, StreamReadings, Export, InterpolateBatch, health Watch,
+  // reflection) brdfd holds at once (daemon/stream_registry.h): per token, per role, and for
+  // calls without a token. A stream beyond a cap fails with RESOURCE_EXHAUSTED naming the key.
+  int max_streams_per_token = 64;
+  int max_streams_analyst = 1024;
+  int max_streams_operator = 256;
+  int max_streams_unauthenticated = 64;
+  // A stream whose client has read nothing for this long (one message waiting to be sent the
+  // whole time) is cancelled, freeing what it holds (an export's file).
+  int stream_stall_timeout_s = 60;
 };
 
 struct StorageConfig {

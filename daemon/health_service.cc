@@ -7,7 +7,19 @@ using grpc::health::v1::HealthCheckResponse;
 
 }  // namespace
 
-HealthService::HealthService(const StopSignal& stopping) : stopping_(stopping) {}
+HealthService::HealthService(const StopSignal& stopping, StreamRegistry& streams)
+    : stopping_(stopping), streams_(streams) {}
+
+void HealthService::ServeOn(ControlLoop& loop) {
+  using grpc::health::v1::HealthCheckRequest;
+  loop.Add<HealthCheckRequest, HealthCheckResponse>(
+      [this](grpc::ServerContext* c, HealthCheckRequest* r,
+             grpc::ServerAsyncResponseWriter<HealthCheckResponse>* w,
+             grpc::ServerCompletionQueue* q, void* tag) { RequestCheck(c, r, w, q, q, tag); },
+      [this](grpc::ServerContext* c, const HealthCheckRequest* r, HealthCheckResponse* out) {
+        return Check(c, r, out);
+      });
+}
 
 void HealthService::SetServingStatus(const std::string& service, bool serving) {
   {
@@ -46,8 +58,9 @@ grpc::Status HealthService::Check(grpc::ServerContext* /*context*/,
           (known.empty() ? "" : ", ") + (name.empty() ? std::string("\"\" (the server)") : name);
     }
     if (known.empty()) known = "none yet (brdfd is starting)";
-    return {grpc::StatusCode::NOT_FOUND,
-            "health: no service \"" + request->service() + "\"; ask for one of: " + known};
+    return {grpc::StatusCode::NOT_FOUND, "health: no service \"" +
+                                             PrintablePrefix(request->service()) +
+                                             "\"; ask for one of: " + known};
   }
   response->set_status(status);
   return grpc::Status::OK;
@@ -56,6 +69,10 @@ grpc::Status HealthService::Check(grpc::ServerContext* /*context*/,
 grpc::Status HealthService::Watch(grpc::ServerContext* context,
                                   const grpc::health::v1::HealthCheckRequest* request,
                                   grpc::ServerWriter<HealthCheckResponse>* writer) {
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  if (grpc::Status st = streams_.Open(*context, nullptr, "health Watch", &slot); !st.ok()) {
+    return st;
+  }
   MutexLock lock(mu_);
   std::uint64_t sent_version = version_;
   Status sent = StatusLocked(request->service());
@@ -63,7 +80,7 @@ grpc::Status HealthService::Watch(grpc::ServerContext* context,
     HealthCheckResponse response;
     response.set_status(sent);
     lock.Unlock();
-    if (!writer->Write(response)) return grpc::Status::OK;  // the client went away
+    if (!slot->Write(writer, response)) return grpc::Status::OK;  // the client went away
     lock.Lock();
     // Until the status changes (a new version may leave it as it was: not sent again).
     for (;;) {

@@ -13,15 +13,22 @@
 #include <string>
 
 #include "core/mutex.h"
+#include "daemon/control_loop.h"
 #include "daemon/service_common.h"
+#include "daemon/stream_registry.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 
 namespace brdf::daemon {
 
-class HealthService final : public grpc::health::v1::Health::Service {
+class HealthService final
+    : public grpc::health::v1::Health::WithAsyncMethod_Check<grpc::health::v1::Health::Service> {
  public:
   // `stopping` ends Watch streams; it must outlive the service.
-  explicit HealthService(const StopSignal& stopping);
+  HealthService(const StopSignal& stopping, StreamRegistry& streams);
+
+  // Check is served by `loop` (control_loop.h), apart from the streams; Watch by the pool.
+  // Before the server is built.
+  void ServeOn(ControlLoop& loop);
 
   // Sets one service's status ("" is the server as a whole), waking its watchers.
   void SetServingStatus(const std::string& service, bool serving);
@@ -41,6 +48,7 @@ class HealthService final : public grpc::health::v1::Health::Service {
   Status StatusLocked(const std::string& service) const REQUIRES(mu_);
 
   const StopSignal& stopping_;
+  StreamRegistry& streams_;
   mutable Mutex mu_;
   CondVar changed_;
   std::map<std::string, bool> serving_ GUARDED_BY(mu_);  // by service name

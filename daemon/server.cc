@@ -2,7 +2,6 @@
 
 #include <absl/synchronization/mutex.h>
 #include <arpa/inet.h>
-#include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/resource_quota.h>
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server_builder.h>
@@ -12,15 +11,31 @@
 
 #include <algorithm>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <thread>
+
+#include "daemon/token_gate.h"
 
 namespace brdf::daemon {
 namespace {
 
+// The control plane's threads (control_loop.h): one answers while the other may wait on the
+// store (SubmitPlan's commit).
+constexpr int kControlThreads = 2;
+
 // The services by their full names, for the health service's per-service status.
 constexpr const char* kServiceNames[] = {"brdf.v1.Control", "brdf.v1.Data",
                                          "brdf.v1.Interpolation"};
+
+// Every service the server registers, for reflection's list_services.
+std::vector<std::string> ServedServices() {
+  std::vector<std::string> names(std::begin(kServiceNames), std::end(kServiceNames));
+  names.push_back("grpc.health.v1.Health");
+  names.push_back("grpc.reflection.v1.ServerReflection");
+  names.push_back("grpc.reflection.v1alpha.ServerReflection");
+  return names;
+}
 
 // Reads a PEM file and checks that it holds a block of the expected kind ("CERTIFICATE",
 // "PRIVATE KEY": also matches "EC PRIVATE KEY", "RSA PRIVATE KEY"). gRPC itself only says that
@@ -110,15 +125,19 @@ int InterpolateLoopThreads(unsigned cores) {
 
 Server::Server(const ServerConfig& config, SessionManager& manager, IndexCache& cache,
                const Authenticator& auth)
-    : health_(stopping_),
-      control_(manager, auth, stopping_),
-      data_(manager, auth, stopping_),
-      interpolation_(cache, auth, stopping_),
+    : streams_(config, auth.enabled()),
+      control_loop_(kControlThreads),
+      health_(stopping_, streams_),
+      control_(manager, auth, stopping_, streams_),
+      data_(manager, auth, stopping_, streams_),
+      interpolation_(cache, auth, stopping_, streams_),
       interpolate_loop_(interpolation_,
                         config.interpolate_threads > 0
                             ? config.interpolate_threads
                             : InterpolateLoopThreads(std::thread::hardware_concurrency()),
-                        config.interpolate_cpus) {}
+                        config.interpolate_cpus),
+      reflection_v1_(ServedServices(), streams_),
+      reflection_v1alpha_(ServedServices(), streams_) {}
 
 Server::~Server() {
   Shutdown(std::chrono::seconds(1));
@@ -146,7 +165,9 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
     credentials = grpc::SslServerCredentials(ssl);
     tls = true;
   } else {
-    credentials = grpc::InsecureServerCredentials();
+    // Plaintext as gRPC's xDS credentials with the insecure fallback (no xDS server here, so
+    // plaintext is all they do): unlike InsecureServerCredentials() they take the token gate.
+    credentials = grpc::XdsServerCredentials(grpc::InsecureServerCredentials());
     if (!IsLoopbackAddress(config.listen)) {
       spdlog::warn(
           "serving {} in PLAINTEXT on a non-loopback address: bearer tokens and data cross the "
@@ -159,26 +180,30 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   // on: every lock gRPC takes records the lock in a global graph, about a tenth of the CPU of a
   // small call. Upstream release builds have it off; so do we (process-wide, before any call).
   absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
-  // Set up before the builder is made. gRPC's own health service stays off: health_ serves it.
-  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
 
   if (Status st = CheckCpusAvailable(config.interpolate_cpus); !st.ok()) return st;
   std::unique_ptr<Server> server(new Server(config, manager, cache, auth));
   grpc::ServerBuilder builder;
   int selected_port = 0;
+  credentials->SetAuthMetadataProcessor(std::make_shared<TokenGate>(auth));
   builder.AddListeningPort(config.listen, credentials, &selected_port);
   // One daemon per address: without SO_REUSEPORT a second brdfd's bind fails instead of sharing
   // the port (and answering some of the first one's calls).
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
   grpc::ResourceQuota quota("brdfd");
-  quota.SetMaxThreads(kMaxServerThreads);
+  quota.SetMaxThreads(ServerThreadCap(config));
   builder.SetResourceQuota(quota);
   builder.RegisterService(&server->health_);
   builder.RegisterService(&server->control_);
   builder.RegisterService(&server->data_);
   builder.RegisterService(&server->interpolation_);
+  builder.RegisterService(&server->reflection_v1_);
+  builder.RegisterService(&server->reflection_v1alpha_);
   server->interpolate_loop_.AddQueues(builder);
+  server->health_.ServeOn(server->control_loop_);
+  server->control_.ServeOn(server->control_loop_);
+  server->control_loop_.AddQueue(builder);
   server->server_ = builder.BuildAndStart();
   const bool unix_socket = config.listen.rfind("unix:", 0) == 0;
   if (!server->server_ || (!unix_socket && selected_port == 0)) {
@@ -189,6 +214,7 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
                    "; change [server] listen or stop the process that holds it");
   }
   server->interpolate_loop_.Start();
+  server->control_loop_.Start();
   server->tls_ = tls;
   server->port_ = selected_port;
   server->address_ = unix_socket ? config.listen
@@ -197,9 +223,13 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   spdlog::info(
       "limits: requests up to {} bytes (larger: RESOURCE_EXHAUSTED), InterpolateBatch up to {} "
       "directions in chunks of up to {} results, notes up to {} bytes, pages up to {} sessions, "
-      "{} call threads, Interpolate on {} loop thread(s){}",
+      "open streams up to {} per token, {} analyst, {} operator, {} without a token (a stream "
+      "not read for {} s is cancelled), {} call threads, control plane on {} thread(s), "
+      "Interpolate on {} loop thread(s){}",
       kMaxReceiveMessageBytes, kMaxBatchDirections, kMaxChunkSize, kMaxNoteBytes, kMaxPageSize,
-      kMaxServerThreads, server->interpolate_loop_.threads(),
+      config.max_streams_per_token, config.max_streams_analyst, config.max_streams_operator,
+      config.max_streams_unauthenticated, config.stream_stall_timeout_s, ServerThreadCap(config),
+      server->control_loop_.threads(), server->interpolate_loop_.threads(),
       tls ? (config.tls->client_ca.empty() ? "; TLS" : "; TLS, client certificates required")
           : "; plaintext");
   server->health_.SetServingStatus("", true);
@@ -213,8 +243,10 @@ void Server::Shutdown(std::chrono::milliseconds grace) {
   health_.SetServingStatus(false);
   stopping_.Stop();
   interpolate_loop_.BeginShutdown();
+  control_loop_.BeginShutdown();
   server_->Shutdown(std::chrono::system_clock::now() + grace);
   interpolate_loop_.Stop();
+  control_loop_.Stop();
   server_->Wait();
 }
 

@@ -1,11 +1,15 @@
 // The gRPC server: the Control, Data and Interpolation services, the standard health service
-// (grpc.health.v1.Health: "" and each brdf.v1 service SERVING while up) and server reflection,
+// (grpc.health.v1.Health: "" and each brdf.v1 service SERVING while up) and server reflection
+// (grpc.reflection.v1 and v1alpha, reflection_service.h),
 // on the configured address, in plaintext or TLS ([server.tls]; client_ca → clients must present
-// a certificate). Synchronous API: each call runs on a thread of gRPC's pool, capped at
-// kMaxServerThreads (calls beyond it fail with RESOURCE_EXHAUSTED instead of piling up). One
-// exception, Interpolate, the call analysis clients make by the thousand: it is answered by
-// brdfd's own loop threads on gRPC's completion-queue API (interpolate_loop.h), one per two
-// cores.
+// a certificate). Every call passes the token gate first (token_gate.h: the bearer token is
+// checked from the metadata, before the request is read). Three sets of threads answer:
+//  - the control plane (the operator's verbs, GetRigStatus, health Check): ControlLoop's threads
+//    on gRPC's completion-queue API (control_loop.h), whatever the streams hold;
+//  - Interpolate, the call analysis clients make by the thousand: brdfd's own loop threads on the
+//    completion-queue API (interpolate_loop.h), one per two cores;
+//  - everything else, the streams among them: gRPC's synchronous pool, one thread per call in
+//    flight, capped at ServerThreadCap (stream_registry.h), above the caps on open streams.
 #pragma once
 
 #include <grpcpp/server.h>
@@ -17,18 +21,19 @@
 #include "core/status.h"
 #include "daemon/auth.h"
 #include "daemon/config.h"
+#include "daemon/control_loop.h"
 #include "daemon/health_service.h"
 #include "daemon/index_cache.h"
 #include "daemon/interpolate_loop.h"
+#include "daemon/reflection_service.h"
 #include "daemon/service_common.h"
 #include "daemon/service_control.h"
 #include "daemon/service_data.h"
 #include "daemon/service_interpolation.h"
 #include "daemon/session_manager.h"
+#include "daemon/stream_registry.h"
 
 namespace brdf::daemon {
-
-inline constexpr int kMaxServerThreads = 256;
 
 // Interpolate's loop threads (interpolate_loop.h) on a machine with `cores` cores: one per two
 // cores, at least one, at most 8. Each keeps a core busy under load; the others are left to
@@ -68,11 +73,15 @@ class Server {
          const Authenticator& auth);
 
   StopSignal stopping_;
+  StreamRegistry streams_;  // before the services, which hold slots in it
+  ControlLoop control_loop_;
   HealthService health_;
   ControlService control_;
   DataService data_;
   InterpolationService interpolation_;
   InterpolateLoop interpolate_loop_;  // after interpolation_, which it serves
+  ReflectionV1Service reflection_v1_;
+  ReflectionV1AlphaService reflection_v1alpha_;
   std::unique_ptr<grpc::Server> server_;
   std::string address_;
   int port_ = 0;

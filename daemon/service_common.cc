@@ -42,11 +42,33 @@ grpc::Status ToGrpcStatus(const Status& status) {
       code = StatusCode::INTERNAL;
       break;
   }
-  return grpc::Status(code, status.message());
+  return grpc::Status(code, BoundedMessage(status.message()));
+}
+
+std::string BoundedMessage(std::string message) {
+  if (message.size() <= kMaxErrorMessageBytes) return message;
+  std::size_t cut = kMaxErrorMessageBytes - 32;
+  // Not inside a UTF-8 sequence: back up over continuation bytes (10xxxxxx).
+  while (cut > 0 && (static_cast<unsigned char>(message[cut]) & 0xC0) == 0x80) --cut;
+  const std::size_t full = message.size();
+  message.resize(cut);
+  return message + "... (" + std::to_string(full) + " bytes)";
+}
+
+std::string PrintablePrefix(std::string_view text, std::size_t max) {
+  std::string out;
+  const std::size_t n = std::min(text.size(), max);
+  out.reserve(n + 24);
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = text[i];
+    out += (c >= 0x20 && c < 0x7f) ? c : '?';
+  }
+  if (text.size() > max) out += "... (" + std::to_string(text.size()) + " bytes)";
+  return out;
 }
 
 grpc::Status InvalidField(const std::string& field, const std::string& what) {
-  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, field + ": " + what);
+  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, BoundedMessage(field + ": " + what));
 }
 
 grpc::Status ParseQuantityField(int quantity, Quantity* out) {

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 
 #include "brdf/v1/brdf.pb.h"
 #include "core/interp/interpolator.h"
@@ -44,11 +45,23 @@ inline constexpr std::uint32_t kMaxPageSize = 1000;
 // client went away or the daemon is stopping.
 inline constexpr std::chrono::milliseconds kStreamPollInterval{200};
 
-// brdfd Status → gRPC status, code per session_manager.h: kInvalidArgument → INVALID_ARGUMENT,
+// brdfd Status → gRPC status (message through BoundedMessage), code per session_manager.h:
+// kInvalidArgument → INVALID_ARGUMENT,
 // kNotFound → NOT_FOUND, kFailedPrecondition → FAILED_PRECONDITION, kIoError → UNAVAILABLE,
 // kTimeout → DEADLINE_EXCEEDED, kCancelled → CANCELLED, device errors → UNAVAILABLE, kInternal
-// and kConfigurationError → INTERNAL. The message is kept as it is.
+// and kConfigurationError → INTERNAL. The message is kept, up to kMaxErrorMessageBytes.
 grpc::Status ToGrpcStatus(const Status& status);
+
+// A client's string as an error message may quote it: at most `max` bytes, each byte outside
+// printable ASCII as '?', a longer one cut and marked ("abc... (102400 bytes)"). gRPC carries
+// an error message in a trailer, which clients cap at a few KiB.
+std::string PrintablePrefix(std::string_view text, std::size_t max = 64);
+
+// Longest error message brdfd sends (BoundedMessage); the trailer that carries it stays small.
+inline constexpr std::size_t kMaxErrorMessageBytes = 1024;
+// `message` cut to kMaxErrorMessageBytes at a character boundary, marked with its full length:
+// the last guard in case a message quotes more of a client's string than it should.
+std::string BoundedMessage(std::string message);
 
 // INVALID_ARGUMENT "<field>: <what>".
 grpc::Status InvalidField(const std::string& field, const std::string& what);

@@ -14,8 +14,25 @@
 namespace brdf::daemon {
 
 ControlService::ControlService(SessionManager& manager, const Authenticator& auth,
-                               const StopSignal& stopping)
-    : manager_(manager), auth_(auth), stopping_(stopping) {}
+                               const StopSignal& stopping, StreamRegistry& streams)
+    : manager_(manager), auth_(auth), stopping_(stopping), streams_(streams) {}
+
+void ControlService::ServeOn(ControlLoop& loop) {
+  // Each method's async request (RequestX) and its handler (X), by name.
+#define BRDF_CONTROL_METHOD(Name, Req, Resp)                                                    \
+  loop.Add<v1::Req, v1::Resp>(                                                                  \
+      [this](grpc::ServerContext* c, v1::Req* r, grpc::ServerAsyncResponseWriter<v1::Resp>* w,  \
+             grpc::ServerCompletionQueue* q, void* tag) { Request##Name(c, r, w, q, q, tag); }, \
+      [this](grpc::ServerContext* c, const v1::Req* r, v1::Resp* out) { return Name(c, r, out); })
+  BRDF_CONTROL_METHOD(SubmitPlan, SubmitPlanRequest, SubmitPlanResponse);
+  BRDF_CONTROL_METHOD(StartSession, StartSessionRequest, StartSessionResponse);
+  BRDF_CONTROL_METHOD(PauseSession, PauseSessionRequest, PauseSessionResponse);
+  BRDF_CONTROL_METHOD(ResumeSession, ResumeSessionRequest, ResumeSessionResponse);
+  BRDF_CONTROL_METHOD(AbortSession, AbortSessionRequest, AbortSessionResponse);
+  BRDF_CONTROL_METHOD(AnswerPrompt, AnswerPromptRequest, AnswerPromptResponse);
+  BRDF_CONTROL_METHOD(GetRigStatus, GetRigStatusRequest, RigStatus);
+#undef BRDF_CONTROL_METHOD
+}
 
 namespace {
 
@@ -106,8 +123,11 @@ grpc::Status ControlService::PauseSession(grpc::ServerContext* context,
       return InvalidField("mode", "unknown pause mode " + std::to_string(request->mode()) +
                                       "; use PAUSE_MODE_DEFERRED or PAUSE_MODE_IMMEDIATE");
   }
+  Result<v1::Session> before = manager_.GetSession(id);
   Result<v1::Session> session = manager_.Pause(id, mode, caller.ToActor());
   if (!session.ok()) return ToGrpcStatus(session.status());
+  response->set_already_paused(before.ok() && before->state() == v1::SESSION_STATE_PAUSED &&
+                               session->state() == v1::SESSION_STATE_PAUSED);
   *response->mutable_session() = std::move(*session);
   return grpc::Status::OK;
 }
@@ -209,7 +229,7 @@ grpc::Status ControlService::ListSessions(grpc::ServerContext* context,
     if (!ParseSessionIdField(request->page_token(), "page_token", &token).ok()) {
       const std::string shown =
           request->page_token().size() <= kMaxSessionIdBytes
-              ? "\"" + request->page_token() + "\""
+              ? "\"" + PrintablePrefix(request->page_token(), kMaxSessionIdBytes) + "\""
               : "the " + std::to_string(request->page_token().size()) + "-byte token given";
       return InvalidField("page_token",
                           shown +
@@ -260,6 +280,10 @@ grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
       !st.ok()) {
     return st;
   }
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  if (grpc::Status st = streams_.Open(*context, &caller, "WatchSession", &slot); !st.ok()) {
+    return st;
+  }
   SessionId id = 0;
   if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
   Result<std::shared_ptr<EventSubscription>> subscribed = manager_.Subscribe(id);
@@ -277,7 +301,7 @@ grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
     std::optional<v1::SessionEvent> event =
         sub->Next(stopping ? std::chrono::milliseconds(0) : kStreamPollInterval);
     if (event.has_value()) {
-      if (!writer->Write(*event)) {
+      if (!slot->Write(writer, *event)) {
         sub->Close();
         return grpc::Status(grpc::StatusCode::CANCELLED, "WatchSession: the client went away");
       }

@@ -5,15 +5,29 @@
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/auth.h"
+#include "daemon/control_loop.h"
 #include "daemon/service_common.h"
 #include "daemon/session_manager.h"
+#include "daemon/stream_registry.h"
 
 namespace brdf::daemon {
 
-class ControlService final : public v1::Control::Service {
+// The control plane's methods, served by ControlLoop (control_loop.h), not the synchronous pool.
+using ControlServiceBase =
+    v1::Control::WithAsyncMethod_SubmitPlan<v1::Control::WithAsyncMethod_StartSession<
+        v1::Control::WithAsyncMethod_PauseSession<v1::Control::WithAsyncMethod_ResumeSession<
+            v1::Control::WithAsyncMethod_AbortSession<v1::Control::WithAsyncMethod_AnswerPrompt<
+                v1::Control::WithAsyncMethod_GetRigStatus<v1::Control::Service>>>>>>>;
+
+class ControlService final : public ControlServiceBase {
  public:
   // All three must outlive the service. `stopping` ends WatchSession streams at shutdown.
-  ControlService(SessionManager& manager, const Authenticator& auth, const StopSignal& stopping);
+  ControlService(SessionManager& manager, const Authenticator& auth, const StopSignal& stopping,
+                 StreamRegistry& streams);
+
+  // Adds the control plane's methods (the operator's verbs and GetRigStatus) to `loop`, which
+  // then answers them with the methods below. Before the server is built.
+  void ServeOn(ControlLoop& loop);
 
   grpc::Status SubmitPlan(grpc::ServerContext* context, const v1::SubmitPlanRequest* request,
                           v1::SubmitPlanResponse* response) override;
@@ -44,6 +58,7 @@ class ControlService final : public v1::Control::Service {
   SessionManager& manager_;
   const Authenticator& auth_;
   const StopSignal& stopping_;
+  StreamRegistry& streams_;
 };
 
 }  // namespace brdf::daemon

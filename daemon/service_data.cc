@@ -7,8 +7,8 @@
 namespace brdf::daemon {
 
 DataService::DataService(SessionManager& manager, const Authenticator& auth,
-                         const StopSignal& stopping)
-    : manager_(manager), auth_(auth), stopping_(stopping) {
+                         const StopSignal& stopping, StreamRegistry& streams)
+    : manager_(manager), auth_(auth), stopping_(stopping), streams_(streams) {
   listener_ = manager_.AddReadingListener([this](SessionId, const storage::ReadingRecord&) {
     {
       MutexLock lock(mu_);
@@ -38,6 +38,10 @@ grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
   Caller caller;
   if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "StreamReadings", &caller);
       !st.ok()) {
+    return st;
+  }
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  if (grpc::Status st = streams_.Open(*context, &caller, "StreamReadings", &slot); !st.ok()) {
     return st;
   }
   SessionId id = 0;
@@ -100,7 +104,7 @@ grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
     for (const storage::ReadingRecord& r : *page) {
       last = r.id;
       if (!kinds.empty() && kinds.count(r.kind) == 0) continue;
-      if (!writer->Write(ToProtoReading(r, extras))) {
+      if (!slot->Write(writer, ToProtoReading(r, extras))) {
         return grpc::Status(grpc::StatusCode::CANCELLED, "StreamReadings: the client went away");
       }
     }

@@ -13,6 +13,7 @@
 #include "daemon/auth.h"
 #include "daemon/service_common.h"
 #include "daemon/session_manager.h"
+#include "daemon/stream_registry.h"
 
 namespace brdf::daemon {
 
@@ -23,7 +24,8 @@ class DataService final : public v1::Data::Service {
 
   // Registers a reading listener on `manager` (removed by the destructor). All three must
   // outlive the service.
-  DataService(SessionManager& manager, const Authenticator& auth, const StopSignal& stopping);
+  DataService(SessionManager& manager, const Authenticator& auth, const StopSignal& stopping,
+              StreamRegistry& streams);
   ~DataService() override;
 
   grpc::Status StreamReadings(grpc::ServerContext* context,
@@ -43,6 +45,7 @@ class DataService final : public v1::Data::Service {
   SessionManager& manager_;
   const Authenticator& auth_;
   const StopSignal& stopping_;
+  StreamRegistry& streams_;
   int listener_ = 0;
 
   mutable Mutex mu_;

@@ -52,9 +52,11 @@ constexpr double kProgressStep = 0.005;
 class ExportStream {
  public:
   ExportStream(grpc::ServerContext& context, grpc::ServerWriter<v1::ExportChunk>& writer,
-               const StopSignal& stopping, std::size_t chunk_bytes, CancelToken cancel)
+               StreamRegistry::Slot& slot, const StopSignal& stopping, std::size_t chunk_bytes,
+               CancelToken cancel)
       : context_(context),
         writer_(writer),
+        slot_(slot),
         stopping_(stopping),
         chunk_bytes_(chunk_bytes),
         cancel_(std::move(cancel)) {}
@@ -126,7 +128,7 @@ class ExportStream {
 
   void Send(const v1::ExportChunk& chunk) {
     if (broken_) return;
-    if (!writer_.Write(chunk)) {
+    if (!slot_.Write(&writer_, chunk)) {
       broken_ = true;
       CheckCancelled();
     }
@@ -134,6 +136,7 @@ class ExportStream {
 
   grpc::ServerContext& context_;
   grpc::ServerWriter<v1::ExportChunk>& writer_;
+  StreamRegistry::Slot& slot_;
   const StopSignal& stopping_;
   const std::size_t chunk_bytes_;
   CancelToken cancel_;
@@ -382,13 +385,17 @@ grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportR
   if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "Export", &caller); !st.ok()) {
     return st;
   }
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  if (grpc::Status st = streams_.Open(*context, &caller, "Export", &slot, /*computes=*/true);
+      !st.ok())
+    return st;
   ExportSettings settings;
   if (grpc::Status st = ParseRequest(*request, &settings); !st.ok()) return st;
 
   CancelToken cancel;
   Result<CallContext> ctx = ExportContext(*context, cancel);
   if (!ctx.ok()) return ToGrpcStatus(ctx.status());
-  ExportStream stream(*context, *writer, stopping_, settings.chunk_bytes, cancel);
+  ExportStream stream(*context, *writer, *slot, stopping_, settings.chunk_bytes, cancel);
   ExportStreamBuf buffer(stream);
   std::ostream out(&buffer);
 

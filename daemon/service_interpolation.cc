@@ -13,8 +13,8 @@
 namespace brdf::daemon {
 
 InterpolationService::InterpolationService(IndexCache& cache, const Authenticator& auth,
-                                           const StopSignal& stopping)
-    : cache_(cache), auth_(auth), stopping_(stopping) {}
+                                           const StopSignal& stopping, StreamRegistry& streams)
+    : cache_(cache), auth_(auth), stopping_(stopping), streams_(streams) {}
 
 namespace {
 
@@ -230,6 +230,11 @@ grpc::Status InterpolationService::InterpolateBatch(
       !st.ok()) {
     return st;
   }
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  if (grpc::Status st =
+          streams_.Open(*context, &caller, "InterpolateBatch", &slot, /*computes=*/true);
+      !st.ok())
+    return st;
   SessionId id = 0;
   if (grpc::Status st = SessionOf(request->session_id(), &id); !st.ok()) return st;
   Settings settings;
@@ -311,7 +316,7 @@ grpc::Status InterpolationService::InterpolateBatch(
     ToResult(request->directions(i), std::move(answer), settings, index, out.add_results());
     if (out.results_size() < chunk && i + 1 < n) return true;
     // Blocks while the client is slow to read (flow control); false: the client went away.
-    if (!writer->Write(out)) {
+    if (!slot->Write(writer, out)) {
       outcome = grpc::Status(grpc::StatusCode::CANCELLED, "InterpolateBatch: the client went away");
       return false;
     }

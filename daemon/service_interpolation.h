@@ -26,6 +26,7 @@
 #include "daemon/auth.h"
 #include "daemon/index_cache.h"
 #include "daemon/service_common.h"
+#include "daemon/stream_registry.h"
 
 namespace brdf::daemon {
 
@@ -38,7 +39,8 @@ class InterpolationService final
     : public v1::Interpolation::WithAsyncMethod_Interpolate<v1::Interpolation::Service> {
  public:
   // All three must outlive the service.
-  InterpolationService(IndexCache& cache, const Authenticator& auth, const StopSignal& stopping);
+  InterpolationService(IndexCache& cache, const Authenticator& auth, const StopSignal& stopping,
+                       StreamRegistry& streams);
 
   grpc::Status InterpolateBatch(grpc::ServerContext* context,
                                 const v1::InterpolateBatchRequest* request,
@@ -63,6 +65,7 @@ class InterpolationService final
   IndexCache& cache_;
   const Authenticator& auth_;
   const StopSignal& stopping_;
+  StreamRegistry& streams_;
 };
 
 }  // namespace brdf::daemon

@@ -161,6 +161,31 @@ level = "debug"
   EXPECT_NEAR(ToRigDescription(m5).reading_overhead_s, 0.3 + 0.050, 1e-12);
 }
 
+TEST(ConfigTest, StreamCapsAndStallTimeout) {
+  Result<Config> r = ParseConfig(
+      "[server]\nmax_streams_per_token = 8\nmax_streams_analyst = 100\n"
+      "max_streams_operator = 20\nmax_streams_unauthenticated = 0\nstream_stall_timeout_s = 5\n");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->server.max_streams_per_token, 8);
+  EXPECT_EQ(r->server.max_streams_analyst, 100);
+  EXPECT_EQ(r->server.max_streams_operator, 20);
+  EXPECT_EQ(r->server.max_streams_unauthenticated, 0);  // no health Watch, no reflection
+  EXPECT_EQ(r->server.stream_stall_timeout_s, 5);
+  Result<Config> defaults = ParseConfig("");
+  ASSERT_TRUE(defaults.ok());
+  EXPECT_EQ(defaults->server.max_streams_per_token, 64);
+  EXPECT_EQ(defaults->server.max_streams_analyst, 1024);
+  EXPECT_EQ(defaults->server.max_streams_operator, 256);
+  EXPECT_EQ(defaults->server.max_streams_unauthenticated, 64);
+  EXPECT_EQ(defaults->server.stream_stall_timeout_s, 60);
+  EXPECT_THAT(Refusal("[server]\nmax_streams_per_token = 0\n"),
+              HasSubstr("server.max_streams_per_token"));
+  EXPECT_THAT(Refusal("[server]\nmax_streams_operator = 0\n"),
+              HasSubstr("server.max_streams_operator"));
+  EXPECT_THAT(Refusal("[server]\nstream_stall_timeout_s = 0\n"),
+              HasSubstr("server.stream_stall_timeout_s"));
+}
+
 TEST(ConfigTest, InterpolateLoopThreadsAndCpus) {
   Result<Config> r = ParseConfig("[server]\ninterpolate_threads = 2\ninterpolate_cpus = [1, 0]\n");
   ASSERT_TRUE(r.ok()) << r.status().ToString();

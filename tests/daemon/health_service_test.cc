@@ -24,14 +24,19 @@ class HealthServiceTest : public ::testing::Test {
     int port = 0;
     builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
     builder.RegisterService(&health_);
+    health_.ServeOn(loop_);  // Check, as server.cc serves it
+    loop_.AddQueue(builder);
     server_ = builder.BuildAndStart();
+    loop_.Start();
     ASSERT_TRUE(server_ != nullptr && port > 0);
     stub_ = grpc::health::v1::Health::NewStub(grpc::CreateChannel(
         "127.0.0.1:" + std::to_string(port), grpc::InsecureChannelCredentials()));
   }
   void TearDown() override {
     stopping_.Stop();
+    loop_.BeginShutdown();
     server_->Shutdown(std::chrono::system_clock::now() + 2s);
+    loop_.Stop();
   }
 
   grpc::Status Check(const std::string& service, HealthCheckResponse* response) {
@@ -43,7 +48,9 @@ class HealthServiceTest : public ::testing::Test {
   }
 
   StopSignal stopping_;
-  HealthService health_{stopping_};
+  StreamRegistry streams_{ServerConfig{}, false};
+  ControlLoop loop_{1};
+  HealthService health_{stopping_, streams_};
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<grpc::health::v1::Health::Stub> stub_;
 };

@@ -67,7 +67,7 @@ class InterpStreamTest : public ::testing::Test {
     ASSERT_TRUE(store.ok()) << store.status().ToString();
     store_ = std::move(*store);
     cache_ = std::make_unique<IndexCache>(store_);
-    service_ = std::make_unique<InterpolationService>(*cache_, auth_, stopping_);
+    service_ = std::make_unique<InterpolationService>(*cache_, auth_, stopping_, streams_);
 
     grpc::ServerBuilder builder;
     int port = 0;
@@ -208,6 +208,7 @@ class InterpStreamTest : public ::testing::Test {
   std::unique_ptr<IndexCache> cache_;
   Authenticator auth_{{}};
   StopSignal stopping_;
+  StreamRegistry streams_{daemon::ServerConfig{}, false};
   std::unique_ptr<InterpolationService> service_;
   std::unique_ptr<InterpolateLoop> loop_;  // serves service_'s Interpolate
   std::atomic<int> sent_{0};

@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# The control plane under analyst load (issue 20): PauseSession and GetRigStatus latency on an idle
+# brdfd, then with 1,000 analyst streams open (400 WatchSession and 300 StreamReadings read as
+# they come, 200 InterpolateBatch and 100 Export never read) and 8 clients calling Interpolate,
+# in the same run; prints bench_control_plane's line (ratios loaded ÷ idle, goal ≤ 3, no control
+# call failed). The daemon runs against brdf-sim with a 10,000-reading session (bench_storage)
+# for the data calls and a paused session (started, then paused at its first prompt) for the
+# verbs. Usage: bench/daemon/control_plane.sh [BUILD_DIR] (default: build-bench; builds what it
+# needs unless BENCH_NO_BUILD=1). BENCH_STREAMS (default 1000), BENCH_KEEP=1 keeps the logs.
+set -euo pipefail
+
+here="$(cd "$(dirname "$0")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+build="${1:-${BRDF_BENCH_BUILD:-$root/build-bench}}"
+case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
+streams="${BENCH_STREAMS:-1000}"
+if [[ "${BENCH_NO_BUILD:-0}" != 1 ]]; then
+  if [[ ! -f "$build/build.ninja" && ! -f "$build/Makefile" ]]; then
+    cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+  fi
+  cmake --build "$build" -j2 --target brdfd brdf-sim brdfctl bench_storage \
+    bench_control_plane >&2
+fi
+brdfd="$build/daemon/brdfd"
+sim="$build/tools/brdf-sim/brdf-sim"
+ctl="$build/tools/brdfctl/brdfctl"
+bin="$build/bench/daemon"
+
+work="$(mktemp -d /tmp/brdfd-ctlbench.XXXXXX)"
+pids=()
+cleanup() {
+  local p
+  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+  if [[ "${BENCH_KEEP:-0}" == 1 ]]; then echo "kept: $work" >&2; else rm -rf "$work"; fi
+}
+trap cleanup EXIT
+wait_line() {
+  local i
+  for ((i = 0; i < $3 * 10; i++)); do
+    if grep -q "$2" "$1" 2>/dev/null; then return 0; fi
+    sleep 0.1
+  done
+  echo "control_plane.sh: no '$2' in $1 after $3 s" >&2
+  return 1
+}
+operator_token="bench-operator-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
+analyst_token="bench-analyst-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
+
+echo "== a 10,000-reading session (bench_storage), brdf-sim, brdfd" >&2
+"$bin/bench_storage" create --db "$work/bench.db" --readings 10000 >/dev/null
+"$sim" --time-scale 10 --seed 1 --modbus-port 0 --wake-window 0 --log-level warn \
+  >"$work/sim.out" 2>"$work/sim.log" </dev/null &
+pids+=("$!")
+wait_line "$work/sim.out" '^ready' 20
+modbus="$(awk '$1 == "modbus-tcp" { print $2 }' "$work/sim.out")"
+pr650="$(awk '$1 == "pr650" { print $2 }' "$work/sim.out")"
+cat >"$work/brdfd.toml" <<EOF
+[server]
+listen = "127.0.0.1:0"
+# One analyst token holds all the streams: the per-token cap is raised to let it.
+max_streams_per_token = $((streams + 24))
+max_streams_analyst = $((streams + 24))
+stream_stall_timeout_s = 600
+[storage]
+database = "$work/bench.db"
+[meter]
+port = "$pr650"
+pacing_ms = 5
+quiet_gap_ms = 10
+[stage]
+transport = "tcp"
+address = "$modbus"
+detector_arm_motorized = true
+[stage.axes.delta]
+present = true
+[[auth.tokens]]
+name = "bench-operator"
+token = "$operator_token"
+role = "operator"
+[[auth.tokens]]
+name = "bench-analyst"
+token = "$analyst_token"
+role = "analyst"
+[log]
+level = "warn"
+EOF
+"$brdfd" --config "$work/brdfd.toml" >"$work/brdfd.out" 2>"$work/brdfd.log" </dev/null &
+brdfd_pid=$!
+pids+=("$brdfd_pid")
+wait_line "$work/brdfd.out" '^brdfd listening on' 20
+address="$(awk '/^brdfd listening on/ { print $4 }' "$work/brdfd.out")"
+export BRDF_ADDRESS="$address" BRDF_TOKEN="$operator_token"
+
+cat >"$work/plan.json" <<'EOF'
+{"name": "bench: the session the operator pauses",
+ "sampleRotation": {"delta": {"start": 20, "stop": 60, "step": 10},
+                    "alpha": {"start": 0, "stop": 60, "step": 5}, "beta": {"step": 15}},
+ "reference": {"perDetectorPosition": true},
+ "measurement": {"integrationMs": 50, "averages": 1}}
+EOF
+paused="$("$ctl" submit "$work/plan.json" --start --quiet)"
+for ((i = 0; i < 200; i++)); do
+  if "$ctl" pause "$paused" --immediate >/dev/null 2>&1 &&
+    "$ctl" --json get "$paused" 2>/dev/null | grep -q 'SESSION_STATE_PAUSED'; then break; fi
+  sleep 0.1
+done
+
+echo "== control calls idle, then with $streams analyst streams and 8 Interpolate clients" >&2
+line="$("$bin/bench_control_plane" --address "$address" --operator-token "$operator_token" \
+  --analyst-token "$analyst_token" --pause-session "$paused" --data-session 1 \
+  --streams "$streams")" || rc=$?
+echo "$line"
+"$ctl" get "$paused" | head -3 >&2
+echo "brdfd VmHWM $(awk '$1 == "VmHWM:" { print $2 }' "/proc/$brdfd_pid/status") kB, threads $(awk '$1 == "Threads:" { print $2 }' "/proc/$brdfd_pid/status")" >&2
+exit "${rc:-0}"

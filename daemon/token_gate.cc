@@ -1,0 +1,23 @@
+#include "daemon/token_gate.h"
+
+#include <optional>
+#include <string_view>
+
+namespace brdf::daemon {
+
+grpc::Status TokenGate::Process(const InputMetadata& metadata, grpc::AuthContext* /*context*/,
+                                OutputMetadata* /*consumed*/, OutputMetadata* /*response*/) {
+  std::string_view path;
+  std::string_view header;
+  for (const auto& [key, value] : metadata) {
+    const std::string_view k(key.data(), key.size());
+    if (k == ":path") path = std::string_view(value.data(), value.size());
+    if (k == "authorization") header = std::string_view(value.data(), value.size());
+  }
+  const std::optional<Access> access = MethodAccess(path);
+  if (!access.has_value() || !auth_.enabled()) return grpc::Status::OK;
+  Caller caller;
+  return auth_.Check(header, *access, MethodName(path), "", &caller);
+}
+
+}  // namespace brdf::daemon

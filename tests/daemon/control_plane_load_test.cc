@@ -1,0 +1,194 @@
+// The control plane under analyst load (ctest label "load"; issue 20, the smaller version of
+// bench/daemon/control_plane.sh): while a session records, 400 analyst streams are open
+// (WatchSession read, StreamReadings following, InterpolateBatch and Export never read) and two
+// clients call Interpolate; the operator's PauseSession and ResumeSession, GetRigStatus and the
+// health service's Check must all answer, each within a few seconds, and none may fail. Before
+// the control plane had threads of its own, such streams took every thread of gRPC's pool (256)
+// and these calls failed with "Server Threadpool Exhausted" (as main's brdfd did here: at 300
+// streams some of them still finished in time, at 400 GetRigStatus, Health and Pause failed).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+#include <vector>
+
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "tests/daemon/daemon_test_rig.h"
+#include "tests/support/plan_fixtures.h"
+
+namespace brdf::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr int kStreams = 400;
+constexpr auto kAnswerWithin = 5s;
+
+const std::string kLongPlan = PlanFixture("control plane under load")
+                                  .SampleRotation({30, 30, 10}, {0, 60, 5}, 10)
+                                  .Measurement(100, 1)
+                                  .Retry(3, 0);
+
+// A stream held open by the test: its reader and context (cancelled at the end).
+struct Held {
+  std::unique_ptr<grpc::ClientContext> context;
+  std::unique_ptr<grpc::ClientReaderInterface<v1::SessionEvent>> watch;
+  std::unique_ptr<grpc::ClientReaderInterface<v1::Reading>> readings;
+  std::unique_ptr<grpc::ClientReaderInterface<v1::InterpolateBatchChunk>> batch;
+  std::unique_ptr<grpc::ClientReaderInterface<v1::ExportChunk>> exported;
+};
+
+TEST(ControlPlaneLoadTest, OperatorCallsAnswerWhile400AnalystStreamsAreOpen) {
+  DaemonRig rig;
+  Status st = rig.StartSim();
+  ASSERT_TRUE(st.ok()) << st.ToString();
+  std::string toml = DaemonConfigToml(rig.sim(), rig.database());
+  const std::string listen = "listen = \"127.0.0.1:0\"\n";
+  toml.insert(toml.find(listen) + listen.size(), "max_streams_per_token = 450\n");
+  st = rig.StartDaemon(toml);
+  ASSERT_TRUE(st.ok()) << st.ToString();
+  Result<v1::Session> submitted = rig.Submit(kLongPlan);
+  ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
+  const std::string id = submitted->session_id();
+  GrpcOperator op(rig, id);
+  const v1::Session recording = rig.WaitFor(
+      id, [](const v1::Session& s) { return s.progress().done_samples() >= 2; }, 45s);
+  ASSERT_GE(recording.progress().done_samples(), 2u) << rig.log();
+
+  // The analysts' streams, over 8 connections of their own.
+  std::vector<std::shared_ptr<grpc::Channel>> channels;
+  for (int c = 0; c < 8; ++c) {
+    grpc::ChannelArguments args;
+    args.SetInt("brdf.test.connection", c);
+    channels.push_back(grpc::CreateCustomChannel(rig.daemon()->address(),
+                                                 grpc::InsecureChannelCredentials(), args));
+  }
+  std::vector<Held> held;
+  int snapshots = 0;
+  for (int i = 0; i < kStreams; ++i) {
+    const auto& channel = channels[static_cast<std::size_t>(i) % channels.size()];
+    Held h;
+    h.context = DaemonRig::Context(kAnalystToken, 120s);
+    switch (i % 10) {
+      case 0:
+      case 1:
+      case 2:
+      case 3: {  // WatchSession, its snapshot read
+        v1::WatchSessionRequest r;
+        r.set_session_id(id);
+        h.watch = v1::Control::NewStub(channel)->WatchSession(h.context.get(), r);
+        v1::SessionEvent first;
+        if (h.watch->Read(&first)) ++snapshots;
+        break;
+      }
+      case 4:
+      case 5:
+      case 6: {  // StreamReadings following the session, never read
+        v1::StreamReadingsRequest r;
+        r.set_session_id(id);
+        r.set_follow(true);
+        h.readings = v1::Data::NewStub(channel)->StreamReadings(h.context.get(), r);
+        break;
+      }
+      case 7:
+      case 8: {  // InterpolateBatch of 2,000 directions, never read
+        v1::InterpolateBatchRequest r;
+        r.set_session_id(id);
+        for (int d = 0; d < 2000; ++d) {
+          v1::IsoDirection* at = r.add_directions()->mutable_iso();
+          at->set_theta_i(30);
+          at->set_theta_o(10 + d % 60);
+          at->set_phi(d % 180);
+        }
+        h.batch = v1::Interpolation::NewStub(channel)->InterpolateBatch(h.context.get(), r);
+        break;
+      }
+      default: {  // Export, never read
+        v1::ExportRequest r;
+        r.set_session_id(id);
+        r.set_format(v1::EXPORT_FORMAT_READINGS_CSV);
+        h.exported = v1::Data::NewStub(channel)->Export(h.context.get(), r);
+        break;
+      }
+    }
+    held.push_back(std::move(h));
+  }
+  EXPECT_EQ(snapshots, kStreams * 4 / 10) << "every watcher got its snapshot";
+
+  // Two Interpolate clients meanwhile.
+  std::atomic<bool> stop{false};
+  std::atomic<int> interpolated{0};
+  std::vector<std::thread> clients;
+  for (int c = 0; c < 2; ++c) {
+    clients.emplace_back([&] {
+      auto stub = v1::Interpolation::NewStub(rig.channel());
+      while (!stop) {
+        v1::InterpolateRequest r;
+        r.set_session_id(id);
+        v1::IsoDirection* at = r.mutable_direction()->mutable_iso();
+        at->set_theta_i(30);
+        at->set_theta_o(30);
+        at->set_phi(10);
+        v1::InterpolateResponse answer;
+        if (stub->Interpolate(DaemonRig::Context(kAnalystToken).get(), r, &answer).ok()) {
+          ++interpolated;
+        }
+      }
+    });
+  }
+  std::this_thread::sleep_for(1s);
+
+  auto within = [](std::chrono::steady_clock::time_point begin) {
+    return std::chrono::steady_clock::now() - begin < kAnswerWithin;
+  };
+  auto health = grpc::health::v1::Health::NewStub(rig.channel());
+  for (int round = 0; round < 3; ++round) {
+    auto begin = std::chrono::steady_clock::now();
+    v1::RigStatus status;
+    grpc::Status s =
+        rig.control().GetRigStatus(DaemonRig::Context(kOperatorToken, 10s).get(), {}, &status);
+    EXPECT_TRUE(s.ok()) << s.error_code() << " " << s.error_message();
+    EXPECT_TRUE(within(begin)) << "GetRigStatus took too long";
+
+    begin = std::chrono::steady_clock::now();
+    grpc::ClientContext health_context;
+    health_context.set_deadline(std::chrono::system_clock::now() + 10s);
+    grpc::health::v1::HealthCheckResponse healthy;
+    s = health->Check(&health_context, {}, &healthy);
+    EXPECT_TRUE(s.ok()) << s.error_code() << " " << s.error_message();
+    EXPECT_TRUE(within(begin)) << "health Check took too long";
+
+    begin = std::chrono::steady_clock::now();
+    v1::PauseSessionRequest pause;
+    pause.set_session_id(id);
+    pause.set_mode(v1::PAUSE_MODE_IMMEDIATE);
+    v1::PauseSessionResponse paused;
+    s = rig.control().PauseSession(DaemonRig::Context(kOperatorToken, 10s).get(), pause, &paused);
+    ASSERT_TRUE(s.ok()) << s.error_code() << " " << s.error_message() << "\n" << rig.log();
+    EXPECT_EQ(paused.session().state(), v1::SESSION_STATE_PAUSED);
+    EXPECT_TRUE(within(begin)) << "PauseSession took too long";
+
+    begin = std::chrono::steady_clock::now();
+    v1::ResumeSessionRequest resume;
+    resume.set_session_id(id);
+    v1::ResumeSessionResponse resumed;
+    s = rig.control().ResumeSession(DaemonRig::Context(kOperatorToken, 10s).get(), resume,
+                                    &resumed);
+    ASSERT_TRUE(s.ok()) << s.error_code() << " " << s.error_message();
+    EXPECT_TRUE(within(begin)) << "ResumeSession took too long";
+  }
+  stop = true;
+  for (std::thread& t : clients) t.join();
+  EXPECT_GT(interpolated.load(), 0);
+  for (Held& h : held) h.context->TryCancel();
+  op.Stop();
+  v1::AbortSessionRequest abort;
+  abort.set_session_id(id);
+  abort.set_reason("test done");
+  v1::AbortSessionResponse aborted;
+  (void)rig.control().AbortSession(DaemonRig::Context().get(), abort, &aborted);
+}
+
+}  // namespace
+}  // namespace brdf::testing
