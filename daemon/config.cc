@@ -335,6 +335,7 @@ void ReadMeter(TableReader& root, Config& c, Issues& issues) {
   t.Int("measurement_timeout_ms", m.measurement_timeout_ms, 1000, 600000);
   t.Int("wake_attempts", m.wake_attempts, 1, 20);
   t.Bool("measure_with_spectrum", m.measure_with_spectrum);
+  t.Int("rts_settle_ms", m.rts_settle_ms, 0, 10000);
   if (const toml::table* q = t.Table("quality")) {
     for (const auto& [key, node] : *q) {
       const std::string code_text(key.str());

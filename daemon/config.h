@@ -24,9 +24,10 @@
 //   pacing_ms = 100                     # pause after an exchange before the next command
 //   quiet_gap_ms = 50                   # silence that ends a reply
 //   reply_timeout_ms = 2000             # short replies (B, D110, D120, D5)
-//   measurement_timeout_ms = 30000      # M0, S, F
+//   measurement_timeout_ms = 30000      # S, F; margin of M0/M5 over averages × integration
 //   wake_attempts = 5                   # remote-mode wake-up tries before asking for a power cycle
 //   measure_with_spectrum = true        # M5 (one exchange per reading); false: M0 then D5
+//   rts_settle_ms = 1000                # wait after RTS drop/raise before the first command
 //   [meter.quality]                     # overrides of the quality policy, by code
 //   "18" = "accept_and_flag"            # accept, accept_and_flag, retry, retry_then_flag,
 //   "30" = { action = "retry", accept_flagged_when_exhausted = true }  # adapt_integration,
@@ -114,6 +115,7 @@ struct MeterConfig {
   int measurement_timeout_ms = 30000;
   int wake_attempts = 5;
   bool measure_with_spectrum = true;
+  int rts_settle_ms = 1000;  // wake-up: wait after RTS is raised again (manual: > 0.5 s)
   // Rules that replace the driver's defaults for these quality codes (0–99).
   std::map<int, drivers::pr650::QualityRule> quality_overrides;
 };

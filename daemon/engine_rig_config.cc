@@ -26,6 +26,7 @@ drivers::Pr650Options MeterOptions(const MeterConfig& m) {
   o.measurement_timeout = milliseconds(m.measurement_timeout_ms);
   o.wake_attempts = m.wake_attempts;
   o.measure_with_spectrum = m.measure_with_spectrum;
+  o.wake_settle = milliseconds(m.rts_settle_ms);
   for (const auto& [code, rule] : m.quality_overrides) o.quality_policy.Set(code, rule);
   o.log = [](std::string_view line) { spdlog::debug("pr650: {}", line); };
   return o;

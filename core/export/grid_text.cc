@@ -69,6 +69,10 @@ Status CsvGridWriter::Begin(const RegularGrid& grid, const WavelengthGrid& bands
   h += "# spectral columns: headed by wavelength in nm, " + std::to_string(bands.count) +
        " bands from " + FormatNumber(bands.start_nm) + " to " + FormatNumber(bands.last_nm()) +
        " every " + FormatNumber(bands.step_nm) + " nm; values in " + QuantityUnit(info_.quantity) +
+       (info_.quantity == Quantity::kRadiance
+            ? " (per nm, not per band: Psychtoolbox and BrainardLab files hold " +
+                  FormatNumber(bands.step_nm) + " × these values)"
+            : std::string()) +
        "\n";
   h += "theta_i,theta_o,phi,status";
   for (std::size_t b = 0; b < bands.count; ++b) {

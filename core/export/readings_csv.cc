@@ -20,6 +20,8 @@ std::string Header(const Session& session, Quantity quantity, const WavelengthGr
        ": " + QuantityDefinition(quantity) + "\n";
   h += "# units: radiance (the meter's readings I, I0, D) in W·m⁻²·sr⁻¹·nm⁻¹; reflectance "
        "unitless; BRDF in sr⁻¹; angles in degrees; wavelengths in nm\n";
+  h += "# radiance is per nm of wavelength, as the PR-650 reports it, at band centres; files of "
+       "Psychtoolbox and BrainardLab hold power per band (per 4 nm: 4 × these values)\n";
   if (quantity == Quantity::kRadiance) {
     h += "# rows: every reading (sample, reference = white standard I0, dark = ambient D), "
          "spectral radiance as the meter reported it in W·m⁻²·sr⁻¹·nm⁻¹ (no dark subtracted)\n";

@@ -1,5 +1,7 @@
 #include "drivers/pr650/pr650_options.h"
 
+#include <algorithm>
+
 namespace brdf::drivers {
 
 namespace {
@@ -28,6 +30,9 @@ Status ValidatePr650Options(const Pr650Options& o) {
   if (!InRange(o.measurement_timeout, 1, 600'000)) {
     return Bad("measurement_timeout must be 1–600000 ms");
   }
+  if (!InRange(o.adaptive_integration_max, 1, 60'000)) {
+    return Bad("adaptive_integration_max must be 1–60000 ms (the PR-650's is 6000 ms)");
+  }
   if (!InRange(o.rts_drop, 0, 10'000))
     return Bad("rts_drop must be 0–10000 ms (> 50 ms on a meter)");
   if (!InRange(o.wake_settle, 0, 10'000)) return Bad("wake_settle must be 0–10000 ms");
@@ -39,6 +44,14 @@ Status ValidatePr650Options(const Pr650Options& o) {
     return Bad("max_measure_attempts must be 1–50");
   }
   return Status::Ok();
+}
+
+std::chrono::milliseconds MeasurementReplyTimeout(const Pr650Options& options, int integration_ms,
+                                                  int averages) {
+  const std::chrono::milliseconds integration = integration_ms > 0
+                                                    ? std::chrono::milliseconds(integration_ms)
+                                                    : options.adaptive_integration_max;
+  return options.measurement_timeout + integration * std::max(1, averages);
 }
 
 }  // namespace brdf::drivers

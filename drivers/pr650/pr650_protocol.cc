@@ -229,10 +229,16 @@ std::optional<double> ParseNumber(std::string_view field) {
   return value;
 }
 
+bool IsNoMeasurementReply(std::string_view reply) {
+  const std::vector<std::string> lines = SplitReplyLines(reply);
+  return lines.size() == 1 && Trim(lines.front()) == "-1";
+}
+
 Result<int> ParseStatusReply(std::string_view reply, std::string_view command) {
   auto lines = ExpectLines(reply, command, 1, "one status line \"000\"");
   if (!lines.ok()) return lines.status();
   const std::string& line = lines.value().front();
+  if (Trim(line) == "-1") return kNoMeasurementStatus;
   const std::optional<int> code = ParseCode(line);
   if (!code) return LineError(command, 1, line, "a 3-digit status such as \"000\"");
   return *code;
@@ -263,16 +269,28 @@ std::string DescribeSetupReply(int code) {
 }
 
 Result<FlickerReply> ParseFlickerReply(std::string_view reply) {
-  auto lines = ExpectLines(reply, kFlickerCommand, 1, "one line \"qq,freq\"");
-  if (!lines.ok()) return lines.status();
-  const std::string& line = lines.value().front();
+  const std::vector<std::string> lines = SplitReplyLines(reply);
+  if (lines.empty()) return LineCountError(kFlickerCommand, 0, "one line \"qq,freq\"", reply);
+  const std::string& line = lines.front();
+  if (!AllPrintable(line)) {
+    return LineError(kFlickerCommand, 1, line, "\"qq,freq\" in printable ASCII");
+  }
   const auto fields = SplitFields(line);
-  if (fields.size() != 2) return LineError(kFlickerCommand, 1, line, "\"qq,freq\" (2 fields)");
-  FlickerReply out;
+  if (fields.size() < 2) return LineError(kFlickerCommand, 1, line, "\"qq,freq\" (2 fields)");
   const auto code = ParseCode(fields[0]);
-  const auto freq = ParseNumber(fields[1]);
   if (!code) return LineError(kFlickerCommand, 1, line, "a quality code \"qq\" in field 1");
+  // The frequency is the number the field starts with; a unit or other text after it is ignored.
+  const std::string_view field = Trim(fields[1]);
+  std::size_t end = 0;
+  while (end < field.size() && (IsDigit(field[end]) || field[end] == '.' || field[end] == '+' ||
+                                field[end] == '-' || field[end] == 'E' || field[end] == 'e')) {
+    ++end;
+  }
+  std::optional<double> freq;
+  // Shrink the prefix until it parses ("100.0E" of "100.0Ehz" is not a number, "100.0" is).
+  for (std::size_t n = end; n > 0 && !freq; --n) freq = ParseNumber(field.substr(0, n));
   if (!freq) return LineError(kFlickerCommand, 1, line, "a frequency in Hz in field 2");
+  FlickerReply out;
   out.quality_code = *code;
   out.frequency_hz = *freq;
   return out;

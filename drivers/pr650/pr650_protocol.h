@@ -73,9 +73,17 @@ Result<std::string> FormatSetupCommand(const SetupFields& fields);
 // counts, a missing exponent and blank padding are accepted too. No inf/nan/hex.
 std::optional<double> ParseNumber(std::string_view field);
 
+// The status line "-1": the meter has no measurement to report (a report asked for before any
+// measurement, or a measurement that gave no data). The open drivers read it as "no data".
+inline constexpr int kNoMeasurementStatus = -1;
+
+// True when `reply` is the single status line "-1" (blank padding and line ends allowed), the
+// whole reply a meter sends instead of a report it cannot give.
+bool IsNoMeasurementReply(std::string_view reply);
+
 // The "000" reply to B0–B3 and M0, a 3-digit status whose numeric value is the quality code (0 =
 // OK). Compared numerically ("0", "00" and "000" are all 0) so that "1" and "01" agree. Accepts 1–3
-// digits. `command` only names the reply in error messages.
+// digits, and "-1" (kNoMeasurementStatus). `command` only names the reply in error messages.
 Result<int> ParseStatusReply(std::string_view reply, std::string_view command);
 
 // The "pp" reply to S: 0 = accepted, 1–8 = position of the bad field, 50 = accessory error.
@@ -84,7 +92,8 @@ Result<int> ParseSetupReply(std::string_view reply);
 // What a setup reply code means, for messages ("field 6 (integration time) is out of range").
 std::string DescribeSetupReply(int code);
 
-// The "qq,freq" reply to F.
+// The "qq,freq" reply to F. Text after the frequency (a unit, further fields, further lines) is
+// ignored: the quality code and the number the frequency field starts with are what counts.
 struct FlickerReply {
   int quality_code = 0;
   double frequency_hz = 0;

@@ -366,10 +366,7 @@ Result<MeasurementOutcome> Pr650Spectroradiometer::Measure(const CallContext& ct
   BRDF_RETURN_IF_ERROR(StartMeasuring(ctx));
   std::vector<std::string> notes;
   for (int attempt = 1;; ++attempt) {
-    Result<std::string> reply =
-        Exchange(pr650::kMeasureCommand, 1, options_.measurement_timeout, ctx);
-    if (!reply.ok()) return WithSilenceHint(reply.status(), ctx);
-    Result<int> code = pr650::ParseStatusReply(*reply, pr650::kMeasureCommand);
+    Result<int> code = MeasureAndHold(ctx);
     if (!code.ok()) return code.status();
     const pr650::QualityDecision decision = Judge(*code, attempt, notes);
     if (Accepted(decision)) {
@@ -380,14 +377,62 @@ Result<MeasurementOutcome> Pr650Spectroradiometer::Measure(const CallContext& ct
   }
 }
 
+Result<int> Pr650Spectroradiometer::MeasureAndHold(const CallContext& ctx) {
+  constexpr std::string_view kCommand = pr650::kMeasureCommand;
+  Result<std::string> reply = Exchange(kCommand, 1, MeasurementTimeout(), ctx);
+  if (!reply.ok()) return WithMeasurementHint(reply.status(), ctx);
+  Result<int> code = pr650::ParseStatusReply(*reply, kCommand);
+  if (!code.ok()) return code.status();
+  if (*code == pr650::kNoMeasurementStatus) return NoMeasurement(kCommand);
+  return code;
+}
+
+std::chrono::milliseconds Pr650Spectroradiometer::MeasurementTimeout() const {
+  const SetupFields current = CurrentSetup();
+  return MeasurementReplyTimeout(options_, current.integration_ms, current.averages);
+}
+
+Status Pr650Spectroradiometer::NoMeasurement(std::string_view command) const {
+  return DeviceError(pr650::kNoMeasurementStatus,
+                     "PR-650 on " + options_.port + " answered " + std::string(command) +
+                         " with -1: it holds no measurement to report (the measurement gave no "
+                         "data, or the meter was switched off and on since it measured); measure "
+                         "again, and check the meter's display if it persists");
+}
+
+Status Pr650Spectroradiometer::WithMeasurementHint(const Status& status,
+                                                   const CallContext& ctx) const {
+  if (status.code() != StatusCode::kTimeout || ctx.expired()) return status;
+  const SetupFields current = CurrentSetup();
+  const std::string integration =
+      current.integration_ms > 0
+          ? std::to_string(current.integration_ms) + " ms"
+          : "adaptive (up to " + std::to_string(options_.adaptive_integration_max.count()) + " ms)";
+  return Status(StatusCode::kTimeout,
+                status.message() + ": the measurement did not end within " +
+                    std::to_string(MeasurementTimeout().count()) + " ms (" +
+                    std::to_string(current.averages) + " average(s) of " + integration +
+                    " integration plus a margin of " +
+                    std::to_string(options_.measurement_timeout.count()) +
+                    " ms, [meter] measurement_timeout_ms). If the meter's display shows it still "
+                    "measuring, raise that margin; if it stays blank, check its power and cable, "
+                    "then connect again");
+}
+
 Result<SpectrumReport> Pr650Spectroradiometer::TransferSpectrum(const CallContext& ctx) {
   BRDF_RETURN_IF_ERROR(RequireConnected());
   if (!holds_measurement_) {
     return FailedPrecondition("PR-650 on " + options_.port +
                               " holds no accepted measurement: call Measure first");
   }
-  Result<std::string> reply = Exchange(pr650::kSpectrumCommand, pr650::SpectrumReplyLines(grid_),
-                                       options_.reply_timeout, ctx);
+  bool no_measurement = false;
+  Result<std::string> reply = Exchange(
+      pr650::kSpectrumCommand, pr650::SpectrumReplyLines(grid_), options_.reply_timeout, ctx,
+      [&](std::string_view line) { no_measurement = pr650::IsNoMeasurementReply(line); });
+  if (no_measurement) {
+    holds_measurement_ = false;
+    return NoMeasurement(pr650::kSpectrumCommand);
+  }
   if (!reply.ok()) return WithSilenceHint(reply.status(), ctx);
   return SpectrumFromReply(*reply, pr650::kSpectrumCommand);
 }
@@ -407,43 +452,89 @@ Result<SpectrumReport> Pr650Spectroradiometer::SpectrumFromReply(std::string_vie
 
 Result<MeasuredSpectrum> Pr650Spectroradiometer::MeasureSpectrum(const CallContext& ctx,
                                                                  const MeasuredCallback& measured) {
-  if (!options_.measure_with_spectrum) return Spectroradiometer::MeasureSpectrum(ctx, measured);
   BRDF_RETURN_IF_ERROR(StartMeasuring(ctx));
-  constexpr std::string_view kCommand = pr650::kMeasureSpectrumCommand;
+  // M5: one exchange, the report follows the measurement. Otherwise M0, then D5.
+  const bool one_exchange = options_.measure_with_spectrum;
+  const std::string_view command =
+      one_exchange ? pr650::kMeasureSpectrumCommand : pr650::kSpectrumCommand;
   std::vector<std::string> notes;
   for (int attempt = 1;; ++attempt) {
-    // The report's status line is the measurement's quality code: judge it as soon as it arrives,
-    // and let the caller go on (move the stage) while the bands stream in.
-    std::optional<int> code;
+    std::optional<int> m0_code;  // M0's status, judged already
     pr650::QualityDecision decision;
+    if (!one_exchange) {
+      Result<int> status = MeasureAndHold(ctx);
+      if (!status.ok()) return status.status();
+      decision = Judge(*status, attempt, notes);
+      if (!Accepted(decision)) {
+        BRDF_RETURN_IF_ERROR(PrepareRemeasure(*status, decision, attempt, notes, ctx));
+        continue;
+      }
+      m0_code = *status;
+      holds_measurement_ = true;
+    }
+    // The report's status line is the measurement's quality code in both modes (a meter may answer
+    // M0 with 000 and put low light or overload here): judge it as soon as it arrives, and let the
+    // caller go on (move the stage) while the bands stream in.
+    std::optional<int> code;
+    bool no_measurement = false;
     auto judge_status_line = [&](std::string_view line) {
-      Result<pr650::SpectrumHeader> header = pr650::ParseSpectrumHeader(line, kCommand);
+      if (pr650::IsNoMeasurementReply(line)) {
+        no_measurement = true;
+        return;
+      }
+      Result<pr650::SpectrumHeader> header = pr650::ParseSpectrumHeader(line, command);
       if (!header.ok()) return;  // the whole reply's parse below says what is wrong
       code = header->quality_code;
-      decision = Judge(*code, attempt, notes);
+      // The code M0 answered with was judged already; the report's is judged when it says more.
+      if (m0_code != code) decision = Judge(*code, attempt, notes);
       if (Accepted(decision) && measured) measured(Outcome(*code, decision, attempt, notes));
     };
-    Result<std::string> reply = Exchange(kCommand, pr650::SpectrumReplyLines(grid_),
-                                         options_.measurement_timeout, ctx, judge_status_line);
+    const Duration timeout = one_exchange ? Duration(MeasurementTimeout()) : options_.reply_timeout;
+    Result<std::string> reply =
+        Exchange(command, pr650::SpectrumReplyLines(grid_), timeout, ctx, judge_status_line);
+    if (no_measurement || (reply.ok() && pr650::IsNoMeasurementReply(*reply))) {
+      holds_measurement_ = false;
+      return NoMeasurement(command);
+    }
     const bool rejected = code.has_value() && !Accepted(decision);
     if (!reply.ok()) {
       // After a rejected measurement the meter may send its status line alone: the reader then
       // reports a truncated reply, which is no error here (the policy measures again or fails).
       if (!rejected || reply.status().code() != StatusCode::kProtocolError) {
-        return WithSilenceHint(reply.status(), ctx);
+        return one_exchange ? WithMeasurementHint(reply.status(), ctx)
+                            : WithSilenceHint(reply.status(), ctx);
       }
     }
     if (!rejected) {
-      Result<SpectrumReport> report = SpectrumFromReply(*reply, kCommand);
+      Result<SpectrumReport> report = SpectrumFromReply(*reply, command);
       if (!report.ok()) return report.status();
       if (!code.has_value()) {  // cannot happen: a parsed report has a status line
-        return ProtocolError("PR-650 reply to M5 on " + options_.port + " had no status line");
+        return ProtocolError("PR-650 reply to " + std::string(command) + " on " + options_.port +
+                             " had no status line");
       }
       holds_measurement_ = true;
-      return MeasuredSpectrum{Outcome(*code, decision, attempt, notes), std::move(*report)};
+      MeasurementOutcome outcome = Outcome(*code, decision, attempt, notes);
+      FlagUnits(report->units_code, outcome);
+      return MeasuredSpectrum{std::move(outcome), std::move(*report)};
     }
+    holds_measurement_ = false;
     BRDF_RETURN_IF_ERROR(PrepareRemeasure(*code, decision, attempt, notes, ctx));
   }
+}
+
+void Pr650Spectroradiometer::FlagUnits(int units_code, MeasurementOutcome& outcome) const {
+  if (units_code == 0) return;  // spectral radiance, W·m⁻²·sr⁻¹·nm⁻¹
+  const std::string note =
+      units_code == 2
+          ? "units code 2: the meter reports uncalibrated values, not spectral radiance; check its "
+            "calibration before using this reading"
+          : "units code " + std::to_string(units_code) +
+                (units_code == 1 ? ": the meter reports spectral irradiance (W·m⁻²·nm⁻¹), not "
+                                   "radiance; check the accessory fitted to it"
+                                 : ": not spectral radiance (the PR-650 knows 0, 1 and 2)");
+  outcome.flagged = true;
+  outcome.note = outcome.note.empty() ? note : outcome.note + "; " + note;
+  Log("reading on " + options_.port + " flagged: " + note);
 }
 
 }  // namespace brdf::drivers

@@ -11,8 +11,15 @@
 // the meter may still answer (an M0 takes up to 30 s), the next exchange first waits for and
 // discards that late reply, so it is never mistaken for the answer to a new command.
 //
-// M0 reply: the reference gives only "000" for success. This driver (and brdf-sim) read it as a
-// 3-digit status whose value is the quality code ("018" = low light); D5 repeats the code.
+// M0 reply: the sources give only "000" for success. This driver reads it as a 3-digit status
+// whose value is the quality code ("018" = low light), and judges the report's own quality code
+// (the D5/M5 status line) too, so a meter that answers M0 with 000 cannot hide low light or
+// overload. A "-1" in place of a status or report means the meter holds no measurement:
+// kDeviceError with device code -1, which the caller may measure again.
+//
+// A measurement's reply (M0, M5) may take averages × integration time (adaptive: 6,000 ms) plus
+// measurement_timeout as a margin (MeasurementReplyTimeout). A spectrum in other units than
+// radiance (units code 1 irradiance, 2 uncalibrated) is returned flagged, with a note.
 //
 // Errors: kTimeout, kCancelled, kDeviceError (device_code = quality code, or the S reply's bad
 // field position / 50), kProtocolError, kDisconnected (port vanished: Connect again once it is
@@ -81,6 +88,16 @@ class Pr650Spectroradiometer final : public Spectroradiometer {
   // note); an accepted code becomes Outcome; otherwise PrepareRemeasure fails (kDeviceError) or
   // changes the setup as the policy asks before the next attempt.
   Status StartMeasuring(const CallContext& ctx);
+  // One M0: the status the meter answers (the quality code), or kDeviceError -1 (no data).
+  Result<int> MeasureAndHold(const CallContext& ctx);
+  // The first-byte timeout of a measurement's reply with the current setup.
+  std::chrono::milliseconds MeasurementTimeout() const;
+  // kDeviceError -1: the meter answered `command` with "-1".
+  Status NoMeasurement(std::string_view command) const;
+  // A measurement's timeout with what it was made of and what the operator can do.
+  Status WithMeasurementHint(const Status& status, const CallContext& ctx) const;
+  // Flags `outcome` (with a note) when the report is not spectral radiance (units code != 0).
+  void FlagUnits(int units_code, MeasurementOutcome& outcome) const;
   pr650::QualityDecision Judge(int code, int attempt, std::vector<std::string>& notes) const;
   static bool Accepted(const pr650::QualityDecision& decision);
   MeasurementOutcome Outcome(int code, const pr650::QualityDecision& decision, int attempt,

@@ -35,7 +35,7 @@ Status CtlRig::Start() {
        << "[storage]\ndatabase = \"" << dir_.file("brdfd.db").string() << "\"\n"
        << "[meter]\nport = \"" << sim_->pr650_path() << "\"\n"
        << "pacing_ms = 5\nquiet_gap_ms = 20\nreply_timeout_ms = 1000\n"
-       << "measurement_timeout_ms = 5000\nwake_attempts = 3\n"
+       << "measurement_timeout_ms = 5000\nwake_attempts = 3\nrts_settle_ms = 20\n"
        << "[meter.quality]\n\"10\" = \"accept_and_flag\"\n"
        << "[stage]\ntransport = \"tcp\"\naddress = \"" << modbus() << "\"\n"
        << "response_timeout_ms = 300\ndetector_arm_motorized = true\n"

@@ -69,6 +69,7 @@ reply_timeout_ms = 1500
 measurement_timeout_ms = 20000
 wake_attempts = 3
 measure_with_spectrum = false
+rts_settle_ms = 700
 [meter.quality]
 18 = "fail"
 "30" = { action = "retry", accept_flagged_when_exhausted = true }
@@ -122,6 +123,7 @@ level = "debug"
   EXPECT_TRUE(c.meter.hardware_flow_control);
   EXPECT_EQ(c.meter.measurement_timeout_ms, 20000);
   EXPECT_FALSE(c.meter.measure_with_spectrum);
+  EXPECT_EQ(c.meter.rts_settle_ms, 700);
   ASSERT_EQ(c.meter.quality_overrides.size(), 2u);
   EXPECT_EQ(c.meter.quality_overrides.at(18).action, drivers::pr650::QualityAction::kFail);
   EXPECT_EQ(c.meter.quality_overrides.at(30).action, drivers::pr650::QualityAction::kRetry);
@@ -254,6 +256,7 @@ TEST(ConfigTest, ValuesOutOfRange) {
   EXPECT_THAT(Refusal("[meter]\npacing_ms = -1\n"), HasSubstr("meter.pacing_ms: -1 is outside"));
   EXPECT_THAT(Refusal("[meter]\nmeasurement_timeout_ms = 10\n"),
               HasSubstr("meter.measurement_timeout_ms"));
+  EXPECT_THAT(Refusal("[meter]\nrts_settle_ms = 20000\n"), HasSubstr("meter.rts_settle_ms"));
   EXPECT_THAT(Refusal("[meter.quality]\n123 = \"retry\"\n"), HasSubstr("not a quality code"));
   EXPECT_THAT(Refusal("[meter.quality]\n18 = \"ignore\"\n"), HasSubstr("\"ignore\" is not one of"));
   EXPECT_THAT(Refusal("[meter.quality]\n18 = {}\n"), HasSubstr("meter.quality.18.action: missing"));

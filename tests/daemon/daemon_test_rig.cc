@@ -23,6 +23,7 @@ std::string DaemonConfigToml(const SimProcess& sim, const std::string& database)
     << "reply_timeout_ms = 500\n"
     << "measurement_timeout_ms = 3000\n"
     << "wake_attempts = 3\n"
+    << "rts_settle_ms = 20\n"
     // Dark readings are weak by nature (the simulator's earn quality 10): accept them flagged,
     // as a lab that takes darks configures it.
     << "[meter.quality]\n"

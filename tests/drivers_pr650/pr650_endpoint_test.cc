@@ -11,6 +11,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "core/wavelength_grid.h"
@@ -158,7 +160,8 @@ TEST_F(Pr650EndpointTest, SetupFieldsAreCheckedWithTheBadFieldPosition) {
 TEST_F(Pr650EndpointTest, UnknownCommandsGetNoReply) {
   Start();
   ASSERT_EQ(client_->Ask("B3\n"), "000\r\n");
-  EXPECT_EQ(client_->Ask("M4\n"), "");  // M1–M3 are answered since the simulator has reports 1–3
+  EXPECT_EQ(client_->Ask("M7\n"), "");  // M1–M6 are answered: the simulator has reports 1–6
+  EXPECT_EQ(client_->Ask("D111\n"), "");
   EXPECT_EQ(client_->Ask("HELLO\n"), "");
   EXPECT_EQ(client_->Ask("B4\n"), "");
 }
@@ -388,13 +391,54 @@ TEST_F(Pr650EndpointTest, NoReportBeforeAMeasurement) {
   EXPECT_EQ(client_->Ask("D5\n"), std::string(sim::kNoMeasurementReply) + "\r\n");
 }
 
-TEST_F(Pr650EndpointTest, UndocumentedReportsAreNotAnswered) {
+TEST_F(Pr650EndpointTest, ReportsFourAndSixAndD201AsTheOpenDriversParseThem) {
   Start(MeterOptions());
+  // Mcalibrator2: a bare S, then D201 repeats the setup's reply.
+  ASSERT_EQ(client_->Ask("S\n"), "00\r\n");
+  EXPECT_EQ(client_->Ask("D201\n"), "00\r\n");
+  ASSERT_EQ(client_->Ask("S1,,,,,5,,1\n"), "06\r\n");
+  EXPECT_EQ(client_->Ask("D201\n"), "06\r\n");
+  const std::string m6 = client_->Ask("M6\n");
+  const sim::Pr650Tristimulus t = TestSpectrumTristimulus();
+  const double sum = t.X + t.Y + t.Z;
+  const double d = t.X + 15 * t.Y + 3 * t.Z;
+  char want[96];
+  std::snprintf(want, sizeof want, "00,0,%.3E,.%04ld,.%04ld,.%04ld,.%04ld\r\n", t.Y,
+                std::lround(t.X / sum * 1e4), std::lround(t.Y / sum * 1e4),
+                std::lround(4 * t.X / d * 1e4), std::lround(9 * t.Y / d * 1e4));
+  EXPECT_EQ(m6, want);
+  EXPECT_EQ(client_->Ask("D06\n"), m6);  // response codes by value
+  // D4: luminance, colour temperature (K), deviation; fields as a float() parser splits them.
+  const std::string d4 = client_->Ask("D4\n");
+  std::vector<std::string> fields;
+  std::stringstream split(d4.substr(0, d4.find('\r')));
+  for (std::string f; std::getline(split, f, ',');) fields.push_back(f);
+  ASSERT_EQ(fields.size(), 5u) << d4;
+  const sim::Pr650ColourTemperature ct = sim::Pr650ColourTemperatureOf(t.X / sum, t.Y / sum);
+  EXPECT_NEAR(std::stod(fields[3]), ct.kelvin, ct.kelvin * 1e-3);
+  EXPECT_GT(ct.kelvin, 1000);
+  EXPECT_NEAR(std::stod(fields[4]), ct.duv, 1e-4);
+  EXPECT_EQ(backend_.setups().size(), 1u);  // D4, D6 and D201 did not measure
+}
+
+TEST_F(Pr650EndpointTest, ColourTemperatureOfKnownIlluminants) {
+  // D65 (x .3127, y .3290): about 6,500 K, just above the locus; illuminant A: 2,856 K, on it.
+  const sim::Pr650ColourTemperature d65 = sim::Pr650ColourTemperatureOf(0.3127, 0.3290);
+  EXPECT_NEAR(d65.kelvin, 6504, 15);
+  EXPECT_NEAR(d65.duv, 0.0032, 0.0005);
+  const sim::Pr650ColourTemperature a = sim::Pr650ColourTemperatureOf(0.4476, 0.4074);
+  EXPECT_NEAR(a.kelvin, 2856, 15);
+  EXPECT_NEAR(a.duv, 0.0, 0.0005);
+}
+
+TEST_F(Pr650EndpointTest, NoDataAndUnitsCodeFaultsShowInTheReports) {
+  Start(MeterOptions());
+  control_.set_serial({.no_data_next = 1, .units_code = 2});
   ASSERT_EQ(client_->Ask("M0\n"), "000\r\n");
-  for (const char* command : {"D4\n", "D6\n", "D201\n", "M4\n", "M6\n"}) {
-    EXPECT_EQ(client_->Ask(command), "") << command;
-  }
-  EXPECT_EQ(backend_.setups().size(), 1u);  // M4/M6 did not measure
+  EXPECT_EQ(client_->Ask("D5\n"), "-1\r\n");
+  EXPECT_EQ(client_->Ask("M5\n").substr(0, 6), "00,2\r\n");
+  EXPECT_EQ(control_.serial().no_data_next, 0);
+  EXPECT_THAT(client_->Ask("D1\n"), StartsWith("00,2,"));
 }
 
 TEST_F(Pr650EndpointTest, TheBareCrHeaderVariantRunsQualityIntoTheIntensityLine) {

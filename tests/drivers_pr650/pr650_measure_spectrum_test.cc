@@ -14,6 +14,7 @@ namespace {
 using namespace std::chrono_literals;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using SteadyClock = std::chrono::steady_clock;
 
 // What the `measured` callback saw.
@@ -161,6 +162,80 @@ TEST_F(Pr650DriverTest, WithoutMeasureWithSpectrumAReadingIsM0ThenD5) {
   ExpectSpectrumOf(taken->report, 0.0789);
   ASSERT_EQ(calls.outcomes.size(), 1u);
   EXPECT_GE(SteadyClock::now() - calls.last_at, 120ms);  // before the D5 transfer
+}
+
+// The meter's own M0 reply is 000 whatever the quality: the D5 report's quality code is judged.
+TEST_F(Pr650DriverTest, WithM0ThenD5TheReportsQualityIsJudged) {
+  sim::Pr650EndpointOptions meter_like = FastEndpointOptions();
+  meter_like.m0_reply_is_quality = false;
+  StartEndpoint(meter_like);
+  options_.measure_with_spectrum = false;
+  auto meter = Configured(200);
+  InjectQuality(18, 1);
+  auto low = meter->MeasureSpectrum(Ctx(), {});
+  ASSERT_TRUE(low.ok()) << low.status().ToString();
+  EXPECT_EQ(low->outcome.quality_code, 18);
+  EXPECT_TRUE(low->outcome.flagged);
+  // Overload in the report: the integration is halved and the reading measured again.
+  InjectQuality(19, 1);
+  auto over = meter->MeasureSpectrum(Ctx(), {});
+  ASSERT_TRUE(over.ok()) << over.status().ToString();
+  EXPECT_EQ(over->outcome.quality_code, 0);
+  EXPECT_EQ(over->outcome.integration_ms, 100);
+  EXPECT_EQ(over->outcome.attempts, 2);
+}
+
+TEST_F(Pr650DriverTest, MinusOneIsAFailedMeasurementInBothModes) {
+  auto meter = Configured(200);
+  control_.UpdateSerial([](sim::SerialFaults& f) { return f.no_data_next = 1; });
+  auto m5 = meter->MeasureSpectrum(Ctx(), {});
+  ASSERT_EQ(m5.status().code(), StatusCode::kDeviceError) << m5.status().ToString();
+  EXPECT_EQ(m5.status().device_code(), -1);
+  EXPECT_THAT(m5.status().message(), HasSubstr("holds no measurement"));
+  EXPECT_TRUE(meter->MeasureSpectrum(Ctx(), {}).ok());  // measured again, it works
+
+  options_.measure_with_spectrum = false;
+  auto m0 = Configured(200);
+  control_.UpdateSerial([](sim::SerialFaults& f) { return f.no_data_next = 1; });
+  auto d5 = m0->MeasureSpectrum(Ctx(), {});
+  ASSERT_EQ(d5.status().code(), StatusCode::kDeviceError) << d5.status().ToString();
+  EXPECT_EQ(d5.status().device_code(), -1);
+  EXPECT_THAT(d5.status().message(), HasSubstr("answered D5 with -1"));
+}
+
+TEST_F(Pr650DriverTest, AnUncalibratedReportIsFlaggedWithANote) {
+  auto meter = Configured(200);
+  control_.UpdateSerial([](sim::SerialFaults& f) { return f.units_code = 2; });
+  auto taken = meter->MeasureSpectrum(Ctx(), {});
+  ASSERT_TRUE(taken.ok()) << taken.status().ToString();
+  EXPECT_EQ(taken->report.units_code, 2);
+  EXPECT_EQ(taken->outcome.quality_code, 0);
+  EXPECT_TRUE(taken->outcome.flagged);
+  EXPECT_THAT(taken->outcome.note, HasSubstr("uncalibrated"));
+}
+
+TEST_F(Pr650DriverTest, TheMeasurementTimeoutFollowsIntegrationTimesAverages) {
+  // A measurement of 2 × 1,000 ms takes 2 s simulated, 0.2 s real; with a 50 ms margin the reply
+  // still comes within 2,050 ms. A silent meter's timeout says what it was made of.
+  options_.measurement_timeout = std::chrono::milliseconds(50);
+  options_.reply_timeout = std::chrono::milliseconds(400);
+  auto meter = Driver();
+  ASSERT_TRUE(meter->Connect(Ctx()).ok());
+  ASSERT_TRUE(meter->Configure({1000, 2, false}, Ctx()).ok());
+  backend_.set_default_duration(2.0);  // simulated s: 0.2 s real
+  EXPECT_TRUE(meter->MeasureSpectrum(Ctx(), {}).ok());
+  control_.UpdateSerial([](sim::SerialFaults& f) { return f.silent = true; });
+  auto silent = meter->MeasureSpectrum(Ctx(), {});
+  ASSERT_EQ(silent.status().code(), StatusCode::kTimeout);
+  EXPECT_THAT(silent.status().message(), HasSubstr("within 2050 ms (2 average(s) of 1000 ms"));
+  EXPECT_THAT(silent.status().message(), Not(HasSubstr("switched off")));
+}
+
+TEST(MeasurementReplyTimeout, IntegrationTimesAveragesPlusTheMargin) {
+  drivers::Pr650Options o;
+  EXPECT_EQ(drivers::MeasurementReplyTimeout(o, 6000, 99).count(), 30000 + 594000);
+  EXPECT_EQ(drivers::MeasurementReplyTimeout(o, 0, 2).count(), 30000 + 12000);  // adaptive
+  EXPECT_EQ(drivers::MeasurementReplyTimeout(o, 100, 0).count(), 30100);
 }
 
 TEST_F(Pr650DriverTest, MeasureSpectrumBeforeConnectIsRefused) {

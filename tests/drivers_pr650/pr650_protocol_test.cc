@@ -152,6 +152,26 @@ TEST(BacklightCommand, OnlyLevelsZeroToThree) {
 
 // ---- F, D1, D2 ---------------------------------------------------------------------------------
 
+TEST(ParseFlickerReply, TextAfterTheFrequencyIsIgnored) {
+  for (const char* reply : {"00,100.0 Hz\r\n", "00,100.0,1\r\n", "00,100.0Hz\r\n",
+                            "00,1.000E+02 hz\r\n", "00,100.0\r\nREADY\r\n"}) {
+    auto r = ParseFlickerReply(reply);
+    ASSERT_TRUE(r.ok()) << reply << ": " << r.status().ToString();
+    EXPECT_DOUBLE_EQ(r->frequency_hz, 100.0) << reply;
+    EXPECT_EQ(r->quality_code, 0);
+  }
+  EXPECT_EQ(ParseFlickerReply("00,Hz\r\n").status().code(), StatusCode::kProtocolError);
+}
+
+TEST(ParseStatusReply, MinusOneIsNoMeasurement) {
+  EXPECT_EQ(*ParseStatusReply("-1\r\n", "M0"), kNoMeasurementStatus);
+  EXPECT_TRUE(IsNoMeasurementReply("-1\r\n"));
+  EXPECT_TRUE(IsNoMeasurementReply(" -1 \r\n"));
+  EXPECT_FALSE(IsNoMeasurementReply("-1\r\n00,0\r\n"));
+  EXPECT_FALSE(IsNoMeasurementReply("000\r\n"));
+  EXPECT_EQ(ParseStatusReply("-2\r\n", "M0").status().code(), StatusCode::kProtocolError);
+}
+
 TEST(ParseFlickerReply, QualityAndFrequency) {
   auto r = ParseFlickerReply("00,100.0\r\n");
   ASSERT_TRUE(r.ok()) << r.status().ToString();

@@ -177,7 +177,7 @@ Status DatabaseReadOnly(DaemonRig& rig, bool on) {
 bool SerialConsumed(DaemonRig& rig) {
   Result<sim::SerialFaults> f = rig.sim_control().SerialFaults();
   return f.ok() && f->garbage_next == 0 && f->truncate_next == 0 && f->quality_count == 0 &&
-         f->vanish_seconds == 0;
+         f->vanish_seconds == 0 && f->no_data_next == 0;
 }
 bool ModbusConsumed(DaemonRig& rig) {
   Result<sim::ModbusFaults> f = rig.sim_control().ModbusFaults();
@@ -263,6 +263,17 @@ const FaultCase kMatrix[] = {
        f.quality_count = 1000;
      }),
      ClearSerial, "quality", 42, nullptr, nullptr},
+    {"SerialNoDataOnce", "one measurement gives no data: its report is \"-1\" (measured again)",
+     Expect::kRecovers, 2, Serial([](auto& f) { f.no_data_next = 1; }), nullptr, "", -1,
+     SerialConsumed, nullptr},
+    {"SerialUncalibratedUnits", "the meter reports units code 2 (uncalibrated): flagged",
+     Expect::kRecovers, 0, Serial([](auto& f) { f.units_code = 2; }), nullptr, "", -1,
+     // A persistent setting, not a "next N" fault: it fired when a reading came back flagged.
+     [](DaemonRig& rig) {
+       Result<sim::SerialFaults> f = rig.sim_control().SerialFaults();
+       return f.ok() && f->units_code == 2;
+     },
+     SomeReading(0, true)},
     // Modbus stage.
     {"ModbusException02", "exception 02 (illegal data address) on every axis request",
      Expect::kPauses, 2, Modbus([](auto& f) {

@@ -112,8 +112,11 @@ Status ModbusControl::SetSerialFaults(const sim::SerialFaults& f) {
       Word(f.quality_count),
       static_cast<std::uint16_t>(vanish_ms >> 16),
       static_cast<std::uint16_t>(vanish_ms & 0xFFFFu),
+      Word(f.no_data_next),
+      Word(f.units_code),
   };
   static_assert(map::kSerialVanishMs - map::kSerialSilent == 5, "serial fault block layout");
+  static_assert(map::kSerialUnitsCode - map::kSerialSilent == 8, "serial fault block layout");
   return WriteRegisters(map::kSerialSilent, regs);
 }
 
@@ -127,7 +130,7 @@ Status ModbusControl::SetModbusFaults(const sim::ModbusFaults& f) {
 }
 
 Result<sim::SerialFaults> ModbusControl::SerialFaults() {
-  auto r = ReadRegisters(map::kSerialSilent, 7);
+  auto r = ReadRegisters(map::kSerialSilent, 9);
   if (!r.ok()) return r.status();
   const auto& v = *r;
   sim::SerialFaults f;
@@ -137,6 +140,8 @@ Result<sim::SerialFaults> ModbusControl::SerialFaults() {
   f.quality_code = v[3];
   f.quality_count = v[4];
   f.vanish_seconds = ((static_cast<std::uint32_t>(v[5]) << 16) | v[6]) / 1000.0;
+  f.no_data_next = v[7];
+  f.units_code = v[8];
   return f;
 }
 

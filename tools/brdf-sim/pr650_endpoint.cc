@@ -31,9 +31,24 @@ std::string Trim(const std::string& s) {
   return s.substr(first, last - first + 1);
 }
 
-// The reports brdf-sim answers: D1 (Y, x, y), D2 (X, Y, Z), D3 (Y, u', v'), D5 (spectrum).
+// The reports brdf-sim answers: D1 (Y, x, y), D2 (X, Y, Z), D3 (Y, u', v'), D4 (Y, colour
+// temperature, its deviation), D5 (spectrum), D6 (Y, x, y, u', v').
 bool IsServedReport(int report) {
-  return report == 1 || report == 2 || report == 3 || report == 5;
+  return report >= 1 && report <= 6;
+}
+
+// The response code of an M or D command, by value: "M5", "M05" and "M005" are all 5. A bare "M"
+// is M1 (the meter's default response code); a bare "D" or anything not digits is no code.
+std::optional<int> ResponseCode(const std::string& command) {
+  if (command.empty() || (command[0] != 'M' && command[0] != 'D')) return std::nullopt;
+  if (command.size() == 1) return command[0] == 'M' ? std::optional<int>(1) : std::nullopt;
+  if (command.size() > 5) return std::nullopt;
+  int code = 0;
+  for (std::size_t i = 1; i < command.size(); ++i) {
+    if (command[i] < '0' || command[i] > '9') return std::nullopt;
+    code = code * 10 + (command[i] - '0');
+  }
+  return code;
 }
 
 // Junk of the same shape as the reply it replaces (same line count and lengths), so a driver
@@ -103,6 +118,7 @@ void Pr650Endpoint::PowerCycle() {
   standalone_ = false;
   setup_ = MeterSetup{};
   sync_ = false;
+  last_setup_reply_ = 0;
   last_ = Measurement{};
   input_.clear();
   // Whatever was sent to the meter while it was off is lost.
@@ -201,10 +217,13 @@ void Pr650Endpoint::Handle(const std::string& command) {
   }
   if (command[0] == 'S') {
     const Pr650SetupResult result = ApplyPr650Setup(std::string_view(command).substr(1));
-    if (result.reply_code == 0) {
+    {
       std::lock_guard lock(mu_);
-      setup_ = result.setup;
-      sync_ = result.sync;
+      last_setup_reply_ = result.reply_code;
+      if (result.reply_code == 0) {
+        setup_ = result.setup;
+        sync_ = result.sync;
+      }
     }
     char text[8];
     std::snprintf(text, sizeof text, "%02d", result.reply_code);
@@ -214,17 +233,17 @@ void Pr650Endpoint::Handle(const std::string& command) {
   if (command == "F") {
     char text[32];
     std::snprintf(text, sizeof text, "00,%.1f", options_.flicker_hz);
-    Reply({text});
+    Reply({text + options_.flicker_reply_suffix});
     return;
   }
-  const bool two_chars = command.size() == 2;
-  const int digit = two_chars ? command[1] - '0' : -1;
-  if (two_chars && command[0] == 'M' && (digit == 0 || IsServedReport(digit))) {
+  const std::optional<int> code = ResponseCode(command);
+  if (!code.has_value()) return;  // unknown: the simulated meter does not answer
+  if (command[0] == 'M' && (*code == 0 || IsServedReport(*code))) {
     // M0 measures and holds; Mn is M0 followed by report n, in one reply.
     const std::optional<int> quality_code = Measure(epoch);
     if (!quality_code.has_value()) return;
-    if (digit != 0) {
-      ReplyReport(digit);
+    if (*code != 0) {
+      ReplyReport(*code);
       return;
     }
     const int status = options_.m0_reply_is_quality ? std::clamp(*quality_code, 0, 999) : 0;
@@ -233,21 +252,35 @@ void Pr650Endpoint::Handle(const std::string& command) {
     Reply({text});
     return;
   }
-  if (two_chars && command[0] == 'D' && IsServedReport(digit)) {
-    ReplyReport(digit);
+  if (command[0] != 'D') return;  // M7 … M98: not served
+  if (IsServedReport(*code)) {
+    ReplyReport(*code);
     return;
   }
-  if (command == "D110") {
+  if (*code == 110) {
     std::string serial = options_.serial_number.substr(0, 8);
     serial.resize(8, ' ');
     Reply({serial});
     return;
   }
-  if (command == "D120") {
+  if (*code == 120) {
     Reply({Pr650LayoutLine()});
     return;
   }
-  // Unknown or undocumented (D4, D6, M4, M6, D201, ...): the simulated meter does not answer.
+  if (*code == 201) {
+    // The reply to the last S command again ("pp"); 00 before any.
+    int reply = 0;
+    {
+      std::lock_guard lock(mu_);
+      reply = last_setup_reply_;
+    }
+    char text[8];
+    std::snprintf(text, sizeof text, "%02d", reply);
+    Reply({text});
+    return;
+  }
+  // Other response codes (D19's binary block, D111, ...): no source documents them for the
+  // PR-650; the simulated meter does not answer.
 }
 
 std::optional<int> Pr650Endpoint::Measure(unsigned epoch) {
@@ -258,16 +291,23 @@ std::optional<int> Pr650Endpoint::Measure(unsigned epoch) {
     measured_setups_.push_back(setup);
   }
   SimMeasurement m = backend_.Measure(setup);
-  const int forced = control_.UpdateSerial([](SerialFaults& f) {
-    if (f.quality_count <= 0) return -1;
-    --f.quality_count;
-    return f.quality_code;
+  const auto [forced, no_data] = control_.UpdateSerial([](SerialFaults& f) {
+    int code = -1;
+    if (f.quality_count > 0) {
+      --f.quality_count;
+      code = f.quality_code;
+    }
+    const bool none = f.no_data_next > 0;
+    if (none) --f.no_data_next;
+    return std::pair{code, none};
   });
   if (forced >= 0) m.quality_code = forced;
   if (!SleepReal(options_.time_scale.ToReal(std::max(0.0, m.duration_s)))) return std::nullopt;
   std::lock_guard lock(mu_);
   if (epoch != power_epoch_) return std::nullopt;  // switched off mid-measurement: no reply
-  last_ = Measurement{true, m.quality_code, m.integrated, std::move(m.radiance)};
+  // A measurement that gave no data leaves nothing to report: the reports answer "-1".
+  last_ = no_data ? Measurement{}
+                  : Measurement{true, m.quality_code, m.integrated, std::move(m.radiance)};
   return m.quality_code;
 }
 
@@ -281,9 +321,9 @@ void Pr650Endpoint::ReplyReport(int report) {
     Reply({kNoMeasurementReply});
     return;
   }
-  constexpr int kUnitsRadiance = 0;
+  const int units_code = control_.serial().units_code;
   if (report != 5) {
-    Reply({Pr650ColorimetryLine(report, last.quality_code, kUnitsRadiance,
+    Reply({Pr650ColorimetryLine(report, last.quality_code, units_code,
                                 Pr650TristimulusOf(last.radiance))});
     return;
   }
@@ -292,8 +332,7 @@ void Pr650Endpoint::ReplyReport(int report) {
     f.vanish_seconds = 0;
     return seconds;
   });
-  Reply(Pr650SpectrumLines(last.quality_code, kUnitsRadiance, last.integrated, last.radiance),
-        vanish);
+  Reply(Pr650SpectrumLines(last.quality_code, units_code, last.integrated, last.radiance), vanish);
 }
 
 void Pr650Endpoint::Reply(std::vector<std::string> lines, double vanish_seconds) {

@@ -4,8 +4,10 @@
 //   commands (case-insensitive, ended by CR or LF)     replies (lines end CR LF)
 //   B0 … B3                                             000
 //   S<acc1>,<acc2>,<acc3>,<acc4>,<sync>,<integ>,<avg>,<units>   pp (00 ok, 01–08 bad field, 09 too
-//                                                       many fields, 50 accessory not fitted)
-//   F                                                   qq,freq  ("00,100.0")
+//                                                       many fields, 50 accessory not fitted);
+//                                                       "S" alone keeps the defaults (00)
+//   F                                                   qq,freq  ("00,100.0"; flicker_reply_suffix
+//                                                       appended)
 //   M0                                                  000 once the measurement is done (its
 //                                                       quality is in the reports); with
 //                                                       m0_reply_is_quality the quality code
@@ -13,16 +15,23 @@
 //   D1                                                  qq,U,Y.YYYEsee,.xxxx,.yyyy  (Y, x, y)
 //   D2                                                  qq,U,X.XXXEsee,Y.YYYEsee,Z.ZZZEsee
 //   D3                                                  qq,U,Y.YYYEsee,.uuuu,.vvvv  (Y, u', v')
+//   D4                                                  qq,U,Y.YYYEsee,T.TTTEsee,+.dddd (Y, CCT
+//                                                       in K, deviation from the locus)
 //   D5                                                  qq,U / integrated / 101 × "0380.,r.rrrEsee"
-//   M1, M2, M3, M5                                      a measurement, then report 1, 2, 3 or 5 as
-//                                                       its reply (also after a bad quality code)
+//   D6                                                  qq,U,Y.YYYEsee,.xxxx,.yyyy,.uuuu,.vvvv
+//   M1 … M6 (M alone: M1)                               a measurement, then report 1 … 6 as its
+//                                                       reply (also after a bad quality code)
 //   D110                                                the serial number, blank-padded to 8
 //   D120                                                0101,008.0,0380.,0780.,004.
-//   anything else (D4, D6, M4, M6, D201, ...)           no reply: no source documents them
+//   D201                                                the last S command's reply pp again (00
+//                                                       before any)
+//   anything else (M19, D111, E, ...)                   no reply: no source documents them
+// Response codes are read by value, so "M01" is M1 and "D05" is D5 (one source writes M01).
 //
-// A report asked for before any measurement since power-on (D1–D3, D5) is answered with the
-// status line "-1" alone (kNoMeasurementReply), the value the open programs treat as "no data";
-// the meter never sends a spectrum it has not measured.
+// A report asked for before any measurement since power-on (D1–D6), or after a measurement that
+// gave no data (SerialFaults::no_data_next), is answered with the status line "-1" alone
+// (kNoMeasurementReply), the value the open programs treat as "no data"; the meter never sends
+// a spectrum it has not measured. The reports carry SerialFaults::units_code (0 unless set).
 // Remote mode starts only if the first command arrives within wake_window_s (simulated) of
 // power-on (Start or PowerCycle); otherwise the meter stays in stand-alone mode and answers
 // nothing until power-cycled. Faults come from SimControl::serial() at each command; the "next N"
@@ -82,6 +91,8 @@ struct Pr650EndpointOptions {
   std::string link_path;
   std::string serial_number = "60925301";
   double flicker_hz = 100.0;  // what F reports (a 50 Hz mains lamp flickers at 100 Hz)
+  // Text after "qq,freq" in F's reply (" Hz", ",x"): a meter or adapter that adds to the reply.
+  std::string flicker_reply_suffix;
   // M0 answers with the quality code ("018") instead of the meter's "000": what brdf-sim did
   // before it followed the meter, for drivers that judge the quality from M0's reply.
   bool m0_reply_is_quality = false;
@@ -162,6 +173,7 @@ class Pr650Endpoint {
   bool standalone_ = false;  // the wake-up window was missed: silent until power-cycled
   MeterSetup setup_;
   bool sync_ = false;
+  int last_setup_reply_ = 0;  // the last S command's reply code, for D201
   Measurement last_;
   std::vector<std::string> commands_;
   std::vector<MeterSetup> measured_setups_;

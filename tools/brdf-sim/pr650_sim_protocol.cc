@@ -93,22 +93,64 @@ Pr650Tristimulus Pr650TristimulusOf(const std::vector<double>& radiance) {
   return t;
 }
 
+Pr650ColourTemperature Pr650ColourTemperatureOf(double x, double y) {
+  Pr650ColourTemperature t;
+  if (y <= 0 || std::abs(0.1858 - y) < 1e-9) return t;
+  const double n = (x - 0.3320) / (0.1858 - y);
+  t.kelvin = ((449.0 * n + 3525.0) * n + 6823.3) * n + 5520.33;
+  if (t.kelvin <= 0) return Pr650ColourTemperature{};
+  // CIE 1960 uv of the sample and of the Planckian locus at that temperature.
+  const double d = -2 * x + 12 * y + 3;
+  const double u = 4 * x / d;
+  const double v = 6 * y / d;
+  const double k = t.kelvin;
+  const double u_locus = (0.860117757 + 1.54118254e-4 * k + 1.28641212e-7 * k * k) /
+                         (1 + 8.42420235e-4 * k + 7.08145163e-7 * k * k);
+  const double v_locus = (0.317398726 + 4.22806245e-5 * k + 4.20481691e-8 * k * k) /
+                         (1 - 2.89741816e-5 * k + 1.61456053e-7 * k * k);
+  const double distance = std::hypot(u - u_locus, v - v_locus);
+  t.duv = v >= v_locus ? distance : -distance;
+  return t;
+}
+
+namespace {
+
+// "+.dddd" / "-.dddd": a small signed value as the meter prints coordinates, with a sign.
+std::string SignedFraction(double value) {
+  const long scaled = std::lround(std::clamp(std::abs(value), 0.0, 0.9999) * 10000);
+  char text[16];
+  std::snprintf(text, sizeof text, "%c.%04ld", value < 0 ? '-' : '+', scaled);
+  return text;
+}
+
+}  // namespace
+
 std::string Pr650ColorimetryLine(int report, int quality_code, int units_code,
                                  const Pr650Tristimulus& xyz) {
   const double sum = xyz.X + xyz.Y + xyz.Z;
   const double uv_denominator = xyz.X + 15 * xyz.Y + 3 * xyz.Z;
+  const double x = sum > 0 ? xyz.X / sum : 0;
+  const double y = sum > 0 ? xyz.Y / sum : 0;
+  const double u = uv_denominator > 0 ? 4 * xyz.X / uv_denominator : 0;
+  const double v = uv_denominator > 0 ? 9 * xyz.Y / uv_denominator : 0;
   const std::string head = ReportHead(quality_code, units_code);
   switch (report) {
     case 1:
-      return head + FormatPr650Number(xyz.Y) + "," + Coordinate(sum > 0 ? xyz.X / sum : 0) + "," +
-             Coordinate(sum > 0 ? xyz.Y / sum : 0);
+      return head + FormatPr650Number(xyz.Y) + "," + Coordinate(x) + "," + Coordinate(y);
     case 2:
       return head + FormatPr650Number(xyz.X) + "," + FormatPr650Number(xyz.Y) + "," +
              FormatPr650Number(xyz.Z);
     case 3:
-      return head + FormatPr650Number(xyz.Y) + "," +
-             Coordinate(uv_denominator > 0 ? 4 * xyz.X / uv_denominator : 0) + "," +
-             Coordinate(uv_denominator > 0 ? 9 * xyz.Y / uv_denominator : 0);
+      return head + FormatPr650Number(xyz.Y) + "," + Coordinate(u) + "," + Coordinate(v);
+    case 4: {
+      const Pr650ColourTemperature t =
+          sum > 0 ? Pr650ColourTemperatureOf(x, y) : Pr650ColourTemperature{};
+      return head + FormatPr650Number(xyz.Y) + "," + FormatPr650Number(t.kelvin) + "," +
+             SignedFraction(t.duv);
+    }
+    case 6:
+      return head + FormatPr650Number(xyz.Y) + "," + Coordinate(x) + "," + Coordinate(y) + "," +
+             Coordinate(u) + "," + Coordinate(v);
     default:
       return {};
   }

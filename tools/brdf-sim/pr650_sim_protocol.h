@@ -39,10 +39,24 @@ Pr650Tristimulus Pr650TristimulusOf(const std::vector<double>& radiance);
 //   1  "qq,U,Y.YYYEsee,.xxxx,.yyyy"      luminance and CIE 1931 x, y
 //   2  "qq,U,X.XXXEsee,Y.YYYEsee,Z.ZZZEsee"  tristimulus values
 //   3  "qq,U,Y.YYYEsee,.uuuu,.vvvv"      luminance and CIE 1976 u', v'
-// Chromaticities are 4 decimals with no leading 0; black (X + Y + Z = 0) gives .0000. `report` is
-// 1, 2 or 3; any other number returns an empty string.
+//   4  "qq,U,Y.YYYEsee,T.TTTEsee,+.dddd" luminance, correlated colour temperature in K and the
+//                                        distance from the Planckian locus in CIE 1960 uv
+//                                        (positive above it); the digits of T and d are
+//                                        brdf-sim's choice (the sources give the fields only)
+//   6  "qq,U,Y.YYYEsee,.xxxx,.yyyy,.uuuu,.vvvv"  luminance, x, y, u', v'
+// Chromaticities are 4 decimals with no leading 0; black (X + Y + Z = 0) gives .0000 (and a
+// temperature of 0). `report` is 1, 2, 3, 4 or 6; any other number returns an empty string.
 std::string Pr650ColorimetryLine(int report, int quality_code, int units_code,
                                  const Pr650Tristimulus& xyz);
+
+// Correlated colour temperature (K) of chromaticity x, y (McCamy's cubic, good to a few K between
+// 2,000 and 12,500 K) and its signed distance from the Planckian locus in CIE 1960 uv (Krystek's
+// rational fit of the locus).
+struct Pr650ColourTemperature {
+  double kelvin = 0;
+  double duv = 0;
+};
+Pr650ColourTemperature Pr650ColourTemperatureOf(double x, double y);
 
 // The D120 layout line: "0101,008.0,0380.,0780.,004.".
 std::string Pr650LayoutLine();

@@ -56,14 +56,16 @@ class StagePoseSource {
 };
 
 struct SerialFaults {
-  bool silent = false;        // the meter answers nothing (not in remote mode, cable switch)
-  int garbage_next = 0;       // the next N replies are replaced by garbage bytes
-  int truncate_next = 0;      // the next N replies stop half-way
+  bool silent = false;    // the meter answers nothing (not in remote mode, cable switch)
+  int garbage_next = 0;   // the next N replies are replaced by garbage bytes
+  int truncate_next = 0;  // the next N replies stop half-way
   // The injected quality code is a fault of the meter: the PR-650 endpoint applies it over the
   // backend's own code and counts quality_count down (one place only; the optics never do).
   int quality_code = 0;       // force this quality code ...
   int quality_count = 0;      // ... for the next N measurements
   double vanish_seconds = 0;  // >0: the port vanishes during the next D5 transfer, back after this
+  int no_data_next = 0;       // the next N measurements give no data: their reports answer "-1"
+  int units_code = 0;         // the reports' units code: 0 radiance, 1 irradiance, 2 uncalibrated
 };
 
 struct ModbusFaults {

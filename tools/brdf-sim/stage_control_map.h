@@ -17,6 +17,8 @@
 //     14  serial.quality_count      ... for the next N measurements
 //  15-16  serial.vanish_ms          32-bit, high word first: >0 = the port vanishes during the next
 //                                   D5 transfer and comes back after this many (simulated) ms
+//     17  serial.no_data_next       N: the next N measurements give no data (reports answer "-1")
+//     18  serial.units_code         0 radiance, 1 irradiance, 2 uncalibrated: the reports' units
 //     20  modbus.exception_code     exception (2 illegal address, 6 busy, ...) to reply with ...
 //     21  modbus.exception_count    ... to the next N axis requests (the request is not applied)
 //     22  modbus.late_reply_ms      delay the next N axis replies by this many real ms ...
@@ -26,7 +28,7 @@
 //     25  modbus.alarm_mid_move     1: the next move raises an alarm (code 0x30) half-way
 //     26  modbus.stall              1: the next move never clears MOVE (until STOP or ALM-RST)
 //
-// Registers 2–9 and 17–19 read 0 and refuse writes (exception 02), as do addresses past 26.
+// Registers 2–9 and 19 read 0 and refuse writes (exception 02), as do addresses past 26.
 // A value out of range (mounted 3, a flag of 2, exception code 12) is refused with exception 03
 // and nothing of that write is applied. Faults apply to the axis unit ids only, never to the
 // control unit itself, so setting a fault cannot consume it.
@@ -49,6 +51,8 @@ inline constexpr std::uint16_t kSerialTruncateNext = 12;
 inline constexpr std::uint16_t kSerialQualityCode = 13;
 inline constexpr std::uint16_t kSerialQualityCount = 14;
 inline constexpr std::uint16_t kSerialVanishMs = 15;  // 2 registers, high word first
+inline constexpr std::uint16_t kSerialNoDataNext = 17;
+inline constexpr std::uint16_t kSerialUnitsCode = 18;
 inline constexpr std::uint16_t kModbusExceptionCode = 20;
 inline constexpr std::uint16_t kModbusExceptionCount = 21;
 inline constexpr std::uint16_t kModbusLateReplyMs = 22;

@@ -14,7 +14,7 @@ namespace cm = control_map;
 
 bool Defined(std::uint16_t a) {
   return a == cm::kMountedTarget || a == cm::kPowerCycleMeter ||
-         (a >= cm::kSerialSilent && a <= cm::kSerialVanishMs + 1) ||
+         (a >= cm::kSerialSilent && a <= cm::kSerialUnitsCode) ||
          (a >= cm::kModbusExceptionCode && a <= cm::kModbusStall);
 }
 
@@ -42,6 +42,8 @@ std::vector<std::uint16_t> Snapshot(const SimControl& control) {
       std::clamp(std::llround(s.vanish_seconds * 1000.0), 0LL, 0xFFFFFFFFLL));
   r[cm::kSerialVanishMs] = static_cast<std::uint16_t>(vanish_ms >> 16);
   r[cm::kSerialVanishMs + 1] = static_cast<std::uint16_t>(vanish_ms & 0xFFFF);
+  r[cm::kSerialNoDataNext] = Clamp16(s.no_data_next);
+  r[cm::kSerialUnitsCode] = Clamp16(s.units_code);
   r[cm::kModbusExceptionCode] = Clamp16(m.exception_code);
   r[cm::kModbusExceptionCount] = Clamp16(m.exception_count);
   r[cm::kModbusLateReplyMs] = Clamp16(m.late_reply_ms);
@@ -77,6 +79,7 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
     if (a == cm::kPowerCycleMeter && v > 1) return modbus::kIllegalDataValue;
     if (IsFlag(a) && v > 1) return modbus::kIllegalDataValue;
     if (a == cm::kModbusExceptionCode && v > 0x0B) return modbus::kIllegalDataValue;
+    if (a == cm::kSerialUnitsCode && v > 2) return modbus::kIllegalDataValue;
   }
   auto image = Snapshot(control_);
   for (std::size_t i = 0; i < values.size(); ++i) image[address + i] = values[i];
@@ -85,7 +88,7 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
   if (written(cm::kMountedTarget)) {
     control_.set_mounted(static_cast<MountedTarget>(image[cm::kMountedTarget]));
   }
-  if (address <= cm::kSerialVanishMs + 1 && address + values.size() > cm::kSerialSilent) {
+  if (address <= cm::kSerialUnitsCode && address + values.size() > cm::kSerialSilent) {
     control_.UpdateSerial([&](SerialFaults& s) {
       if (written(cm::kSerialSilent)) s.silent = image[cm::kSerialSilent] != 0;
       if (written(cm::kSerialGarbageNext)) s.garbage_next = image[cm::kSerialGarbageNext];
@@ -97,6 +100,8 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
                                  image[cm::kSerialVanishMs + 1];
         s.vanish_seconds = ms / 1000.0;
       }
+      if (written(cm::kSerialNoDataNext)) s.no_data_next = image[cm::kSerialNoDataNext];
+      if (written(cm::kSerialUnitsCode)) s.units_code = image[cm::kSerialUnitsCode];
     });
   }
   if (address <= cm::kModbusStall && address + values.size() > cm::kModbusExceptionCode) {

@@ -20,7 +20,12 @@ void PrintReading(std::ostream& out, const v1::Reading& r, bool spectra) {
   out << r.id() << "  step " << r.step_index() << "  " << ReadingKindName(r.kind()) << "  "
       << PoseText(r.pose());
   if (r.kind() == v1::READING_KIND_SAMPLE) out << "  " << IsoText(r.iso());
-  out << "  q " << r.quality_code() << "  " << r.integration_ms() << " ms";
+  out << "  q " << r.quality_code() << "  ";
+  if (r.integration_ms() == 0) {
+    out << "adaptive";  // the PR-650 does not report the integration time it chose
+  } else {
+    out << r.integration_ms() << " ms";
+  }
   if (r.averages() > 1) out << " ×" << r.averages();
   if (r.flagged()) out << "  FLAGGED (" << r.flag_reason() << ")";
   if (!r.label().empty()) out << "  \"" << r.label() << "\"";
