@@ -209,10 +209,25 @@ void Rig::SetConnection(DeviceHealth& health, DeviceConnection connection) {
   status_.updated_at = now;
 }
 
-std::chrono::milliseconds Rig::BackoffAfter(int failed_attempts) const {
+void Rig::RetryStageNow() {
+  if (!stage_) return;
+  {
+    MutexLock lock(status_mu_);
+    if (status_.stage.connection != DeviceConnection::kDisconnected) return;
+    status_.stage.failed_attempts = 0;
+    next_stage_attempt_ = steady_clock::now();
+  }
+  {
+    MutexLock lock(thread_mu_);
+    retry_now_ = true;
+  }
+  wake_.NotifyAll();
+}
+
+std::chrono::milliseconds Rig::BackoffAfter(int failed_attempts, milliseconds cap) const {
   double ms = static_cast<double>(options_.backoff_initial.count()) *
               std::pow(options_.backoff_multiplier, std::max(0, failed_attempts - 1));
-  ms = std::min(ms, static_cast<double>(options_.backoff_max.count()));
+  ms = std::min(ms, static_cast<double>(cap.count()));
   return milliseconds(static_cast<std::int64_t>(ms));
 }
 
@@ -229,7 +244,8 @@ void Rig::NoteMeterResult(const Status& status, bool connecting) {
   if (connecting || LinkLost(status)) {
     ++h.failed_attempts;
     SetConnection(h, DeviceConnection::kDisconnected);
-    next_meter_attempt_ = steady_clock::now() + BackoffAfter(h.failed_attempts);
+    next_meter_attempt_ =
+        steady_clock::now() + BackoffAfter(h.failed_attempts, options_.backoff_max);
   } else if (DeviceFault(status)) {
     SetConnection(h, DeviceConnection::kFault);
   }
@@ -248,7 +264,9 @@ void Rig::NoteStageResult(const Status& status, bool connecting) {
   if (connecting || status.code() == StatusCode::kDisconnected) {
     ++h.failed_attempts;
     SetConnection(h, DeviceConnection::kDisconnected);
-    next_stage_attempt_ = steady_clock::now() + BackoffAfter(h.failed_attempts);
+    next_stage_attempt_ =
+        steady_clock::now() +
+        BackoffAfter(h.failed_attempts, std::min(options_.backoff_max, options_.stage_backoff_max));
     if (!connecting) stage_reset_requested_ = true;
   } else if (DeviceFault(status)) {
     SetConnection(h, DeviceConnection::kFault);
@@ -419,8 +437,10 @@ void Rig::Supervise() {
     }
     wait = std::max(wait, milliseconds(10));
     MutexLock lock(thread_mu_);
-    wake_.WaitFor(thread_mu_, wait, [this]() REQUIRES(thread_mu_) { return stopping_; });
+    wake_.WaitFor(thread_mu_, wait,
+                  [this]() REQUIRES(thread_mu_) { return stopping_ || retry_now_; });
     if (stopping_) return;
+    retry_now_ = false;
   }
 }
 
