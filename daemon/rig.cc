@@ -214,7 +214,6 @@ void Rig::RetryStageNow() {
   {
     MutexLock lock(status_mu_);
     if (status_.stage.connection != DeviceConnection::kDisconnected) return;
-    status_.stage.failed_attempts = 0;
     next_stage_attempt_ = steady_clock::now();
   }
   {
@@ -317,7 +316,16 @@ Status Rig::ConnectStageLocked(const CallContext& ctx) {
   if (st.ok()) {
     spdlog::info("stage connected ({})", address);
   } else if (st.code() != StatusCode::kCancelled) {
-    spdlog::warn("stage on {} not connected: {}", address, st.ToString());
+    // Attempts come every reconnect_max_ms (1 s) while the stage is away: warn on the first
+    // failure and then once a minute or so, the rest at debug level.
+    int failed = 0;
+    {
+      MutexLock lock(status_mu_);
+      failed = status_.stage.failed_attempts;
+    }
+    spdlog::log(failed <= 1 || failed % 60 == 0 ? spdlog::level::warn : spdlog::level::debug,
+                "stage on {} not connected (attempt {} in a row): {}", address, failed,
+                st.ToString());
   }
   return st;
 }

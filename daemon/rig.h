@@ -109,8 +109,9 @@ class Rig {
   void Stop();
 
   RigStatus GetStatus() const;
-  // The operator is looking (rig status) or resuming: a disconnected stage is tried again now,
-  // its back-off starting over, and the supervisor is woken for it. Cheap when connected.
+  // The operator is looking (rig status) or resuming: a disconnected stage is tried again now
+  // (the supervisor is woken for it) instead of at the end of its back-off. Cheap when connected
+  // or already connecting; the count of failed attempts goes on (for the log's pace).
   void RetryStageNow();
   const plan::RigDescription& description() const { return description_; }
 
