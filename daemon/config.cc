@@ -424,6 +424,8 @@ void ReadStage(TableReader& root, Config& c, Issues& issues) {
   if (t.OneOf("parity", parity, {"N", "E", "O"})) s.parity = parity[0];
   t.OneOf("profile", s.profile, {"az", "leadshine", "moons"});
   t.Int("response_timeout_ms", s.response_timeout_ms, 10, 60000);
+  t.Int("busy_window_ms", s.busy_window_ms, 0, 600000);
+  t.Int("reconnect_max_ms", s.reconnect_max_ms, 100, 300000);
   t.Bool("detector_arm_motorized", s.detector_arm_motorized);
   if (s.transport == "rtu" && s.device.empty()) {
     issues.Add(table ? table->source() : toml::source_region{}, "stage.device",

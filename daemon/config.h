@@ -40,6 +40,9 @@
 //   parity = "E"                        # rtu: "N", "E" or "O"
 //   profile = "az"                      # register map: "az", "leadshine" or "moons"
 //   response_timeout_ms = 500
+//   busy_window_ms = 3000               # exception 04/06 retried with back-off this long, then
+//                                       #   the session pauses naming the exception
+//   reconnect_max_ms = 1000             # longest wait between reconnection attempts
 //   detector_arm_motorized = false      # true: δ is a Modbus axis ([stage.axes.delta] present)
 //   [stage.axes.alpha]                  # also beta, gamma, delta
 //   present = true                      # default: true for alpha and beta, false for gamma, delta
@@ -140,6 +143,8 @@ struct StageConfig {
   char parity = 'E';               // rtu
   std::string profile = "az";      // "az", "leadshine", "moons"
   int response_timeout_ms = 500;
+  int busy_window_ms = 3000;    // exception 04/06: retry with back-off this long (issue 21)
+  int reconnect_max_ms = 1000;  // longest wait between stage reconnection attempts
   bool detector_arm_motorized = false;
   AxisSettings alpha{true, 1, 10000.0 / 360.0, 0, 1, 0, 90, 10};
   AxisSettings beta{true, 2, 10000.0 / 360.0, 0, 1, -180, 180, 20};

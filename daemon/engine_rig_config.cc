@@ -64,6 +64,7 @@ Result<drivers::stage::ModbusStageConfig> StageOptions(const StageConfig& s) {
     bus.endpoint = drivers::stage::TcpEndpoint{s.host, s.port};
   }
   bus.response_timeout = std::chrono::milliseconds(s.response_timeout_ms);
+  bus.busy_window = std::chrono::milliseconds(s.busy_window_ms);
   c.buses = {bus};
   c.axes[0] = Axis(s.alpha, true);
   c.axes[1] = Axis(s.beta, true);
@@ -84,6 +85,7 @@ Result<std::unique_ptr<Rig>> Rig::FromConfig(const Config& config, Options optio
   auto stage = drivers::stage::ModbusStage::Create(*stage_options);
   if (!stage.ok()) return stage.status().WithContext("config [stage]");
 
+  options.stage_backoff_max = std::chrono::milliseconds(config.stage.reconnect_max_ms);
   const std::string stage_address =
       config.stage.transport == "rtu" ? config.stage.device
                                       : config.stage.host + ":" + std::to_string(config.stage.port);

@@ -209,10 +209,24 @@ void Rig::SetConnection(DeviceHealth& health, DeviceConnection connection) {
   status_.updated_at = now;
 }
 
-std::chrono::milliseconds Rig::BackoffAfter(int failed_attempts) const {
+void Rig::RetryStageNow() {
+  if (!stage_) return;
+  {
+    MutexLock lock(status_mu_);
+    if (status_.stage.connection != DeviceConnection::kDisconnected) return;
+    next_stage_attempt_ = steady_clock::now();
+  }
+  {
+    MutexLock lock(thread_mu_);
+    retry_now_ = true;
+  }
+  wake_.NotifyAll();
+}
+
+std::chrono::milliseconds Rig::BackoffAfter(int failed_attempts, milliseconds cap) const {
   double ms = static_cast<double>(options_.backoff_initial.count()) *
               std::pow(options_.backoff_multiplier, std::max(0, failed_attempts - 1));
-  ms = std::min(ms, static_cast<double>(options_.backoff_max.count()));
+  ms = std::min(ms, static_cast<double>(cap.count()));
   return milliseconds(static_cast<std::int64_t>(ms));
 }
 
@@ -229,7 +243,8 @@ void Rig::NoteMeterResult(const Status& status, bool connecting) {
   if (connecting || LinkLost(status)) {
     ++h.failed_attempts;
     SetConnection(h, DeviceConnection::kDisconnected);
-    next_meter_attempt_ = steady_clock::now() + BackoffAfter(h.failed_attempts);
+    next_meter_attempt_ =
+        steady_clock::now() + BackoffAfter(h.failed_attempts, options_.backoff_max);
   } else if (DeviceFault(status)) {
     SetConnection(h, DeviceConnection::kFault);
   }
@@ -248,7 +263,9 @@ void Rig::NoteStageResult(const Status& status, bool connecting) {
   if (connecting || status.code() == StatusCode::kDisconnected) {
     ++h.failed_attempts;
     SetConnection(h, DeviceConnection::kDisconnected);
-    next_stage_attempt_ = steady_clock::now() + BackoffAfter(h.failed_attempts);
+    next_stage_attempt_ =
+        steady_clock::now() +
+        BackoffAfter(h.failed_attempts, std::min(options_.backoff_max, options_.stage_backoff_max));
     if (!connecting) stage_reset_requested_ = true;
   } else if (DeviceFault(status)) {
     SetConnection(h, DeviceConnection::kFault);
@@ -299,7 +316,16 @@ Status Rig::ConnectStageLocked(const CallContext& ctx) {
   if (st.ok()) {
     spdlog::info("stage connected ({})", address);
   } else if (st.code() != StatusCode::kCancelled) {
-    spdlog::warn("stage on {} not connected: {}", address, st.ToString());
+    // Attempts come every reconnect_max_ms (1 s) while the stage is away: warn on the first
+    // failure and then once a minute or so, the rest at debug level.
+    int failed = 0;
+    {
+      MutexLock lock(status_mu_);
+      failed = status_.stage.failed_attempts;
+    }
+    spdlog::log(failed <= 1 || failed % 60 == 0 ? spdlog::level::warn : spdlog::level::debug,
+                "stage on {} not connected (attempt {} in a row): {}", address, failed,
+                st.ToString());
   }
   return st;
 }
@@ -419,8 +445,10 @@ void Rig::Supervise() {
     }
     wait = std::max(wait, milliseconds(10));
     MutexLock lock(thread_mu_);
-    wake_.WaitFor(thread_mu_, wait, [this]() REQUIRES(thread_mu_) { return stopping_; });
+    wake_.WaitFor(thread_mu_, wait,
+                  [this]() REQUIRES(thread_mu_) { return stopping_ || retry_now_; });
     if (stopping_) return;
+    retry_now_ = false;
   }
 }
 

@@ -76,6 +76,10 @@ class Rig {
     std::chrono::milliseconds backoff_initial{500};
     double backoff_multiplier = 2;
     std::chrono::milliseconds backoff_max{30000};
+    // Longest wait between stage connection attempts: a stage that answers again shows as
+    // connected within this plus one attempt ([stage] reconnect_max_ms). A refused TCP connect
+    // or a missing serial device fails at once, so short waits cost the rig nothing.
+    std::chrono::milliseconds stage_backoff_max{1000};
     // Deadline of one connection attempt (the PR-650's wake-up takes a few seconds).
     std::chrono::milliseconds connect_timeout{15000};
     // How often the supervisor reads the live pose while the stage is connected.
@@ -105,6 +109,10 @@ class Rig {
   void Stop();
 
   RigStatus GetStatus() const;
+  // The operator is looking (rig status) or resuming: a disconnected stage is tried again now
+  // (the supervisor is woken for it) instead of at the end of its back-off. Cheap when connected
+  // or already connecting; the count of failed attempts goes on (for the log's pace).
+  void RetryStageNow();
   const plan::RigDescription& description() const { return description_; }
 
   // Runs `fn` with the meter held exclusively, connecting it first (within ctx) when it is not
@@ -136,7 +144,7 @@ class Rig {
   void NoteMeterResult(const Status& status, bool connecting);
   void NoteStageResult(const Status& status, bool connecting);
   void SetConnection(DeviceHealth& health, DeviceConnection connection) REQUIRES(status_mu_);
-  std::chrono::milliseconds BackoffAfter(int failed_attempts) const;
+  std::chrono::milliseconds BackoffAfter(int failed_attempts, std::chrono::milliseconds cap) const;
 
   plan::RigDescription description_;
   Options options_;
@@ -158,6 +166,7 @@ class Rig {
   Mutex thread_mu_;
   CondVar wake_;
   bool stopping_ GUARDED_BY(thread_mu_) = false;
+  bool retry_now_ GUARDED_BY(thread_mu_) = false;  // RetryStageNow: end the supervisor's wait
   std::thread supervisor_;
   CancelToken supervisor_cancel_;
 };

@@ -604,6 +604,7 @@ Result<v1::Session> SessionManager::Pause(SessionId session, PauseMode mode, con
 }
 
 Result<v1::Session> SessionManager::Resume(SessionId session, const Actor& actor) {
+  rig_->RetryStageNow();  // a stage that is back need not wait out its reconnect back-off
   return impl_->Verb(session, actor, "session.resume", "resumed by " + Who(actor),
                      [&]() REQUIRES(impl_->mu) -> Status {
                        Result<SessionState> from = impl_->StateLocked(session);
@@ -703,6 +704,7 @@ Result<std::shared_ptr<const SessionPlan>> SessionManager::Plan(SessionId sessio
 }
 
 v1::RigStatus SessionManager::GetRigStatus() const {
+  rig_->RetryStageNow();  // the operator is looking: a stage that is back shows as back
   v1::RigStatus status = ToProto(rig_->GetStatus());
   MutexLock lock(impl_->mu);
   if (impl_->holder.has_value()) status.set_active_session_id(std::to_string(*impl_->holder));

@@ -7,6 +7,35 @@
 
 namespace brdf::drivers::stage {
 
+namespace {
+
+const char* WordOrderName(WordOrder order) {
+  return order == WordOrder::kHighFirst ? "high_first" : "low_first";
+}
+
+// A write the drive refused with exception 02, 03 or 04 is most often a register profile that does
+// not match the drive's settings: with the other word order every 32-bit value arrives with its
+// halves swapped (a position or rate out of range, a data number that does not exist). Says so,
+// naming the profile settings to check; other failures pass through unchanged.
+Status ExplainRefusedWrite(const Status& st, const RegisterProfile& profile) {
+  const bool refused =
+      (st.code() == StatusCode::kConfigurationError || st.code() == StatusCode::kDeviceError) &&
+      st.device_code() >= 2 && st.device_code() <= 4;
+  if (!refused) return st;
+  return Status(st.code(),
+                st.message() +
+                    ". The drive refused a write: this usually means the stage "
+                    "profile '" +
+                    profile.name +
+                    "' does not match the drive's settings. Check the profile's word_order (\"" +
+                    WordOrderName(profile.word_order) +
+                    "\") against the drive's word-order parameter, then its register addresses "
+                    "and the ramp values and unit (brdf-stage-check reads them from the drive)",
+                st.device_code());
+}
+
+}  // namespace
+
 AxisIo::AxisIo(Axis axis, AxisConfig config, const RegisterProfile& profile, ModbusBus& bus)
     : axis_(axis),
       config_(std::move(config)),
@@ -93,13 +122,16 @@ Status AxisIo::StartMove(double target_deg, const CallContext& ctx) const {
   if (trigger_in_block) put(profile_.trigger, profile_.trigger_value);
 
   Status st = bus_.WriteRegisters(config_.unit_id, span.start, std::move(block), ctx);
-  if (!st.ok()) return st.WithContext(name_ + ": writing the operation block");
+  if (!st.ok()) {
+    return ExplainRefusedWrite(st, profile_).WithContext(name_ + ": writing the operation block");
+  }
   if (trigger_in_block) return Status::Ok();
 
   std::vector<std::uint16_t> trigger(static_cast<std::size_t>(profile_.trigger.words), 0);
   EncodeField(profile_.trigger_value, profile_.trigger.words, profile_.word_order, trigger);
   st = bus_.WriteRegisters(config_.unit_id, profile_.trigger.address, std::move(trigger), ctx);
-  if (!st.ok()) return st.WithContext(name_ + ": writing the trigger");
+  if (!st.ok())
+    return ExplainRefusedWrite(st, profile_).WithContext(name_ + ": writing the trigger");
   return Status::Ok();
 }
 

@@ -105,6 +105,8 @@ class ModbusBus::Link {
   // One request with the bounded retry policy of the header.
   Status Execute(Job& job) {
     int timeouts = 0, busy = 0, garbled = 0, relinks = 0;
+    SteadyClock::time_point busy_since;
+    milliseconds busy_backoff = config_.busy_backoff;
     const std::string what = description_ + " " + job.What();
     while (true) {
       if (job.GivenUp() || stopping_) return GaveUp(job);
@@ -141,15 +143,22 @@ class ModbusBus::Link {
                       "); the drive does not accept this register or value: check the register "
                       "profile and the unit id",
                   ModbusExceptionCode(err)};
-        case ModbusFailure::kBusy:
-          if (++busy > config_.busy_retries) {
-            return DeviceError(ModbusExceptionCode(err),
-                               problem + " (exception 6) after " +
-                                   std::to_string(config_.busy_retries) +
-                                   " retries; the drive stays busy, try again later");
+        case ModbusFailure::kBusy: {
+          const auto now = SteadyClock::now();
+          if (busy++ == 0) busy_since = now;
+          if (now - busy_since >= config_.busy_window) {
+            const int code = ModbusExceptionCode(err);
+            return DeviceError(
+                code, problem + " (exception " + std::to_string(code) + ", " +
+                          std::to_string(busy) + " answers over " +
+                          std::to_string(config_.busy_window.count()) + " ms, the stage's " +
+                          "busy_window_ms); the drive stays busy or refuses to execute: check "
+                          "the drive's display or alarm log");
           }
-          if (!Sleep(config_.busy_backoff, job)) return GaveUp(job);
+          if (!Sleep(busy_backoff, job)) return GaveUp(job);
+          busy_backoff = std::min(busy_backoff * 2, config_.busy_backoff_max);
           continue;
+        }
         case ModbusFailure::kDeviceException:
           return DeviceError(ModbusExceptionCode(err),
                              problem + " (exception " + std::to_string(ModbusExceptionCode(err)) +
@@ -296,7 +305,10 @@ Status ValidateBus(int index, const BusConfig& c) {
   }
   if (c.response_timeout.count() <= 0) return fail("response_timeout", "must be positive");
   if (c.timeout_retries < 0) return fail("timeout_retries", "must be 0 or more");
-  if (c.busy_retries < 0) return fail("busy_retries", "must be 0 or more");
+  if (c.busy_window.count() < 0) return fail("busy_window", "must not be negative");
+  if (c.busy_backoff_max < c.busy_backoff) {
+    return fail("busy_backoff_max", "must not be shorter than busy_backoff");
+  }
   if (c.garbled_retries < 0) return fail("garbled_retries", "must be 0 or more");
   if (c.reconnect_attempts < 1) return fail("reconnect_attempts", "must be 1 or more");
   if (c.busy_backoff.count() < 0 || c.reconnect_backoff.count() < 0 || c.rtu_drain.count() < 0) {

@@ -10,7 +10,10 @@
 //  - the input is flushed before every request, and the response timeout is configurable
 //    (default 0.5 s); MODBUS_ERROR_RECOVERY_LINK is never used (it can loop for seconds);
 //  - exception 01/02/03 → kConfigurationError, no retry (the register map does not fit the drive);
-//  - exception 06 (busy) → retried busy_retries times with busy_backoff, then kDeviceError 6;
+//  - exception 04 (on an AZ: command execution disabled, e.g. while the drive is busy or just
+//    after a change of setting) and 06 (busy) → retried with a back-off that starts at
+//    busy_backoff and doubles up to busy_backoff_max, for busy_window in all, then kDeviceError
+//    with the exception code (a configuration mismatch is named by the caller, see axis_io.h);
 //  - other exceptions → kDeviceError with the exception code;
 //  - no reply (ETIMEDOUT) → retried timeout_retries times, then kTimeout;
 //  - a reply that does not belong to the request (TCP transaction-id mismatch, RTU CRC or slave
@@ -59,8 +62,10 @@ struct BusConfig {
   std::variant<TcpEndpoint, RtuEndpoint> endpoint = TcpEndpoint{};
   std::chrono::milliseconds response_timeout{500};
   int timeout_retries = 2;
-  int busy_retries = 5;
-  std::chrono::milliseconds busy_backoff{50};
+  // Exception 04/06: keep retrying for this long from the first such answer to a request.
+  std::chrono::milliseconds busy_window{3000};
+  std::chrono::milliseconds busy_backoff{50};       // first wait; doubles after each retry
+  std::chrono::milliseconds busy_backoff_max{500};  // longest wait between retries
   int garbled_retries = 2;
   int reconnect_attempts = 3;
   std::chrono::milliseconds reconnect_backoff{100};  // doubles after each failed attempt

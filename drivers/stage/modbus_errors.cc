@@ -21,6 +21,7 @@ ModbusFailure ClassifyModbusErrno(int err) {
     case MODBUS_EXCEPTION_ILLEGAL_DATA_ADDRESS:
     case MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE:
       return ModbusFailure::kIllegalRequest;
+    case MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE:  // the AZ answers 04 while it cannot execute
     case MODBUS_EXCEPTION_SLAVE_OR_SERVER_BUSY:
       return ModbusFailure::kBusy;
     default:

@@ -9,8 +9,8 @@ namespace brdf::drivers::stage {
 
 enum class ModbusFailure {
   kIllegalRequest,   // exception 01/02/03: the configured register map does not fit the drive
-  kBusy,             // exception 06: the drive is busy, retry later
-  kDeviceException,  // any other exception (04 device failure, 0A/0B gateway, ...)
+  kBusy,             // exception 04 (AZ: command execution disabled) or 06 (busy): retry later
+  kDeviceException,  // any other exception (05, 0A/0B gateway, ...)
   kTimeout,          // no reply within the response timeout
   kStaleOrGarbled,   // a reply that does not belong to the request: late reply, CRC, wrong slave
   kLinkDown,         // the connection or port is gone

@@ -170,7 +170,7 @@ RegisterProfile RegisterProfile::Leadshine() {
                              .moving = 0x0004,        // running
                              .in_position = 0x0020};  // path completed
   p.alarm_code = Field(0x2203, 1);
-  p.feedback_position = Field(0x602A, 2);
+  p.feedback_position = Field(0x602C, 2);  // current position (0x602A was read before issue 21)
   return p;
 }
 
@@ -202,7 +202,7 @@ RegisterProfile RegisterProfile::Moons() {
                              .moving = 0x0010,
                              .in_position = 0x0008};
   p.alarm_code = Field(0, 1);
-  p.feedback_position = Field(6, 2);  // encoder position
+  p.feedback_position = Field(4, 2);  // encoder position, 40005-40006 (6-7 is the commanded one)
   return p;
 }
 

@@ -221,12 +221,49 @@ TEST_P(ModbusStageTest, Exception06IsRetriedAndRecovers) {
   EXPECT_EQ(rig_.control().modbus().exception_count, 0);
   EXPECT_NEAR(SimDeg(2), -20, kTolerance);
 
-  // A drive that stays busy is reported after the bounded retries (5 by default).
-  rig_.control().set_modbus({.exception_code = 6, .exception_count = 50});
+  // A drive that stays busy is reported once the busy window (here 300 ms) has passed.
+  rig_.control().set_modbus({.exception_code = 6, .exception_count = 1000});
   auto state = rig_.stage().ReadAxis(Axis::kGamma, rig_.Ctx());
   EXPECT_EQ(state.status().code(), StatusCode::kDeviceError) << state.status().ToString();
   EXPECT_EQ(state.status().device_code(), 6);
-  EXPECT_EQ(rig_.control().modbus().exception_count, 50 - 6);
+  EXPECT_TRUE(Contains(state.status(), "busy_window_ms")) << state.status().message();
+  const int asked = 1000 - rig_.control().modbus().exception_count;
+  // 5, 10, 20, 40, 80, 160 ms of back-off fill the window: about 7 answers, not hundreds.
+  EXPECT_GE(asked, 4);
+  EXPECT_LE(asked, 12);
+}
+
+// Exception 04 (an AZ: command execution disabled) is waited out like a busy drive: a burst
+// shorter than the busy window costs nothing, a longer one is a kDeviceError 4 naming the window.
+TEST_P(ModbusStageTest, Exception04BurstsAreRetriedWithinTheBusyWindow) {
+  rig_.control().set_modbus({.exception_code = 4, .exception_count = 4});
+  MoveOk(To{.alpha = 25});
+  EXPECT_EQ(rig_.control().modbus().exception_count, 0);
+  EXPECT_NEAR(SimDeg(0), 25, kTolerance);
+
+  rig_.control().set_modbus({.exception_code = 4, .exception_count = 1000});
+  const Status st = rig_.stage().MoveTo(To{.alpha = 30}, rig_.Ctx());
+  EXPECT_EQ(st.code(), StatusCode::kDeviceError) << st.ToString();
+  EXPECT_EQ(st.device_code(), 4);
+  EXPECT_TRUE(Contains(st, "exception 4")) << st.message();
+  EXPECT_TRUE(Contains(st, "busy_window_ms")) << st.message();
+  rig_.control().set_modbus({});
+  EXPECT_NEAR(SimDeg(0), 25, kTolerance);  // the refused block moved nothing
+}
+
+// A drive set to lower word first: every 32-bit value the driver writes arrives with its halves
+// swapped, the drive refuses the block, and the error names the profile's word_order.
+TEST_P(ModbusStageTest, AWordOrderMismatchIsNamedInTheError) {
+  StageRig rig;
+  auto sim_config = DefaultSimConfig();
+  for (auto& axis : sim_config.axes) axis.word_order = sim::SimWordOrder::kLowFirst;
+  ASSERT_TRUE(rig.StartSim(std::move(sim_config)));
+  ASSERT_TRUE(rig.Connect(GetParam()));  // status reads answer, whatever the word order
+  const Status st = rig.stage().MoveTo(To{.alpha = 10}, rig.Ctx());
+  EXPECT_EQ(st.code(), StatusCode::kConfigurationError) << st.ToString();
+  EXPECT_TRUE(Contains(st, "word_order (\"high_first\")")) << st.message();
+  EXPECT_TRUE(Contains(st, "profile 'az'")) << st.message();
+  EXPECT_TRUE(Contains(st, "operation block")) << st.message();
 }
 
 TEST_P(ModbusStageTest, ALateReplyIsNeverTakenForTheNextAnswer) {

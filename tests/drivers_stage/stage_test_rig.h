@@ -54,6 +54,7 @@ class StageRig {
     bus.response_timeout = std::chrono::milliseconds(200);
     bus.reconnect_backoff = std::chrono::milliseconds(10);
     bus.busy_backoff = std::chrono::milliseconds(5);
+    bus.busy_window = std::chrono::milliseconds(300);
     bus.rtu_drain = std::chrono::milliseconds(200);
     return bus;
   }

@@ -51,7 +51,7 @@ const std::string kFaultPlan = PlanFixture("fault campaign")
 
 // brdfd's configuration for the campaign: the daemon tests' one WITHOUT their quality-10
 // override (darks must pass on the default policy), and a meter measurement timeout that a
-// silent meter uses up quickly.
+// silent meter uses up quickly, and a stage busy window of 1 s (exception 04/06 rows).
 std::string FaultConfigToml(const SimProcess& sim, const std::string& database) {
   std::string toml = DaemonConfigToml(sim, database);
   const std::string override_10 = "[meter.quality]\n\"10\" = \"accept_and_flag\"\n";
@@ -61,6 +61,10 @@ std::string FaultConfigToml(const SimProcess& sim, const std::string& database) 
   const std::string timeout = "measurement_timeout_ms = 3000";
   if (const auto at = toml.find(timeout); at != std::string::npos) {
     toml.replace(at, timeout.size(), "measurement_timeout_ms = 1500");
+  }
+  const std::string stage_timeout = "response_timeout_ms = 300\n";
+  if (const auto at = toml.find(stage_timeout); at != std::string::npos) {
+    toml.insert(at + stage_timeout.size(), "busy_window_ms = 1000\n");
   }
   return toml;
 }
@@ -293,6 +297,20 @@ const FaultCase kMatrix[] = {
        f.exception_count = 1000;
      }),
      ClearModbus, "busy", 6, nullptr, nullptr},
+    // Exception 04 (an AZ: command execution disabled) is waited out for [stage] busy_window_ms
+    // (1 s here): a burst shorter than that costs nothing, a longer one pauses naming it.
+    {"ModbusException04Burst", "exception 04 on the next three requests", Expect::kRecovers, 2,
+     Modbus([](auto& f) {
+       f.exception_code = 4;
+       f.exception_count = 3;
+     }),
+     nullptr, "", -1, ModbusConsumed, nullptr},
+    {"ModbusException04OutlastsTheBusyWindow", "exception 04 on every request", Expect::kPauses, 2,
+     Modbus([](auto& f) {
+       f.exception_code = 4;
+       f.exception_count = 1000;
+     }),
+     ClearModbus, "busy_window_ms", 4, nullptr, nullptr},
     {"ModbusLateReplies", "the next two replies come after the response timeout", Expect::kRecovers,
      2, Modbus([](auto& f) {
        f.late_reply_ms = 700;
