@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/export/grid_text.h"
 #include "core/export/merl_export.h"
 #include "core/export/regular_grid.h"
 #include "core/export/synthetic_session.h"
@@ -144,6 +145,17 @@ TEST(FillChain, PaperGridSessionLeavesNoHoleAboveTheHorizon) {
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r->nan_cells, 0u);
   EXPECT_EQ(grid_chain->Tally().asked(), grid->cells());
+
+  // The sidecar says how the grid was made: symmetry options, axis scales, the fill and its counts.
+  const std::string json = GridDescriptionJson(
+      *grid, derived->grid, GridExportInfo{1, "demo", Quantity::kBrdf, "octant", 2320, 0}, *r,
+      InterpolantInfo{true, true, {1, 1, 0.5}, grid_chain->Tally().Json()});
+  EXPECT_NE(json.find("\"mirror_phi\": true"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"reciprocity\": true"), std::string::npos);
+  EXPECT_NE(json.find("\"axis_scale\": [1, 1, 0.5]"), std::string::npos);
+  EXPECT_NE(json.find("\"fill\": {\"policy\": \"chain\""), std::string::npos);
+  EXPECT_NE(GridDescriptionJson(*grid, derived->grid, {}, *r).find("\"axis_scale\": null"),
+            std::string::npos);
 }
 
 }  // namespace
