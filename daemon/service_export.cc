@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/call_context.h"
+#include "core/export/fill_chain.h"
 #include "core/export/grid_text.h"
 #include "core/export/merl_export.h"
 #include "core/export/npy_writer.h"
@@ -320,8 +321,13 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
   exports::RunControl control;
   control.threads = 0;  // every hardware thread: the executor waits on devices, not the CPU
   control.progress = [&stream](double f) { stream.Progress("resampling", 0.05 + 0.95 * f); };
-  Result<exports::GridReport> r = exports::ResampleOnGrid(
-      exports::InterpolatorSource(*in->interpolator), *grid, bands, control, ctx, sink);
+  // Over the API the chosen method alone fills the grid (fill policy none; the chain is
+  // brdf-export's --fill until Data.Export carries the choice); the sidecar says so.
+  const exports::FillChain fill(
+      exports::FillPolicy::kNone,
+      {{exports::Provenance::kInterpolated, exports::InterpolatorSource(*in->interpolator)}});
+  Result<exports::GridReport> r =
+      exports::ResampleOnGrid(fill.Source(), *grid, bands, control, ctx, sink);
   if (!r.ok()) return r.status();
   report->set_summary(r->Summary());
   report->set_cells(r->cells);
@@ -338,7 +344,9 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
       report->add_shape(n);
     }
     report->add_shape(bands.count);
-    report->set_description_json(exports::GridDescriptionJson(*grid, bands, info, *r));
+    const exports::InterpolantInfo how{s.options.mirror_phi, s.options.reciprocity,
+                                       s.options.axis_scale, fill.Tally().Json()};
+    report->set_description_json(exports::GridDescriptionJson(*grid, bands, info, *r, how));
   }
   return Status();
 }

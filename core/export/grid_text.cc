@@ -120,7 +120,8 @@ Status CsvGridWriter::Finish(const GridReport& report) {
 }
 
 std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& bands,
-                                const GridExportInfo& info, const GridReport& report) {
+                                const GridExportInfo& info, const GridReport& report,
+                                const InterpolantInfo& how) {
   std::string j = "{\n";
   j += "  \"format\": \"brdfd regular grid (.npy, float64, C order)\",\n";
   j += "  \"axes\": [\"theta_i\", \"theta_o\", \"phi\", \"band\"],\n";
@@ -141,6 +142,18 @@ std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& b
   j += "  \"unit\": " + JsonString(QuantityUnit(info.quantity)) + ",\n";
   j += "  \"definition\": " + JsonString(QuantityDefinition(info.quantity)) + ",\n";
   j += "  \"method\": " + JsonString(info.method) + ",\n";
+  j += std::string("  \"mirror_phi\": ") + (how.mirror_phi ? "true" : "false") + ",\n";
+  j += std::string("  \"reciprocity\": ") + (how.reciprocity ? "true" : "false") + ",\n";
+  std::string scale = "null";
+  if (!how.axis_scale.empty()) {
+    scale = "[";
+    for (std::size_t k = 0; k < how.axis_scale.size(); ++k) {
+      scale += (k ? ", " : "") + FormatNumber(how.axis_scale[k]);
+    }
+    scale += "]";
+  }
+  j += "  \"axis_scale\": " + scale + ",\n";
+  if (!how.fill_json.empty()) j += "  \"fill\": " + how.fill_json + ",\n";
   j += "  \"samples\": " + std::to_string(info.samples) + ",\n";
   j += "  \"samples_left_out\": " + std::to_string(info.skipped) + ",\n";
   j += "  \"cells\": " + std::to_string(report.cells) + ",\n";

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "core/export/regular_grid.h"
 #include "core/export/session_data.h"
@@ -20,6 +21,14 @@ struct GridExportInfo {
   std::string method;       // the interpolation method ("octant", …)
   std::size_t samples = 0;  // sample readings the interpolator was built from
   std::size_t skipped = 0;  // sample readings left out
+};
+
+// How the interpolant was made, so that two grids made differently can be told apart.
+struct InterpolantInfo {
+  bool mirror_phi = false;
+  bool reciprocity = false;
+  std::vector<double> axis_scale;  // empty: all 1
+  std::string fill_json;           // the fill policy and its counts (FillTally::Json()); or empty
 };
 
 // A GridSink writing CSV: '#' comment lines documenting the quantity, unit, angles and axes, then
@@ -43,9 +52,12 @@ class CsvGridWriter : public GridSink {
 };
 
 // A JSON object describing an .npy grid export: shape and axis order, each axis (start, step,
-// count, in degrees), the wavelengths, quantity, unit, method, and the counts per status.
+// count, in degrees), the wavelengths, quantity, unit, method, symmetry options ("mirror_phi",
+// "reciprocity"), "axis_scale" (null: all 1), "fill" (policy and per-provenance counts), and the
+// counts per status.
 std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& bands,
-                                const GridExportInfo& info, const GridReport& report);
+                                const GridExportInfo& info, const GridReport& report,
+                                const InterpolantInfo& how = {});
 
 // Comment lines (without the leading "# ") shared by the text exports: the angle convention.
 std::vector<std::string> AngleConventionLines();

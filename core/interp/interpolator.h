@@ -37,7 +37,9 @@ struct Options {
   // Raw degrees make φ span twice θ's range; scaling changes which neighbours win.
   std::vector<double> axis_scale;
   // Symmetry augmentation, isotropic (3D) data only. Both off by default: the paper's method as
-  // published. mirror_phi adds (θi, θo, −φ) for every sample; reciprocity adds (θo, θi, φ).
+  // published. mirror_phi adds (θi, θo, −φ) and (θi, θo, 360° − φ) for every sample (both exact:
+  // the second fills the specular side, φ near 180°); reciprocity adds (θo, θi, φ) (and its
+  // mirror images when both are on).
   // Augmented copies keep the id of the sample they copy and rank after all measured samples.
   bool mirror_phi = false;
   bool reciprocity = false;

@@ -45,8 +45,7 @@ Status ValidateOptions(const Options& options, int dims) {
 }
 
 std::size_t ImageCount(const Options& options) {
-  return 1 + (options.mirror_phi ? 1 : 0) + (options.reciprocity ? 1 : 0) +
-         (options.mirror_phi && options.reciprocity ? 1 : 0);
+  return (options.mirror_phi ? 3 : 1) * (options.reciprocity ? 2 : 1);
 }
 
 Result<PointCloud> BuildPointCloud(const SampleSet& samples, const Options& options) {
@@ -76,24 +75,32 @@ Result<PointCloud> BuildPointCloudTail(const SampleSet& samples, const Options& 
   cloud.coords.reserve((n - first) * copies * d);
   cloud.sample.reserve((n - first) * copies);
 
-  // One block per image; swap: θi ↔ θo, mirror: φ → −φ (0 − φ, so that φ = 0 stays +0).
-  auto add_block = [&](bool swap, bool mirror) {
+  // One block per image; swap: θi ↔ θo; mirror: φ → −φ (0 − φ, so that φ = 0 stays +0), or
+  // φ → 360° − φ (the copy beyond 180° that fills the specular side).
+  enum class Phi { kSame, kNegated, kFromFullTurn };
+  auto add_block = [&](bool swap, Phi mirror) {
     for (std::size_t i = first; i < n; ++i) {
       const auto c = samples.coords(i);
       if (dims == 3) {
         cloud.coords.push_back(swap ? c[1] : c[0]);
         cloud.coords.push_back(swap ? c[0] : c[1]);
-        cloud.coords.push_back(mirror ? 0.0 - c[2] : c[2]);
+        cloud.coords.push_back(mirror == Phi::kNegated        ? 0.0 - c[2]
+                               : mirror == Phi::kFromFullTurn ? 360.0 - c[2]
+                                                              : c[2]);
       } else {
         cloud.coords.insert(cloud.coords.end(), c.begin(), c.end());
       }
       cloud.sample.push_back(static_cast<std::uint32_t>(i));
     }
   };
-  add_block(false, false);
-  if (options.mirror_phi) add_block(false, true);
-  if (options.reciprocity) add_block(true, false);
-  if (options.mirror_phi && options.reciprocity) add_block(true, true);
+  for (const bool swap : {false, true}) {
+    if (swap && !options.reciprocity) break;
+    add_block(swap, Phi::kSame);
+    if (options.mirror_phi) {
+      add_block(swap, Phi::kNegated);
+      add_block(swap, Phi::kFromFullTurn);
+    }
+  }
 
   cloud.scaled.resize(cloud.coords.size());
   for (std::size_t k = 0; k < cloud.coords.size(); ++k) {

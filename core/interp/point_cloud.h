@@ -21,10 +21,12 @@ Status ValidateOptions(const Options& options, int dims);
 
 // A point's rank is its position in the cloud: measured samples first, in SampleSet order
 // (rank i = sample i), then one block of copies per symmetry, each block in sample order:
-//   mirror_phi only:        (θi, θo, −φ)
+//   mirror_phi only:        (θi, θo, −φ), then (θi, θo, 360° − φ)
 //   reciprocity only:       (θo, θi, φ)
-//   both:                   (θi, θo, −φ), then (θo, θi, φ), then (θo, θi, −φ)
-// (the two symmetries generate a group of four images; all of them are exact for isotropic data).
+//   both:                   (θi, θo, −φ), (θi, θo, 360° − φ), then (θo, θi, φ), (θo, θi, −φ),
+//                           (θo, θi, 360° − φ)
+// (all of them are exact for isotropic data: φ and −φ are the same relative azimuth, and so are
+// −φ and 360° − φ; the copy beyond 180° is the one that encloses queries near the specular plane).
 // Rank is the tie-breaker: of two points at the same distance the lower rank wins, so a measured
 // sample always beats a copy. Copies that coincide with their original are kept: they can never
 // win.
@@ -86,7 +88,7 @@ inline double SquaredDistance(const double* a, const double* b, int dims) {
 // Errors: a SampleSet that is empty or not 3D/4D, and everything ValidateOptions rejects.
 Result<PointCloud> BuildPointCloud(const SampleSet& samples, const Options& options);
 
-// How many images of each sample the cloud holds (1 + one per symmetry copy): 1, 2 or 4.
+// How many images of each sample the cloud holds: 1, ×3 with mirror_phi, ×2 with reciprocity.
 std::size_t ImageCount(const Options& options);
 
 // The part of BuildPointCloud(samples, options) that samples [first, samples.size()) contribute,

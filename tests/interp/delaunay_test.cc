@@ -399,8 +399,10 @@ TEST(Delaunay, MirrorPhiExtendsTheHullToNegativeAzimuths) {
     }
   }
   EXPECT_TRUE(found);
-  // φ = 0 samples coincide with their mirror images: the measured one is kept, once.
-  EXPECT_EQ(interp->point_count(), 2 * pts.size() - 4);
+  // Three images per sample (φ, −φ, 360° − φ). The box's four φ = 0 corners coincide with their
+  // −φ images, and their 360° − φ images with the four φ = 360° corners, whose 360° − φ images
+  // coincide with the φ = 0 corners: 12 duplicates, the first (measured) of each kept once.
+  EXPECT_EQ(interp->point_count(), 3 * pts.size() - 12);
 }
 
 TEST(Delaunay, ReciprocityAddsSwappedCopies) {

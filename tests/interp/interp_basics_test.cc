@@ -93,11 +93,12 @@ TEST(PointCloudTest, CopiesRankAfterMeasuredSamples) {
   o.axis_scale = {1, 2, 0.5};
   const Result<PointCloud> cloud = BuildPointCloud(set, o);
   ASSERT_TRUE(cloud.ok());
-  ASSERT_EQ(cloud->size(), 8u);
-  const std::vector<std::vector<double>> expected = {{10, 20, 30},  {40, 50, 0},  {10, 20, -30},
-                                                     {40, 50, 0},   {20, 10, 30}, {50, 40, 0},
-                                                     {20, 10, -30}, {50, 40, 0}};
-  for (std::size_t r = 0; r < 8; ++r) {
+  // Images in blocks: measured, −φ, 360° − φ, then the same three swapped (θi ↔ θo).
+  ASSERT_EQ(cloud->size(), 12u);
+  const std::vector<std::vector<double>> expected = {
+      {10, 20, 30}, {40, 50, 0}, {10, 20, -30}, {40, 50, 0}, {10, 20, 330}, {40, 50, 360},
+      {20, 10, 30}, {50, 40, 0}, {20, 10, -30}, {50, 40, 0}, {20, 10, 330}, {50, 40, 360}};
+  for (std::size_t r = 0; r < 12; ++r) {
     const auto p = cloud->point(r);
     EXPECT_EQ(std::vector<double>(p.begin(), p.end()), expected[r]) << r;
     EXPECT_EQ(cloud->sample[r], r % 2);

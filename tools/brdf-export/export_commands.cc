@@ -3,10 +3,13 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <system_error>
 
 #include "core/analytic_brdf.h"
+#include "core/export/fill_chain.h"
 #include "core/export/grid_text.h"
 #include "core/export/merl_export.h"
 #include "core/export/merl_reader.h"
@@ -91,13 +94,59 @@ Result<std::vector<double>> ParseNumbers(const std::string& text, const char* wh
 struct Interpolation {
   exports::DerivedSamples derived;
   std::unique_ptr<interp::Interpolator> interpolator;
+  std::shared_ptr<const interp::SampleSet> interpolator_samples;
+  interp::Options options;
+  // The fill chain's other stages (fill_chain.h) and the chain itself.
+  std::unique_ptr<interp::Interpolator> fallback;  // Delaunay, unless the method is Delaunay
+  std::optional<fit::CookTorranceFit> model;
+  std::unique_ptr<exports::FillChain> chain;
+
+  exports::InterpolantInfo Info() const {
+    return {options.mirror_phi, options.reciprocity, options.axis_scale,
+            chain ? chain->Tally().Json() : std::string()};
+  }
 };
+
+// The fill chain over `in`'s interpolator: alone (kNone), or followed by Delaunay on the same
+// samples and options and by the Cook-Torrance model fitted to the samples (kChain).
+Status BuildFillChain(Interpolation& in, exports::FillPolicy policy, interp::Method method,
+                      std::ostream& err) {
+  std::vector<exports::FillChain::Stage> stages;
+  stages.push_back(
+      {exports::Provenance::kInterpolated, exports::InterpolatorSource(*in.interpolator)});
+  if (policy == exports::FillPolicy::kChain) {
+    if (method != interp::Method::kDelaunay) {
+      Result<std::unique_ptr<interp::Interpolator>> d =
+          interp::MakeInterpolator(interp::Method::kDelaunay, in.interpolator_samples, in.options);
+      if (!d.ok()) return d.status().WithContext("the fill chain's Delaunay fallback");
+      in.fallback = std::move(*d);
+      stages.push_back({exports::Provenance::kFallback, exports::InterpolatorSource(*in.fallback)});
+    }
+    fit::Observations data(in.derived.grid);
+    for (const exports::DerivedSample& s : in.derived.samples) {
+      if (Status st = data.Add(s.iso, s.values); !st.ok()) {
+        return st.WithContext("the fill chain's model, reading " + std::to_string(s.reading_id));
+      }
+    }
+    Result<fit::CookTorranceFit> model = fit::FitCookTorrance(data, {}, RunContext());
+    if (!model.ok()) return model.status().WithContext("the fill chain's model");
+    in.model = std::move(*model);
+    err << "brdf-export: fill chain: " << interp::MethodName(method)
+        << (in.fallback ? ", then delaunay" : "") << ", then Cook-Torrance (relative RMS "
+        << in.model->overall.relative_rms << " over " << data.size() << " readings)\n";
+    stages.push_back({exports::Provenance::kModel, exports::ModelSource(*in.model)});
+  }
+  in.chain = std::make_unique<exports::FillChain>(policy, std::move(stages));
+  return Status::Ok();
+}
 
 Result<Interpolation> BuildInterpolator(const exports::Session& session, exports::Quantity q,
                                         const CommonOptions& c, const InterpChoice& choice,
                                         std::ostream& err) {
   Result<interp::Method> method = interp::ParseMethod(choice.method);
   if (!method.ok()) return method.status();
+  Result<exports::FillPolicy> policy = exports::ParseFillPolicy(choice.fill);
+  if (!policy.ok()) return policy.status();
   interp::Options options;
   options.mirror_phi = choice.mirror_phi;
   options.reciprocity = choice.reciprocity;
@@ -122,7 +171,13 @@ Result<Interpolation> BuildInterpolator(const exports::Session& session, exports
     err << "brdf-export: " << derived->skipped.size()
         << " sample readings left out; the first: " << derived->skipped.front().reason << "\n";
   }
-  return Interpolation{std::move(*derived), std::move(*interpolator)};
+  Interpolation in;
+  in.derived = std::move(*derived);
+  in.interpolator = std::move(*interpolator);
+  in.interpolator_samples = *set;
+  in.options = options;
+  BRDF_RETURN_IF_ERROR(BuildFillChain(in, *policy, *method, err));
+  return in;
 }
 
 exports::RunControl Control(const CommonOptions& c, ProgressLine* line) {
@@ -207,18 +262,18 @@ int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
   exports::CsvGridWriter csv((*file)->stream(), info);
   exports::GridSink& sink = format == "npy" ? static_cast<exports::GridSink&>(npy) : csv;
   ProgressLine line(err, "brdf-export grid", StderrIsTerminal());
-  Result<exports::GridReport> report =
-      exports::ResampleOnGrid(exports::InterpolatorSource(*in->interpolator), *grid, bands,
-                              Control(c, c.quiet ? nullptr : &line), RunContext(), sink);
+  Result<exports::GridReport> report = exports::ResampleOnGrid(
+      in->chain->Source(), *grid, bands, Control(c, c.quiet ? nullptr : &line), RunContext(), sink);
   line.Finish();
   if (!report.ok()) return Fail(err, "grid", report.status());
   if (Status st = (*file)->Commit(); !st.ok()) return Fail(err, "grid", st);
   if (format == "npy") {
     Result<std::unique_ptr<OutputFile>> json = OutputFile::Open(c.output + ".json");
     if (!json.ok()) return Fail(err, "grid", json.status());
-    (*json)->stream() << exports::GridDescriptionJson(*grid, bands, info, *report);
+    (*json)->stream() << exports::GridDescriptionJson(*grid, bands, info, *report, in->Info());
     if (Status st = (*json)->Commit(); !st.ok()) return Fail(err, "grid", st);
   }
+  err << "brdf-export grid: fill " << in->chain->Tally().Summary() << "\n";
   err << "brdf-export grid: " << report->Summary() << " → " << c.output
       << (format == "npy" ? " (axes, wavelengths, units: " + c.output + ".json)" : "") << "\n";
   return kExitOk;
@@ -252,7 +307,7 @@ int RunMerl(const CommonOptions& c, const MerlOptions& o, std::ostream& out, std
   err << "brdf-export merl: 90 × 90 × 180 cells by " << o.interp.method << " on "
       << exports::ResolveThreads(c.threads) << " threads, linear sRGB under D65\n";
   ProgressLine line(err, "brdf-export merl", StderrIsTerminal());
-  const exports::SpectrumSource source = exports::InterpolatorSource(*in->interpolator);
+  const exports::SpectrumSource source = in->chain->Source();
   Result<exports::MerlExport> table = exports::BuildMerlTable(
       source, bands, *rgb, Control(c, c.quiet ? nullptr : &line), RunContext());
   line.Finish();
@@ -263,6 +318,7 @@ int RunMerl(const CommonOptions& c, const MerlOptions& o, std::ostream& out, std
     return Fail(err, "merl", st);
   }
   if (Status st = (*file)->Commit(); !st.ok()) return Fail(err, "merl", st);
+  err << "brdf-export merl: fill " << in->chain->Tally().Summary() << "\n";
   err << "brdf-export merl: " << table->report.Summary() << " → " << c.output << "\n";
 
   if (!probes.empty()) {

@@ -25,7 +25,13 @@ void AddInterpOptions(CLI::App& app, InterpChoice& c, bool reciprocity_by_defaul
       ->check(CLI::IsMember({"octant", "delaunay", "nearest"}))
       ->capture_default_str();
   app.add_option("--scale", c.scale, "per-axis multipliers a,b,c applied before distances");
-  app.add_flag("--mirror-phi", c.mirror_phi, "add the mirrored copies (θi, θo, −φ)");
+  app.add_flag("--mirror-phi", c.mirror_phi,
+               "add the mirrored copies (θi, θo, −φ) and (θi, θo, 360° − φ)");
+  app.add_option("--fill", c.fill,
+                 "cells the method cannot fill: none (left NaN / −1) or chain (Delaunay, then the "
+                 "fitted Cook-Torrance model)")
+      ->check(CLI::IsMember({"none", "chain"}))
+      ->capture_default_str();
   if (reciprocity_by_default) {
     // A MERL cell stands for a pair of directions and its swap alike (φd and φd + π share it):
     // the interpolator gets the swapped copies so that its answer is reciprocal too.

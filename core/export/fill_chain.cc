@@ -1,0 +1,163 @@
+#include "core/export/fill_chain.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+
+#include "core/fit/models.h"
+
+namespace brdf::exports {
+
+const char* FillPolicyName(FillPolicy p) {
+  return p == FillPolicy::kChain ? "chain" : "none";
+}
+
+Result<FillPolicy> ParseFillPolicy(const std::string& name) {
+  if (name == "none") return FillPolicy::kNone;
+  if (name == "chain") return FillPolicy::kChain;
+  return InvalidArgument("fill policy '" + name +
+                         "': use none (the chosen method alone, holes stay NaN / −1) or chain "
+                         "(the method, then Delaunay, then the fitted model)");
+}
+
+const char* ProvenanceName(Provenance p) {
+  switch (p) {
+    case Provenance::kInterpolated:
+      return "interpolated";
+    case Provenance::kFallback:
+      return "fallback";
+    case Provenance::kModel:
+      return "model";
+  }
+  return "?";
+}
+
+double FillTally::model_fraction() const {
+  const std::size_t n = asked();
+  return n == 0 ? 0.0 : static_cast<double>(model) / static_cast<double>(n);
+}
+
+std::string FillTally::Summary() const {
+  char percent[32];
+  std::snprintf(percent, sizeof percent, "%.3f %%", 100 * model_fraction());
+  return std::string(FillPolicyName(policy)) + ": " + std::to_string(interpolated) +
+         " interpolated, " + std::to_string(fallback) + " fallback, " + std::to_string(model) +
+         " model (" + percent + "), " + std::to_string(empty) + " empty";
+}
+
+std::string FillTally::Json() const {
+  char fraction[32];
+  std::snprintf(fraction, sizeof fraction, "%.6g", model_fraction());
+  return std::string("{\"policy\": \"") + FillPolicyName(policy) +
+         "\", \"interpolated\": " + std::to_string(interpolated) +
+         ", \"fallback\": " + std::to_string(fallback) + ", \"model\": " + std::to_string(model) +
+         ", \"empty\": " + std::to_string(empty) + ", \"model_fraction\": " + fraction + "}";
+}
+
+FillChain::FillChain(FillPolicy policy, std::vector<Stage> stages)
+    : policy_(policy), stages_(std::move(stages)), counters_(std::make_unique<Counters>()) {
+  if (policy_ == FillPolicy::kNone && stages_.size() > 1) {
+    stages_.erase(stages_.begin() + 1, stages_.end());
+  }
+}
+
+void FillChain::Count(std::size_t stage_or_empty, std::size_t n) const {
+  if (n == 0) return;
+  if (stage_or_empty >= stages_.size()) {
+    counters_->empty += n;
+    return;
+  }
+  switch (stages_[stage_or_empty].provenance) {
+    case Provenance::kInterpolated:
+      counters_->interpolated += n;
+      break;
+    case Provenance::kFallback:
+      counters_->fallback += n;
+      break;
+    case Provenance::kModel:
+      counters_->model += n;
+      break;
+  }
+}
+
+interp::InterpStatus FillChain::AnswerOne(const IsoDirection& at, std::span<double> out) const {
+  interp::InterpStatus first = interp::InterpStatus::kOutsideHull;
+  for (std::size_t s = 0; s < stages_.size(); ++s) {
+    const interp::InterpStatus st = stages_[s].source(at, out);
+    if (s == 0) first = st;
+    if (st == interp::InterpStatus::kOk) {
+      Count(s, 1);
+      return st;
+    }
+  }
+  Count(stages_.size(), 1);
+  return first;
+}
+
+void FillChain::AnswerMany(std::span<const double> directions,
+                           std::span<interp::InterpStatus> statuses,
+                           std::span<double> spectra) const {
+  const std::size_t n = statuses.size();
+  if (n == 0) return;
+  const std::size_t bands = spectra.size() / n;
+  stages_.front().source.Spectra(directions, statuses, spectra);
+  std::vector<std::size_t> missing;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (statuses[i] != interp::InterpStatus::kOk) missing.push_back(i);
+  }
+  Count(0, n - missing.size());
+  std::vector<double> dirs;
+  std::vector<interp::InterpStatus> sub_status;
+  std::vector<double> sub_spectra;
+  for (std::size_t s = 1; s < stages_.size() && !missing.empty(); ++s) {
+    dirs.clear();
+    for (std::size_t i : missing) {
+      dirs.insert(dirs.end(), directions.begin() + static_cast<std::ptrdiff_t>(3 * i),
+                  directions.begin() + static_cast<std::ptrdiff_t>(3 * i + 3));
+    }
+    sub_status.assign(missing.size(), interp::InterpStatus::kOk);
+    sub_spectra.assign(missing.size() * bands, 0.0);
+    stages_[s].source.Spectra(dirs, sub_status, sub_spectra);
+    std::vector<std::size_t> still;
+    for (std::size_t q = 0; q < missing.size(); ++q) {
+      const std::size_t i = missing[q];
+      if (sub_status[q] != interp::InterpStatus::kOk) {
+        still.push_back(i);
+        continue;
+      }
+      statuses[i] = interp::InterpStatus::kOk;
+      std::copy_n(sub_spectra.begin() + static_cast<std::ptrdiff_t>(q * bands), bands,
+                  spectra.begin() + static_cast<std::ptrdiff_t>(i * bands));
+    }
+    Count(s, missing.size() - still.size());
+    missing = std::move(still);
+  }
+  Count(stages_.size(), missing.size());  // rows stay NaN with the first stage's status
+}
+
+SpectrumSource FillChain::Source() const {
+  return SpectrumSource(
+      [this](const IsoDirection& at, std::span<double> out) { return AnswerOne(at, out); },
+      [this](std::span<const double> directions, std::span<interp::InterpStatus> statuses,
+             std::span<double> spectra) { AnswerMany(directions, statuses, spectra); });
+}
+
+FillTally FillChain::Tally() const {
+  FillTally t;
+  t.policy = policy_;
+  t.interpolated = counters_->interpolated.load();
+  t.fallback = counters_->fallback.load();
+  t.model = counters_->model.load();
+  t.empty = counters_->empty.load();
+  return t;
+}
+
+SpectrumSource ModelSource(const fit::CookTorranceFit& model) {
+  return [params = model.band](const IsoDirection& at, std::span<double> out) {
+    const std::size_t n = std::min(out.size(), params.size());
+    for (std::size_t b = 0; b < n; ++b) out[b] = fit::CookTorranceBrdf(at, params[b]);
+    return interp::InterpStatus::kOk;
+  };
+}
+
+}  // namespace brdf::exports
