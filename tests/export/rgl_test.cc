@@ -179,5 +179,35 @@ TEST(RglExport, ReaderGivesBackTheInterpolantOverTheMeasuredHemisphere) {
   EXPECT_LT(p95, 0.10);
 }
 
+TEST(RglExport, RgbFileIsTheSpectralFileThroughTheD65Weights) {
+  const Fixture& f = Paint();
+  RglOptions o;
+  o.theta_i_count = 8;
+  o.sample_res = 16;
+  Result<RglExport> spectral = Build(f, o);
+  o.rgb = testing::D65Weights(f.derived.grid);
+  Result<RglExport> rgb = Build(f, o);
+  ASSERT_TRUE(spectral.ok() && rgb.ok());
+  Result<std::map<std::string, RglTensor>> t = ParseTensorFile(Written(*rgb));
+  ASSERT_TRUE(t.ok());
+  EXPECT_EQ(t->count("spectra") + t->count("wavelengths"), 0u);
+  EXPECT_EQ(t->at("rgb").shape, (std::vector<std::uint64_t>{1, 8, 3, 16, 16}));
+  Result<RglMaterial> ms = RglMaterial::Parse(Written(*spectral));
+  Result<RglMaterial> mr = RglMaterial::Parse(Written(*rgb));
+  ASSERT_TRUE(ms.ok() && mr.ok());
+  EXPECT_TRUE(mr->rgb());
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int q = 0; q < 200; ++q) {
+    const Directions d{70 * u(rng), 360 * u(rng), 70 * u(rng), 360 * u(rng)};
+    const std::vector<double> s = ms->Brdf(d);
+    const Rgb expected = o.rgb->Apply(s);
+    const std::vector<double> c = mr->Brdf(d);
+    ASSERT_EQ(c.size(), 3u);
+    const double e[3] = {expected.r, expected.g, expected.b};
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], std::max(0.0, e[k]), 1e-4 + 1e-4 * e[k]) << q;
+  }
+}
+
 }  // namespace
 }  // namespace brdf::exports
