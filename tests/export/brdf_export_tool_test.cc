@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "core/export/merl_reader.h"
+#include "core/export/rgl_reader.h"
 #include "core/export/synthetic_session.h"
 #include "export_test_util.h"
 #include "storage/session_store.h"
@@ -199,6 +200,27 @@ TEST_F(BrdfExportTool, MerlFileReadsBackWhereTheToolLookedUp) {
     EXPECT_NEAR(file.g, std::stod(rows[i][6]), 0.15 * std::stod(rows[i][6]));
   }
   EXPECT_NE(r.err.find("below the horizon"), std::string::npos) << r.err;
+}
+
+TEST_F(BrdfExportTool, RglFilesSpectralAndRgbParse) {
+  ToolRun r = Exec(SessionArgs() + " rgl --theta-i 6 --resolution 12 -o " + File("paint.bsdf"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Result<RglMaterial> spectral = RglMaterial::Parse(ReadFile(File("paint.bsdf")));
+  ASSERT_TRUE(spectral.ok()) << spectral.status().ToString();
+  EXPECT_EQ(spectral->wavelengths().size(), 101u);
+  EXPECT_NE(r.err.find("retro-reflection readings"), std::string::npos) << r.err;
+  // A white-referenced paint: f at 30°/30° off-specular is a few tenths of sr⁻¹, not 0.
+  const std::vector<double> f = spectral->Brdf({30, 0, 30, 120});
+  EXPECT_GT(f[42], 0.05);
+  EXPECT_LT(f[42], 1.0);
+  r = Exec(SessionArgs() + " rgl --rgb --theta-i 6 --resolution 12 -o " + File("paint_rgb.bsdf"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Result<RglMaterial> rgb = RglMaterial::Parse(ReadFile(File("paint_rgb.bsdf")));
+  ASSERT_TRUE(rgb.ok()) << rgb.status().ToString();
+  EXPECT_TRUE(rgb->rgb());
+  r = Exec(SessionArgs() + " rgl -o -");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("-o PATH.bsdf"), std::string::npos) << r.err;
 }
 
 TEST_F(BrdfExportTool, FitReportsParametersAndResiduals) {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -17,9 +18,11 @@
 #include "core/export/number_text.h"
 #include "core/export/readings_csv.h"
 #include "core/export/regular_grid.h"
+#include "core/export/rgl_export.h"
 #include "core/export/synthetic_session.h"
 #include "core/fit/fit.h"
 #include "core/fit/fit_report.h"
+#include "core/fit/models.h"
 #include "data/cie_tables.h"
 #include "storage/session_readings.h"
 #include "tools/brdf-export/output_file.h"
@@ -343,6 +346,97 @@ int RunMerl(const CommonOptions& c, const MerlOptions& o, std::ostream& out, std
           << FormatNumber(merl.b) << "\n";
     }
   }
+  return kExitOk;
+}
+
+namespace {
+
+// Retro-reflection f(θ, θ, 0) of a Cook-Torrance fit (band means of kd, ks; shared α, F0): the
+// microfacet source when a session has no δ = 0 readings.
+Result<exports::RetroProfile> RetroFromFittedModel(const exports::DerivedSamples& derived) {
+  fit::Observations data(derived.grid);
+  for (const exports::DerivedSample& s : derived.samples) {
+    if (Status st = data.Add(s.iso, s.values); !st.ok()) {
+      return st.WithContext("reading " + std::to_string(s.reading_id));
+    }
+  }
+  Result<fit::CookTorranceFit> r = fit::FitCookTorrance(data, {}, RunContext());
+  if (!r.ok()) return r.status();
+  fit::CookTorranceParams mean = r->band.front();
+  mean.kd = mean.ks = 0;
+  for (const fit::CookTorranceParams& b : r->band) {
+    mean.kd += b.kd / static_cast<double>(r->band.size());
+    mean.ks += b.ks / static_cast<double>(r->band.size());
+  }
+  exports::RetroProfile p;
+  for (int t = 0; t <= 89; ++t) {
+    p.theta_deg.push_back(static_cast<double>(t));
+    const double theta = static_cast<double>(t);
+    p.value.push_back(fit::CookTorranceBrdf({theta, theta, 0}, mean));
+  }
+  p.origin = "the fitted Cook-Torrance (GGX) model, α = " + exports::FormatNumber(mean.alpha) +
+             " (power iteration on its retro-reflection)";
+  return p;
+}
+
+}  // namespace
+
+int RunRgl(const CommonOptions& c, const RglCommandOptions& o, std::ostream& err) {
+  if (c.output == "-") {
+    return Fail(err, "rgl", InvalidArgument("an RGL .bsdf needs a file: give -o PATH.bsdf"));
+  }
+  Result<exports::Session> session = LoadInput(c);
+  if (!session.ok()) return Fail(err, "rgl", session.status());
+  Result<Interpolation> in =
+      BuildInterpolator(*session, exports::Quantity::kBrdf, c, o.interp, err);
+  if (!in.ok()) return Fail(err, "rgl", in.status());
+  const WavelengthGrid bands = in->derived.grid;
+  exports::RglOptions options;
+  options.theta_i_count = o.theta_i_count;
+  options.sample_res = o.sample_res;
+  options.theta_i_max_deg = 0;
+  for (const exports::DerivedSample& s : in->derived.samples) {
+    options.theta_i_max_deg = std::max({options.theta_i_max_deg, s.iso.theta_i, s.iso.theta_o});
+  }
+  options.theta_i_max_deg = std::min(options.theta_i_max_deg, 89.0);
+  options.description = "brdfd session " + std::to_string(session->id) + " '" + session->name +
+                        "', BRDF by " + o.interp.method + (o.rgb ? ", linear sRGB (D65)" : "");
+  if (o.rgb) {
+    Result<data::CieTables> cie = data::LoadCieTables(o.colord_dir);
+    if (!cie.ok()) return Fail(err, "rgl", cie.status());
+    Result<exports::SpectralRgbWeights> rgb =
+        exports::SpectralRgbWeights::Make(bands, cie->d65, cie->cmf);
+    if (!rgb.ok()) return Fail(err, "rgl", rgb.status());
+    options.rgb = *rgb;
+  }
+  Result<exports::RetroProfile> retro = exports::RetroReflectionFromSamples(in->derived);
+  if (!retro.ok()) {
+    err << "brdf-export rgl: " << retro.status().message() << "; fitting Cook-Torrance (GGX)\n";
+    retro = RetroFromFittedModel(in->derived);
+    if (!retro.ok()) return Fail(err, "rgl", retro.status());
+  }
+  // Where the chosen method has no value, the nearest reading's (counted as fallback).
+  Result<std::shared_ptr<const interp::SampleSet>> set = exports::ToSampleSet(in->derived);
+  if (!set.ok()) return Fail(err, "rgl", set.status());
+  Result<std::unique_ptr<interp::Interpolator>> nearest =
+      interp::MakeInterpolator(interp::Method::kNearest, *set, {});
+  if (!nearest.ok()) return Fail(err, "rgl", nearest.status());
+
+  err << "brdf-export rgl: " << options.theta_i_count << " θi slices × " << options.sample_res
+      << "² nodes by " << o.interp.method << (o.rgb ? ", RGB" : ", spectral") << "\n";
+  ProgressLine line(err, "brdf-export rgl", StderrIsTerminal());
+  Result<exports::RglExport> table = exports::BuildRgl(
+      exports::InterpolatorSource(*in->interpolator), exports::InterpolatorSource(**nearest), bands,
+      *retro, options, Control(c, c.quiet ? nullptr : &line), RunContext());
+  line.Finish();
+  if (!table.ok()) return Fail(err, "rgl", table.status());
+  Result<std::unique_ptr<OutputFile>> file = OutputFile::Open(c.output);
+  if (!file.ok()) return Fail(err, "rgl", file.status());
+  if (Status st = exports::WriteRgl(table->fields, (*file)->stream()); !st.ok()) {
+    return Fail(err, "rgl", st);
+  }
+  if (Status st = (*file)->Commit(); !st.ok()) return Fail(err, "rgl", st);
+  err << "brdf-export rgl: " << table->report.Summary() << " → " << c.output << "\n";
   return kExitOk;
 }
 

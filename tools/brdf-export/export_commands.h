@@ -55,6 +55,14 @@ struct MerlOptions {
   std::vector<std::string> probes;  // "θi,φi,θo,φo": print interpolated and file RGB there
 };
 
+struct RglCommandOptions {
+  InterpChoice interp;
+  std::string colord_dir = "/usr/share/colord";
+  bool rgb = false;  // an RGB file (linear sRGB under D65) instead of the spectral one
+  std::size_t theta_i_count = 24;
+  std::size_t sample_res = 48;
+};
+
 struct FitCommandOptions {
   std::string model = "both";  // lambert, cook-torrance, both
   bool per_band = false;       // α and F0 per band instead of shared
@@ -65,6 +73,9 @@ int RunCsv(const CommonOptions& common, const CsvOptions& options, std::ostream&
 int RunGrid(const CommonOptions& common, const GridOptions& options, std::ostream& err);
 int RunMerl(const CommonOptions& common, const MerlOptions& options, std::ostream& out,
             std::ostream& err);
+// The RGL material (.bsdf, core/export/rgl_export.h): the microfacet distribution from the
+// session's retro-reflection readings, else from a fitted Cook-Torrance (GGX) model.
+int RunRgl(const CommonOptions& common, const RglCommandOptions& options, std::ostream& err);
 int RunFit(const CommonOptions& common, const FitCommandOptions& options, std::ostream& err);
 
 }  // namespace brdf::export_tool

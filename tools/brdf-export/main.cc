@@ -1,6 +1,7 @@
 // brdf-export: a session's readings out to the tools a lab already uses (README.md).
 //   brdf-export --db PATH --session N csv  [--quantity radiance|reflectance|brdf] -o OUT.csv
 //   brdf-export --db PATH --session N grid [--steps 1,1,1] [--nodes] [--method M] -o OUT.npy
+//   brdf-export --db PATH --session N rgl [--rgb] [--method M] -o OUT.bsdf
 //   brdf-export --db PATH --session N merl [--method M] [--probe θi,φi,θo,φo]… -o OUT.binary
 //   brdf-export --db PATH --session N fit  [--model lambert|cook-torrance|both] -o OUT.csv
 //   (--demo instead of --db/--session: a synthetic paint-like session on the paper's grid)
@@ -91,6 +92,17 @@ int main(int argc, char** argv) {
   merl_cmd->add_option("--probe", merl.probes,
                        "θi,φi,θo,φo: print the interpolated RGB and the file's RGB there");
 
+  RglCommandOptions rgl;
+  CLI::App* rgl_cmd = app.add_subcommand(
+      "rgl", "RGL material .bsdf (Dupuy & Jakob 2018; Mitsuba 3, pbrt-v4), spectral or --rgb");
+  AddInterpOptions(*rgl_cmd, rgl.interp, true);
+  rgl_cmd->add_flag("--rgb", rgl.rgb, "linear sRGB under D65 (field rgb) instead of spectra");
+  rgl_cmd->add_option("--colord", rgl.colord_dir, "where colord-data's CIE tables are (--rgb)")
+      ->capture_default_str();
+  rgl_cmd->add_option("--theta-i", rgl.theta_i_count, "θi slices")->capture_default_str();
+  rgl_cmd->add_option("--resolution", rgl.sample_res, "nodes per side of the warped square")
+      ->capture_default_str();
+
   FitCommandOptions fit;
   CLI::App* fit_cmd =
       app.add_subcommand("fit", "fit Lambert and Cook-Torrance (GGX) per wavelength; CSV report");
@@ -100,7 +112,7 @@ int main(int argc, char** argv) {
   fit_cmd->add_flag("--per-band", fit.per_band,
                     "fit the roughness α and F0 per band (default: shared by all bands)");
 
-  for (CLI::App* sub : {csv_cmd, grid_cmd, merl_cmd, fit_cmd}) sub->fallthrough();
+  for (CLI::App* sub : {csv_cmd, grid_cmd, merl_cmd, rgl_cmd, fit_cmd}) sub->fallthrough();
 
   try {
     app.parse(argc, argv);
@@ -111,5 +123,6 @@ int main(int argc, char** argv) {
   if (csv_cmd->parsed()) return RunCsv(common, csv, std::cerr);
   if (grid_cmd->parsed()) return RunGrid(common, grid, std::cerr);
   if (merl_cmd->parsed()) return RunMerl(common, merl, std::cout, std::cerr);
+  if (rgl_cmd->parsed()) return RunRgl(common, rgl, std::cerr);
   return RunFit(common, fit, std::cerr);
 }
