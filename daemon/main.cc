@@ -122,6 +122,11 @@ int main(int argc, char** argv) {
   SessionManager::Options manager_options;
   manager_options.rig_description = ToRigDescription(config);
   manager_options.white_reflectance = config.sample.white_reflectance;
+  manager_options.rig_name = RigName(config);
+  if (Status adopted = store->AdoptUnnamedSessions(manager_options.rig_name); !adopted.ok()) {
+    spdlog::critical("naming the rig of older sessions failed: {}", adopted.ToString());
+    return kExitFailure;
+  }
   SessionManager manager(store, std::shared_ptr<Rig>(std::move(*rig)), manager_options);
 
   Result<std::vector<SessionId>> recovered = manager.Recover();

@@ -116,8 +116,22 @@ CREATE TABLE audit (
 CREATE INDEX audit_by_session ON audit (session_id, id) WHERE session_id IS NOT NULL;
 )sql";
 
-constexpr std::array<Migration, 1> kMigrations{{
+// Version 2: global identity. Every session gets a random (version 4) UUID -- existing ones get
+// theirs here -- and the name of the rig that recorded it ('' until the daemon adopts them).
+constexpr std::string_view kV2 = R"sql(
+ALTER TABLE sessions ADD COLUMN uuid TEXT;
+ALTER TABLE sessions ADD COLUMN rig TEXT NOT NULL DEFAULT '';
+UPDATE sessions SET uuid =
+  lower(hex(randomblob(4))) || '-' || lower(hex(randomblob(2))) || '-4' ||
+  substr(lower(hex(randomblob(2))), 2) || '-' || substr('89ab', 1 + (abs(random()) % 4), 1) ||
+  substr(lower(hex(randomblob(2))), 2) || '-' || lower(hex(randomblob(6)))
+  WHERE uuid IS NULL;
+CREATE UNIQUE INDEX sessions_by_uuid ON sessions (uuid);
+)sql";
+
+constexpr std::array<Migration, 2> kMigrations{{
     {1, "create sessions, steps, readings, devices and audit", kV1},
+    {2, "give every session a UUID and its rig's name", kV2},
 }};
 
 std::string Hex(std::int64_t v) {

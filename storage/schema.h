@@ -1,9 +1,10 @@
 // The database schema and its migrations. The full description is in storage/schema.md; in short
-// (schema version 1):
+// (schema version 2):
 //
 //   sessions  id, name, plan_kind, plan_json (the plan as submitted), state, state_reason,
 //             created_at, started_at, finished_at, created_by_role, total_steps, done_steps
-//             (steps done or skipped), white_reflectance, meter_serial, config_json
+//             (steps done or skipped), white_reflectance, meter_serial, config_json, uuid (v2:
+//             global identity, unique), rig (v2: the recording rig's name)
 //   steps     (session_id, step_index) primary key; kind (move|prompt|reference|dark|sample),
 //             alpha beta gamma delta (degrees), prompt, prompt_kind, expected_action,
 //             target_theta_i target_phi_i target_theta_o target_phi_o (all or none), label,

@@ -7,13 +7,15 @@
 #include "storage/assign_or_return.h"
 #include "storage/schema.h"
 #include "storage/spectrum_blob.h"
+#include "storage/uuid.h"
 
 namespace brdf::storage {
 namespace {
 
 constexpr std::string_view kSessionColumns =
     "id, name, plan_kind, plan_json, state, state_reason, created_at, started_at, finished_at, "
-    "created_by_role, total_steps, done_steps, white_reflectance, meter_serial, config_json";
+    "created_by_role, total_steps, done_steps, white_reflectance, meter_serial, config_json, "
+    "uuid, rig";
 
 constexpr std::string_view kStepColumns =
     "session_id, step_index, kind, alpha, beta, gamma, delta, prompt, prompt_kind, "
@@ -66,6 +68,8 @@ Result<SessionRecord> ReadSession(const Statement& st, const std::string& path) 
   s.white_reflectance = st.OptionalDouble(12);
   s.meter_serial = st.Text(13);
   s.config_json = st.Text(14);
+  s.uuid = st.Text(15);
+  s.rig = st.Text(16);
   return s;
 }
 
@@ -289,8 +293,8 @@ Result<std::int64_t> SessionStore::CreateSession(const NewSession& session,
     BRDF_STORAGE_ASSIGN_OR_RETURN(
         Statement st,
         db.Prepare("INSERT INTO sessions (name, plan_kind, plan_json, state, created_at, "
-                   "created_by_role, total_steps, white_reflectance, meter_serial, config_json) "
-                   "VALUES (?, ?, ?, 'queued', ?, ?, ?, ?, ?, ?)"));
+                   "created_by_role, total_steps, white_reflectance, meter_serial, config_json, "
+                   "uuid, rig) VALUES (?, ?, ?, 'queued', ?, ?, ?, ?, ?, ?, ?, ?)"));
     st.Bind(1, session.name)
         .Bind(2, session.plan_kind)
         .Bind(3, session.plan_json)
@@ -299,7 +303,9 @@ Result<std::int64_t> SessionStore::CreateSession(const NewSession& session,
         .Bind(6, static_cast<std::int64_t>(steps.size()))
         .Bind(7, session.white_reflectance)
         .Bind(8, session.meter_serial)
-        .Bind(9, session.config_json);
+        .Bind(9, session.config_json)
+        .Bind(10, session.uuid.empty() ? NewUuid() : session.uuid)
+        .Bind(11, session.rig);
     BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
   }
   const std::int64_t id = db.last_insert_rowid();
@@ -388,6 +394,25 @@ Status SessionStore::SetSessionMeterSerial(std::int64_t session, const std::stri
   BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
   if (db.changes() == 0) return NotFound("no " + SessionName(session) + " in " + path_);
   return Status::Ok();
+}
+
+Status SessionStore::AdoptUnnamedSessions(const std::string& rig) {
+  MutexLock lock(write_mu_);
+  Database& db = *writer_;
+  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
+                                db.Prepare("UPDATE sessions SET rig = ? WHERE rig = ''"));
+  st.Bind(1, rig);
+  return st.Run().WithContext("naming the rig of sessions recorded before rig names");
+}
+
+Result<SessionRecord> SessionStore::GetSessionByUuid(const std::string& uuid) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(kSessionColumns) +
+                                                          " FROM sessions WHERE uuid = ?"));
+  st.Bind(1, uuid);
+  BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+  if (!row) return NotFound("no session with uuid " + uuid + " in " + path_);
+  return ReadSession(st, path_);
 }
 
 Result<SessionRecord> SessionStore::GetSession(std::int64_t session) {

@@ -95,6 +95,11 @@ class SessionStore {
   Status SetSessionMeterSerial(std::int64_t session, const std::string& meter_serial);
 
   Result<SessionRecord> GetSession(std::int64_t session);
+  // The session with this global id; kNotFound when there is none.
+  Result<SessionRecord> GetSessionByUuid(const std::string& uuid);
+  // Sessions recorded before rigs had names (rig '') become `rig`'s: the daemon calls it at start
+  // with its own name, since a database belongs to one rig.
+  Status AdoptUnnamedSessions(const std::string& rig);
   // All sessions, oldest first.
   Result<std::vector<SessionRecord>> ListSessions();
 
