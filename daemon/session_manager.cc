@@ -694,6 +694,11 @@ Result<std::shared_ptr<const SessionPlan>> SessionManager::Plan(SessionId sessio
 
 v1::RigStatus SessionManager::GetRigStatus() const {
   v1::RigStatus status = ToProto(rig_->GetStatus());
+  if (options_.archive_status) {
+    *status.mutable_archive() = options_.archive_status();
+  } else {
+    status.mutable_archive()->set_state(v1::ARCHIVE_STATE_OFF);
+  }
   MutexLock lock(impl_->mu);
   if (impl_->holder.has_value()) status.set_active_session_id(std::to_string(*impl_->holder));
   return status;

@@ -94,6 +94,8 @@ class SessionManager {
     double white_reflectance = 0.99;
     // The rig's name, stored with every session (config [rig] name, default the host name).
     std::string rig_name;
+    // GetRigStatus's archive part (ArchiveShipper::Snapshot); unset: shipping is off.
+    std::function<v1::ArchiveStatus()> archive_status;
     // Move to the next pose while the meter transfers the previous spectrum (DESIGN.md). Off only
     // for benchmarks comparing the two.
     bool pipelining = true;

@@ -129,9 +129,37 @@ UPDATE sessions SET uuid =
 CREATE UNIQUE INDEX sessions_by_uuid ON sessions (uuid);
 )sql";
 
-constexpr std::array<Migration, 2> kMigrations{{
+// Version 3: shipping to the lab archive. Triggers note every session and step change in an
+// outbox, in the same transaction as the change, while shipping is on (archive_marks 'enabled');
+// readings, devices and audit entries are shipped by id above their high-water mark.
+constexpr std::string_view kV3 = R"sql(
+CREATE TABLE archive_outbox (
+  seq        INTEGER PRIMARY KEY,
+  session_id INTEGER NOT NULL,
+  step_index INTEGER
+);
+CREATE TABLE archive_marks (
+  name  TEXT PRIMARY KEY,
+  value INTEGER NOT NULL
+) WITHOUT ROWID;
+INSERT INTO archive_marks (name, value)
+  VALUES ('enabled', 0), ('readings', 0), ('devices', 0), ('audit', 0);
+CREATE TRIGGER archive_session_created AFTER INSERT ON sessions
+  WHEN (SELECT value FROM archive_marks WHERE name = 'enabled') = 1
+  BEGIN INSERT INTO archive_outbox (session_id, step_index) VALUES (NEW.id, -1); END;
+CREATE TRIGGER archive_session_changed AFTER UPDATE ON sessions
+  WHEN (SELECT value FROM archive_marks WHERE name = 'enabled') = 1
+  BEGIN INSERT INTO archive_outbox (session_id, step_index) VALUES (NEW.id, NULL); END;
+CREATE TRIGGER archive_step_changed AFTER UPDATE ON steps
+  WHEN (SELECT value FROM archive_marks WHERE name = 'enabled') = 1
+  BEGIN INSERT INTO archive_outbox (session_id, step_index) VALUES (NEW.session_id, NEW.step_index);
+  END;
+)sql";
+
+constexpr std::array<Migration, 3> kMigrations{{
     {1, "create sessions, steps, readings, devices and audit", kV1},
     {2, "give every session a UUID and its rig's name", kV2},
+    {3, "keep an outbox and marks for shipping to the lab archive", kV3},
 }};
 
 std::string Hex(std::int64_t v) {
