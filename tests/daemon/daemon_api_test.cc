@@ -157,6 +157,11 @@ TEST_F(DaemonApiTest, SessionsHaveAUuidTheRigsNameAndTheSampleBlock) {
   EXPECT_EQ(list.sessions(1).uuid(), a->uuid());
   EXPECT_EQ(list.sessions(1).sample().material(), "paint");
   EXPECT_FALSE(list.sessions(1).has_plan());
+  // No [archive] configured: GetRigStatus says shipping is off.
+  v1::RigStatus status;
+  st = rig_.control().GetRigStatus(DaemonRig::Context().get(), {}, &status);
+  ASSERT_TRUE(st.ok()) << st.error_message();
+  EXPECT_EQ(status.archive().state(), v1::ARCHIVE_STATE_OFF);
 }
 
 TEST_F(DaemonApiTest, StartsWithoutDevicesAndReportsThemDisconnected) {
