@@ -1,5 +1,5 @@
 // The database schema and its migrations. The full description is in storage/schema.md; in short
-// (schema version 2):
+// (schema version 3):
 //
 //   sessions  id, name, plan_kind, plan_json (the plan as submitted), state, state_reason,
 //             created_at, started_at, finished_at, created_by_role, total_steps, done_steps
@@ -18,6 +18,9 @@
 //   devices   id, session_id (nullable), kind, model, serial, first_seen; unique per
 //             (session, kind, model, serial)
 //   audit     id, at, role, actor (a token's name, never the token), action, session_id, detail
+//   archive_outbox, archive_marks (v3): what the shipper to the lab archive has still to send
+//             (triggers note session and step changes while shipping is on; marks for readings,
+//             devices, audit)
 //
 // Timestamps are Unix seconds (REAL, UTC). Angles are degrees. Enumerations are lower-case words
 // guarded by CHECK constraints.
