@@ -8,6 +8,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <thread>
@@ -224,6 +225,38 @@ TEST_F(ArchiveShipperTest, TwoRigsThroughAnArchiveStoppedAndKilledEndExact) {
   EXPECT_EQ(*pg_->Psql("SELECT count(DISTINCT rig) FROM sessions"), "2");
   // Recording never waited for the archive (a commit with fsync is milliseconds; 500 is far).
   EXPECT_LT(slowest_ms.load(), 500.0);
+}
+
+// The archive cuts the shipper's connection again and again (pg_terminate_backend, as a flaky
+// network or an administrator would) while a session records: the archive still ends exact.
+TEST_F(ArchiveShipperTest, DroppedConnectionsMidShippingEndExact) {
+  auto store = OpenStore("rig-a.db");
+  auto shipper = StartShipper(store, "rig-a");
+  NewSession n = MakeNewSession();
+  n.rig = "rig-a";
+  Result<std::int64_t> id = store->CreateSession(n, MakeSteps(400));
+  ASSERT_TRUE(store->SetSessionState(*id, SessionState::kRunning, "").ok());
+  std::atomic<bool> done{false};
+  int cuts = 0;
+  std::thread cutter([&] {
+    while (!done) {
+      Result<std::string> killed = pg_->Psql(
+          "SELECT count(pg_terminate_backend(pid)) FROM pg_stat_activity "
+          "WHERE application_name = 'brdfd'");
+      if (killed.ok() && *killed != "0") ++cuts;
+      std::this_thread::sleep_for(30ms);
+    }
+  });
+  std::optional<std::int64_t> ref;
+  for (int i = 0; i < 400; ++i) {
+    ASSERT_TRUE(RecordStep(*store, *id, i, ref).ok());
+    std::this_thread::sleep_for(1ms);
+  }
+  done = true;
+  cutter.join();
+  EXPECT_GT(cuts, 3) << "the connection was hardly cut";
+  ASSERT_TRUE(WaitCaughtUp(*shipper)) << shipper->Snapshot().DebugString();
+  ExpectArchiveHoldsExactly(*store, "rig-a");
 }
 
 // A wrong password: the shipper says REFUSED (without the password), recording goes on; once the
