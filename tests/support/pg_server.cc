@@ -94,7 +94,9 @@ std::string PgServer::BinDir() {
 }
 
 std::string PgServer::Unavailable() {
-  if (BinDir().empty()) {
+  std::error_code ec;
+  const std::string bin = BinDir();
+  if (bin.empty() || !fs::exists(bin + "/initdb", ec) || !fs::exists(bin + "/postgres", ec)) {
     return "PostgreSQL server binaries not found (/usr/lib/postgresql/<version>/bin/initdb); "
            "run deploy/install-deps.sh (package postgresql-15) to run the archive tests";
   }
@@ -105,11 +107,13 @@ Result<std::unique_ptr<PgServer>> PgServer::Start() {
   std::unique_ptr<PgServer> s(new PgServer());
   s->bin_ = BinDir();
   if (s->bin_.empty()) return NotFound(Unavailable());
+  // As root the server runs as `nobody`, who must be able to reach the directory: /tmp then
+  // (world-searchable), not a TMPDIR that may be private to root. The unix socket's path must
+  // also stay short (sun_path is 108 bytes).
   const char* tmp = std::getenv("TMPDIR");
-  std::string pattern = std::string(tmp != nullptr && *tmp != '\0' && std::strlen(tmp) < 60
-                                        ? tmp
-                                        : "/tmp") +
-                        "/brdf-pg-XXXXXX";
+  const bool use_tmpdir =
+      ::geteuid() != 0 && tmp != nullptr && *tmp != '\0' && std::strlen(tmp) < 60;
+  std::string pattern = std::string(use_tmpdir ? tmp : "/tmp") + "/brdf-pg-XXXXXX";
   if (::mkdtemp(pattern.data()) == nullptr) return IoError("mkdtemp " + pattern + " failed");
   s->dir_ = pattern;
   if (::geteuid() == 0) {
