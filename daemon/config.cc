@@ -1,6 +1,7 @@
 #include "daemon/config.h"
 
 #include <toml++/toml.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
@@ -551,6 +552,21 @@ Result<Config> ParseConfig(std::string_view toml_text, std::string_view source) 
     t.Double("white_reflectance", c.sample.white_reflectance, 0, 1, /*lo_open=*/true);
     t.Finish();
   }
+  {
+    TableReader t(root.Table("rig"), "rig", issues);
+    t.String("name", c.rig.name);
+    t.Finish();
+  }
+  if (const toml::table* archive = root.Table("archive"); archive != nullptr) {
+    TableReader t(archive, "archive", issues);
+    if (!t.String("credentials", c.archive.credentials) && !t.Node("credentials")) {
+      issues.Add(archive->source(), "archive.credentials",
+                 "missing; give the path of a file holding the archive's libpq conninfo");
+    }
+    t.Int("batch_readings", c.archive.batch_readings, 1, 10000);
+    t.Int("retry_ms", c.archive.retry_ms, 10, 600000);
+    t.Finish();
+  }
   ReadAuth(root, c, issues);
   {
     TableReader t(root.Table("log"), "log", issues);
@@ -583,6 +599,13 @@ Result<Config> LoadConfig(const std::string& path) {
   std::fclose(f);
   if (failed) return IoError("config " + path + ": read error");
   return ParseConfig(text, path);
+}
+
+std::string RigName(const Config& config) {
+  if (!config.rig.name.empty()) return config.rig.name;
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) == 0 && host[0] != '\0') return host;
+  return "rig";
 }
 
 plan::RigDescription ToRigDescription(const Config& config) {

@@ -57,6 +57,15 @@
 //   [sample]
 //   white_reflectance = 0.99            # ρw of the white standard (the RS-3), in (0, 1]
 //
+//   [rig]
+//   name = "rig-a"                      # names the sessions this rig records (default: host name)
+//
+//   [archive]                           # optional: ship everything recorded to a lab PostgreSQL
+//   credentials = "/etc/brdfd/archive.conninfo"  # file holding a libpq conninfo (host, dbname,
+//                                       #   user, password, sslmode …); never put it in this file
+//   batch_readings = 200                # readings per archive transaction
+//   retry_ms = 2000                     # wait before reconnecting after a failure
+//
 //   [[auth.tokens]]                     # none: the API needs no token (bind to localhost!)
 //   name = "lab-pc"
 //   token = "at least 16 characters"
@@ -156,6 +165,18 @@ struct SampleConfig {
   double white_reflectance = 0.99;
 };
 
+struct RigConfig {
+  std::string name;  // empty: the host name (RigName)
+};
+
+// [archive]: present when `credentials` is not empty.
+struct ArchiveConfig {
+  std::string credentials;  // path of the file holding the libpq conninfo
+  int batch_readings = 200;
+  int retry_ms = 2000;
+  bool enabled() const { return !credentials.empty(); }
+};
+
 enum class Role { kOperator, kAnalyst };
 const char* RoleName(Role role);  // "operator", "analyst"
 
@@ -175,6 +196,8 @@ struct Config {
   MeterConfig meter;
   StageConfig stage;
   SampleConfig sample;
+  RigConfig rig;
+  ArchiveConfig archive;
   std::vector<TokenConfig> tokens;  // [[auth.tokens]]
   LogConfig log;
 };
@@ -192,6 +215,9 @@ Result<Config> ParseConfig(std::string_view toml_text, std::string_view source =
 
 // Reads and parses a file. kNotFound / kIoError when it cannot be read; else as ParseConfig.
 Result<Config> LoadConfig(const std::string& path);
+
+// [rig] name, else the host name ("rig" when even that is unknown).
+std::string RigName(const Config& config);
 
 // What core/plan needs to know about this rig: motorized axes, travel, speeds, the convention
 // (zero offsets and signs), and the meter's transfer time at the configured baud rate.

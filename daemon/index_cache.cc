@@ -4,6 +4,7 @@
 #include <optional>
 #include <utility>
 
+#include "core/plan/sample.h"
 #include "daemon/index_build.h"
 #include "daemon/index_samples.h"
 #include "daemon/session_plan.h"
@@ -219,16 +220,20 @@ Status IndexCache::Load(Entry& entry, SessionId session, std::uint64_t* read) {
   Result<storage::SessionRecord> record = store_->GetSession(session);
   if (!record.ok()) return record.status();
   bool anisotropic = false;
+  std::optional<Spectrum> white_spectrum;
   if (plans_) {
     Result<std::shared_ptr<const SessionPlan>> plan = plans_(session);
     if (!plan.ok()) return plan.status();
     anisotropic = (*plan)->plan.anisotropic();
+    white_spectrum = plan::WhiteReflectanceSpectrumOf((*plan)->plan);
   } else {
     Result<SessionPlan> plan = ParseSessionPlan(*record);
     if (!plan.ok()) return plan.status();
     anisotropic = plan->plan.anisotropic();
+    white_spectrum = plan::WhiteReflectanceSpectrumOf(plan->plan);
   }
-  IndexSamples samples(anisotropic, record->white_reflectance.value_or(kWhiteStandardReflectance));
+  IndexSamples samples(anisotropic, record->white_reflectance.value_or(kWhiteStandardReflectance),
+                       std::move(white_spectrum));
   std::int64_t through = 0;
   for (;;) {
     Result<std::vector<storage::ReadingRecord>> page =

@@ -8,8 +8,9 @@
 
 namespace brdf::daemon {
 
-IndexSamples::IndexSamples(bool anisotropic, double white_reflectance)
-    : anisotropic_(anisotropic), deriver_(white_reflectance) {}
+IndexSamples::IndexSamples(bool anisotropic, double white_reflectance,
+                           std::optional<Spectrum> white_spectrum)
+    : anisotropic_(anisotropic), deriver_(white_reflectance, std::move(white_spectrum)) {}
 
 bool IndexSamples::Fold(const storage::ReadingRecord& record) {
   if (record.id <= working_.through_id) return false;

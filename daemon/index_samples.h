@@ -37,8 +37,10 @@ class IndexSamples {
     std::int64_t through_id = 0;  // every reading with id ≤ this was folded
   };
 
-  // anisotropic: (θi, φi, θo, φo) coordinates, else (θi, θo, φ); ρw: the session's.
-  IndexSamples(bool anisotropic, double white_reflectance);
+  // anisotropic: (θi, φi, θo, φo) coordinates, else (θi, θo, φ); ρw (and ρw(λ) when the plan's
+  // sample block gives it): the session's.
+  IndexSamples(bool anisotropic, double white_reflectance,
+               std::optional<Spectrum> white_spectrum = std::nullopt);
 
   // Folds one reading, in the order they were taken. A reading at or before the last one folded
   // is ignored (the first load from the store and the commit events may both hand it over).

@@ -28,6 +28,7 @@
 #include <string>
 #include <thread>
 
+#include "daemon/archive_shipper.h"
 #include "daemon/auth.h"
 #include "daemon/config.h"
 #include "daemon/index_cache.h"
@@ -139,9 +140,39 @@ int main(int argc, char** argv) {
     return kExitConfiguration;
   }
 
+  // Shipping to the lab archive: its own thread, never in the executor's way (archive_shipper.h).
+  std::unique_ptr<ArchiveShipper> shipper;
+  if (config.archive.enabled()) {
+    ArchiveShipper::Options archive_options;
+    archive_options.credentials_path = config.archive.credentials;
+    archive_options.rig = RigName(config);
+    archive_options.batch_readings = config.archive.batch_readings;
+    archive_options.retry = std::chrono::milliseconds(config.archive.retry_ms);
+    Result<std::unique_ptr<ArchiveShipper>> started =
+        ArchiveShipper::Start(store, std::move(archive_options));
+    if (!started.ok()) {
+      spdlog::critical("cannot start shipping to the archive: {}", started.status().ToString());
+      return kExitFailure;
+    }
+    shipper = std::move(*started);
+    spdlog::info("shipping to the archive (credentials from {}) as rig \"{}\"",
+                 config.archive.credentials, RigName(config));
+  } else if (Status off = store->SetArchiveShipping(false); !off.ok()) {
+    spdlog::critical("cannot turn off the archive outbox: {}", off.ToString());
+    return kExitFailure;
+  }
+
   SessionManager::Options manager_options;
+  if (shipper != nullptr) {
+    manager_options.archive_status = [&shipper] { return shipper->Snapshot(); };
+  }
   manager_options.rig_description = ToRigDescription(config);
   manager_options.white_reflectance = config.sample.white_reflectance;
+  manager_options.rig_name = RigName(config);
+  if (Status adopted = store->AdoptUnnamedSessions(manager_options.rig_name); !adopted.ok()) {
+    spdlog::critical("naming the rig of older sessions failed: {}", adopted.ToString());
+    return kExitFailure;
+  }
   SessionManager manager(store, std::shared_ptr<Rig>(std::move(*rig)), manager_options);
 
   Result<std::vector<SessionId>> recovered = manager.Recover();
@@ -217,6 +248,7 @@ int main(int argc, char** argv) {
     }
   }
   stopper.join();
+  if (shipper != nullptr) shipper->Stop();
   spdlog::info("stopped");
   return kExitOk;
 }

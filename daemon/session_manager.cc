@@ -14,6 +14,7 @@
 #include "core/plan/plan_proto.h"
 #include "core/plan/plan_settings.h"
 #include "core/plan/plan_summary.h"
+#include "core/plan/sample.h"
 #include "core/plan/timing.h"
 #include "daemon/engine_steps.h"
 #include "daemon/executor.h"
@@ -271,6 +272,9 @@ struct SessionManager::Impl final : public ExecutorHost {
     const SessionPlan& plan = kept.ok() ? **kept : kNoPlan;
     const plan::PlanSettings& settings = plan.settings;
     if (with_plan) *s.mutable_plan() = plan.plan;
+    s.set_uuid(rec->uuid);
+    s.set_rig(rec->rig);
+    if (plan.plan.has_sample()) *s.mutable_sample() = plan.plan.sample();
 
     const std::vector<plan::Step> plan_steps = ToPlanSteps(*steps);
     *s.mutable_summary() = plan::ToProto(
@@ -545,7 +549,8 @@ Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor
   session.plan_kind = PlanKindWord(plan);
   session.plan_json = std::move(*json);
   session.created_by_role = actor.role;
-  session.white_reflectance = options_.white_reflectance;
+  session.white_reflectance = plan::WhiteReflectanceOf(plan).value_or(options_.white_reflectance);
+  session.rig = options_.rig_name;
   if (std::optional<drivers::MeterIdentity> id = rig_->meter_identity(); id.has_value()) {
     session.meter_serial = id->serial_number;
   }
@@ -706,6 +711,11 @@ Result<std::shared_ptr<const SessionPlan>> SessionManager::Plan(SessionId sessio
 v1::RigStatus SessionManager::GetRigStatus() const {
   rig_->RetryStageNow();  // the operator is looking: a stage that is back shows as back
   v1::RigStatus status = ToProto(rig_->GetStatus());
+  if (options_.archive_status) {
+    *status.mutable_archive() = options_.archive_status();
+  } else {
+    status.mutable_archive()->set_state(v1::ARCHIVE_STATE_OFF);
+  }
   MutexLock lock(impl_->mu);
   if (impl_->holder.has_value()) status.set_active_session_id(std::to_string(*impl_->holder));
   return status;

@@ -92,6 +92,10 @@ class SessionManager {
     plan::RigDescription rig_description;
     // White standard's reflectance stored with every session (ρw, the paper's 0.99).
     double white_reflectance = 0.99;
+    // The rig's name, stored with every session (config [rig] name, default the host name).
+    std::string rig_name;
+    // GetRigStatus's archive part (ArchiveShipper::Snapshot); unset: shipping is off.
+    std::function<v1::ArchiveStatus()> archive_status;
     // Move to the next pose while the meter transfers the previous spectrum (DESIGN.md). Off only
     // for benchmarks comparing the two.
     bool pipelining = true;

@@ -13,6 +13,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-grpcio python3-protobuf python3-serial
   python3-scipy python3-matplotlib colord-data
+  # the lab archive: libpq for brdfd and brdf-archive; the server and psql for its tests
+  libpq-dev postgresql-15 postgresql-client-15
 )
 if [[ "${1:-}" == "--with-extras" ]]; then
   packages+=(clang-14 libclang-rt-14-dev)

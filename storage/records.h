@@ -58,6 +58,8 @@ struct NewSession {
   std::optional<double> white_reflectance;  // ρw of the white standard (the paper's 0.99)
   std::string meter_serial;        // the spectroradiometer expected/used; may be filled later
   std::string config_json = "{}";  // anything else worth keeping (rig config, settings)
+  std::string uuid;  // global identity (lower-case v4 UUID); empty: the store makes one
+  std::string rig;   // the rig recording it ([rig] name)
 };
 
 struct SessionRecord {
@@ -76,6 +78,8 @@ struct SessionRecord {
   std::optional<double> white_reflectance;
   std::string meter_serial;
   std::string config_json;
+  std::string uuid;  // global identity: a random (version 4) UUID, lower-case with hyphens
+  std::string rig;   // the rig that recorded it; '' for sessions older than rig naming
 };
 
 // One planned step. Steps are numbered 0, 1, 2, … in execution order.

@@ -116,8 +116,50 @@ CREATE TABLE audit (
 CREATE INDEX audit_by_session ON audit (session_id, id) WHERE session_id IS NOT NULL;
 )sql";
 
-constexpr std::array<Migration, 1> kMigrations{{
+// Version 2: global identity. Every session gets a random (version 4) UUID -- existing ones get
+// theirs here -- and the name of the rig that recorded it ('' until the daemon adopts them).
+constexpr std::string_view kV2 = R"sql(
+ALTER TABLE sessions ADD COLUMN uuid TEXT;
+ALTER TABLE sessions ADD COLUMN rig TEXT NOT NULL DEFAULT '';
+UPDATE sessions SET uuid =
+  lower(hex(randomblob(4))) || '-' || lower(hex(randomblob(2))) || '-4' ||
+  substr(lower(hex(randomblob(2))), 2) || '-' || substr('89ab', 1 + (abs(random()) % 4), 1) ||
+  substr(lower(hex(randomblob(2))), 2) || '-' || lower(hex(randomblob(6)))
+  WHERE uuid IS NULL;
+CREATE UNIQUE INDEX sessions_by_uuid ON sessions (uuid);
+)sql";
+
+// Version 3: shipping to the lab archive. Triggers note every session and step change in an
+// outbox, in the same transaction as the change, while shipping is on (archive_marks 'enabled');
+// readings, devices and audit entries are shipped by id above their high-water mark.
+constexpr std::string_view kV3 = R"sql(
+CREATE TABLE archive_outbox (
+  seq        INTEGER PRIMARY KEY,
+  session_id INTEGER NOT NULL,
+  step_index INTEGER
+);
+CREATE TABLE archive_marks (
+  name  TEXT PRIMARY KEY,
+  value INTEGER NOT NULL
+) WITHOUT ROWID;
+INSERT INTO archive_marks (name, value)
+  VALUES ('enabled', 0), ('readings', 0), ('devices', 0), ('audit', 0);
+CREATE TRIGGER archive_session_created AFTER INSERT ON sessions
+  WHEN (SELECT value FROM archive_marks WHERE name = 'enabled') = 1
+  BEGIN INSERT INTO archive_outbox (session_id, step_index) VALUES (NEW.id, -1); END;
+CREATE TRIGGER archive_session_changed AFTER UPDATE ON sessions
+  WHEN (SELECT value FROM archive_marks WHERE name = 'enabled') = 1
+  BEGIN INSERT INTO archive_outbox (session_id, step_index) VALUES (NEW.id, NULL); END;
+CREATE TRIGGER archive_step_changed AFTER UPDATE ON steps
+  WHEN (SELECT value FROM archive_marks WHERE name = 'enabled') = 1
+  BEGIN INSERT INTO archive_outbox (session_id, step_index) VALUES (NEW.session_id, NEW.step_index);
+  END;
+)sql";
+
+constexpr std::array<Migration, 3> kMigrations{{
     {1, "create sessions, steps, readings, devices and audit", kV1},
+    {2, "give every session a UUID and its rig's name", kV2},
+    {3, "keep an outbox and marks for shipping to the lab archive", kV3},
 }};
 
 std::string Hex(std::int64_t v) {

@@ -1,9 +1,10 @@
 // The database schema and its migrations. The full description is in storage/schema.md; in short
-// (schema version 1):
+// (schema version 3):
 //
 //   sessions  id, name, plan_kind, plan_json (the plan as submitted), state, state_reason,
 //             created_at, started_at, finished_at, created_by_role, total_steps, done_steps
-//             (steps done or skipped), white_reflectance, meter_serial, config_json
+//             (steps done or skipped), white_reflectance, meter_serial, config_json, uuid (v2:
+//             global identity, unique), rig (v2: the recording rig's name)
 //   steps     (session_id, step_index) primary key; kind (move|prompt|reference|dark|sample),
 //             alpha beta gamma delta (degrees), prompt, prompt_kind, expected_action,
 //             target_theta_i target_phi_i target_theta_o target_phi_o (all or none), label,
@@ -17,6 +18,9 @@
 //   devices   id, session_id (nullable), kind, model, serial, first_seen; unique per
 //             (session, kind, model, serial)
 //   audit     id, at, role, actor (a token's name, never the token), action, session_id, detail
+//   archive_outbox, archive_marks (v3): what the shipper to the lab archive has still to send
+//             (triggers note session and step changes while shipping is on; marks for readings,
+//             devices, audit)
 //
 // Timestamps are Unix seconds (REAL, UTC). Angles are degrees. Enumerations are lower-case words
 // guarded by CHECK constraints.

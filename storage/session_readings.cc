@@ -1,5 +1,8 @@
 #include "storage/session_readings.h"
 
+#include "core/plan/plan_json.h"
+#include "core/plan/sample.h"
+
 namespace brdf::storage {
 
 Reading ToReading(const ReadingRecord& r) {
@@ -30,6 +33,12 @@ Result<SessionReadings> LoadSessionReadings(SessionStore& store, std::int64_t se
   session.id = record->id;
   session.name = record->name;
   session.white_reflectance = record->white_reflectance;
+  if (Result<v1::Plan> plan = plan::ParsePlanJson(record->plan_json); plan.ok()) {
+    session.white_reflectance_spectrum = plan::WhiteReflectanceSpectrumOf(*plan);
+  } else {
+    return Internal("session " + std::to_string(session_id) +
+                    ": its stored plan does not parse: " + plan.status().message());
+  }
   BRDF_RETURN_IF_ERROR(store.ForEachReading(session_id, [&](const ReadingRecord& r) {
     session.readings.push_back(ToReading(r));
     return Status::Ok();

@@ -31,6 +31,7 @@
 #include "core/status.h"
 #include "storage/reader_pool.h"
 #include "storage/records.h"
+#include "storage/ship_batch.h"
 #include "storage/sqlite.h"
 
 namespace brdf::storage {
@@ -96,6 +97,11 @@ class SessionStore {
   Status SetSessionMeterSerial(std::int64_t session, const std::string& meter_serial);
 
   Result<SessionRecord> GetSession(std::int64_t session);
+  // The session with this global id; kNotFound when there is none.
+  Result<SessionRecord> GetSessionByUuid(const std::string& uuid);
+  // Sessions recorded before rigs had names (rig '') become `rig`'s: the daemon calls it at start
+  // with its own name, since a database belongs to one rig.
+  Status AdoptUnnamedSessions(const std::string& rig);
   // All sessions, oldest first.
   Result<std::vector<SessionRecord>> ListSessions();
 
@@ -152,6 +158,20 @@ class SessionStore {
   Status AppendAudit(const AuditRecord& entry);
   // The newest `limit` (> 0) entries, newest first; of one session, or of all when nullopt.
   Result<std::vector<AuditRecord>> GetAudit(std::optional<std::int64_t> session, int limit);
+
+  // --- Shipping to the lab archive (session_store_archive.cc, archive-schema.md) -------------
+
+  // Turns the outbox on or off. Turning it on when it was off queues every session (and all its
+  // steps) again, since changes made while it was off were not noted; off clears it.
+  Status SetArchiveShipping(bool enabled);
+  // The next batch: up to `max_changes` outbox entries, and -- only when the outbox is drained in
+  // the same snapshot, so that every session and step a row refers to is shipped before it --
+  // up to `max_readings` readings, and the devices and audit entries above their marks.
+  Result<ShipBatch> NextShipBatch(int max_readings, int max_changes);
+  // After the archive committed `batch`: moves the marks and drops the outbox entries it covered,
+  // in one transaction.
+  Status MarkShipped(const ShipBatch& batch);
+  Result<ShipLag> ShippingLag();
 
   // --- Checking ---------------------------------------------------------------------------------
 

@@ -16,7 +16,7 @@ Result<DerivedSamples> DeriveSamples(const Session& session, Quantity quantity,
                            ": white reflectance ρw = " + std::to_string(white) +
                            " is not a positive number; fix the session's white_reflectance");
   }
-  ReadingDeriver deriver(white);
+  ReadingDeriver deriver(white, session.white_reflectance_spectrum);
   DerivedSamples out;
   out.quantity = quantity;
   out.white_reflectance = white;

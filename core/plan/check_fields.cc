@@ -7,6 +7,7 @@
 #include "core/geometry.h"
 #include "core/plan/angle_text.h"
 #include "core/plan/plan_settings.h"
+#include "core/plan/sample.h"
 
 namespace brdf::plan {
 namespace {
@@ -428,6 +429,7 @@ void CheckPlanFields(const v1::Plan& plan, const RigDescription& rig, ProblemSin
   check.Reference(plan.reference());
   check.Measurement(plan.measurement());
   check.Retry(plan.retry());
+  if (plan.has_sample()) CheckSample(plan.sample(), sink);
 }
 
 }  // namespace brdf::plan

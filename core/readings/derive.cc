@@ -27,7 +27,8 @@ void Fail(SampleQuantities& out, Quantity q, const std::string& why) {
 
 }  // namespace
 
-ReadingDeriver::ReadingDeriver(double white_reflectance) : white_reflectance_(white_reflectance) {}
+ReadingDeriver::ReadingDeriver(double white_reflectance, std::optional<Spectrum> white_spectrum)
+    : white_reflectance_(white_reflectance), white_spectrum_(std::move(white_spectrum)) {}
 
 std::optional<SampleQuantities> ReadingDeriver::Fold(const Reading& reading) {
   switch (reading.kind) {
@@ -55,7 +56,19 @@ SampleQuantities ReadingDeriver::Derive(const Reading& r) {
     FailAll(out, valid.message());
     return out;
   }
-  if (!grid_.has_value()) grid_ = r.spectrum.grid;
+  if (!grid_.has_value()) {
+    grid_ = r.spectrum.grid;
+    if (white_spectrum_.has_value()) {
+      Result<Spectrum> on_grid = Resample(*white_spectrum_, *grid_);
+      if (!on_grid.ok()) {
+        on_grid = InvalidArgument(
+            "the white standard's ρw spectrum (" + std::to_string(white_spectrum_->grid.start_nm) +
+            "–" + std::to_string(white_spectrum_->grid.last_nm()) +
+            " nm) does not cover the session's grid: " + on_grid.status().message());
+      }
+      white_on_grid_ = std::move(on_grid);
+    }
+  }
   if (!(r.spectrum.grid == *grid_)) {
     FailAll(out, Name(r) + ": its wavelength grid differs from the session's first sample reading");
     return out;
@@ -109,8 +122,16 @@ SampleQuantities ReadingDeriver::Derive(const Reading& r) {
     Fail(out, Quantity::kBrdf, Name(r) + ": " + reflectance.status().message());
     return out;
   }
+  if (white_on_grid_.has_value() && !white_on_grid_->ok()) {
+    Fail(out, Quantity::kBrdf, Name(r) + ": " + white_on_grid_->status().message());
+    out.values[static_cast<int>(Quantity::kReflectance)] = std::move(reflectance->values);
+    return out;
+  }
   Result<Spectrum> brdf =
-      BrdfFromReflectance(*reflectance, white_reflectance_, ref->theta_i, r.directions.theta_i);
+      white_on_grid_.has_value()
+          ? BrdfFromReflectance(*reflectance, **white_on_grid_, ref->theta_i, r.directions.theta_i)
+          : BrdfFromReflectance(*reflectance, white_reflectance_, ref->theta_i,
+                                r.directions.theta_i);
   out.values[static_cast<int>(Quantity::kReflectance)] = std::move(reflectance->values);
   if (!brdf.ok()) {
     Fail(out, Quantity::kBrdf, Name(r) + ": " + brdf.status().message());

@@ -43,8 +43,12 @@ struct SampleQuantities {
 // names an earlier reference and dark). Not thread-safe: one owner.
 class ReadingDeriver {
  public:
-  // ρw: the session's white reflectance (WhiteReflectanceOf).
-  explicit ReadingDeriver(double white_reflectance);
+  // ρw: the session's white reflectance (WhiteReflectanceOf). white_spectrum: ρw(λ) from the
+  // white standard's certificate (a plan's sample block); when given it replaces the number in
+  // the BRDF, linearly interpolated onto the session's grid (a grid reaching outside it gives no
+  // BRDF, with the reason).
+  explicit ReadingDeriver(double white_reflectance,
+                          std::optional<Spectrum> white_spectrum = std::nullopt);
 
   // Takes the next reading. A reference or dark is kept for the samples that name it (nullopt);
   // a sample comes back with its quantities.
@@ -63,6 +67,9 @@ class ReadingDeriver {
   SampleQuantities Derive(const Reading& sample);
 
   double white_reflectance_;
+  std::optional<Spectrum> white_spectrum_;
+  // white_spectrum_ on the session's grid, or why it cannot be (made with the first sample).
+  std::optional<Result<Spectrum>> white_on_grid_;
   std::optional<WavelengthGrid> grid_;
   std::unordered_map<std::int64_t, Reference> references_;
   std::unordered_map<std::int64_t, Spectrum> darks_;

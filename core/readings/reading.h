@@ -38,6 +38,8 @@ struct SessionReadings {
   std::string name;
   // ρw of the white standard; nullopt: the paper's RS-3, kWhiteStandardReflectance (0.99).
   std::optional<double> white_reflectance;
+  // ρw(λ) from the plan's sample block; when set the BRDF uses it instead of the number.
+  std::optional<Spectrum> white_reflectance_spectrum;
   std::vector<Reading> readings;  // in id order (the order they were taken)
 };
 

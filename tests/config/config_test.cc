@@ -47,6 +47,30 @@ TEST(ConfigTest, EmptyFileGivesTheDefaults) {
   EXPECT_EQ(c.log.level, "info");
 }
 
+// [rig] names the sessions (default: the host name); [archive] ships them to the lab's PostgreSQL
+// and needs a credentials file, never a conninfo in the configuration itself.
+TEST(ConfigTest, RigNameAndArchive) {
+  const Result<Config> none = ParseConfig("", "empty.toml");
+  ASSERT_TRUE(none.ok());
+  EXPECT_FALSE(none->archive.enabled());
+  EXPECT_FALSE(RigName(*none).empty());
+  const Result<Config> r = ParseConfig(
+      "[rig]\nname = \"rig-a\"\n[archive]\ncredentials = \"/etc/brdfd/archive.conninfo\"\n"
+      "batch_readings = 50\nretry_ms = 500\n",
+      "lab.toml");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(RigName(*r), "rig-a");
+  EXPECT_TRUE(r->archive.enabled());
+  EXPECT_EQ(r->archive.credentials, "/etc/brdfd/archive.conninfo");
+  EXPECT_EQ(r->archive.batch_readings, 50);
+  EXPECT_EQ(r->archive.retry_ms, 500);
+  EXPECT_THAT(Refusal("[archive]\nretry_ms = 500\n"), HasSubstr("archive.credentials: missing"));
+  EXPECT_THAT(Refusal("[archive]\ncredentials = \"f\"\nconninfo = \"host=x password=y\"\n"),
+              HasSubstr("archive.conninfo"));
+  EXPECT_THAT(Refusal("[archive]\ncredentials = \"f\"\nbatch_readings = 0\n"),
+              HasSubstr("archive.batch_readings"));
+}
+
 TEST(ConfigTest, FullFile) {
   const Result<Config> r = ParseConfig(R"(
 [server]

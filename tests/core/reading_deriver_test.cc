@@ -68,5 +68,34 @@ TEST(ReadingDeriver, WhatCannotBeComputedSaysWhy) {
             std::string::npos);
 }
 
+// A white standard's certificate gives ρw(λ): the BRDF uses it band by band, interpolated onto
+// the session's grid, instead of the one number.
+TEST(ReadingDeriver, WhiteReflectanceSpectrumReplacesTheNumber) {
+  const Spectrum white{WavelengthGrid{400, 200, 3}, {0.90, 0.94, 0.98}};  // 400, 600, 800 nm
+  ReadingDeriver deriver(0.5, white);
+  deriver.Fold(Make(1, ReadingKind::kReference, {0, 0, 30, 180}, {2.0, 2.0}));
+  Reading sample = Make(2, ReadingKind::kSample, {0, 0, 20, 90}, {1.0, 1.0});
+  sample.reference_id = 1;
+  std::optional<SampleQuantities> q = deriver.Fold(sample);
+  ASSERT_TRUE(q.has_value() && q->has(Quantity::kBrdf)) << q->reason(Quantity::kBrdf);
+  // kGrid is 500 and 600 nm: ρw 0.92 and 0.94; R = 0.5; equal incidence.
+  EXPECT_NEAR(q->of(Quantity::kBrdf)[0], 0.5 * 0.92 / std::numbers::pi, 1e-15);
+  EXPECT_NEAR(q->of(Quantity::kBrdf)[1], 0.5 * 0.94 / std::numbers::pi, 1e-15);
+  EXPECT_DOUBLE_EQ(q->of(Quantity::kReflectance)[0], 0.5);
+}
+
+TEST(ReadingDeriver, WhiteSpectrumNotCoveringTheGridGivesNoBrdfAndSaysWhy) {
+  ReadingDeriver deriver(0.99, Spectrum{WavelengthGrid{520, 10, 3}, {0.9, 0.9, 0.9}});
+  deriver.Fold(Make(1, ReadingKind::kReference, {0, 0, 30, 180}, {2.0, 2.0}));
+  Reading sample = Make(2, ReadingKind::kSample, {0, 0, 20, 90}, {1.0, 1.0});
+  sample.reference_id = 1;
+  std::optional<SampleQuantities> q = deriver.Fold(sample);
+  ASSERT_TRUE(q.has_value());
+  EXPECT_TRUE(q->has(Quantity::kReflectance));
+  EXPECT_FALSE(q->has(Quantity::kBrdf));
+  EXPECT_NE(q->reason(Quantity::kBrdf).find("ρw spectrum"), std::string::npos)
+      << q->reason(Quantity::kBrdf);
+}
+
 }  // namespace
 }  // namespace brdf

@@ -5,6 +5,7 @@
 #include <grpcpp/generic/generic_stub.h>
 #include <gtest/gtest.h>
 #include <sched.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -128,6 +129,39 @@ Result<std::string> ReflectionListServices(grpc::Channel& channel) {
   std::string text;
   for (const auto& s : slices) text.append(reinterpret_cast<const char*>(s.begin()), s.size());
   return text;
+}
+
+// Global identity and the catalogue: a submitted session has a v4 UUID, names its rig (the host
+// name when [rig] name is not configured) and carries its plan's sample block, in GetSession and
+// in ListSessions (where the plan itself is left out).
+TEST_F(DaemonApiTest, SessionsHaveAUuidTheRigsNameAndTheSampleBlock) {
+  const std::string plan = R"({"name": "gloss", "poseList": {"poses": [{"alpha": 10, "beta": 0,
+    "delta": 40}]}, "sample": {"id": "P-0042", "name": "red gloss", "material": "paint",
+    "tags": ["glossy", "red"], "whiteStandardId": "RS-3 #1187", "whiteReflectance": 0.97}})";
+  Result<v1::Session> a = rig_.Submit(plan, /*start_now=*/false);
+  Result<v1::Session> b = rig_.Submit(plan, /*start_now=*/false);
+  ASSERT_TRUE(a.ok() && b.ok()) << a.status().ToString();
+  char host[256] = {};
+  ASSERT_EQ(gethostname(host, sizeof host - 1), 0);
+  EXPECT_EQ(a->uuid().size(), 36u) << a->uuid();
+  EXPECT_EQ(a->uuid()[14], '4') << a->uuid();
+  EXPECT_NE(a->uuid(), b->uuid());
+  EXPECT_EQ(a->rig(), host);
+  EXPECT_EQ(a->sample().id(), "P-0042");
+  EXPECT_EQ(a->sample().tags_size(), 2);
+  v1::ListSessionsRequest request;
+  v1::ListSessionsResponse list;
+  grpc::Status st = rig_.control().ListSessions(DaemonRig::Context().get(), request, &list);
+  ASSERT_TRUE(st.ok()) << st.error_message();
+  ASSERT_EQ(list.sessions_size(), 2);
+  EXPECT_EQ(list.sessions(1).uuid(), a->uuid());
+  EXPECT_EQ(list.sessions(1).sample().material(), "paint");
+  EXPECT_FALSE(list.sessions(1).has_plan());
+  // No [archive] configured: GetRigStatus says shipping is off.
+  v1::RigStatus status;
+  st = rig_.control().GetRigStatus(DaemonRig::Context().get(), {}, &status);
+  ASSERT_TRUE(st.ok()) << st.error_message();
+  EXPECT_EQ(status.archive().state(), v1::ARCHIVE_STATE_OFF);
 }
 
 TEST_F(DaemonApiTest, StartsWithoutDevicesAndReportsThemDisconnected) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/plan/analyze_plan.h"
+#include "core/plan/sample.h"
 #include "plan_test_util.h"
 
 namespace brdf::plan {
@@ -43,6 +44,40 @@ TEST(ValidatePlanTest, ExamplePlansAreValid) {
     EXPECT_TRUE(a.valid()) << FormatProblems(a.problems);
     EXPECT_GT(a.summary.sample_readings, 0);
   }
+}
+
+TEST(ValidatePlanTest, SampleBlockIsCheckedAndGivesRhoW) {
+  const v1::Plan good = PlanFromJson(R"({
+    "name": "gloss", "poseList": {"poses": [{"alpha": 10, "beta": 0, "delta": 30}]},
+    "sample": {"id": "P-0042", "name": "red gloss", "material": "paint", "tags": ["glossy"],
+               "whiteStandardId": "RS-3 #1187",
+               "whiteReflectanceSpectrum": {"startNm": 380, "stepNm": 100, "values": [0.97, 0.98, 0.99, 0.99, 0.99]}}
+  })");
+  EXPECT_TRUE(ValidatePlan(good, RigDescription{}).empty())
+      << FormatProblems(ValidatePlan(good, RigDescription{}));
+  std::optional<Spectrum> white = WhiteReflectanceSpectrumOf(good);
+  ASSERT_TRUE(white.has_value());
+  EXPECT_EQ(white->grid.count, 5u);
+  EXPECT_DOUBLE_EQ(white->grid.last_nm(), 780);
+  EXPECT_FALSE(WhiteReflectanceOf(good).has_value());  // the spectrum wins
+
+  const v1::Plan bad = PlanFromJson(R"({
+    "name": "gloss", "poseList": {"poses": [{"alpha": 10, "beta": 0, "delta": 30}]},
+    "sample": {"tags": ["ok", ""], "whiteReflectance": 1.5,
+               "whiteReflectanceSpectrum": {"startNm": 380, "stepNm": 0, "values": [2.0]}}
+  })");
+  const std::vector<Problem> problems = ValidatePlan(bad, RigDescription{});
+  EXPECT_THAT(
+      Paths(problems),
+      UnorderedElementsAreArray(
+          {"sample.tags[1]", "sample.whiteReflectance", "sample.whiteReflectanceSpectrum.stepNm",
+           "sample.whiteReflectanceSpectrum.values", "sample.whiteReflectanceSpectrum.values"}));
+
+  const v1::Plan number = PlanFromJson(R"({
+    "name": "n", "poseList": {"poses": [{"alpha": 10, "beta": 0, "delta": 30}]},
+    "sample": {"whiteReflectance": 0.97}
+  })");
+  EXPECT_EQ(WhiteReflectanceOf(number), 0.97);
 }
 
 TEST(ValidatePlanTest, SampleRotationRangeProblemsAllAtOnce) {

@@ -207,6 +207,21 @@ int RunList(CommandContext& ctx, const std::vector<std::string>& states, unsigne
   return kExitOk;
 }
 
+// "archive: caught up" / "archive: unreachable, 120 reading(s) behind (35.2 s) -- <why>".
+void PrintArchiveStatus(std::ostream& out, const v1::ArchiveStatus& a) {
+  static const char* const kWords[] = {"unknown",  "off",         "connecting", "caught up",
+                                       "shipping", "unreachable", "refused"};
+  const int state = static_cast<int>(a.state());
+  out << "archive: " << (state >= 0 && state < 7 ? kWords[state] : "unknown");
+  if (a.state() != v1::ARCHIVE_STATE_OFF) {
+    out << ", " << a.lag_readings() << " reading(s) behind";
+    if (a.lag_readings() > 0) out << " (" << Num(a.lag_seconds(), 3) << " s)";
+    out << ", " << a.shipped_readings() << " shipped since start";
+  }
+  if (!a.detail().empty()) out << " -- " << a.detail();
+  out << "\n";
+}
+
 int RunRig(CommandContext& ctx) {
   v1::GetRigStatusRequest request;
   v1::RigStatus reply;
@@ -240,6 +255,7 @@ int RunRig(CommandContext& ctx) {
   }
   ctx.out << "active session: "
           << (reply.active_session_id().empty() ? "none" : reply.active_session_id()) << "\n";
+  PrintArchiveStatus(ctx.out, reply.archive());
   return kExitOk;
 }
 

@@ -1,0 +1,220 @@
+// bench_archive_lag: how far the lab archive trails the rig while a session records.
+//
+// A real PostgreSQL (tests/support/pg_server.h, Debian's server in a temporary directory) and a
+// real SQLite file; readings are committed through SessionStore::CompleteStepWithReading at a
+// steady pace while the daemon's ArchiveShipper runs. Lag of a reading = when the archive's
+// transaction holding it began (readings.archived_at, PostgreSQL's now()) − when the rig committed
+// it (recorded_at); same machine, same clock. Baseline measured in the same run: the rig's own
+// commit time per reading (the fsync'd SQLite transaction). Medians and p99 are printed, and the
+// ratio of the lag's median to the commit's median.
+//
+// Then the catalogue at lab scale: --sessions sessions with --readings readings in all, generated
+// inside PostgreSQL (generate_series), and the ListSessions-style catalogue query (filter by
+// material and tag, newest first, a page of 100) timed --queries times: p50 and p99, against the
+// same query without a filter as the baseline. (SQL over libpq; the brdf-archive server itself is
+// not part of this build.)
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+#include <vector>
+
+#include "daemon/archive_shipper.h"
+#include "storage/archive_schema.h"
+#include "storage/pg.h"
+#include "storage/session_store.h"
+#include "tests/support/pg_server.h"
+
+namespace {
+
+using namespace std::chrono_literals;
+using brdf::Result;
+using brdf::Status;
+namespace storage = brdf::storage;
+
+double Quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5));
+  return v[i];
+}
+
+double Ms(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration<double, std::milli>(d).count();
+}
+
+int Fail(const std::string& what, const Status& st) {
+  std::fprintf(stderr, "bench_archive_lag: %s: %s\n", what.c_str(), st.ToString().c_str());
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("lag of the lab archive behind the rig, and the catalogue query at lab scale");
+  int readings = 2000;
+  int pace_ms = 5;
+  int sessions = 1000;
+  long total_readings = 1000000;
+  int queries = 200;
+  app.add_option("--lag-readings", readings, "readings recorded while shipping");
+  app.add_option("--pace-ms", pace_ms, "pause between readings (ms)");
+  app.add_option("--sessions", sessions, "catalogue: sessions in the archive");
+  app.add_option("--readings", total_readings, "catalogue: readings in the archive (0: skip)");
+  app.add_option("--queries", queries, "catalogue: queries timed");
+  CLI11_PARSE(app, argc, argv);
+
+  if (std::string why = brdf::testing::PgServer::Unavailable(); !why.empty()) {
+    std::fprintf(stderr, "bench_archive_lag: %s\n", why.c_str());
+    return 2;
+  }
+  Result<std::unique_ptr<brdf::testing::PgServer>> pg = brdf::testing::PgServer::Start();
+  if (!pg.ok()) return Fail("starting PostgreSQL", pg.status());
+  const std::string dir = (*pg)->dir();
+
+  // --- Lag while a session records ---------------------------------------------------------
+  char tmpl[] = "/tmp/brdf-lag-XXXXXX";
+  if (::mkdtemp(tmpl) == nullptr) return 1;
+  const std::string work = tmpl;
+  Result<std::unique_ptr<storage::SessionStore>> opened =
+      storage::SessionStore::Open(work + "/rig.db");
+  if (!opened.ok()) return Fail("opening the rig's database", opened.status());
+  std::shared_ptr<storage::SessionStore> store = std::move(*opened);
+  Result<std::string> cred =
+      brdf::testing::PgServer::WriteCredentials(work + "/archive.conninfo", (*pg)->conninfo());
+  brdf::daemon::ArchiveShipper::Options o;
+  o.credentials_path = *cred;
+  o.rig = "bench-rig";
+  Result<std::unique_ptr<brdf::daemon::ArchiveShipper>> shipper =
+      brdf::daemon::ArchiveShipper::Start(store, o);
+  if (!shipper.ok()) return Fail("starting the shipper", shipper.status());
+
+  storage::NewSession n;
+  n.name = "lag";
+  n.plan_kind = "pose_list";
+  n.plan_json = "{}";
+  n.rig = "bench-rig";
+  std::vector<storage::StepRecord> steps(static_cast<std::size_t>(readings));
+  for (int i = 0; i < readings; ++i) {
+    steps[i].step_index = i;
+    steps[i].kind = storage::StepKind::kSample;
+    steps[i].target = brdf::Directions{10, 0, 20, 90};
+  }
+  Result<std::int64_t> id = store->CreateSession(n, steps);
+  if (!id.ok()) return Fail("creating the session", id.status());
+  if (Status st = store->SetSessionState(*id, brdf::SessionState::kRunning, ""); !st.ok()) {
+    return Fail("starting the session", st);
+  }
+  std::vector<double> commit_ms;
+  for (int i = 0; i < readings; ++i) {
+    storage::ReadingRecord r;
+    r.kind = brdf::ReadingKind::kSample;
+    r.directions = brdf::Directions{10, 0, 20, 90};
+    r.grid = brdf::WavelengthGrid::Pr650();
+    r.spectrum.assign(r.grid.count, 1e-3 * (i + 1));
+    const auto t0 = std::chrono::steady_clock::now();
+    Result<std::int64_t> rid = store->CompleteStepWithReading(*id, i, r);
+    commit_ms.push_back(Ms(std::chrono::steady_clock::now() - t0));
+    if (!rid.ok()) return Fail("recording", rid.status());
+    std::this_thread::sleep_for(std::chrono::milliseconds(pace_ms));
+  }
+  const auto deadline = std::chrono::steady_clock::now() + 120s;
+  while ((*shipper)->Snapshot().lag_readings() > 0 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(20ms);
+  }
+  (*shipper)->Stop();
+  Result<std::unique_ptr<storage::PgConnection>> conn =
+      storage::PgConnection::Open((*pg)->conninfo());
+  if (!conn.ok()) return Fail("connecting", conn.status());
+  Result<storage::PgResult> lags =
+      (*conn)->Query("SELECT (extract(epoch FROM archived_at) - recorded_at) * 1000 FROM readings");
+  if (!lags.ok()) return Fail("reading the lags", lags.status());
+  std::vector<double> lag_ms;
+  for (int i = 0; i < lags->rows(); ++i) lag_ms.push_back(lags->Double(i, 0));
+  std::printf(
+      "archive lag while recording (%d readings, one every %d ms + commit; shipper polls "
+      "every %lld ms, batches of %d)\n",
+      readings, pace_ms, static_cast<long long>(o.poll.count()), o.batch_readings);
+  std::printf("  readings in the archive      %zu of %d\n", lag_ms.size(), readings);
+  std::printf("  lag p50 / p99 / max          %.2f / %.2f / %.2f ms\n", Quantile(lag_ms, 0.5),
+              Quantile(lag_ms, 0.99), Quantile(lag_ms, 1.0));
+  std::printf("  rig commit p50 / p99         %.2f / %.2f ms (baseline)\n",
+              Quantile(commit_ms, 0.5), Quantile(commit_ms, 0.99));
+  std::printf("  lag p50 / commit p50         %.1f\n",
+              Quantile(lag_ms, 0.5) / std::max(1e-9, Quantile(commit_ms, 0.5)));
+  std::filesystem::remove_all(work);
+
+  // --- The catalogue at lab scale ------------------------------------------------------------
+  if (total_readings <= 0) return 0;
+  const long per_session = std::max(1L, total_readings / sessions);
+  const auto g0 = std::chrono::steady_clock::now();
+  const std::string fill =
+      "INSERT INTO sessions (uuid, rig, rig_session_id, name, plan_kind, plan_json, state, "
+      "created_at, total_steps, done_steps, sample_id, sample_name, material, tags) "
+      "SELECT gen_random_uuid(), 'rig-' || (s % 4), s, 'session ' || s, 'pose_list', '{}', "
+      "'completed', 1.7e9 + s * 60, " +
+      std::to_string(per_session) + ", " + std::to_string(per_session) +
+      ", 'P-' || (s % 300), 'sample ' || (s % 300), "
+      "(ARRAY['paint','fabric','metal','paper','plastic'])[1 + s % 5], "
+      "ARRAY[(ARRAY['glossy','matte','red','blue','rough','smooth'])[1 + s % 6], "
+      "(ARRAY['glossy','matte','red','blue','rough','smooth'])[1 + (s / 6) % 6]] "
+      "FROM generate_series(1, " +
+      std::to_string(sessions) +
+      ") s;"
+      "INSERT INTO steps (session_uuid, step_index, kind, alpha, beta, gamma, delta, state) "
+      "SELECT uuid, i, 'sample', 0, 0, 0, 0, 'done' FROM sessions, generate_series(0, " +
+      std::to_string(per_session - 1) +
+      ") i WHERE rig_session_id > 0;"
+      "INSERT INTO readings (session_uuid, step_index, rig_reading_id, kind, alpha, beta, gamma, "
+      "delta, theta_i, phi_i, theta_o, phi_o, wl_start_nm, wl_step_nm, wl_count, spectrum, "
+      "recorded_at) SELECT session_uuid, step_index, step_index + 1, 'sample', 0, 0, 0, 0, 10, 0, "
+      "20, 90, 380, 4, 101, decode(repeat('0000000000000040', 101), 'hex'), 1.7e9 "
+      "FROM steps WHERE step_index >= 0 AND session_uuid IN "
+      "(SELECT uuid FROM sessions WHERE rig <> 'bench-rig'); ANALYZE;";
+  if (Status st = (*conn)->Exec("DELETE FROM readings; DELETE FROM steps; DELETE FROM sessions;");
+      !st.ok()) {
+    return Fail("clearing", st);
+  }
+  if (Status st = (*conn)->Exec(fill); !st.ok()) return Fail("filling the catalogue", st);
+  Result<storage::PgResult> counts = (*conn)->Query(
+      "SELECT (SELECT count(*) FROM sessions), (SELECT count(*) FROM readings), "
+      "pg_size_pretty(pg_database_size(current_database()))");
+  std::printf("catalogue: %s sessions, %s readings (%s), generated in %.1f s\n",
+              std::string(counts->Text(0, 0)).c_str(), std::string(counts->Text(0, 1)).c_str(),
+              std::string(counts->Text(0, 2)).c_str(),
+              Ms(std::chrono::steady_clock::now() - g0) / 1000);
+  auto time_query = [&](const std::string& sql, storage::PgParams params) {
+    std::vector<double> ms;
+    for (int q = 0; q < queries; ++q) {
+      const auto t0 = std::chrono::steady_clock::now();
+      Result<storage::PgResult> r = (*conn)->Query(sql, params);
+      ms.push_back(Ms(std::chrono::steady_clock::now() - t0));
+      if (!r.ok()) {
+        std::fprintf(stderr, "%s\n", r.status().ToString().c_str());
+        return std::vector<double>{};
+      }
+    }
+    return ms;
+  };
+  const std::string page = " ORDER BY created_at DESC, uuid LIMIT 100";
+  const std::string columns =
+      "SELECT s.uuid, s.rig, s.name, s.state, s.created_at, s.total_steps, s.done_steps, "
+      "s.sample_id, s.sample_name, s.material, s.tags FROM sessions s";
+  std::vector<double> filtered = time_query(
+      columns + " WHERE lower(material) = lower($1) AND $2 = ANY (tags) AND rig = $3" + page,
+      storage::PgParams().Add("paint").Add("glossy").Add("rig-0"));
+  std::vector<double> plain = time_query(columns + page, storage::PgParams());
+  std::printf(
+      "  catalogue query (material + tag + rig, page of 100), %d times: p50 %.3f ms, "
+      "p99 %.3f ms\n",
+      queries, Quantile(filtered, 0.5), Quantile(filtered, 0.99));
+  std::printf(
+      "  baseline: first page without a filter: p50 %.3f ms, p99 %.3f ms; ratio of "
+      "medians %.2f\n",
+      Quantile(plain, 0.5), Quantile(plain, 0.99),
+      Quantile(filtered, 0.5) / std::max(1e-9, Quantile(plain, 0.5)));
+  (void)dir;
+  return 0;
+}

@@ -1,0 +1,34 @@
+// How storage reads its rows back into records: the column lists of sessions, steps and readings
+// and the functions that turn a row (selected with those columns, in that order) into a record.
+// Shared by SessionStore and its archive shipping (session_store_archive.cc); internal to storage/.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "core/status.h"
+#include "storage/records.h"
+#include "storage/sqlite.h"
+
+namespace brdf::storage {
+
+// A row whose enumeration text does not parse has been damaged outside brdfd (CHECK constraints
+// keep brdfd's own writes valid).
+template <typename T>
+Result<T> FromColumn(Result<T> parsed, const std::string& path, const std::string& where) {
+  if (parsed.ok()) return parsed;
+  return IoError(where + " in " + path + " is damaged: " + parsed.status().message() +
+                 "; run CheckSession or sqlite3 " + path + " 'PRAGMA integrity_check'");
+}
+
+extern const std::string_view kSessionColumns;
+extern const std::string_view kStepColumns;
+extern const std::string_view kReadingColumns;
+
+// A row whose enumeration text does not parse has been damaged outside brdfd: kIoError naming
+// `path` and what to run.
+Result<SessionRecord> ReadSession(const Statement& st, const std::string& path);
+Result<StepRecord> ReadStep(const Statement& st, const std::string& path);
+Result<ReadingRecord> ReadReading(const Statement& st, const std::string& path);
+
+}  // namespace brdf::storage

@@ -1,0 +1,73 @@
+#include "tests/archive/archive_compare.h"
+
+#include <gtest/gtest.h>
+
+#include "storage/pg.h"
+#include "storage/spectrum_blob.h"
+
+namespace brdf::storage::testing {
+
+// Every reading of every session of `store` is in the archive exactly once with the same
+// content, and the archive holds no other reading of those sessions.
+void ExpectArchiveHoldsExactly(const std::string& conninfo, SessionStore& store,
+                               const std::string& rig) {
+  Result<std::unique_ptr<PgConnection>> conn = PgConnection::Open(conninfo);
+  ASSERT_TRUE(conn.ok()) << conn.status().ToString();
+  Result<std::vector<SessionRecord>> sessions = store.ListSessions();
+  ASSERT_TRUE(sessions.ok());
+  std::int64_t total = 0;
+  for (const SessionRecord& s : *sessions) {
+    SCOPED_TRACE("session " + std::to_string(s.id) + " " + s.uuid);
+    Result<PgResult> row = (*conn)->Query(
+        "SELECT rig, rig_session_id, state, done_steps, total_steps, plan_json, created_at "
+        "FROM sessions WHERE uuid = $1",
+        PgParams().Add(s.uuid));
+    ASSERT_TRUE(row.ok()) << row.status().ToString();
+    ASSERT_EQ(row->rows(), 1);
+    EXPECT_EQ(row->Text(0, 0), rig);
+    EXPECT_EQ(row->Int64(0, 1), s.id);
+    EXPECT_EQ(row->Text(0, 2), ToString(s.state));
+    EXPECT_EQ(row->Int64(0, 3), s.done_steps);
+    EXPECT_EQ(row->Int64(0, 4), s.total_steps);
+    EXPECT_EQ(row->Text(0, 5), s.plan_json);
+    EXPECT_EQ(row->Double(0, 6), s.created_at);
+    Result<PgResult> steps = (*conn)->Query(
+        "SELECT count(*), count(*) FILTER (WHERE state = 'done') FROM steps "
+        "WHERE session_uuid = $1",
+        PgParams().Add(s.uuid));
+    ASSERT_TRUE(steps.ok());
+    EXPECT_EQ(steps->Int64(0, 0), s.total_steps);
+    EXPECT_EQ(steps->Int64(0, 1), s.done_steps);
+
+    Result<std::vector<ReadingRecord>> mine = store.GetReadings(s.id, 0, 1 << 20);
+    ASSERT_TRUE(mine.ok());
+    Result<PgResult> theirs = (*conn)->Query(
+        "SELECT rig_reading_id, step_index, kind, spectrum, recorded_at, reference_reading_id, "
+        "theta_i, flagged, quality_code FROM readings WHERE session_uuid = $1 "
+        "ORDER BY rig_reading_id",
+        PgParams().Add(s.uuid));
+    ASSERT_TRUE(theirs.ok()) << theirs.status().ToString();
+    ASSERT_EQ(theirs->rows(), static_cast<int>(mine->size()));
+    for (int i = 0; i < theirs->rows(); ++i) {
+      const ReadingRecord& r = (*mine)[static_cast<std::size_t>(i)];
+      EXPECT_EQ(theirs->Int64(i, 0), r.id);
+      EXPECT_EQ(theirs->Int64(i, 1), r.step_index);
+      EXPECT_EQ(theirs->Text(i, 2), ToString(r.kind));
+      EXPECT_EQ(theirs->Bytes(i, 3), EncodeSpectrum(r.spectrum)) << "reading " << r.id;
+      EXPECT_EQ(theirs->Double(i, 4), r.recorded_at);
+      EXPECT_EQ(theirs->OptionalInt64(i, 5), r.reference_reading_id);
+      EXPECT_EQ(theirs->Double(i, 6), r.directions.theta_i);
+      EXPECT_EQ(theirs->Text(i, 7), r.flagged ? "t" : "f");
+      EXPECT_EQ(theirs->Int64(i, 8), r.quality_code);
+    }
+    total += theirs->rows();
+  }
+  Result<PgResult> all = (*conn)->Query(
+      "SELECT count(*) FROM readings r JOIN sessions s ON s.uuid = r.session_uuid WHERE s.rig = "
+      "$1",
+      PgParams().Add(rig));
+  ASSERT_TRUE(all.ok());
+  EXPECT_EQ(all->Int64(0, 0), total);
+}
+
+}  // namespace brdf::storage::testing

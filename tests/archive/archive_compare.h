@@ -1,0 +1,17 @@
+// Compares the lab archive with a rig's database, reading by reading.
+#pragma once
+
+#include <string>
+
+#include "storage/session_store.h"
+
+namespace brdf::storage::testing {
+
+// Every session of `store` is in the archive (at `conninfo`) under `rig` with the same state,
+// steps and counts, and every reading is there exactly once with the same id, step, kind, spectrum
+// bytes, timestamp, reference, angles, flag and quality code; the archive holds no other reading
+// of that rig. Reports through gtest's EXPECT/ASSERT.
+void ExpectArchiveHoldsExactly(const std::string& conninfo, SessionStore& store,
+                               const std::string& rig);
+
+}  // namespace brdf::storage::testing

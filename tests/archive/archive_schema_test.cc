@@ -1,0 +1,104 @@
+// The archive's schema on a real PostgreSQL: a new database gets the latest version, migrating
+// again changes nothing, a newer archive is refused, and the libpq layer reports a wrong password
+// and an unreachable server as what they are -- without the password in the message.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <thread>
+
+#include "storage/archive_schema.h"
+#include "storage/pg.h"
+#include "tests/support/pg_server.h"
+
+namespace brdf::storage {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+using testing::PgServer;
+
+class ArchiveSchemaTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (std::string why = PgServer::Unavailable(); !why.empty()) GTEST_SKIP() << why;
+    Result<std::unique_ptr<PgServer>> pg = PgServer::Start();
+    ASSERT_TRUE(pg.ok()) << pg.status().ToString();
+    pg_ = std::move(*pg);
+  }
+  std::unique_ptr<PgConnection> Connect() {
+    Result<std::unique_ptr<PgConnection>> c = PgConnection::Open(pg_->conninfo());
+    EXPECT_TRUE(c.ok()) << c.status().ToString();
+    return c.ok() ? std::move(*c) : nullptr;
+  }
+  std::unique_ptr<PgServer> pg_;
+};
+
+TEST_F(ArchiveSchemaTest, NewArchiveGetsTheLatestSchemaAndMigratingAgainIsANoOp) {
+  auto conn = Connect();
+  ASSERT_NE(conn, nullptr);
+  EXPECT_GE(conn->server_version(), 120000);
+  EXPECT_EQ(*ArchiveVersion(*conn), 0);
+  ASSERT_TRUE(MigrateArchive(*conn).ok());
+  EXPECT_EQ(*ArchiveVersion(*conn), LatestArchiveVersion());
+  ASSERT_TRUE(MigrateArchive(*conn).ok());
+  EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM archive_schema"),
+            std::to_string(LatestArchiveVersion()));
+  EXPECT_EQ(*pg_->Psql("SELECT string_agg(table_name, ',' ORDER BY table_name) FROM "
+                       "information_schema.tables WHERE table_schema = 'public'"),
+            "archive_schema,audit,devices,readings,sessions,steps");
+}
+
+TEST_F(ArchiveSchemaTest, TwoConnectionsMigratingAtOnceBothSucceed) {
+  auto a = Connect();
+  auto b = Connect();
+  ASSERT_TRUE(a && b);
+  Status sa, sb;
+  std::thread t([&] { sa = MigrateArchive(*a); });
+  sb = MigrateArchive(*b);
+  t.join();
+  EXPECT_TRUE(sa.ok()) << sa.ToString();
+  EXPECT_TRUE(sb.ok()) << sb.ToString();
+  EXPECT_EQ(*ArchiveVersion(*a), LatestArchiveVersion());
+}
+
+TEST_F(ArchiveSchemaTest, NewerArchiveIsRefused) {
+  auto conn = Connect();
+  ASSERT_TRUE(MigrateArchive(*conn).ok());
+  ASSERT_TRUE(pg_->Psql("INSERT INTO archive_schema (version, description) VALUES (99, 'later')")
+                  .ok());
+  Status s = MigrateArchive(*conn);
+  EXPECT_EQ(s.code(), StatusCode::kFailedPrecondition);
+  EXPECT_THAT(s.message(), HasSubstr("schema version 99"));
+}
+
+TEST_F(ArchiveSchemaTest, WrongPasswordAndUnreachableServerSayWhatHappened) {
+  auto wrong = PgConnection::Open(pg_->conninfo_with_password("not-the-password-42"));
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_EQ(wrong.status().code(), StatusCode::kConfigurationError) << wrong.status().ToString();
+  EXPECT_THAT(wrong.status().message(), HasSubstr("password"));
+  EXPECT_THAT(wrong.status().message(), Not(HasSubstr("not-the-password-42")));
+  ASSERT_TRUE(pg_->Stop().ok());
+  auto away = PgConnection::Open(pg_->conninfo());
+  ASSERT_FALSE(away.ok());
+  EXPECT_EQ(away.status().code(), StatusCode::kDisconnected) << away.status().ToString();
+}
+
+TEST_F(ArchiveSchemaTest, ValuesRoundTripExactly) {
+  auto conn = Connect();
+  ASSERT_TRUE(MigrateArchive(*conn).ok());
+  const double tricky[] = {0.1, 1.0 / 3.0, 5e-324, 1.7976931348623157e308, -0.0, 123456.789e-7};
+  for (double v : tricky) {
+    Result<PgResult> r = conn->Query("SELECT $1::double precision", PgParams().Add(v));
+    ASSERT_TRUE(r.ok()) << r.status().ToString();
+    const double back = r->Double(0, 0);
+    EXPECT_EQ(std::memcmp(&back, &v, sizeof v), 0) << v << " came back as " << back;
+  }
+  const std::vector<std::uint8_t> bytes = {0, 1, 0x5c, 0x78, 0xff, 0};
+  Result<PgResult> r = conn->Query("SELECT $1::bytea", PgParams().AddBytes(bytes));
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->Bytes(0, 0), bytes);
+}
+
+}  // namespace
+}  // namespace brdf::storage

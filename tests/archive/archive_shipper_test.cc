@@ -1,0 +1,326 @@
+// The shipper in process, on real parts: a real SQLite file (SessionStore), a real PostgreSQL
+// (tests/support/pg_server.h) that is stopped, killed and restarted while sessions record, and
+// the daemon's ArchiveShipper thread. After every fault the archive is compared with the rig's
+// database reading by reading (ids, steps, every spectrum byte, timestamps): each reading is in
+// the archive exactly once, and recording never waited for the archive.
+#include "daemon/archive_shipper.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "storage/archive_schema.h"
+#include "storage/archive_writer.h"
+#include "storage/pg.h"
+#include "storage/spectrum_blob.h"
+#include "tests/archive/archive_compare.h"
+#include "tests/storage/storage_test_util.h"
+#include "tests/support/pg_server.h"
+
+namespace brdf::storage {
+namespace {
+
+using namespace std::chrono_literals;
+using brdf::testing::PgServer;
+using daemon::ArchiveShipper;
+using ::testing::HasSubstr;
+using testing::MakeNewSession;
+using testing::MakeReading;
+using testing::MakeSteps;
+using ::testing::Not;
+using testing::TempDir;
+
+// Records step `i` of a session made with MakeSteps: a move is completed, a measuring step gets
+// its reading (samples name the latest reference).
+Status RecordStep(SessionStore& store, std::int64_t session, int i,
+                  std::optional<std::int64_t>& reference) {
+  const StepKind kind = testing::KindOfStep(i);
+  if (kind == StepKind::kMove) return store.CompleteStep(session, i);
+  ReadingRecord r = MakeReading(i, *ReadingKindFor(kind));
+  if (kind == StepKind::kSample) r.reference_reading_id = reference;
+  Result<std::int64_t> id = store.CompleteStepWithReading(session, i, r);
+  if (!id.ok()) return id.status();
+  if (kind == StepKind::kReference) reference = *id;
+  return Status::Ok();
+}
+
+class ArchiveShipperTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (std::string why = PgServer::Unavailable(); !why.empty()) GTEST_SKIP() << why;
+    Result<std::unique_ptr<PgServer>> pg = PgServer::Start();
+    ASSERT_TRUE(pg.ok()) << pg.status().ToString();
+    pg_ = std::move(*pg);
+    credentials_ = *PgServer::WriteCredentials(dir_.File("archive.conninfo"), pg_->conninfo());
+  }
+  void TearDown() override {
+    if (HasFailure() && pg_ != nullptr) std::cerr << "---- postgres log ----\n" << pg_->log();
+  }
+
+  std::shared_ptr<SessionStore> OpenStore(const std::string& name) {
+    Result<std::unique_ptr<SessionStore>> s = SessionStore::Open(dir_.File(name));
+    EXPECT_TRUE(s.ok()) << s.status().ToString();
+    return s.ok() ? std::shared_ptr<SessionStore>(std::move(*s)) : nullptr;
+  }
+  std::unique_ptr<ArchiveShipper> StartShipper(std::shared_ptr<SessionStore> store,
+                                               const std::string& rig) {
+    ArchiveShipper::Options o;
+    o.credentials_path = credentials_;
+    o.rig = rig;
+    o.batch_readings = 50;
+    o.retry = 100ms;
+    o.poll = 20ms;
+    Result<std::unique_ptr<ArchiveShipper>> s = ArchiveShipper::Start(std::move(store), o);
+    EXPECT_TRUE(s.ok()) << s.status().ToString();
+    return s.ok() ? std::move(*s) : nullptr;
+  }
+  // Until the shipper says it is caught up with nothing left (or 30 s).
+  bool WaitCaughtUp(ArchiveShipper& shipper) {
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
+    while (std::chrono::steady_clock::now() < deadline) {
+      const v1::ArchiveStatus s = shipper.Snapshot();
+      if (s.state() == v1::ARCHIVE_STATE_CAUGHT_UP && s.lag_readings() == 0) return true;
+      std::this_thread::sleep_for(20ms);
+    }
+    return false;
+  }
+  v1::ArchiveState WaitState(ArchiveShipper& shipper, v1::ArchiveState want) {
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    v1::ArchiveState seen = v1::ARCHIVE_STATE_UNSPECIFIED;
+    while (std::chrono::steady_clock::now() < deadline) {
+      seen = shipper.Snapshot().state();
+      if (seen == want) return seen;
+      std::this_thread::sleep_for(20ms);
+    }
+    return seen;
+  }
+
+  void ExpectArchiveHoldsExactly(SessionStore& store, const std::string& rig) {
+    testing::ExpectArchiveHoldsExactly(pg_->conninfo(), store, rig);
+  }
+
+  TempDir dir_;
+  std::unique_ptr<PgServer> pg_;
+  std::string credentials_;
+};
+
+TEST_F(ArchiveShipperTest, ShipsEverythingRecordedWithTheCatalogue) {
+  auto store = OpenStore("rig-a.db");
+  NewSession n = MakeNewSession();
+  n.rig = "rig-a";
+  n.plan_json = R"({"name": "gloss", "sample": {"id": "P-7", "name": "Red Gloss",
+    "material": "paint", "tags": ["glossy", "red \"wine\""], "whiteStandardId": "RS-3"}})";
+  Result<std::int64_t> id = store->CreateSession(n, MakeSteps(40));
+  ASSERT_TRUE(id.ok());
+  ASSERT_TRUE(store->SetSessionState(*id, SessionState::kRunning, "").ok());
+  ASSERT_TRUE(store->RecordDevice({0, *id, "spectroradiometer", "PR-650", "60954201", 0}).ok());
+  ASSERT_TRUE(store->AppendAudit({0, 0, "operator", "lab-pc", "session.start", *id, "x"}).ok());
+  auto shipper = StartShipper(store, "rig-a");
+  std::optional<std::int64_t> ref;
+  for (int i = 0; i < 40; ++i) ASSERT_TRUE(RecordStep(*store, *id, i, ref).ok());
+  ASSERT_TRUE(store->SetSessionState(*id, SessionState::kCompleted, "").ok());
+  ASSERT_TRUE(WaitCaughtUp(*shipper)) << shipper->Snapshot().DebugString();
+  ExpectArchiveHoldsExactly(*store, "rig-a");
+  EXPECT_EQ(*pg_->Psql("SELECT sample_id || '|' || sample_name || '|' || material || '|' || "
+                       "array_to_string(tags, ';') || '|' || white_standard_id FROM sessions"),
+            "P-7|Red Gloss|paint|glossy;red \"wine\"|RS-3");
+  EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM sessions WHERE 'glossy' = ANY (tags)"), "1");
+  EXPECT_EQ(*pg_->Psql("SELECT kind || '/' || serial FROM devices"), "spectroradiometer/60954201");
+  EXPECT_EQ(*pg_->Psql("SELECT action || '/' || actor FROM audit"), "session.start/lab-pc");
+  EXPECT_EQ(shipper->Snapshot().shipped_readings(), 36u);  // 40 steps less 4 moves
+}
+
+// The archive commits a batch and the rig dies before it records its marks: the batch is sent
+// again and changes nothing.
+TEST_F(ArchiveShipperTest, ABatchShippedTwiceChangesNothing) {
+  auto store = OpenStore("rig-a.db");
+  ASSERT_TRUE(store->SetArchiveShipping(true).ok());
+  NewSession n = MakeNewSession();
+  n.rig = "rig-a";
+  Result<std::int64_t> id = store->CreateSession(n, MakeSteps(30));
+  ASSERT_TRUE(store->SetSessionState(*id, SessionState::kRunning, "").ok());
+  std::optional<std::int64_t> ref;
+  for (int i = 0; i < 30; ++i) ASSERT_TRUE(RecordStep(*store, *id, i, ref).ok());
+  Result<std::unique_ptr<PgConnection>> conn = PgConnection::Open(pg_->conninfo());
+  ASSERT_TRUE(conn.ok());
+  ASSERT_TRUE(MigrateArchive(**conn).ok());
+  Result<ShipBatch> batch = store->NextShipBatch(1000, 1000);
+  ASSERT_TRUE(batch.ok()) << batch.status().ToString();
+  ASSERT_EQ(batch->readings.size(), 27u);
+  ASSERT_TRUE(WriteToArchive(**conn, "rig-a", *batch).ok());
+  // ... crash here: no MarkShipped. The next run ships the same rows again.
+  Result<ShipBatch> again = store->NextShipBatch(1000, 1000);
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->readings.size(), 27u);
+  Status st = WriteToArchive(**conn, "rig-a", *again);
+  ASSERT_TRUE(st.ok()) << st.ToString();
+  ASSERT_TRUE(store->MarkShipped(*again).ok());
+  EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM readings"), "27");
+  EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM steps"), "30");
+  Result<ShipBatch> after = store->NextShipBatch(1000, 1000);
+  ASSERT_TRUE(after.ok());
+  EXPECT_TRUE(after->empty());
+  ExpectArchiveHoldsExactly(*store, "rig-a");
+}
+
+// Two rigs record at the same time; the archive is stopped in the middle of their sessions, then
+// killed, and comes back: recording never waits, and in the end the archive holds exactly both
+// rigs' readings.
+TEST_F(ArchiveShipperTest, TwoRigsThroughAnArchiveStoppedAndKilledEndExact) {
+  auto a = OpenStore("rig-a.db");
+  auto b = OpenStore("rig-b.db");
+  auto ship_a = StartShipper(a, "rig-a");
+  auto ship_b = StartShipper(b, "rig-b");
+  constexpr int kSteps = 300;
+  std::atomic<int> phase{0};
+  std::atomic<double> slowest_ms{0};
+  auto record = [&](std::shared_ptr<SessionStore> store, const std::string& rig) {
+    for (int session = 0; session < 2; ++session) {
+      NewSession n = MakeNewSession(rig + " session " + std::to_string(session));
+      n.rig = rig;
+      Result<std::int64_t> id = store->CreateSession(n, MakeSteps(kSteps));
+      ASSERT_TRUE(id.ok());
+      ASSERT_TRUE(store->SetSessionState(*id, SessionState::kRunning, "").ok());
+      std::optional<std::int64_t> ref;
+      for (int i = 0; i < kSteps; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        ASSERT_TRUE(RecordStep(*store, *id, i, ref).ok());
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count();
+        if (ms > slowest_ms) slowest_ms = ms;
+        std::this_thread::sleep_for(2ms);
+      }
+      ASSERT_TRUE(store->SetSessionState(*id, SessionState::kCompleted, "").ok());
+    }
+    ++phase;
+  };
+  std::thread ta(record, a, "rig-a");
+  std::thread tb(record, b, "rig-b");
+  std::this_thread::sleep_for(300ms);
+  ASSERT_TRUE(pg_->Stop().ok());
+  EXPECT_EQ(WaitState(*ship_a, v1::ARCHIVE_STATE_UNREACHABLE), v1::ARCHIVE_STATE_UNREACHABLE);
+  std::this_thread::sleep_for(300ms);
+  const v1::ArchiveStatus away = ship_b->Snapshot();
+  EXPECT_GT(away.lag_readings(), 0u);
+  EXPECT_GT(away.lag_seconds(), 0.0);
+  ASSERT_TRUE(pg_->Restart().ok());
+  std::this_thread::sleep_for(400ms);
+  ASSERT_TRUE(pg_->Kill().ok());  // as a crash, mid-batch
+  std::this_thread::sleep_for(300ms);
+  ASSERT_TRUE(pg_->Restart().ok());
+  ta.join();
+  tb.join();
+  ASSERT_EQ(phase.load(), 2);
+  ASSERT_TRUE(WaitCaughtUp(*ship_a)) << ship_a->Snapshot().DebugString();
+  ASSERT_TRUE(WaitCaughtUp(*ship_b)) << ship_b->Snapshot().DebugString();
+  ExpectArchiveHoldsExactly(*a, "rig-a");
+  ExpectArchiveHoldsExactly(*b, "rig-b");
+  const std::int64_t per_rig = 2 * (kSteps - kSteps / 10);
+  EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM readings"), std::to_string(2 * per_rig));
+  EXPECT_EQ(*pg_->Psql("SELECT count(DISTINCT rig) FROM sessions"), "2");
+  // Recording never waited for the archive (a commit with fsync is milliseconds; 500 is far).
+  EXPECT_LT(slowest_ms.load(), 500.0);
+}
+
+// The archive cuts the shipper's connection again and again (pg_terminate_backend, as a flaky
+// network or an administrator would) while a session records: the archive still ends exact.
+TEST_F(ArchiveShipperTest, DroppedConnectionsMidShippingEndExact) {
+  auto store = OpenStore("rig-a.db");
+  auto shipper = StartShipper(store, "rig-a");
+  NewSession n = MakeNewSession();
+  n.rig = "rig-a";
+  Result<std::int64_t> id = store->CreateSession(n, MakeSteps(400));
+  ASSERT_TRUE(store->SetSessionState(*id, SessionState::kRunning, "").ok());
+  std::atomic<bool> done{false};
+  int cuts = 0;
+  std::thread cutter([&] {
+    while (!done) {
+      Result<std::string> killed = pg_->Psql(
+          "SELECT count(pg_terminate_backend(pid)) FROM pg_stat_activity "
+          "WHERE application_name = 'brdfd'");
+      if (killed.ok() && *killed != "0") ++cuts;
+      std::this_thread::sleep_for(30ms);
+    }
+  });
+  std::optional<std::int64_t> ref;
+  for (int i = 0; i < 400; ++i) {
+    ASSERT_TRUE(RecordStep(*store, *id, i, ref).ok());
+    std::this_thread::sleep_for(1ms);
+  }
+  done = true;
+  cutter.join();
+  EXPECT_GT(cuts, 3) << "the connection was hardly cut";
+  ASSERT_TRUE(WaitCaughtUp(*shipper)) << shipper->Snapshot().DebugString();
+  ExpectArchiveHoldsExactly(*store, "rig-a");
+}
+
+// A wrong password: the shipper says REFUSED (without the password), recording goes on; once the
+// credentials file is fixed it catches up without a restart.
+TEST_F(ArchiveShipperTest, WrongPasswordNeverPausesRecordingAndFixingTheFileCatchesUp) {
+  ASSERT_TRUE(
+      PgServer::WriteCredentials(credentials_, pg_->conninfo_with_password("wrong-secret-123456"))
+          .ok());
+  auto store = OpenStore("rig-a.db");
+  auto shipper = StartShipper(store, "rig-a");
+  NewSession n = MakeNewSession();
+  n.rig = "rig-a";
+  Result<std::int64_t> id = store->CreateSession(n, MakeSteps(50));
+  ASSERT_TRUE(store->SetSessionState(*id, SessionState::kRunning, "").ok());
+  std::optional<std::int64_t> ref;
+  for (int i = 0; i < 50; ++i) ASSERT_TRUE(RecordStep(*store, *id, i, ref).ok());
+  ASSERT_EQ(WaitState(*shipper, v1::ARCHIVE_STATE_REFUSED), v1::ARCHIVE_STATE_REFUSED);
+  const v1::ArchiveStatus refused = shipper->Snapshot();
+  EXPECT_THAT(refused.detail(), HasSubstr("password"));
+  EXPECT_THAT(refused.detail(), Not(HasSubstr("wrong-secret-123456")));
+  EXPECT_EQ(refused.lag_readings(), 45u);
+  ASSERT_TRUE(PgServer::WriteCredentials(credentials_, pg_->conninfo()).ok());
+  ASSERT_TRUE(WaitCaughtUp(*shipper)) << shipper->Snapshot().DebugString();
+  ExpectArchiveHoldsExactly(*store, "rig-a");
+}
+
+// An unreachable archive (nothing listens) and a missing credentials file: recording goes on.
+TEST_F(ArchiveShipperTest, UnreachableArchiveAndMissingCredentialsNeverPauseRecording) {
+  ASSERT_TRUE(pg_->Stop().ok());
+  auto store = OpenStore("rig-a.db");
+  auto shipper = StartShipper(store, "rig-a");
+  NewSession n = MakeNewSession();
+  Result<std::int64_t> id = store->CreateSession(n, MakeSteps(20));
+  ASSERT_TRUE(store->SetSessionState(*id, SessionState::kRunning, "").ok());
+  std::optional<std::int64_t> ref;
+  for (int i = 0; i < 20; ++i) ASSERT_TRUE(RecordStep(*store, *id, i, ref).ok());
+  EXPECT_EQ(WaitState(*shipper, v1::ARCHIVE_STATE_UNREACHABLE), v1::ARCHIVE_STATE_UNREACHABLE);
+  EXPECT_EQ(shipper->Snapshot().lag_readings(), 18u);
+  shipper.reset();
+  ArchiveShipper::Options o;
+  o.credentials_path = dir_.File("no-such.conninfo");
+  o.rig = "rig-a";
+  o.retry = 100ms;
+  auto missing = ArchiveShipper::Start(store, o);
+  ASSERT_TRUE(missing.ok());
+  EXPECT_EQ(WaitState(**missing, v1::ARCHIVE_STATE_REFUSED), v1::ARCHIVE_STATE_REFUSED);
+  EXPECT_THAT((*missing)->Snapshot().detail(), HasSubstr("no-such.conninfo"));
+}
+
+// Sessions recorded before shipping was on (or while it was off) are shipped once it is on.
+TEST_F(ArchiveShipperTest, SessionsFromBeforeShippingAreShippedWhenItIsTurnedOn) {
+  auto store = OpenStore("rig-a.db");
+  ASSERT_TRUE(store->SetArchiveShipping(false).ok());
+  NewSession n = MakeNewSession();
+  n.rig = "rig-a";
+  Result<std::int64_t> id = store->CreateSession(n, MakeSteps(20));
+  ASSERT_TRUE(store->SetSessionState(*id, SessionState::kRunning, "").ok());
+  std::optional<std::int64_t> ref;
+  for (int i = 0; i < 20; ++i) ASSERT_TRUE(RecordStep(*store, *id, i, ref).ok());
+  EXPECT_EQ(store->ShippingLag()->pending_changes, 0);  // the outbox stays empty while off
+  auto shipper = StartShipper(store, "rig-a");
+  ASSERT_TRUE(WaitCaughtUp(*shipper));
+  ExpectArchiveHoldsExactly(*store, "rig-a");
+}
+
+}  // namespace
+}  // namespace brdf::storage

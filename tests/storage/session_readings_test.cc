@@ -1,0 +1,53 @@
+// storage/session_readings.h: a stored session handed out as core/readings values, with what the
+// derivation needs of the session itself -- ρw as stored, and ρw(λ) from the plan's sample block.
+#include "storage/session_readings.h"
+
+#include <gtest/gtest.h>
+
+#include "storage_test_util.h"
+
+namespace brdf::storage {
+namespace {
+
+using testing::MakeNewSession;
+using testing::MakeReading;
+using testing::MakeSteps;
+using testing::TempDir;
+
+TEST(SessionReadingsTest, TheSampleBlocksWhiteSpectrumComesWithTheReadings) {
+  TempDir dir;
+  auto store = SessionStore::Open(dir.File("rig.db"));
+  ASSERT_TRUE(store.ok());
+  NewSession n = MakeNewSession();
+  n.plan_json = R"({"name": "gloss", "sample": {"id": "P-1", "whiteReflectanceSpectrum":
+    {"startNm": 380, "stepNm": 200, "values": [0.95, 0.97, 0.99]}}})";
+  n.white_reflectance = 0.5;
+  auto id = (*store)->CreateSession(n, MakeSteps(3));
+  ASSERT_TRUE(id.ok());
+  ASSERT_TRUE((*store)->SetSessionState(*id, SessionState::kRunning, "").ok());
+  ASSERT_TRUE(
+      (*store)->CompleteStepWithReading(*id, 1, MakeReading(1, ReadingKind::kReference)).ok());
+  Result<SessionReadings> s = LoadSessionReadings(**store, *id);
+  ASSERT_TRUE(s.ok()) << s.status().ToString();
+  EXPECT_EQ(s->white_reflectance, 0.5);
+  ASSERT_TRUE(s->white_reflectance_spectrum.has_value());
+  EXPECT_EQ(s->white_reflectance_spectrum->grid.count, 3u);
+  EXPECT_EQ(s->white_reflectance_spectrum->values[2], 0.99);
+  EXPECT_EQ(s->readings.size(), 1u);
+
+  // No sample block: no spectrum; a plan that no longer parses is an internal error naming it.
+  NewSession plain = MakeNewSession();
+  plain.plan_json = R"({"name": "plain"})";
+  auto other = (*store)->CreateSession(plain, MakeSteps(2));
+  ASSERT_TRUE(other.ok());
+  Result<SessionReadings> none = LoadSessionReadings(**store, *other);
+  ASSERT_TRUE(none.ok()) << none.status().ToString();
+  EXPECT_FALSE(none->white_reflectance_spectrum.has_value());
+  auto broken = (*store)->CreateSession(MakeNewSession(), MakeSteps(2));  // "kind": not a Plan key
+  Result<SessionReadings> bad = LoadSessionReadings(**store, *broken);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("stored plan does not parse"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace brdf::storage
