@@ -13,7 +13,14 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-grpcio python3-protobuf python3-serial
   python3-scipy python3-matplotlib colord-data
+  libcpp-httplib-dev chromium
 )
+# The web console's build needs node and npm; Debian's nodejs and npm unless a node is already
+# installed (another distribution of node, e.g. NodeSource's, brings its own npm and conflicts
+# with Debian's npm package).
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  packages+=(nodejs npm)
+fi
 if [[ "${1:-}" == "--with-extras" ]]; then
   packages+=(clang-14 libclang-rt-14-dev)
 fi
