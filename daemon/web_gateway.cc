@@ -115,6 +115,11 @@ namespace {
 
 void ServeStream(const std::shared_ptr<JsonRpc>& rpc, const std::shared_ptr<WebStreams>& streams,
                  const WebMethod& method, const httplib::Request& req, httplib::Response& res) {
+  OmitFields omit;
+  if (grpc::Status st = ParseOmit(method, req.get_param_value("omit"), &omit); !st.ok()) {
+    ReplyError(res, st);
+    return;
+  }
   auto call = std::make_shared<StreamCall>();
   if (!streams->Admit(call.get())) {
     ReplyError(res, grpc::Status(grpc::RESOURCE_EXHAUSTED,
@@ -124,23 +129,23 @@ void ServeStream(const std::shared_ptr<JsonRpc>& rpc, const std::shared_ptr<WebS
     return;
   }
   StreamCall* raw = call.get();
-  call->reader = std::thread(
-      [rpc, raw, &method, body = req.body, auth = req.get_header_value("Authorization")] {
-        grpc::Status st = rpc->Stream(method, body, auth, &raw->context, [raw](std::string json) {
-          MutexLock lock(raw->mu);
-          raw->cv.Wait(raw->mu, [raw]() REQUIRES(raw->mu) {
-            return raw->abandoned || raw->queue.size() < kMaxQueuedMessages;
-          });
-          if (raw->abandoned) return false;
-          raw->queue.push_back(std::move(json));
-          raw->cv.NotifyAll();
-          return true;
-        });
-        MutexLock lock(raw->mu);
-        raw->done = true;
-        raw->status = std::move(st);
-        raw->cv.NotifyAll();
+  call->reader = std::thread([rpc, raw, &method, body = req.body, omit = std::move(omit),
+                              auth = req.get_header_value("Authorization")] {
+    grpc::Status st = rpc->Stream(method, body, auth, omit, &raw->context, [raw](std::string json) {
+      MutexLock lock(raw->mu);
+      raw->cv.Wait(raw->mu, [raw]() REQUIRES(raw->mu) {
+        return raw->abandoned || raw->queue.size() < kMaxQueuedMessages;
       });
+      if (raw->abandoned) return false;
+      raw->queue.push_back(std::move(json));
+      raw->cv.NotifyAll();
+      return true;
+    });
+    MutexLock lock(raw->mu);
+    raw->done = true;
+    raw->status = std::move(st);
+    raw->cv.NotifyAll();
+  });
   auto finish = [streams, call] {
     call->Abandon();
     if (call->reader.joinable()) call->reader.join();

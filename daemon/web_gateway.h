@@ -5,6 +5,7 @@
 //        unary methods   → 200 application/json, the response; errors → {"code","message"} with
 //                          401 (no or unknown token), 403 (role), 400 (bad request or JSON),
 //                          404, 409 (not in this state), 413 (body over kMaxBodyBytes), 429, 503…
+//        ?omit=f1,f2     → (streams) those top-level fields of every answer left out
 //        stream methods  → 200 text/event-stream: one "data: <json>" event per message, then
 //                          "event: end" with {"code","message"} (OK or why the stream ended);
 //                          a call refused before its first message is answered as a unary error.

@@ -214,8 +214,33 @@ grpc::Status JsonRpc::Unary(const WebMethod& method, std::string_view json_reque
   return st;
 }
 
+grpc::Status ParseOmit(const WebMethod& method, std::string_view comma_separated,
+                       OmitFields* fields) {
+  const pb::Descriptor* type = method.descriptor->output_type();
+  std::size_t start = 0;
+  while (start < comma_separated.size()) {
+    std::size_t end = comma_separated.find(',', start);
+    if (end == std::string_view::npos) end = comma_separated.size();
+    const std::string name(comma_separated.substr(start, end - start));
+    const pb::FieldDescriptor* field = type->FindFieldByName(name);
+    if (field == nullptr) {
+      std::string known;
+      for (int i = 0; i < type->field_count(); ++i) {
+        known += (known.empty() ? "" : ", ") + type->field(i)->name();
+      }
+      return grpc::Status(
+          grpc::INVALID_ARGUMENT,
+          "omit: " + type->full_name() + " has no field \"" + name + "\" (fields: " + known + ")");
+    }
+    fields->push_back(field);
+    start = end + 1;
+  }
+  return grpc::Status::OK;
+}
+
 grpc::Status JsonRpc::Stream(const WebMethod& method, std::string_view json_request,
-                             const std::string& authorization, grpc::ClientContext* context,
+                             const std::string& authorization, const OmitFields& omit,
+                             grpc::ClientContext* context,
                              const std::function<bool(std::string json)>& on_message) const {
   std::unique_ptr<pb::Message> request;
   if (grpc::Status st = PrepareRequest(method, json_request, authorization, context, &request);
@@ -229,6 +254,8 @@ grpc::Status JsonRpc::Stream(const WebMethod& method, std::string_view json_requ
                                                                *request));
   std::unique_ptr<pb::Message> answer = NewMessage(method.descriptor->output_type());
   while (reader->Read(answer.get())) {
+    for (const pb::FieldDescriptor* field : omit)
+      answer->GetReflection()->ClearField(answer.get(), field);
     if (!on_message(ToJson(*answer))) {
       context->TryCancel();
       break;

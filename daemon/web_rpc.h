@@ -17,6 +17,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace brdf::daemon {
 
@@ -37,6 +38,13 @@ grpc::Status ParseJsonRequest(std::string_view json, google::protobuf::Message* 
 
 // The message as JSON (one line).
 std::string ToJson(const google::protobuf::Message& message);
+
+// Top-level fields of the answers to leave out ("radiance"), named as in brdf.proto; the web
+// explorer lists 50,000 readings without their spectra this way. A name the answer type does not
+// have is INVALID_ARGUMENT (naming the known fields).
+using OmitFields = std::vector<const google::protobuf::FieldDescriptor*>;
+grpc::Status ParseOmit(const WebMethod& method, std::string_view comma_separated,
+                       OmitFields* fields);
 
 // The gRPC status as the gateway's JSON error body: {"code":"PERMISSION_DENIED","message":"…"}.
 std::string StatusJson(const grpc::Status& status);
@@ -61,7 +69,8 @@ class JsonRpc {
   // false to cancel the call. `context` is the caller's so that another thread may TryCancel it;
   // fresh, one per call.
   grpc::Status Stream(const WebMethod& method, std::string_view json_request,
-                      const std::string& authorization, grpc::ClientContext* context,
+                      const std::string& authorization, const OmitFields& omit,
+                      grpc::ClientContext* context,
                       const std::function<bool(std::string json)>& on_message) const;
 
  private:

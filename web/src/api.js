@@ -30,9 +30,11 @@ export async function call(method, body = {}) {
 }
 
 // Calls a server-streaming method; onMessage(msg) for each message; resolves when the stream
-// ends OK, rejects with the reason otherwise. `signal` (AbortController) cancels it.
-export async function stream(method, body, onMessage, signal) {
-  const r = await fetch(`/api/brdf.v1.${method}`, { method: 'POST', headers: headers(), body: JSON.stringify(body), signal });
+// ends OK, rejects with the reason otherwise. `signal` (AbortController) cancels it. `omit`:
+// top-level fields of every answer the gateway leaves out (e.g. ['radiance']).
+export async function stream(method, body, onMessage, signal, omit = []) {
+  const query = omit.length ? `?omit=${omit.map(encodeURIComponent).join(',')}` : '';
+  const r = await fetch(`/api/brdf.v1.${method}${query}`, { method: 'POST', headers: headers(), body: JSON.stringify(body), signal });
   if (!r.ok) throw await errorOf(r);
   const reader = r.body.getReader();
   const decoder = new TextDecoder();

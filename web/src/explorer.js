@@ -76,7 +76,9 @@ export function createExplorer(root, report) {
     const t0 = performance.now();
     readings = [];
     let first = 0;
-    await stream('Data/StreamReadings', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (r) => { if (!first) first = performance.now() - t0; readings.push(r); });
+    // Where each reading was taken, without its spectrum (fetched on a click): a 50,000-reading
+    // session is then a few MB instead of 150.
+    await stream('Data/StreamReadings', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (r) => { if (!first) first = performance.now() - t0; readings.push(r); }, undefined, ['radiance']);
     const streamed = performance.now() - t0;
     byId = new Map(readings.map((r) => [r.id, r]));
     if (readings.length === 0) {
@@ -103,11 +105,13 @@ export function createExplorer(root, report) {
     const r = byId.get(id);
     if (!r) return;
     readingInfo.textContent = `reading ${r.id}: α ${r.pose.alpha}°, β ${r.pose.beta}°, δ ${r.pose.delta}°; θi ${r.iso.theta_i.toFixed(1)}°, θo ${r.iso.theta_o.toFixed(1)}°, φ ${r.iso.phi.toFixed(1)}°; quality ${r.quality_code}${r.flagged ? ' (flagged)' : ''}`;
-    const traces = [{ x: wavelengths(r.grid, r.radiance.length), y: r.radiance, name: 'radiance (W·m⁻²·sr⁻¹·nm⁻¹)' }];
-    for (const [q, label] of [['QUANTITY_REFLECTANCE', 'reflectance'], ['QUANTITY_BRDF', 'BRDF (sr⁻¹)']]) {
+    // The reading's own spectrum in each quantity: the nearest reading to its own direction is
+    // itself (the daemon converts radiance to reflectance and BRDF with its reference).
+    const traces = [];
+    for (const [q, label, axis] of [['QUANTITY_RADIANCE', 'radiance (W·m⁻²·sr⁻¹·nm⁻¹)', 'y'], ['QUANTITY_REFLECTANCE', 'reflectance', 'y2'], ['QUANTITY_BRDF', 'BRDF (sr⁻¹)', 'y2']]) {
       try {
         const res = (await call('Interpolation/Interpolate', { session_id: session, method: 'INTERPOLATION_METHOD_NEAREST', quantity: q, direction: { iso: r.iso } })).result;
-        if (res.status === 'INTERPOLATION_STATUS_OK') traces.push({ x: wavelengths(res.grid, res.spectrum.length), y: res.spectrum, name: label, yaxis: 'y2' });
+        if (res.status === 'INTERPOLATION_STATUS_OK') traces.push({ x: wavelengths(res.grid, res.spectrum.length), y: res.spectrum, name: label, yaxis: axis });
       } catch (e) { report(e.message); }
     }
     Plotly.react(spectrum, traces, { height: 320, margin: { t: 20 }, xaxis: { title: { text: 'wavelength nm' } }, yaxis: { title: { text: 'radiance' } }, yaxis2: { overlaying: 'y', side: 'right', title: { text: 'reflectance, BRDF' } } }, PLOT);

@@ -56,6 +56,8 @@ try {
   const g = await fetch(api('Control/ListSessions'));
   check(g.status === 405, 'GET on the API → 405');
 
+  r = await post('Data/StreamReadings?omit=radiance,nonsense', { session_id: '1' }, rig.analystToken);
+  check(r.status === 400 && /no field "nonsense"/.test(r.json.message), `?omit= of an unknown field → 400 (${r.json?.message})`);
   r = await post('Control/WatchSession', { session_id: '1' }, '');
   check(r.status === 401 && !(r.headers.get('content-type') || '').includes('event-stream'), 'a stream without a token → 401, not an event stream');
   r = await post('Control/WatchSession', { session_id: '999999' }, rig.analystToken);
