@@ -313,6 +313,22 @@ void ReadServer(TableReader& root, Config& c, Issues& issues) {
   t.Finish();
 }
 
+void ReadWeb(TableReader& root, Config& c, Issues& issues) {
+  TableReader t(root.Table("web"), "web", issues);
+  std::string listen;
+  if (t.String("listen", listen)) {
+    std::string host, reason;
+    int port = 0;
+    if (!SplitHostPort(listen, 0, host, port, reason)) {
+      t.Issue(*t.Node("listen"), "listen", reason + "; give e.g. \"127.0.0.1:8080\"");
+    } else {
+      c.web.listen = listen;
+    }
+  }
+  t.String("root", c.web.root);
+  t.Finish();
+}
+
 void ReadMeter(TableReader& root, Config& c, Issues& issues) {
   TableReader t(root.Table("meter"), "meter", issues);
   MeterConfig& m = c.meter;
@@ -573,6 +589,7 @@ Result<Config> ParseConfig(std::string_view toml_text, std::string_view source) 
     t.OneOf("level", c.log.level, {"trace", "debug", "info", "warn", "error", "critical", "off"});
     t.Finish();
   }
+  ReadWeb(root, c, issues);
   root.Finish();
   if (!issues.empty()) return ConfigurationError(issues.Join(source));
   return c;

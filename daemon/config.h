@@ -73,6 +73,10 @@
 //
 //   [log]
 //   level = "info"                      # trace, debug, info, warn, error, critical, off
+//
+//   [web]                               # the browser console (web_gateway.h); off by default
+//   listen = "127.0.0.1:8080"           # host:port (port 0: any free port); TLS from [server.tls]
+//   root = "/usr/share/brdfd/web"       # the built front end (default: installed, else build tree)
 #pragma once
 
 #include <map>
@@ -190,6 +194,12 @@ struct LogConfig {
   std::string level = "info";
 };
 
+// [web]: the gateway is off while listen is empty.
+struct WebConfig {
+  std::string listen;
+  std::string root;
+};
+
 struct Config {
   ServerConfig server;
   StorageConfig storage;
@@ -200,6 +210,7 @@ struct Config {
   ArchiveConfig archive;
   std::vector<TokenConfig> tokens;  // [[auth.tokens]]
   LogConfig log;
+  WebConfig web;
 };
 
 // Shortest acceptable token, in bytes.

@@ -8,7 +8,8 @@
 // rig (devices connect in the background: an absent device shows as disconnected and is
 // retried, the API is up meanwhile), then the gRPC server. Once serving it prints exactly one
 // line on stdout, "brdfd listening on <address>" (the real port when the configured port is 0),
-// and tells systemd READY=1 when built with libsystemd.
+// and tells systemd READY=1 when built with libsystemd. With [web] listen set, the web console
+// (web_gateway.h) starts first and its line, "brdfd web console on <url>", comes just before.
 //
 // SIGTERM / SIGINT: a deferred pause of the running session (the step in progress finishes, for
 // up to --shutdown-timeout, then it is cancelled and redone on resume), the devices close, the
@@ -24,6 +25,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <thread>
@@ -35,6 +37,7 @@
 #include "daemon/one_owner.h"
 #include "daemon/rig.h"
 #include "daemon/server.h"
+#include "daemon/web_gateway.h"
 #include "daemon/session_manager.h"
 #include "drivers/exclusive_open.h"
 #include "storage/session_store.h"
@@ -53,6 +56,18 @@ constexpr int kExitConfiguration = 2;  // a bad command line or configuration fi
 void Notify([[maybe_unused]] const std::string& state) {
 #ifdef BRDF_HAVE_SYSTEMD
   sd_notify(0, state.c_str());
+#endif
+}
+
+// The built front end: [web] root, else the installed one, else the build tree's (a daemon run
+// from its build directory, as the quick start and the tests do).
+std::string WebRoot(const brdf::daemon::WebConfig& web) {
+  if (!web.root.empty()) return web.root;
+#if defined(BRDF_WEB_INSTALL_DIR) && defined(BRDF_WEB_BUILD_DIR)
+  if (std::ifstream(std::string(BRDF_WEB_INSTALL_DIR) + "/index.html")) return BRDF_WEB_INSTALL_DIR;
+  return BRDF_WEB_BUILD_DIR;
+#else
+  return {};
 #endif
 }
 
@@ -218,6 +233,20 @@ int main(int argc, char** argv) {
     return kExitFailure;
   }
   spdlog::info("serving on {} ({})", (*server)->address(), (*server)->tls() ? "TLS" : "plaintext");
+  std::unique_ptr<WebGateway> web;
+  if (!config.web.listen.empty()) {
+    Result<std::unique_ptr<WebGateway>> started =
+        WebGateway::Start(config.web, config.server.tls, WebRoot(config.web),
+                          (*server)->InProcessChannel());
+    if (!started.ok()) {
+      spdlog::critical("{}", started.status().ToString());
+      (*server)->Shutdown(std::chrono::seconds(1));
+      manager.RemoveReadingListener(cache_listener);
+      return kExitFailure;
+    }
+    web = std::move(*started);
+    std::printf("brdfd web console on %s\n", web->url().c_str());
+  }
   std::printf("brdfd listening on %s\n", (*server)->address().c_str());
   std::fflush(stdout);
   Notify("READY=1\nSTATUS=serving on " + (*server)->address());
@@ -234,6 +263,7 @@ int main(int argc, char** argv) {
     manager.Shutdown(std::chrono::milliseconds(static_cast<long>(shutdown_timeout_s * 1000)));
     manager.RemoveReadingListener(cache_listener);
     spdlog::info("sessions paused and devices closed; stopping the server");
+    if (web) web->Stop();
     (*server)->Shutdown(std::chrono::seconds(2));
     done = true;
   });

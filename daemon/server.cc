@@ -237,6 +237,12 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   return server;
 }
 
+std::shared_ptr<grpc::Channel> Server::InProcessChannel() {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(-1);  // answers are limited by the services themselves
+  return server_->InProcessChannel(args);
+}
+
 void Server::Shutdown(std::chrono::milliseconds grace) {
   if (shut_down_ || !server_) return;
   shut_down_ = true;

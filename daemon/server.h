@@ -64,6 +64,11 @@ class Server {
   int port() const { return port_; }
   bool tls() const { return tls_; }
 
+  // A channel to these services inside the process (no socket, no TLS): calls on it pass the
+  // same authentication, roles, validation and limits as calls from the network. The web
+  // gateway (web_gateway.h) forwards the browser's calls through it.
+  std::shared_ptr<grpc::Channel> InProcessChannel();
+
   // Health → NOT_SERVING, long-lived streams end (after sending what is queued), then calls in
   // flight get up to `grace` to finish before they are cancelled. Idempotent.
   void Shutdown(std::chrono::milliseconds grace);

@@ -15,7 +15,15 @@ packages=(
   python3-scipy python3-matplotlib colord-data
   # the lab archive: libpq for brdfd and brdf-archive; the server and psql for its tests
   libpq-dev postgresql-15 postgresql-client-15
+  # the web console: its HTTP server, and the browser its tests drive
+  libcpp-httplib-dev chromium
 )
+# The web console's build needs node and npm; Debian's nodejs and npm unless a node is already
+# installed (another distribution of node, e.g. NodeSource's, brings its own npm and conflicts
+# with Debian's npm package).
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  packages+=(nodejs npm)
+fi
 if [[ "${1:-}" == "--with-extras" ]]; then
   packages+=(clang-14 libclang-rt-14-dev)
 fi

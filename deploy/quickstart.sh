@@ -9,7 +9,8 @@
 #      would do them on the real rig;
 #   4. prints the interpolated spectrum at a direction between the samples, next to the spectra
 #      and weights of the readings it blends;
-#   5. leaves brdfd and brdf-sim running and says how to use and stop them.
+#   5. leaves brdfd and brdf-sim running and says how to use and stop them, and prints the URL
+#      of the web console (operator console and explorer in the browser).
 # Running it again stops what the previous run started (pid files in ./run/) and starts afresh.
 #
 # Usage: deploy/quickstart.sh [--no-build]   build (unless --no-build) and run the live demo
@@ -17,7 +18,8 @@
 #        deploy/quickstart.sh --offline      no daemon: the offline interpolation demo
 #                                            (brdf-interp demo; extra arguments go to it)
 # Environment: BUILD_DIR (default ./build), RUN_DIR (default ./run), JOBS (build jobs, default:
-# number of cores), QUICKSTART_TIME_SCALE (how much faster the simulated rig runs; default 8, so
+# number of cores), QUICKSTART_WEB_PORT (the web console's first choice of port, default 8080),
+# QUICKSTART_TIME_SCALE (how much faster the simulated rig runs; default 8, so
 # the demo takes about a minute), QUICKSTART_PORT (brdfd's first choice of port, default 50051).
 set -euo pipefail
 
@@ -27,6 +29,7 @@ run="${RUN_DIR:-$root/run}"
 jobs="${JOBS:-$(nproc)}"
 time_scale="${QUICKSTART_TIME_SCALE:-8}"
 first_port="${QUICKSTART_PORT:-50051}"
+first_web_port="${QUICKSTART_WEB_PORT:-8080}"
 
 case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
 case "$run" in /*) ;; *) run="$PWD/$run" ;; esac
@@ -150,6 +153,9 @@ if [[ $build_it -eq 1 ]]; then
     cmake --build "$build" -j "$jobs" --target brdf-interp
   else
     cmake --build "$build" -j "$jobs" --target brdfd brdf-sim brdfctl
+    # The web console's front end (a target only when node and npm are there).
+    cmake --build "$build" -j "$jobs" --target brdf_web 2>/dev/null ||
+      echo "quickstart: the web console's front end was not built (node/npm missing?); the demo goes on"
   fi
 fi
 
@@ -225,6 +231,11 @@ while port_busy "$port"; do
   [[ $port -lt $((first_port + 20)) ]] || die "no free port in $first_port…$port; set QUICKSTART_PORT"
 done
 address="127.0.0.1:$port"
+web_port="$first_web_port"
+while port_busy "$web_port" || [[ "$web_port" == "$port" ]]; do
+  web_port=$((web_port + 1))
+  [[ $web_port -lt $((first_web_port + 20)) ]] || die "no free port for the web console; set QUICKSTART_WEB_PORT"
+done
 
 # The meter's pacing and the stage's settling are shortened by the same factor as the simulated
 # time; everything else is deploy/brdfd.example.toml's defaults (see that file for every key).
@@ -268,6 +279,9 @@ name = "quickstart-analyst"
 token = "$analyst_token"
 role = "analyst"
 
+[web]
+listen = "127.0.0.1:$web_port"   # the web console (operator console and explorer)
+
 [log]
 level = "info"
 EOF
@@ -277,6 +291,8 @@ say "starting brdfd on $address"
 start_detached brdfd "$brdfd" --config "$run/brdfd.toml" --shutdown-timeout 5
 wait_for_line brdfd '^brdfd listening on' 20
 echo "quickstart: brdfd pid $(cat "$run/brdfd.pid"), log $run/brdfd.log"
+web_url="$(awk '/^brdfd web console on / { print $5 }' "$run/brdfd.out")"
+[[ -z "$web_url" ]] || echo "quickstart: web console on $web_url (token: $run/operator.token)"
 
 export BRDF_ADDRESS="$address"
 export BRDF_TOKEN="$operator_token"
@@ -368,6 +384,13 @@ example "brdfctl abort <id> --reason \"lamp flickers\"" "stop for good (data kep
 example "brdfctl export $session csv -o demo.csv" "readings, units in the header"
 example "brdfctl export $session grid --steps 5 -o demo.npy" "regular grid (+ demo.npy.json)"
 example "brdfctl export $session merl -o demo.binary" "MERL BRDF file (RGB, D65)"
+if [[ -n "$web_url" ]]; then
+  cat <<EOF
+
+In the browser: $web_url
+  sign in with the token in $run/operator.token (operator) or $run/analyst.token (read only)
+EOF
+fi
 cat <<EOF
 
 Files: $run/brdfd.toml (configuration), $run/brdfd.db (data),

@@ -383,5 +383,19 @@ TEST(ConfigTest, OversizedFileIsRefused) {
   EXPECT_THAT(Refusal(big), HasSubstr("cap"));
 }
 
+TEST(ConfigTest, WebConsoleIsOffUnlessListenIsSet) {
+  Result<Config> defaults = ParseConfig("");
+  ASSERT_TRUE(defaults.ok());
+  EXPECT_TRUE(defaults->web.listen.empty());
+  EXPECT_TRUE(defaults->web.root.empty());
+  Result<Config> r = ParseConfig("[web]\nlisten = \"127.0.0.1:0\"\nroot = \"/srv/brdfd-web\"\n");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->web.listen, "127.0.0.1:0");
+  EXPECT_EQ(r->web.root, "/srv/brdfd-web");
+  EXPECT_THAT(Refusal("[web]\nlisten = \"8080\"\n"), HasSubstr("web.listen"));
+  EXPECT_THAT(Refusal("[web]\nlisten = \"127.0.0.1:70000\"\n"), HasSubstr("web.listen"));
+  EXPECT_THAT(Refusal("[web]\nlisen = \"127.0.0.1:8080\"\n"), HasSubstr("unknown key web.lisen"));
+}
+
 }  // namespace
 }  // namespace brdf::daemon

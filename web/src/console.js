@@ -1,0 +1,224 @@
+// The operator console: the queue and history, submitting a plan (validated first: problems at
+// their field paths, the estimated time), the operator verbs, live progress with ETA and the
+// coverage of the hemisphere (WatchSession), prompts, the rig and the session's events.
+// Analysts see the same pages without any control (and the server refuses control anyway).
+import Plotly from 'plotly.js-strict-dist-min';
+import { call, stream } from './api.js';
+import { el, clear, stateName, duration } from './dom.js';
+
+const ACTIVE = ['SESSION_STATE_QUEUED', 'SESSION_STATE_RUNNING', 'SESSION_STATE_PAUSING', 'SESSION_STATE_PAUSED', 'SESSION_STATE_AWAITING_OPERATOR'];
+
+export function createConsole(root, role, report) {
+  const operator = role === 'operator';
+  let selected = null;          // session id
+  let watch = null;             // AbortController of the WatchSession stream
+  let events = [];
+  let covered = [];             // sample readings' directions
+  let lastReadingId = 0;
+  let coverageBusy = false;
+
+  const sessionsBody = el('tbody');
+  const planFile = el('input', { type: 'file', id: 'plan-file', accept: '.json,application/json' });
+  const validation = el('div', { id: 'validation' });
+  const submitButton = el('button', { id: 'submit-plan', disabled: true }, 'Submit');
+  const submitStartButton = el('button', { id: 'submit-start', disabled: true }, 'Submit and start');
+  const detail = el('div', { id: 'session-detail' }, el('p', {}, 'Select a session.'));
+  const rig = el('div', { id: 'rig' });
+  const coverage = el('div', { id: 'coverage', class: 'plot' });
+  const eventList = el('ol', { id: 'events' });
+  let plan = null;
+
+  root.append(
+    el('div', { class: 'columns' },
+      el('div', { class: 'col' },
+        el('h2', {}, 'Sessions'),
+        el('table', { id: 'sessions' }, el('thead', {}, el('tr', {}, el('th', {}, 'name'), el('th', {}, 'state'), el('th', {}, 'progress'), el('th', {}, 'created'))), sessionsBody),
+        el('h2', {}, 'Plan'),
+        el('p', {}, 'Choose a plan file (JSON); it is checked against this rig before anything is stored.'),
+        planFile, validation,
+        operator ? el('div', { class: 'buttons' }, submitButton, submitStartButton) : el('p', { class: 'muted' }, 'Analyst token: read only.'),
+        el('h2', {}, 'Rig'), rig),
+      el('div', { class: 'col wide' },
+        el('h2', {}, 'Session'), detail,
+        el('h3', {}, 'Hemisphere coverage (measured outgoing directions)'), coverage,
+        el('h3', {}, 'Events'), eventList)));
+
+  planFile.addEventListener('change', async () => {
+    clear(validation);
+    plan = null;
+    submitButton.disabled = submitStartButton.disabled = true;
+    const file = planFile.files[0];
+    if (!file) return;
+    try { plan = JSON.parse(await file.text()); }
+    catch (e) { validation.append(el('p', { class: 'error' }, `${file.name} is not JSON: ${e.message}`)); return; }
+    try {
+      const v = await call('Control/ValidatePlan', { plan });
+      if (v.valid) {
+        validation.append(el('p', { class: 'ok', id: 'plan-valid' },
+          `valid: ${v.step_count} steps, ${v.summary?.sample_readings ?? '?'} sample readings, ${v.operator_interventions} operator interventions, estimated ${duration(v.estimated_duration_s)}`));
+        submitButton.disabled = submitStartButton.disabled = false;
+      } else {
+        validation.append(el('p', { class: 'error' }, `${v.problems.length} problem(s):`),
+          el('ul', { id: 'plan-problems' }, v.problems.map((p) => el('li', {}, el('code', {}, p.field_path || '(plan)'), ' ', p.message))));
+      }
+    } catch (e) { validation.append(el('p', { class: 'error' }, e.message)); }
+  });
+
+  async function submit(start) {
+    try {
+      const r = await call('Control/SubmitPlan', { plan, start_now: start });
+      report('');
+      await refreshSessions();
+      select(r.session.session_id);
+    } catch (e) { report(e.message); }
+  }
+  submitButton.addEventListener('click', () => submit(false));
+  submitStartButton.addEventListener('click', () => submit(true));
+
+  async function refreshSessions() {
+    const r = await call('Control/ListSessions', { page_size: 50 });
+    clear(sessionsBody);
+    for (const s of r.sessions) {
+      const p = s.progress || {};
+      sessionsBody.append(el('tr', {
+        class: s.session_id === selected ? 'selected' : '', 'data-id': s.session_id,
+        onclick: () => select(s.session_id),
+      }, el('td', {}, s.name || s.session_id), el('td', { class: `state ${stateName(s.state)}` }, stateName(s.state)),
+      el('td', {}, `${p.done_steps}/${p.total_steps}`), el('td', {}, (s.created_at || '').replace('T', ' ').slice(0, 19))));
+    }
+    return r.sessions;
+  }
+
+  async function refreshRig() {
+    try {
+      const r = await call('Control/GetRigStatus', {});
+      clear(rig).append(
+        el('ul', {}, r.devices.map((d) => el('li', {}, `${d.name}: ${String(d.state).replace('CONNECTION_STATE_', '').toLowerCase()} ${d.model} ${d.address} ${d.detail}`))),
+        el('p', {}, r.live_pose_valid ? `pose α ${r.live_pose.alpha.toFixed(2)}°, β ${r.live_pose.beta.toFixed(2)}°, γ ${r.live_pose.gamma.toFixed(2)}°, δ ${r.live_pose.delta.toFixed(2)}°` : 'pose unknown'),
+        el('p', {}, `meter serial: ${r.meter_serial || '—'}`),
+        r.active_session_id ? el('p', {}, `active session: ${r.active_session_id}`) : null);
+    } catch (e) { clear(rig).append(el('p', { class: 'error' }, e.message)); }
+  }
+
+  function verb(label, id, fn) {
+    return el('button', { id, onclick: async () => { try { await fn(); report(''); } catch (e) { report(e.message); } } }, label);
+  }
+
+  function renderSession(s) {
+    const p = s.progress || {};
+    const fraction = p.total_steps ? p.done_steps / p.total_steps : 0;
+    const state = s.state;
+    const items = [
+      el('p', {}, el('strong', {}, s.name || ''), ' ', el('code', {}, s.session_id)),
+      el('p', {}, 'state: ', el('span', { id: 'session-state', class: `state ${stateName(state)}` }, stateName(state)), s.end_reason ? ` — ${s.end_reason}` : ''),
+      el('progress', { id: 'session-progress', max: 1, value: fraction }),
+      el('p', { id: 'progress-text' }, `${p.done_steps}/${p.total_steps} steps, ${p.done_samples}/${p.total_samples} sample readings` +
+        (ACTIVE.includes(state) && state !== 'SESSION_STATE_QUEUED' ? `, ETA ${duration(s.eta_s)}` : '')),
+      s.last_quality_code ? el('p', {}, `last meter quality code: ${s.last_quality_code}`) : null,
+      s.last_fault ? el('p', { class: 'error' }, `fault at step ${s.last_fault.step_index}: ${s.last_fault.code} ${s.last_fault.reason}${s.last_fault.will_retry ? ' (retrying)' : ''}`) : null,
+    ];
+    if (s.pending_prompt) {
+      const pr = s.pending_prompt;
+      items.push(el('div', { class: 'prompt', id: 'prompt', 'data-kind': pr.kind, 'data-step': pr.step_index },
+        el('h3', {}, 'The operator must act'),
+        el('p', { id: 'prompt-text' }, pr.text),
+        pr.expected_action ? el('p', {}, pr.expected_action) : null,
+        operator ? el('div', {}, el('input', { id: 'prompt-note', placeholder: 'note (optional)' }),
+          verb('Done — continue', 'answer-prompt', async () => {
+            const note = document.getElementById('prompt-note').value;
+            await call('Control/AnswerPrompt', { session_id: s.session_id, step_index: pr.step_index, note });
+          })) : null));
+    }
+    if (operator) {
+      const id = s.session_id;
+      const abortReason = el('input', { id: 'abort-reason', placeholder: 'abort reason' });
+      items.push(el('div', { class: 'buttons', id: 'controls' },
+        state === 'SESSION_STATE_QUEUED' ? verb('Start', 'start', () => call('Control/StartSession', { session_id: id })) : null,
+        ['SESSION_STATE_RUNNING', 'SESSION_STATE_AWAITING_OPERATOR'].includes(state) ? [
+          verb('Pause (after this step)', 'pause-deferred', () => call('Control/PauseSession', { session_id: id, mode: 'PAUSE_MODE_DEFERRED' })),
+          verb('Pause now', 'pause-immediate', () => call('Control/PauseSession', { session_id: id, mode: 'PAUSE_MODE_IMMEDIATE' }))] : null,
+        ['SESSION_STATE_PAUSED', 'SESSION_STATE_PAUSING'].includes(state) ? verb('Resume', 'resume', () => call('Control/ResumeSession', { session_id: id })) : null,
+        ACTIVE.includes(state) ? [abortReason, verb('Abort', 'abort', () => call('Control/AbortSession', { session_id: id, reason: abortReason.value || 'aborted from the web console' }))] : null));
+    }
+    clear(detail).append(...items.filter(Boolean));
+  }
+
+  function addEvent(ev) {
+    let text = '';
+    if (ev.snapshot) text = `snapshot: ${stateName(ev.snapshot.state)}`;
+    else if (ev.state_changed) text = `${stateName(ev.state_changed.from)} → ${stateName(ev.state_changed.to)}${ev.state_changed.reason ? ` (${ev.state_changed.reason})` : ''}`;
+    else if (ev.prompt) text = `prompt: ${ev.prompt.text}`;
+    else if (ev.step_completed) text = `step ${ev.step_completed.step_index} done (${String(ev.step_completed.kind).replace('STEP_KIND_', '').toLowerCase()})${ev.step_completed.flagged ? ', flagged' : ''}`;
+    else if (ev.fault) text = `fault: ${ev.fault.code} ${ev.fault.reason}`;
+    events.unshift(`${(ev.time || '').slice(11, 19)} #${ev.sequence} ${text}`);
+    events = events.slice(0, 200);
+    clear(eventList).append(...events.map((t) => el('li', {}, t)));
+  }
+
+  async function updateCoverage(id) {
+    if (coverageBusy) return;
+    coverageBusy = true;
+    try {
+      await stream('Data/StreamReadings', { session_id: id, kinds: ['READING_KIND_SAMPLE'], after_id: String(lastReadingId) }, (r) => {
+        lastReadingId = Math.max(lastReadingId, Number(r.id));
+        covered.push(r.directions);
+      });
+      Plotly.react(coverage, [{
+        type: 'scatterpolar', mode: 'markers',
+        r: covered.map((d) => d.theta_o), theta: covered.map((d) => d.phi_o),
+        marker: { size: 6, color: covered.map((d) => d.theta_i), colorscale: 'Viridis', showscale: true, colorbar: { title: { text: 'θi °' } } },
+      }], {
+        margin: { t: 20, b: 20, l: 30, r: 30 }, height: 320,
+        polar: { radialaxis: { range: [0, 90], title: { text: 'θo °' } }, angularaxis: { direction: 'counterclockwise' } },
+      }, { displaylogo: false, responsive: true });
+    } catch (e) { report(e.message); }
+    finally { coverageBusy = false; }
+  }
+
+  async function select(id) {
+    if (watch) watch.abort();
+    selected = id;
+    events = [];
+    covered = [];
+    lastReadingId = 0;
+    clear(eventList);
+    for (const tr of sessionsBody.children) tr.classList.toggle('selected', tr.dataset.id === id);
+    const controller = new AbortController();
+    watch = controller;
+    let session = null;
+    updateCoverage(id);
+    stream('Control/WatchSession', { session_id: id }, async (ev) => {
+      addEvent(ev);
+      if (ev.snapshot) session = ev.snapshot;
+      else if (session) {
+        if (ev.step_completed) {
+          session.progress = ev.step_completed.progress;
+          session.eta_s = ev.step_completed.eta_s;
+          if (ev.step_completed.kind === 'STEP_KIND_SAMPLE') updateCoverage(id);
+        }
+        if (ev.state_changed || ev.prompt || ev.fault) {
+          try { session = await call('Control/GetSession', { session_id: id }); } catch (e) { report(e.message); }
+          refreshSessions();
+        }
+      }
+      if (session && selected === id) renderSession(session);
+    }, controller.signal).then(async () => {
+      // The session ended: the final state and readings.
+      if (selected !== id) return;
+      try { renderSession(await call('Control/GetSession', { session_id: id })); } catch (e) { report(e.message); }
+      updateCoverage(id);
+      refreshSessions();
+    }).catch((e) => { if (e.name !== 'AbortError' && selected === id) report(e.message); });
+  }
+
+  const timers = [];
+  return {
+    async show() {
+      const sessions = await refreshSessions();
+      refreshRig();
+      timers.push(setInterval(refreshRig, 2000), setInterval(() => refreshSessions().catch(() => {}), 5000));
+      if (!selected && sessions.length) select(sessions[0].session_id);
+    },
+    hide() { while (timers.length) clearInterval(timers.pop()); },
+  };
+}

@@ -1,0 +1,222 @@
+// The explorer: the paper's Figure 7 (a session's readings in (α, β, δ) and in (θi, θo, φ),
+// rotatable), a reading's spectrum on click, the interpolated spectrum at a chosen direction with
+// its vertices and weights (Figure 8, method switch), a polar plot in the plane of incidence
+// with a wavelength slider, and downloads of every export (Data.Export).
+import Plotly from 'plotly.js-strict-dist-min';
+import { call, stream } from './api.js';
+import { el, clear, stateName } from './dom.js';
+
+const PLOT = { displaylogo: false, responsive: true };
+
+function wavelengths(grid, n) {
+  const count = n ?? grid.count;
+  return Array.from({ length: count }, (_, i) => grid.start_nm + i * grid.step_nm);
+}
+
+function fromBase64(s) {
+  const bin = atob(s);
+  const out = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; i++) out[i] = bin.charCodeAt(i);
+  return out;
+}
+
+export function createExplorer(root, report) {
+  const sessionSelect = el('select', { id: 'explorer-session' });
+  const loadInfo = el('span', { id: 'explorer-info' });
+  const fig7a = el('div', { id: 'fig7-pose', class: 'plot half' });
+  const fig7b = el('div', { id: 'fig7-iso', class: 'plot half' });
+  const spectrum = el('div', { id: 'reading-spectrum', class: 'plot' });
+  const readingInfo = el('p', { id: 'reading-info' }, 'Click a reading in either plot.');
+  const quantity = el('select', { id: 'quantity' }, el('option', { value: 'QUANTITY_BRDF' }, 'BRDF (sr⁻¹)'), el('option', { value: 'QUANTITY_REFLECTANCE' }, 'reflectance'), el('option', { value: 'QUANTITY_RADIANCE' }, 'radiance'));
+  const method = el('select', { id: 'method' }, el('option', { value: 'INTERPOLATION_METHOD_OCTANT' }, 'octant (paper)'), el('option', { value: 'INTERPOLATION_METHOD_DELAUNAY' }, 'Delaunay'), el('option', { value: 'INTERPOLATION_METHOD_NEAREST' }, 'nearest'));
+  const ti = el('input', { id: 'q-theta-i', type: 'number', value: 35, min: 0, max: 90, step: 'any' });
+  const to = el('input', { id: 'q-theta-o', type: 'number', value: 40, min: 0, max: 90, step: 'any' });
+  const phi = el('input', { id: 'q-phi', type: 'number', value: 40, min: 0, max: 180, step: 'any' });
+  const interp = el('div', { id: 'interp-spectrum', class: 'plot' });
+  const interpInfo = el('div', { id: 'interp-info' });
+  const polar = el('div', { id: 'polar', class: 'plot half' });
+  const slider = el('input', { id: 'wavelength', type: 'range', min: 0, max: 0, value: 0 });
+  const sliderLabel = el('span', { id: 'wavelength-label' });
+  const downloads = el('div', { id: 'downloads', class: 'buttons' });
+  const downloadInfo = el('p', { id: 'download-info' });
+
+  let readings = [];
+  let byId = new Map();
+  let session = '';
+  let polarData = null;
+
+  root.append(
+    el('div', { class: 'buttons' }, el('label', {}, 'Session ', sessionSelect), el('button', { id: 'explorer-load', onclick: () => load(sessionSelect.value) }, 'Load'), loadInfo),
+    el('h2', {}, 'Figure 7: the readings'),
+    el('div', { class: 'row' }, fig7a, fig7b),
+    readingInfo, spectrum,
+    el('h2', {}, 'Figure 8: a direction between the readings'),
+    el('form', { id: 'direction-form', class: 'buttons', onsubmit: (e) => { e.preventDefault(); interpolate(); } },
+      el('label', {}, 'θi ', ti), el('label', {}, 'θo ', to), el('label', {}, 'φ ', phi),
+      el('label', {}, 'method ', method), el('label', {}, 'quantity ', quantity),
+      el('button', { id: 'interpolate', type: 'submit' }, 'Interpolate')),
+    interpInfo, interp,
+    el('h2', {}, 'Plane of incidence'),
+    el('div', { class: 'buttons' }, el('label', {}, 'wavelength ', slider), sliderLabel),
+    polar,
+    el('h2', {}, 'Downloads'), downloads, downloadInfo);
+
+  async function listSessions() {
+    const r = await call('Control/ListSessions', { page_size: 100 });
+    clear(sessionSelect);
+    for (const s of r.sessions) sessionSelect.append(el('option', { value: s.session_id }, `${s.name || s.session_id} (${stateName(s.state)})`));
+    // The newest session with readings first.
+    const measured = r.sessions.find((s) => Number(s.progress?.done_samples) > 0);
+    if (measured) sessionSelect.value = measured.session_id;
+  }
+
+  async function load(id) {
+    if (!id) return;
+    session = id;
+    const t0 = performance.now();
+    readings = [];
+    let first = 0;
+    // Where each reading was taken, without its spectrum (fetched on a click): a 50,000-reading
+    // session is then a few MB instead of 150.
+    await stream('Data/StreamReadings', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (r) => { if (!first) first = performance.now() - t0; readings.push(r); }, undefined, ['radiance']);
+    const streamed = performance.now() - t0;
+    byId = new Map(readings.map((r) => [r.id, r]));
+    if (readings.length === 0) {
+      loadInfo.textContent = 'this session has no sample readings yet';
+      for (const p of [fig7a, fig7b, spectrum, polar]) Plotly.purge(p);
+      return;
+    }
+    const custom = readings.map((r) => r.id);
+    const marker = { size: 3, color: readings.map((r) => r.iso.theta_i), colorscale: 'Viridis' };
+    Plotly.react(fig7a, [{ type: 'scatter3d', mode: 'markers', x: readings.map((r) => r.pose.alpha), y: readings.map((r) => r.pose.beta), z: readings.map((r) => r.pose.delta), customdata: custom, marker }],
+      { title: { text: '(α, β, δ)' }, height: 420, margin: { l: 0, r: 0, t: 30, b: 0 }, scene: { xaxis: { title: { text: 'α °' } }, yaxis: { title: { text: 'β °' } }, zaxis: { title: { text: 'δ °' } } } }, PLOT);
+    Plotly.react(fig7b, [{ type: 'scatter3d', mode: 'markers', x: readings.map((r) => r.iso.theta_i), y: readings.map((r) => r.iso.theta_o), z: readings.map((r) => r.iso.phi), customdata: custom, marker }],
+      { title: { text: '(θi, θo, φ)' }, height: 420, margin: { l: 0, r: 0, t: 30, b: 0 }, scene: { xaxis: { title: { text: 'θi °' } }, yaxis: { title: { text: 'θo °' } }, zaxis: { title: { text: 'φ °' } } } }, PLOT);
+    for (const fig of [fig7a, fig7b]) {
+      fig.removeAllListeners?.('plotly_click');
+      fig.on('plotly_click', (ev) => showReading(ev.points[0].customdata));
+    }
+    loadInfo.textContent = `${readings.length} sample readings loaded in ${Math.round(streamed)} ms (first after ${Math.round(first)} ms), plotted in ${Math.round(performance.now() - t0 - streamed)} ms`;
+    renderDownloads();
+    await planeOfIncidence();
+  }
+
+  async function showReading(id) {
+    const r = byId.get(id);
+    if (!r) return;
+    readingInfo.textContent = `reading ${r.id}: α ${r.pose.alpha}°, β ${r.pose.beta}°, δ ${r.pose.delta}°; θi ${r.iso.theta_i.toFixed(1)}°, θo ${r.iso.theta_o.toFixed(1)}°, φ ${r.iso.phi.toFixed(1)}°; quality ${r.quality_code}${r.flagged ? ' (flagged)' : ''}`;
+    // The reading's own spectrum in each quantity: the nearest reading to its own direction is
+    // itself (the daemon converts radiance to reflectance and BRDF with its reference).
+    const traces = [];
+    for (const [q, label, axis] of [['QUANTITY_RADIANCE', 'radiance (W·m⁻²·sr⁻¹·nm⁻¹)', 'y'], ['QUANTITY_REFLECTANCE', 'reflectance', 'y2'], ['QUANTITY_BRDF', 'BRDF (sr⁻¹)', 'y2']]) {
+      try {
+        const res = (await call('Interpolation/Interpolate', { session_id: session, method: 'INTERPOLATION_METHOD_NEAREST', quantity: q, direction: { iso: r.iso } })).result;
+        if (res.status === 'INTERPOLATION_STATUS_OK') traces.push({ x: wavelengths(res.grid, res.spectrum.length), y: res.spectrum, name: label, yaxis: axis });
+      } catch (e) { report(e.message); }
+    }
+    Plotly.react(spectrum, traces, { height: 320, margin: { t: 20 }, xaxis: { title: { text: 'wavelength nm' } }, yaxis: { title: { text: 'radiance' } }, yaxis2: { overlaying: 'y', side: 'right', title: { text: 'reflectance, BRDF' } } }, PLOT);
+  }
+
+  async function interpolate() {
+    if (!session) { report('load a session first'); return; }
+    const t0 = performance.now();
+    try {
+      const res = (await call('Interpolation/Interpolate', { session_id: session, method: method.value, quantity: quantity.value, direction: { iso: { theta_i: Number(ti.value), theta_o: Number(to.value), phi: Number(phi.value) } } })).result;
+      const ms = performance.now() - t0;
+      clear(interpInfo);
+      if (res.status !== 'INTERPOLATION_STATUS_OK') {
+        interpInfo.append(el('p', { class: 'error', id: 'interp-status' }, `${res.status.replace('INTERPOLATION_STATUS_', '').toLowerCase()}: ${res.detail}`));
+        Plotly.purge(interp);
+        return;
+      }
+      interpInfo.append(el('p', { id: 'interp-status' }, `${res.spectrum.length} wavelengths from ${res.vertices.length} readings in ${Math.round(ms)} ms`),
+        el('table', { id: 'vertices' }, el('tr', {}, el('th', {}, 'reading'), el('th', {}, '(θi, θo, φ)'), el('th', {}, 'weight')),
+          res.vertices.map((v) => el('tr', {}, el('td', {}, v.reading_id), el('td', {}, v.coords.map((c) => c.toFixed(1)).join(', ')), el('td', {}, v.weight.toFixed(3))))));
+      const x = wavelengths(res.grid, res.spectrum.length);
+      const traces = [{ x, y: res.spectrum, name: 'interpolated', line: { width: 3, color: 'black' } }];
+      const verts = await Promise.all(res.vertices.map((v) => call('Interpolation/Interpolate', { session_id: session, method: 'INTERPOLATION_METHOD_NEAREST', quantity: quantity.value, direction: { iso: { theta_i: v.coords[0], theta_o: v.coords[1], phi: v.coords[2] } } }).catch(() => null)));
+      verts.forEach((vr, i) => { if (vr?.result?.status === 'INTERPOLATION_STATUS_OK') traces.push({ x, y: vr.result.spectrum, name: `reading ${res.vertices[i].reading_id} (w ${res.vertices[i].weight.toFixed(2)})`, line: { dash: 'dot' } }); });
+      Plotly.react(interp, traces, { height: 340, margin: { t: 20 }, xaxis: { title: { text: 'wavelength nm' } }, yaxis: { title: { text: quantity.selectedOptions[0].textContent } } }, PLOT);
+    } catch (e) { report(e.message); }
+  }
+
+  // BRDF along the plane of incidence at θi: θo from −85° (φ 0, the lamp's side) to 85° (φ 180,
+  // the specular side), one batch; the slider picks the wavelength.
+  async function planeOfIncidence() {
+    const thetaI = Number(ti.value);
+    const angles = [];
+    for (let a = -85; a <= 85; a += 5) angles.push(a);
+    const directions = angles.map((a) => ({ iso: { theta_i: thetaI, theta_o: Math.abs(a), phi: a >= 0 ? 180 : 0 } }));
+    // The paper's method where the readings enclose the direction; the nearest reading (said so
+    // in the title) where a sparse grid leaves too little of the plane covered.
+    let results = [];
+    let used = '';
+    for (const m of ['INTERPOLATION_METHOD_OCTANT', 'INTERPOLATION_METHOD_NEAREST']) {
+      results = new Array(angles.length);
+      try {
+        await stream('Interpolation/InterpolateBatch', { session_id: session, method: m, quantity: 'QUANTITY_BRDF', directions }, (chunk) => {
+          chunk.results.forEach((r, i) => { results[chunk.first_index + i] = r; });
+        });
+      } catch (e) { report(e.message); return; }
+      used = m.replace('INTERPOLATION_METHOD_', '').toLowerCase();
+      if (results.filter((r) => r && r.status === 'INTERPOLATION_STATUS_OK').length >= 5) break;
+    }
+    const grid = results.find((r) => r && r.status === 'INTERPOLATION_STATUS_OK');
+    if (!grid) { clear(polar).append(el('p', { class: 'muted' }, `no BRDF in the plane of incidence at θi ${thetaI}°`)); return; }
+    polarData = { angles, results, grid: grid.grid, count: grid.spectrum.length, thetaI, used };
+    slider.max = String(polarData.count - 1);
+    slider.value = String(Math.floor(polarData.count / 2));
+    drawPolar();
+  }
+
+  function drawPolar() {
+    if (!polarData) return;
+    const k = Number(slider.value);
+    const nm = polarData.grid.start_nm + k * polarData.grid.step_nm;
+    sliderLabel.textContent = `${nm} nm`;
+    const ok = polarData.results.map((r) => r && r.status === 'INTERPOLATION_STATUS_OK');
+    Plotly.react(polar, [{ type: 'scatterpolar', mode: 'lines+markers', theta: polarData.angles.filter((_, i) => ok[i]).map((a) => a + 90), r: polarData.results.filter((_, i) => ok[i]).map((r) => r.spectrum[k]), name: `θi ${polarData.thetaI}°` }],
+      { height: 380, margin: { t: 30 }, title: { text: `BRDF (sr⁻¹) in the plane of incidence, θi ${polarData.thetaI}°, ${nm} nm (${polarData.used})` }, polar: { sector: [0, 180], angularaxis: { rotation: 180, direction: 'clockwise', tickvals: [0, 30, 60, 90, 120, 150, 180], ticktext: ['−90° lamp side', '−60°', '−30°', 'normal', '30°', '60°', '90° specular side'] } } }, PLOT);
+  }
+  slider.addEventListener('input', drawPolar);
+
+  const EXPORTS = [
+    ['EXPORT_FORMAT_READINGS_CSV', 'readings CSV'],
+    ['EXPORT_FORMAT_GRID_NPY', 'grid .npy'],
+    ['EXPORT_FORMAT_GRID_CSV', 'grid CSV'],
+    ['EXPORT_FORMAT_MERL_BINARY', 'MERL .binary'],
+  ];
+  function renderDownloads() {
+    clear(downloads);
+    for (const [format, label] of EXPORTS) {
+      downloads.append(el('button', { id: `export-${format.replace('EXPORT_FORMAT_', '').toLowerCase()}`, onclick: () => download(format) }, label));
+    }
+  }
+
+  async function download(format) {
+    const parts = [];
+    let reportMsg = null;
+    downloadInfo.textContent = 'exporting…';
+    try {
+      await stream('Data/Export', { session_id: session, format }, (chunk) => {
+        if (chunk.progress) downloadInfo.textContent = `${chunk.progress.stage} ${Math.round(100 * chunk.progress.fraction)} %`;
+        if (chunk.data) parts.push(fromBase64(chunk.data.content));
+        if (chunk.report) reportMsg = chunk.report;
+      });
+    } catch (e) { downloadInfo.textContent = e.message; return; }
+    const blob = new Blob(parts, { type: 'application/octet-stream' });
+    const a = el('a', { href: URL.createObjectURL(blob), download: reportMsg?.file_name || 'export' });
+    document.body.append(a);
+    a.click();
+    a.remove();
+    downloadInfo.textContent = `${reportMsg?.file_name}: ${blob.size} bytes. ${reportMsg?.summary || ''}`;
+  }
+
+  return {
+    async show() {
+      await listSessions();
+      if (!session && sessionSelect.value) await load(sessionSelect.value);
+    },
+    hide() {},
+  };
+}

@@ -1,0 +1,64 @@
+// brdfd's web front end: sign in with a bearer token (kept in this tab's sessionStorage only),
+// then the console (#console) or the explorer (#explorer).
+import './style.css';
+import { call, getToken, setToken, probeRole } from './api.js';
+import { createConsole } from './console.js';
+import { createExplorer } from './explorer.js';
+
+const $ = (id) => document.getElementById(id);
+let role = null;
+let views = null;
+let current = null;
+
+function report(message) {
+  let bar = $('error-bar');
+  if (!bar) {
+    bar = document.createElement('p');
+    bar.id = 'error-bar';
+    bar.className = 'error';
+    document.querySelector('main').prepend(bar);
+  }
+  bar.textContent = message;
+}
+
+async function route() {
+  if (!role) return;
+  const name = location.hash === '#explorer' ? 'explorer' : 'console';
+  if (current === name) return;
+  if (current) { views[current].hide(); $(`${current}-view`).hidden = true; }
+  current = name;
+  $(`${name}-view`).hidden = false;
+  for (const n of ['console', 'explorer']) $(`nav-${n}`).classList.toggle('active', n === name);
+  try { await views[name].show(); } catch (e) { report(e.message); }
+}
+
+async function signIn() {
+  try {
+    await call('Control/ListSessions', { page_size: 1 });
+    role = await probeRole();
+  } catch (e) {
+    setToken('');
+    $('login-view').hidden = false;
+    $('login-error').textContent = e.code === 'UNAUTHENTICATED' ? 'That token is not known to this brdfd.' : e.message;
+    return;
+  }
+  $('login-view').hidden = true;
+  $('nav').hidden = false;
+  $('logout').hidden = false;
+  $('who').textContent = role;
+  $('who').className = `role ${role}`;
+  document.body.dataset.role = role;
+  views = { console: createConsole($('console-view'), role, report), explorer: createExplorer($('explorer-view'), report) };
+  await route();
+}
+
+$('login-form').addEventListener('submit', (e) => {
+  e.preventDefault();
+  setToken($('token').value.trim());
+  $('token').value = '';
+  signIn();
+});
+$('logout').addEventListener('click', () => { setToken(''); location.hash = ''; location.reload(); });
+window.addEventListener('hashchange', route);
+
+if (getToken()) signIn(); else $('login-view').hidden = false;

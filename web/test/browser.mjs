@@ -1,0 +1,208 @@
+// The console and the explorer in a real browser: Debian's Chromium, headless, driven by
+// puppeteer-core against a real brdfd on brdf-sim. As an operator: sign in, submit the demo plan
+// from its file (validated, with the estimated time), watch progress move, answer the prompts
+// (doing on the simulator what the prompt asks), pause and resume, then the explorer: Figure 7,
+// a reading's spectrum, a direction's interpolated spectrum with its vertices (two methods), the
+// plane of incidence, an export downloaded. As an analyst: no control anywhere, and the server
+// refuses one sent anyway. No errors in the browser console. Screenshots of every view go to
+// $BRDF_TEST_OUTPUT_DIR.
+import puppeteer from 'puppeteer-core';
+import { readFileSync, readdirSync, existsSync } from 'node:fs';
+import { join, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { startRig, outputDir, check } from './rig.mjs';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const demo = join(here, '../../examples/plans/demo.json');
+const out = outputDir();
+const chromium = process.env.BRDF_CHROMIUM || '/usr/bin/chromium';
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+const rig = await startRig({ timeScale: 30 });
+const browser = await puppeteer.launch({
+  executablePath: chromium,
+  headless: true,
+  args: ['--no-sandbox', '--disable-dev-shm-usage', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--window-size=1400,1000'],
+  defaultViewport: { width: 1400, height: 1000 },
+});
+const errors = [];
+function watchErrors(page, who) {
+  page.on('pageerror', (e) => errors.push(`${who}: page error: ${e.message}`));
+  page.on('console', (m) => {
+    if (m.type() !== 'error') return;
+    const url = m.location()?.url || '';
+    // The role probe (api.js probeRole) is answered 400 for an operator and 403 for an analyst
+    // by design; Chromium logs any 4xx of a fetch.
+    if (url.endsWith('/api/brdf.v1.Control/PauseSession') && /status of 40[03]/.test(m.text())) return;
+    errors.push(`${who}: console: ${m.text()} ${url}`);
+  });
+}
+const shot = (page, name) => page.screenshot({ path: join(out, `${name}.png`), fullPage: true });
+// A click through the DOM: the console re-renders its session panel on every event, so an
+// element handle may be stale by the time a mouse click would land.
+const clickId = (page, id) => page.evaluate((i) => { const e = document.getElementById(i); if (!e) throw new Error(`no #${i}`); e.click(); }, id);
+const text = (page, sel) => page.$eval(sel, (e) => e.textContent).catch(() => null);
+
+let failed = false;
+try {
+  // --- operator -------------------------------------------------------------------------------
+  const page = await browser.newPage();
+  watchErrors(page, 'operator');
+  await page.goto(rig.url, { waitUntil: 'load' });
+  await page.waitForSelector('#login-view:not([hidden])');
+  await shot(page, '01-login');
+  await page.type('#token', 'wrong-token-wrong-token');
+  await page.click('#login-button');
+  await page.waitForFunction(() => document.getElementById('login-error').textContent.length > 0);
+  check(/not known/.test(await text(page, '#login-error')), 'a wrong token is refused at sign-in');
+  // Chromium logs that refusal (401) as a failed load: expected, once.
+  const refusal = errors.findIndex((e) => /status of 401/.test(e) && e.includes('Control/ListSessions'));
+  if (refusal >= 0) errors.splice(refusal, 1);
+  await page.type('#token', rig.operatorToken);
+  await page.click('#login-button');
+  await page.waitForFunction(() => document.getElementById('who').textContent === 'operator');
+  check(await page.evaluate(() => sessionStorage.getItem('brdfd.token') !== null && localStorage.length === 0), 'the token is kept in sessionStorage only');
+
+  const input = await page.waitForSelector('#plan-file');
+  await input.uploadFile(demo);
+  await page.waitForSelector('#plan-valid');
+  const valid = await text(page, '#plan-valid');
+  check(/estimated/.test(valid), `the plan file is validated: ${valid}`);
+  await shot(page, '02-console-plan-validated');
+  await clickId(page, 'submit-start');
+  await page.waitForFunction(() => ['running', 'awaiting_operator', 'queued'].includes(document.getElementById('session-state')?.textContent));
+
+  let prompts = 0;
+  let paused = false;
+  let resumed = false;
+  let lastProgress = -1;
+  let progressMoves = 0;
+  const deadline = Date.now() + 120000;
+  for (;;) {
+    if (Date.now() > deadline) throw new Error('the demo session did not finish within 2 minutes');
+    const state = await text(page, '#session-state');
+    if (state === 'completed') break;
+    if (['failed', 'aborted'].includes(state)) throw new Error(`the session ended ${state}`);
+    const p = await page.$eval('#session-progress', (e) => Number(e.value)).catch(() => lastProgress);
+    if (p > lastProgress) { if (lastProgress >= 0) progressMoves++; lastProgress = p; }
+    const prompt = await page.$('#answer-prompt');
+    if (prompt && state === 'awaiting_operator') {
+      const kind = await page.$eval('#prompt', (e) => e.dataset.kind);
+      const step = await page.$eval('#prompt', (e) => e.dataset.step);
+      if (prompts === 0) await shot(page, '03-console-prompt');
+      await rig.simMount(kind);
+      await clickId(page, 'answer-prompt');
+      prompts++;
+      await page.waitForFunction((s) => document.getElementById('prompt')?.dataset.step !== s, { timeout: 15000 }, step);
+      continue;
+    }
+    if (!paused && state === 'running' && progressMoves >= 2 && prompts >= 1) {
+      await clickId(page, 'pause-deferred');
+      await page.waitForFunction(() => document.getElementById('session-state')?.textContent === 'paused', { timeout: 30000 });
+      paused = true;
+      const before = await page.$eval('#session-progress', (e) => Number(e.value));
+      await sleep(1500);
+      const after = await page.$eval('#session-progress', (e) => Number(e.value));
+      check(before === after, 'no progress while paused');
+      await shot(page, '04-console-paused');
+      await clickId(page, 'resume');
+      await page.waitForFunction(() => document.getElementById('session-state')?.textContent !== 'paused', { timeout: 15000 });
+      resumed = true;
+      continue;
+    }
+    await sleep(150);
+  }
+  check(true, 'the demo session completed');
+  check(prompts >= 1, `prompts answered in the browser: ${prompts}`);
+  check(progressMoves >= 3, `progress moved live ${progressMoves} times`);
+  check(paused && resumed, 'paused (deferred) and resumed from the browser');
+  await page.waitForFunction(() => document.querySelectorAll('#coverage .scatterlayer .point, #coverage .point').length > 0, { timeout: 15000 });
+  check((await page.$$eval('#events li', (l) => l.length)) > 5, 'the session\'s events are listed');
+  check(/connected/.test(await text(page, '#rig')), 'the rig status shows the devices');
+  await shot(page, '05-console-completed');
+
+  // --- explorer ---------------------------------------------------------------------------------
+  await page.goto(`${rig.url}#explorer`);
+  const t0 = Date.now();
+  await page.waitForFunction(() => /sample readings loaded/.test(document.getElementById('explorer-info')?.textContent || ''), { timeout: 30000 });
+  await page.waitForSelector('#fig7-iso .gl-container canvas, #fig7-iso canvas');
+  console.log(`explorer: first view in ${Date.now() - t0} ms (${await text(page, '#explorer-info')})`);
+  const readingId = await page.evaluate(() => {
+    const gd = document.getElementById('fig7-iso');
+    const id = gd.data[0].customdata[5];
+    gd.emit('plotly_click', { points: [{ customdata: id }] });
+    return id;
+  });
+  await page.waitForFunction(() => document.querySelectorAll('#reading-spectrum .scatterlayer .trace').length >= 2, { timeout: 15000 });
+  check((await text(page, '#reading-info')).startsWith(`reading ${readingId}`), `a reading's spectrum shows (${await text(page, '#reading-info')})`);
+  await shot(page, '06-explorer-figure7');
+
+  for (const method of ['INTERPOLATION_METHOD_OCTANT', 'INTERPOLATION_METHOD_DELAUNAY']) {
+    await page.select('#method', method);
+    await page.evaluate(() => { document.getElementById('interp-status')?.remove(); });
+    await clickId(page, 'interpolate');
+    await page.waitForSelector('#interp-status');
+    const status = await text(page, '#interp-status');
+    check(/wavelengths from \d+ readings/.test(status), `${method}: ${status}`);
+    const rows = await page.$$eval('#vertices tr', (r) => r.length - 1);
+    check(rows >= 1, `${method}: ${rows} vertices with weights`);
+    await page.waitForFunction(() => document.querySelectorAll('#interp-spectrum .scatterlayer .trace').length >= 2, { timeout: 15000 });
+  }
+  await page.waitForSelector('#polar .scatterlayer .trace, #polar .trace');
+  const nm0 = await text(page, '#wavelength-label');
+  await page.$eval('#wavelength', (e) => { e.value = '5'; e.dispatchEvent(new Event('input')); });
+  check((await text(page, '#wavelength-label')) !== nm0, `the wavelength slider redraws the polar plot (${nm0} → ${await text(page, '#wavelength-label')})`);
+  await shot(page, '07-explorer-direction-polar');
+
+  const cdp = await page.createCDPSession();
+  await cdp.send('Browser.setDownloadBehavior', { behavior: 'allow', downloadPath: out });
+  await clickId(page, 'export-readings_csv');
+  await page.waitForFunction(() => /bytes/.test(document.getElementById('download-info').textContent), { timeout: 30000 });
+  let csv = null;
+  for (let i = 0; i < 50 && !csv; i++) {
+    csv = readdirSync(out).find((f) => f.endsWith('.csv'));
+    if (!csv) await sleep(100);
+  }
+  check(csv && readFileSync(join(out, csv), 'utf8').split('\n').length > 10, `the readings CSV export downloaded (${csv})`);
+
+  // --- analyst ----------------------------------------------------------------------------------
+  const queued = await fetch(new URL('/api/brdf.v1.Control/SubmitPlan', rig.url), { method: 'POST', headers: { 'Content-Type': 'application/json', Authorization: `Bearer ${rig.operatorToken}` }, body: JSON.stringify({ plan: JSON.parse(readFileSync(demo, 'utf8')) }) }).then((r) => r.json());
+  const context = await browser.createBrowserContext();
+  const analyst = await context.newPage();
+  watchErrors(analyst, 'analyst');
+  await analyst.goto(rig.url);
+  await analyst.waitForSelector('#login-view:not([hidden])');
+  await analyst.type('#token', rig.analystToken);
+  await analyst.click('#login-button');
+  await analyst.waitForFunction(() => document.getElementById('who').textContent === 'analyst');
+  await analyst.waitForFunction(() => document.getElementById('session-state')?.textContent === 'queued');
+  for (const sel of ['#submit-plan', '#submit-start', '#controls', '#start', '#pause-deferred', '#pause-immediate', '#resume', '#abort', '#answer-prompt']) {
+    check((await analyst.$(sel)) === null, `analyst: no ${sel}`);
+  }
+  const refused = await analyst.evaluate(async (id) => {
+    const r = await fetch('/api/brdf.v1.Control/StartSession', { method: 'POST', headers: { 'Content-Type': 'application/json', Authorization: `Bearer ${sessionStorage.getItem('brdfd.token')}` }, body: JSON.stringify({ session_id: id }) });
+    return r.status;
+  }, queued.session.session_id);
+  check(refused === 403, 'analyst: a control call sent anyway is refused by the server (403)');
+  await shot(analyst, '08-analyst-console');
+  await analyst.goto(`${rig.url}#explorer`);
+  await analyst.waitForSelector('#explorer-session option');
+  await shot(analyst, '09-analyst-explorer');
+  // The analyst's one expected refusal (above) is logged by Chromium as a failed load.
+  const isExpected = (e) => e.startsWith('analyst: console: Failed to load resource: the server responded with a status of 403') && e.includes('StartSession');
+  const unexpected = errors.filter((e) => !isExpected(e));
+  check(unexpected.length === 0, `no errors in the browser console${unexpected.length ? `: ${unexpected.join(' | ')}` : ''}`);
+} catch (e) {
+  failed = true;
+  console.error(e.stack || e);
+  console.error('browser errors:', errors.join('\n'));
+  console.error(readFileSync(rig.daemonLog, 'utf8').slice(-3000));
+  try { for (const p of await browser.pages()) await p.screenshot({ path: join(out, `failure-${Date.now()}.png`), fullPage: true }); } catch { /* best effort */ }
+} finally {
+  const t = Date.now();
+  await Promise.race([browser.close().catch(() => {}), sleep(5000)]);
+  browser.process()?.kill('SIGKILL');
+  await rig.stop();
+  console.log(`teardown ${Date.now() - t} ms`);
+}
+process.exit(failed ? 1 : 0);

@@ -1,0 +1,120 @@
+// The web gateway probed like the gRPC API, over real HTTP against a real brdfd on brdf-sim: no
+// token, a wrong token, the wrong role, oversized and malformed requests, unknown methods, a
+// stream refused before its first event, security headers, no inline script, no CORS.
+import { readFileSync } from 'node:fs';
+import { join, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import net from 'node:net';
+import { startRig, check } from './rig.mjs';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const rig = await startRig();
+const api = (m) => new URL(`/api/brdf.v1.${m}`, rig.url).href;
+async function post(method, body, token, extra = {}) {
+  const headers = { 'Content-Type': 'application/json', ...(token ? { Authorization: `Bearer ${token}` } : {}), ...(extra.headers || {}) };
+  const r = await fetch(api(method), { method: 'POST', headers, body: typeof body === 'string' ? body : JSON.stringify(body) });
+  const text = await r.text();
+  let json = null;
+  try { json = JSON.parse(text); } catch { /* not JSON */ }
+  return { status: r.status, json, text, headers: r.headers };
+}
+
+let failed = false;
+try {
+  const plan = JSON.parse(readFileSync(join(here, '../../examples/plans/demo.json'), 'utf8'));
+
+  let r = await post('Control/ListSessions', {}, '');
+  check(r.status === 401 && r.json.code === 'UNAUTHENTICATED', `no token → 401 UNAUTHENTICATED (${r.status} ${r.text})`);
+  r = await post('Control/ListSessions', {}, 'not-a-token-of-this-daemon');
+  check(r.status === 401 && r.json.code === 'UNAUTHENTICATED', `unknown token → 401 (${r.status})`);
+  r = await post('Control/ListSessions', {}, rig.analystToken);
+  check(r.status === 200 && Array.isArray(r.json.sessions), 'analyst may list sessions');
+  r = await post('Control/SubmitPlan', { plan }, rig.analystToken);
+  check(r.status === 403 && r.json.code === 'PERMISSION_DENIED', `analyst SubmitPlan → 403 PERMISSION_DENIED (${r.status} ${r.text})`);
+  r = await post('Control/PauseSession', { session_id: '' }, rig.analystToken);
+  check(r.status === 403, 'analyst PauseSession → 403 before the body is looked at');
+
+  r = await post('Control/ValidatePlan', { plan: { name: 'x', sampleRotation: { delta: { start: 0, stop: 400, step: 0 } } } }, rig.operatorToken);
+  check(r.status === 200 && r.json.valid === false && r.json.problems.length > 0 && r.json.problems.every((p) => typeof p.field_path === 'string'),
+    `an invalid plan → problems at field paths (${r.json?.problems?.map((p) => p.field_path).join(', ')})`);
+  r = await post('Control/ValidatePlan', { plan }, rig.operatorToken);
+  check(r.status === 200 && r.json.valid === true && r.json.estimated_duration_s > 0, `the demo plan validates, estimated ${r.json.estimated_duration_s} s`);
+
+  r = await post('Control/ListSessions', '{"page_size": ', rig.operatorToken);
+  check(r.status === 400 && r.json.code === 'INVALID_ARGUMENT' && /invalid JSON/.test(r.json.message), `malformed JSON → 400 (${r.json?.message})`);
+  r = await post('Control/ListSessions', { page_sise: 3 }, rig.operatorToken);
+  check(r.status === 400 && /page_sise/.test(r.json.message), `unknown field → 400 naming it (${r.json?.message})`);
+  r = await post('Control/ListSessions', { page_size: 'many' }, rig.operatorToken);
+  check(r.status === 400, 'wrong type → 400');
+  r = await post('Control/Explode', {}, rig.operatorToken);
+  check(r.status === 404 && r.json.code === 'UNIMPLEMENTED', 'unknown method → 404');
+  r = await post('Control/ListSessions', '{}', rig.operatorToken, { headers: { 'Content-Type': 'text/plain' } });
+  check(r.status === 415, 'a text/plain body → 415 (no form posts)');
+  const big = JSON.stringify({ plan: { name: 'x'.repeat(2 * 1024 * 1024) } });
+  r = await post('Control/SubmitPlan', big, rig.operatorToken);
+  check(r.status === 413, `a 2 MiB body → 413 (${r.status})`);
+  const g = await fetch(api('Control/ListSessions'));
+  check(g.status === 405, 'GET on the API → 405');
+
+  r = await post('Data/StreamReadings?omit=radiance,nonsense', { session_id: '1' }, rig.analystToken);
+  check(r.status === 400 && /no field "nonsense"/.test(r.json.message), `?omit= of an unknown field → 400 (${r.json?.message})`);
+  r = await post('Control/WatchSession', { session_id: '1' }, '');
+  check(r.status === 401 && !(r.headers.get('content-type') || '').includes('event-stream'), 'a stream without a token → 401, not an event stream');
+  r = await post('Control/WatchSession', { session_id: '999999' }, rig.analystToken);
+  check(r.status === 404, `a stream of an unknown session → 404 (${r.status} ${r.text})`);
+
+  const sub = await post('Control/SubmitPlan', { plan }, rig.operatorToken);
+  check(sub.status === 200 && sub.json.session.state === 'SESSION_STATE_QUEUED', 'operator submits the demo plan');
+  const id = sub.json.session.session_id;
+  const res = await fetch(api('Control/WatchSession'), { method: 'POST', headers: { 'Content-Type': 'application/json', Authorization: `Bearer ${rig.analystToken}` }, body: JSON.stringify({ session_id: id }) });
+  check(res.status === 200 && res.headers.get('content-type').startsWith('text/event-stream'), 'WatchSession → text/event-stream');
+  const reader = res.body.getReader();
+  let text = '';
+  while (!text.includes('\n\n')) text += new TextDecoder().decode((await reader.read()).value);
+  const first = JSON.parse(text.split('\n\n')[0].replace(/^data: /, ''));
+  check(first.snapshot && first.snapshot.session_id === id, 'its first event is the snapshot');
+  await reader.cancel();
+  r = await post('Control/AbortSession', { session_id: id, reason: 'gateway test' }, rig.operatorToken);
+  check(r.status === 200 && r.json.session.state === 'SESSION_STATE_ABORTED', 'operator aborts it');
+  r = await post('Control/ResumeSession', { session_id: id }, rig.operatorToken);
+  check(r.status === 409 && r.json.code === 'FAILED_PRECONDITION', 'resuming an aborted session → 409');
+
+  const page = await fetch(rig.url);
+  const html = await page.text();
+  const csp = page.headers.get('content-security-policy') || '';
+  check(page.status === 200 && html.includes('id="login-view"'), 'GET / serves the console');
+  check(/script-src 'self'(;|$)/.test(csp) && csp.includes("frame-ancestors 'none'") && csp.includes("default-src 'none'"), `CSP: ${csp}`);
+  check(!/<script(?![^>]*\bsrc=)[^>]*>/.test(html), 'index.html has no inline script');
+  check(page.headers.get('x-content-type-options') === 'nosniff' && page.headers.get('referrer-policy') === 'no-referrer' && page.headers.get('x-frame-options') === 'DENY', 'nosniff, no-referrer, DENY');
+  check(r.headers.get('content-security-policy') === csp, 'API answers carry the same headers');
+  const cors = await fetch(api('Control/ListSessions'), { method: 'POST', headers: { Origin: 'http://evil.example', 'Content-Type': 'application/json', Authorization: `Bearer ${rig.analystToken}` }, body: '{}' });
+  check(cors.headers.get('access-control-allow-origin') === null, 'no CORS: other origins cannot read answers');
+
+  // A raw request line climbing out of the web root.
+  const u = new URL(rig.url);
+  const raw = await new Promise((resolve) => {
+    const s = net.connect(Number(u.port), u.hostname, () => s.write('GET /../../../../etc/passwd HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n'));
+    let d = '';
+    s.on('data', (c) => { d += c; });
+    s.on('end', () => resolve(d));
+    s.on('error', () => resolve(d));
+  });
+  check(!raw.includes('root:x:0:0') && /^HTTP\/1\.1 (400|404)/.test(raw), `path traversal refused (${raw.split('\r\n')[0]})`);
+  // A header flood is refused, not buffered.
+  const flood = await new Promise((resolve) => {
+    const s = net.connect(Number(u.port), u.hostname, () => s.write(`POST /api/brdf.v1.Control/ListSessions HTTP/1.1\r\nHost: x\r\nX-Big: ${'a'.repeat(20000)}\r\n\r\n`));
+    let d = '';
+    s.on('data', (c) => { d += c; });
+    s.on('end', () => resolve(d));
+    s.on('error', () => resolve(d));
+    s.setTimeout(5000, () => { s.destroy(); resolve(d); });
+  });
+  check(!flood.startsWith('HTTP/1.1 200'), `a 20 kB header is refused (${flood.split('\r\n')[0] || 'connection closed'})`);
+} catch (e) {
+  failed = true;
+  console.error(e.stack || e);
+  console.error(readFileSync(rig.daemonLog, 'utf8').slice(-3000));
+} finally {
+  await rig.stop();
+}
+process.exit(failed ? 1 : 0);

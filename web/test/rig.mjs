@@ -1,0 +1,113 @@
+// brdf-sim and brdfd as real processes for the web tests: the simulated rig (a PR-650 on a pty,
+// the stage on Modbus TCP), brdfd with an operator and an analyst token and the web console on a
+// free port. Paths come from BRDF_BUILD_DIR (the CMake build tree).
+import { spawn, execFile } from 'node:child_process';
+import { mkdtempSync, writeFileSync, readFileSync, existsSync, mkdirSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { createInterface } from 'node:readline';
+
+export const build = process.env.BRDF_BUILD_DIR;
+if (!build) throw new Error('set BRDF_BUILD_DIR to the CMake build directory');
+const brdfd = join(build, 'daemon/brdfd');
+const sim = join(build, 'tools/brdf-sim/brdf-sim');
+const ctl = join(build, 'tools/brdfctl/brdfctl');
+
+function lines(child, onLine) {
+  createInterface({ input: child.stdout }).on('line', onLine);
+}
+
+function waitFor(child, name, want, seconds, log) {
+  return new Promise((resolve, reject) => {
+    const found = {};
+    const timer = setTimeout(() => reject(new Error(`${name} did not start in ${seconds} s: ${tail(log)}`)), seconds * 1000);
+    child.on('exit', (code) => { clearTimeout(timer); reject(new Error(`${name} exited (${code}): ${tail(log)}`)); });
+    lines(child, (line) => {
+      for (const [key, re] of Object.entries(want)) {
+        const m = re.exec(line);
+        if (m) found[key] = m[1];
+      }
+      if (Object.keys(want).every((k) => k in found)) { clearTimeout(timer); resolve(found); }
+    });
+  });
+}
+
+function tail(file) {
+  try { return readFileSync(file, 'utf8').slice(-3000); } catch { return ''; }
+}
+
+export async function startRig({ timeScale = 40 } = {}) {
+  const dir = mkdtempSync(join(tmpdir(), 'brdf-web-'));
+  const operatorToken = 'op-' + Math.random().toString(36).slice(2) + 'xxxxxxxxxxxxxxxx';
+  const analystToken = 'an-' + Math.random().toString(36).slice(2) + 'yyyyyyyyyyyyyyyy';
+  const { openSync } = await import('node:fs');
+  const simLog = join(dir, 'sim.log');
+  const simProc = spawn(sim, ['--time-scale', String(timeScale), '--seed', '1', '--modbus-port', '0',
+    '--pr650-link', join(dir, 'pr650'), '--wake-window', '0', '--log-level', 'warn'],
+  { stdio: ['ignore', 'pipe', openSync(simLog, 'w')] });
+  const simInfo = await waitFor(simProc, 'brdf-sim', { modbus: /^modbus-tcp (\S+)/, pr650: /^pr650 (\S+)/, ready: /^(ready)/ }, 20, simLog);
+  const config = join(dir, 'brdfd.toml');
+  writeFileSync(config, `[server]
+listen = "127.0.0.1:0"
+[storage]
+database = "${dir}/brdfd.db"
+[meter]
+port = "${simInfo.pr650}"
+pacing_ms = 5
+quiet_gap_ms = 20
+[meter.quality]
+"10" = "accept_and_flag"
+[stage]
+transport = "tcp"
+address = "${simInfo.modbus}"
+detector_arm_motorized = true
+[stage.axes.delta]
+present = true
+[sample]
+white_reflectance = 0.99
+[[auth.tokens]]
+name = "web-operator"
+token = "${operatorToken}"
+role = "operator"
+[[auth.tokens]]
+name = "web-analyst"
+token = "${analystToken}"
+role = "analyst"
+[web]
+listen = "127.0.0.1:0"
+[log]
+level = "info"
+`);
+  const daemonLog = join(dir, 'brdfd.log');
+  const daemon = spawn(brdfd, ['--config', config, '--shutdown-timeout', '3'], { stdio: ['ignore', 'pipe', openSync(daemonLog, 'w')] });
+  const info = await waitFor(daemon, 'brdfd', { web: /^brdfd web console on (\S+)/, grpc: /^brdfd listening on (\S+)/ }, 20, daemonLog);
+  const rig = {
+    dir, url: info.web, grpc: info.grpc, modbus: simInfo.modbus, operatorToken, analystToken, daemonLog,
+    // What an operator does by hand at a prompt, done on the simulator.
+    simMount(kind) {
+      const target = { PROMPT_KIND_MOUNT_WHITE: 'white', PROMPT_KIND_MOUNT_SAMPLE: 'sample', PROMPT_KIND_CLOSE_SHUTTER: 'dark' }[kind];
+      if (!target) return Promise.resolve();
+      return new Promise((resolve, reject) => execFile(ctl, ['sim-mount', target, '--modbus', simInfo.modbus], (err, so, se) => (err ? reject(new Error(se)) : resolve())));
+    },
+    async stop() {
+      for (const p of [daemon, simProc]) {
+        if (p.exitCode !== null) continue;
+        p.kill('SIGTERM');
+        await new Promise((r) => { const t = setTimeout(() => { p.kill('SIGKILL'); r(); }, 8000); p.on('exit', () => { clearTimeout(t); r(); }); });
+      }
+    },
+  };
+  return rig;
+}
+
+export function outputDir() {
+  const d = process.env.BRDF_TEST_OUTPUT_DIR || join(process.cwd(), 'web-test-output');
+  if (!existsSync(d)) mkdirSync(d, { recursive: true });
+  return d;
+}
+
+const started = Date.now();
+export function check(cond, message) {
+  if (!cond) throw new Error(`check failed: ${message}`);
+  console.log(`ok (${((Date.now() - started) / 1000).toFixed(1)} s): ${message}`);
+}
