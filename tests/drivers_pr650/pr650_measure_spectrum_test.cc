@@ -193,6 +193,7 @@ TEST_F(Pr650DriverTest, MinusOneIsAFailedMeasurementInBothModes) {
   EXPECT_EQ(m5.status().device_code(), -1);
   EXPECT_THAT(m5.status().message(), HasSubstr("holds no measurement"));
   EXPECT_TRUE(meter->MeasureSpectrum(Ctx(), {}).ok());  // measured again, it works
+  meter.reset();  // the port is held exclusively: the second driver opens it after the first
 
   options_.measure_with_spectrum = false;
   auto m0 = Configured(200);
