@@ -50,7 +50,7 @@ struct IndexCache::Entry {
   std::atomic<std::uint64_t> used{0};         // IndexCache::tick_ of the last query
 };
 
-IndexCache::IndexCache(std::shared_ptr<storage::SessionStore> store, Options options,
+IndexCache::IndexCache(std::shared_ptr<storage::SessionReader> store, Options options,
                        PlanSource plans)
     : store_(std::move(store)), options_(options), plans_(std::move(plans)) {}
 
@@ -95,6 +95,22 @@ IndexCache::Stats IndexCache::stats() const {
   s.bytes = 0;
   for (const auto& [id, e] : entries_) s.bytes += e->bytes.load() + e->pending_bytes.load();
   return s;
+}
+
+std::vector<std::pair<SessionId, std::int64_t>> IndexCache::HeldThrough() const {
+  std::vector<std::pair<SessionId, std::shared_ptr<Entry>>> entries;
+  {
+    std::shared_lock lock(mu_);
+    entries.assign(entries_.begin(), entries_.end());
+  }
+  std::vector<std::pair<SessionId, std::int64_t>> out;
+  for (const auto& [id, entry] : entries) {
+    const std::int64_t announced = entry->announced_id.load();
+    std::shared_lock state(entry->state_mu);
+    if (!entry->loaded) continue;
+    out.emplace_back(id, std::max(announced, entry->samples->published().through_id));
+  }
+  return out;
 }
 
 std::shared_ptr<const IndexSnapshot> IndexCache::FreshHit(SessionId session, Quantity quantity,

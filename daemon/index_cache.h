@@ -50,6 +50,7 @@
 #include <mutex>
 #include <shared_mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/interp/interpolator.h"
@@ -59,6 +60,7 @@
 #include "daemon/session_manager.h"
 #include "daemon/session_plan.h"
 #include "storage/records.h"
+#include "storage/session_reader.h"
 #include "storage/session_store.h"
 
 namespace brdf::daemon {
@@ -116,9 +118,11 @@ class IndexCache {
   // stored record on a first load (ParseSessionPlan), as a standalone cache must.
   using PlanSource = std::function<Result<std::shared_ptr<const SessionPlan>>(SessionId)>;
 
-  IndexCache(std::shared_ptr<storage::SessionStore> store, Options options,
+  // `store`: where a first load reads the session (the rig's SessionStore; brdf-archive's
+  // storage::ArchiveReader).
+  IndexCache(std::shared_ptr<storage::SessionReader> store, Options options,
              PlanSource plans = nullptr);
-  explicit IndexCache(std::shared_ptr<storage::SessionStore> store)
+  explicit IndexCache(std::shared_ptr<storage::SessionReader> store)
       : IndexCache(std::move(store), Options()) {}
   IndexCache(const IndexCache&) = delete;
   IndexCache& operator=(const IndexCache&) = delete;
@@ -150,6 +154,12 @@ class IndexCache {
 
   Stats stats() const;
 
+  // The sessions cached and loaded, each with the highest reading id it holds (folded or handed
+  // over). A server without commit events (brdf-archive) asks its store for the readings above
+  // it now and then and hands them over with OnReading, so that a session still being recorded
+  // (or shipped) grows as it does on the rig.
+  std::vector<std::pair<SessionId, std::int64_t>> HeldThrough() const;
+
  private:
   struct Entry;
   // The steps of Get, in order. Lookup finds or adds the session's entry (mu_ exclusive for an
@@ -175,7 +185,7 @@ class IndexCache {
   };
   void Count(const Counts& counts);
 
-  std::shared_ptr<storage::SessionStore> store_;
+  std::shared_ptr<storage::SessionReader> store_;
   Options options_;
   PlanSource plans_;
 

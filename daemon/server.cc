@@ -24,18 +24,8 @@ namespace {
 // store (SubmitPlan's commit).
 constexpr int kControlThreads = 2;
 
-// The services by their full names, for the health service's per-service status.
-constexpr const char* kServiceNames[] = {"brdf.v1.Control", "brdf.v1.Data",
+constexpr const char* kBrdfServices[] = {"brdf.v1.Control", "brdf.v1.Data",
                                          "brdf.v1.Interpolation"};
-
-// Every service the server registers, for reflection's list_services.
-std::vector<std::string> ServedServices() {
-  std::vector<std::string> names(std::begin(kServiceNames), std::end(kServiceNames));
-  names.push_back("grpc.health.v1.Health");
-  names.push_back("grpc.reflection.v1.ServerReflection");
-  names.push_back("grpc.reflection.v1alpha.ServerReflection");
-  return names;
-}
 
 // Reads a PEM file and checks that it holds a block of the expected kind ("CERTIFICATE",
 // "PRIVATE KEY": also matches "EC PRIVATE KEY", "RSA PRIVATE KEY"). gRPC itself only says that
@@ -119,6 +109,81 @@ bool IsLoopbackAddress(const std::string& listen) {
   return false;
 }
 
+Result<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(const ServerConfig& config,
+                                                                       bool* tls) {
+  std::shared_ptr<grpc::ServerCredentials> credentials;
+  *tls = false;
+  if (config.tls.has_value()) {
+    Result<std::string> cert = ReadPem(config.tls->cert, "server.tls.cert", "CERTIFICATE");
+    if (!cert.ok()) return cert.status();
+    Result<std::string> key = ReadPem(config.tls->key, "server.tls.key", "PRIVATE KEY");
+    if (!key.ok()) return key.status();
+    WarnIfReadableByOthers(config.tls->key);
+    grpc::SslServerCredentialsOptions ssl(GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE);
+    ssl.pem_key_cert_pairs.push_back({*key, *cert});
+    if (!config.tls->client_ca.empty()) {
+      Result<std::string> ca =
+          ReadPem(config.tls->client_ca, "server.tls.client_ca", "CERTIFICATE");
+      if (!ca.ok()) return ca.status();
+      ssl.pem_root_certs = *ca;
+      ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
+    }
+    credentials = grpc::SslServerCredentials(ssl);
+    *tls = true;
+  } else {
+    // Plaintext as gRPC's xDS credentials with the insecure fallback (no xDS server here, so
+    // plaintext is all they do): unlike InsecureServerCredentials() they take the token gate.
+    credentials = grpc::XdsServerCredentials(grpc::InsecureServerCredentials());
+    if (!IsLoopbackAddress(config.listen)) {
+      spdlog::warn(
+          "serving {} in PLAINTEXT on a non-loopback address: bearer tokens and data cross the "
+          "network unencrypted; configure [server.tls] (cert, key) or listen on 127.0.0.1",
+          config.listen);
+    }
+  }
+  return credentials;
+}
+
+std::vector<std::string> BrdfServiceNames() {
+  return {std::begin(kBrdfServices), std::end(kBrdfServices)};
+}
+
+std::vector<std::string> ServedServices() {
+  std::vector<std::string> names = BrdfServiceNames();
+  names.push_back("grpc.health.v1.Health");
+  names.push_back("grpc.reflection.v1.ServerReflection");
+  names.push_back("grpc.reflection.v1alpha.ServerReflection");
+  return names;
+}
+
+void PrepareServerBuilder(grpc::ServerBuilder& builder, const ServerConfig& config,
+                          const std::shared_ptr<grpc::ServerCredentials>& credentials,
+                          const Authenticator& auth, int* selected_port) {
+  credentials->SetAuthMetadataProcessor(std::make_shared<TokenGate>(auth));
+  builder.AddListeningPort(config.listen, credentials, selected_port);
+  // One daemon per address: without SO_REUSEPORT a second brdfd's bind fails instead of sharing
+  // the port (and answering some of the first one's calls).
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
+  grpc::ResourceQuota quota("brdfd");
+  quota.SetMaxThreads(ServerThreadCap(config));
+  builder.SetResourceQuota(quota);
+}
+
+Result<std::string> BoundAddress(const ServerConfig& config, bool built, int selected_port,
+                                 bool tls) {
+  const bool unix_socket = config.listen.rfind("unix:", 0) == 0;
+  if (!built || (!unix_socket && selected_port == 0)) {
+    return IoError("cannot listen on " + config.listen +
+                   (tls ? " with TLS (address in use, not allowed, no such interface, or the "
+                          "certificate and key in [server.tls] do not form a valid pair)"
+                        : " (address in use, not allowed, or no such interface)") +
+                   "; change [server] listen or stop the process that holds it");
+  }
+  if (unix_socket) return config.listen;
+  return config.listen.substr(0, config.listen.rfind(':') + 1) + std::to_string(selected_port);
+}
+
 int InterpolateLoopThreads(unsigned cores) {
   return static_cast<int>(std::clamp(cores / 2, 1U, 8U));
 }
@@ -145,36 +210,10 @@ Server::~Server() {
 
 Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, SessionManager& manager,
                                               IndexCache& cache, const Authenticator& auth) {
-  std::shared_ptr<grpc::ServerCredentials> credentials;
   bool tls = false;
-  if (config.tls.has_value()) {
-    Result<std::string> cert = ReadPem(config.tls->cert, "server.tls.cert", "CERTIFICATE");
-    if (!cert.ok()) return cert.status();
-    Result<std::string> key = ReadPem(config.tls->key, "server.tls.key", "PRIVATE KEY");
-    if (!key.ok()) return key.status();
-    WarnIfReadableByOthers(config.tls->key);
-    grpc::SslServerCredentialsOptions ssl(GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE);
-    ssl.pem_key_cert_pairs.push_back({*key, *cert});
-    if (!config.tls->client_ca.empty()) {
-      Result<std::string> ca =
-          ReadPem(config.tls->client_ca, "server.tls.client_ca", "CERTIFICATE");
-      if (!ca.ok()) return ca.status();
-      ssl.pem_root_certs = *ca;
-      ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
-    }
-    credentials = grpc::SslServerCredentials(ssl);
-    tls = true;
-  } else {
-    // Plaintext as gRPC's xDS credentials with the insecure fallback (no xDS server here, so
-    // plaintext is all they do): unlike InsecureServerCredentials() they take the token gate.
-    credentials = grpc::XdsServerCredentials(grpc::InsecureServerCredentials());
-    if (!IsLoopbackAddress(config.listen)) {
-      spdlog::warn(
-          "serving {} in PLAINTEXT on a non-loopback address: bearer tokens and data cross the "
-          "network unencrypted; configure [server.tls] (cert, key) or listen on 127.0.0.1",
-          config.listen);
-    }
-  }
+  Result<std::shared_ptr<grpc::ServerCredentials>> made = MakeServerCredentials(config, &tls);
+  if (!made.ok()) return made.status();
+  std::shared_ptr<grpc::ServerCredentials> credentials = *made;
 
   // Debian builds Abseil without NDEBUG, which leaves absl::Mutex's lock-order (deadlock) graph
   // on: every lock gRPC takes records the lock in a global graph, about a tenth of the CPU of a
@@ -185,15 +224,7 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   std::unique_ptr<Server> server(new Server(config, manager, cache, auth));
   grpc::ServerBuilder builder;
   int selected_port = 0;
-  credentials->SetAuthMetadataProcessor(std::make_shared<TokenGate>(auth));
-  builder.AddListeningPort(config.listen, credentials, &selected_port);
-  // One daemon per address: without SO_REUSEPORT a second brdfd's bind fails instead of sharing
-  // the port (and answering some of the first one's calls).
-  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
-  builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
-  grpc::ResourceQuota quota("brdfd");
-  quota.SetMaxThreads(ServerThreadCap(config));
-  builder.SetResourceQuota(quota);
+  PrepareServerBuilder(builder, config, credentials, auth, &selected_port);
   builder.RegisterService(&server->health_);
   builder.RegisterService(&server->control_);
   builder.RegisterService(&server->data_);
@@ -205,21 +236,14 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   server->control_.ServeOn(server->control_loop_);
   server->control_loop_.AddQueue(builder);
   server->server_ = builder.BuildAndStart();
-  const bool unix_socket = config.listen.rfind("unix:", 0) == 0;
-  if (!server->server_ || (!unix_socket && selected_port == 0)) {
-    return IoError("cannot listen on " + config.listen +
-                   (tls ? " with TLS (address in use, not allowed, no such interface, or the "
-                          "certificate and key in [server.tls] do not form a valid pair)"
-                        : " (address in use, not allowed, or no such interface)") +
-                   "; change [server] listen or stop the process that holds it");
-  }
+  Result<std::string> address =
+      BoundAddress(config, server->server_ != nullptr, selected_port, tls);
+  if (!address.ok()) return address.status();
   server->interpolate_loop_.Start();
   server->control_loop_.Start();
   server->tls_ = tls;
   server->port_ = selected_port;
-  server->address_ = unix_socket ? config.listen
-                                 : config.listen.substr(0, config.listen.rfind(':') + 1) +
-                                       std::to_string(selected_port);
+  server->address_ = *address;
   spdlog::info(
       "limits: requests up to {} bytes (larger: RESOURCE_EXHAUSTED), InterpolateBatch up to {} "
       "directions in chunks of up to {} results, notes up to {} bytes, pages up to {} sessions, "
@@ -233,7 +257,7 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
       tls ? (config.tls->client_ca.empty() ? "; TLS" : "; TLS, client certificates required")
           : "; plaintext");
   server->health_.SetServingStatus("", true);
-  for (const char* name : kServiceNames) server->health_.SetServingStatus(name, true);
+  for (const std::string& name : BrdfServiceNames()) server->health_.SetServingStatus(name, true);
   return server;
 }
 

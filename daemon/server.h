@@ -12,11 +12,14 @@
 //    flight, capped at ServerThreadCap (stream_registry.h), above the caps on open streams.
 #pragma once
 
+#include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server.h>
+#include <grpcpp/server_builder.h>
 
 #include <chrono>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/status.h"
 #include "daemon/auth.h"
@@ -43,6 +46,31 @@ int InterpolateLoopThreads(unsigned cores);
 // True for addresses only this machine can reach: literal 127.0.0.0/8, ::1, ::ffff:127.x.y.z,
 // "localhost", unix sockets. Host names (other than localhost) and 0.0.0.0 / [::] are not.
 bool IsLoopbackAddress(const std::string& listen);
+
+// The brdf.v1 services by their full names (the health service's per-service status), and with
+// them every service the server registers (reflection's list_services). brdf-archive serves the
+// same.
+std::vector<std::string> BrdfServiceNames();
+std::vector<std::string> ServedServices();
+
+// The server's credentials from [server] and [server.tls]: TLS (client certificates required
+// when client_ca is set; `tls` true) or plaintext that still takes the token gate (a warning is
+// logged when a non-loopback address is served in plaintext). kConfigurationError naming the key
+// when a TLS file cannot be read or holds no PEM block of its kind. brdfd and brdf-archive both.
+Result<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(const ServerConfig& config,
+                                                                       bool* tls);
+
+// What brdfd and brdf-archive set up alike on their builder: the listening port with
+// `credentials` behind the token gate (token_gate.h), no SO_REUSEPORT (one server per address),
+// the request size limit and the thread cap (ServerThreadCap). `*selected_port` is the port bound,
+// once the server is built.
+void PrepareServerBuilder(grpc::ServerBuilder& builder, const ServerConfig& config,
+                          const std::shared_ptr<grpc::ServerCredentials>& credentials,
+                          const Authenticator& auth, int* selected_port);
+// After BuildAndStart (`built`: it returned a server): the address served, with the port bound
+// ("127.0.0.1:43123", "unix:/run/brdfd.sock"); kIoError naming the address when nothing was bound.
+Result<std::string> BoundAddress(const ServerConfig& config, bool built, int selected_port,
+                                 bool tls);
 
 class Server {
  public:

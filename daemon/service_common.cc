@@ -1,6 +1,7 @@
 #include "daemon/service_common.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <sstream>
 
@@ -210,6 +211,87 @@ void StopSignal::Stop() {
 bool StopSignal::WaitFor(std::chrono::steady_clock::duration d) const {
   MutexLock lock(mu_);
   return cv_.WaitFor(mu_, d, [this] { return stopped_.load(); });
+}
+
+namespace {
+
+std::string Lower(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
+grpc::Status TimestampField(const v1::ListSessionsRequest& request, bool after,
+                            std::optional<double>* out) {
+  if (after ? !request.has_created_after() : !request.has_created_before()) return grpc::Status::OK;
+  const google::protobuf::Timestamp& t = after ? request.created_after() : request.created_before();
+  if (t.nanos() < 0 || t.nanos() > 999999999) {
+    return InvalidField(after ? "created_after" : "created_before",
+                        "nanos " + std::to_string(t.nanos()) + " is outside 0 … 999,999,999");
+  }
+  *out = static_cast<double>(t.seconds()) + t.nanos() * 1e-9;
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
+grpc::Status ParseReadingKinds(const v1::StreamReadingsRequest& request,
+                               std::set<storage::ReadingKind>* kinds) {
+  for (int i = 0; i < request.kinds_size(); ++i) {
+    switch (request.kinds(i)) {
+      case v1::READING_KIND_SAMPLE:
+        kinds->insert(storage::ReadingKind::kSample);
+        break;
+      case v1::READING_KIND_REFERENCE:
+        kinds->insert(storage::ReadingKind::kReference);
+        break;
+      case v1::READING_KIND_DARK:
+        kinds->insert(storage::ReadingKind::kDark);
+        break;
+      default:
+        return InvalidField("kinds[" + std::to_string(i) + "]",
+                            "unknown reading kind " + std::to_string(request.kinds(i)) +
+                                "; use READING_KIND_SAMPLE, _REFERENCE or _DARK");
+    }
+  }
+  return grpc::Status::OK;
+}
+
+bool CatalogueFilter::Matches(const v1::Session& session) const {
+  if (!rig.empty() && session.rig() != rig) return false;
+  const v1::Sample& s = session.sample();
+  if (!sample.empty() && s.id() != sample && Lower(s.name()) != Lower(sample)) return false;
+  if (!material.empty() && Lower(s.material()) != Lower(material)) return false;
+  if (!tag.empty() && std::find(s.tags().begin(), s.tags().end(), tag) == s.tags().end()) {
+    return false;
+  }
+  const double created =
+      static_cast<double>(session.created_at().seconds()) + session.created_at().nanos() * 1e-9;
+  if (created_after.has_value() && created < *created_after) return false;
+  if (created_before.has_value() && !(created < *created_before)) return false;
+  return true;
+}
+
+grpc::Status ParseCatalogueFilter(const v1::ListSessionsRequest& request, CatalogueFilter* out) {
+  CatalogueFilter f;
+  for (int i = 0; i < request.states_size(); ++i) {
+    const int state = request.states(i);
+    if (!v1::SessionState_IsValid(state) || state == v1::SESSION_STATE_UNSPECIFIED) {
+      return InvalidField("states[" + std::to_string(i) + "]",
+                          "unknown session state " + std::to_string(state));
+    }
+    f.states.push_back(FromProtoState(static_cast<v1::SessionState>(state)));
+  }
+  f.rig = request.rig();
+  f.sample = request.sample();
+  f.material = request.material();
+  f.tag = request.tag();
+  if (grpc::Status st = TimestampField(request, true, &f.created_after); !st.ok()) return st;
+  if (grpc::Status st = TimestampField(request, false, &f.created_before); !st.ok()) return st;
+  if (f.created_after && f.created_before && !(*f.created_after < *f.created_before)) {
+    return InvalidField("created_before", "must be later than created_after");
+  }
+  *out = std::move(f);
+  return grpc::Status::OK;
 }
 
 }  // namespace brdf::daemon

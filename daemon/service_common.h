@@ -10,8 +10,11 @@
 #include <chrono>
 #include <cstdint>
 #include <map>
+#include <optional>
+#include <set>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "brdf/v1/brdf.pb.h"
 #include "core/interp/interpolator.h"
@@ -92,6 +95,28 @@ struct ReadingExtras {
   std::uint32_t averages = 1;
 };
 v1::Reading ToProtoReading(const storage::ReadingRecord& record, const ReadingExtras& extras);
+
+// StreamReadingsRequest.kinds as a set (empty: every kind); INVALID_ARGUMENT naming "kinds[i]"
+// for a kind the API does not have.
+grpc::Status ParseReadingKinds(const v1::StreamReadingsRequest& request,
+                               std::set<storage::ReadingKind>* kinds);
+
+// ListSessions' catalogue filters (ListSessionsRequest fields 4-9), checked: brdfd applies them
+// to its sessions with Matches, brdf-archive in its SQL (storage/archive_reader.h), with the same
+// meaning. Timestamps as Unix seconds.
+struct CatalogueFilter {
+  std::vector<SessionState> states;  // ListSessionsRequest.states (Matches leaves them out)
+  std::string rig;
+  std::string sample;    // the sample's id, or its name ignoring case
+  std::string material;  // ignoring case
+  std::string tag;
+  std::optional<double> created_after;   // created_at ≥
+  std::optional<double> created_before;  // created_at <
+  bool Matches(const v1::Session& session) const;
+};
+// INVALID_ARGUMENT naming the field for an unknown state, a timestamp out of range (nanos outside
+// 0…999,999,999) or created_before not after created_after.
+grpc::Status ParseCatalogueFilter(const v1::ListSessionsRequest& request, CatalogueFilter* out);
 
 // Set once at shutdown; streams end when they see it. Waiters wake at once.
 class StopSignal {

@@ -212,15 +212,8 @@ grpc::Status ControlService::ListSessions(grpc::ServerContext* context,
       !st.ok()) {
     return st;
   }
-  std::vector<SessionState> states;
-  for (int i = 0; i < request->states_size(); ++i) {
-    const int state = request->states(i);
-    if (!v1::SessionState_IsValid(state) || state == v1::SESSION_STATE_UNSPECIFIED) {
-      return InvalidField("states[" + std::to_string(i) + "]",
-                          "unknown session state " + std::to_string(state));
-    }
-    states.push_back(FromProtoState(static_cast<v1::SessionState>(state)));
-  }
+  CatalogueFilter filter;
+  if (grpc::Status st = ParseCatalogueFilter(*request, &filter); !st.ok()) return st;
   // The page token is the id of the last session of the previous page: sessions are listed
   // newest (highest id) first, so the next page holds the ids below it. Stable under inserts.
   std::optional<SessionId> before;
@@ -241,7 +234,7 @@ grpc::Status ControlService::ListSessions(grpc::ServerContext* context,
   const std::uint32_t page_size =
       request->page_size() == 0 ? kDefaultPageSize : std::min(request->page_size(), kMaxPageSize);
 
-  Result<std::vector<v1::Session>> sessions = manager_.ListSessions(states);
+  Result<std::vector<v1::Session>> sessions = manager_.ListSessions(filter.states);
   if (!sessions.ok()) return ToGrpcStatus(sessions.status());
   std::optional<SessionId> last;
   bool more = false;
@@ -249,6 +242,7 @@ grpc::Status ControlService::ListSessions(grpc::ServerContext* context,
     Result<SessionId> id = ParseSessionId(s.session_id());
     if (!id.ok()) continue;
     if (before.has_value() && *id >= *before) continue;
+    if (!filter.Matches(s)) continue;
     if (static_cast<std::uint32_t>(response->sessions_size()) == page_size) {
       more = true;
       break;

@@ -19,9 +19,6 @@ namespace brdf::daemon {
 
 class DataService final : public v1::Data::Service {
  public:
-  // Readings per page read from the store (and written before the next page is read).
-  static constexpr int kPageSize = 256;
-
   // Registers a reading listener on `manager` (removed by the destructor). All three must
   // outlive the service.
   DataService(SessionManager& manager, const Authenticator& auth, const StopSignal& stopping,

@@ -1,15 +1,14 @@
 #!/usr/bin/env bash
 # A lab in one machine: a local PostgreSQL (Debian's postgresql-15) as the lab's archive, and two
 # simulated rigs (two brdf-sim, two brdfd named rig-a and rig-b) that record at the same time and
-# ship everything to it. Shows each rig's archive status (brdfctl rig) and what the archive holds
-# (psql): both rigs' sessions with their sample catalogue and reading counts, next to each rig's
-# own count. Everything lives in ./lab-run/ (gitignored); --stop stops what it started.
-#
-# Not yet: listing and interpolating the archive through brdf-archive (not part of this build);
-# the archive is read with psql here.
+# ship everything to it, and brdf-archive, the archive's read server. Shows each rig's archive
+# status (brdfctl rig), what the archive holds (psql: both rigs' sessions with their sample
+# catalogue and reading counts, next to each rig's own count), then lists both rigs' sessions and
+# interpolates each through ONE brdfctl pointed at brdf-archive, comparing the answer with the
+# rig's own. Everything lives in ./lab-run/ (gitignored); --stop stops what it started.
 #
 # Usage: deploy/lab-demo.sh [--no-build]     build (unless --no-build) and run
-#        deploy/lab-demo.sh --stop           stop PostgreSQL, both brdfd and both brdf-sim
+#        deploy/lab-demo.sh --stop           stop brdf-archive, PostgreSQL, both brdfd and brdf-sim
 # Environment: BUILD_DIR (default ./build), LAB_RUN_DIR (default ./lab-run), LAB_TIME_SCALE (default 8).
 set -euo pipefail
 
@@ -22,6 +21,7 @@ case "$run" in /*) ;; *) run="$PWD/$run" ;; esac
 brdfd="$build/daemon/brdfd"
 sim="$build/tools/brdf-sim/brdf-sim"
 ctl="$build/tools/brdfctl/brdfctl"
+archive_server="$build/daemon/brdf-archive"
 pgbin="$(ls -d /usr/lib/postgresql/*/bin 2>/dev/null | sort -V | tail -n 1)"
 
 say() { printf '\nlab-demo: %s\n' "$*"; }
@@ -50,6 +50,7 @@ stop_pid() {
 }
 
 stop_all() {
+  stop_pid "$run/archive/brdf-archive.pid"
   for r in rig-a rig-b; do stop_pid "$run/$r/brdfd.pid"; done
   for r in rig-a rig-b; do stop_pid "$run/$r/brdf-sim.pid"; done
   if [[ -f "$run/pg/data/postmaster.pid" ]]; then
@@ -92,14 +93,14 @@ if [[ $build_it -eq 1 ]]; then
   "$root/deploy/install-deps.sh"
   pgbin="$(ls -d /usr/lib/postgresql/*/bin 2>/dev/null | sort -V | tail -n 1)"
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-  cmake --build "$build" -j "$(nproc)" --target brdfd brdf-sim brdfctl
+  cmake --build "$build" -j "$(nproc)" --target brdfd brdf-sim brdfctl brdf-archive
 fi
 [[ -n "$pgbin" && -x "$pgbin/initdb" ]] || die "PostgreSQL is not installed (deploy/install-deps.sh installs postgresql-15)"
 
 mkdir -p "$run"
 stop_all
-rm -rf "$run/pg" "$run/rig-a" "$run/rig-b"
-mkdir -p "$run/pg" "$run/rig-a" "$run/rig-b"
+rm -rf "$run/pg" "$run/rig-a" "$run/rig-b" "$run/archive"
+mkdir -p "$run/pg" "$run/rig-a" "$run/rig-b" "$run/archive"
 chmod 755 "$run"
 
 # --- the archive ---------------------------------------------------------------------------------
@@ -218,10 +219,54 @@ say "each rig's own count (sqlite3), to compare"
 for r in rig-a rig-b; do
   printf '%s: %s readings\n' "$r" "$(sqlite3 "$run/$r/brdfd.db" 'SELECT count(*) FROM readings')"
 done
+# --- brdf-archive: the archive's read server -----------------------------------------------------
+say "starting brdf-archive (the read API over the archive; stateless, so several can run)"
+d="$run/archive"
+(umask 077 && cp "$run/rig-a/archive.conninfo" "$d/archive.conninfo")
+archive_address="127.0.0.1:$(free_port)"
+cat >"$d/brdf-archive.toml" <<EOF
+[server]
+listen = "$archive_address"
+[archive]
+credentials = "$d/archive.conninfo"
+[[auth.tokens]]
+name = "lab-demo"
+token = "$token"
+role = "analyst"
+EOF
+chmod 600 "$d/brdf-archive.toml"
+start_detached "$d/brdf-archive.pid" "$d/brdf-archive.out" "$d/brdf-archive.log" \
+  "$archive_server" --config "$d/brdf-archive.toml"
+wait_for_line "$d/brdf-archive.out" '^brdf-archive listening on' 20
+echo "lab-demo: brdf-archive on $archive_address"
+
+say "every session of both rigs, through brdf-archive (brdfctl list)"
+BRDF_ADDRESS="$archive_address" "$ctl" list
+say "only the paints (brdfctl list --material paint), then the matte samples (--tag matte)"
+BRDF_ADDRESS="$archive_address" "$ctl" list --material paint
+BRDF_ADDRESS="$archive_address" "$ctl" list --tag matte
+
+say "each rig's session interpolated through brdf-archive, compared with the rig's own answer"
+where=(--theta-i 20 --theta-o 25 --phi 150 --method nearest --every 25)
+first_id() { python3 -c 'import json,sys; print(json.load(sys.stdin)["sessions"][0]["sessionId"])'; }
+for r in rig-a rig-b; do
+  archive_id="$(BRDF_ADDRESS="$archive_address" "$ctl" --json list --rig "$r" | first_id)"
+  rig_id="$(BRDF_ADDRESS="${address[$r]}" "$ctl" --json list | first_id)"
+  echo "lab-demo: $r: its session $rig_id is session $archive_id in the archive"
+  BRDF_ADDRESS="$archive_address" "$ctl" interpolate "$archive_id" "${where[@]}" |
+    tee "$run/$r/from-archive.txt"
+  BRDF_ADDRESS="${address[$r]}" "$ctl" interpolate "$rig_id" "${where[@]}" >"$run/$r/from-rig.txt"
+  # The first line names the session by its id, which differs; the rest must not.
+  cmp -s <(tail -n +2 "$run/$r/from-archive.txt") <(tail -n +2 "$run/$r/from-rig.txt") ||
+    die "$r: the archive's answer differs from the rig's ($run/$r/from-archive.txt, from-rig.txt)"
+  echo "lab-demo: $r: the archive's answer is the rig's, byte for byte (but for the session id)"
+done
+
 cat <<EOF
 
 lab-demo: done; everything keeps running. Stop it all: deploy/lab-demo.sh --stop
-  archive: PGPASSWORD=… $pgbin/psql -h $run/pg -p $pg_port -U brdf -d postgres
+  archive: BRDF_TOKEN=$token BRDF_ADDRESS=$archive_address $ctl list   (brdf-archive)
+           PGPASSWORD=… $pgbin/psql -h $run/pg -p $pg_port -U brdf -d postgres
            (the password is in $run/rig-a/archive.conninfo)
   rigs:    BRDF_TOKEN=$token BRDF_ADDRESS=${address[rig-a]} (rig-a) / ${address[rig-b]} (rig-b) $ctl rig
 EOF

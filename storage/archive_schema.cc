@@ -124,8 +124,17 @@ CREATE TABLE audit (
 CREATE INDEX audit_by_session ON audit (session_uuid) WHERE session_uuid IS NOT NULL;
 )sql";
 
-constexpr std::array<ArchiveMigration, 1> kArchiveMigrations{{
+// Version 2: brdf-archive's session ids. The API names a session by a positive number; across
+// rigs the rigs' own ids collide, so the archive numbers its sessions itself (existing rows are
+// numbered by the ALTER, in no particular order; new ones as they are first shipped).
+constexpr std::string_view kArchiveV2 = R"sql(
+ALTER TABLE sessions ADD COLUMN archive_id bigserial;
+CREATE UNIQUE INDEX sessions_by_archive_id ON sessions (archive_id);
+)sql";
+
+constexpr std::array<ArchiveMigration, 2> kArchiveMigrations{{
     {1, "create sessions, steps, readings, devices and audit", kArchiveV1},
+    {2, "number the sessions for brdf-archive (sessions.archive_id)", kArchiveV2},
 }};
 
 // "BRDF": the advisory lock key that serialises migrations across rigs and servers.

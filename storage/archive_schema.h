@@ -1,11 +1,12 @@
 // The lab archive's schema on PostgreSQL and its migrations. The full description is in
-// storage/archive-schema.md; in short (archive schema version 1):
+// storage/archive-schema.md; in short (archive schema version 2):
 //
 //   archive_schema  version, description, applied_at: one row per migration applied
 //   sessions  uuid (primary key: the session's global identity), rig, rig_session_id (the id on
 //             its rig; unique per rig), the rig's session columns (name … config_json), and the
 //             catalogue taken from the plan's sample block: sample_id, sample_name, material,
-//             sample_description, tags (text[]), white_standard_id; archived_at, updated_at
+//             sample_description, tags (text[]), white_standard_id; archived_at, updated_at;
+//             archive_id (v2: the session's id in brdf-archive's API, unique)
 //   steps     (session_uuid, step_index) primary key; the rig's step columns
 //   readings  (session_uuid, step_index) primary key — one reading per step, as on the rig;
 //             rig_reading_id (the reading's id on its rig, unique per session); the rig's reading

@@ -31,6 +31,7 @@
 #include "core/status.h"
 #include "storage/reader_pool.h"
 #include "storage/records.h"
+#include "storage/session_reader.h"
 #include "storage/ship_batch.h"
 #include "storage/sqlite.h"
 
@@ -59,7 +60,7 @@ struct IntegrityReport {
   std::string Summary() const;
 };
 
-class SessionStore {
+class SessionStore final : public SessionReader {
  public:
   struct Options {
     // How long a write waits for another process's lock (e.g. a backup) before kTimeout.
@@ -77,7 +78,7 @@ class SessionStore {
   static Result<std::unique_ptr<SessionStore>> Open(const std::string& path) {
     return Open(path, Options());
   }
-  ~SessionStore();
+  ~SessionStore() override;
 
   const std::string& path() const { return path_; }
 
@@ -96,7 +97,7 @@ class SessionStore {
   // The meter actually in use, once identified (sessions.meter_serial).
   Status SetSessionMeterSerial(std::int64_t session, const std::string& meter_serial);
 
-  Result<SessionRecord> GetSession(std::int64_t session);
+  Result<SessionRecord> GetSession(std::int64_t session) override;
   // The session with this global id; kNotFound when there is none.
   Result<SessionRecord> GetSessionByUuid(const std::string& uuid);
   // Sessions recorded before rigs had names (rig '') become `rig`'s: the daemon calls it at start
@@ -111,7 +112,7 @@ class SessionStore {
 
   // --- Steps ------------------------------------------------------------------------------------
 
-  Result<std::vector<StepRecord>> GetSteps(std::int64_t session);
+  Result<std::vector<StepRecord>> GetSteps(std::int64_t session) override;
   // The lowest-numbered pending step; nullopt when every step is done or skipped.
   Result<std::optional<int>> FirstUnfinishedStep(std::int64_t session);
 
@@ -139,7 +140,7 @@ class SessionStore {
   // Up to `limit` (> 0) readings of `session` with id > after_id, ascending id: page with the last
   // id seen. Readings are append-only, so paging never skips or repeats one.
   Result<std::vector<ReadingRecord>> GetReadings(std::int64_t session, std::int64_t after_id,
-                                                 int limit);
+                                                 int limit) override;
   Result<ReadingRecord> GetReading(std::int64_t reading_id);
   // Calls `visit` for every reading of `session` in id order, a page at a time (memory bounded by
   // one page; no lock or read transaction is held while `visit` runs, so it may be slow). A

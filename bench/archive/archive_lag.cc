@@ -11,8 +11,13 @@
 // Then the catalogue at lab scale: --sessions sessions with --readings readings in all, generated
 // inside PostgreSQL (generate_series), and the ListSessions-style catalogue query (filter by
 // material and tag, newest first, a page of 100) timed --queries times: p50 and p99, against the
-// same query without a filter as the baseline. (SQL over libpq; the brdf-archive server itself is
-// not part of this build.)
+// same query without a filter as the baseline (SQL over libpq). Then the same through a
+// brdf-archive server (daemon/archive_server.h, in this process, over gRPC on a loopback port):
+// ListSessions with the filter against ListSessions without one, and the first Interpolate on a
+// cold session (its 1,000 readings read from PostgreSQL, the index built) against the next
+// Interpolate on the same session (warm), each over --cold sessions.
+#include <grpcpp/create_channel.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -21,7 +26,11 @@
 #include <thread>
 #include <vector>
 
+#include "brdf/v1/brdf.grpc.pb.h"
+#include "daemon/archive_server.h"
 #include "daemon/archive_shipper.h"
+#include "daemon/auth.h"
+#include "storage/archive_reader.h"
 #include "storage/archive_schema.h"
 #include "storage/pg.h"
 #include "storage/session_store.h"
@@ -59,11 +68,13 @@ int main(int argc, char** argv) {
   int sessions = 1000;
   long total_readings = 1000000;
   int queries = 200;
+  int cold = 10;
   app.add_option("--lag-readings", readings, "readings recorded while shipping");
   app.add_option("--pace-ms", pace_ms, "pause between readings (ms)");
   app.add_option("--sessions", sessions, "catalogue: sessions in the archive");
   app.add_option("--readings", total_readings, "catalogue: readings in the archive (0: skip)");
   app.add_option("--queries", queries, "catalogue: queries timed");
+  app.add_option("--cold", cold, "brdf-archive: cold sessions interpolated");
   CLI11_PARSE(app, argc, argv);
 
   if (std::string why = brdf::testing::PgServer::Unavailable(); !why.empty()) {
@@ -169,8 +180,10 @@ int main(int argc, char** argv) {
       ") i WHERE rig_session_id > 0;"
       "INSERT INTO readings (session_uuid, step_index, rig_reading_id, kind, alpha, beta, gamma, "
       "delta, theta_i, phi_i, theta_o, phi_o, wl_start_nm, wl_step_nm, wl_count, spectrum, "
-      "recorded_at) SELECT session_uuid, step_index, step_index + 1, 'sample', 0, 0, 0, 0, 10, 0, "
-      "20, 90, 380, 4, 101, decode(repeat('0000000000000040', 101), 'hex'), 1.7e9 "
+      "recorded_at) SELECT session_uuid, step_index, step_index + 1, 'sample', 0, 0, 0, 0, "
+      "5 + (step_index % 8) * 10, 0, 5 + (step_index / 8 % 9) * 10, "
+      "(step_index / 72 % 19) * 10 - 90, 380, 4, 101, "
+      "decode(repeat('0000000000000040', 101), 'hex'), 1.7e9 "
       "FROM steps WHERE step_index >= 0 AND session_uuid IN "
       "(SELECT uuid FROM sessions WHERE rig <> 'bench-rig'); ANALYZE;";
   if (Status st = (*conn)->Exec("DELETE FROM readings; DELETE FROM steps; DELETE FROM sessions;");
@@ -215,6 +228,81 @@ int main(int argc, char** argv) {
       "medians %.2f\n",
       Quantile(plain, 0.5), Quantile(plain, 0.99),
       Quantile(filtered, 0.5) / std::max(1e-9, Quantile(plain, 0.5)));
+
+  // --- The same through brdf-archive ----------------------------------------------------------
+  Result<std::shared_ptr<storage::ArchiveReader>> reader =
+      storage::ArchiveReader::Open((*pg)->conninfo());
+  if (!reader.ok()) return Fail("opening the archive", reader.status());
+  brdf::daemon::ServerConfig server_config;
+  server_config.listen = "127.0.0.1:0";
+  brdf::daemon::Authenticator auth({});
+  Result<std::unique_ptr<brdf::daemon::ArchiveServer>> server = brdf::daemon::ArchiveServer::Start(
+      server_config, *reader, auth, brdf::daemon::ArchiveServer::Options());
+  if (!server.ok()) return Fail("starting brdf-archive", server.status());
+  auto channel = grpc::CreateChannel((*server)->address(), grpc::InsecureChannelCredentials());
+  auto control = brdf::v1::Control::NewStub(channel);
+  auto interpolation = brdf::v1::Interpolation::NewStub(channel);
+  auto time_list = [&](const brdf::v1::ListSessionsRequest& request) {
+    std::vector<double> ms;
+    for (int q = 0; q < queries; ++q) {
+      grpc::ClientContext context;
+      brdf::v1::ListSessionsResponse response;
+      const auto t0 = std::chrono::steady_clock::now();
+      grpc::Status st = control->ListSessions(&context, request, &response);
+      ms.push_back(Ms(std::chrono::steady_clock::now() - t0));
+      if (!st.ok()) std::fprintf(stderr, "ListSessions: %s\n", st.error_message().c_str());
+    }
+    return ms;
+  };
+  brdf::v1::ListSessionsRequest filter;
+  filter.set_material("paint");
+  filter.set_tag("glossy");
+  filter.set_rig("rig-0");
+  const std::vector<double> listed = time_list(filter);
+  const std::vector<double> all = time_list(brdf::v1::ListSessionsRequest());
+  std::printf("brdf-archive on %s:\n", (*server)->address().c_str());
+  std::printf(
+      "  ListSessions (material + tag + rig), %d times: p50 %.3f ms, p99 %.3f ms\n"
+      "  baseline: ListSessions without a filter (a page of 100): p50 %.3f ms, p99 %.3f ms; "
+      "ratio of medians %.2f\n",
+      queries, Quantile(listed, 0.5), Quantile(listed, 0.99), Quantile(all, 0.5),
+      Quantile(all, 0.99), Quantile(listed, 0.5) / std::max(1e-9, Quantile(all, 0.5)));
+  brdf::v1::ListSessionsRequest some;
+  some.set_page_size(static_cast<std::uint32_t>(cold));
+  brdf::v1::ListSessionsResponse sessions_page;
+  {
+    grpc::ClientContext context;
+    if (!control->ListSessions(&context, some, &sessions_page).ok()) return 1;
+  }
+  std::vector<double> first_ms, warm_ms;
+  int answered = 0;
+  for (const brdf::v1::Session& s : sessions_page.sessions()) {
+    brdf::v1::InterpolateRequest request;
+    request.set_session_id(s.session_id());
+    request.set_quantity(brdf::v1::QUANTITY_RADIANCE);
+    request.mutable_direction()->mutable_iso()->set_theta_i(33);
+    request.mutable_direction()->mutable_iso()->set_theta_o(41);
+    request.mutable_direction()->mutable_iso()->set_phi(57);
+    for (std::vector<double>* into : {&first_ms, &warm_ms}) {
+      grpc::ClientContext context;
+      brdf::v1::InterpolateResponse response;
+      const auto t0 = std::chrono::steady_clock::now();
+      grpc::Status st = interpolation->Interpolate(&context, request, &response);
+      into->push_back(Ms(std::chrono::steady_clock::now() - t0));
+      if (st.ok() && into == &first_ms) ++answered;
+      if (!st.ok() && into == &first_ms) {
+        std::fprintf(stderr, "Interpolate: %s\n", st.error_message().c_str());
+      }
+    }
+  }
+  std::printf(
+      "  first Interpolate on a cold session (%zu sessions of %ld readings, %d answered): "
+      "p50 %.1f ms, max %.1f ms\n"
+      "  baseline: the next Interpolate on the same session (warm): p50 %.3f ms; ratio of "
+      "medians %.0f\n",
+      first_ms.size(), per_session, answered, Quantile(first_ms, 0.5), Quantile(first_ms, 1.0),
+      Quantile(warm_ms, 0.5), Quantile(first_ms, 0.5) / std::max(1e-9, Quantile(warm_ms, 0.5)));
+  (*server)->Shutdown(std::chrono::seconds(1));
   (void)dir;
   return 0;
 }

@@ -166,8 +166,13 @@ int RunGet(CommandContext& ctx, const std::string& session_id) {
   return kExitOk;
 }
 
-int RunList(CommandContext& ctx, const std::vector<std::string>& states, unsigned limit) {
+int RunList(CommandContext& ctx, const std::vector<std::string>& states, unsigned limit,
+            const ListFilters& filters) {
   v1::ListSessionsRequest request;
+  request.set_rig(filters.rig);
+  request.set_sample(filters.sample);
+  request.set_material(filters.material);
+  request.set_tag(filters.tag);
   for (const std::string& name : states) {
     v1::SessionState state{};
     if (!ParseStateName(name, &state)) {
@@ -200,7 +205,9 @@ int RunList(CommandContext& ctx, const std::vector<std::string>& states, unsigne
     return kExitOk;
   }
   if (all.sessions().empty()) {
-    ctx.out << "no sessions" << (states.empty() ? "" : " in those states") << "\n";
+    const bool filtered = !states.empty() || !filters.rig.empty() || !filters.sample.empty() ||
+                          !filters.material.empty() || !filters.tag.empty();
+    ctx.out << "no sessions" << (filtered ? " match" : "") << "\n";
     return kExitOk;
   }
   for (const v1::Session& s : all.sessions()) ctx.out << SessionLine(s) << "\n";

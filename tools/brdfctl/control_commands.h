@@ -28,7 +28,15 @@ int RunGet(CommandContext& ctx, const std::string& session_id);
 
 // ListSessions, every page (newest first), only `states` when given ("running", "paused", …);
 // at most `limit` sessions (0: all).
-int RunList(CommandContext& ctx, const std::vector<std::string>& states, unsigned limit);
+// ListSessions' catalogue filters (empty: none), as brdfd and brdf-archive apply them.
+struct ListFilters {
+  std::string rig;
+  std::string sample;  // the sample's id, or its name ignoring case
+  std::string material;
+  std::string tag;
+};
+int RunList(CommandContext& ctx, const std::vector<std::string>& states, unsigned limit,
+            const ListFilters& filters = {});
 
 // GetRigStatus: devices, axes, live pose, meter serial, the session holding the rig.
 int RunRig(CommandContext& ctx);

@@ -144,6 +144,13 @@ int main(int argc, char** argv) {
                    "completed, aborted, failed (repeat or comma-separate)")
       ->delimiter(',');
   list->add_option("--limit", limit, "at most this many (0: all)");
+  ListFilters list_filters;
+  list->add_option("--rig", list_filters.rig, "only sessions recorded by this rig ([rig] name)");
+  list->add_option("--sample", list_filters.sample,
+                   "only sessions of this sample: its id, or its name (ignoring case)");
+  list->add_option("--material", list_filters.material,
+                   "only sessions of samples of this material (ignoring case)");
+  list->add_option("--tag", list_filters.tag, "only sessions of samples carrying this tag");
   CLI::App* rig = app.add_subcommand("rig", "the rig: devices, axes, live pose, meter serial");
 
   WatchOptions watch_options;
@@ -294,7 +301,7 @@ int main(int argc, char** argv) {
   if (abort_cmd->parsed()) return RunAbort(ctx, session_id, reason);
   if (answer->parsed()) return RunAnswer(ctx, session_id, step_index, note);
   if (get->parsed()) return RunGet(ctx, session_id);
-  if (list->parsed()) return RunList(ctx, states, limit);
+  if (list->parsed()) return RunList(ctx, states, limit, list_filters);
   if (rig->parsed()) return RunRig(ctx);
   if (watch->parsed()) {
     watch_options.session_id = session_id;

@@ -24,6 +24,7 @@ std::string SessionLine(const v1::Session& s) {
                     std::to_string(s.progress().total_steps()) + " steps";
   if (s.eta_s() > 0) out += "  ETA " + Duration(s.eta_s());
   out += "  " + s.name();
+  if (!s.rig().empty()) out += "  (rig " + s.rig() + ")";
   return out;
 }
 

@@ -1,0 +1,91 @@
+// ArchiveServer: brdf-archive's gRPC server -- the lab archive (PostgreSQL) served with the read
+// side of brdfd's API, on the same terms as brdfd: the same token gate, roles and [server.tls]
+// (MakeServerCredentials), the same limits and stream caps (stream_registry.h), the standard
+// health service and server reflection.
+//
+//   Control        archive_services.h: GetSession, ListSessions; the rig's verbs refused
+//   Data           archive_services.h: StreamReadings; Export not yet
+//   Interpolation  brdfd's own InterpolationService and InterpolateLoop over an IndexCache whose
+//                  store is the archive (storage/archive_reader.h): the same code, over the same
+//                  records, answers as on the rig, bit for bit
+//
+// Stateless: nothing but caches lives here, so several ArchiveServers (processes, machines) can
+// serve one archive behind a load balancer. The index cache is kept current without commit
+// events: every `refresh` a thread asks the archive for readings above those each cached session
+// holds and hands them over (IndexCache::OnReading), so a session still recording on its rig
+// grows here as it is shipped.
+#pragma once
+
+#include <grpcpp/server.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "core/status.h"
+#include "daemon/archive_services.h"
+#include "daemon/auth.h"
+#include "daemon/config.h"
+#include "daemon/control_loop.h"
+#include "daemon/health_service.h"
+#include "daemon/index_cache.h"
+#include "daemon/interpolate_loop.h"
+#include "daemon/reflection_service.h"
+#include "daemon/service_interpolation.h"
+#include "daemon/stream_registry.h"
+#include "storage/archive_reader.h"
+
+namespace brdf::daemon {
+
+class ArchiveServer {
+ public:
+  struct Options {
+    // How often cached sessions are brought up to date with the archive.
+    std::chrono::milliseconds refresh{1000};
+    IndexCache::Options cache;
+  };
+
+  // Serves `archive` on config.listen (port 0: any free port). Errors as Server::Start's.
+  // `auth` must outlive the server.
+  static Result<std::unique_ptr<ArchiveServer>> Start(
+      const ServerConfig& config, std::shared_ptr<storage::ArchiveReader> archive,
+      const Authenticator& auth, Options options);
+  ~ArchiveServer();  // Shutdown(1 s)
+  ArchiveServer(const ArchiveServer&) = delete;
+  ArchiveServer& operator=(const ArchiveServer&) = delete;
+
+  const std::string& address() const { return address_; }
+  bool tls() const { return tls_; }
+  IndexCache::Stats cache_stats() const { return cache_.stats(); }
+
+  // Health → NOT_SERVING, streams end, calls in flight get `grace`. Idempotent.
+  void Shutdown(std::chrono::milliseconds grace);
+
+ private:
+  ArchiveServer(const ServerConfig& config, std::shared_ptr<storage::ArchiveReader> archive,
+                const Authenticator& auth, Options options);
+  // The refresh thread's loop, until stopping_.
+  void Refresh();
+
+  std::shared_ptr<storage::ArchiveReader> archive_;
+  Options options_;
+  IndexCache cache_;
+  StopSignal stopping_;
+  StreamRegistry streams_;
+  ControlLoop control_loop_;  // the health service's Check
+  HealthService health_;
+  ArchiveControlService control_;
+  ArchiveDataService data_;
+  InterpolationService interpolation_;
+  InterpolateLoop interpolate_loop_;
+  ReflectionV1Service reflection_v1_;
+  ReflectionV1AlphaService reflection_v1alpha_;
+  std::unique_ptr<grpc::Server> server_;
+  std::thread refresher_;
+  std::string address_;
+  bool tls_ = false;
+  bool shut_down_ = false;
+};
+
+}  // namespace brdf::daemon

@@ -1,0 +1,35 @@
+// SessionReader: reading a recorded session -- its record, its steps and its readings a page at a
+// time -- whatever holds it. The rig's SQLite store (session_store.h) is one; the lab archive in
+// PostgreSQL (archive_reader.h) is another. What answers from a session's data (the daemon's
+// index cache, hence Interpolate and InterpolateBatch) reads through this interface, so the rig
+// and brdf-archive answer with the same code from the same records, bit for bit.
+//
+// Contract, for every implementation:
+//   - ids are the reader's own session ids (positive); readings keep the ids they were recorded
+//     with, and a reading's reference_reading_id / dark_reading_id name readings of the same
+//     session by those ids;
+//   - GetReadings pages in ascending reading id: up to `limit` (> 0) readings with id > after_id;
+//     readings are append-only, so paging never skips or repeats one;
+//   - kNotFound for an unknown session; kIoError (or kDisconnected) when the data cannot be read.
+// Thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/status.h"
+#include "storage/records.h"
+
+namespace brdf::storage {
+
+class SessionReader {
+ public:
+  virtual ~SessionReader() = default;
+
+  virtual Result<SessionRecord> GetSession(std::int64_t session) = 0;
+  virtual Result<std::vector<StepRecord>> GetSteps(std::int64_t session) = 0;
+  virtual Result<std::vector<ReadingRecord>> GetReadings(std::int64_t session,
+                                                         std::int64_t after_id, int limit) = 0;
+};
+
+}  // namespace brdf::storage

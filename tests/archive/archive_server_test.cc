@@ -1,0 +1,500 @@
+// brdf-archive against a real PostgreSQL and a real rig: brdf-sim and brdfd (processes) record
+// and ship; two brdf-archive processes serve the archive. For the same session the archive
+// answers Interpolate, InterpolateBatch and StreamReadings exactly as the rig's brdfd does (the
+// messages compared field by field, doubles exactly), ListSessions filters and pages across the
+// catalogue (brdfd applies the same filters), the rig's verbs are refused naming the rig, and
+// brdfctl works against it unchanged.
+#include <gmock/gmock.h>
+#include <google/protobuf/util/message_differencer.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <fstream>
+#include <stdexcept>
+#include <thread>
+
+#include "daemon/config.h"
+#include "tests/brdfctl/ctl_runner.h"
+#include "tests/daemon/daemon_test_rig.h"
+#include "tests/support/pg_server.h"
+#include "tests/support/plan_fixtures.h"
+#include "tests/support/process_launcher.h"
+
+namespace brdf::testing {
+namespace {
+
+using namespace std::chrono_literals;
+using ::google::protobuf::util::MessageDifferencer;
+using ::testing::HasSubstr;
+using Clock = std::chrono::steady_clock;
+
+constexpr std::string_view kListening = "brdf-archive listening on ";
+
+// One brdf-archive process and its stubs.
+class ArchiveProcess {
+ public:
+  static Result<std::unique_ptr<ArchiveProcess>> Start(const std::string& config,
+                                                       const std::string& log) {
+    Result<std::string> binary =
+        BuiltProgram("brdf-archive", "daemon/brdf-archive", "BRDF_ARCHIVE_BINARY");
+    if (!binary.ok()) return binary.status();
+    LaunchOptions options({"--config", config});
+    options.stderr_to = LaunchOptions::Stderr::kAppendToFile;
+    options.stderr_path = log;
+    Result<std::unique_ptr<ChildProcess>> child =
+        ChildProcess::Launch("brdf-archive", *binary, options);
+    if (!child.ok()) return child.status();
+    std::unique_ptr<ArchiveProcess> a(new ArchiveProcess());
+    a->child_ = std::move(*child);
+    Result<std::string> line = a->child_->ReadLine(Clock::now() + 15s);
+    if (!line.ok() || line->rfind(kListening, 0) != 0) {
+      return Internal("brdf-archive did not start: " +
+                      (line.ok() ? *line : line.status().ToString()));
+    }
+    a->address_ = line->substr(kListening.size());
+    a->channel_ = grpc::CreateChannel(a->address_, grpc::InsecureChannelCredentials());
+    a->control_ = v1::Control::NewStub(a->channel_);
+    a->data_ = v1::Data::NewStub(a->channel_);
+    a->interpolation_ = v1::Interpolation::NewStub(a->channel_);
+    return a;
+  }
+  std::optional<int> Stop() { return child_->Terminate(10s); }
+
+  const std::string& address() const { return address_; }
+  v1::Control::Stub& control() { return *control_; }
+  v1::Data::Stub& data() { return *data_; }
+  v1::Interpolation::Stub& interpolation() { return *interpolation_; }
+
+ private:
+  ArchiveProcess() = default;
+  std::unique_ptr<ChildProcess> child_;
+  std::string address_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::Control::Stub> control_;
+  std::unique_ptr<v1::Data::Stub> data_;
+  std::unique_ptr<v1::Interpolation::Stub> interpolation_;
+};
+
+// `text` with "session <id>" written "session <as>".
+std::string WithId(std::string text, const std::string& id, const std::string& as) {
+  const std::string from = "session " + id;
+  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + 1)) {
+    const std::size_t end = at + from.size();
+    if (end < text.size() && std::isdigit(static_cast<unsigned char>(text[end]))) continue;
+    text.replace(at, from.size(), "session " + as);
+  }
+  return text;
+}
+
+// The plan's JSON with a sample block.
+std::string WithSample(const std::string& plan_json, const std::string& sample_json) {
+  return "{\"sample\": " + sample_json + ", " + plan_json.substr(plan_json.find('{') + 1);
+}
+
+const std::string kPaint =
+    R"({"id": "P-0042", "name": "Red Gloss", "material": "paint", "tags": ["glossy", "red"]})";
+const std::string kFabric =
+    R"({"id": "F-0007", "name": "grey felt", "material": "fabric", "tags": ["matte"]})";
+
+// Every (θi, θo, φ) of a small grid over and around the session's readings.
+std::vector<v1::DirectionQuery> Directions() {
+  std::vector<v1::DirectionQuery> out;
+  for (double ti : {0.0, 7.5, 15.0, 22.0, 35.0}) {
+    for (double to : {10.0, 20.0, 31.0, 40.0}) {
+      for (double phi : {0.0, 45.0, 120.0, 170.0, 180.0}) {
+        v1::DirectionQuery q;
+        q.mutable_iso()->set_theta_i(ti);
+        q.mutable_iso()->set_theta_o(to);
+        q.mutable_iso()->set_phi(phi);
+        out.push_back(q);
+      }
+    }
+  }
+  return out;
+}
+
+class ArchiveServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (std::string why = PgServer::Unavailable(); !why.empty()) GTEST_SKIP() << why;
+    Result<std::unique_ptr<PgServer>> pg = PgServer::Start();
+    ASSERT_TRUE(pg.ok()) << pg.status().ToString();
+    pg_ = std::move(*pg);
+    rig_ = std::make_unique<DaemonRig>();
+    ASSERT_TRUE(rig_->StartSim().ok());
+    const std::string cred = rig_->dir().file("archive.conninfo").string();
+    ASSERT_TRUE(PgServer::WriteCredentials(cred, pg_->conninfo()).ok());
+    const std::string toml = DaemonConfigToml(rig_->sim(), rig_->database()) +
+                             "[rig]\nname = \"rig-a\"\n[archive]\ncredentials = \"" + cred +
+                             "\"\nretry_ms = 100\n";
+    Status daemon = rig_->StartDaemon(toml);
+    ASSERT_TRUE(daemon.ok()) << daemon.ToString();
+  }
+  void TearDown() override {
+    for (auto& op : operators_) op->Stop();
+    for (auto& a : archives_) (void)a->Stop();
+    if (rig_ != nullptr && rig_->daemon() != nullptr) (void)rig_->StopDaemon();
+    if (HasFailure() && rig_ != nullptr) std::cerr << "---- brdfd log ----\n" << rig_->log();
+    if (HasFailure()) {
+      for (std::size_t i = 0; i < archives_.size(); ++i) {
+        std::ifstream in(rig_->dir().file("archive" + std::to_string(i) + ".log"));
+        std::cerr << "---- brdf-archive " << i << " log ----\n" << in.rdbuf();
+      }
+    }
+  }
+
+  // Submits (started), with an operator answering its prompts.
+  v1::Session Submit(const std::string& plan_json) {
+    Result<v1::Session> s = rig_->Submit(plan_json);
+    EXPECT_TRUE(s.ok()) << s.status().ToString();
+    if (!s.ok()) return {};
+    operators_.push_back(std::make_unique<GrpcOperator>(*rig_, s->session_id()));
+    return *s;
+  }
+  bool WaitCaughtUp() {
+    const auto deadline = Clock::now() + 30s;
+    while (Clock::now() < deadline) {
+      v1::RigStatus status;
+      if (rig_->control().GetRigStatus(DaemonRig::Context().get(), {}, &status).ok() &&
+          status.archive().state() == v1::ARCHIVE_STATE_CAUGHT_UP &&
+          status.archive().lag_readings() == 0) {
+        return true;
+      }
+      std::this_thread::sleep_for(50ms);
+    }
+    return false;
+  }
+  ArchiveProcess& StartArchive() {
+    const std::size_t i = archives_.size();
+    const std::string cred = rig_->dir().file("archive-server.conninfo").string();
+    EXPECT_TRUE(PgServer::WriteCredentials(cred, pg_->conninfo()).ok());
+    const std::string config = rig_->dir().file("archive" + std::to_string(i) + ".toml").string();
+    std::ofstream(config) << "[server]\nlisten = \"127.0.0.1:0\"\n[archive]\ncredentials = \""
+                          << cred << "\"\n[[auth.tokens]]\nname = \"op\"\ntoken = \""
+                          << kOperatorToken
+                          << "\"\nrole = \"operator\"\n[[auth.tokens]]\nname = \"an\"\ntoken = \""
+                          << kAnalystToken << "\"\nrole = \"analyst\"\n";
+    Result<std::unique_ptr<ArchiveProcess>> a = ArchiveProcess::Start(
+        config, rig_->dir().file("archive" + std::to_string(i) + ".log").string());
+    if (!a.ok()) {
+      ADD_FAILURE() << a.status().ToString();
+      throw std::runtime_error("brdf-archive did not start");
+    }
+    archives_.push_back(std::move(*a));
+    return *archives_.back();
+  }
+
+  // ListSessions (every page), as uuids.
+  static std::vector<std::string> Uuids(v1::Control::Stub& control,
+                                        v1::ListSessionsRequest request) {
+    std::vector<std::string> out;
+    for (int pages = 0; pages < 100; ++pages) {
+      v1::ListSessionsResponse page;
+      grpc::Status st =
+          control.ListSessions(DaemonRig::Context(kAnalystToken).get(), request, &page);
+      EXPECT_TRUE(st.ok()) << st.error_message();
+      if (!st.ok()) break;
+      for (const v1::Session& s : page.sessions()) out.push_back(s.uuid());
+      if (page.next_page_token().empty()) break;
+      request.set_page_token(page.next_page_token());
+    }
+    return out;
+  }
+
+  // The archive's id of the session with `uuid`.
+  static std::string ArchiveId(ArchiveProcess& a, const std::string& uuid) {
+    v1::ListSessionsResponse all;
+    EXPECT_TRUE(a.control().ListSessions(DaemonRig::Context().get(), {}, &all).ok());
+    for (const v1::Session& s : all.sessions()) {
+      if (s.uuid() == uuid) return s.session_id();
+    }
+    ADD_FAILURE() << "session " << uuid << " is not in the archive";
+    return "";
+  }
+
+  // Interpolate at every direction: the responses (or the statuses, as "code: message").
+  static std::vector<std::string> InterpolateAll(v1::Interpolation::Stub& stub,
+                                                 const std::string& id, v1::Quantity quantity) {
+    std::vector<std::string> out;
+    for (const v1::DirectionQuery& d : Directions()) {
+      v1::InterpolateRequest request;
+      request.set_session_id(id);
+      request.set_quantity(quantity);
+      *request.mutable_direction() = d;
+      v1::InterpolateResponse response;
+      grpc::Status st =
+          stub.Interpolate(DaemonRig::Context(kAnalystToken).get(), request, &response);
+      out.push_back(st.ok() ? response.SerializeAsString()
+                            : std::to_string(st.error_code()) + ": " + st.error_message());
+    }
+    return out;
+  }
+  static std::vector<v1::InterpolationResult> Batch(v1::Interpolation::Stub& stub,
+                                                    const std::string& id) {
+    v1::InterpolateBatchRequest request;
+    request.set_session_id(id);
+    request.set_quantity(v1::QUANTITY_BRDF);
+    for (const v1::DirectionQuery& d : Directions()) *request.add_directions() = d;
+    request.set_chunk_size(16);
+    auto context = DaemonRig::Context(kAnalystToken);
+    auto reader = stub.InterpolateBatch(context.get(), request);
+    std::vector<v1::InterpolationResult> out;
+    v1::InterpolateBatchChunk chunk;
+    while (reader->Read(&chunk)) {
+      for (const v1::InterpolationResult& r : chunk.results()) out.push_back(r);
+    }
+    grpc::Status st = reader->Finish();
+    EXPECT_TRUE(st.ok()) << st.error_message();
+    return out;
+  }
+  static std::vector<v1::Reading> Readings(v1::Data::Stub& data, const std::string& id) {
+    v1::StreamReadingsRequest request;
+    request.set_session_id(id);
+    auto context = DaemonRig::Context(kAnalystToken);
+    auto reader = data.StreamReadings(context.get(), request);
+    std::vector<v1::Reading> out;
+    v1::Reading r;
+    while (reader->Read(&r)) out.push_back(r);
+    grpc::Status st = reader->Finish();
+    EXPECT_TRUE(st.ok()) << st.error_message();
+    return out;
+  }
+
+  std::unique_ptr<PgServer> pg_;
+  std::unique_ptr<DaemonRig> rig_;
+  std::vector<std::unique_ptr<GrpcOperator>> operators_;
+  std::vector<std::unique_ptr<ArchiveProcess>> archives_;
+};
+
+TEST_F(ArchiveServerTest, TwoReplicasAnswerBitForBitWhatTheRigAnswers) {
+  const v1::Session paint = Submit(WithSample(plans::InterpolationGrid(), kPaint));
+  const v1::Session felt = Submit(WithSample(plans::TinyPoseList(), kFabric));
+  for (const v1::Session& s : {paint, felt}) {
+    ASSERT_EQ(rig_->WaitForState(s.session_id(), v1::SESSION_STATE_COMPLETED, 120s).state(),
+              v1::SESSION_STATE_COMPLETED);
+  }
+  ASSERT_TRUE(WaitCaughtUp());
+  ArchiveProcess& a = StartArchive();
+  ArchiveProcess& b = StartArchive();
+
+  // The catalogue, across the archive; the rig's brdfd filters the same way.
+  const std::string p = paint.uuid();
+  const std::string f = felt.uuid();
+  v1::ListSessionsRequest q;
+  for (v1::Control::Stub* control : {&a.control(), &b.control(), &rig_->control()}) {
+    EXPECT_EQ(Uuids(*control, q), (std::vector<std::string>{f, p}));  // newest first
+    q.set_material("PAINT");
+    EXPECT_EQ(Uuids(*control, q), std::vector<std::string>{p});
+    q.Clear();
+    q.set_tag("matte");
+    EXPECT_EQ(Uuids(*control, q), std::vector<std::string>{f});
+    q.Clear();
+    q.set_sample("red gloss");
+    EXPECT_EQ(Uuids(*control, q), std::vector<std::string>{p});
+    q.set_sample("F-0007");
+    EXPECT_EQ(Uuids(*control, q), std::vector<std::string>{f});
+    q.Clear();
+    q.set_rig("rig-a");
+    q.add_states(v1::SESSION_STATE_COMPLETED);
+    q.set_page_size(1);  // two pages
+    EXPECT_EQ(Uuids(*control, q), (std::vector<std::string>{f, p}));
+    q.set_rig("rig-b");
+    EXPECT_TRUE(Uuids(*control, q).empty());
+    q.Clear();
+    q.mutable_created_before()->set_seconds(paint.created_at().seconds() - 1);
+    EXPECT_TRUE(Uuids(*control, q).empty());
+    q.Clear();
+    q.mutable_created_after()->set_seconds(paint.created_at().seconds() - 1);
+    EXPECT_EQ(Uuids(*control, q).size(), 2U);
+    q.Clear();
+  }
+
+  const std::string id_a = ArchiveId(a, p);
+  ASSERT_EQ(id_a, ArchiveId(b, p)) << "replicas number sessions alike";
+  v1::GetSessionRequest get;
+  get.set_session_id(id_a);
+  v1::Session archived;
+  ASSERT_TRUE(a.control().GetSession(DaemonRig::Context().get(), get, &archived).ok());
+  const v1::Session on_rig = *rig_->Get(paint.session_id());
+  EXPECT_EQ(archived.uuid(), p);
+  EXPECT_EQ(archived.rig(), "rig-a");
+  EXPECT_EQ(archived.state(), v1::SESSION_STATE_COMPLETED);
+  EXPECT_TRUE(MessageDifferencer::Equals(archived.plan(), on_rig.plan()));
+  EXPECT_TRUE(MessageDifferencer::Equals(archived.sample(), on_rig.sample()));
+  EXPECT_TRUE(MessageDifferencer::Equals(archived.progress(), on_rig.progress()));
+  EXPECT_TRUE(MessageDifferencer::Equals(archived.created_at(), on_rig.created_at()));
+
+  // Interpolate in every quantity: byte for byte the rig's responses, on both replicas.
+  for (v1::Quantity quantity :
+       {v1::QUANTITY_BRDF, v1::QUANTITY_REFLECTANCE, v1::QUANTITY_RADIANCE}) {
+    const std::vector<std::string> rig_answers =
+        InterpolateAll(rig_->interpolation(), paint.session_id(), quantity);
+    int answered = 0;
+    for (const std::string& s : rig_answers) answered += s.find(": ") == std::string::npos;
+    EXPECT_GT(answered, 20) << "the grid should mostly be answerable";
+    EXPECT_EQ(InterpolateAll(a.interpolation(), id_a, quantity), rig_answers);
+    EXPECT_EQ(InterpolateAll(b.interpolation(), id_a, quantity), rig_answers);
+  }
+  const std::vector<v1::InterpolationResult> rig_batch =
+      Batch(rig_->interpolation(), paint.session_id());
+  ASSERT_EQ(rig_batch.size(), Directions().size());
+  for (ArchiveProcess* server : {&a, &b}) {
+    const std::vector<v1::InterpolationResult> batch = Batch(server->interpolation(), id_a);
+    ASSERT_EQ(batch.size(), rig_batch.size());
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      EXPECT_EQ(batch[i].SerializeAsString(), rig_batch[i].SerializeAsString())
+          << "direction " << i;
+    }
+  }
+
+  // The readings, as the rig streams them (but for the session id, which is the archive's).
+  std::vector<v1::Reading> rig_readings = Readings(rig_->data(), paint.session_id());
+  std::vector<v1::Reading> archive_readings = Readings(b.data(), id_a);
+  ASSERT_EQ(archive_readings.size(), rig_readings.size());
+  ASSERT_GT(rig_readings.size(), 10U);
+  for (std::size_t i = 0; i < rig_readings.size(); ++i) {
+    EXPECT_EQ(archive_readings[i].session_id(), id_a);
+    archive_readings[i].set_session_id(rig_readings[i].session_id());
+    EXPECT_EQ(archive_readings[i].SerializeAsString(), rig_readings[i].SerializeAsString())
+        << "reading " << rig_readings[i].id();
+  }
+}
+
+TEST_F(ArchiveServerTest, RefusesTheRigsVerbsAndUnknownSessionsAndChecksTokens) {
+  const v1::Session s = Submit(plans::TinyPoseList());
+  ASSERT_EQ(rig_->WaitForState(s.session_id(), v1::SESSION_STATE_COMPLETED, 60s).state(),
+            v1::SESSION_STATE_COMPLETED);
+  ASSERT_TRUE(WaitCaughtUp());
+  ArchiveProcess& a = StartArchive();
+  const std::string id = ArchiveId(a, s.uuid());
+
+  v1::PauseSessionRequest pause;
+  pause.set_session_id(id);
+  v1::PauseSessionResponse paused;
+  grpc::Status st = a.control().PauseSession(DaemonRig::Context().get(), pause, &paused);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(st.error_message(), HasSubstr("brdf-archive"));
+  EXPECT_THAT(st.error_message(), HasSubstr("rig \"rig-a\"'s brdfd"));
+  v1::SubmitPlanRequest submit;
+  v1::SubmitPlanResponse submitted;
+  st = a.control().SubmitPlan(DaemonRig::Context(kAnalystToken).get(), submit, &submitted);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::PERMISSION_DENIED) << "roles as on a rig";
+  v1::RigStatus rig_status;
+  st = a.control().GetRigStatus(DaemonRig::Context().get(), {}, &rig_status);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+
+  v1::GetSessionRequest get;
+  get.set_session_id(id);
+  v1::Session got;
+  st = a.control().GetSession(DaemonRig::Context("").get(), get, &got);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  get.set_session_id("987654");
+  st = a.control().GetSession(DaemonRig::Context().get(), get, &got);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::NOT_FOUND) << st.error_message();
+  v1::ListSessionsRequest list;
+  list.set_page_token("17");
+  v1::ListSessionsResponse listed;
+  st = a.control().ListSessions(DaemonRig::Context().get(), list, &listed);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(st.error_message(), HasSubstr("page_token"));
+}
+
+TEST_F(ArchiveServerTest, BrdfctlListsAndInterpolatesThroughTheArchiveUnchanged) {
+  const v1::Session paint = Submit(WithSample(plans::InterpolationGrid(), kPaint));
+  ASSERT_EQ(rig_->WaitForState(paint.session_id(), v1::SESSION_STATE_COMPLETED, 120s).state(),
+            v1::SESSION_STATE_COMPLETED);
+  ASSERT_TRUE(WaitCaughtUp());
+  ArchiveProcess& a = StartArchive();
+  const std::string id = ArchiveId(a, paint.uuid());
+  const EnvVars archive_env{{"BRDF_ADDRESS", a.address()}, {"BRDF_TOKEN", kAnalystToken}};
+  const EnvVars rig_env{{"BRDF_ADDRESS", rig_->daemon()->address()}, {"BRDF_TOKEN", kAnalystToken}};
+
+  Result<CommandResult> list = RunBrdfctl({"list", "--material", "paint"}, archive_env);
+  ASSERT_TRUE(list.ok());
+  EXPECT_EQ(list->exit_code, 0) << list->err;
+  ASSERT_EQ(Lines(list->out).size(), 1U) << list->out;
+  EXPECT_THAT(list->out, HasSubstr(id + "  completed"));
+  EXPECT_THAT(list->out, HasSubstr("(rig rig-a)"));
+  Result<CommandResult> none = RunBrdfctl({"list", "--tag", "no-such-tag"}, archive_env);
+  ASSERT_TRUE(none.ok());
+  EXPECT_EQ(none->out, "no sessions match\n");
+
+  // The same answer, to the byte; and the same refusal where the octant method finds no sample.
+  for (const std::vector<std::string>& where :
+       {std::vector<std::string>{"--theta-i", "15", "--theta-o", "31", "--phi", "170", "--method",
+                                 "nearest"},
+        std::vector<std::string>{"--theta-i", "15", "--theta-o", "31", "--phi", "170"}}) {
+    std::vector<std::string> on_archive = {"interpolate", id};
+    std::vector<std::string> on_rig = {"interpolate", paint.session_id()};
+    on_archive.insert(on_archive.end(), where.begin(), where.end());
+    on_rig.insert(on_rig.end(), where.begin(), where.end());
+    Result<CommandResult> from_archive = RunBrdfctl(on_archive, archive_env);
+    Result<CommandResult> from_rig = RunBrdfctl(on_rig, rig_env);
+    ASSERT_TRUE(from_archive.ok() && from_rig.ok());
+    EXPECT_EQ(from_archive->exit_code, from_rig->exit_code) << from_archive->err;
+    // The same text but for the session id ("session 7: …"), which is the archive's there.
+    EXPECT_EQ(WithId(from_archive->out, id, "ID"), WithId(from_rig->out, paint.session_id(), "ID"));
+    EXPECT_EQ(WithId(from_archive->err, id, "ID"), WithId(from_rig->err, paint.session_id(), "ID"));
+    if (where.size() == 8) {
+      EXPECT_EQ(from_rig->exit_code, 0) << from_rig->err;
+      EXPECT_GT(Lines(from_rig->out).size(), 10U);
+    }
+  }
+}
+
+TEST_F(ArchiveServerTest, ASessionCachedWhileRecordingGrowsAsItIsShipped) {
+  ASSERT_TRUE(WaitCaughtUp()) << "the rig migrates the archive when it first connects";
+  ArchiveProcess& a = StartArchive();
+  const v1::Session paint = Submit(WithSample(plans::InterpolationGrid(), kPaint));
+  rig_->WaitFor(
+      paint.session_id(), [](const v1::Session& s) { return s.progress().done_samples() >= 6; },
+      60s);
+  // Cache the session in the archive server while it records.
+  std::string id;
+  std::vector<std::string> early;
+  const auto deadline = Clock::now() + 30s;
+  while (Clock::now() < deadline) {
+    v1::ListSessionsResponse all;
+    if (a.control().ListSessions(DaemonRig::Context().get(), {}, &all).ok() &&
+        all.sessions_size() == 1) {
+      id = all.sessions(0).session_id();
+      early = InterpolateAll(a.interpolation(), id, v1::QUANTITY_BRDF);
+      if (std::count_if(early.begin(), early.end(), [](const std::string& s) {
+            return s.find(": ") == std::string::npos;
+          }) > 0) {
+        break;
+      }
+    }
+    std::this_thread::sleep_for(100ms);
+  }
+  ASSERT_FALSE(id.empty());
+  ASSERT_EQ(rig_->WaitForState(paint.session_id(), v1::SESSION_STATE_COMPLETED, 120s).state(),
+            v1::SESSION_STATE_COMPLETED);
+  ASSERT_TRUE(WaitCaughtUp());
+  const std::vector<std::string> final_answers =
+      InterpolateAll(rig_->interpolation(), paint.session_id(), v1::QUANTITY_BRDF);
+  EXPECT_NE(early, final_answers) << "the early answers should be over fewer readings";
+  // Within a few refresh periods the archive server's cached index has every reading.
+  std::vector<std::string> now;
+  const auto until = Clock::now() + 15s;
+  while (Clock::now() < until) {
+    now = InterpolateAll(a.interpolation(), id, v1::QUANTITY_BRDF);
+    if (now == final_answers) break;
+    std::this_thread::sleep_for(200ms);
+  }
+  EXPECT_EQ(now, final_answers);
+}
+
+TEST(ArchiveServerConfigTest, TheExampleConfigurationParsesWithCredentialsAndAnAnalystToken) {
+  Result<daemon::Config> config =
+      daemon::LoadConfig(SourceDir() + "/deploy/brdf-archive.example.toml");
+  ASSERT_TRUE(config.ok()) << config.status().ToString();
+  EXPECT_TRUE(config->archive.enabled());
+  ASSERT_EQ(config->tokens.size(), 1U);
+  EXPECT_EQ(config->tokens[0].role, daemon::Role::kAnalyst);
+}
+
+}  // namespace
+}  // namespace brdf::testing
