@@ -7,14 +7,18 @@
 // the export (its CancelToken) at the next progress report or chunk.
 //
 // The exports are the same code as brdf-export's (storage/session_readings.h: the session;
-// data/cie_tables.h: the CIE tables; core/export: the formats), so a file from the daemon and one
-// from the tool are the same bytes for the same session and options.
+// data/cie_tables.h: the CIE tables; core/export: the formats; core/export/session_interpolant.h:
+// the interpolant behind the fill chain, and the RGL material), so a file from the daemon and one
+// from the tool are the same bytes for the same session and options. Grids, MERL and RGL fill
+// through the chain unless the request's fill is NONE, and the report counts each cell's
+// provenance (ExportReport.fill).
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <ostream>
 #include <streambuf>
 #include <string>
@@ -27,8 +31,10 @@
 #include "core/export/npy_writer.h"
 #include "core/export/readings_csv.h"
 #include "core/export/regular_grid.h"
+#include "core/export/rgl_export.h"
 #include "core/export/run_control.h"
 #include "core/export/session_data.h"
+#include "core/export/session_interpolant.h"
 #include "core/export/spectral_rgb.h"
 #include "core/export/spectrum_source.h"
 #include "daemon/service_data.h"
@@ -46,6 +52,10 @@ constexpr std::uint32_t kMaxExportChunkBytes = 4 * 1024 * 1024 - 1024;
 constexpr std::chrono::hours kLongestExport{24};
 // A progress message goes out when the fraction moved by this much (or the stage changed).
 constexpr double kProgressStep = 0.005;
+// RGL: the largest θi slice count and warped-square resolution a request may ask (the file is
+// built in memory: 4 · slices · nodes² · bands bytes of spectra).
+constexpr std::uint32_t kMaxRglThetaI = 90;
+constexpr std::uint32_t kMaxRglResolution = 128;
 
 // The stream of one Export call: progress messages, the file's bytes in chunks of at most
 // `chunk_bytes`, the report. Used from the handler's thread only (core/export calls progress on
@@ -181,7 +191,53 @@ struct ExportSettings {
   bool nodes = false;
   bool exclude_flagged = false;
   std::size_t chunk_bytes = kDefaultExportChunkBytes;
+  exports::FillPolicy fill = exports::FillPolicy::kChain;
+  bool rgb = false;                // RGL
+  exports::SessionRglOptions rgl;  // RGL: θi slices and resolution (rgb weights added later)
 };
+
+grpc::Status ParseFillField(v1::ExportFill fill, exports::FillPolicy* out) {
+  switch (fill) {
+    case v1::EXPORT_FILL_UNSPECIFIED:
+    case v1::EXPORT_FILL_CHAIN:
+      *out = exports::FillPolicy::kChain;
+      return grpc::Status::OK;
+    case v1::EXPORT_FILL_NONE:
+      *out = exports::FillPolicy::kNone;
+      return grpc::Status::OK;
+    default:
+      return InvalidField("fill", "give NONE or CHAIN, or leave it unset for the chain (got " +
+                                      std::to_string(fill) + ")");
+  }
+}
+
+grpc::Status ParseRglFields(const v1::ExportRequest& r, ExportSettings* out) {
+  const bool rgl = r.format() == v1::EXPORT_FORMAT_RGL_BSDF;
+  if (!rgl && (r.rgb() || r.rgl_theta_i_count() != 0 || r.rgl_resolution() != 0)) {
+    return InvalidField(r.rgb()                      ? "rgb"
+                        : r.rgl_theta_i_count() != 0 ? "rgl_theta_i_count"
+                                                     : "rgl_resolution",
+                        "is for RGL exports (format RGL_BSDF); leave it unset for this format");
+  }
+  out->rgb = r.rgb();
+  if (r.rgl_theta_i_count() != 0) {
+    if (r.rgl_theta_i_count() < 2 || r.rgl_theta_i_count() > kMaxRglThetaI) {
+      return InvalidField("rgl_theta_i_count", "give 2 to " + std::to_string(kMaxRglThetaI) +
+                                                   " θi slices, or 0 for 24 (got " +
+                                                   std::to_string(r.rgl_theta_i_count()) + ")");
+    }
+    out->rgl.theta_i_count = r.rgl_theta_i_count();
+  }
+  if (r.rgl_resolution() != 0) {
+    if (r.rgl_resolution() < 2 || r.rgl_resolution() > kMaxRglResolution) {
+      return InvalidField("rgl_resolution", "give 2 to " + std::to_string(kMaxRglResolution) +
+                                                " nodes per side, or 0 for 48 (got " +
+                                                std::to_string(r.rgl_resolution()) + ")");
+    }
+    out->rgl.sample_res = r.rgl_resolution();
+  }
+  return grpc::Status::OK;
+}
 
 grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
   Result<SessionId> id = ParseSessionId(r.session_id(), "session_id");
@@ -192,17 +248,24 @@ grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
     case v1::EXPORT_FORMAT_GRID_NPY:
     case v1::EXPORT_FORMAT_GRID_CSV:
     case v1::EXPORT_FORMAT_MERL_BINARY:
+    case v1::EXPORT_FORMAT_RGL_BSDF:
       out->format = r.format();
       break;
     default:
       return InvalidField("format",
-                          "give one of READINGS_CSV, GRID_NPY, GRID_CSV, MERL_BINARY (got " +
+                          "give one of READINGS_CSV, GRID_NPY, GRID_CSV, MERL_BINARY, RGL_BSDF "
+                          "(got " +
                               std::to_string(r.format()) + ")");
   }
   if (grpc::Status st = ParseQuantityField(r.quantity(), &out->quantity); !st.ok()) return st;
   if (r.format() == v1::EXPORT_FORMAT_MERL_BINARY && out->quantity != exports::Quantity::kBrdf) {
     return InvalidField("quantity", "a MERL file holds the BRDF; leave quantity unset or BRDF");
   }
+  if (r.format() == v1::EXPORT_FORMAT_RGL_BSDF && out->quantity != exports::Quantity::kBrdf) {
+    return InvalidField("quantity", "an RGL file holds the BRDF; leave quantity unset or BRDF");
+  }
+  if (grpc::Status st = ParseFillField(r.fill(), &out->fill); !st.ok()) return st;
+  if (grpc::Status st = ParseRglFields(r, out); !st.ok()) return st;
   if (grpc::Status st = ParseMethodField(r.method(), &out->method); !st.ok()) return st;
   const v1::InterpolationOptions& o = r.options();
   if (o.axis_scale_size() != 0 && o.axis_scale_size() != 3) {
@@ -255,6 +318,8 @@ std::string FileName(const ExportSettings& s) {
       return base + "-grid-" + q + ".npy";
     case v1::EXPORT_FORMAT_GRID_CSV:
       return base + "-grid-" + q + ".csv";
+    case v1::EXPORT_FORMAT_RGL_BSDF:
+      return base + (s.rgb ? "-rgb" : "") + ".bsdf";
     default:
       return base + ".binary";
   }
@@ -265,23 +330,42 @@ void AddSkipped(const std::vector<exports::SkippedReading>& skipped, v1::ExportR
   if (!skipped.empty()) report->set_first_skip_reason(skipped.front().reason);
 }
 
-// The session's interpolator over the derived quantity (as brdf-export builds it).
-struct SessionInterpolator {
-  exports::DerivedSamples derived;
-  std::unique_ptr<interp::Interpolator> interpolator;
-};
-
-Result<SessionInterpolator> BuildInterpolator(const exports::Session& session,
-                                              exports::Quantity quantity, const ExportSettings& s) {
+// The session's interpolant over the derived quantity behind the fill chain (as brdf-export
+// builds it: session_interpolant.h).
+Result<exports::SessionInterpolant> BuildInterpolator(const exports::Session& session,
+                                                      exports::Quantity quantity,
+                                                      const ExportSettings& s,
+                                                      const CallContext& ctx) {
   Result<exports::DerivedSamples> derived =
       exports::DeriveSamples(session, quantity, {s.exclude_flagged});
   if (!derived.ok()) return derived.status();
-  Result<std::shared_ptr<const interp::SampleSet>> set = exports::ToSampleSet(*derived);
-  if (!set.ok()) return set.status();
-  Result<std::unique_ptr<interp::Interpolator>> interpolator =
-      interp::MakeInterpolator(s.method, *set, s.options);
-  if (!interpolator.ok()) return interpolator.status();
-  return SessionInterpolator{std::move(*derived), std::move(*interpolator)};
+  return exports::BuildSessionInterpolant(std::move(*derived), s.method, s.options, s.fill, ctx);
+}
+
+// The cell counts of a MERL or RGL table (unfilled: by the interpolation's why).
+void AddTableCounts(std::size_t cells, std::size_t filled,
+                    const std::map<interp::InterpStatus, std::size_t>& unfilled,
+                    std::size_t below_horizon, std::size_t clamped, v1::ExportReport* report) {
+  report->set_cells(cells);
+  report->set_filled_cells(filled);
+  std::size_t unfilled_total = 0;
+  for (const auto& [status, count] : unfilled) {
+    (*report->mutable_unfilled_by_status())[interp::InterpStatusName(status)] = count;
+    unfilled_total += count;
+  }
+  report->set_unfilled_cells(unfilled_total);
+  report->set_below_horizon_cells(below_horizon);
+  report->set_clamped_cells(clamped);
+}
+
+void AddFill(const exports::FillTally& tally, v1::ExportReport* report) {
+  v1::ExportFillCounts* fill = report->mutable_fill();
+  fill->set_policy(exports::FillPolicyName(tally.policy));
+  fill->set_interpolated(tally.interpolated);
+  fill->set_fallback(tally.fallback);
+  fill->set_model(tally.model);
+  fill->set_empty(tally.empty);
+  fill->set_model_fraction(tally.model_fraction());
 }
 
 // Each export writes its file to `out` (through the stream) and fills the report; progress runs
@@ -305,7 +389,7 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
       s.steps[0], s.steps[1], s.steps[2],
       s.nodes ? exports::GridPlacement::kNodes : exports::GridPlacement::kCellCentres);
   if (!grid.ok()) return grid.status();
-  Result<SessionInterpolator> in = BuildInterpolator(session, s.quantity, s);
+  Result<exports::SessionInterpolant> in = BuildInterpolator(session, s.quantity, s, ctx);
   if (!in.ok()) return in.status();
   const WavelengthGrid bands = in->derived.grid;
   const exports::GridExportInfo info{session.id,
@@ -321,13 +405,8 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
   exports::RunControl control;
   control.threads = 0;  // every hardware thread: the executor waits on devices, not the CPU
   control.progress = [&stream](double f) { stream.Progress("resampling", 0.05 + 0.95 * f); };
-  // Over the API the chosen method alone fills the grid (fill policy none; the chain is
-  // brdf-export's --fill until Data.Export carries the choice); the sidecar says so.
-  const exports::FillChain fill(
-      exports::FillPolicy::kNone,
-      {{exports::Provenance::kInterpolated, exports::InterpolatorSource(*in->interpolator)}});
   Result<exports::GridReport> r =
-      exports::ResampleOnGrid(fill.Source(), *grid, bands, control, ctx, sink);
+      exports::ResampleOnGrid(in->chain->Source(), *grid, bands, control, ctx, sink);
   if (!r.ok()) return r.status();
   report->set_summary(r->Summary());
   report->set_cells(r->cells);
@@ -339,14 +418,13 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
     }
   }
   AddSkipped(in->derived.skipped, report);
+  AddFill(in->chain->Tally(), report);
   if (as_npy) {
     for (std::size_t n : {grid->theta_i.count, grid->theta_o.count, grid->phi.count}) {
       report->add_shape(n);
     }
     report->add_shape(bands.count);
-    const exports::InterpolantInfo how{s.options.mirror_phi, s.options.reciprocity,
-                                       s.options.axis_scale, fill.Tally().Json()};
-    report->set_description_json(exports::GridDescriptionJson(*grid, bands, info, *r, how));
+    report->set_description_json(exports::GridDescriptionJson(*grid, bands, info, *r, in->Info()));
   }
   return Status();
 }
@@ -355,7 +433,8 @@ Status ExportMerl(const exports::Session& session, const ExportSettings& s, cons
                   ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
   Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir);
   if (!cie.ok()) return cie.status();
-  Result<SessionInterpolator> in = BuildInterpolator(session, exports::Quantity::kBrdf, s);
+  Result<exports::SessionInterpolant> in =
+      BuildInterpolator(session, exports::Quantity::kBrdf, s, ctx);
   if (!in.ok()) return in.status();
   const WavelengthGrid bands = in->derived.grid;
   Result<exports::SpectralRgbWeights> rgb =
@@ -366,22 +445,48 @@ Status ExportMerl(const exports::Session& session, const ExportSettings& s, cons
   control.progress = [&stream](double f) {
     stream.Progress("building the MERL table", 0.05 + 0.85 * f);
   };
-  Result<exports::MerlExport> table = exports::BuildMerlTable(
-      exports::InterpolatorSource(*in->interpolator), bands, *rgb, control, ctx);
+  Result<exports::MerlExport> table =
+      exports::BuildMerlTable(in->chain->Source(), bands, *rgb, control, ctx);
   if (!table.ok()) return table.status();
   stream.Progress("sending", 0.9);
   if (Status st = exports::WriteMerl(table->table, out); !st.ok()) return st;
   const exports::MerlReport& m = table->report;
   report->set_summary(m.Summary());
-  report->set_cells(m.cells);
-  report->set_filled_cells(m.filled);
-  report->set_unfilled_cells(m.unfilled_total());
-  for (const auto& [status, count] : m.unfilled) {
-    (*report->mutable_unfilled_by_status())[interp::InterpStatusName(status)] = count;
-  }
-  report->set_below_horizon_cells(m.below_horizon);
-  report->set_clamped_cells(m.clamped);
+  AddTableCounts(m.cells, m.filled, m.unfilled, m.below_horizon, m.clamped, report);
   AddSkipped(in->derived.skipped, report);
+  AddFill(in->chain->Tally(), report);
+  return Status();
+}
+
+Status ExportRgl(const exports::Session& session, const ExportSettings& s, const CallContext& ctx,
+                 ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
+  exports::SessionRglOptions options = s.rgl;
+  Result<exports::SessionInterpolant> in =
+      BuildInterpolator(session, exports::Quantity::kBrdf, s, ctx);
+  if (!in.ok()) return in.status();
+  if (s.rgb) {
+    Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir);
+    if (!cie.ok()) return cie.status();
+    Result<exports::SpectralRgbWeights> rgb =
+        exports::SpectralRgbWeights::Make(in->derived.grid, cie->d65, cie->cmf);
+    if (!rgb.ok()) return rgb.status();
+    options.rgb = *rgb;
+  }
+  exports::RunControl control;
+  control.threads = 0;
+  control.progress = [&stream](double f) {
+    stream.Progress("building the RGL tables", 0.05 + 0.85 * f);
+  };
+  Result<exports::RglExport> table = exports::BuildSessionRgl(session, *in, options, control, ctx);
+  if (!table.ok()) return table.status();
+  stream.Progress("sending", 0.9);
+  if (Status st = exports::WriteRgl(table->fields, out); !st.ok()) return st;
+  const exports::RglReport& g = table->report;
+  report->set_summary(g.Summary());
+  AddTableCounts(g.cells, g.interpolated + g.fallback, g.unfilled, g.below_horizon, g.clamped,
+                 report);
+  AddSkipped(in->derived.skipped, report);
+  AddFill(in->chain->Tally(), report);
   return Status();
 }
 
@@ -428,6 +533,9 @@ grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportR
       break;
     case v1::EXPORT_FORMAT_MERL_BINARY:
       st = ExportMerl(*session, settings, *ctx, stream, out, &report);
+      break;
+    case v1::EXPORT_FORMAT_RGL_BSDF:
+      st = ExportRgl(*session, settings, *ctx, stream, out, &report);
       break;
     default:
       st = ExportGrid(*session, settings, *ctx, stream, out, &report);

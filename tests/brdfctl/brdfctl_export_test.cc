@@ -1,7 +1,8 @@
 // `brdfctl export` as a user runs it: the built brdfctl against brdfd and brdf-sim (processes),
 // with an analyst token, on a small session measured once in the test. The files it writes are
 // checked on their own terms: the MERL file's size, the .npy loaded by NumPy (/usr/bin/python3),
-// whose NaN cells must be the count brdfctl reports, the CSV's rows.
+// whose NaN cells must be the count brdfctl reports, the CSV's rows, the RGL .bsdf read by
+// tools/check/rgl_read.py, the fill counts.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -123,6 +124,43 @@ TEST_F(BrdfctlExportTest, AnAnalystExportsMerlGridAndCsvFilesThatTheirReadersLoa
   EXPECT_EQ(b.exit_code, 2) << Describe(b);
   EXPECT_FALSE(std::filesystem::exists(bad));
   EXPECT_FALSE(std::filesystem::exists(bad + ".partial"));
+}
+
+// rgl: the .bsdf reads back with tools/check/rgl_read.py, with a value where a renderer looks;
+// the fill line counts the chain's cells, none of them empty. --fill none leaves a grid's holes
+// and counts them; --rgb on a grid is the user's error.
+TEST_F(BrdfctlExportTest, RglReadsBackAndTheFillIsReported) {
+  const std::string bsdf = Path("session.bsdf");
+  const CommandResult r =
+      Ctl({"export", id_, "rgl", "--theta-i", "4", "--resolution", "12", "-o", bsdf});
+  ASSERT_EQ(r.exit_code, 0) << Describe(r);
+  EXPECT_FALSE(std::filesystem::exists(bsdf + ".partial"));
+  EXPECT_NE(r.err.find("fill chain: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" 0 empty"), std::string::npos) << r.err;
+  const CommandResult read =
+      RunShell(std::string("/usr/bin/python3 '") + BRDF_TEST_SOURCE_DIR +
+               "/tools/check/rgl_read.py' '" + bsdf + "' --at 20,0,25,180 2>&1");
+  ASSERT_EQ(read.exit_code, 0) << Describe(read);
+  EXPECT_NE(read.out.find("spectra: float32"), std::string::npos) << read.out;
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(read.out, match,
+                                std::regex("20,0,25,180 ([0-9.e+-]+) ([0-9.e+-]+) ([0-9.e+-]+)")))
+      << read.out;
+  for (int k = 1; k <= 3; ++k) EXPECT_GT(std::stod(match[k]), 0) << read.out;
+
+  const std::string npy = Path("holes.npy");
+  const CommandResult g =
+      Ctl({"export", id_, "grid", "--steps", "10,10,20", "--fill", "none", "-o", npy});
+  ASSERT_EQ(g.exit_code, 0) << Describe(g);
+  ASSERT_TRUE(std::regex_search(g.err, match, std::regex("NaN cells: ([0-9]+)"))) << g.err;
+  const std::string nan_cells = match[1];
+  EXPECT_GT(std::stoi(nan_cells), 0) << g.err;
+  EXPECT_NE(g.err.find("fill none: "), std::string::npos) << g.err;
+  EXPECT_NE(g.err.find(", " + nan_cells + " empty"), std::string::npos) << g.err;
+
+  const CommandResult bad = Ctl({"export", id_, "grid", "--rgb", "-o", Path("rgb.npy")});
+  EXPECT_EQ(bad.exit_code, 2) << Describe(bad);
+  EXPECT_FALSE(std::filesystem::exists(Path("rgb.npy")));
 }
 
 }  // namespace

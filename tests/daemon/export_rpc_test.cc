@@ -1,7 +1,8 @@
 // Data.Export over gRPC against a real brdfd and brdf-sim (processes): one small session is
 // measured once for the suite, then exported in each format. The checks are on the bytes the
 // client receives, parsed independently of the daemon's report (the CSV's rows, the .npy header
-// and its NaN cells, the MERL file's size and missing cells), and on the stream's contract:
+// and its NaN cells, the MERL file's size and missing cells, the RGL file against brdf-export's
+// on the same database, the fill counts), and on the stream's contract:
 // progress that never decreases and ends at 1, data chunks in order without gaps and no larger
 // than asked, the report last with the byte count received.
 #include <gtest/gtest.h>
@@ -10,16 +11,21 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <optional>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/export/merl_layout.h"
 #include "core/export/merl_reader.h"
+#include "core/export/rgl_reader.h"
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/support/plan_fixtures.h"
+#include "tests/support/process_launcher.h"
 
 namespace brdf::testing {
 namespace {
@@ -138,6 +144,26 @@ class ExportRpcTest : public ::testing::Test {
     EXPECT_EQ(r.report->bytes(), r.file.size());
     ASSERT_FALSE(r.progress.empty());
     EXPECT_EQ(r.progress.back().fraction(), 1.0);
+  }
+
+  // brdf-export run on the daemon's database for the suite's session with `args` (the command
+  // and its options, without -o); the file it wrote, or why it failed.
+  static Result<std::string> ToolExport(std::vector<std::string> args) {
+    Result<std::string> tool =
+        BuiltProgram("brdf-export", "tools/brdf-export/brdf-export", "BRDF_EXPORT_BINARY");
+    if (!tool.ok()) return tool.status();
+    TempDir dir("brdf-export-rpc");
+    const std::string path = dir.file("out").string();
+    std::vector<std::string> all = {"--db", rig_->database(), "--session", *session_id_, "--quiet"};
+    all.insert(all.end(), args.begin(), args.end());
+    all.insert(all.end(), {"-o", path});
+    Result<CommandResult> run = RunToCompletion("brdf-export", *tool, LaunchOptions(all), 120s);
+    if (!run.ok()) return run.status();
+    if (run->exit_code != 0) {
+      return Internal("brdf-export exited " + std::to_string(run->exit_code) + ": " + run->err);
+    }
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
   }
 
   static std::size_t SampleReadings() {
@@ -283,6 +309,110 @@ TEST_F(ExportRpcTest, MerlFileHasMerlsSizeAndItsMissingCellsMatchTheReport) {
   EXPECT_EQ(report.filled_cells(), exports::kMerlCells - missing);
   EXPECT_GT(report.filled_cells(), 0u);
   EXPECT_EQ(report.file_name(), "session-" + *session_id_ + ".binary");
+  // The default fill is the chain: every cell above the horizon has a value.
+  EXPECT_EQ(report.unfilled_cells(), 0u);
+  EXPECT_EQ(missing, report.below_horizon_cells());
+  ASSERT_TRUE(report.has_fill());
+  EXPECT_EQ(report.fill().policy(), "chain");
+  EXPECT_EQ(report.fill().empty(), 0u);
+  EXPECT_EQ(report.fill().interpolated() + report.fill().fallback() + report.fill().model(),
+            report.filled_cells());
+}
+
+// fill none leaves NaN cells on a grid and counts them as empty; the chain fills each of them
+// (by Delaunay or the fitted model) and counts where the values came from.
+TEST_F(ExportRpcTest, GridFillNoneLeavesHolesAndTheChainFillsThemAndCountsThem) {
+  v1::ExportRequest request = Request(v1::EXPORT_FORMAT_GRID_NPY);
+  request.set_step_theta_i(10);
+  request.set_step_theta_o(10);
+  request.set_step_phi(20);
+  request.set_fill(v1::EXPORT_FILL_NONE);
+  const ExportResult none = Export(request);
+  ExpectCompleteStream(none);
+  ASSERT_TRUE(none.report->has_fill());
+  const v1::ExportFillCounts& holes = none.report->fill();
+  EXPECT_EQ(holes.policy(), "none");
+  EXPECT_GT(holes.empty(), 0u) << "this small session leaves the octant method holes";
+  EXPECT_EQ(holes.empty(), none.report->unfilled_cells());
+  EXPECT_EQ(holes.fallback() + holes.model(), 0u);
+  EXPECT_NE(none.report->description_json().find("\"policy\": \"none\""), std::string::npos)
+      << none.report->description_json();
+
+  request.set_fill(v1::EXPORT_FILL_CHAIN);
+  const ExportResult chain = Export(request);
+  ExpectCompleteStream(chain);
+  const v1::ExportFillCounts& filled = chain.report->fill();
+  EXPECT_EQ(filled.policy(), "chain");
+  EXPECT_EQ(chain.report->unfilled_cells(), 0u);
+  EXPECT_EQ(filled.empty(), 0u);
+  EXPECT_EQ(filled.interpolated(), holes.interpolated());
+  EXPECT_EQ(filled.fallback() + filled.model(), holes.empty());
+  EXPECT_DOUBLE_EQ(filled.model_fraction(), static_cast<double>(filled.model()) /
+                                                static_cast<double>(chain.report->cells()));
+  const std::size_t data_start = 10 + static_cast<unsigned char>(chain.file[8]) +
+                                 256u * static_cast<unsigned char>(chain.file[9]);
+  ASSERT_EQ(chain.file.size(), data_start + 729u * 101u * 8u);
+  for (std::size_t i = 0; i < 729u * 101u; ++i) {
+    double v = 0;
+    std::memcpy(&v, chain.file.data() + data_start + i * 8, 8);
+    ASSERT_TRUE(std::isfinite(v)) << "value " << i << " of the chain-filled grid";
+  }
+}
+
+// An RGL export over gRPC is brdf-export's file for the same session and options, byte for byte
+// (spectral and RGB); it reads back as a material whose BRDF has a value at every direction
+// above the surface, and the report counts the fill.
+TEST_F(ExportRpcTest, RglIsBrdfExportsFileByteForByteAndHasNoHoles) {
+  v1::ExportRequest request = Request(v1::EXPORT_FORMAT_RGL_BSDF);
+  request.mutable_options()->set_reciprocity(true);  // brdf-export rgl's default
+  request.set_rgl_theta_i_count(6);
+  request.set_rgl_resolution(16);
+  request.set_chunk_bytes(64 * 1024);
+  const ExportResult rgl = Export(request);
+  ExpectCompleteStream(rgl);
+  EXPECT_EQ(rgl.report->file_name(), "session-" + *session_id_ + ".bsdf");
+  Result<std::string> tool = ToolExport({"rgl", "--theta-i", "6", "--resolution", "16"});
+  ASSERT_TRUE(tool.ok()) << tool.status().ToString();
+  ASSERT_EQ(rgl.file.size(), tool->size());
+  EXPECT_TRUE(rgl.file == *tool) << "the daemon's .bsdf differs from brdf-export's";
+
+  const v1::ExportReport& report = *rgl.report;
+  EXPECT_EQ(report.cells(), 6u * 16u * 16u);
+  EXPECT_EQ(report.unfilled_cells(), 0u);
+  EXPECT_EQ(report.filled_cells() + report.below_horizon_cells(), report.cells());
+  ASSERT_TRUE(report.has_fill());
+  EXPECT_EQ(report.fill().policy(), "chain");
+  EXPECT_EQ(report.fill().empty(), 0u);
+  EXPECT_EQ(report.fill().interpolated() + report.fill().fallback() + report.fill().model(),
+            report.filled_cells());
+
+  Result<exports::RglMaterial> material = exports::RglMaterial::Parse(rgl.file);
+  ASSERT_TRUE(material.ok()) << material.status().ToString();
+  EXPECT_FALSE(material->rgb());
+  EXPECT_EQ(material->channels(), 101u);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> theta(0, 40), phi(0, 360);
+  for (int k = 0; k < 200; ++k) {
+    const Directions d{theta(random), phi(random), theta(random), phi(random)};
+    const std::vector<double> f = material->Brdf(d);
+    double mean = 0;
+    for (double v : f) mean += v / static_cast<double>(f.size());
+    ASSERT_TRUE(std::isfinite(mean) && mean > 0)
+        << "no value at θi " << d.theta_i << ", φi " << d.phi_i << ", θo " << d.theta_o << ", φo "
+        << d.phi_o;
+  }
+
+  request.set_rgb(true);
+  const ExportResult rgb = Export(request);
+  ExpectCompleteStream(rgb);
+  EXPECT_EQ(rgb.report->file_name(), "session-" + *session_id_ + "-rgb.bsdf");
+  Result<std::string> tool_rgb =
+      ToolExport({"rgl", "--rgb", "--theta-i", "6", "--resolution", "16"});
+  ASSERT_TRUE(tool_rgb.ok()) << tool_rgb.status().ToString();
+  EXPECT_TRUE(rgb.file == *tool_rgb) << "the daemon's RGB .bsdf differs from brdf-export's";
+  Result<exports::RglMaterial> rgb_material = exports::RglMaterial::Parse(rgb.file);
+  ASSERT_TRUE(rgb_material.ok()) << rgb_material.status().ToString();
+  EXPECT_TRUE(rgb_material->rgb());
 }
 
 TEST_F(ExportRpcTest, BadRequestsFailWithTheCodeAndNameTheField) {
@@ -300,6 +430,25 @@ TEST_F(ExportRpcTest, BadRequestsFailWithTheCodeAndNameTheField) {
   v1::ExportRequest merl_radiance = Request(v1::EXPORT_FORMAT_MERL_BINARY);
   merl_radiance.set_quantity(v1::QUANTITY_RADIANCE);
   EXPECT_EQ(Export(merl_radiance).status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  v1::ExportRequest rgl_radiance = Request(v1::EXPORT_FORMAT_RGL_BSDF);
+  rgl_radiance.set_quantity(v1::QUANTITY_RADIANCE);
+  EXPECT_EQ(Export(rgl_radiance).status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  v1::ExportRequest rgb_grid = Request(v1::EXPORT_FORMAT_GRID_NPY);
+  rgb_grid.set_rgb(true);
+  const ExportResult bad_rgb = Export(rgb_grid);
+  EXPECT_EQ(bad_rgb.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(bad_rgb.status.error_message().find("rgb"), std::string::npos);
+  v1::ExportRequest huge = Request(v1::EXPORT_FORMAT_RGL_BSDF);
+  huge.set_rgl_resolution(100000);
+  const ExportResult bad_resolution = Export(huge);
+  EXPECT_EQ(bad_resolution.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(bad_resolution.status.error_message().find("rgl_resolution"), std::string::npos);
+  v1::ExportRequest bad_fill = Request(v1::EXPORT_FORMAT_GRID_NPY);
+  bad_fill.set_fill(static_cast<v1::ExportFill>(42));
+  const ExportResult fill_42 = Export(bad_fill);
+  EXPECT_EQ(fill_42.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(fill_42.status.error_message().find("fill"), std::string::npos);
 
   v1::ExportRequest unknown = Request(v1::EXPORT_FORMAT_READINGS_CSV);
   unknown.set_session_id("987654");

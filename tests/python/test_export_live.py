@@ -2,7 +2,9 @@
 
 setUpClass runs test_live.py's small sample-rotation plan to completion (the operator's prompts
 answered on the simulator), then every test exports that session: the readings as CSV, a coarse
-regular grid as .npy and CSV, a MERL .binary, and the failures (unknown session, bad steps, a
+regular grid as .npy and CSV (with the fill chain and without), a MERL .binary, an RGL .bsdf
+(byte for byte brdf-export's on the daemon's database, read by tools/check/rgl_read.py and
+brdf_client.rgl), and the failures (unknown session, bad steps, a
 caller that gives up) that must leave no file behind. StreamChecks replaces the daemon by a
 server that sends broken streams (a gap, a wrong byte count, no report), which brdfd never does
 on purpose, to see the client refuse them. Exit code 77 (ctest: skipped) when brdfd
@@ -13,6 +15,7 @@ import concurrent.futures
 import csv
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 import unittest
@@ -30,6 +33,7 @@ import live_rig  # noqa: E402
 from brdf_client import BrdfClient, BrdfError, brdf_pb2, names  # noqa: E402
 from brdf_client._stubs import brdf_pb2_grpc  # noqa: E402
 from brdf_client.export import ExportResult  # noqa: E402
+from brdf_client.rgl import Material  # noqa: E402
 from test_live import PLAN, PROMPT_ACTIONS  # noqa: E402
 
 MERL_BYTES = 90 * 90 * 180 * 3 * 8 + 12
@@ -235,6 +239,67 @@ class LiveExport(unittest.TestCase):
         self.assertEqual(r.cells - r.filled_cells, r.unfilled_cells + r.below_horizon_cells)
         self.assertGreater(r.filled_cells, 0)
         self.assertTrue(np.all(table[:, ~missing] >= 0))
+        # The default fill chain leaves no cell above the horizon without a value.
+        self.assertEqual(r.unfilled_cells, 0)
+        self.assertEqual(int(missing.sum()), r.below_horizon_cells)
+        self.assertEqual(r.fill["policy"], "chain")
+        self.assertEqual(r.fill["empty"], 0)
+        self.assertEqual(r.fill["interpolated"] + r.fill["fallback"] + r.fill["model"],
+                         r.filled_cells)
+
+    def test_grid_fill_none_and_chain(self):
+        none_path = self.path("none.npy")
+        folder = os.path.dirname(none_path)
+        none = self.client.export(self.session_id, "grid", none_path, fill="none", **GRID_STEPS)
+        holes = np.isnan(np.load(none.path)).all(axis=-1)
+        self.assertEqual(none.fill["policy"], "none")
+        self.assertGreater(int(holes.sum()), 0, "this small session leaves the octant holes")
+        self.assertEqual(none.fill["empty"], int(holes.sum()))
+        self.assertEqual(none.description["fill"]["policy"], "none")
+        chain = self.client.export(self.session_id, "grid", os.path.join(folder, "chain.npy"),
+                                   **GRID_STEPS)
+        grid = np.load(chain.path)
+        self.assertTrue(np.all(np.isfinite(grid)))
+        self.assertEqual(chain.fill["policy"], "chain")
+        self.assertEqual(chain.fill["empty"], 0)
+        self.assertEqual(chain.fill["fallback"] + chain.fill["model"], none.fill["empty"])
+        np.testing.assert_array_equal(grid[~holes], np.load(none.path)[~holes])
+
+    def test_rgl_is_brdf_exports_file_and_has_no_holes(self):
+        path = self.path("sample.bsdf")
+        progress = Progress()
+        r = self.client.export(self.session_id, "rgl", path, rgl_theta_i_count=6,
+                               rgl_resolution=16, on_progress=progress)
+        self.assertEqual((r.format, r.file_name), ("rgl_bsdf", f"session-{self.session_id}.bsdf"))
+        self.assertOnlyFile(path)
+        self.assertProgress(progress)
+        self.assertEqual(r.cells, 6 * 16 * 16)
+        self.assertEqual(r.unfilled_cells, 0)
+        self.assertEqual(r.fill["policy"], "chain")
+        self.assertEqual(r.fill["empty"], 0)
+        # brdf-export on the daemon's database, same session and options (reciprocity is on for
+        # both by default): the same bytes.
+        tool = os.path.join(live_rig.build_dir(), "tools", "brdf-export", "brdf-export")
+        theirs = os.path.join(os.path.dirname(path), "tool.bsdf")
+        subprocess.run([tool, "--db", os.path.join(self.rig.dir, "brdfd.db"), "--session",
+                        str(self.session_id), "--quiet", "rgl", "--theta-i", "6",
+                        "--resolution", "16", "-o", theirs], check=True, capture_output=True)
+        with open(path, "rb") as a, open(theirs, "rb") as b:
+            self.assertTrue(a.read() == b.read(), "the daemon's .bsdf differs from brdf-export's")
+        # tools/check/rgl_read.py reads it (fields, and f at a direction) ...
+        check = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "check", "rgl_read.py"),
+                                path, "--at", "20,0,20,180"], capture_output=True, text=True)
+        self.assertEqual(check.returncode, 0, check.stderr)
+        self.assertIn("spectra: float32", check.stdout)
+        # ... and the Python reader finds a value at every direction above the surface.
+        m = Material(path)
+        rng = np.random.default_rng(3)
+        d = np.radians
+        n = 300
+        f = m.brdf(d(rng.uniform(0, 40, n)), d(rng.uniform(0, 360, n)),
+                   d(rng.uniform(0, 40, n)), d(rng.uniform(0, 360, n)))
+        self.assertTrue(np.all(np.isfinite(f)))
+        self.assertTrue(np.all(f.mean(axis=1) > 0), "a direction without a value")
 
     # --- failures leave no file -------------------------------------------------------------------
 
@@ -277,6 +342,12 @@ class LiveExport(unittest.TestCase):
             self.client.export(self.session_id, "tiff", path)
         with self.assertRaises(ValueError):
             self.client.export(self.session_id, "grid", path, method="cubic")
+        with self.assertRaises(ValueError):
+            self.client.export(self.session_id, "grid", path, rgb=True)
+        with self.assertRaises(ValueError):
+            self.client.export(self.session_id, "merl", path, fill="holes")
+        with self.assertRaises(ValueError):
+            self.client.export(self.session_id, "csv", path, fill="none")
         self.assertEqual(os.listdir(os.path.dirname(path)), [])
 
 

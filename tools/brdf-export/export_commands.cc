@@ -19,6 +19,7 @@
 #include "core/export/readings_csv.h"
 #include "core/export/regular_grid.h"
 #include "core/export/rgl_export.h"
+#include "core/export/session_interpolant.h"
 #include "core/export/synthetic_session.h"
 #include "core/fit/fit.h"
 #include "core/fit/fit_report.h"
@@ -94,53 +95,14 @@ Result<std::vector<double>> ParseNumbers(const std::string& text, const char* wh
   return out;
 }
 
-struct Interpolation {
-  exports::DerivedSamples derived;
-  std::unique_ptr<interp::Interpolator> interpolator;
-  std::shared_ptr<const interp::SampleSet> interpolator_samples;
-  interp::Options options;
-  // The fill chain's other stages (fill_chain.h) and the chain itself.
-  std::unique_ptr<interp::Interpolator> fallback;  // Delaunay, unless the method is Delaunay
-  std::optional<fit::CookTorranceFit> model;
-  std::unique_ptr<exports::FillChain> chain;
+using Interpolation = exports::SessionInterpolant;
 
-  exports::InterpolantInfo Info() const {
-    return {options.mirror_phi, options.reciprocity, options.axis_scale,
-            chain ? chain->Tally().Json() : std::string()};
-  }
-};
-
-// The fill chain over `in`'s interpolator: alone (kNone), or followed by Delaunay on the same
-// samples and options and by the Cook-Torrance model fitted to the samples (kChain).
-Status BuildFillChain(Interpolation& in, exports::FillPolicy policy, interp::Method method,
-                      std::ostream& err) {
-  std::vector<exports::FillChain::Stage> stages;
-  stages.push_back(
-      {exports::Provenance::kInterpolated, exports::InterpolatorSource(*in.interpolator)});
-  if (policy == exports::FillPolicy::kChain) {
-    if (method != interp::Method::kDelaunay) {
-      Result<std::unique_ptr<interp::Interpolator>> d =
-          interp::MakeInterpolator(interp::Method::kDelaunay, in.interpolator_samples, in.options);
-      if (!d.ok()) return d.status().WithContext("the fill chain's Delaunay fallback");
-      in.fallback = std::move(*d);
-      stages.push_back({exports::Provenance::kFallback, exports::InterpolatorSource(*in.fallback)});
-    }
-    fit::Observations data(in.derived.grid);
-    for (const exports::DerivedSample& s : in.derived.samples) {
-      if (Status st = data.Add(s.iso, s.values); !st.ok()) {
-        return st.WithContext("the fill chain's model, reading " + std::to_string(s.reading_id));
-      }
-    }
-    Result<fit::CookTorranceFit> model = fit::FitCookTorrance(data, {}, RunContext());
-    if (!model.ok()) return model.status().WithContext("the fill chain's model");
-    in.model = std::move(*model);
-    err << "brdf-export: fill chain: " << interp::MethodName(method)
-        << (in.fallback ? ", then delaunay" : "") << ", then Cook-Torrance (relative RMS "
-        << in.model->overall.relative_rms << " over " << data.size() << " readings)\n";
-    stages.push_back({exports::Provenance::kModel, exports::ModelSource(*in.model)});
-  }
-  in.chain = std::make_unique<exports::FillChain>(policy, std::move(stages));
-  return Status::Ok();
+// The fill chain's stages, on stderr.
+void DescribeFillChain(const Interpolation& in, std::ostream& err) {
+  if (!in.model) return;
+  err << "brdf-export: fill chain: " << interp::MethodName(in.method)
+      << (in.fallback ? ", then delaunay" : "") << ", then Cook-Torrance (relative RMS "
+      << in.model->overall.relative_rms << " over " << in.derived.samples.size() << " readings)\n";
 }
 
 Result<Interpolation> BuildInterpolator(const exports::Session& session, exports::Quantity q,
@@ -165,21 +127,14 @@ Result<Interpolation> BuildInterpolator(const exports::Session& session, exports
   }
   Result<exports::DerivedSamples> derived = exports::DeriveSamples(session, q, {c.exclude_flagged});
   if (!derived.ok()) return derived.status();
-  Result<std::shared_ptr<const interp::SampleSet>> set = exports::ToSampleSet(*derived);
-  if (!set.ok()) return set.status();
-  Result<std::unique_ptr<interp::Interpolator>> interpolator =
-      interp::MakeInterpolator(*method, *set, options);
-  if (!interpolator.ok()) return interpolator.status();
   if (!derived->skipped.empty()) {
     err << "brdf-export: " << derived->skipped.size()
         << " sample readings left out; the first: " << derived->skipped.front().reason << "\n";
   }
-  Interpolation in;
-  in.derived = std::move(*derived);
-  in.interpolator = std::move(*interpolator);
-  in.interpolator_samples = *set;
-  in.options = options;
-  BRDF_RETURN_IF_ERROR(BuildFillChain(in, *policy, *method, err));
+  Result<Interpolation> in = exports::BuildSessionInterpolant(std::move(*derived), *method, options,
+                                                              *policy, RunContext());
+  if (!in.ok()) return in.status();
+  DescribeFillChain(*in, err);
   return in;
 }
 
@@ -349,38 +304,6 @@ int RunMerl(const CommonOptions& c, const MerlOptions& o, std::ostream& out, std
   return kExitOk;
 }
 
-namespace {
-
-// Retro-reflection f(θ, θ, 0) of a Cook-Torrance fit (band means of kd, ks; shared α, F0): the
-// microfacet source when a session has no δ = 0 readings.
-Result<exports::RetroProfile> RetroFromFittedModel(const exports::DerivedSamples& derived) {
-  fit::Observations data(derived.grid);
-  for (const exports::DerivedSample& s : derived.samples) {
-    if (Status st = data.Add(s.iso, s.values); !st.ok()) {
-      return st.WithContext("reading " + std::to_string(s.reading_id));
-    }
-  }
-  Result<fit::CookTorranceFit> r = fit::FitCookTorrance(data, {}, RunContext());
-  if (!r.ok()) return r.status();
-  fit::CookTorranceParams mean = r->band.front();
-  mean.kd = mean.ks = 0;
-  for (const fit::CookTorranceParams& b : r->band) {
-    mean.kd += b.kd / static_cast<double>(r->band.size());
-    mean.ks += b.ks / static_cast<double>(r->band.size());
-  }
-  exports::RetroProfile p;
-  for (int t = 0; t <= 89; ++t) {
-    p.theta_deg.push_back(static_cast<double>(t));
-    const double theta = static_cast<double>(t);
-    p.value.push_back(fit::CookTorranceBrdf({theta, theta, 0}, mean));
-  }
-  p.origin = "the fitted Cook-Torrance (GGX) model, α = " + exports::FormatNumber(mean.alpha) +
-             " (power iteration on its retro-reflection)";
-  return p;
-}
-
-}  // namespace
-
 int RunRgl(const CommonOptions& c, const RglCommandOptions& o, std::ostream& err) {
   if (c.output == "-") {
     return Fail(err, "rgl", InvalidArgument("an RGL .bsdf needs a file: give -o PATH.bsdf"));
@@ -390,44 +313,22 @@ int RunRgl(const CommonOptions& c, const RglCommandOptions& o, std::ostream& err
   Result<Interpolation> in =
       BuildInterpolator(*session, exports::Quantity::kBrdf, c, o.interp, err);
   if (!in.ok()) return Fail(err, "rgl", in.status());
-  const WavelengthGrid bands = in->derived.grid;
-  exports::RglOptions options;
+  exports::SessionRglOptions options;
   options.theta_i_count = o.theta_i_count;
   options.sample_res = o.sample_res;
-  options.theta_i_max_deg = 0;
-  for (const exports::DerivedSample& s : in->derived.samples) {
-    options.theta_i_max_deg = std::max({options.theta_i_max_deg, s.iso.theta_i, s.iso.theta_o});
-  }
-  options.theta_i_max_deg = std::min(options.theta_i_max_deg, 89.0);
-  options.description = "brdfd session " + std::to_string(session->id) + " '" + session->name +
-                        "', BRDF by " + o.interp.method + (o.rgb ? ", linear sRGB (D65)" : "");
   if (o.rgb) {
     Result<data::CieTables> cie = data::LoadCieTables(o.colord_dir);
     if (!cie.ok()) return Fail(err, "rgl", cie.status());
     Result<exports::SpectralRgbWeights> rgb =
-        exports::SpectralRgbWeights::Make(bands, cie->d65, cie->cmf);
+        exports::SpectralRgbWeights::Make(in->derived.grid, cie->d65, cie->cmf);
     if (!rgb.ok()) return Fail(err, "rgl", rgb.status());
     options.rgb = *rgb;
   }
-  Result<exports::RetroProfile> retro = exports::RetroReflectionFromSamples(in->derived);
-  if (!retro.ok()) {
-    err << "brdf-export rgl: " << retro.status().message() << "; fitting Cook-Torrance (GGX)\n";
-    retro = RetroFromFittedModel(in->derived);
-    if (!retro.ok()) return Fail(err, "rgl", retro.status());
-  }
-  // Where the chosen method has no value, the nearest reading's (counted as fallback).
-  Result<std::shared_ptr<const interp::SampleSet>> set = exports::ToSampleSet(in->derived);
-  if (!set.ok()) return Fail(err, "rgl", set.status());
-  Result<std::unique_ptr<interp::Interpolator>> nearest =
-      interp::MakeInterpolator(interp::Method::kNearest, *set, {});
-  if (!nearest.ok()) return Fail(err, "rgl", nearest.status());
-
   err << "brdf-export rgl: " << options.theta_i_count << " θi slices × " << options.sample_res
       << "² nodes by " << o.interp.method << (o.rgb ? ", RGB" : ", spectral") << "\n";
   ProgressLine line(err, "brdf-export rgl", StderrIsTerminal());
-  Result<exports::RglExport> table = exports::BuildRgl(
-      exports::InterpolatorSource(*in->interpolator), exports::InterpolatorSource(**nearest), bands,
-      *retro, options, Control(c, c.quiet ? nullptr : &line), RunContext());
+  Result<exports::RglExport> table = exports::BuildSessionRgl(
+      *session, *in, options, Control(c, c.quiet ? nullptr : &line), RunContext());
   line.Finish();
   if (!table.ok()) return Fail(err, "rgl", table.status());
   Result<std::unique_ptr<OutputFile>> file = OutputFile::Open(c.output);
@@ -436,6 +337,7 @@ int RunRgl(const CommonOptions& c, const RglCommandOptions& o, std::ostream& err
     return Fail(err, "rgl", st);
   }
   if (Status st = (*file)->Commit(); !st.ok()) return Fail(err, "rgl", st);
+  err << "brdf-export rgl: fill " << in->chain->Tally().Summary() << "\n";
   err << "brdf-export rgl: " << table->report.Summary() << " → " << c.output << "\n";
   return kExitOk;
 }

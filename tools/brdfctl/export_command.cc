@@ -49,8 +49,10 @@ int BuildRequest(const ExportOptions& o, std::ostream& err, v1::ExportRequest* r
     }
   } else if (o.what == "merl") {
     request->set_format(v1::EXPORT_FORMAT_MERL_BINARY);
+  } else if (o.what == "rgl") {
+    request->set_format(v1::EXPORT_FORMAT_RGL_BSDF);
   } else {
-    return Invalid(err, "'" + o.what + "': export csv, grid or merl");
+    return Invalid(err, "'" + o.what + "': export csv, grid, merl or rgl");
   }
 
   if (o.quantity == "brdf") {
@@ -62,8 +64,26 @@ int BuildRequest(const ExportOptions& o, std::ostream& err, v1::ExportRequest* r
   } else {
     return Invalid(err, "--quantity '" + o.quantity + "': use radiance, reflectance or brdf");
   }
-  if (o.what == "merl" && o.quantity != "brdf") {
-    return Invalid(err, "a MERL file holds the BRDF: leave out --quantity");
+  const bool rgl = o.what == "rgl";
+  if ((o.what == "merl" || rgl) && o.quantity != "brdf") {
+    return Invalid(
+        err, std::string(rgl ? "an RGL" : "a MERL") + " file holds the BRDF: leave out --quantity");
+  }
+  if (!rgl && (o.rgb || o.theta_i_count != 0 || o.resolution != 0)) {
+    return Invalid(err, "--rgb, --theta-i and --resolution are for rgl exports");
+  }
+  request->set_rgb(o.rgb);
+  request->set_rgl_theta_i_count(o.theta_i_count);
+  request->set_rgl_resolution(o.resolution);
+  if (o.fill == "chain") {
+    request->set_fill(v1::EXPORT_FILL_CHAIN);
+  } else if (o.fill == "none") {
+    request->set_fill(v1::EXPORT_FILL_NONE);
+  } else {
+    return Invalid(err, "--fill '" + o.fill + "': use chain or none");
+  }
+  if (o.what == "csv" && o.fill != "chain") {
+    return Invalid(err, "--fill is for grid, merl and rgl exports");
   }
 
   if (o.method == "octant") {
@@ -78,8 +98,8 @@ int BuildRequest(const ExportOptions& o, std::ostream& err, v1::ExportRequest* r
   v1::InterpolationOptions* options = request->mutable_options();
   for (double s : o.axis_scale) options->add_axis_scale(s);
   options->set_mirror_phi(o.mirror_phi);
-  // A MERL cell stands for a pair of directions and its swap alike (as brdf-export merl).
-  options->set_reciprocity(o.what == "merl" ? !o.no_reciprocity : o.reciprocity);
+  // A MERL or RGL cell stands for a pair of directions and its swap alike (as brdf-export).
+  options->set_reciprocity(o.what == "merl" || rgl ? !o.no_reciprocity : o.reciprocity);
 
   if (!o.steps.empty()) {
     if (!grid) return Invalid(err, "--steps is for grid exports");
@@ -149,6 +169,14 @@ void PrintReport(std::ostream& err, const v1::ExportReport& r, const std::string
     err << ") float64, NaN cells: " << r.unfilled_cells() << "; axes, wavelengths, unit: " << path
         << ".json\n";
   }
+  if (r.has_fill()) {
+    const v1::ExportFillCounts& f = r.fill();
+    char fraction[32];
+    std::snprintf(fraction, sizeof fraction, "%.2f %%", 100 * f.model_fraction());
+    err << "brdfctl export: fill " << f.policy() << ": " << f.interpolated() << " interpolated, "
+        << f.fallback() << " fallback, " << f.model() << " model (" << fraction << "), "
+        << f.empty() << " empty\n";
+  }
 }
 
 }  // namespace
@@ -158,7 +186,8 @@ int RunExport(CommandContext& ctx, const ExportOptions& o) {
   if (int rc = BuildRequest(o, ctx.err, &request); rc != kExitOk) return rc;
   const bool to_stdout = o.output == "-";
   if (to_stdout && (request.format() == v1::EXPORT_FORMAT_GRID_NPY ||
-                    request.format() == v1::EXPORT_FORMAT_MERL_BINARY)) {
+                    request.format() == v1::EXPORT_FORMAT_MERL_BINARY ||
+                    request.format() == v1::EXPORT_FORMAT_RGL_BSDF)) {
     return Invalid(ctx.err, "a binary export needs a file: give -o FILE");
   }
 

@@ -1,9 +1,12 @@
-// `brdfctl export <id> csv|grid|merl [-o FILE]`: a session exported by the daemon (Data.Export)
+// `brdfctl export <id> csv|grid|merl|rgl [-o FILE]`: a session exported by the daemon (Data.Export)
 // and written to a local file, so that it works from any machine that reaches brdfd:
 //   csv   the readings, one row each (pose, directions, quality, spectrum; units in the header)
 //   grid  the session's interpolator on a regular (θi, θo, φ) grid, as .npy (with FILE.json
 //         describing axes, wavelengths and unit) or CSV; NaN where the method cannot fill a cell
 //   merl  a MERL .binary (90 × 90 × 180, linear sRGB under D65)
+//   rgl   an RGL material .bsdf (Mitsuba 3, pbrt-v4; docs/rgl-format.md), spectral or --rgb
+// Grid, merl and rgl fill the cells the method cannot with --fill chain (the default: Delaunay,
+// then the fitted Cook-Torrance model) or leave them (--fill none); the report counts each.
 // The formats are core/export's, the same as brdf-export's (tools/brdf-export/README.md).
 // While the daemon works, a progress line shows the stage, the fraction done and the bytes
 // received (redrawn on a terminal, one line per 10 % otherwise). The file is written as
@@ -23,17 +26,21 @@ namespace brdf::ctl {
 
 struct ExportOptions {
   std::string session_id;
-  std::string what;               // csv, grid, merl
+  std::string what;               // csv, grid, merl, rgl
   std::string output;             // empty: the daemon's file name; "-": standard output
   std::string quantity = "brdf";  // radiance, reflectance, brdf (csv, grid)
   std::string format;             // grid: npy or csv; empty: from the output's extension
   std::vector<double> steps;      // grid: dθi,dθo,dφ in degrees, or one for all; empty: 1°
   bool nodes = false;             // grid: nodes 0…90 (180) instead of cell centres
-  std::string method = "octant";  // grid, merl: octant, delaunay, nearest
+  std::string method = "octant";  // grid, merl, rgl: octant, delaunay, nearest
   std::vector<double> axis_scale;
   bool mirror_phi = false;
   bool reciprocity = false;     // grid: also the θi↔θo swapped readings
-  bool no_reciprocity = false;  // merl: reciprocity is on by default; this turns it off
+  bool no_reciprocity = false;  // merl, rgl: reciprocity is on by default; this turns it off
+  std::string fill = "chain";   // grid, merl, rgl: chain or none
+  bool rgb = false;             // rgl: linear sRGB under D65 instead of spectra
+  unsigned theta_i_count = 0;   // rgl: θi slices; 0: the daemon's default (24)
+  unsigned resolution = 0;      // rgl: nodes per side of the warped square; 0: 48
   bool exclude_flagged = false;
   bool progress = true;       // draw the progress line on standard error
   bool progress_tty = false;  // redraw it in place (standard error is a terminal)

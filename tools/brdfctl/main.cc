@@ -1,7 +1,7 @@
 // brdfctl: the command line for brdfd. Every API call is a subcommand (README.md):
 //   brdfctl validate|submit PLAN.json, start|pause|resume|abort|get|watch|readings ID,
 //   answer ID STEP, list, rig, interpolate ID --theta-i A --theta-o B --phi C,
-//   export ID csv|grid|merl [-o FILE]
+//   export ID csv|grid|merl|rgl [-o FILE]
 // plus `sim-mount` for the simulated rig only. Address and token from --address/--token or
 // BRDF_ADDRESS/BRDF_TOKEN. Exit status: exit_codes.h.
 #include <sys/ioctl.h>
@@ -222,11 +222,13 @@ int main(int argc, char** argv) {
   ExportOptions export_options;
   bool export_no_progress = false;
   CLI::App* export_cmd = app.add_subcommand(
-      "export", "a session as a file: readings CSV, a regular grid (.npy or CSV), a MERL .binary");
+      "export",
+      "a session as a file: readings CSV, a regular grid (.npy or CSV), a MERL .binary, an RGL "
+      ".bsdf");
   add_id(export_cmd);
-  export_cmd->add_option("what", export_options.what, "csv, grid or merl")
+  export_cmd->add_option("what", export_options.what, "csv, grid, merl or rgl")
       ->required()
-      ->check(CLI::IsMember({"csv", "grid", "merl"}));
+      ->check(CLI::IsMember({"csv", "grid", "merl", "rgl"}));
   export_cmd->add_option("-o,--output", export_options.output,
                          "the file (default: the daemon's name for it, e.g. "
                          "session-1-grid-brdf.npy); - for standard output (csv)");
@@ -251,9 +253,21 @@ int main(int argc, char** argv) {
   export_cmd->add_flag("--mirror-phi", export_options.mirror_phi,
                        "also use readings mirrored to −φ");
   export_cmd->add_flag("--reciprocity", export_options.reciprocity,
-                       "grid: also use readings with θi and θo swapped (merl: always, see below)");
+                       "grid: also use readings with θi and θo swapped (merl, rgl: always, see "
+                       "below)");
   export_cmd->add_flag("--no-reciprocity", export_options.no_reciprocity,
-                       "merl: do not add the θi↔θo swapped readings");
+                       "merl, rgl: do not add the θi↔θo swapped readings");
+  export_cmd
+      ->add_option("--fill", export_options.fill,
+                   "grid, merl, rgl: cells the method cannot fill: chain (Delaunay, then the "
+                   "fitted Cook-Torrance model) or none (NaN / −1)")
+      ->check(CLI::IsMember({"chain", "none"}))
+      ->capture_default_str();
+  export_cmd->add_flag("--rgb", export_options.rgb,
+                       "rgl: linear sRGB under D65 (field rgb) instead of spectra");
+  export_cmd->add_option("--theta-i", export_options.theta_i_count, "rgl: θi slices (default 24)");
+  export_cmd->add_option("--resolution", export_options.resolution,
+                         "rgl: nodes per side of the warped square (default 48)");
   export_cmd->add_flag("--exclude-flagged", export_options.exclude_flagged,
                        "leave out readings the quality policy flagged");
   export_cmd->add_flag("--no-progress", export_no_progress, "no progress line");

@@ -325,6 +325,7 @@ class BrdfClient:
     def export(self, session_id, fmt, path, *, quantity=None, method="octant", axis_scale=None,
                mirror_phi=False, reciprocity=None, step_theta_i=0.0, step_theta_o=0.0,
                step_phi=0.0, grid_nodes=False, exclude_flagged=False, chunk_bytes=0,
+               fill="chain", rgb=False, rgl_theta_i_count=0, rgl_resolution=0,
                on_progress=None, timeout=None):
         """Has the daemon export the session as a file and saves it at `path`; returns an
         ExportResult (file name, bytes, summary, rows, cells, filled_cells, shape, ...).
@@ -332,16 +333,23 @@ class BrdfClient:
         fmt: "csv" (the readings, one row each), "grid" (the session's interpolator on a regular
             (θi, θo, φ) grid: CSV when `path` ends in ".csv", else NumPy .npy, float64 of shape
             (nθi, nθo, nφ, bands), NaN where the method cannot fill a cell), "merl" (a MERL
-            .binary, 90 × 90 × 180 linear sRGB, −1 where unfilled); or "grid_npy", "grid_csv".
+            .binary, 90 × 90 × 180 linear sRGB, −1 where unfilled), "rgl" (an RGL material .bsdf
+            for Mitsuba 3 and pbrt-v4, spectral or with rgb=True linear sRGB; read it with
+            brdf_client.rgl.read_rgl); or "grid_npy", "grid_csv".
         path: the file; an existing folder: the daemon's file name (session-3-grid-brdf.npy, ...)
             in it. The bytes go to `path`.partial, which is renamed to `path` only once the
             report has arrived and the bytes are complete, so a failed or interrupted export never
             leaves a truncated file (the partial file is removed).
         quantity: csv and grids: "brdf" (sr⁻¹; None: the daemon's default, BRDF), "reflectance"
             or "radiance" (csv: every reading, raw). MERL is always the BRDF.
-        method, axis_scale, mirror_phi: grids and MERL, as interpolate(). reciprocity: also use
-            the θi↔θo swapped readings; None: on for MERL (a cell stands for a pair of
+        method, axis_scale, mirror_phi: grids, MERL and RGL, as interpolate(). reciprocity: also
+            use the θi↔θo swapped readings; None: on for MERL and RGL (a cell stands for a pair of
             directions and its swap alike, as `brdfctl export merl`), off otherwise.
+        fill: grids, MERL, RGL: "chain" (cells the method cannot fill take Delaunay's value, then
+            the fitted Cook-Torrance model's: no holes above the horizon) or "none" (NaN / −1);
+            the result's fill counts where the values came from.
+        rgb, rgl_theta_i_count, rgl_resolution: RGL: linear sRGB instead of spectra; θi slices
+            (0: 24) and nodes per side of the warped square (0: 48).
         step_theta_i, step_theta_o, step_phi: grids: degrees, dividing 90 (θ) or 180 (φ);
             0: 1°. grid_nodes: sample 0, step, …, 90 (180) instead of the cells' centres.
         exclude_flagged: leave out readings the quality policy flagged.
@@ -365,7 +373,9 @@ class BrdfClient:
                                  mirror_phi=mirror_phi, reciprocity=reciprocity,
                                  step_theta_i=step_theta_i, step_theta_o=step_theta_o,
                                  step_phi=step_phi, grid_nodes=grid_nodes,
-                                 exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes)
+                                 exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes,
+                                 fill=fill, rgb=rgb, rgl_theta_i_count=rgl_theta_i_count,
+                                 rgl_resolution=rgl_resolution)
         partial = (os.path.join(path, f"brdf_client-export-{session_id}") if into_folder
                    else path) + ".partial"
         rpc = "Data.Export"

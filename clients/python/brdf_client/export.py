@@ -1,7 +1,8 @@
 """Session exports (Data.Export): the request from Python arguments, and what an export produced.
 
 brdfd writes a session as a file — the readings as CSV, the session's interpolator on a regular
-(θi, θo, φ) grid as a NumPy .npy or CSV, or a MERL .binary — and streams it back: progress
+(θi, θo, φ) grid as a NumPy .npy or CSV, a MERL .binary, or an RGL material .bsdf (spectral or
+RGB; brdf_client.rgl reads it) — and streams it back: progress
 messages, the file's bytes in order, then a report. BrdfClient.export saves the bytes; this module
 builds the ExportRequest the way `brdfctl export` does (same words, same defaults) and turns the
 report into an ExportResult. The formats are described in tools/brdf-export/README.md.
@@ -24,12 +25,18 @@ FORMATS = {
     "grid_csv": brdf_pb2.EXPORT_FORMAT_GRID_CSV,
     "merl": brdf_pb2.EXPORT_FORMAT_MERL_BINARY,
     "merl_binary": brdf_pb2.EXPORT_FORMAT_MERL_BINARY,
+    "rgl": brdf_pb2.EXPORT_FORMAT_RGL_BSDF,
+    "rgl_bsdf": brdf_pb2.EXPORT_FORMAT_RGL_BSDF,
 }
+# Formats whose cells the fill policy covers, and the policies by name.
+FILLED_FORMATS = frozenset((brdf_pb2.EXPORT_FORMAT_GRID_NPY, brdf_pb2.EXPORT_FORMAT_GRID_CSV,
+                            brdf_pb2.EXPORT_FORMAT_MERL_BINARY, brdf_pb2.EXPORT_FORMAT_RGL_BSDF))
+FILLS = {"chain": brdf_pb2.EXPORT_FILL_CHAIN, "none": brdf_pb2.EXPORT_FILL_NONE}
 GRID_FORMATS = frozenset((brdf_pb2.EXPORT_FORMAT_GRID_NPY, brdf_pb2.EXPORT_FORMAT_GRID_CSV))
 
 
 def format_name(value):
-    """ExportFormat number → "readings_csv", "grid_npy", "grid_csv", "merl_binary"."""
+    """ExportFormat number → "readings_csv", "grid_npy", "grid_csv", "merl_binary", "rgl_bsdf"."""
     name = brdf_pb2.ExportFormat.Name(value)
     return name[len("EXPORT_FORMAT_"):].lower()
 
@@ -38,7 +45,8 @@ def export_format(fmt, path=""):
     """`fmt` as an ExportFormat number.
 
     fmt: "csv" (the readings), "grid" (the regular grid: CSV when `path` ends in ".csv", else
-    .npy), "merl"; or the proto's names "readings_csv", "grid_npy", "grid_csv", "merl_binary";
+    .npy), "merl", "rgl"; or the proto's names "readings_csv", "grid_npy", "grid_csv",
+    "merl_binary", "rgl_bsdf";
     or an ExportFormat number. Anything else raises ValueError listing the accepted words.
     """
     if isinstance(fmt, str) and fmt.strip().lower() == "grid":
@@ -47,32 +55,42 @@ def export_format(fmt, path=""):
     if isinstance(fmt, str):
         key = fmt.strip().lower().replace("-", "_")
         if key not in FORMATS:
-            raise ValueError(f"unknown export format {fmt!r}; use csv, grid, merl (or "
-                             "readings_csv, grid_npy, grid_csv, merl_binary)")
+            raise ValueError(f"unknown export format {fmt!r}; use csv, grid, merl, rgl (or "
+                             "readings_csv, grid_npy, grid_csv, merl_binary, rgl_bsdf)")
         return FORMATS[key]
     value = int(fmt)
     if value not in brdf_pb2.ExportFormat.values() or value == 0:
-        raise ValueError(f"unknown export format {fmt!r}; use csv, grid or merl")
+        raise ValueError(f"unknown export format {fmt!r}; use csv, grid, merl or rgl")
     return value
 
 
 def export_request(session_id, fmt, path="", *, quantity=None, method="octant",
                    axis_scale=None, mirror_phi=False, reciprocity=None, step_theta_i=0.0,
                    step_theta_o=0.0, step_phi=0.0, grid_nodes=False, exclude_flagged=False,
-                   chunk_bytes=0):
+                   chunk_bytes=0, fill="chain", rgb=False, rgl_theta_i_count=0, rgl_resolution=0):
     """The ExportRequest for BrdfClient.export's arguments (which document them).
 
-    As brdfctl: reciprocity None means on for MERL (a MERL cell stands for a pair of directions
-    and its swap alike) and off for the others. Grid steps on a non-grid export raise ValueError
-    rather than being silently ignored; the daemon checks the rest (INVALID_ARGUMENT).
+    As brdfctl: reciprocity None means on for MERL and RGL (a cell stands for a pair of
+    directions and its swap alike) and off for the others. Grid steps on a non-grid export, RGL
+    options on another and a fill other than "chain" on the readings CSV raise ValueError rather
+    than being silently ignored; the daemon checks the rest (INVALID_ARGUMENT).
     """
     value = export_format(fmt, path)
+    rgl = value == brdf_pb2.EXPORT_FORMAT_RGL_BSDF
+    if not rgl and (rgb or rgl_theta_i_count or rgl_resolution):
+        raise ValueError(f"rgb, rgl_theta_i_count and rgl_resolution are for RGL exports, not "
+                         f"{format_name(value)}")
+    fill_key = str(fill).strip().lower()
+    if fill_key not in FILLS:
+        raise ValueError(f"unknown fill {fill!r}; use chain or none")
+    if value not in FILLED_FORMATS and fill_key != "chain":
+        raise ValueError(f"fill is for grid, MERL and RGL exports, not {format_name(value)}")
     steps = (step_theta_i, step_theta_o, step_phi)
     if value not in GRID_FORMATS and (any(steps) or grid_nodes):
         raise ValueError(f"grid steps and grid_nodes are for grid exports, not "
                          f"{format_name(value)}")
     if reciprocity is None:
-        reciprocity = value == brdf_pb2.EXPORT_FORMAT_MERL_BINARY
+        reciprocity = value == brdf_pb2.EXPORT_FORMAT_MERL_BINARY or rgl
     options = brdf_pb2.InterpolationOptions(axis_scale=list(axis_scale or ()),
                                             mirror_phi=mirror_phi, reciprocity=reciprocity)
     return brdf_pb2.ExportRequest(
@@ -80,7 +98,9 @@ def export_request(session_id, fmt, path="", *, quantity=None, method="octant",
         quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"),
         method=names.to_enum(method, names.METHODS, "method"), options=options,
         step_theta_i=step_theta_i, step_theta_o=step_theta_o, step_phi=step_phi,
-        grid_nodes=grid_nodes, exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes)
+        grid_nodes=grid_nodes, exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes,
+        fill=FILLS[fill_key] if value in FILLED_FORMATS else 0, rgb=rgb,
+        rgl_theta_i_count=rgl_theta_i_count, rgl_resolution=rgl_resolution)
 
 
 @dataclasses.dataclass
@@ -89,22 +109,26 @@ class ExportResult:
 
     Attributes:
       path:        the file written (the `path` given, or the daemon's file name in that folder).
-      format:      "readings_csv", "grid_npy", "grid_csv" or "merl_binary".
+      format:      "readings_csv", "grid_npy", "grid_csv", "merl_binary" or "rgl_bsdf".
       file_name:   the daemon's name for the file, e.g. "session-3-grid-brdf.npy".
       bytes:       size of the file (checked against the bytes received).
       summary:     one line, e.g. "16200 cells: 15012 ok, 1188 NaN (1100 empty_octant, …)".
       rows:        readings CSV: rows written (readings; for reflectance and BRDF the sample
                    readings that could be converted).
-      cells, filled_cells, unfilled_cells: grids and MERL: cells in the file, with a value,
-                   without one (NaN in a grid; −1 in a MERL file, below-horizon cells excluded).
+      cells, filled_cells, unfilled_cells: grids, MERL and RGL: cells in the file, with a value,
+                   without one (NaN in a grid; −1 in a MERL file, below-horizon cells excluded;
+                   RGL: the nodes of all θi slices).
       unfilled_by_status: {"empty_octant": n, ...}: unfilled cells by why.
-      below_horizon_cells, clamped_cells: MERL: −1 cells below the surface; filled cells with a
-                   negative linear-sRGB component set to 0.
+      below_horizon_cells, clamped_cells: MERL, RGL: cells below the surface (−1; RGL 0);
+                   filled cells with a negative linear-sRGB component set to 0.
       skipped_readings, first_skip_reason: sample readings left out, and why the first one was.
       shape:       grid .npy: (nθi, nθo, nφ, bands); else ().
       description: grid .npy: the axes, wavelengths, quantity, unit, method and counts (the
                    report's description_json, parsed); else None.
       warnings:    things to know, e.g. several dial positions γ folded together.
+      fill:        grids, MERL, RGL: where the cells' values came from, {"policy": "chain" or
+                   "none", "interpolated": n, "fallback": n, "model": n, "empty": n,
+                   "model_fraction": x}; None for the readings CSV.
     """
 
     path: str
@@ -124,6 +148,7 @@ class ExportResult:
     shape: tuple = ()
     description: dict = None
     warnings: list = dataclasses.field(default_factory=list)
+    fill: dict = None
 
     @classmethod
     def from_report(cls, report, path, fmt):
@@ -139,4 +164,12 @@ class ExportResult:
                    first_skip_reason=report.first_skip_reason, shape=tuple(report.shape),
                    description=(json.loads(report.description_json)
                                 if report.description_json else None),
-                   warnings=list(report.warnings))
+                   warnings=list(report.warnings),
+                   fill=(_fill_counts(report.fill) if report.HasField("fill") else None))
+
+
+def _fill_counts(fill):
+    """ExportFillCounts → the dict ExportResult.fill documents."""
+    return {"policy": fill.policy, "interpolated": fill.interpolated,
+            "fallback": fill.fallback, "model": fill.model, "empty": fill.empty,
+            "model_fraction": fill.model_fraction}

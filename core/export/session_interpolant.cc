@@ -1,0 +1,121 @@
+#include "core/export/session_interpolant.h"
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+#include "core/export/number_text.h"
+#include "core/fit/models.h"
+
+namespace brdf::exports {
+namespace {
+
+Result<fit::CookTorranceFit> FitModel(const DerivedSamples& derived, const CallContext& ctx) {
+  fit::Observations data(derived.grid);
+  for (const DerivedSample& s : derived.samples) {
+    if (Status st = data.Add(s.iso, s.values); !st.ok()) {
+      return st.WithContext("reading " + std::to_string(s.reading_id));
+    }
+  }
+  return fit::FitCookTorrance(data, {}, ctx);
+}
+
+// Retro-reflection f(θ, θ, 0) of a Cook-Torrance fit (band means of kd, ks; shared α, F0): the
+// microfacet source when a session has no δ = 0 readings.
+RetroProfile RetroFromModel(const fit::CookTorranceFit& model) {
+  fit::CookTorranceParams mean = model.band.front();
+  mean.kd = mean.ks = 0;
+  for (const fit::CookTorranceParams& b : model.band) {
+    mean.kd += b.kd / static_cast<double>(model.band.size());
+    mean.ks += b.ks / static_cast<double>(model.band.size());
+  }
+  RetroProfile p;
+  for (int t = 0; t <= 89; ++t) {
+    const double theta = static_cast<double>(t);
+    p.theta_deg.push_back(theta);
+    p.value.push_back(fit::CookTorranceBrdf({theta, theta, 0}, mean));
+  }
+  p.origin = "the fitted Cook-Torrance (GGX) model, α = " + FormatNumber(mean.alpha) +
+             " (power iteration on its retro-reflection)";
+  return p;
+}
+
+}  // namespace
+
+InterpolantInfo SessionInterpolant::Info() const {
+  return {options.mirror_phi, options.reciprocity, options.axis_scale,
+          chain ? chain->Tally().Json() : std::string()};
+}
+
+Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, interp::Method method,
+                                                   const interp::Options& options,
+                                                   FillPolicy policy, const CallContext& ctx) {
+  SessionInterpolant in;
+  in.derived = std::move(derived);
+  in.method = method;
+  in.options = options;
+  Result<std::shared_ptr<const interp::SampleSet>> set = ToSampleSet(in.derived);
+  if (!set.ok()) return set.status();
+  in.samples = *set;
+  Result<std::unique_ptr<interp::Interpolator>> chosen =
+      interp::MakeInterpolator(method, in.samples, options);
+  if (!chosen.ok()) return chosen.status();
+  in.interpolator = std::move(*chosen);
+
+  std::vector<FillChain::Stage> stages;
+  stages.push_back({Provenance::kInterpolated, InterpolatorSource(*in.interpolator)});
+  if (policy == FillPolicy::kChain) {
+    if (method != interp::Method::kDelaunay) {
+      Result<std::unique_ptr<interp::Interpolator>> d =
+          interp::MakeInterpolator(interp::Method::kDelaunay, in.samples, options);
+      if (!d.ok()) return d.status().WithContext("the fill chain's Delaunay fallback");
+      in.fallback = std::move(*d);
+      stages.push_back({Provenance::kFallback, InterpolatorSource(*in.fallback)});
+    }
+    Result<fit::CookTorranceFit> model = FitModel(in.derived, ctx);
+    if (!model.ok()) return model.status().WithContext("the fill chain's model");
+    in.model = std::move(*model);
+    stages.push_back({Provenance::kModel, ModelSource(*in.model)});
+  }
+  in.chain = std::make_unique<FillChain>(policy, std::move(stages));
+  return in;
+}
+
+Result<RglExport> BuildSessionRgl(const Session& session, const SessionInterpolant& in,
+                                  const SessionRglOptions& o, const RunControl& control,
+                                  const CallContext& ctx) {
+  RglOptions options;
+  options.theta_i_count = o.theta_i_count;
+  options.sample_res = o.sample_res;
+  options.theta_i_max_deg = 0;
+  for (const DerivedSample& s : in.derived.samples) {
+    options.theta_i_max_deg = std::max({options.theta_i_max_deg, s.iso.theta_i, s.iso.theta_o});
+  }
+  options.theta_i_max_deg = std::min(options.theta_i_max_deg, 89.0);
+  options.description = "brdfd session " + std::to_string(session.id) + " '" + session.name +
+                        "', BRDF by " + interp::MethodName(in.method) +
+                        (o.rgb ? ", linear sRGB (D65)" : "");
+  options.rgb = o.rgb;
+
+  Result<RetroProfile> retro = RetroReflectionFromSamples(in.derived);
+  if (!retro.ok()) {
+    if (in.model) {
+      retro = RetroFromModel(*in.model);
+    } else {
+      Result<fit::CookTorranceFit> model = FitModel(in.derived, ctx);
+      if (!model.ok()) {
+        return model.status().WithContext(retro.status().message() +
+                                          "; fitting Cook-Torrance (GGX) instead");
+      }
+      retro = RetroFromModel(*model);
+    }
+  }
+  // Where the chain has no value (fill policy none), the nearest reading's.
+  Result<std::unique_ptr<interp::Interpolator>> nearest =
+      interp::MakeInterpolator(interp::Method::kNearest, in.samples, {});
+  if (!nearest.ok()) return nearest.status();
+  return BuildRgl(in.chain->Source(), InterpolatorSource(**nearest), in.derived.grid, *retro,
+                  options, control, ctx);
+}
+
+}  // namespace brdf::exports

@@ -1,0 +1,66 @@
+// A session's interpolant as every export that fills a table builds it (brdf-export and the
+// daemon's Data.Export alike, so that the same session and options give the same bytes): the
+// chosen interpolation method on the derived samples, behind the fill chain (fill_chain.h) —
+// alone with FillPolicy kNone; with kChain followed by Delaunay on the same samples and options
+// (unless the method is Delaunay) and by the Cook-Torrance (GGX) model fitted to the samples.
+// Also the RGL export of such an interpolant (rgl_export.h), with its microfacet distribution
+// from the session's retro-reflection readings or, without them, from the fitted model. Pure:
+// no I/O.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/call_context.h"
+#include "core/export/fill_chain.h"
+#include "core/export/grid_text.h"
+#include "core/export/rgl_export.h"
+#include "core/export/run_control.h"
+#include "core/export/session_data.h"
+#include "core/export/spectral_rgb.h"
+#include "core/fit/fit.h"
+#include "core/interp/interpolator.h"
+#include "core/status.h"
+
+namespace brdf::exports {
+
+struct SessionInterpolant {
+  DerivedSamples derived;
+  std::shared_ptr<const interp::SampleSet> samples;
+  interp::Method method = interp::Method::kOctant;
+  interp::Options options;
+  std::unique_ptr<interp::Interpolator> interpolator;  // the chosen method
+  std::unique_ptr<interp::Interpolator> fallback;      // kChain: Delaunay, unless the method is
+  std::optional<fit::CookTorranceFit> model;           // kChain: the fitted model
+  std::unique_ptr<FillChain> chain;                    // ask chain->Source(), read its Tally()
+
+  // The symmetry options, axis scales and fill counts so far, for a grid's sidecar.
+  InterpolantInfo Info() const;
+};
+
+// Errors: no usable sample (from the interpolator), a sample the fit refuses or a failed fit
+// (with context naming the fill chain's stage), kCancelled / kTimeout from `ctx` (the fit).
+Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, interp::Method method,
+                                                   const interp::Options& options,
+                                                   FillPolicy policy, const CallContext& ctx);
+
+struct SessionRglOptions {
+  std::size_t theta_i_count = 24;  // θi slices
+  std::size_t sample_res = 48;     // nodes per side of the warped square
+  // When set: an RGB file (linear sRGB under D65) instead of the spectral one.
+  std::optional<SpectralRgbWeights> rgb;
+};
+
+// The RGL material of `session` (its id and name go in the file's description) from `in` (the
+// BRDF): the fill chain's source answers every node above the surface; where it has none (fill
+// policy none) the nearest reading's value is taken (counted as fallback). θi slices run up to
+// the largest θi or θo measured (at most 89°). Errors: as BuildRgl, and the fit when the session
+// has no retro-reflection readings.
+Result<RglExport> BuildSessionRgl(const Session& session, const SessionInterpolant& in,
+                                  const SessionRglOptions& options, const RunControl& control,
+                                  const CallContext& ctx);
+
+}  // namespace brdf::exports
