@@ -1,5 +1,7 @@
 #include "drivers/stage/profile_file.h"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -9,7 +11,6 @@
 #include <optional>
 #include <set>
 #include <sstream>
-#include <toml++/toml.h>
 #include <utility>
 
 #include "drivers/stage/builtin_profiles.h"
@@ -47,9 +48,7 @@ class ProfileReader {
   explicit ProfileReader(std::string source) : source_(std::move(source)) {}
 
   bool failed() const { return !error_.empty(); }
-  Status status() const {
-    return failed() ? ConfigurationError(error_) : Status::Ok();
-  }
+  Status status() const { return failed() ? ConfigurationError(error_) : Status::Ok(); }
 
   void Fail(const toml::node* at, const std::string& key, const std::string& problem) {
     if (failed()) return;
@@ -117,8 +116,8 @@ class ProfileReader {
     return v;
   }
 
-  std::optional<double> Number(const toml::table& t, const std::string& path,
-                               std::string_view key, bool required) {
+  std::optional<double> Number(const toml::table& t, const std::string& path, std::string_view key,
+                               bool required) {
     const toml::node* n = Get(t, path, key, required);
     if (n == nullptr || failed()) return std::nullopt;
     if (!n->is_number()) {
@@ -135,7 +134,7 @@ class ProfileReader {
   }
 
   std::optional<std::string> String(const toml::table& t, const std::string& path,
-                                     std::string_view key, bool required) {
+                                    std::string_view key, bool required) {
     const toml::node* n = Get(t, path, key, required);
     if (n == nullptr || failed()) return std::nullopt;
     if (!n->is_string()) {
@@ -182,13 +181,14 @@ class ProfileReader {
     known.insert(extra.begin(), extra.end());
     for (const auto& [k, v] : *f) {
       if (known.count(k.str()) == 0) {
-        Fail(&v, Join(p, k.str()), "unknown key (known here: address, words" +
-                                       std::string(extra.size() ? ", and the entry's own" : "") +
-                                       ")");
+        Fail(&v, Join(p, k.str()),
+             "unknown key (known here: address, words" +
+                 std::string(extra.size() ? ", and the entry's own" : "") + ")");
       }
     }
     RegisterField out;
-    if (auto a = Int(*f, p, "address", true, 0, 0xFFFF)) out.address = static_cast<std::uint16_t>(*a);
+    if (auto a = Int(*f, p, "address", true, 0, 0xFFFF))
+      out.address = static_cast<std::uint16_t>(*a);
     if (auto w = Int(*f, p, "words", true, 1, 2)) out.words = static_cast<int>(*w);
     return out;
   }
@@ -219,7 +219,8 @@ CommandAction ReadCommand(ProfileReader& r, const toml::table& root, std::string
     return c;
   }
   c.kind = CommandAction::Kind::kWriteValue;
-  if (auto a = r.Int(*t, p, "address", true, 0, 0xFFFF)) c.field.address = static_cast<std::uint16_t>(*a);
+  if (auto a = r.Int(*t, p, "address", true, 0, 0xFFFF))
+    c.field.address = static_cast<std::uint16_t>(*a);
   c.field.words = 1;
   if (auto w = r.Int(*t, p, "words", false, 1, 2)) c.field.words = static_cast<int>(*w);
   return c;
@@ -259,9 +260,9 @@ void ReadRamp(ProfileReader& r, const toml::table& root, RegisterProfile& p) {
                  " register(s); lower it or check ramp.unit and ramp.per_unit");
       return;
     }
-    p.block_constants.push_back(BlockConstant{
-        reg, static_cast<std::int32_t>(static_cast<std::uint32_t>(counts)),
-        std::string(what) + " (" + Trimmed(*v) + " " + p.ramp.unit + ")"});
+    p.block_constants.push_back(
+        BlockConstant{reg, static_cast<std::int32_t>(static_cast<std::uint32_t>(counts)),
+                      std::string(what) + " (" + Trimmed(*v) + " " + p.ramp.unit + ")"});
   }
 }
 
@@ -319,8 +320,10 @@ void ReadStatusBits(ProfileReader& r, const toml::table& root, RegisterProfile& 
   if (t == nullptr) return;
   r.OnlyKnown(*t, "status_bits", {"ready", "alarm", "busy", "moving", "in_position"});
   const std::pair<const char*, std::uint32_t*> masks[] = {
-      {"ready", &p.status_bits.ready},   {"alarm", &p.status_bits.alarm},
-      {"busy", &p.status_bits.busy},     {"moving", &p.status_bits.moving},
+      {"ready", &p.status_bits.ready},
+      {"alarm", &p.status_bits.alarm},
+      {"busy", &p.status_bits.busy},
+      {"moving", &p.status_bits.moving},
       {"in_position", &p.status_bits.in_position}};
   for (const auto& [key, mask] : masks) {
     const bool required = std::string_view(key) == "moving" || std::string_view(key) == "alarm";
@@ -342,21 +345,27 @@ Result<RegisterProfile> ParseProfileText(std::string_view text, const std::strin
   try {
     doc = toml::parse(text, source);
   } catch (const toml::parse_error& e) {
-    return ConfigurationError("stage profile file " + source + ": line " +
-                              std::to_string(e.source().begin.line) + ", column " +
-                              std::to_string(e.source().begin.column) + ": not valid TOML: " +
-                              std::string(e.description()) + "; fix the file");
+    return ConfigurationError(
+        "stage profile file " + source + ": line " + std::to_string(e.source().begin.line) +
+        ", column " + std::to_string(e.source().begin.column) +
+        ": not valid TOML: " + std::string(e.description()) + "; fix the file");
   } catch (const std::exception& e) {
     return ConfigurationError("stage profile file " + source + ": cannot parse: " + e.what());
   }
 
   ProfileReader r(source);
   RegisterProfile p;
-  r.OnlyKnown(doc, "",
-              {"name", "drive", "source", "verified_against_hardware", "word_order", "block_start",
-               "absolute_type", "operation_type", "position", "speed", "speed_scale",
-               "block_constants", "ramp", "trigger", "input_command", "home", "stop",
-               "alarm_reset", "status", "status_bits", "alarm_code", "feedback_position"});
+  r.OnlyKnown(doc, "", {"name",          "drive",
+                        "source",        "verified_against_hardware",
+                        "word_order",    "block_start",
+                        "absolute_type", "operation_type",
+                        "position",      "speed",
+                        "speed_scale",   "block_constants",
+                        "ramp",          "trigger",
+                        "input_command", "home",
+                        "stop",          "alarm_reset",
+                        "status",        "status_bits",
+                        "alarm_code",    "feedback_position"});
   if (auto v = r.String(doc, "", "name", true)) p.name = *v;
   if (auto v = r.String(doc, "", "drive", false)) p.drive = *v;
   if (auto v = r.String(doc, "", "source", true)) p.source = *v;

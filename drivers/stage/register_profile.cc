@@ -95,9 +95,15 @@ std::vector<NamedField> BlockFields(const RegisterProfile& p) {
 
 }  // namespace
 
-RegisterProfile RegisterProfile::AzDefault() { return BuiltinProfileOrDie("az"); }
-RegisterProfile RegisterProfile::Leadshine() { return BuiltinProfileOrDie("leadshine"); }
-RegisterProfile RegisterProfile::Moons() { return BuiltinProfileOrDie("moons"); }
+RegisterProfile RegisterProfile::AzDefault() {
+  return BuiltinProfileOrDie("az");
+}
+RegisterProfile RegisterProfile::Leadshine() {
+  return BuiltinProfileOrDie("leadshine");
+}
+RegisterProfile RegisterProfile::Moons() {
+  return BuiltinProfileOrDie("moons");
+}
 
 BlockSpan OperationBlockSpan(const RegisterProfile& profile) {
   int end = profile.block_start;

@@ -97,11 +97,11 @@ struct RegisterProfile {
   // The operation block, written with one FC16 starting at block_start and covering every field
   // below that lies in it (gaps are written as 0).
   std::uint16_t block_start = 0;
-  RegisterField operation_type;    // absent on drives whose trigger implies the type
-  std::int32_t absolute_type = 1;  // value meaning "absolute position"
-  RegisterField position;          // target, in counts
-  RegisterField speed;             // in counts per second × speed_scale
-  double speed_scale = 1.0;        // register units per (count/s), e.g. rpm per count/s
+  RegisterField operation_type;                // absent on drives whose trigger implies the type
+  std::int32_t absolute_type = 1;              // value meaning "absolute position"
+  RegisterField position;                      // target, in counts
+  RegisterField speed;                         // in counts per second × speed_scale
+  double speed_scale = 1.0;                    // register units per (count/s), e.g. rpm per count/s
   std::vector<BlockConstant> block_constants;  // sorted by address; includes the ramp's two
   RampSettings ramp;
 

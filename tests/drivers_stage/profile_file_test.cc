@@ -6,11 +6,11 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 namespace brdf::drivers::stage {
 namespace {
@@ -20,8 +20,12 @@ using ::testing::HasSubstr;
 
 // The register maps as brdfd compiled them in before issue 21 (register_profile.cc at 867d95c),
 // written out field by field; the shipped files must reproduce every register and value.
-RegisterField F(std::uint16_t a, int w) { return RegisterField{a, w}; }
-CommandAction Pulse(std::uint32_t bits) { return {CommandAction::Kind::kPulseBits, {}, bits}; }
+RegisterField F(std::uint16_t a, int w) {
+  return RegisterField{a, w};
+}
+CommandAction Pulse(std::uint32_t bits) {
+  return {CommandAction::Kind::kPulseBits, {}, bits};
+}
 CommandAction Write(std::uint16_t a, std::uint32_t v) {
   return {CommandAction::Kind::kWriteValue, F(a, 1), v};
 }
@@ -234,8 +238,9 @@ TEST(StageProfileFiles, BadFilesAreRefusedNamingTheFileLineKeyAndWhatToDo) {
               AllOf(HasSubstr("key 'status_bits.in_positon'"), HasSubstr("unknown key")));
   EXPECT_THAT(Refusal(AzWith("[feedback_position]", "[feedback]")),
               AllOf(HasSubstr("key 'feedback'"), HasSubstr("unknown key")));
-  EXPECT_THAT(Refusal(AzWith("words = 2\n\n[feedback_position]", "words = 3\n\n[feedback_position]")),
-              AllOf(HasSubstr("key 'alarm_code.words'"), HasSubstr("must be 1–2, got 3")));
+  EXPECT_THAT(
+      Refusal(AzWith("words = 2\n\n[feedback_position]", "words = 3\n\n[feedback_position]")),
+      AllOf(HasSubstr("key 'alarm_code.words'"), HasSubstr("must be 1–2, got 3")));
   EXPECT_THAT(Refusal(AzWith("acceleration = 1000.0", "acceleration = 5e6")),
               AllOf(HasSubstr("key 'ramp.acceleration'"), HasSubstr("does not fit")));
   EXPECT_THAT(Refusal(AzWith("deceleration = 1000.0", "deceleration = -1")),
@@ -263,7 +268,8 @@ TEST(StageProfileFiles, AFileThatCannotBeReadIsNamed) {
 }
 
 TEST(StageProfileFiles, ALabsOwnFileLoadsFromDisk) {
-  const std::string path = ::testing::TempDir() + "/lab-profile-" + std::to_string(getpid()) + ".toml";
+  const std::string path =
+      ::testing::TempDir() + "/lab-profile-" + std::to_string(getpid()) + ".toml";
   {
     std::ofstream out(path);
     out << AzWith("word_order = \"high_first\"", "word_order = \"low_first\"");

@@ -2,11 +2,11 @@
 // [stage] profile_file, and a file that cannot work refused with the key, the file and the line.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include "daemon/config.h"
 #include "daemon/rig.h"
@@ -31,8 +31,7 @@ class RigStageProfile : public ::testing::Test {
 
 TEST_F(RigStageProfile, ALabsOwnFileIsUsedAndABadOneIsRefusedNamingFileKeyAndLine) {
   Config config;
-  config.stage.profile_file =
-      Write(std::string(drivers::stage::BuiltinProfileText("moons")));
+  config.stage.profile_file = Write(std::string(drivers::stage::BuiltinProfileText("moons")));
   auto rig = Rig::FromConfig(config, Rig::Options());
   ASSERT_TRUE(rig.ok()) << rig.status().message();
   EXPECT_THAT((*rig)->GetStatus().stage.model, HasSubstr("profile file " + path_));
@@ -50,7 +49,8 @@ TEST_F(RigStageProfile, ALabsOwnFileIsUsedAndABadOneIsRefusedNamingFileKeyAndLin
   config.stage.profile_file = path_ + ".missing";
   auto missing = Rig::FromConfig(config, Rig::Options());
   ASSERT_FALSE(missing.ok());
-  EXPECT_THAT(missing.status().message(), AllOf(HasSubstr(".missing"), HasSubstr("cannot be read")));
+  EXPECT_THAT(missing.status().message(),
+              AllOf(HasSubstr(".missing"), HasSubstr("cannot be read")));
 }
 
 }  // namespace
