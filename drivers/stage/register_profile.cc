@@ -96,13 +96,16 @@ std::vector<NamedField> BlockFields(const RegisterProfile& p) {
 }  // namespace
 
 RegisterProfile RegisterProfile::AzDefault() {
-  return BuiltinProfileOrDie("az");
+  static const RegisterProfile kProfile = BuiltinProfileOrDie("az");  // parsed once
+  return kProfile;
 }
 RegisterProfile RegisterProfile::Leadshine() {
-  return BuiltinProfileOrDie("leadshine");
+  static const RegisterProfile kProfile = BuiltinProfileOrDie("leadshine");  // parsed once
+  return kProfile;
 }
 RegisterProfile RegisterProfile::Moons() {
-  return BuiltinProfileOrDie("moons");
+  static const RegisterProfile kProfile = BuiltinProfileOrDie("moons");  // parsed once
+  return kProfile;
 }
 
 BlockSpan OperationBlockSpan(const RegisterProfile& profile) {
