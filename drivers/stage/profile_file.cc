@@ -9,7 +9,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <optional>
-#include <set>
 #include <sstream>
 #include <utility>
 
@@ -171,21 +170,13 @@ class ProfileReader {
     return std::nullopt;
   }
 
-  // { address, words } plus `extra` keys the caller reads itself.
+  // A register table: { address, words }.
   RegisterField Field(const toml::table& t, const std::string& path, std::string_view key,
-                      bool required, std::initializer_list<std::string_view> extra = {}) {
+                      bool required) {
     const toml::table* f = Table(t, path, key, required);
     if (f == nullptr) return {};
     const std::string p = Join(path, key);
-    std::set<std::string_view> known{"address", "words"};
-    known.insert(extra.begin(), extra.end());
-    for (const auto& [k, v] : *f) {
-      if (known.count(k.str()) == 0) {
-        Fail(&v, Join(p, k.str()),
-             "unknown key (known here: address, words" +
-                 std::string(extra.size() ? ", and the entry's own" : "") + ")");
-      }
-    }
+    OnlyKnown(*f, p, {"address", "words"});
     RegisterField out;
     if (auto a = Int(*f, p, "address", true, 0, 0xFFFF))
       out.address = static_cast<std::uint16_t>(*a);
