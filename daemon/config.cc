@@ -440,6 +440,12 @@ void ReadStage(TableReader& root, Config& c, Issues& issues) {
   std::string parity;
   if (t.OneOf("parity", parity, {"N", "E", "O"})) s.parity = parity[0];
   t.OneOf("profile", s.profile, {"az", "leadshine", "moons"});
+  if (t.String("profile_file", s.profile_file)) {
+    if (t.Node("profile") != nullptr) {
+      t.Issue(*t.Node("profile_file"), "profile_file",
+              "given with profile; keep one: profile names a built-in map, profile_file a file");
+    }
+  }
   t.Int("response_timeout_ms", s.response_timeout_ms, 10, 60000);
   t.Int("busy_window_ms", s.busy_window_ms, 0, 600000);
   t.Int("reconnect_max_ms", s.reconnect_max_ms, 100, 300000);

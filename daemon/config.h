@@ -39,6 +39,8 @@
 //   baud = 115200                       # rtu
 //   parity = "E"                        # rtu: "N", "E" or "O"
 //   profile = "az"                      # register map: "az", "leadshine" or "moons"
+//   profile_file = "/etc/brdfd/stage-profile.toml"  # or the lab's own map (a copy of one of
+//                                       #   share/brdfd/stage-profiles/*.toml); not with profile
 //   response_timeout_ms = 500
 //   busy_window_ms = 3000               # exception 04/06 retried with back-off this long, then
 //                                       #   the session pauses naming the exception
@@ -155,6 +157,7 @@ struct StageConfig {
   int baud = 115200;               // rtu
   char parity = 'E';               // rtu
   std::string profile = "az";      // "az", "leadshine", "moons"
+  std::string profile_file;        // a lab's profile file; replaces `profile` (issue 21)
   int response_timeout_ms = 500;
   int busy_window_ms = 3000;    // exception 04/06: retry with back-off this long (issue 21)
   int reconnect_max_ms = 1000;  // longest wait between stage reconnection attempts

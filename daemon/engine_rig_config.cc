@@ -10,6 +10,7 @@
 #include "daemon/rig.h"
 #include "drivers/pr650/pr650_spectroradiometer.h"
 #include "drivers/stage/modbus_stage.h"
+#include "drivers/stage/profile_file.h"
 
 namespace brdf::daemon {
 namespace {
@@ -45,17 +46,27 @@ drivers::stage::AxisConfig Axis(const AxisSettings& a, bool present) {
   return c;
 }
 
+// "az profile", or "profile file /etc/brdfd/stage.toml".
+std::string StageProfileLabel(const StageConfig& s) {
+  return s.profile_file.empty() ? s.profile + " profile" : "profile file " + s.profile_file;
+}
+
 Result<drivers::stage::ModbusStageConfig> StageOptions(const StageConfig& s) {
   drivers::stage::ModbusStageConfig c;
-  if (s.profile == "az") {
-    c.profile = drivers::stage::RegisterProfile::AzDefault();
-  } else if (s.profile == "leadshine") {
-    c.profile = drivers::stage::RegisterProfile::Leadshine();
-  } else if (s.profile == "moons") {
-    c.profile = drivers::stage::RegisterProfile::Moons();
-  } else {
-    return ConfigurationError("config stage.profile: unknown register profile \"" + s.profile +
-                              "\" (known: az, leadshine, moons)");
+  // The register map: a lab's own file ([stage] profile_file), else a built-in one by name.
+  Result<drivers::stage::RegisterProfile> profile =
+      s.profile_file.empty() ? drivers::stage::BuiltinProfile(s.profile)
+                             : drivers::stage::LoadProfileFile(s.profile_file);
+  if (!profile.ok()) {
+    return profile.status().WithContext(s.profile_file.empty() ? "config stage.profile"
+                                                               : "config stage.profile_file");
+  }
+  c.profile = std::move(profile).value();
+  if (!c.profile.verified_against_hardware) {
+    spdlog::warn(
+        "stage register profile '{}' is not verified against a drive: check every address, bit "
+        "and opcode against the drive's manual (docs/stage-modbus.md) and run brdf-stage-probe",
+        c.profile.name);
   }
   drivers::stage::BusConfig bus;
   if (s.transport == "rtu") {
@@ -92,7 +103,7 @@ Result<std::unique_ptr<Rig>> Rig::FromConfig(const Config& config, Options optio
   return std::make_unique<Rig>(
       std::make_unique<drivers::Pr650Spectroradiometer>(std::move(meter_options)),
       DeviceInfo{"PR-650", config.meter.port}, std::move(*stage),
-      DeviceInfo{"Modbus stage (" + config.stage.profile + " profile)", stage_address},
+      DeviceInfo{"Modbus stage (" + StageProfileLabel(config.stage) + ")", stage_address},
       ToRigDescription(config), options);
 }
 

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "drivers/stage/modbus_codec.h"
+#include "drivers/stage/profile_file.h"
 
 namespace brdf::drivers::stage {
 
@@ -21,18 +22,6 @@ std::string Hex(unsigned value) {
   return buf;
 }
 
-RegisterField Field(std::uint16_t address, int words) {
-  return RegisterField{address, words};
-}
-
-CommandAction PulseBits(std::uint32_t bits) {
-  return CommandAction{CommandAction::Kind::kPulseBits, {}, bits};
-}
-
-CommandAction WriteValue(std::uint16_t address, std::uint32_t value) {
-  return CommandAction{CommandAction::Kind::kWriteValue, Field(address, 1), value};
-}
-
 class ProfileChecker {
  public:
   explicit ProfileChecker(const RegisterProfile& p)
@@ -40,7 +29,7 @@ class ProfileChecker {
 
   Status Fail(const std::string& field, const std::string& problem) const {
     return ConfigurationError("stage profile '" + name_ + "' field '" + field + "': " + problem +
-                              "; fix the stage register profile in the configuration");
+                              "; fix the stage register profile");
   }
 
   // `required` fields need 1 or 2 words; optional ones may also have 0 (absent).
@@ -78,7 +67,7 @@ class ProfileChecker {
         if (c.value == 0) return Fail(field + ".value", "the bits to pulse are 0");
         return CheckValue(field + ".value", c.value, p.input_command, false);
       case CommandAction::Kind::kWriteValue:
-        BRDF_RETURN_IF_ERROR(CheckField(field + ".field", c.field, true));
+        BRDF_RETURN_IF_ERROR(CheckField(field, c.field, true));
         return CheckValue(field + ".value", c.value, c.field, false);
     }
     return Fail(field + ".kind", "unknown command kind");
@@ -107,103 +96,16 @@ std::vector<NamedField> BlockFields(const RegisterProfile& p) {
 }  // namespace
 
 RegisterProfile RegisterProfile::AzDefault() {
-  RegisterProfile p;
-  p.name = "az";
-  p.verified_against_hardware = true;  // against the reference map (stage-modbus.md)
-  p.word_order = WordOrder::kHighFirst;
-  p.block_start = 0x0058;
-  p.block_constants = {
-      {Field(0x0058, 2), 0, "data number"},
-      {Field(0x0060, 2), 1'000'000, "start/changing rate"},
-      {Field(0x0062, 2), 1'000'000, "stop rate"},
-      {Field(0x0064, 2), 1000, "operating current (100.0 %)"},
-  };
-  p.operation_type = Field(0x005A, 2);
-  p.absolute_type = 1;
-  p.position = Field(0x005C, 2);
-  p.speed = Field(0x005E, 2);
-  p.speed_scale = 1.0;  // Hz = counts per second
-  p.trigger_style = TriggerStyle::kTriggerInBlock;
-  p.trigger = Field(0x0066, 2);
-  p.trigger_value = 1;  // apply the whole block and start
-  p.input_command = Field(0x007C, 2);
-  p.home = PulseBits(1u << 4);         // ZHOME
-  p.stop = PulseBits(1u << 5);         // STOP
-  p.alarm_reset = PulseBits(1u << 7);  // ALM-RST
-  p.status = Field(0x007E, 2);
-  p.status_bits = StatusBits{.ready = 1u << 5,
-                             .alarm = 1u << 7,
-                             .busy = 1u << 8,
-                             .moving = 1u << 13,
-                             .in_position = 1u << 14};
-  p.alarm_code = Field(0x0080, 2);
-  p.feedback_position = Field(0x00CC, 2);
-  return p;
+  static const RegisterProfile kProfile = BuiltinProfileOrDie("az");  // parsed once
+  return kProfile;
 }
-
 RegisterProfile RegisterProfile::Leadshine() {
-  // From Leadshine PR-mode documentation; unverified against a drive.
-  RegisterProfile p;
-  p.name = "leadshine";
-  p.verified_against_hardware = false;
-  p.word_order = WordOrder::kHighFirst;
-  p.block_start = 0x6200;
-  p.operation_type = Field(0x6200, 1);  // PR0 mode word
-  p.absolute_type = 0x0001;             // position move, absolute
-  p.position = Field(0x6201, 2);        // 0x6201 high, 0x6202 low
-  p.speed = Field(0x6203, 1);           // rpm
-  p.speed_scale = 60.0 / 10000.0;       // rpm per (count/s) at 10,000 counts per motor revolution
-  p.block_constants = {
-      {Field(0x6204, 1), 100, "acceleration (ms/1000 rpm)"},
-      {Field(0x6205, 1), 100, "deceleration (ms/1000 rpm)"},
-  };
-  p.trigger_style = TriggerStyle::kWriteValueToRegister;
-  p.trigger = Field(0x6002, 1);
-  p.trigger_value = 0x0010;                    // trigger PR0
-  p.home = WriteValue(0x6002, 0x0020);         // homing
-  p.stop = WriteValue(0x6002, 0x0040);         // emergency stop
-  p.alarm_reset = WriteValue(0x1801, 0x1111);  // reset current alarm
-  p.status = Field(0x1003, 1);
-  p.status_bits = StatusBits{.ready = 0x0002,  // enabled
-                             .alarm = 0x0001,  // fault
-                             .busy = 0,
-                             .moving = 0x0004,        // running
-                             .in_position = 0x0020};  // path completed
-  p.alarm_code = Field(0x2203, 1);
-  p.feedback_position = Field(0x602C, 2);  // current position (0x602A was read before issue 21)
-  return p;
+  static const RegisterProfile kProfile = BuiltinProfileOrDie("leadshine");  // parsed once
+  return kProfile;
 }
-
 RegisterProfile RegisterProfile::Moons() {
-  // From Applied Motion's Modbus register table (40001-based, so PDU = register − 40001);
-  // unverified against a drive.
-  RegisterProfile p;
-  p.name = "moons";
-  p.verified_against_hardware = false;
-  p.word_order = WordOrder::kHighFirst;
-  p.block_start = 27;
-  p.block_constants = {
-      {Field(27, 1), 600, "acceleration AC"},
-      {Field(28, 1), 600, "deceleration DE"},
-  };
-  p.speed = Field(29, 1);           // VE, 1/240 rev/s
-  p.speed_scale = 240.0 / 20000.0;  // at 20,000 counts per revolution
-  p.position = Field(30, 2);        // DI, 32-bit
-  p.trigger_style = TriggerStyle::kOpcodeRegister;
-  p.trigger = Field(124, 1);
-  p.trigger_value = 0x66;                 // FP, feed to position (absolute)
-  p.home = CommandAction{};               // seek-home needs drive-specific parameters
-  p.stop = WriteValue(124, 0xE1);         // SK, stop and kill buffer
-  p.alarm_reset = WriteValue(124, 0xBA);  // AR, alarm reset
-  p.status = Field(1, 1);
-  p.status_bits = StatusBits{.ready = 0x0001,           // motor enabled
-                             .alarm = 0x0004 | 0x0200,  // drive fault, alarm present
-                             .busy = 0,
-                             .moving = 0x0010,
-                             .in_position = 0x0008};
-  p.alarm_code = Field(0, 1);
-  p.feedback_position = Field(4, 2);  // encoder position, 40005-40006 (6-7 is the commanded one)
-  return p;
+  static const RegisterProfile kProfile = BuiltinProfileOrDie("moons");  // parsed once
+  return kProfile;
 }
 
 BlockSpan OperationBlockSpan(const RegisterProfile& profile) {

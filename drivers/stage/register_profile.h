@@ -76,8 +76,20 @@ struct StatusBits {
   std::uint32_t in_position = 0;
 };
 
+// Acceleration and deceleration as the lab gives them: in the unit the drive is set to (the AZ's
+// acceleration/deceleration unit parameter: kHz/s, s or ms/kHz), and how many register counts
+// make one unit. The profile file's [ramp] turns them into two block constants.
+struct RampSettings {
+  std::string unit;     // "kHz/s", "ms/1000 rpm", ...; for messages and the probe's report
+  double per_unit = 1;  // register counts per unit (AZ: 1000, the registers hold 0.001 kHz/s)
+  double acceleration = 0;
+  double deceleration = 0;
+};
+
 struct RegisterProfile {
   std::string name;
+  std::string drive;   // which drive and mode the map is for
+  std::string source;  // the manual tables it follows (docs/stage-modbus.md has the detail)
   // False for maps taken from manuals but never run against a drive: the daemon logs a warning.
   bool verified_against_hardware = false;
   WordOrder word_order = WordOrder::kHighFirst;
@@ -85,12 +97,13 @@ struct RegisterProfile {
   // The operation block, written with one FC16 starting at block_start and covering every field
   // below that lies in it (gaps are written as 0).
   std::uint16_t block_start = 0;
-  RegisterField operation_type;    // absent on drives whose trigger implies the type
-  std::int32_t absolute_type = 1;  // value meaning "absolute position"
-  RegisterField position;          // target, in counts
-  RegisterField speed;             // in counts per second × speed_scale
-  double speed_scale = 1.0;        // register units per (count/s), e.g. rpm per count/s
-  std::vector<BlockConstant> block_constants;
+  RegisterField operation_type;                // absent on drives whose trigger implies the type
+  std::int32_t absolute_type = 1;              // value meaning "absolute position"
+  RegisterField position;                      // target, in counts
+  RegisterField speed;                         // in counts per second × speed_scale
+  double speed_scale = 1.0;                    // register units per (count/s), e.g. rpm per count/s
+  std::vector<BlockConstant> block_constants;  // sorted by address; includes the ramp's two
+  RampSettings ramp;
 
   TriggerStyle trigger_style = TriggerStyle::kTriggerInBlock;
   RegisterField trigger;
@@ -107,6 +120,9 @@ struct RegisterProfile {
   RegisterField alarm_code;         // absent: the alarm bit is reported with code 0
   RegisterField feedback_position;  // counts; sources disagree on the address, keep it configurable
 
+  // The built-in profiles, parsed from the files shipped in deploy/stage-profiles/ (compiled into
+  // the binary, profile_file.h). A built-in file that does not parse is a build defect: these
+  // abort with the parser's message (tests/drivers_stage checks every shipped file loads).
   // The default: Oriental Motor AZ-like direct data operation (stage-modbus.md). Verified against
   // the reference map and the simulator.
   static RegisterProfile AzDefault();

@@ -290,6 +290,9 @@ TEST(ConfigTest, ValuesOutOfRange) {
   EXPECT_THAT(Refusal("[stage]\naddress = \"10.0.0.1:0\"\n"), HasSubstr("port 0"));
   EXPECT_THAT(Refusal("[stage]\nparity = \"X\"\n"), HasSubstr("stage.parity"));
   EXPECT_THAT(Refusal("[stage]\nprofile = \"arcus\"\n"), HasSubstr("stage.profile"));
+  EXPECT_THAT(Refusal("[stage]\nprofile = \"az\"\nprofile_file = \"/etc/brdfd/s.toml\"\n"),
+              HasSubstr("stage.profile_file: given with profile; keep one"));
+  EXPECT_THAT(Refusal("[stage]\nprofile_file = \"\"\n"), HasSubstr("stage.profile_file: must not be empty"));
   EXPECT_THAT(Refusal("[stage.axes.alpha]\nunit_id = 0\n"), HasSubstr("stage.axes.alpha.unit_id"));
   EXPECT_THAT(Refusal("[stage.axes.alpha]\ncounts_per_degree = 0\n"),
               HasSubstr("stage.axes.alpha.counts_per_degree"));

@@ -23,6 +23,7 @@ int FuzzStageRtu(const std::uint8_t* data, std::size_t size);
 int FuzzPlanJson(const std::uint8_t* data, std::size_t size);
 int FuzzConfig(const std::uint8_t* data, std::size_t size);
 int FuzzInterpCsv(const std::uint8_t* data, std::size_t size);
+int FuzzStageProfile(const std::uint8_t* data, std::size_t size);
 
 namespace {
 
@@ -70,6 +71,9 @@ TEST(FuzzCorpusReplay, PlanJson) {
 }
 TEST(FuzzCorpusReplay, Config) {
   EXPECT_GE(Replay("config", FuzzConfig), 3u);
+}
+TEST(FuzzCorpusReplay, StageProfile) {
+  EXPECT_GE(Replay("stage_profile", FuzzStageProfile), 6u);
 }
 TEST(FuzzCorpusReplay, InterpCsv) {
   EXPECT_GE(Replay("interp_csv", FuzzInterpCsv), 3u);

@@ -20,7 +20,7 @@ if ! cmake --install "$build" --prefix "$prefix" >"$prefix.log" 2>&1; then
 fi
 rm -f "$prefix.log"
 
-for exe in brdfd brdfctl brdf-sim brdf-interp brdf-export; do
+for exe in brdfd brdfctl brdf-sim brdf-interp brdf-export brdf-stage-probe; do
   if [[ ! -x "$prefix/bin/$exe" ]]; then
     fail "bin/$exe is missing or not executable"
   elif ! "$prefix/bin/$exe" --help >/dev/null 2>&1; then
@@ -64,6 +64,10 @@ for f in brdf_client/__init__.py brdf_client/client.py examples/quickstart_figur
 done
 [[ -f "$prefix/share/brdfd/proto/brdf/v1/brdf.proto" ]] || fail "share/brdfd/proto is missing"
 [[ -f "$prefix/share/brdfd/plans/demo.json" ]] || fail "share/brdfd/plans/demo.json is missing"
+for profile in az leadshine moons; do
+  grep -q "^name = \"$profile\"" "$prefix/share/brdfd/stage-profiles/$profile.toml" 2>/dev/null ||
+    fail "share/brdfd/stage-profiles/$profile.toml is missing"
+done
 if [[ -x /usr/bin/python3 ]] && command -v grpc_python_plugin >/dev/null; then
   # The installed client generates its stubs from the installed .proto files and imports.
   out="$(cd / && BRDF_PY_STUBS="$prefix/stubs" /usr/bin/python3 -c "
