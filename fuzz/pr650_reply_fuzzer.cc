@@ -62,7 +62,9 @@ int FuzzPr650Reply(const std::uint8_t* data, std::size_t size) {
 
   if (auto n = ParseNumber(reply)) BRDF_FUZZ_CHECK(std::isfinite(*n), "ParseNumber: not finite");
   if (auto s = ParseStatusReply(reply, "M0"); s.ok()) {
-    BRDF_FUZZ_CHECK(*s >= 0 && *s <= 999, "status code outside 0-999");
+    // "-1" is the meter's own "no measurement" report (kNoMeasurementStatus), accepted on purpose.
+    BRDF_FUZZ_CHECK((*s >= 0 && *s <= 999) || *s == kNoMeasurementStatus,
+                    "status code outside 0-999 and not the no-measurement -1");
   }
   if (auto s = ParseSetupReply(reply); s.ok()) (void)DescribeSetupReply(*s);
   if (auto f = ParseFlickerReply(reply); f.ok()) {
