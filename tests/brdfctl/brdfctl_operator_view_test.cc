@@ -142,5 +142,36 @@ TEST_F(OperatorViewTest, WatchWithdrawsTheQuestionWhenTheSessionPausesAndShowsWh
   EXPECT_FALSE(std::filesystem::exists(marker));
 }
 
+// `watch --on-prompt` without --auto-confirm, its standard input not a terminal: watch neither asks
+// nor confirms, so the hook is not run; it says so and how to have it run, instead of leaving the
+// operator to wonder why the prompt stays open.
+TEST_F(OperatorViewTest, WatchSaysTheHookNeedsAutoConfirmWhenItCannotAsk) {
+  const std::string id = SubmitDemo();
+  ASSERT_FALSE(id.empty());
+  const std::string out = rig_.dir().file("watch.out").string();
+  const std::string marker = rig_.dir().file("hook-ran").string();
+  const std::string ctl = *BrdfctlBinary();
+  LaunchOptions watch({"-c", "exec '" + ctl + "' watch " + id +
+                                 " --no-progress --on-prompt 'touch " + marker +
+                                 "' < /dev/null > " + out + " 2>&1"});
+  watch.set_env = rig_.Env();
+  Result<std::unique_ptr<ChildProcess>> watcher = ChildProcess::Launch("sh", "/bin/sh", watch);
+  ASSERT_TRUE(watcher.ok()) << watcher.status().ToString();
+
+  ASSERT_TRUE(Eventually([&] { return ReadText(out).find("not confirmed") != std::string::npos; }))
+      << ReadText(out);
+  const std::string shown = ReadText(out);
+  EXPECT_NE(shown.find("--on-prompt runs only before a confirmation: add --auto-confirm"),
+            std::string::npos)
+      << shown;
+  EXPECT_FALSE(std::filesystem::exists(marker)) << shown;
+  const CommandResult got = Ctl({"get", id});
+  EXPECT_NE(got.out.find("state        awaiting_operator"), std::string::npos) << Describe(got);
+
+  const CommandResult abort = Ctl({"abort", id, "--reason", "test over"});
+  ASSERT_EQ(abort.exit_code, 0) << Describe(abort);
+  EXPECT_EQ((*watcher)->WaitUntil(std::chrono::steady_clock::now() + 20s), 4) << ReadText(out);
+}
+
 }  // namespace
 }  // namespace brdf::testing

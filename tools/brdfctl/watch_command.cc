@@ -198,6 +198,12 @@ class Watcher {
       answer_.clear();
       return kExitOk;
     }
+    if (!options_.on_prompt.empty()) {
+      // Not asking and not confirming: the hook is not run, and saying so beats silence.
+      notes_ << "  --on-prompt runs only before a confirmation: add --auto-confirm (or --ask to "
+                "answer y/N on standard input)"
+             << std::endl;
+    }
     Decline(step);
     return kExitOk;
   }
