@@ -39,6 +39,13 @@ AnalyticBrdf AnalyticBrdf::PaintLike() {
   return AnalyticBrdf(AnalyticBrdfParams{});
 }
 
+AnalyticBrdf AnalyticBrdf::Glossy() {
+  AnalyticBrdfParams p;
+  p.specular_weight = 0.3;
+  p.exponent_x = p.exponent_y = 200;
+  return AnalyticBrdf(p);
+}
+
 AnalyticBrdf AnalyticBrdf::Brushed() {
   AnalyticBrdfParams p;
   // Brushing leaves fine grooves along the bitangent: the highlight is wide across the grooves

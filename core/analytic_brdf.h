@@ -33,6 +33,10 @@ class AnalyticBrdf {
   // The default paint-like isotropic sample, and an anisotropic (brushed) variant.
   static AnalyticBrdf PaintLike();
   static AnalyticBrdf Brushed();
+  // A glossy isotropic variant: the paint's diffuse base under a stronger, narrower lobe
+  // (specular_weight 0.3, exponent 200: the lobe falls to half at θh ≈ 4.7°), the sample on which
+  // interpolation near the specular peak is judged.
+  static AnalyticBrdf Glossy();
 
   bool anisotropic() const { return p_.exponent_x != p_.exponent_y; }
   const AnalyticBrdfParams& params() const { return p_; }

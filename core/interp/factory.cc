@@ -1,6 +1,7 @@
 // MakeInterpolator: the one entry point that picks a method. Kept in its own file so that code
 // which only needs the octant or nearest methods (their own factories) does not pull in Qhull.
 #include "core/interp/delaunay.h"
+#include "core/interp/half_difference.h"
 #include "core/interp/interpolator.h"
 #include "core/interp/nearest.h"
 #include "core/interp/octant.h"
@@ -10,6 +11,9 @@ namespace brdf::interp {
 Result<std::unique_ptr<Interpolator>> MakeInterpolator(Method method,
                                                        std::shared_ptr<const SampleSet> samples,
                                                        const Options& options) {
+  if (options.coordinates == Coordinates::kHalfDifference) {
+    return MakeHalfDifferenceInterpolator(method, std::move(samples), options);
+  }
   switch (method) {
     case Method::kOctant:
       return MakeOctantInterpolator(std::move(samples), options);

@@ -25,6 +25,17 @@ Result<Method> ParseMethod(const std::string& name) {
                          "'; use one of: octant, delaunay, nearest");
 }
 
+const char* CoordinatesName(Coordinates c) {
+  return c == Coordinates::kHalfDifference ? "half_difference" : "incidence";
+}
+
+Result<Coordinates> ParseCoordinates(const std::string& name) {
+  if (name == "incidence") return Coordinates::kIncidence;
+  if (name == "half_difference" || name == "half-diff") return Coordinates::kHalfDifference;
+  return InvalidArgument("unknown coordinates '" + name +
+                         "'; use incidence (θi, θo, φ) or half-diff (θh, θd, φd)");
+}
+
 const char* InterpStatusName(InterpStatus s) {
   switch (s) {
     case InterpStatus::kOk:

@@ -3,7 +3,9 @@
 // were blended, where they are, with which weights, by which method, and whether it worked.
 //
 // Coordinates are (θi, θo, φ) for isotropic data (3D) or (θi, φi, θo, φo) for anisotropic data
-// (4D), in degrees. Pure: no I/O.
+// (4D), in degrees: samples and queries always come in these. Isotropic data may be interpolated
+// in Rusinkiewicz's half/difference angles instead (Options.coordinates, half_difference.h).
+// Pure: no I/O.
 #pragma once
 
 #include <algorithm>
@@ -31,6 +33,14 @@ enum class InterpStatus {
 };
 const char* InterpStatusName(InterpStatus s);  // "ok", "empty_octant", ...
 
+// The space a method measures distances and blends in. Samples and queries are given in
+// (θi, θo, φ) either way. kHalfDifference (isotropic data only) maps every sample and query to
+// (θh, θd, φd) first, where a specular lobe lies along the θh axis (half_difference.h).
+enum class Coordinates { kIncidence, kHalfDifference };
+const char* CoordinatesName(Coordinates c);  // "incidence", "half_difference"
+// Accepts "incidence", "half_difference" and "half-diff" (the command lines' spelling).
+Result<Coordinates> ParseCoordinates(const std::string& name);
+
 // Options shared by all methods.
 struct Options {
   // Per-axis multipliers applied to coordinates before distances are measured (empty = all 1).
@@ -43,6 +53,10 @@ struct Options {
   // Augmented copies keep the id of the sample they copy and rank after all measured samples.
   bool mirror_phi = false;
   bool reciprocity = false;
+  // kHalfDifference: interpolate in half/difference angles (3D data only), at the points
+  // (θh·cos φd, θh·sin φd, θd); axis_scale then multiplies those three (default all 1); the
+  // mirror images are always added there, reciprocity adds its own (half_difference.h).
+  Coordinates coordinates = Coordinates::kIncidence;
 };
 
 // Scattered samples: N points of `dims` coordinates, each with a spectrum of `bands` values and

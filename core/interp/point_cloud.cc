@@ -17,6 +17,11 @@ Status ValidateOptions(const Options& options, int dims) {
     return InvalidArgument("interpolation needs 3D (θi, θo, φ) or 4D (θi, φi, θo, φo) data, not " +
                            std::to_string(dims) + "D");
   }
+  if (options.coordinates != Coordinates::kIncidence) {
+    return InvalidArgument(
+        "option coordinates half_difference: build the interpolator with MakeInterpolator, "
+        "which maps the samples to (θh, θd, φd) first");
+  }
   if (!options.axis_scale.empty()) {
     if (options.axis_scale.size() != static_cast<std::size_t>(dims)) {
       return InvalidArgument("option axis_scale has " + std::to_string(options.axis_scale.size()) +

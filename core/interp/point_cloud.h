@@ -15,6 +15,7 @@
 namespace brdf::interp {
 
 // Checks `options` for data of `dims` coordinates. Errors (kInvalidArgument) name the option:
+// coordinates other than incidence (only MakeInterpolator maps to half/difference angles);
 // axis_scale of the wrong length or with a value that is not finite and positive; mirror_phi or
 // reciprocity on 4D (anisotropic) data, where they are not symmetries.
 Status ValidateOptions(const Options& options, int dims);

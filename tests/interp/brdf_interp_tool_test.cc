@@ -254,4 +254,39 @@ TEST_F(BrdfInterpToolTest, DemoExplainsOneAnswer) {
   EXPECT_THAT(far.out, HasSubstr("Status: empty_octant"));
 }
 
+TEST_F(BrdfInterpToolTest, HalfDifferenceCoordinates) {
+  ASSERT_EQ(Exec("synth --grid paper -o " + Path("paper.csv")).status, 0);
+  ASSERT_EQ(Exec("synth --grid random 200 --seed 3 --coordinates-only -o " + Path("q.csv")).status,
+            0);
+  for (const char* method : {"octant", "delaunay", "nearest"}) {
+    const ToolRun r = Exec(Path("paper.csv") + " " + Path("q.csv") + " --method " + method +
+                           " --coordinates half-diff --explain -o " + Path("out.csv"));
+    ASSERT_EQ(r.status, 0) << method << ": " << r.err;
+    const auto rows = ParseCsv(Slurp(Path("out.csv")));
+    ASSERT_EQ(rows.size(), 201u) << method;
+    std::size_t ok = 0;
+    for (std::size_t i = 1; i < rows.size(); ++i) ok += rows[i][3] == "ok";
+    EXPECT_GT(ok, 0u) << method;
+  }
+  // 4D data has no half/difference angles: refused, naming the option.
+  ASSERT_EQ(Exec("synth --grid random 50 --dims 4 -o " + Path("s4.csv")).status, 0);
+  ASSERT_EQ(Exec("synth --grid random 5 --dims 4 --coordinates-only -o " + Path("q4.csv")).status,
+            0);
+  const ToolRun four = Exec(Path("s4.csv") + " " + Path("q4.csv") + " --coordinates half-diff");
+  EXPECT_EQ(four.status, 2);
+  EXPECT_THAT(four.err, HasSubstr("coordinates"));
+  const ToolRun demo = Exec("demo --coordinates half-diff --query 42.5,42.5,177.5");
+  ASSERT_EQ(demo.status, 0) << demo.err;
+  EXPECT_THAT(demo.out, AllOf(HasSubstr("half/difference"), HasSubstr("Status: ok")));
+}
+
+TEST_F(BrdfInterpToolTest, AccuracyComparesBothCoordinates) {
+  const ToolRun r = Exec("accuracy --sample glossy --queries 2000");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out,
+              AllOf(HasSubstr("glossy"), HasSubstr("| octant | θh, θd, φd |"),
+                    HasSubstr("| delaunay | θi, θo, φ |"), HasSubstr("| nearest | θh, θd, φd |")));
+  EXPECT_EQ(Exec("accuracy --sample velvet").status, 2);
+}
+
 }  // namespace

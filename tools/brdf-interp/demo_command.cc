@@ -53,6 +53,9 @@ int RunDemo(const DemoRequest& request, std::ostream& out, std::ostream& err) {
   interp::Options options;
   options.mirror_phi = request.mirror_phi;
   options.reciprocity = request.reciprocity;
+  Result<interp::Coordinates> coordinates = interp::ParseCoordinates(request.coordinates);
+  if (!coordinates.ok()) return fail(coordinates.status().WithContext("--coordinates"));
+  options.coordinates = *coordinates;
   if (!request.scale.empty()) {
     Result<std::vector<double>> scale = ParseNumberList(request.scale, "--scale");
     if (!scale.ok()) return fail(scale.status());
@@ -73,7 +76,11 @@ int RunDemo(const DemoRequest& request, std::ostream& out, std::ostream& err) {
       << " nm\n";
   out << Format("Query (θi, θo, φ) = (%g, %g, %g)°, method ", query[0], query[1], query[2])
       << request.method << (options.mirror_phi ? ", mirror φ" : "")
-      << (options.reciprocity ? ", reciprocity" : "") << "\n";
+      << (options.reciprocity ? ", reciprocity" : "")
+      << (options.coordinates == interp::Coordinates::kHalfDifference
+              ? ", in half/difference angles (θh, θd, φd)"
+              : "")
+      << "\n";
 
   const interp::Interpolation answer = (*interpolator)->Evaluate(query);
   out << "Status: " << interp::InterpStatusName(answer.status);
@@ -87,9 +94,11 @@ int RunDemo(const DemoRequest& request, std::ostream& out, std::ostream& err) {
   out << "Vertices:\n  letter  row    θi        θo        φ         weight\n";
   for (std::size_t k = 0; k < answer.vertices.size(); ++k) {
     const interp::Vertex& v = answer.vertices[k];
-    // For the octant method the letter is the octant the vertex won (relative to the query).
+    // For the octant method the letter is the octant the vertex won (relative to the query; in
+    // half/difference angles the octants are of (θh, θd, φd), not of the columns shown).
     std::string letter = "-";
-    if (answer.method == interp::Method::kOctant) {
+    if (answer.method == interp::Method::kOctant &&
+        options.coordinates == interp::Coordinates::kIncidence) {
       letter =
           std::string(1, interp::OctantLetter(interp::OrthantOf(v.coords.data(), query.data(), 3)));
     }

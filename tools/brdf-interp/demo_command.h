@@ -16,6 +16,7 @@ struct DemoRequest {
   std::string scale;
   bool mirror_phi = false;
   bool reciprocity = false;
+  std::string coordinates = "incidence";  // or "half-diff"
 };
 
 // The built-in query: between samples, inside the rig's range.

@@ -23,6 +23,9 @@ int RunInterp(const InterpRequest& request, std::ostream& err) {
   interp::Options options;
   options.mirror_phi = request.mirror_phi;
   options.reciprocity = request.reciprocity;
+  Result<interp::Coordinates> coordinates = interp::ParseCoordinates(request.coordinates);
+  if (!coordinates.ok()) return Fail(err, coordinates.status().WithContext("--coordinates"));
+  options.coordinates = *coordinates;
   if (!request.scale.empty()) {
     Result<std::vector<double>> scale = ParseNumberList(request.scale, "--scale");
     if (!scale.ok()) return Fail(err, scale.status());

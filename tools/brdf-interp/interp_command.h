@@ -16,6 +16,7 @@ struct InterpRequest {
   std::string scale;  // "a,b,c[,d]" or ""
   bool mirror_phi = false;
   bool reciprocity = false;
+  std::string coordinates = "incidence";  // or "half-diff" (interp::ParseCoordinates)
   bool explain = false;
 };
 

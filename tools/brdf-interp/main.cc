@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "tools/brdf-interp/accuracy_command.h"
 #include "tools/brdf-interp/demo_command.h"
 #include "tools/brdf-interp/interp_command.h"
 #include "tools/brdf-interp/synth_command.h"
@@ -26,7 +27,7 @@ Exit status: 0 done (per-query failures are in the status column), 2 bad argumen
 (the message names file, line and column), 1 system failure.)";
 
 void AddMethodOptions(CLI::App& app, std::string& method, std::string& scale, bool& mirror,
-                      bool& reciprocity) {
+                      bool& reciprocity, std::string& coordinates) {
   app.add_option("--method", method,
                  "octant (the paper's), octant-reference (its O(N) scan), "
                  "delaunay, nearest")
@@ -36,6 +37,11 @@ void AddMethodOptions(CLI::App& app, std::string& method, std::string& scale, bo
                  "per-axis multipliers a,b,c[,d] applied before distances are measured");
   app.add_flag("--mirror-phi", mirror, "add mirrored copies (θi, θo, −φ) (3D data only)");
   app.add_flag("--reciprocity", reciprocity, "add swapped copies (θo, θi, φ) (3D data only)");
+  app.add_option("--coordinates", coordinates,
+                 "incidence: interpolate in (θi, θo, φ); half-diff: in Rusinkiewicz's (θh, θd, "
+                 "φd) (3D data only; --scale then scales (θh·cos φd, θh·sin φd, θd))")
+      ->check(CLI::IsMember({"incidence", "half-diff"}))
+      ->capture_default_str();
 }
 
 }  // namespace
@@ -50,7 +56,8 @@ int main(int argc, char** argv) {
   bool demo_flag = false;
   app.add_option("samples", interp.samples_path, "samples CSV");
   app.add_option("queries", interp.queries_path, "queries CSV");
-  AddMethodOptions(app, interp.method, interp.scale, interp.mirror_phi, interp.reciprocity);
+  AddMethodOptions(app, interp.method, interp.scale, interp.mirror_phi, interp.reciprocity,
+                   interp.coordinates);
   app.add_option("--threads", interp.threads, "threads evaluating queries (output order is fixed)")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
@@ -62,8 +69,27 @@ int main(int argc, char** argv) {
   CLI::App* demo_cmd = app.add_subcommand(
       "demo",
       "interpolate the analytic paint sample on the paper's rig grid and explain one answer");
-  AddMethodOptions(*demo_cmd, demo.method, demo.scale, demo.mirror_phi, demo.reciprocity);
+  AddMethodOptions(*demo_cmd, demo.method, demo.scale, demo.mirror_phi, demo.reciprocity,
+                   demo.coordinates);
   demo_cmd->add_option("--query", demo.query, "θi,θo,φ in degrees (default 37,52,128)");
+
+  AccuracyRequest accuracy;
+  CLI::App* accuracy_cmd = app.add_subcommand(
+      "accuracy",
+      "RMS and specular-peak error of every method, in (θi, θo, φ) and in (θh, θd, φd), against "
+      "the analytic samples on the paper's rig grid");
+  accuracy_cmd->add_option("--sample", accuracy.sample, "paint, glossy or both")
+      ->check(CLI::IsMember({"paint", "glossy", "both"}))
+      ->capture_default_str();
+  accuracy_cmd->add_option("--queries", accuracy.queries, "random rig poses")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
+  accuracy_cmd->add_option("--seed", accuracy.seed, "random seed")->capture_default_str();
+  accuracy_cmd->add_option("--scale", accuracy.scale, "axis scales for (θi, θo, φ)");
+  accuracy_cmd->add_option("--half-scale", accuracy.half_scale,
+                           "axis scales for (θh·cos φd, θh·sin φd, θd) (default 1,1,1)");
+  accuracy_cmd->add_flag("--mirror-phi", accuracy.mirror_phi, "add the mirrored copies");
+  accuracy_cmd->add_flag("--reciprocity", accuracy.reciprocity, "add the swapped copies");
 
   SynthRequest synth;
   std::vector<std::string> grid_args;
@@ -98,11 +124,13 @@ int main(int argc, char** argv) {
     return RunSynth(synth, std::cerr);
   }
   if (demo_cmd->parsed()) return RunDemo(demo, std::cout, std::cerr);
+  if (accuracy_cmd->parsed()) return RunAccuracy(accuracy, std::cout, std::cerr);
   if (demo_flag) {
     demo.method = interp.method;
     demo.scale = interp.scale;
     demo.mirror_phi = interp.mirror_phi;
     demo.reciprocity = interp.reciprocity;
+    demo.coordinates = interp.coordinates;
     return RunDemo(demo, std::cout, std::cerr);
   }
   if (interp.samples_path.empty() || interp.queries_path.empty()) {

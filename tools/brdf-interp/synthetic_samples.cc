@@ -54,7 +54,12 @@ Directions PointDirections(std::span<const double> p) {
 
 std::shared_ptr<interp::SampleSet> SyntheticSamples(const SyntheticPoints& points,
                                                     const WavelengthGrid& grid) {
-  const AnalyticBrdf brdf = SyntheticBrdf(points.dims);
+  return SyntheticSamples(points, grid, SyntheticBrdf(points.dims));
+}
+
+std::shared_ptr<interp::SampleSet> SyntheticSamples(const SyntheticPoints& points,
+                                                    const WavelengthGrid& grid,
+                                                    const AnalyticBrdf& brdf) {
   auto set = std::make_shared<interp::SampleSet>(points.dims, static_cast<int>(grid.count));
   const auto d = static_cast<std::size_t>(points.dims);
   std::vector<double> spectrum(grid.count);

@@ -37,5 +37,9 @@ Directions PointDirections(std::span<const double> point);
 // A SampleSet of the points with the analytic spectra; ids are the point indices.
 std::shared_ptr<interp::SampleSet> SyntheticSamples(const SyntheticPoints& points,
                                                     const WavelengthGrid& grid);
+// The same with another known sample.
+std::shared_ptr<interp::SampleSet> SyntheticSamples(const SyntheticPoints& points,
+                                                    const WavelengthGrid& grid,
+                                                    const AnalyticBrdf& brdf);
 
 }  // namespace brdf::interp_tool

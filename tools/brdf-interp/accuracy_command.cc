@@ -1,0 +1,175 @@
+#include "tools/brdf-interp/accuracy_command.h"
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "core/analytic_brdf.h"
+#include "core/geometry.h"
+#include "core/interp/half_difference.h"
+#include "tools/brdf-interp/synthetic_samples.h"
+#include "tools/brdf-interp/tool_common.h"
+
+namespace brdf::interp_tool {
+namespace {
+
+constexpr double kPeakQuery[3] = {42.5, 42.5, 177.5};
+constexpr double kNearPeakThetaHalfDeg = 10.0;
+
+// n random rig poses (see the header) as (θi, θo, φ), through the rig's own kinematics.
+std::vector<double> RigPoseQueries(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  auto uniform = [&rng](double lo, double hi) {
+    return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
+  };
+  std::vector<double> out;
+  out.reserve(3 * n);
+  while (out.size() < 3 * n) {
+    Pose pose;
+    pose.alpha = uniform(0, 70);
+    pose.beta = uniform(-175, 180);
+    pose.delta = uniform(0, 146.25);
+    const Directions d = PoseToDirections(pose);
+    if (!IsValid(d, 89.999)) continue;
+    const IsoDirection iso = ToIsotropic(d);
+    out.insert(out.end(), {iso.theta_i, iso.theta_o, iso.phi});
+  }
+  return out;
+}
+
+struct Row {
+  std::string method;
+  interp::Coordinates coordinates;
+  std::vector<interp::InterpStatus> status;
+  std::vector<double> spectra;  // queries × bands
+  double peak = std::nan("");   // relative error at the peak query
+  std::size_t ok = 0;
+};
+
+std::string Percent(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%+.2f %%", 100 * v);
+  return b;
+}
+
+}  // namespace
+
+int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream& err) {
+  auto fail = [&err](const Status& s) {
+    err << "brdf-interp accuracy: " << s.message() << "\n";
+    return ExitCodeFor(s);
+  };
+  std::vector<std::pair<std::string, AnalyticBrdf>> samples;
+  if (request.sample == "paint" || request.sample == "both") {
+    samples.emplace_back("paint (AnalyticBrdf::PaintLike)", AnalyticBrdf::PaintLike());
+  }
+  if (request.sample == "glossy" || request.sample == "both") {
+    samples.emplace_back("glossy (AnalyticBrdf::Glossy)", AnalyticBrdf::Glossy());
+  }
+  if (samples.empty()) {
+    return fail(InvalidArgument("--sample '" + request.sample + "': use paint, glossy or both"));
+  }
+  if (request.queries == 0) return fail(InvalidArgument("--queries: give at least one query"));
+  interp::Options incidence;
+  incidence.mirror_phi = request.mirror_phi;
+  incidence.reciprocity = request.reciprocity;
+  interp::Options half = incidence;
+  half.coordinates = interp::Coordinates::kHalfDifference;
+  if (!request.scale.empty()) {
+    Result<std::vector<double>> s = ParseNumberList(request.scale, "--scale");
+    if (!s.ok()) return fail(s.status());
+    incidence.axis_scale = *s;
+  }
+  if (!request.half_scale.empty()) {
+    Result<std::vector<double>> s = ParseNumberList(request.half_scale, "--half-scale");
+    if (!s.ok()) return fail(s.status());
+    half.axis_scale = *s;
+  }
+
+  Result<SyntheticPoints> grid = PaperGridPoints();
+  if (!grid.ok()) return fail(grid.status());
+  const WavelengthGrid wavelengths = WavelengthGrid::Pr650();
+  const std::size_t bands = wavelengths.count;
+  const auto peak_band =
+      static_cast<std::size_t>(std::lround((550.0 - wavelengths.start_nm) / wavelengths.step_nm));
+  const std::vector<double> queries = RigPoseQueries(request.queries, request.seed);
+  const std::size_t n = request.queries;
+
+  out << "Paper's rig grid: " << grid->size() << " points; " << n << " random rig poses (seed "
+      << request.seed << ")" << (request.mirror_phi ? "; mirror φ" : "")
+      << (request.reciprocity ? "; reciprocity" : "") << "; scales (θi, θo, φ) "
+      << (request.scale.empty() ? "1,1,1" : request.scale) << ", (θh·cos φd, θh·sin φd, θd) "
+      << (request.half_scale.empty() ? "1,1,1 (default)" : request.half_scale) << "\n";
+  out << "peak: (" << kPeakQuery[0] << ", " << kPeakQuery[1] << ", " << kPeakQuery[2] << ") at "
+      << wavelengths.at(peak_band) << " nm; RMS over the queries every row answered\n";
+
+  for (const auto& [name, brdf] : samples) {
+    const auto set = SyntheticSamples(*grid, wavelengths, brdf);
+    std::vector<double> truth(n * bands);
+    for (std::size_t q = 0; q < n; ++q) {
+      brdf.EvaluateSpectrum({queries[3 * q], 0, queries[3 * q + 1], queries[3 * q + 2]},
+                            wavelengths, std::span<double>(truth).subspan(q * bands, bands));
+    }
+    const double peak_truth =
+        brdf.Evaluate({kPeakQuery[0], 0, kPeakQuery[1], kPeakQuery[2]}, wavelengths.at(peak_band));
+
+    std::vector<Row> rows;
+    for (const char* method : {"octant", "delaunay", "nearest"}) {
+      for (const interp::Options* o : {&incidence, &half}) {
+        Row row{method, o->coordinates, std::vector<interp::InterpStatus>(n),
+                std::vector<double>(n * bands)};
+        auto made = MakeNamedInterpolator(method, set, *o);
+        if (!made.ok()) return fail(made.status());
+        (*made)->SpectraAt(queries, row.status, row.spectra);
+        for (interp::InterpStatus s : row.status) row.ok += s == interp::InterpStatus::kOk;
+        std::vector<double> peak(bands);
+        if ((*made)->SpectrumAt(kPeakQuery, peak) == interp::InterpStatus::kOk) {
+          row.peak = (peak[peak_band] - peak_truth) / peak_truth;
+        }
+        rows.push_back(std::move(row));
+      }
+    }
+    // The common set: queries every row answered.
+    std::vector<bool> common(n, true), near_peak(n, false);
+    std::size_t common_count = 0, near_count = 0;
+    for (std::size_t q = 0; q < n; ++q) {
+      for (const Row& r : rows) common[q] = common[q] && r.status[q] == interp::InterpStatus::kOk;
+      const double theta_h =
+          interp::ToHalfDifference({queries[3 * q], queries[3 * q + 1], queries[3 * q + 2]})
+              .theta_h;
+      near_peak[q] = common[q] && theta_h < kNearPeakThetaHalfDeg;
+      common_count += common[q];
+      near_count += near_peak[q];
+    }
+    out << "\n"
+        << name << ": " << common_count << " common queries, " << near_count
+        << " of them with θh < " << kNearPeakThetaHalfDeg << "°\n";
+    out << "| method | coordinates | ok | RMS | RMS θh<10° | peak |\n|---|---|---|---|---|---|\n";
+    for (const Row& r : rows) {
+      auto rms = [&](const std::vector<bool>& use) {
+        double sum = 0, mean = 0, count = 0;
+        for (std::size_t q = 0; q < n; ++q) {
+          if (!use[q]) continue;
+          for (std::size_t b = 0; b < bands; ++b) {
+            const double d = r.spectra[q * bands + b] - truth[q * bands + b];
+            sum += d * d;
+            mean += truth[q * bands + b];
+            count += 1;
+          }
+        }
+        return count == 0 ? std::nan("") : std::sqrt(sum / count) / (mean / count);
+      };
+      char line[256];
+      std::snprintf(line, sizeof line, "| %s | %s | %zu | %.2f %% | %.2f %% | %s |\n",
+                    r.method.c_str(),
+                    r.coordinates == interp::Coordinates::kIncidence ? "θi, θo, φ" : "θh, θd, φd",
+                    r.ok, 100 * rms(common), 100 * rms(near_peak),
+                    std::isnan(r.peak) ? "failed" : Percent(r.peak).c_str());
+      out << line;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace brdf::interp_tool

@@ -1,0 +1,35 @@
+// `brdf-interp accuracy`: how close each method comes to a known BRDF, in both coordinate systems.
+// "Measures" an analytic sample (core/analytic_brdf.h: the simulator's paint-like sample, and a
+// glossy variant) on the paper's rig grid (2,153 distinct points), interpolates it at random rig
+// poses (α in [0°, 70°], β in [−175°, 180°], δ in [0°, 146.25°], uniform, both directions within
+// 89.999° of the normal, seeded) with octant, Delaunay and nearest, each in (θi, θo, φ) and in
+// (θh, θd, φd), and prints per sample and method:
+//   ok        the queries answered;
+//   RMS       sqrt(mean (value − truth)²) over all bands of the queries that EVERY row of the
+//             sample answered, as a percentage of the mean truth there (a common set, so rows
+//             compare like with like);
+//   RMS θh<10 the same over those of the common queries within 10° of the specular
+//             configuration (the half vector within 10° of the normal);
+//   peak      the relative error at the specular-peak query (42.5°, 42.5°, 177.5°) in the band
+//             nearest 550 nm ("failed" when the method has no answer there).
+#pragma once
+
+#include <cstdint>
+#include <ostream>
+#include <string>
+
+namespace brdf::interp_tool {
+
+struct AccuracyRequest {
+  std::string sample = "both";  // paint | glossy | both
+  std::size_t queries = 20000;
+  std::uint64_t seed = 19;
+  std::string scale;       // axis scales for (θi, θo, φ); "" = none
+  std::string half_scale;  // axis scales for (θh·cos φd, θh·sin φd, θd); "" = the default
+  bool mirror_phi = false;
+  bool reciprocity = false;
+};
+
+int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream& err);
+
+}  // namespace brdf::interp_tool
