@@ -15,11 +15,14 @@
 // brdf-archive server (daemon/archive_server.h, in this process, over gRPC on a loopback port):
 // ListSessions with the filter against ListSessions without one, and the first Interpolate on a
 // cold session (its 1,000 readings read from PostgreSQL, the index built) against the next
-// Interpolate on the same session (warm), each over --cold sessions.
+// Interpolate on the same session (warm), each over --cold sessions. Last, InterpolateBatch
+// throughput of two clients on one brdf-archive against two clients on two replicas, with one
+// client alone as the baseline.
 #include <grpcpp/create_channel.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -75,6 +78,12 @@ int main(int argc, char** argv) {
   app.add_option("--readings", total_readings, "catalogue: readings in the archive (0: skip)");
   app.add_option("--queries", queries, "catalogue: queries timed");
   app.add_option("--cold", cold, "brdf-archive: cold sessions interpolated");
+  int batch = 4096;
+  int batch_calls = 5;
+  int rounds = 3;
+  app.add_option("--batch", batch, "InterpolateBatch: directions per call");
+  app.add_option("--batch-calls", batch_calls, "InterpolateBatch: calls per client and round");
+  app.add_option("--rounds", rounds, "InterpolateBatch: rounds (medians)");
   CLI11_PARSE(app, argc, argv);
 
   if (std::string why = brdf::testing::PgServer::Unavailable(); !why.empty()) {
@@ -302,6 +311,88 @@ int main(int argc, char** argv) {
       "medians %.0f\n",
       first_ms.size(), per_session, answered, Quantile(first_ms, 0.5), Quantile(first_ms, 1.0),
       Quantile(warm_ms, 0.5), Quantile(first_ms, 0.5) / std::max(1e-9, Quantile(warm_ms, 0.5)));
+
+  // --- InterpolateBatch throughput, one replica and two ----------------------------------------
+  // Two clients, each sending --batch-calls InterpolateBatch calls of --batch directions on one
+  // session (warm on every replica first). One replica: both clients on the first server; two
+  // replicas: one client each, on two brdf-archive servers over the same PostgreSQL (stateless,
+  // each with its own reader and cache). Baseline in the same run: one client alone on one
+  // replica. Rounds alternate the three layouts; medians of --rounds rounds.
+  if (sessions_page.sessions().empty()) return 0;
+  Result<std::shared_ptr<storage::ArchiveReader>> reader_b =
+      storage::ArchiveReader::Open((*pg)->conninfo());
+  if (!reader_b.ok()) return Fail("opening the archive for the second replica", reader_b.status());
+  Result<std::unique_ptr<brdf::daemon::ArchiveServer>> server_b =
+      brdf::daemon::ArchiveServer::Start(server_config, *reader_b, auth,
+                                         brdf::daemon::ArchiveServer::Options());
+  if (!server_b.ok()) return Fail("starting the second brdf-archive", server_b.status());
+  brdf::v1::InterpolateBatchRequest batch_request;
+  batch_request.set_session_id(sessions_page.sessions(0).session_id());
+  batch_request.set_quantity(brdf::v1::QUANTITY_RADIANCE);
+  batch_request.set_chunk_size(1024);
+  for (int i = 0; i < batch; ++i) {  // a fixed spread over the readings' range (θi, θo, φ)
+    brdf::v1::IsoDirection* d = batch_request.add_directions()->mutable_iso();
+    d->set_theta_i(10 + (i * 37 % 600) / 10.0);
+    d->set_theta_o(10 + (i * 53 % 700) / 10.0);
+    d->set_phi(-80 + (i * 71 % 1600) / 10.0);
+  }
+  auto stub_for = [](const std::string& address) {
+    return brdf::v1::Interpolation::NewStub(
+        grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
+  };
+  double ok_share = 0;  // of the last layout run: results with a spectrum (status OK)
+  // Each client its own channel, so two clients on one replica are two connections.
+  auto run_clients = [&](const std::vector<std::string>& addresses, int calls) -> double {
+    std::vector<std::thread> clients;
+    std::atomic<long> results{0};
+    std::atomic<long> spectra{0};
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const std::string& address : addresses) {
+      clients.emplace_back([&, address] {
+        auto stub = stub_for(address);
+        for (int c = 0; c < calls; ++c) {
+          grpc::ClientContext context;
+          auto stream = stub->InterpolateBatch(&context, batch_request);
+          brdf::v1::InterpolateBatchChunk chunk;
+          while (stream->Read(&chunk)) {
+            results += chunk.results_size();
+            for (const brdf::v1::InterpolationResult& one : chunk.results()) {
+              if (one.status() == brdf::v1::INTERPOLATION_STATUS_OK) ++spectra;
+            }
+          }
+          if (grpc::Status st = stream->Finish(); !st.ok()) {
+            std::fprintf(stderr, "InterpolateBatch: %s\n", st.error_message().c_str());
+          }
+        }
+      });
+    }
+    for (std::thread& t : clients) t.join();
+    const double seconds = Ms(std::chrono::steady_clock::now() - t0) / 1000;
+    ok_share = static_cast<double>(spectra.load()) / std::max(1L, results.load());
+    return results.load() / std::max(1e-9, seconds);
+  };
+  const std::string a = (*server)->address(), b = (*server_b)->address();
+  run_clients({a, b}, 1);  // warm both replicas' caches (the cold load is measured above)
+  std::vector<double> alone, one_replica, two_replicas;
+  for (int r = 0; r < rounds; ++r) {
+    alone.push_back(run_clients({a}, batch_calls));
+    one_replica.push_back(run_clients({a, a}, batch_calls));
+    two_replicas.push_back(run_clients({a, b}, batch_calls));
+  }
+  std::printf(
+      "InterpolateBatch throughput (%d directions per call, %.0f %% answered with a spectrum, %d "
+      "calls per client, %d rounds, medians):\n"
+      "  two clients, one replica:    %.0f directions/s\n"
+      "  two clients, two replicas:   %.0f directions/s (ratio to one replica %.2f)\n"
+      "  baseline: one client alone:  %.0f directions/s (one replica, two clients / alone "
+      "%.2f)\n"
+      "  (both replicas run in this process on this machine's %u cores: the ratio shows what a\n"
+      "   second replica adds when the cores are shared, not two machines' worth)\n",
+      batch, 100 * ok_share, batch_calls, rounds, Quantile(one_replica, 0.5), Quantile(two_replicas, 0.5),
+      Quantile(two_replicas, 0.5) / std::max(1e-9, Quantile(one_replica, 0.5)),
+      Quantile(alone, 0.5), Quantile(one_replica, 0.5) / std::max(1e-9, Quantile(alone, 0.5)),
+      std::thread::hardware_concurrency());
+  (*server_b)->Shutdown(std::chrono::seconds(1));
   (*server)->Shutdown(std::chrono::seconds(1));
   (void)dir;
   return 0;
