@@ -4,6 +4,7 @@
 #include <pwd.h>
 #include <signal.h>
 #include <grp.h>
+#include <sys/mount.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -104,6 +105,10 @@ std::string PgServer::Unavailable() {
 }
 
 Result<std::unique_ptr<PgServer>> PgServer::Start() {
+  return Start(Options());
+}
+
+Result<std::unique_ptr<PgServer>> PgServer::Start(const Options& options) {
   std::unique_ptr<PgServer> s(new PgServer());
   s->bin_ = BinDir();
   if (s->bin_.empty()) return NotFound(Unavailable());
@@ -116,6 +121,15 @@ Result<std::unique_ptr<PgServer>> PgServer::Start() {
   std::string pattern = std::string(use_tmpdir ? tmp : "/tmp") + "/brdf-pg-XXXXXX";
   if (::mkdtemp(pattern.data()) == nullptr) return IoError("mkdtemp " + pattern + " failed");
   s->dir_ = pattern;
+  if (options.disk_bytes > 0) {
+    const std::string size = "size=" + std::to_string(options.disk_bytes) + ",mode=0700";
+    if (::mount("tmpfs", s->dir_.c_str(), "tmpfs", MS_NOSUID | MS_NODEV, size.c_str()) != 0) {
+      return FailedPrecondition("mounting a " + std::to_string(options.disk_bytes >> 20) +
+                                " MiB tmpfs on " + s->dir_ + " for the server's disk failed (" +
+                                std::strerror(errno) + "): a full-disk test needs CAP_SYS_ADMIN");
+    }
+    s->tmpfs_ = true;
+  }
   if (::geteuid() == 0) {
     const passwd* nobody = ::getpwnam("nobody");
     if (nobody == nullptr) return FailedPrecondition("running as root and no user `nobody`");
@@ -207,8 +221,36 @@ Status PgServer::Restart() {
   return Launch();
 }
 
+Status PgServer::FillDisk() {
+  if (!tmpfs_) return FailedPrecondition("FillDisk needs a server started with disk_bytes");
+  const std::string path = dir_ + "/ballast";
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0600);
+  if (fd < 0) return IoError("open " + path + ": " + std::strerror(errno));
+  // Large writes first, then single pages for what is left, until the disk says ENOSPC.
+  const std::vector<char> zeros(1 << 20, 0);
+  for (std::size_t chunk : {zeros.size(), std::size_t{4096}}) {
+    while (::write(fd, zeros.data(), chunk) > 0) {
+    }
+    if (errno != ENOSPC) {
+      const int e = errno;
+      ::close(fd);
+      return IoError("writing " + path + ": " + std::strerror(e));
+    }
+  }
+  ::close(fd);
+  return Status::Ok();
+}
+
+Status PgServer::FreeDisk() {
+  if (::unlink((dir_ + "/ballast").c_str()) != 0 && errno != ENOENT) {
+    return IoError("removing the ballast in " + dir_ + ": " + std::strerror(errno));
+  }
+  return Status::Ok();
+}
+
 PgServer::~PgServer() {
   (void)Stop();
+  if (tmpfs_) ::umount2(dir_.c_str(), MNT_DETACH);
   std::error_code ec;
   if (!dir_.empty()) fs::remove_all(dir_, ec);
 }

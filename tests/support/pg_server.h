@@ -11,6 +11,7 @@
 
 #include <sys/types.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -25,8 +26,16 @@ class PgServer {
   // Why archive tests cannot run ("" when they can): the message a skipped test prints.
   static std::string Unavailable();
 
+  struct Options {
+    // 0: the server's directory is on the machine's disk. Otherwise a tmpfs of this size is
+    // mounted on it (needs CAP_SYS_ADMIN; FailedPrecondition without, which a test skips on),
+    // so that FillDisk can make the server's disk full.
+    std::uint64_t disk_bytes = 0;
+  };
+
   // initdb + start, waiting until the server accepts connections.
   static Result<std::unique_ptr<PgServer>> Start();
+  static Result<std::unique_ptr<PgServer>> Start(const Options& options);
   ~PgServer();  // stops the server and removes its directory
   PgServer(const PgServer&) = delete;
   PgServer& operator=(const PgServer&) = delete;
@@ -54,6 +63,12 @@ class PgServer {
   // The server's log so far.
   std::string log() const;
 
+  // A full disk on the server (Options.disk_bytes only): a ballast file takes every free byte
+  // of the server's tmpfs, so the next write that needs space fails with ENOSPC, as on a real
+  // archive whose disk filled up. FreeDisk removes the ballast.
+  Status FillDisk();
+  Status FreeDisk();
+
  private:
   PgServer() = default;
   Status Launch();
@@ -67,6 +82,7 @@ class PgServer {
   uid_t uid_ = 0;  // the user the server runs as
   gid_t gid_ = 0;
   bool drop_privileges_ = false;
+  bool tmpfs_ = false;  // dir_ is a tmpfs mounted by Start
 };
 
 }  // namespace brdf::testing
