@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "daemon/engine_steps.h"
+#include "daemon/export_session.h"
 #include "daemon/session_plan.h"
 #include "daemon/stream_readings.h"
 
@@ -250,16 +251,10 @@ grpc::Status ArchiveDataService::StreamReadings(grpc::ServerContext* context,
                                ReadingExtrasOf(*archive_, call.session, averages), source, writer);
 }
 
-grpc::Status ArchiveDataService::Export(grpc::ServerContext* context, const v1::ExportRequest*,
-                                        grpc::ServerWriter<v1::ExportChunk>*) {
-  Caller caller;
-  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "Export", &caller); !st.ok()) {
-    return st;
-  }
-  return grpc::Status(grpc::StatusCode::UNIMPLEMENTED,
-                      "Export: brdf-archive does not export yet; export the session from its "
-                      "rig's brdfd (brdfctl export), or stream its readings from here "
-                      "(StreamReadings) and run brdf-export on them");
+grpc::Status ArchiveDataService::Export(grpc::ServerContext* context,
+                                        const v1::ExportRequest* request,
+                                        grpc::ServerWriter<v1::ExportChunk>* writer) {
+  return ExportSession(*context, *request, *writer, auth_, streams_, stopping_, *archive_);
 }
 
 }  // namespace brdf::daemon

@@ -8,7 +8,9 @@
 //            answer FAILED_PRECONDITION saying that this is the archive and naming the rig's brdfd
 //            as the place to ask (the session's rig when the request names a session).
 //   Data     StreamReadings as on the rig (with follow: the archive is polled while the session
-//            is not finished); Export answers UNIMPLEMENTED for now (export from the rig's brdfd).
+//            is not finished); Export as on the rig (export_session.h: the same code over the
+//            archive's records, so the same file, byte for byte, but for the session id the
+//            readings CSV's first line and the file name carry).
 //
 // Session ids are the archive's (sessions.archive_id), not the rig's: the same session has
 // another id here than on its rig; its uuid and rig name are the same everywhere. A Session here

@@ -37,6 +37,7 @@
 #include "core/export/session_interpolant.h"
 #include "core/export/spectral_rgb.h"
 #include "core/export/spectrum_source.h"
+#include "daemon/export_session.h"
 #include "daemon/service_data.h"
 #include "data/cie_tables.h"
 #include "storage/session_readings.h"
@@ -494,27 +495,33 @@ Status ExportRgl(const exports::Session& session, const ExportSettings& s, const
 
 grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportRequest* request,
                                  grpc::ServerWriter<v1::ExportChunk>* writer) {
+  return ExportSession(*context, *request, *writer, auth_, streams_, stopping_, *manager_.store());
+}
+
+grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest& request,
+                           grpc::ServerWriter<v1::ExportChunk>& writer, const Authenticator& auth,
+                           StreamRegistry& streams, const StopSignal& stopping,
+                           storage::SessionReader& reader) {
   Caller caller;
-  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "Export", &caller); !st.ok()) {
+  if (grpc::Status st = auth.Authorize(context, Access::kRead, "Export", &caller); !st.ok()) {
     return st;
   }
   std::unique_ptr<StreamRegistry::Slot> slot;
-  if (grpc::Status st = streams_.Open(*context, &caller, "Export", &slot, /*computes=*/true);
+  if (grpc::Status st = streams.Open(context, &caller, "Export", &slot, /*computes=*/true);
       !st.ok())
     return st;
   ExportSettings settings;
-  if (grpc::Status st = ParseRequest(*request, &settings); !st.ok()) return st;
+  if (grpc::Status st = ParseRequest(request, &settings); !st.ok()) return st;
 
   CancelToken cancel;
-  Result<CallContext> ctx = ExportContext(*context, cancel);
+  Result<CallContext> ctx = ExportContext(context, cancel);
   if (!ctx.ok()) return ToGrpcStatus(ctx.status());
-  ExportStream stream(*context, *writer, *slot, stopping_, settings.chunk_bytes, cancel);
+  ExportStream stream(context, writer, *slot, stopping, settings.chunk_bytes, cancel);
   ExportStreamBuf buffer(stream);
   std::ostream out(&buffer);
 
   stream.Progress("loading readings", 0);
-  Result<exports::Session> session =
-      storage::LoadSessionReadings(*manager_.store(), settings.session_id);
+  Result<exports::Session> session = storage::LoadSessionReadings(reader, settings.session_id);
   if (!session.ok()) return ToGrpcStatus(session.status());
   stream.Progress("loading readings", 0.05);
 
@@ -522,7 +529,7 @@ grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportR
   report.set_file_name(FileName(settings));
   if (settings.format != v1::EXPORT_FORMAT_READINGS_CSV &&
       exports::HasSeveralDialPositions(*session)) {
-    report.add_warnings("session " + request->session_id() +
+    report.add_warnings("session " + request.session_id() +
                         " was measured at several dial positions γ (anisotropic); this export "
                         "uses the isotropic reduction (θi, θo, φ) and folds them together");
   }
@@ -546,7 +553,7 @@ grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportR
     return grpc::Status(grpc::StatusCode::CANCELLED,
                         "Export: the client went away before the file was sent; ask again");
   }
-  if (!st.ok()) return ToGrpcStatus(st.WithContext("Export of session " + request->session_id()));
+  if (!st.ok()) return ToGrpcStatus(st.WithContext("Export of session " + request.session_id()));
   stream.Progress("done", 1.0);
   if (!stream.SendReport(std::move(report))) {
     return grpc::Status(grpc::StatusCode::CANCELLED,

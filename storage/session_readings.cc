@@ -20,8 +20,11 @@ Reading ToReading(const ReadingRecord& r) {
   return out;
 }
 
-Result<SessionReadings> LoadSessionReadings(SessionStore& store, std::int64_t session_id) {
-  Result<SessionRecord> record = store.GetSession(session_id);
+namespace {
+
+// The session's record as a SessionReadings without readings.
+Result<SessionReadings> LoadSessionRecord(SessionReader& reader, std::int64_t session_id) {
+  Result<SessionRecord> record = reader.GetSession(session_id);
   if (!record.ok()) {
     if (record.status().code() == StatusCode::kNotFound) {
       return NotFound("unknown session " + std::to_string(session_id) +
@@ -39,10 +42,35 @@ Result<SessionReadings> LoadSessionReadings(SessionStore& store, std::int64_t se
     return Internal("session " + std::to_string(session_id) +
                     ": its stored plan does not parse: " + plan.status().message());
   }
+  return session;
+}
+
+// Readings asked of a SessionReader per page.
+constexpr int kReadingsPerPage = 4096;
+
+}  // namespace
+
+Result<SessionReadings> LoadSessionReadings(SessionStore& store, std::int64_t session_id) {
+  Result<SessionReadings> session = LoadSessionRecord(store, session_id);
+  if (!session.ok()) return session;
   BRDF_RETURN_IF_ERROR(store.ForEachReading(session_id, [&](const ReadingRecord& r) {
-    session.readings.push_back(ToReading(r));
+    session->readings.push_back(ToReading(r));
     return Status::Ok();
   }));
+  return session;
+}
+
+Result<SessionReadings> LoadSessionReadings(SessionReader& reader, std::int64_t session_id) {
+  Result<SessionReadings> session = LoadSessionRecord(reader, session_id);
+  if (!session.ok()) return session;
+  for (std::int64_t after = 0;;) {
+    Result<std::vector<ReadingRecord>> page =
+        reader.GetReadings(session_id, after, kReadingsPerPage);
+    if (!page.ok()) return page.status();
+    for (const ReadingRecord& r : *page) session->readings.push_back(ToReading(r));
+    if (page->size() < static_cast<std::size_t>(kReadingsPerPage)) break;
+    after = page->back().id;
+  }
   return session;
 }
 

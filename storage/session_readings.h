@@ -2,7 +2,7 @@
 // every reading (sample, reference, dark) converted from its ReadingRecord. The exports (brdfd's
 // Data.Export, brdf-export) load whole sessions so; the daemon's interpolation index converts
 // each committed record as it lands. Read-only use of the store: only GetSession and
-// ForEachReading are called.
+// ForEachReading (a SessionReader's GetReadings) are called.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +10,7 @@
 #include "core/readings/reading.h"
 #include "core/status.h"
 #include "storage/records.h"
+#include "storage/session_reader.h"
 #include "storage/session_store.h"
 
 namespace brdf::storage {
@@ -21,5 +22,8 @@ Reading ToReading(const ReadingRecord& r);
 // The session and all its readings, in id order. kNotFound for an unknown session (naming it and
 // the database), and the store's errors.
 Result<SessionReadings> LoadSessionReadings(SessionStore& store, std::int64_t session_id);
+// The same from any SessionReader (the lab archive: brdf-archive's exports), read a page at a
+// time.
+Result<SessionReadings> LoadSessionReadings(SessionReader& reader, std::int64_t session_id);
 
 }  // namespace brdf::storage

@@ -388,7 +388,8 @@ int main(int argc, char** argv) {
       "%.2f)\n"
       "  (both replicas run in this process on this machine's %u cores: the ratio shows what a\n"
       "   second replica adds when the cores are shared, not two machines' worth)\n",
-      batch, 100 * ok_share, batch_calls, rounds, Quantile(one_replica, 0.5), Quantile(two_replicas, 0.5),
+      batch, 100 * ok_share, batch_calls, rounds, Quantile(one_replica, 0.5),
+      Quantile(two_replicas, 0.5),
       Quantile(two_replicas, 0.5) / std::max(1e-9, Quantile(one_replica, 0.5)),
       Quantile(alone, 0.5), Quantile(one_replica, 0.5) / std::max(1e-9, Quantile(alone, 0.5)),
       std::thread::hardware_concurrency());

@@ -1,9 +1,9 @@
 // brdf-archive against a real PostgreSQL and a real rig: brdf-sim and brdfd (processes) record
 // and ship; two brdf-archive processes serve the archive. For the same session the archive
-// answers Interpolate, InterpolateBatch and StreamReadings exactly as the rig's brdfd does (the
-// messages compared field by field, doubles exactly), ListSessions filters and pages across the
-// catalogue (brdfd applies the same filters), the rig's verbs are refused naming the rig, and
-// brdfctl works against it unchanged.
+// answers Interpolate, InterpolateBatch, StreamReadings and Export exactly as the rig's brdfd does
+// (the messages compared field by field, doubles exactly; the exported files byte for byte),
+// ListSessions filters and pages across the catalogue (brdfd applies the same filters), the rig's
+// verbs are refused naming the rig, and brdfctl works against it unchanged.
 #include <gmock/gmock.h>
 #include <google/protobuf/util/message_differencer.h>
 #include <gtest/gtest.h>
@@ -261,6 +261,23 @@ class ArchiveServerTest : public ::testing::Test {
     EXPECT_TRUE(st.ok()) << st.error_message();
     return out;
   }
+  // An exported file's bytes and the export's report.
+  static std::pair<std::string, v1::ExportReport> Export(v1::Data::Stub& data,
+                                                         v1::ExportRequest request,
+                                                         const std::string& id) {
+    request.set_session_id(id);
+    auto context = DaemonRig::Context(kAnalystToken);
+    auto reader = data.Export(context.get(), request);
+    std::pair<std::string, v1::ExportReport> out;
+    v1::ExportChunk chunk;
+    while (reader->Read(&chunk)) {
+      if (chunk.has_data()) out.first += chunk.data().content();
+      if (chunk.has_report()) out.second = chunk.report();
+    }
+    grpc::Status st = reader->Finish();
+    EXPECT_TRUE(st.ok()) << st.error_message();
+    return out;
+  }
 
   std::unique_ptr<PgServer> pg_;
   std::unique_ptr<DaemonRig> rig_;
@@ -359,6 +376,38 @@ TEST_F(ArchiveServerTest, TwoReplicasAnswerBitForBitWhatTheRigAnswers) {
     archive_readings[i].set_session_id(rig_readings[i].session_id());
     EXPECT_EQ(archive_readings[i].SerializeAsString(), rig_readings[i].SerializeAsString())
         << "reading " << rig_readings[i].id();
+  }
+
+  // Every export format: the rig's file byte for byte (the readings CSV names the session by
+  // the server's id in its first line, and the file name carries it).
+  v1::ExportRequest csv;
+  csv.set_format(v1::EXPORT_FORMAT_READINGS_CSV);
+  v1::ExportRequest grid;
+  grid.set_format(v1::EXPORT_FORMAT_GRID_NPY);
+  grid.set_step_theta_i(15);
+  grid.set_step_theta_o(15);
+  grid.set_step_phi(30);
+  v1::ExportRequest rgl;
+  rgl.set_format(v1::EXPORT_FORMAT_RGL_BSDF);
+  rgl.set_rgl_theta_i_count(4);
+  rgl.set_rgl_resolution(8);
+  v1::ExportRequest merl;
+  merl.set_format(v1::EXPORT_FORMAT_MERL_BINARY);
+  merl.set_fill(v1::EXPORT_FILL_NONE);
+  for (const v1::ExportRequest& request : {csv, grid, rgl, merl}) {
+    auto [rig_file, rig_report] = Export(rig_->data(), request, paint.session_id());
+    auto [archive_file, archive_report] = Export(b.data(), request, id_a);
+    ASSERT_GT(rig_file.size(), 100U) << v1::ExportFormat_Name(request.format());
+    if (request.format() == v1::EXPORT_FORMAT_READINGS_CSV) {
+      EXPECT_THAT(archive_file.substr(0, archive_file.find('\n')), HasSubstr("session " + id_a));
+      rig_file.erase(0, rig_file.find('\n'));
+      archive_file.erase(0, archive_file.find('\n'));
+    }
+    EXPECT_TRUE(archive_file == rig_file) << v1::ExportFormat_Name(request.format());
+    archive_report.clear_file_name();
+    rig_report.clear_file_name();
+    EXPECT_EQ(archive_report.SerializeAsString(), rig_report.SerializeAsString())
+        << v1::ExportFormat_Name(request.format());
   }
 }
 
