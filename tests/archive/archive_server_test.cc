@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cstdlib>
 #include <fstream>
 #include <stdexcept>
 #include <thread>
@@ -450,7 +451,7 @@ TEST_F(ArchiveServerTest, RefusesTheRigsVerbsAndUnknownSessionsAndChecksTokens) 
   EXPECT_THAT(st.error_message(), HasSubstr("page_token"));
 }
 
-TEST_F(ArchiveServerTest, BrdfctlListsAndInterpolatesThroughTheArchiveUnchanged) {
+TEST_F(ArchiveServerTest, BrdfctlAndThePythonClientReadTheArchiveUnchanged) {
   const v1::Session paint = Submit(WithSample(plans::InterpolationGrid(), kPaint));
   ASSERT_EQ(rig_->WaitForState(paint.session_id(), v1::SESSION_STATE_COMPLETED, 120s).state(),
             v1::SESSION_STATE_COMPLETED);
@@ -491,6 +492,38 @@ TEST_F(ArchiveServerTest, BrdfctlListsAndInterpolatesThroughTheArchiveUnchanged)
       EXPECT_GT(Lines(from_rig->out).size(), 10U);
     }
   }
+
+  // The Python client, unchanged, reads the archive as it reads the rig
+  // (tests/archive/python_client_check.py says what it compares).
+  const char* build = std::getenv("BRDF_BUILD_DIR");
+  ASSERT_NE(build, nullptr) << "run through ctest (it sets BRDF_BUILD_DIR)";
+  LaunchOptions python;
+  python.args = {SourceDir() + "/tests/archive/python_client_check.py",
+                 "--rig",
+                 rig_->daemon()->address(),
+                 "--archive",
+                 a.address(),
+                 "--token",
+                 kAnalystToken,
+                 "--rig-session",
+                 paint.session_id(),
+                 "--archive-session",
+                 id,
+                 "--uuid",
+                 paint.uuid(),
+                 "--material",
+                 "paint",
+                 "--workdir",
+                 rig_->dir().path().string()};
+  python.stderr_to = LaunchOptions::Stderr::kPipe;
+  python.stdin_from_null = true;
+  python.set_env = {{"BRDF_PY_STUBS", std::string(build) + "/clients/python/stubs"},
+                    {"PYTHONDONTWRITEBYTECODE", "1"}};
+  Result<CommandResult> checked =
+      RunToCompletion("python3", "/usr/bin/python3", python, std::chrono::seconds(120));
+  ASSERT_TRUE(checked.ok()) << checked.status().ToString();
+  EXPECT_EQ(checked->exit_code, 0) << checked->out << checked->err;
+  EXPECT_THAT(checked->out, HasSubstr("export rgl:")) << checked->out << checked->err;
 }
 
 TEST_F(ArchiveServerTest, ASessionCachedWhileRecordingGrowsAsItIsShipped) {

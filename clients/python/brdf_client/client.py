@@ -195,8 +195,14 @@ class BrdfClient:
         return self._unary(self._control.GetSession,
                            brdf_pb2.GetSessionRequest(session_id=session_id), "Control.GetSession")
 
-    def list_sessions(self, states=None, page_size=0, limit=None):
+    def list_sessions(self, states=None, page_size=0, limit=None, *, rig=None, sample=None,
+                      material=None, tag=None, created_after=None, created_before=None):
         """Sessions, newest first, optionally only those in `states` ("running", ...).
+
+        Catalogue filters (brdfd for its own sessions, brdf-archive across the lab's rigs): `rig`
+        (exactly), `sample` (the sample's id, or its name ignoring case), `material` (ignoring
+        case), `tag` (one of the sample's tags), `created_after` / `created_before` (datetime or
+        Unix seconds: created at or after / before).
 
         Follows the daemon's pages until `limit` sessions (None: all); `page_size` sets how many
         come per call (0: the daemon's 100). Session.plan is empty here; get_session returns it.
@@ -204,12 +210,17 @@ class BrdfClient:
         if isinstance(states, (str, int)):
             states = [states]
         wanted = [names.to_enum(s, names.STATES, "session state") for s in (states or [])]
+        request = brdf_pb2.ListSessionsRequest(states=wanted, page_size=page_size,
+                                               rig=rig or "", sample=sample or "",
+                                               material=material or "", tag=tag or "")
+        for field, when in (("created_after", created_after), ("created_before", created_before)):
+            if when is not None:
+                seconds = when.timestamp() if hasattr(when, "timestamp") else float(when)
+                getattr(request, field).seconds = int(seconds)
         sessions, token = [], ""
         while True:
-            page = self._unary(self._control.ListSessions,
-                               brdf_pb2.ListSessionsRequest(states=wanted, page_size=page_size,
-                                                            page_token=token),
-                               "Control.ListSessions")
+            request.page_token = token
+            page = self._unary(self._control.ListSessions, request, "Control.ListSessions")
             sessions.extend(page.sessions)
             token = page.next_page_token
             if limit is not None and len(sessions) >= limit:
