@@ -12,25 +12,43 @@
 namespace brdf::daemon {
 
 bool IndexKey::operator==(const IndexKey& o) const {
-  return std::tie(quantity, method, axis_scale, mirror_phi, reciprocity) ==
-         std::tie(o.quantity, o.method, o.axis_scale, o.mirror_phi, o.reciprocity);
+  return std::tie(quantity, method, axis_scale, mirror_phi, reciprocity, coordinates) ==
+         std::tie(o.quantity, o.method, o.axis_scale, o.mirror_phi, o.reciprocity, o.coordinates);
 }
 
 IndexKey MakeIndexKey(Quantity quantity, interp::Method method, const interp::Options& options) {
-  IndexKey key{quantity, method, options.axis_scale, options.mirror_phi, options.reciprocity};
+  IndexKey key{
+      quantity,           method, options.axis_scale, options.mirror_phi, options.reciprocity,
+      options.coordinates};
   if (std::all_of(key.axis_scale.begin(), key.axis_scale.end(), [](double s) { return s == 1; })) {
     key.axis_scale.clear();
   }
   return key;
 }
 
+namespace {
+
+const char* AxisNames(const interp::Options& options, int dims) {
+  if (dims == 4) return "θi, φi, θo, φo";
+  return options.coordinates == interp::Coordinates::kHalfDifference ? "θh·cos φd, θh·sin φd, θd"
+                                                                     : "θi, θo, φ";
+}
+
+}  // namespace
+
 Status CheckIndexOptions(const interp::Options& options, int dims, std::int64_t session) {
+  if (dims == 4 && options.coordinates == interp::Coordinates::kHalfDifference) {
+    return InvalidArgument(
+        "options.coordinates: half/difference angles are only for isotropic sessions; session " +
+        std::to_string(session) +
+        " is anisotropic (its BRDF depends on the azimuth the half/difference angles drop): "
+        "interpolate it in incidence coordinates (leave options.coordinates unset or INCIDENCE)");
+  }
   if (!options.axis_scale.empty()) {
     if (static_cast<int>(options.axis_scale.size()) != dims) {
       return InvalidArgument("options.axis_scale: give " + std::to_string(dims) +
-                             " values (one per axis, " +
-                             (dims == 4 ? "θi, φi, θo, φo" : "θi, θo, φ") + ") or none, not " +
-                             std::to_string(options.axis_scale.size()));
+                             " values (one per axis, " + AxisNames(options, dims) +
+                             ") or none, not " + std::to_string(options.axis_scale.size()));
     }
     for (std::size_t i = 0; i < options.axis_scale.size(); ++i) {
       const double s = options.axis_scale[i];
@@ -69,6 +87,9 @@ Result<MadeIndex> MakeIndex(std::shared_ptr<const interp::SampleSet> samples, in
                             const interp::Options& options, const IndexSnapshot* stale,
                             std::int64_t session) {
   // Extending fails only if the set did not grow by Add (it always does); then a fresh build.
+  // Only the octant method in incidence coordinates extends: a half/difference index is no
+  // OctantInterpolator (it wraps one over the images of the samples, made in blocks) and is
+  // rebuilt; the key keeps the coordinates apart, so `stale` is always one of the same kind.
   const auto* base =
       stale != nullptr ? dynamic_cast<const interp::OctantInterpolator*>(stale->interpolator.get())
                        : nullptr;

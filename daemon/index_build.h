@@ -23,13 +23,15 @@ struct IndexKey {
   std::vector<double> axis_scale;  // normalised: empty when all 1
   bool mirror_phi;
   bool reciprocity;
+  interp::Coordinates coordinates;  // an index never answers in the other coordinates
   bool operator==(const IndexKey& o) const;
 };
 
 IndexKey MakeIndexKey(Quantity quantity, interp::Method method, const interp::Options& options);
 
-// kInvalidArgument (naming "options.axis_scale", "options.mirror_phi", "options.reciprocity")
-// when the options do not fit a session of `dims` coordinates.
+// kInvalidArgument (naming "options.axis_scale", "options.mirror_phi", "options.reciprocity",
+// "options.coordinates": half/difference on an anisotropic session) when the options do not fit
+// a session of `dims` coordinates.
 Status CheckIndexOptions(const interp::Options& options, int dims, std::int64_t session);
 
 // kFailedPrecondition when the session has no sample reading with the quantity yet (naming how
@@ -43,7 +45,8 @@ struct MadeIndex {
 };
 
 // The index over `samples`: `stale`'s octant index extended when it is one (made with these
-// options over fewer readings) and the extension keeps its tree, else a fresh build. Errors:
+// options over fewer readings; incidence coordinates only) and the extension keeps its tree,
+// else a fresh build (half/difference indexes are always rebuilt). Errors:
 // kFailedPrecondition naming the method and what to do.
 Result<MadeIndex> MakeIndex(std::shared_ptr<const interp::SampleSet> samples, interp::Method method,
                             const interp::Options& options, const IndexSnapshot* stale,

@@ -1,6 +1,6 @@
 // IndexCache: the interpolation indexes the Interpolation service answers from, one per
-// (session, quantity, method, options), built from the session's SAMPLE readings with
-// core/interp's MakeInterpolator.
+// (session, quantity, method, options: scales, symmetries, coordinates), built from the
+// session's SAMPLE readings with core/interp's MakeInterpolator.
 //
 // Quantities (core/readings/quantity.h, derived by core/readings/derive.h, the same derivation
 // the exports use), per sample reading I:
@@ -26,8 +26,10 @@
 // the session. The octant index (the paper's method, the default) is then extended, not rebuilt:
 // interp::OctantInterpolator::Extend shares the old snapshot's search tree and scans the new
 // readings beside it (answers identical to a fresh build; it folds them into a fresh tree now and
-// then, which counts as a build). Delaunay and nearest-neighbour indexes are rebuilt over the
-// grown set on their next query. Older snapshots are never changed.
+// then, which counts as a build). Delaunay and nearest-neighbour indexes, and every index in
+// half/difference coordinates, are rebuilt over the grown set on their next query. Older
+// snapshots are never changed. The coordinates are part of an index's key (index_build.h), so an
+// index never answers a query in the other coordinates.
 //
 // Memory: the cache keeps at most Options::max_sessions sessions and about Options::max_bytes of
 // samples and indexes, evicting the least recently used session; each session keeps at most
@@ -136,7 +138,7 @@ class IndexCache {
   // appended (the records handed over since) and extended or built. Errors:
   //   kNotFound            no such session;
   //   kInvalidArgument     options that do not fit the session (naming "options.axis_scale",
-  //                        "options.mirror_phi", "options.reciprocity");
+  //                        "options.mirror_phi", "options.reciprocity", "options.coordinates");
   //   kFailedPrecondition  no usable sample reading yet, or the readings cannot be indexed by
   //                        this method (e.g. Delaunay on readings that all lie in one plane);
   //   kIoError             the store could not be read (first load).

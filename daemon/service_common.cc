@@ -108,6 +108,22 @@ grpc::Status ParseMethodField(int method, interp::Method* out) {
   }
 }
 
+grpc::Status ParseCoordinatesField(int coordinates, interp::Coordinates* out) {
+  switch (coordinates) {
+    case v1::INTERPOLATION_COORDINATES_UNSPECIFIED:
+    case v1::INTERPOLATION_COORDINATES_INCIDENCE:
+      *out = interp::Coordinates::kIncidence;
+      return grpc::Status::OK;
+    case v1::INTERPOLATION_COORDINATES_HALF_DIFFERENCE:
+      *out = interp::Coordinates::kHalfDifference;
+      return grpc::Status::OK;
+    default:
+      return InvalidField("options.coordinates", "unknown coordinates " +
+                                                     std::to_string(coordinates) +
+                                                     "; use INCIDENCE or HALF_DIFFERENCE");
+  }
+}
+
 v1::Quantity ToProtoQuantity(Quantity quantity) {
   switch (quantity) {
     case Quantity::kRadiance:

@@ -79,6 +79,10 @@ grpc::Status ParseSessionIdField(const std::string& text, const std::string& fie
 // brdfd's; INVALID_ARGUMENT naming "quantity" / "method" for a value the API does not have.
 grpc::Status ParseQuantityField(int quantity, Quantity* out);
 grpc::Status ParseMethodField(int method, interp::Method* out);
+// InterpolationOptions.coordinates (UNSPECIFIED: incidence) as brdfd's; INVALID_ARGUMENT naming
+// "options.coordinates" for a value the API does not have. Whether the session can take half/
+// difference coordinates is the index's check (index_build.h: CheckIndexOptions).
+grpc::Status ParseCoordinatesField(int coordinates, interp::Coordinates* out);
 v1::Quantity ToProtoQuantity(Quantity quantity);
 
 // Checks a finite angle within [lo, hi]; the message names `field` and the range.

@@ -284,6 +284,10 @@ grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
   out->options.axis_scale.assign(o.axis_scale().begin(), o.axis_scale().end());
   out->options.mirror_phi = o.mirror_phi();
   out->options.reciprocity = o.reciprocity();
+  if (grpc::Status st = ParseCoordinatesField(o.coordinates(), &out->options.coordinates);
+      !st.ok()) {
+    return st;
+  }
   // 0 means the default 1°; MakeRegularGrid checks the rest and names the axis.
   const double steps[3] = {r.step_theta_i(), r.step_theta_o(), r.step_phi()};
   for (int k = 0; k < 3; ++k) out->steps[k] = steps[k] == 0 ? 1.0 : steps[k];

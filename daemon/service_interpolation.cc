@@ -46,7 +46,7 @@ grpc::Status ParseSettings(int method, int quantity, const v1::InterpolationOpti
   out->options.axis_scale.assign(options.axis_scale().begin(), options.axis_scale().end());
   out->options.mirror_phi = options.mirror_phi();
   out->options.reciprocity = options.reciprocity();
-  return grpc::Status::OK;
+  return ParseCoordinatesField(options.coordinates(), &out->options.coordinates);
 }
 
 // Ranges and finiteness, independent of the session. `field` is the DirectionQuery's path.

@@ -144,6 +144,7 @@ std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& b
   j += "  \"method\": " + JsonString(info.method) + ",\n";
   j += std::string("  \"mirror_phi\": ") + (how.mirror_phi ? "true" : "false") + ",\n";
   j += std::string("  \"reciprocity\": ") + (how.reciprocity ? "true" : "false") + ",\n";
+  j += "  \"coordinates\": " + JsonString(how.coordinates) + ",\n";
   std::string scale = "null";
   if (!how.axis_scale.empty()) {
     scale = "[";

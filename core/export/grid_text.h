@@ -29,6 +29,9 @@ struct InterpolantInfo {
   bool reciprocity = false;
   std::vector<double> axis_scale;  // empty: all 1
   std::string fill_json;           // the fill policy and its counts (FillTally::Json()); or empty
+  // Where the method measured and blended (interp::CoordinatesName): "incidence" or
+  // "half_difference" (axis_scale then multiplies the half/difference axes).
+  std::string coordinates = "incidence";
 };
 
 // A GridSink writing CSV: '#' comment lines documenting the quantity, unit, angles and axes, then
@@ -53,8 +56,8 @@ class CsvGridWriter : public GridSink {
 
 // A JSON object describing an .npy grid export: shape and axis order, each axis (start, step,
 // count, in degrees), the wavelengths, quantity, unit, method, symmetry options ("mirror_phi",
-// "reciprocity"), "axis_scale" (null: all 1), "fill" (policy and per-provenance counts), and the
-// counts per status.
+// "reciprocity"), "coordinates" ("incidence" or "half_difference"), "axis_scale" (null: all 1),
+// "fill" (policy and per-provenance counts), and the counts per status.
 std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& bands,
                                 const GridExportInfo& info, const GridReport& report,
                                 const InterpolantInfo& how = {});

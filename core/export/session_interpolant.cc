@@ -44,7 +44,8 @@ RetroProfile RetroFromModel(const fit::CookTorranceFit& model) {
 
 InterpolantInfo SessionInterpolant::Info() const {
   return {options.mirror_phi, options.reciprocity, options.axis_scale,
-          chain ? chain->Tally().Json() : std::string()};
+          chain ? chain->Tally().Json() : std::string(),
+          interp::CoordinatesName(options.coordinates)};
 }
 
 Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, interp::Method method,

@@ -13,6 +13,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Relative margins on squared distances: rounding can only widen the lists (see the header).
 constexpr double kGrow = 1.0 + 1e-9;
 constexpr double kShrink = 1.0 - 1e-9;
+// An axis whose extent is below this fraction of the widest one counts as flat (no grid).
+constexpr double kFlatExtent = 1e-9;
 // Points per orthant that every candidate is compared with (see may_beat_witnesses).
 constexpr int kWitnesses = 4;
 
@@ -75,6 +77,13 @@ void OrthantGrid::Build(const PointCloud& cloud, const std::vector<std::uint32_t
     hi[j] = mx;
     extent[j] = hi[j] - lo[j];
     if (!(extent[j] > 0.0) || !std::isfinite(extent[j])) return;  // flat on an axis: no grid
+  }
+  // Flat up to rounding on an axis (e.g. half/difference points of in-plane readings, whose
+  // θh·sin φd is ±1e-15 at φd = 180°) is flat too: cells as thin as the rounding would make
+  // every other axis max_cells wide, a build of seconds for a handful of points.
+  const double widest_extent = *std::max_element(extent.begin(), extent.end());
+  for (std::size_t j = 0; j < kD; ++j) {
+    if (extent[j] < kFlatExtent * widest_extent) return;
   }
 
   // Cells about as wide on every axis, about cells_per_point · n of them.

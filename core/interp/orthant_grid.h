@@ -63,7 +63,8 @@ class OrthantGrid {
   // No grid: every query falls back.
   OrthantGrid() = default;
   // Builds the lists for a 3D cloud's scaled points (a 4D cloud gets no grid: with 16 orthants
-  // few cells kept a list short enough). A list entry is the point's position in the caller's
+  // few cells kept a list short enough; nor does a cloud flat on an axis, up to rounding: an
+  // extent under 1e-9 of the widest). A list entry is the point's position in the caller's
   // order, position_of[rank] (the k-d tree's own order, whose compact per-axis arrays stay in
   // cache while the lists are read). Keeps no pointer to its arguments.
   // `search` finds the exact winners per orthant around a point (the tree's NearestPerOrthant):

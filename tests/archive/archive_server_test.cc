@@ -232,10 +232,12 @@ class ArchiveServerTest : public ::testing::Test {
     }
     return out;
   }
-  static std::vector<v1::InterpolationResult> Batch(v1::Interpolation::Stub& stub,
-                                                    const std::string& id) {
+  static std::vector<v1::InterpolationResult> Batch(
+      v1::Interpolation::Stub& stub, const std::string& id,
+      v1::InterpolationCoordinates coordinates = v1::INTERPOLATION_COORDINATES_UNSPECIFIED) {
     v1::InterpolateBatchRequest request;
     request.set_session_id(id);
+    request.mutable_options()->set_coordinates(coordinates);
     request.set_quantity(v1::QUANTITY_BRDF);
     for (const v1::DirectionQuery& d : Directions()) *request.add_directions() = d;
     request.set_chunk_size(16);
@@ -365,6 +367,23 @@ TEST_F(ArchiveServerTest, TwoReplicasAnswerBitForBitWhatTheRigAnswers) {
       EXPECT_EQ(batch[i].SerializeAsString(), rig_batch[i].SerializeAsString())
           << "direction " << i;
     }
+  }
+  // In half/difference coordinates too (the same service code): the rig's answers, which are
+  // not the incidence ones.
+  const std::vector<v1::InterpolationResult> rig_half = Batch(
+      rig_->interpolation(), paint.session_id(), v1::INTERPOLATION_COORDINATES_HALF_DIFFERENCE);
+  ASSERT_EQ(rig_half.size(), rig_batch.size());
+  int differ = 0;
+  for (std::size_t i = 0; i < rig_half.size(); ++i) {
+    differ += rig_half[i].SerializeAsString() != rig_batch[i].SerializeAsString();
+  }
+  EXPECT_GT(differ, 0);
+  const std::vector<v1::InterpolationResult> archive_half =
+      Batch(b.interpolation(), id_a, v1::INTERPOLATION_COORDINATES_HALF_DIFFERENCE);
+  ASSERT_EQ(archive_half.size(), rig_half.size());
+  for (std::size_t i = 0; i < archive_half.size(); ++i) {
+    EXPECT_EQ(archive_half[i].SerializeAsString(), rig_half[i].SerializeAsString())
+        << "direction " << i << " in half/difference coordinates";
   }
 
   // The readings, as the rig streams them (but for the session id, which is the archive's).

@@ -3,6 +3,7 @@
 // checked on their own terms: the MERL file's size, the .npy loaded by NumPy (/usr/bin/python3),
 // whose NaN cells must be the count brdfctl reports, the CSV's rows, the RGL .bsdf read by
 // tools/check/rgl_read.py, the fill counts.
+#include <google/protobuf/util/json_util.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -13,6 +14,7 @@
 #include <sstream>
 #include <string>
 
+#include "brdf/v1/brdf.pb.h"
 #include "tests/brdfctl/ctl_test_rig.h"
 #include "tests/support/plan_fixtures.h"
 #include "tests/support/test_env.h"
@@ -117,6 +119,55 @@ TEST_F(BrdfctlExportTest, AnAnalystExportsMerlGridAndCsvFilesThatTheirReadersLoa
   ASSERT_TRUE(std::regex_search(c.err, match, std::regex("([0-9]+) rows"))) << c.err;
   EXPECT_EQ(std::to_string(rows), std::string(match[1]));
   EXPECT_GT(rows, 10u);
+
+  // --coordinates half-diff: the grid's sidecar records it (beside the symmetries and scales),
+  // its values differ from the incidence grid's; interpolate takes the flag too and says so.
+  const std::string half_npy = Path("grid-half.npy");
+  const CommandResult h = Ctl(
+      {"export", id_, "grid", "--steps", "10,10,20", "--coordinates", "half-diff", "-o", half_npy});
+  ASSERT_EQ(h.exit_code, 0) << Describe(h);
+  const std::string compare = Path("compare_npy.py");
+  std::ofstream(compare) << "import json, sys, numpy as np\n"
+                            "a, b = np.load(sys.argv[1]), np.load(sys.argv[2])\n"
+                            "da = json.load(open(sys.argv[1] + '.json'))\n"
+                            "db = json.load(open(sys.argv[2] + '.json'))\n"
+                            "both = np.isfinite(a) & np.isfinite(b)\n"
+                            "print(da['coordinates'], db['coordinates'], db['mirror_phi'], "
+                            "db['axis_scale'], bool((a[both] != b[both]).any()))\n";
+  const CommandResult cmp =
+      RunShell("/usr/bin/python3 '" + compare + "' '" + npy + "' '" + half_npy + "' 2>&1");
+  ASSERT_EQ(cmp.exit_code, 0) << Describe(cmp);
+  EXPECT_EQ(Lines(cmp.out).at(0), "incidence half_difference False None True") << cmp.out;
+
+  // A direction inside the readings' hull in both coordinates (the quick start's 35°, 40°, 40°
+  // is not, in half/difference angles: φd > 90° there, beyond every reading).
+  const std::vector<std::string> at = {"--theta-i", "25",  "--theta-o", "25",
+                                       "--phi",     "100", "--method",  "delaunay"};
+  auto interpolate = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"interpolate", id_};
+    args.insert(args.end(), at.begin(), at.end());
+    args.insert(args.end(), extra.begin(), extra.end());
+    return Ctl(args);
+  };
+  const CommandResult text = interpolate({"--coordinates", "half-diff"});
+  ASSERT_EQ(text.exit_code, 0) << Describe(text);
+  EXPECT_NE(text.out.find("delaunay in half/difference coordinates: ok"), std::string::npos)
+      << Describe(text);
+  const CommandResult half_json = interpolate({"--coordinates", "half-diff", "--json"});
+  const CommandResult incidence_json = interpolate({"--coordinates", "incidence", "--json"});
+  ASSERT_EQ(half_json.exit_code, 0) << Describe(half_json);
+  ASSERT_EQ(incidence_json.exit_code, 0) << Describe(incidence_json);
+  v1::InterpolateResponse half_reply, incidence_reply;
+  ASSERT_TRUE(
+      google::protobuf::util::JsonStringToMessage(Lines(half_json.out).at(0), &half_reply).ok());
+  ASSERT_TRUE(
+      google::protobuf::util::JsonStringToMessage(Lines(incidence_json.out).at(0), &incidence_reply)
+          .ok());
+  ASSERT_EQ(half_reply.result().spectrum_size(), 101);
+  ASSERT_EQ(incidence_reply.result().spectrum_size(), 101);
+  EXPECT_NE(half_reply.result().spectrum(45), incidence_reply.result().spectrum(45));
+  const CommandResult unknown = interpolate({"--coordinates", "polar"});
+  EXPECT_EQ(unknown.exit_code, 2) << Describe(unknown);
 
   // A grid step that does not divide 90° is the user's error (exit 2), and leaves no file.
   const std::string bad = Path("bad.npy");

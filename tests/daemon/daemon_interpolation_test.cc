@@ -21,6 +21,8 @@
 #include "core/analytic_brdf.h"
 #include "core/geometry.h"
 #include "tests/daemon/daemon_test_rig.h"
+#include "tests/daemon/derived_readings.h"
+#include "tests/daemon/interpolation_rig_test.h"
 #include "tests/support/plan_fixtures.h"
 #include "tools/brdf-sim/optics.h"
 
@@ -61,32 +63,7 @@ double GlossBound(const IsoDirection& d) {
          std::pow(std::clamp(cos_h, 0.0, 1.0), p.exponent_x);
 }
 
-struct Derived {
-  std::vector<double> radiance, reflectance, brdf;
-  IsoDirection iso;
-  Directions directions;
-};
-
-// The three quantities of a sample reading from the raw spectra, as geometry.md defines them.
-Derived Derive(const v1::Reading& r, const std::map<std::int64_t, v1::Reading>& by_id) {
-  Derived d;
-  d.iso = {r.iso().theta_i(), r.iso().theta_o(), r.iso().phi()};
-  d.directions = {r.directions().theta_i(), r.directions().phi_i(), r.directions().theta_o(),
-                  r.directions().phi_o()};
-  const v1::Reading& white = by_id.at(r.reference_id());
-  const v1::Reading* dark = r.dark_id() != 0 ? &by_id.at(r.dark_id()) : nullptr;
-  const double cos_ratio = std::cos(white.directions().theta_i() * std::numbers::pi / 180) /
-                           std::cos(r.directions().theta_i() * std::numbers::pi / 180);
-  for (int b = 0; b < r.radiance_size(); ++b) {
-    const double dk = dark ? dark->radiance(b) : 0.0;
-    const double i = r.radiance(b) - dk;
-    const double i0 = white.radiance(b) - dk;
-    d.radiance.push_back(i);
-    d.reflectance.push_back(i / i0);
-    d.brdf.push_back(i / i0 * 0.99 / std::numbers::pi * cos_ratio);
-  }
-  return d;
-}
+using Derived = DerivedReading;
 
 std::vector<double> Truth(const IsoDirection& iso) {
   return sim::TrueBrdf(CanonicalDirections(iso), /*anisotropic=*/false);
@@ -102,55 +79,7 @@ double MaxRelativeError(const std::vector<double>& a, const std::vector<double>&
   return max_diff / max_t;
 }
 
-class DaemonInterpolationTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    Status sim = rig_.StartSim({"--noise-scale", "0"});
-    ASSERT_TRUE(sim.ok()) << sim.ToString();
-    Status daemon = rig_.StartDaemon();
-    ASSERT_TRUE(daemon.ok()) << daemon.ToString();
-  }
-  void TearDown() override {
-    if (op_) {
-      op_->Stop();
-      for (const std::string& e : op_->errors()) ADD_FAILURE() << "operator: " << e;
-    }
-    if (rig_.daemon() != nullptr) {
-      EXPECT_TRUE(rig_.StopDaemon().ok());
-    }
-    if (HasFailure() || std::getenv("BRDF_TEST_SHOW_LOG") != nullptr) {
-      std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n----\n";
-    }
-  }
-
-  grpc::Status Interpolate(const std::string& id, const v1::DirectionQuery& direction,
-                           v1::InterpolationMethod method, v1::Quantity quantity,
-                           v1::InterpolationResult* result,
-                           const v1::InterpolationOptions& options = {}) {
-    v1::InterpolateRequest request;
-    *request.mutable_options() = options;
-    request.set_session_id(id);
-    request.set_method(method);
-    request.set_quantity(quantity);
-    *request.mutable_direction() = direction;
-    v1::InterpolateResponse response;
-    grpc::Status st = rig_.interpolation().Interpolate(DaemonRig::Context(kAnalystToken).get(),
-                                                       request, &response);
-    *result = response.result();
-    return st;
-  }
-
-  static v1::DirectionQuery Iso(const IsoDirection& d) {
-    v1::DirectionQuery q;
-    q.mutable_iso()->set_theta_i(d.theta_i);
-    q.mutable_iso()->set_theta_o(d.theta_o);
-    q.mutable_iso()->set_phi(d.phi);
-    return q;
-  }
-
-  DaemonRig rig_;
-  std::unique_ptr<GrpcOperator> op_;
-};
+class DaemonInterpolationTest : public InterpolationRigTest {};
 
 TEST_F(DaemonInterpolationTest, InterpolatedSpectraFollowTheirProvenanceAndMatchTheTruth) {
   Result<v1::Session> submitted = rig_.Submit(kGridPlan);
@@ -196,7 +125,7 @@ TEST_F(DaemonInterpolationTest, InterpolatedSpectraFollowTheirProvenanceAndMatch
   for (const auto& r : *all) {
     if (r.kind() != v1::READING_KIND_SAMPLE) continue;
     samples.push_back(&by_id[r.id()]);
-    derived[r.id()] = Derive(r, by_id);
+    derived[r.id()] = DeriveReading(r, by_id);
   }
   ASSERT_GE(samples.size(), 20u);
 

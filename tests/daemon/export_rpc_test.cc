@@ -359,6 +359,38 @@ TEST_F(ExportRpcTest, GridFillNoneLeavesHolesAndTheChainFillsThemAndCountsThem) 
   }
 }
 
+// A grid in half/difference coordinates (ExportRequest.options.coordinates) is brdf-export's
+// --coordinates half-diff grid byte for byte, differs from the incidence grid, and its
+// description (the .json sidecar) records the coordinates beside the symmetries and scales.
+TEST_F(ExportRpcTest, GridInHalfDifferenceCoordinatesIsBrdfExportsAndSaysSo) {
+  v1::ExportRequest request = Request(v1::EXPORT_FORMAT_GRID_NPY);
+  request.set_step_theta_i(10);
+  request.set_step_theta_o(10);
+  request.set_step_phi(20);
+  request.set_method(v1::INTERPOLATION_METHOD_DELAUNAY);
+  const ExportResult incidence = Export(request);
+  ExpectCompleteStream(incidence);
+  EXPECT_NE(incidence.report->description_json().find("\"coordinates\": \"incidence\""),
+            std::string::npos)
+      << incidence.report->description_json();
+
+  request.mutable_options()->set_coordinates(v1::INTERPOLATION_COORDINATES_HALF_DIFFERENCE);
+  request.mutable_options()->set_mirror_phi(true);
+  const ExportResult half = Export(request);
+  ExpectCompleteStream(half);
+  const std::string& json = half.report->description_json();
+  EXPECT_NE(json.find("\"coordinates\": \"half_difference\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"mirror_phi\": true"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"axis_scale\": null"), std::string::npos) << json;
+  ASSERT_EQ(half.file.size(), incidence.file.size());
+  EXPECT_NE(half.file, incidence.file);
+
+  Result<std::string> tool = ToolExport({"grid", "--steps", "10,10,20", "--method", "delaunay",
+                                         "--mirror-phi", "--coordinates", "half-diff"});
+  ASSERT_TRUE(tool.ok()) << tool.status().ToString();
+  EXPECT_TRUE(*tool == half.file) << "brdf-export's grid differs from the RPC's";
+}
+
 // An RGL export over gRPC is brdf-export's file for the same session and options, byte for byte
 // (spectral and RGB); it reads back as a material whose BRDF has a value at every direction
 // above the surface, and the report counts the fill.

@@ -185,6 +185,60 @@ TEST_F(IndexCacheTest, ReadersKeepTheirSnapshotWhileNewReadingsBuildTheNext) {
   EXPECT_EQ((*other)->samples.get(), (*next)->samples.get());  // samples shared
 }
 
+// Half/difference coordinates are part of an index's key: with both asked for as readings land,
+// the incidence octant index is extended and the half/difference one rebuilt, and each snapshot
+// answers as a fresh index in its own coordinates over its readings (never the other's).
+TEST_F(IndexCacheTest, CoordinatesAreKeptApartAndAHalfDifferenceIndexIsRebuiltAsReadingsLand) {
+  constexpr int kLanding = 12;
+  SessionFixture s(*store_, 8 + kLanding);
+  FillGrid(s);
+  IndexCache cache(store_);
+  interp::Options incidence;
+  interp::Options half;
+  half.coordinates = interp::Coordinates::kHalfDifference;
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> theta(15, 45), phi(50, 130), r(0.1, 0.9);
+  std::vector<std::array<double, 3>> queries;
+  for (int i = 0; i < 30; ++i) queries.push_back({theta(rng), theta(rng), phi(rng)});
+  auto same_as_fresh = [&](const IndexSnapshot& snap, const interp::Options& options) {
+    auto fresh = interp::MakeInterpolator(interp::Method::kOctant, snap.samples, options);
+    ASSERT_TRUE(fresh.ok()) << fresh.status().ToString();
+    int answered = 0;
+    for (const auto& q : queries) {
+      const interp::Interpolation a = snap.interpolator->Evaluate(q);
+      const interp::Interpolation b = (*fresh)->Evaluate(q);
+      ASSERT_EQ(a.status, b.status);
+      ASSERT_EQ(a.spectrum.size(), b.spectrum.size());
+      for (std::size_t k = 0; k < a.spectrum.size(); ++k) {
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(a.spectrum[k]),
+                  std::bit_cast<std::uint64_t>(b.spectrum[k]));
+      }
+      answered += a.status == interp::InterpStatus::kOk;
+    }
+    EXPECT_GT(answered, 0);
+  };
+  std::uint64_t builds = 0;
+  for (int i = 0; i <= kLanding; ++i) {
+    if (i > 0) {
+      cache.OnReading(s.id(), s.AddSample({theta(rng), 0, theta(rng), phi(rng)}, r(rng)));
+    }
+    auto a = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kOctant, incidence);
+    auto h = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kOctant, half);
+    auto again = cache.Get(s.id(), Quantity::kBrdf, interp::Method::kOctant, incidence);
+    ASSERT_TRUE(a.ok() && h.ok() && again.ok());
+    EXPECT_NE(a->get(), h->get());
+    EXPECT_EQ(a->get(), again->get()) << "the incidence index, not the half/difference one";
+    EXPECT_EQ((*h)->options.coordinates, interp::Coordinates::kHalfDifference);
+    EXPECT_EQ((*a)->samples.get(), (*h)->samples.get());  // the same readings
+    same_as_fresh(**a, incidence);
+    same_as_fresh(**h, half);
+    // Incidence: one build, then extends; half/difference: a build per landing.
+    builds += 1;
+    EXPECT_EQ(cache.stats().builds, builds + 1) << "after reading " << i;
+    EXPECT_EQ(cache.stats().extends, static_cast<std::uint64_t>(i));
+  }
+}
+
 TEST_F(IndexCacheTest, ReadingsLandingOneByOneExtendTheOctantIndexWithFreshBuildAnswers) {
   constexpr int kLanding = 30;
   SessionFixture s(*store_, 8 + kLanding);
@@ -381,6 +435,12 @@ TEST_F(IndexCacheTest, ErrorsNameTheProblem) {
   auto sym = cache.Get(aniso.id(), Quantity::kBrdf, interp::Method::kOctant, mirror);
   EXPECT_EQ(sym.status().code(), StatusCode::kInvalidArgument);
   EXPECT_NE(sym.status().message().find("options.mirror_phi"), std::string::npos);
+  interp::Options half;
+  half.coordinates = interp::Coordinates::kHalfDifference;
+  auto hd = cache.Get(aniso.id(), Quantity::kBrdf, interp::Method::kOctant, half);
+  EXPECT_EQ(hd.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(hd.status().message().find("options.coordinates"), std::string::npos);
+  EXPECT_NE(hd.status().message().find("incidence coordinates"), std::string::npos);
 }
 
 }  // namespace

@@ -200,10 +200,15 @@ TEST(OrthantGridTest, CellsWithoutAListFallBackToTheTree) {
 }
 
 TEST(OrthantGridTest, DegenerateCloudsHaveNoGridAndStillAnswer) {
-  // All points in one plane (no extent on an axis) and a single point: no grid, tree answers.
-  std::vector<Point> flat;
-  for (int k = 0; k < 200; ++k) flat.push_back({1.0 * (k % 20), 2.0 * (k / 20), 5.0});
-  for (const std::vector<Point>& points : {flat, std::vector<Point>{{1, 2, 3}}}) {
+  // All points in one plane (no extent on an axis), in one plane up to rounding (±1e-15 on an
+  // axis, as half/difference points of in-plane readings are: such an axis once made the other
+  // two max_cells wide, a build of seconds), and a single point: no grid, tree answers.
+  std::vector<Point> flat, nearly_flat;
+  for (int k = 0; k < 200; ++k) {
+    flat.push_back({1.0 * (k % 20), 2.0 * (k / 20), 5.0});
+    nearly_flat.push_back({1.0 * (k % 20), 2.0 * (k / 20), 5.0 + (k % 3 - 1) * 1e-15});
+  }
+  for (const std::vector<Point>& points : {flat, nearly_flat, std::vector<Point>{{1, 2, 3}}}) {
     const auto samples = MakeSamples(points, LinearSpectrum(3, 1));
     const PointCloud cloud = BuildPointCloud(*samples, {}).value();
     const KdTree tree(cloud, KdTree::Kernel::kBest, KdTree::Search::kGridThenTree);

@@ -202,6 +202,25 @@ class LiveExport(unittest.TestCase):
         self.assertEqual(r.description["nan_cells"], r.unfilled_cells)
         self.assertEqual(r.description["quantity"], "brdf")
 
+    def test_grid_in_half_difference_coordinates(self):
+        """The .json sidecar (ExportResult.description) records the coordinates; the values
+        differ from the incidence grid's."""
+        inc_path = self.path("inc.npy")  # path() empties the test's folder: one file
+        incidence = self.client.export(self.session_id, "grid", inc_path, method="delaunay",
+                                       **GRID_STEPS)
+        a = np.load(inc_path)
+        half_path = self.path("half.npy")
+        half = self.client.export(self.session_id, "grid", half_path, method="delaunay",
+                                  coordinates="half-diff", **GRID_STEPS)
+        b = np.load(half_path)
+        self.assertEqual(incidence.description["coordinates"], "incidence")
+        self.assertEqual(half.description["coordinates"], "half_difference")
+        both = np.isfinite(a) & np.isfinite(b)
+        self.assertTrue(both.any())
+        self.assertFalse(np.array_equal(a[both], b[both]))
+        with self.assertRaises(ValueError):
+            self.client.export(self.session_id, "csv", self.path("x.csv"), coordinates="half-diff")
+
     def test_grid_nodes_and_csv(self):
         nodes = self.client.export(self.session_id, "grid", self.path("nodes.npy"),
                                    grid_nodes=True, method="nearest", **GRID_STEPS)

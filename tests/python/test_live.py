@@ -261,6 +261,31 @@ class LiveSession(unittest.TestCase):
                 self.assertTrue(np.all(np.isnan(batch.spectra[i])))
         self.assertEqual(list(batch.ok), [r.ok for r in batch])
 
+    def test_interpolate_in_half_difference_coordinates(self):
+        """coordinates="half-diff" reaches the daemon: other answers than incidence, each still
+        the weighted blend of the readings it names; incidence again afterwards is unchanged."""
+        sid = self.session.session_id
+        dirs = _common.candidate_queries(self.readings.of_kind("sample").iso, limit=6)
+        incidence = self.client.interpolate_batch(sid, dirs, method="delaunay")
+        half = self.client.interpolate_batch(sid, dirs, method="delaunay", coordinates="half-diff")
+        again = self.client.interpolate_batch(sid, dirs, method="delaunay",
+                                              coordinates="incidence")
+        np.testing.assert_array_equal(again.spectra, incidence.spectra)
+        both = np.asarray(incidence.ok) & np.asarray(half.ok)
+        self.assertTrue(both.any(), "no direction answered in both coordinates")
+        self.assertFalse(np.array_equal(half.spectra[both], incidence.spectra[both]))
+        for r in half:
+            if r.ok:
+                self.assertAlmostEqual(float(r.weights.sum()), 1.0, places=9)
+                np.testing.assert_allclose(
+                    r.spectrum, r.weights @ vertex_spectra(self.readings, r), rtol=1e-6)
+        one = self.client.interpolate(sid, *dirs[0], method="delaunay", coordinates="half_difference")
+        self.assertEqual(one.status, half[0].status)
+        if one.ok:
+            np.testing.assert_array_equal(one.spectrum, half.spectra[0])
+        with self.assertRaises(ValueError):
+            self.client.interpolate(sid, *dirs[0], coordinates="polar")
+
     # --- errors ----------------------------------------------------------------------------------
 
     def assertCode(self, code, fn, *args, **kwargs):

@@ -130,6 +130,22 @@ class Names(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "octant, delaunay, nearest"):
             names.to_enum("kriging", names.METHODS, "method")
 
+    def test_coordinates_in_options_and_export_requests(self):
+        from brdf_client.export import export_request
+        from brdf_client.interpolation import interpolation_options
+        half = brdf_pb2.INTERPOLATION_COORDINATES_HALF_DIFFERENCE
+        for name in ("half-diff", "half_difference", "Half-Diff"):
+            self.assertEqual(interpolation_options(coordinates=name).coordinates, half)
+        self.assertIsNone(interpolation_options(coordinates=None))
+        self.assertEqual(interpolation_options(coordinates="incidence").coordinates,
+                         brdf_pb2.INTERPOLATION_COORDINATES_INCIDENCE)
+        with self.assertRaisesRegex(ValueError, "unknown coordinates 'polar'"):
+            interpolation_options(coordinates="polar")
+        self.assertEqual(export_request("3", "merl", coordinates="half-diff").options.coordinates,
+                         half)
+        with self.assertRaisesRegex(ValueError, "coordinates are for grid, MERL and RGL"):
+            export_request("3", "csv", coordinates="half-diff")
+
 
 def reading_proto(rid, kind, radiance, theta_i=10.0, grid=(380.0, 4.0, 101)):
     r = brdf_pb2.Reading(id=rid, session_id="1", kind=kind, radiance=radiance,

@@ -112,7 +112,10 @@ Result<Interpolation> BuildInterpolator(const exports::Session& session, exports
   if (!method.ok()) return method.status();
   Result<exports::FillPolicy> policy = exports::ParseFillPolicy(choice.fill);
   if (!policy.ok()) return policy.status();
+  Result<interp::Coordinates> coordinates = interp::ParseCoordinates(choice.coordinates);
+  if (!coordinates.ok()) return coordinates.status();
   interp::Options options;
+  options.coordinates = *coordinates;
   options.mirror_phi = choice.mirror_phi;
   options.reciprocity = choice.reciprocity;
   if (!choice.scale.empty()) {

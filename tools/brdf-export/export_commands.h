@@ -32,6 +32,8 @@ struct InterpChoice {
   std::string scale;              // "a,b,c" or empty
   bool mirror_phi = false;
   bool reciprocity = false;
+  // incidence or half-diff (interp::ParseCoordinates): where the method measures and blends.
+  std::string coordinates = "incidence";
   // none: the method alone (holes stay NaN / −1); chain: then Delaunay, then the fitted
   // Cook-Torrance model (core/export/fill_chain.h).
   std::string fill = "chain";

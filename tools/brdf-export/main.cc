@@ -28,6 +28,11 @@ void AddInterpOptions(CLI::App& app, InterpChoice& c, bool reciprocity_by_defaul
   app.add_option("--scale", c.scale, "per-axis multipliers a,b,c applied before distances");
   app.add_flag("--mirror-phi", c.mirror_phi,
                "add the mirrored copies (θi, θo, −φ) and (θi, θo, 360° − φ)");
+  app.add_option("--coordinates", c.coordinates,
+                 "interpolate in incidence (θi, θo, φ) or half-diff (Rusinkiewicz's "
+                 "half/difference angles) coordinates")
+      ->check(CLI::IsMember({"incidence", "half-diff"}))
+      ->capture_default_str();
   app.add_option("--fill", c.fill,
                  "cells the method cannot fill: none (left NaN / −1) or chain (Delaunay, then the "
                  "fitted Cook-Torrance model)")

@@ -11,6 +11,7 @@
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/json_output.h"
 #include "tools/brdfctl/rpc_error.h"
+#include "tools/brdfctl/text_format.h"
 
 namespace brdf::ctl {
 namespace {
@@ -96,6 +97,14 @@ int BuildRequest(const ExportOptions& o, std::ostream& err, v1::ExportRequest* r
     return Invalid(err, "--method '" + o.method + "': use octant, delaunay or nearest");
   }
   v1::InterpolationOptions* options = request->mutable_options();
+  v1::InterpolationCoordinates coordinates{};
+  if (!ParseCoordinatesName(o.coordinates, &coordinates)) {
+    return Invalid(err, "--coordinates '" + o.coordinates + "': use incidence or half-diff");
+  }
+  if (o.what == "csv" && coordinates != v1::INTERPOLATION_COORDINATES_INCIDENCE) {
+    return Invalid(err, "--coordinates is for grid, merl and rgl exports");
+  }
+  options->set_coordinates(coordinates);
   for (double s : o.axis_scale) options->add_axis_scale(s);
   options->set_mirror_phi(o.mirror_phi);
   // A MERL or RGL cell stands for a pair of directions and its swap alike (as brdf-export).

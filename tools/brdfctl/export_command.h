@@ -35,7 +35,8 @@ struct ExportOptions {
   std::string method = "octant";  // grid, merl, rgl: octant, delaunay, nearest
   std::vector<double> axis_scale;
   bool mirror_phi = false;
-  bool reciprocity = false;     // grid: also the θi↔θo swapped readings
+  std::string coordinates = "incidence";  // grid, merl, rgl: incidence or half-diff
+  bool reciprocity = false;               // grid: also the θi↔θo swapped readings
   bool no_reciprocity = false;  // merl, rgl: reciprocity is on by default; this turns it off
   std::string fill = "chain";   // grid, merl, rgl: chain or none
   bool rgb = false;             // rgl: linear sRGB under D65 instead of spectra

@@ -105,6 +105,12 @@ int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
     return kExitInvalid;
   }
   v1::InterpolationOptions* options = request.mutable_options();
+  v1::InterpolationCoordinates coordinates{};
+  if (!ParseCoordinatesName(o.coordinates, &coordinates)) {
+    ctx.err << "brdfctl: --coordinates " << o.coordinates << ": use incidence or half-diff\n";
+    return kExitInvalid;
+  }
+  options->set_coordinates(coordinates);
   options->set_mirror_phi(o.mirror_phi);
   options->set_reciprocity(o.reciprocity);
   for (double s : o.axis_scale) options->add_axis_scale(s);
@@ -152,7 +158,11 @@ int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
     std::ostream& out = ctx.out;
     out << "session " << o.session_id << ": " << QuantityName(result.quantity()) << " ("
         << QuantityUnit(result.quantity()) << ") at " << QueryText(result.query()) << ", "
-        << MethodName(result.method()) << ": " << InterpolationStatusName(result.status()) << "\n";
+        << MethodName(result.method())
+        << (coordinates == v1::INTERPOLATION_COORDINATES_HALF_DIFFERENCE
+                ? " in half/difference coordinates"
+                : "")
+        << ": " << InterpolationStatusName(result.status()) << "\n";
     if (!result.detail().empty()) out << "  " << result.detail() << "\n";
     if (o.explain && result.vertices_size() > 0) {
       out << "\nvertices (blended readings):\n";

@@ -29,7 +29,8 @@ struct InterpolateOptions {
   bool mirror_phi = false;
   bool reciprocity = false;
   std::vector<double> axis_scale;
-  int every = 1;  // print every Nth band
+  std::string coordinates = "incidence";  // incidence or half-diff (isotropic sessions)
+  int every = 1;                          // print every Nth band
 };
 
 int RunInterpolate(CommandContext& ctx, const InterpolateOptions& options);

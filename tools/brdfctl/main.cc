@@ -218,6 +218,12 @@ int main(int argc, char** argv) {
                         "also use readings with θi and θo swapped");
   interpolate->add_option("--scale", interp.axis_scale, "per-axis distance multipliers a,b,c[,d]")
       ->delimiter(',');
+  interpolate
+      ->add_option("--coordinates", interp.coordinates,
+                   "incidence (θi, θo, φ) or half-diff (Rusinkiewicz's half/difference angles; "
+                   "isotropic sessions)")
+      ->check(CLI::IsMember({"incidence", "half-diff"}))
+      ->capture_default_str();
 
   ExportOptions export_options;
   bool export_no_progress = false;
@@ -252,6 +258,12 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   export_cmd->add_flag("--mirror-phi", export_options.mirror_phi,
                        "also use readings mirrored to −φ");
+  export_cmd
+      ->add_option("--coordinates", export_options.coordinates,
+                   "grid, merl, rgl: interpolate in incidence (θi, θo, φ) or half-diff "
+                   "(Rusinkiewicz's half/difference angles) coordinates")
+      ->check(CLI::IsMember({"incidence", "half-diff"}))
+      ->capture_default_str();
   export_cmd->add_flag("--reciprocity", export_options.reciprocity,
                        "grid: also use readings with θi and θo swapped (merl, rgl: always, see "
                        "below)");

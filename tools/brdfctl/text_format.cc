@@ -40,6 +40,17 @@ std::string QuantityName(v1::Quantity quantity) {
   return ShortEnumName(v1::Quantity_Name(quantity), "QUANTITY_");
 }
 
+bool ParseCoordinatesName(std::string_view name, v1::InterpolationCoordinates* coordinates) {
+  if (name == "incidence") {
+    *coordinates = v1::INTERPOLATION_COORDINATES_INCIDENCE;
+  } else if (name == "half-diff") {
+    *coordinates = v1::INTERPOLATION_COORDINATES_HALF_DIFFERENCE;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 std::string QuantityUnit(v1::Quantity quantity) {
   switch (quantity) {
     case v1::QUANTITY_RADIANCE:

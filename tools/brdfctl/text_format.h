@@ -26,6 +26,10 @@ std::string QuantityName(v1::Quantity quantity);
 // The quantity's unit: "W·m⁻²·sr⁻¹·nm⁻¹", "1" (reflectance), "sr⁻¹".
 std::string QuantityUnit(v1::Quantity quantity);
 
+// The command lines' --coordinates value ("incidence", "half-diff") as the API's; false for an
+// unknown name.
+bool ParseCoordinatesName(std::string_view name, v1::InterpolationCoordinates* coordinates);
+
 // Inverse of StateName ("running" → SESSION_STATE_RUNNING); false for an unknown name.
 bool ParseStateName(std::string_view name, v1::SessionState* state);
 

@@ -337,7 +337,7 @@ class BrdfClient:
                mirror_phi=False, reciprocity=None, step_theta_i=0.0, step_theta_o=0.0,
                step_phi=0.0, grid_nodes=False, exclude_flagged=False, chunk_bytes=0,
                fill="chain", rgb=False, rgl_theta_i_count=0, rgl_resolution=0,
-               on_progress=None, timeout=None):
+               on_progress=None, timeout=None, coordinates=None):
         """Has the daemon export the session as a file and saves it at `path`; returns an
         ExportResult (file name, bytes, summary, rows, cells, filled_cells, shape, ...).
 
@@ -353,7 +353,8 @@ class BrdfClient:
             leaves a truncated file (the partial file is removed).
         quantity: csv and grids: "brdf" (sr⁻¹; None: the daemon's default, BRDF), "reflectance"
             or "radiance" (csv: every reading, raw). MERL is always the BRDF.
-        method, axis_scale, mirror_phi: grids, MERL and RGL, as interpolate(). reciprocity: also
+        method, axis_scale, mirror_phi, coordinates: grids, MERL and RGL, as interpolate() (a
+            grid's .json sidecar records them). reciprocity: also
             use the θi↔θo swapped readings; None: on for MERL and RGL (a cell stands for a pair of
             directions and its swap alike, as `brdfctl export merl`), off otherwise.
         fill: grids, MERL, RGL: "chain" (cells the method cannot fill take Delaunay's value, then
@@ -382,6 +383,7 @@ class BrdfClient:
         request = export_request(session_id, fmt, "" if into_folder else path,
                                  quantity=quantity, method=method, axis_scale=axis_scale,
                                  mirror_phi=mirror_phi, reciprocity=reciprocity,
+                                 coordinates=coordinates,
                                  step_theta_i=step_theta_i, step_theta_o=step_theta_o,
                                  step_phi=step_phi, grid_nodes=grid_nodes,
                                  exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes,
@@ -435,7 +437,7 @@ class BrdfClient:
 
     def interpolate(self, session_id, theta_i, theta_o, phi=None, *, phi_i=None, phi_o=None,
                     method="octant", quantity="brdf", axis_scale=None, mirror_phi=False,
-                    reciprocity=False):
+                    reciprocity=False, coordinates=None):
         """The spectrum at one direction, from the session's SAMPLE readings.
 
         Direction, degrees: (theta_i, theta_o, phi) for isotropic sessions (φ = |φo − φi| in
@@ -443,6 +445,10 @@ class BrdfClient:
         method: "octant" (the paper's), "delaunay" or "nearest".
         quantity: "brdf" (sr⁻¹), "reflectance" (ratio) or "radiance" (W·m⁻²·sr⁻¹·nm⁻¹).
         axis_scale, mirror_phi, reciprocity: brdf.proto's InterpolationOptions.
+        coordinates: where the method measures and blends: "incidence" ((θi, θo, φ); None: the
+            daemon's default, incidence) or "half_difference" / "half-diff" (Rusinkiewicz's
+            half/difference angles; isotropic sessions only, else BrdfError INVALID_ARGUMENT).
+            Directions and the vertices' coordinates stay (θi, θo, φ) either way.
 
         Returns an InterpolationResult. A direction the method cannot fill is not an error: check
         result.ok / result.status ("empty_octant", "outside_hull", ...).
@@ -461,13 +467,13 @@ class BrdfClient:
             session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
             quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"),
             direction=direction_query(direction),
-            options=interpolation_options(axis_scale, mirror_phi, reciprocity))
+            options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates))
         response = self._unary(self._interp.Interpolate, request, "Interpolation.Interpolate")
         return InterpolationResult.from_proto(response.result)
 
     def interpolate_batch(self, session_id, directions, method="octant", quantity="brdf",
                           axis_scale=None, mirror_phi=False, reciprocity=False, chunk_size=0,
-                          timeout=None):
+                          timeout=None, coordinates=None):
         """Spectra at many directions: `directions` is (N, 3) (θi, θo, φ) or (N, 4)
         (θi, φi, θo, φo), degrees. Returns an InterpolationBatch in the order asked (spectra
         (N, m) with NaN rows where the method could not fill the direction)."""
@@ -475,7 +481,7 @@ class BrdfClient:
         request = brdf_pb2.InterpolateBatchRequest(
             session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
             quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"), directions=queries,
-            options=interpolation_options(axis_scale, mirror_phi, reciprocity),
+            options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates),
             chunk_size=chunk_size)
         results = [None] * len(queries)
         for chunk in self._stream(self._interp.InterpolateBatch, request,

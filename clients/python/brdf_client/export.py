@@ -67,7 +67,8 @@ def export_format(fmt, path=""):
 def export_request(session_id, fmt, path="", *, quantity=None, method="octant",
                    axis_scale=None, mirror_phi=False, reciprocity=None, step_theta_i=0.0,
                    step_theta_o=0.0, step_phi=0.0, grid_nodes=False, exclude_flagged=False,
-                   chunk_bytes=0, fill="chain", rgb=False, rgl_theta_i_count=0, rgl_resolution=0):
+                   chunk_bytes=0, fill="chain", rgb=False, rgl_theta_i_count=0, rgl_resolution=0,
+                   coordinates=None):
     """The ExportRequest for BrdfClient.export's arguments (which document them).
 
     As brdfctl: reciprocity None means on for MERL and RGL (a cell stands for a pair of
@@ -91,8 +92,14 @@ def export_request(session_id, fmt, path="", *, quantity=None, method="octant",
                          f"{format_name(value)}")
     if reciprocity is None:
         reciprocity = value == brdf_pb2.EXPORT_FORMAT_MERL_BINARY or rgl
+    coordinates = names.to_enum(coordinates, names.COORDINATES, "coordinates")
+    if value not in FILLED_FORMATS and coordinates not in (
+            0, brdf_pb2.INTERPOLATION_COORDINATES_INCIDENCE):
+        raise ValueError(f"coordinates are for grid, MERL and RGL exports, not "
+                         f"{format_name(value)}")
     options = brdf_pb2.InterpolationOptions(axis_scale=list(axis_scale or ()),
-                                            mirror_phi=mirror_phi, reciprocity=reciprocity)
+                                            mirror_phi=mirror_phi, reciprocity=reciprocity,
+                                            coordinates=coordinates)
     return brdf_pb2.ExportRequest(
         session_id=str(session_id), format=value,
         quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"),
@@ -123,7 +130,8 @@ class ExportResult:
                    filled cells with a negative linear-sRGB component set to 0.
       skipped_readings, first_skip_reason: sample readings left out, and why the first one was.
       shape:       grid .npy: (nθi, nθo, nφ, bands); else ().
-      description: grid .npy: the axes, wavelengths, quantity, unit, method and counts (the
+      description: grid .npy: the axes, wavelengths, quantity, unit, method, options (mirror_phi,
+                   reciprocity, coordinates, axis_scale), fill and counts (the
                    report's description_json, parsed); else None.
       warnings:    things to know, e.g. several dial positions γ folded together.
       fill:        grids, MERL, RGL: where the cells' values came from, {"policy": "chain" or

@@ -169,9 +169,16 @@ def direction_query(direction):
                      f"not {len(d)} numbers")
 
 
-def interpolation_options(axis_scale=None, mirror_phi=False, reciprocity=False):
-    """A brdf.v1.InterpolationOptions, or None when every option is at its default."""
-    if not axis_scale and not mirror_phi and not reciprocity:
+def interpolation_options(axis_scale=None, mirror_phi=False, reciprocity=False,
+                          coordinates=None):
+    """A brdf.v1.InterpolationOptions, or None when every option is at its default.
+
+    coordinates: "incidence" (θi, θo, φ), "half_difference" (or "half-diff": Rusinkiewicz's
+    half/difference angles, isotropic sessions only) or None (the daemon's default, incidence).
+    An unknown name raises ValueError."""
+    coordinates = names.to_enum(coordinates, names.COORDINATES, "coordinates")
+    if not axis_scale and not mirror_phi and not reciprocity and not coordinates:
         return None
     return brdf_pb2.InterpolationOptions(axis_scale=list(axis_scale or []),
-                                         mirror_phi=mirror_phi, reciprocity=reciprocity)
+                                         mirror_phi=mirror_phi, reciprocity=reciprocity,
+                                         coordinates=coordinates)

@@ -12,6 +12,13 @@ METHODS = {
     "delaunay": brdf_pb2.INTERPOLATION_METHOD_DELAUNAY,
     "nearest": brdf_pb2.INTERPOLATION_METHOD_NEAREST,
 }
+# Where a method measures distances and blends (InterpolationOptions.coordinates). "half-diff",
+# the command lines' spelling of "half_difference", arrives here as "half_diff" (to_enum).
+COORDINATES = {
+    "incidence": brdf_pb2.INTERPOLATION_COORDINATES_INCIDENCE,
+    "half_difference": brdf_pb2.INTERPOLATION_COORDINATES_HALF_DIFFERENCE,
+    "half_diff": brdf_pb2.INTERPOLATION_COORDINATES_HALF_DIFFERENCE,
+}
 QUANTITIES = {
     "radiance": brdf_pb2.QUANTITY_RADIANCE,
     "reflectance": brdf_pb2.QUANTITY_REFLECTANCE,

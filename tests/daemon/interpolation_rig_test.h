@@ -1,0 +1,91 @@
+// The fixture of the interpolation tests over gRPC: brdf-sim (noiseless, --noise-scale 0) and
+// brdfd as processes, an operator answering prompts once a test makes one, and calls of
+// Interpolate and InterpolateBatch with an analyst's token. brdfd's log goes to standard error
+// when a test fails (or with BRDF_TEST_SHOW_LOG set).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/pose.h"
+#include "tests/daemon/daemon_test_rig.h"
+
+namespace brdf::testing {
+
+class InterpolationRigTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    Status sim = rig_.StartSim({"--noise-scale", "0"});
+    ASSERT_TRUE(sim.ok()) << sim.ToString();
+    Status daemon = rig_.StartDaemon();
+    ASSERT_TRUE(daemon.ok()) << daemon.ToString();
+  }
+  void TearDown() override {
+    if (op_) {
+      op_->Stop();
+      for (const std::string& e : op_->errors()) ADD_FAILURE() << "operator: " << e;
+    }
+    if (rig_.daemon() != nullptr) {
+      EXPECT_TRUE(rig_.StopDaemon().ok());
+    }
+    if (HasFailure() || std::getenv("BRDF_TEST_SHOW_LOG") != nullptr) {
+      std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n----\n";
+    }
+  }
+
+  grpc::Status Interpolate(const std::string& id, const v1::DirectionQuery& direction,
+                           v1::InterpolationMethod method, v1::Quantity quantity,
+                           v1::InterpolationResult* result,
+                           const v1::InterpolationOptions& options = {}) {
+    v1::InterpolateRequest request;
+    *request.mutable_options() = options;
+    request.set_session_id(id);
+    request.set_method(method);
+    request.set_quantity(quantity);
+    *request.mutable_direction() = direction;
+    v1::InterpolateResponse response;
+    grpc::Status st = rig_.interpolation().Interpolate(DaemonRig::Context(kAnalystToken).get(),
+                                                       request, &response);
+    *result = response.result();
+    return st;
+  }
+
+  // The whole batch's results in order, or the call's error.
+  grpc::Status Batch(const std::string& id, const std::vector<IsoDirection>& queries,
+                     v1::InterpolationMethod method, v1::Quantity quantity,
+                     std::vector<v1::InterpolationResult>* results,
+                     const v1::InterpolationOptions& options = {}) {
+    v1::InterpolateBatchRequest batch;
+    batch.set_session_id(id);
+    batch.set_method(method);
+    batch.set_quantity(quantity);
+    *batch.mutable_options() = options;
+    for (const IsoDirection& q : queries) *batch.add_directions() = Iso(q);
+    auto context = DaemonRig::Context(kAnalystToken);
+    auto reader = rig_.interpolation().InterpolateBatch(context.get(), batch);
+    v1::InterpolateBatchChunk chunk;
+    results->clear();
+    while (reader->Read(&chunk)) {
+      for (const v1::InterpolationResult& r : chunk.results()) results->push_back(r);
+    }
+    return reader->Finish();
+  }
+
+  static v1::DirectionQuery Iso(const IsoDirection& d) {
+    v1::DirectionQuery q;
+    q.mutable_iso()->set_theta_i(d.theta_i);
+    q.mutable_iso()->set_theta_o(d.theta_o);
+    q.mutable_iso()->set_phi(d.phi);
+    return q;
+  }
+
+  DaemonRig rig_;
+  std::unique_ptr<GrpcOperator> op_;
+};
+
+}  // namespace brdf::testing
