@@ -84,15 +84,13 @@ export function createExplorer(root, report) {
     session = id;
     const t0 = performance.now();
     const chunks = [];
-    const streaming = stream('Data/StreamReadingPoints', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (c) => chunks.push(c));
-    const plotting = plotly().then((P) => { Plotly = P; }); // parsed while the readings come
-    await streaming;
+    await stream('Data/StreamReadingPoints', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (c) => chunks.push(c));
     const streamed = performance.now() - t0;
     points = joinColumns(chunks);
     if (points.ids.length === 0) {
       loadInfo.textContent = 'this session has no sample readings yet';
       for (const f of [fig7a, fig7b]) f.setPoints({ x: [], y: [], z: [], value: [] });
-      await plotting;
+      Plotly = await plotly();
       for (const p of [spectrum, polar]) Plotly.purge(p);
       return;
     }
@@ -100,7 +98,10 @@ export function createExplorer(root, report) {
     fig7b.setPoints({ x: points.theta_i, y: points.theta_o, z: points.phi, value: points.theta_i });
     loadInfo.textContent = `${points.ids.length} sample readings loaded in ${Math.round(streamed)} ms, plotted in ${Math.round(performance.now() - t0 - streamed)} ms`;
     renderDownloads();
-    await plotting;
+    // plotly (the 2D plots) only once Figure 7 is on screen: parsing it blocks the page for most
+    // of a second, which would hold up the readings' messages and the point clouds' first frame.
+    await new Promise((r) => requestAnimationFrame(r));
+    Plotly = await plotly();
     await planeOfIncidence();
   }
 
