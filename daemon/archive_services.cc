@@ -231,8 +231,27 @@ ArchiveDataService::ArchiveDataService(std::shared_ptr<storage::ArchiveReader> a
 grpc::Status ArchiveDataService::StreamReadings(grpc::ServerContext* context,
                                                 const v1::StreamReadingsRequest* request,
                                                 grpc::ServerWriter<v1::Reading>* writer) {
+  return Serve(
+      *context, *request,
+      [&](StreamReadingsCall& call, const ReadingExtras& extras, const ReadingSource& source) {
+        return StreamSessionReadings(*context, *request, call, extras, source, writer);
+      });
+}
+
+grpc::Status ArchiveDataService::StreamReadingPoints(
+    grpc::ServerContext* context, const v1::StreamReadingsRequest* request,
+    grpc::ServerWriter<v1::ReadingPoints>* writer) {
+  return Serve(*context, *request,
+               [&](StreamReadingsCall& call, const ReadingExtras&, const ReadingSource& source) {
+                 return StreamSessionReadingPoints(*context, *request, call, source, writer);
+               });
+}
+
+grpc::Status ArchiveDataService::Serve(grpc::ServerContext& context,
+                                       const v1::StreamReadingsRequest& request,
+                                       const ReadingStreamBody& body) {
   StreamReadingsCall call;
-  if (grpc::Status st = CheckStreamReadings(*context, *request, auth_, streams_, &call); !st.ok()) {
+  if (grpc::Status st = CheckStreamReadings(context, request, auth_, streams_, &call); !st.ok()) {
     return st;
   }
   Result<storage::SessionRecord> session = archive_->GetSession(call.session);
@@ -247,8 +266,7 @@ grpc::Status ArchiveDataService::StreamReadings(grpc::ServerContext* context,
   source.ended = [&] { return archive_->Finished(call.session); };
   source.wait = [&] { return stopping_.WaitFor(kArchivePollInterval); };
   source.server = "brdf-archive";
-  return StreamSessionReadings(*context, *request, call,
-                               ReadingExtrasOf(*archive_, call.session, averages), source, writer);
+  return body(call, ReadingExtrasOf(*archive_, call.session, averages), source);
 }
 
 grpc::Status ArchiveDataService::Export(grpc::ServerContext* context,

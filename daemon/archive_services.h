@@ -23,6 +23,7 @@
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/auth.h"
 #include "daemon/service_common.h"
+#include "daemon/stream_readings.h"
 #include "daemon/stream_registry.h"
 #include "storage/archive_reader.h"
 
@@ -79,10 +80,17 @@ class ArchiveDataService final : public v1::Data::Service {
   grpc::Status StreamReadings(grpc::ServerContext* context,
                               const v1::StreamReadingsRequest* request,
                               grpc::ServerWriter<v1::Reading>* writer) override;
+  grpc::Status StreamReadingPoints(grpc::ServerContext* context,
+                                   const v1::StreamReadingsRequest* request,
+                                   grpc::ServerWriter<v1::ReadingPoints>* writer) override;
   grpc::Status Export(grpc::ServerContext* context, const v1::ExportRequest* request,
                       grpc::ServerWriter<v1::ExportChunk>* writer) override;
 
  private:
+  // Both readings streams: the request checked, the session looked up, then `body` with the
+  // archive as the source (polled for newly shipped readings).
+  grpc::Status Serve(grpc::ServerContext& context, const v1::StreamReadingsRequest& request,
+                     const ReadingStreamBody& body);
   std::shared_ptr<storage::ArchiveReader> archive_;
   const Authenticator& auth_;
   const StopSignal& stopping_;

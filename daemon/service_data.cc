@@ -36,8 +36,27 @@ void DataService::WaitForReading(std::uint64_t seen, std::chrono::steady_clock::
 grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
                                          const v1::StreamReadingsRequest* request,
                                          grpc::ServerWriter<v1::Reading>* writer) {
+  return Serve(
+      *context, *request,
+      [&](StreamReadingsCall& call, const ReadingExtras& extras, const ReadingSource& source) {
+        return StreamSessionReadings(*context, *request, call, extras, source, writer);
+      });
+}
+
+grpc::Status DataService::StreamReadingPoints(grpc::ServerContext* context,
+                                              const v1::StreamReadingsRequest* request,
+                                              grpc::ServerWriter<v1::ReadingPoints>* writer) {
+  return Serve(*context, *request,
+               [&](StreamReadingsCall& call, const ReadingExtras&, const ReadingSource& source) {
+                 return StreamSessionReadingPoints(*context, *request, call, source, writer);
+               });
+}
+
+grpc::Status DataService::Serve(grpc::ServerContext& context,
+                                const v1::StreamReadingsRequest& request,
+                                const ReadingStreamBody& body) {
   StreamReadingsCall call;
-  if (grpc::Status st = CheckStreamReadings(*context, *request, auth_, streams_, &call); !st.ok()) {
+  if (grpc::Status st = CheckStreamReadings(context, request, auth_, streams_, &call); !st.ok()) {
     return st;
   }
   storage::SessionStore& store = *manager_.store();
@@ -67,7 +86,7 @@ grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
     WaitForReading(generation, kStreamPollInterval);
     return false;
   };
-  return StreamSessionReadings(*context, *request, call, extras, source, writer);
+  return body(call, extras, source);
 }
 
 }  // namespace brdf::daemon

@@ -13,6 +13,7 @@
 #include "daemon/auth.h"
 #include "daemon/service_common.h"
 #include "daemon/session_manager.h"
+#include "daemon/stream_readings.h"
 #include "daemon/stream_registry.h"
 
 namespace brdf::daemon {
@@ -28,6 +29,10 @@ class DataService final : public v1::Data::Service {
   grpc::Status StreamReadings(grpc::ServerContext* context,
                               const v1::StreamReadingsRequest* request,
                               grpc::ServerWriter<v1::Reading>* writer) override;
+  // The same readings as columns of poses and directions, without spectra.
+  grpc::Status StreamReadingPoints(grpc::ServerContext* context,
+                                   const v1::StreamReadingsRequest* request,
+                                   grpc::ServerWriter<v1::ReadingPoints>* writer) override;
 
   // A session exported to a file (readings CSV, grid .npy/CSV, MERL .binary), streamed as
   // progress, the file's bytes in chunks, then the report. Defined in service_export.cc.
@@ -35,6 +40,11 @@ class DataService final : public v1::Data::Service {
                       grpc::ServerWriter<v1::ExportChunk>* writer) override;
 
  private:
+  // Both readings streams: the request checked, the session looked up, then `body` with the
+  // store as the source (following new readings through the listener).
+  grpc::Status Serve(grpc::ServerContext& context, const v1::StreamReadingsRequest& request,
+                     const ReadingStreamBody& body);
+
   // Woken whenever any reading is committed; followers re-read the store then.
   std::uint64_t Generation() const;
   void WaitForReading(std::uint64_t seen, std::chrono::steady_clock::duration d) const;

@@ -1,12 +1,19 @@
 #include "daemon/stream_readings.h"
 
+#include <functional>
 #include <vector>
+
+#include "core/geometry.h"
 
 namespace brdf::daemon {
 namespace {
 
 // Readings per page read from the store (and written before the next page is read).
 constexpr int kPageSize = 256;
+// StreamReadingPoints reads larger pages (fewer queries; a page is still a few MB).
+constexpr int kPointsPageSize = 2048;
+// Readings per StreamReadingPoints message (8 numbers each: well under gRPC's 4 MB).
+constexpr int kPointsPerMessage = 8192;
 
 }  // namespace
 
@@ -44,12 +51,19 @@ ReadingExtras ReadingExtrasOf(storage::SessionReader& reader, std::int64_t sessi
   return extras;
 }
 
-grpc::Status StreamSessionReadings(grpc::ServerContext& context,
-                                   const v1::StreamReadingsRequest& request,
-                                   StreamReadingsCall& call, const ReadingExtras& extras,
-                                   const ReadingSource& source,
-                                   grpc::ServerWriter<v1::Reading>* writer) {
+namespace {
+
+// The page loop both streams share: the session's readings in id order a page at a time, and
+// with `follow` those that arrive later. on_page gets each page's readings of the asked kinds and
+// whether more are stored right now (false before the stream waits or ends); it returns false
+// when the client went away.
+grpc::Status ForEachReadingPage(
+    grpc::ServerContext& context, const v1::StreamReadingsRequest& request,
+    StreamReadingsCall& call, const ReadingSource& source, int page_size,
+    const std::function<bool(const std::vector<const storage::ReadingRecord*>&, bool more_stored)>&
+        on_page) {
   std::int64_t last = request.after_id();
+  std::vector<const storage::ReadingRecord*> kept;
   for (;;) {
     if (context.IsCancelled()) {
       return grpc::Status(grpc::StatusCode::CANCELLED, "StreamReadings: cancelled by the client");
@@ -61,16 +75,18 @@ grpc::Status StreamSessionReadings(grpc::ServerContext& context,
       ended = *now;
     }
     Result<std::vector<storage::ReadingRecord>> page =
-        source.reader->GetReadings(call.session, last, kPageSize);
+        source.reader->GetReadings(call.session, last, page_size);
     if (!page.ok()) return ToGrpcStatus(page.status());
+    kept.clear();
     for (const storage::ReadingRecord& r : *page) {
       last = r.id;
-      if (!call.kinds.empty() && call.kinds.count(r.kind) == 0) continue;
-      if (!call.slot->Write(writer, ToProtoReading(r, extras))) {
-        return grpc::Status(grpc::StatusCode::CANCELLED, "StreamReadings: the client went away");
-      }
+      if (call.kinds.empty() || call.kinds.count(r.kind) != 0) kept.push_back(&r);
     }
-    if (static_cast<int>(page->size()) == kPageSize) continue;  // more stored: next page now
+    const bool more_stored = static_cast<int>(page->size()) == page_size;
+    if (!on_page(kept, more_stored)) {
+      return grpc::Status(grpc::StatusCode::CANCELLED, "StreamReadings: the client went away");
+    }
+    if (more_stored) continue;  // next page now
     if (ended) return grpc::Status::OK;
     if (source.wait()) {
       return grpc::Status(grpc::StatusCode::UNAVAILABLE,
@@ -79,6 +95,59 @@ grpc::Status StreamSessionReadings(grpc::ServerContext& context,
                               " once it is back");
     }
   }
+}
+
+void AddPoint(const storage::ReadingRecord& r, v1::ReadingPoints* points) {
+  points->add_ids(r.id);
+  points->add_alpha(r.pose.alpha);
+  points->add_beta(r.pose.beta);
+  points->add_delta(r.pose.delta);
+  const IsoDirection iso = ToIsotropic(r.directions);
+  points->add_theta_i(iso.theta_i);
+  points->add_theta_o(iso.theta_o);
+  points->add_phi(iso.phi);
+  points->add_flagged(r.flagged);
+}
+
+}  // namespace
+
+grpc::Status StreamSessionReadings(grpc::ServerContext& context,
+                                   const v1::StreamReadingsRequest& request,
+                                   StreamReadingsCall& call, const ReadingExtras& extras,
+                                   const ReadingSource& source,
+                                   grpc::ServerWriter<v1::Reading>* writer) {
+  return ForEachReadingPage(context, request, call, source, kPageSize,
+                            [&](const std::vector<const storage::ReadingRecord*>& page, bool) {
+                              for (const storage::ReadingRecord* r : page) {
+                                if (!call.slot->Write(writer, ToProtoReading(*r, extras)))
+                                  return false;
+                              }
+                              return true;
+                            });
+}
+
+grpc::Status StreamSessionReadingPoints(grpc::ServerContext& context,
+                                        const v1::StreamReadingsRequest& request,
+                                        StreamReadingsCall& call, const ReadingSource& source,
+                                        grpc::ServerWriter<v1::ReadingPoints>* writer) {
+  v1::ReadingPoints points;
+  return ForEachReadingPage(
+      context, request, call, source, kPointsPageSize,
+      [&](const std::vector<const storage::ReadingRecord*>& page, bool more_stored) {
+        for (const storage::ReadingRecord* r : page) {
+          AddPoint(*r, &points);
+          if (points.ids_size() == kPointsPerMessage) {
+            if (!call.slot->Write(writer, points)) return false;
+            points.Clear();
+          }
+        }
+        // Whatever is held goes out before the stream waits for more or ends.
+        if (!more_stored && points.ids_size() > 0) {
+          if (!call.slot->Write(writer, points)) return false;
+          points.Clear();
+        }
+        return true;
+      });
 }
 
 }  // namespace brdf::daemon

@@ -1,7 +1,8 @@
-// StreamReadings' work, shared by brdfd's Data service (service_data.h, over the rig's store) and
-// brdf-archive's (archive_services.h, over the archive): the request checked, then the session's
-// readings written in id order a page at a time (memory bounded by one page), and with `follow`
-// the readings that arrive later, until the session ends, the client cancels or the server stops.
+// StreamReadings' (and StreamReadingPoints') work, shared by brdfd's Data service (service_data.h,
+// over the rig's store) and brdf-archive's (archive_services.h, over the archive): the request
+// checked, then the session's readings written in id order a page at a time (memory bounded by one
+// page), and with `follow` the readings that arrive later, until the session ends, the client
+// cancels or the server stops.
 #pragma once
 
 #include <functional>
@@ -42,6 +43,11 @@ struct ReadingSource {
   std::string server = "the daemon";  // in the stopping message
 };
 
+// What a readings stream does once its request is checked and its source set up (the rig's and
+// the archive's Data services share their set-up between StreamReadings and StreamReadingPoints).
+using ReadingStreamBody = std::function<grpc::Status(
+    StreamReadingsCall& call, const ReadingExtras& extras, const ReadingSource& source)>;
+
 // The session's step labels from `reader`, with the plan's averaging count (0: 1).
 ReadingExtras ReadingExtrasOf(storage::SessionReader& reader, std::int64_t session,
                               std::uint32_t averages);
@@ -52,5 +58,12 @@ grpc::Status StreamSessionReadings(grpc::ServerContext& context,
                                    StreamReadingsCall& call, const ReadingExtras& extras,
                                    const ReadingSource& source,
                                    grpc::ServerWriter<v1::Reading>* writer);
+
+// The same readings as columns (StreamReadingPoints): up to 8,192 a message, and what is held is
+// written before the stream waits (follow) or ends.
+grpc::Status StreamSessionReadingPoints(grpc::ServerContext& context,
+                                        const v1::StreamReadingsRequest& request,
+                                        StreamReadingsCall& call, const ReadingSource& source,
+                                        grpc::ServerWriter<v1::ReadingPoints>* writer);
 
 }  // namespace brdf::daemon

@@ -45,6 +45,7 @@ const std::map<std::string, Needs>& Classification() {
       {"brdf.v1.Control.WatchSession", Needs::kRead},
       {"brdf.v1.Data.StreamReadings", Needs::kRead},
       {"brdf.v1.Data.Export", Needs::kRead},
+      {"brdf.v1.Data.StreamReadingPoints", Needs::kRead},
       {"brdf.v1.Interpolation.Interpolate", Needs::kRead},
       {"brdf.v1.Interpolation.InterpolateBatch", Needs::kRead},
   };

@@ -188,6 +188,40 @@ TEST_F(DaemonSessionTest, SampleRotationPlanRunsToCompletionWithEveryReadingAndE
     EXPECT_EQ(n, expected);
   }
 
+  // The compact listing (StreamReadingPoints): the same sample readings, in the same order, as
+  // columns of ids, poses and isotropic directions.
+  {
+    v1::StreamReadingsRequest request;
+    request.set_session_id(id);
+    request.add_kinds(v1::READING_KIND_SAMPLE);
+    auto context = DaemonRig::Context(kAnalystToken);
+    auto reader = rig_.data().StreamReadingPoints(context.get(), request);
+    v1::ReadingPoints points;
+    std::vector<const v1::Reading*> samples;
+    for (const auto& r : readings) {
+      if (r.kind() == v1::READING_KIND_SAMPLE) samples.push_back(&r);
+    }
+    std::size_t k = 0;
+    while (reader->Read(&points)) {
+      ASSERT_EQ(points.theta_i_size(), points.ids_size());
+      ASSERT_EQ(points.flagged_size(), points.ids_size());
+      for (int j = 0; j < points.ids_size(); ++j, ++k) {
+        ASSERT_LT(k, samples.size());
+        const v1::Reading& r = *samples[k];
+        EXPECT_EQ(points.ids(j), r.id());
+        EXPECT_EQ(points.alpha(j), r.pose().alpha());
+        EXPECT_EQ(points.beta(j), r.pose().beta());
+        EXPECT_EQ(points.delta(j), r.pose().delta());
+        EXPECT_EQ(points.theta_i(j), r.iso().theta_i());
+        EXPECT_EQ(points.theta_o(j), r.iso().theta_o());
+        EXPECT_EQ(points.phi(j), r.iso().phi());
+        EXPECT_EQ(points.flagged(j), r.flagged());
+      }
+    }
+    EXPECT_TRUE(reader->Finish().ok());
+    EXPECT_EQ(k, samples.size());
+  }
+
   // The watcher: a snapshot first, sequence numbers increasing, step completions with progress,
   // the prompts the plan needs, and the stream closed after the session completed.
   for (int i = 0; i < 100 && !op.finished(); ++i) std::this_thread::sleep_for(20ms);

@@ -1,36 +1,66 @@
 // The explorer on a 50,000-reading session, in headless Chromium: how long the first view takes
-// (sign-in done; from opening #explorer to Figure 7's two 3D plots drawn and the plane of
-// incidence computed) and how long a new direction's spectrum takes (from the click to the
-// interpolated spectrum and its vertex spectra drawn), as medians, with the gateway's no-op round
-// trip (an Interpolate without a direction: authorized, parsed and refused before any index
-// lookup) measured in the same run as the baseline. The session is bench_storage's (a completed
-// isotropic session of N sample readings at random directions); brdfd runs without a rig.
+// (sign-in done; from opening #explorer to Figure 7's two 3D point clouds drawn and the polar
+// plot of the plane of incidence drawn) and how long a new direction's spectrum takes (from the
+// click to the interpolated spectrum and its vertex spectra drawn), as medians, each with a
+// baseline measured in the same run, interleaved: the first view of the SAME explorer on a small
+// session (500 readings, its own brdfd) and the gateway's no-op round trip (an Interpolate
+// without a direction: authorized, parsed and refused before any index lookup). Also printed:
+// the gateway call behind Figure 7 alone (Data.StreamReadingPoints from the page: time, bytes).
+// The sessions are bench_storage's (completed isotropic sessions of N sample readings at random
+// directions); brdfd runs without a rig.
 //   BRDF_BUILD_DIR=build node web/bench/explorer_50k.mjs [readings]    (from web/: node bench/…)
+//   BRDF_BENCH_DB=<50k db> BRDF_BENCH_SMALL_DB=<500 db>: reuse sessions made before (creating the
+//   big one takes minutes; the bench prints where it kept them). BRDF_BENCH_VIEWS: first views
+//   per session (default 5).
+//
+// Measured (2026-12-04, this machine, load average 5–7 from two other builds; chromium with
+// SwiftShader, no GPU):
+//   before (Figure 7 from StreamReadings?omit=radiance, one JSON event per reading, 29 MB;
+//   plotly scatter3d, a glyph mesh per marker): first view 26.7 s (text only; the WebGL frames
+//   took another 15 s), new direction 98.9 ms, no-op 18.8 ms.
+//   after (5 views; Figure 7 from Data.StreamReadingPoints, 3.81 MB in 8 events; three.js
+//   points; plotly loaded after Figure 7 is drawn): first view, Figure 7 drawn, median 1456 ms
+//   (500-reading session 769 ms, ratio 1.89); with the polar plot 3758 ms (small 2910 ms, ratio
+//   1.29: plotly's load and parse, ~2 s under that load, is most of it); new direction median
+//   90.0 ms, no-op 8.6 ms, ratio 10.5; StreamReadingPoints alone 872 ms.
 import puppeteer from 'puppeteer-core';
 import { spawn, execFileSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync, openSync, readFileSync, copyFileSync } from 'node:fs';
+import { mkdtempSync, writeFileSync, openSync, readFileSync, copyFileSync, existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { createInterface } from 'node:readline';
 
 const build = process.env.BRDF_BUILD_DIR;
 const readings = Number(process.argv[2] || 50000);
+const smallReadings = 500;
 const dir = mkdtempSync(join(tmpdir(), 'brdf-web-bench-'));
-const db = join(dir, 'brdfd.db');
-const t0 = Date.now();
-if (process.env.BRDF_BENCH_DB) {
-  copyFileSync(process.env.BRDF_BENCH_DB, db); // a session made before (creating one takes minutes)
-} else {
-  execFileSync(join(build, 'bench/daemon/bench_storage'), ['create', '--db', db, '--readings', String(readings)]);
-  console.log(`session of ${readings} readings created in ${Date.now() - t0} ms (keep ${db} and pass it as BRDF_BENCH_DB)`);
-}
 const token = 'bench-analyst-token-0123456789';
-writeFileSync(join(dir, 'brdfd.toml'), `[server]
+
+// A session database in `dir` (copied from `keep` when given, else created there).
+function sessionDb(name, n, keep) {
+  const db = join(dir, `${name}.db`);
+  const t0 = Date.now();
+  if (keep && existsSync(keep)) {
+    copyFileSync(keep, db);
+  } else {
+    execFileSync(join(build, 'bench/daemon/bench_storage'), ['create', '--db', db, '--readings', String(n)]);
+    const kept = join(tmpdir(), `brdf-web-bench-${n}.db`);
+    copyFileSync(db, kept);
+    console.log(`session of ${n} readings created in ${Date.now() - t0} ms (kept as ${kept}; pass it as ${name === 'big' ? 'BRDF_BENCH_DB' : 'BRDF_BENCH_SMALL_DB'})`);
+  }
+  return db;
+}
+
+// brdfd on `db` without a rig; resolves with the web console's URL.
+async function startDaemon(name, db) {
+  const sub = join(dir, name);
+  execFileSync('mkdir', ['-p', sub]);
+  writeFileSync(join(sub, 'brdfd.toml'), `[server]
 listen = "127.0.0.1:0"
 [storage]
 database = "${db}"
 [meter]
-port = "${dir}/no-meter"
+port = "${sub}/no-meter"
 [stage]
 address = "127.0.0.1:1"
 [[auth.tokens]]
@@ -42,28 +72,61 @@ listen = "127.0.0.1:0"
 [log]
 level = "warn"
 `);
-const daemon = spawn(join(build, 'daemon/brdfd'), ['--config', join(dir, 'brdfd.toml')], { stdio: ['ignore', 'pipe', openSync(join(dir, 'brdfd.log'), 'w')] });
-const url = await new Promise((resolve, reject) => {
-  daemon.on('exit', (c) => reject(new Error(`brdfd exited ${c}: ${readFileSync(join(dir, 'brdfd.log'), 'utf8')}`)));
-  createInterface({ input: daemon.stdout }).on('line', (l) => { const m = /^brdfd web console on (\S+)/.exec(l); if (m) resolve(m[1]); });
-});
+  const daemon = spawn(join(build, 'daemon/brdfd'), ['--config', join(sub, 'brdfd.toml')], { stdio: ['ignore', 'pipe', openSync(join(sub, 'brdfd.log'), 'w')] });
+  const url = await new Promise((resolve, reject) => {
+    daemon.on('exit', (c) => reject(new Error(`brdfd exited ${c}: ${readFileSync(join(sub, 'brdfd.log'), 'utf8')}`)));
+    createInterface({ input: daemon.stdout }).on('line', (l) => { const m = /^brdfd web console on (\S+)/.exec(l); if (m) resolve(m[1]); });
+  });
+  return { daemon, url };
+}
+
+const big = await startDaemon('big', sessionDb('big', readings, process.env.BRDF_BENCH_DB));
+const small = await startDaemon('small', sessionDb('small', smallReadings, process.env.BRDF_BENCH_SMALL_DB));
 const median = (a) => { const s = [...a].sort((x, y) => x - y); return s[Math.floor(s.length / 2)]; };
 const browser = await puppeteer.launch({ executablePath: process.env.BRDF_CHROMIUM || '/usr/bin/chromium', headless: true, args: ['--no-sandbox', '--disable-dev-shm-usage', '--enable-unsafe-swiftshader', '--use-angle=swiftshader'], defaultViewport: { width: 1400, height: 1000 } });
-try {
+
+async function signedIn(url) {
   const page = await browser.newPage();
   await page.goto(url);
   await page.type('#token', token);
   await page.click('#login-button');
   await page.waitForFunction(() => document.getElementById('who').textContent === 'analyst');
-  const firstViews = [];
-  for (let i = 0; i < Number(process.env.BRDF_BENCH_VIEWS || 3); i++) {
-    await page.goto('about:blank'); // a real page load each time (sessionStorage stays)
-    const s = Date.now();
-    await page.goto(`${url}#explorer`);
-    await page.waitForFunction(() => /sample readings loaded/.test(document.getElementById('explorer-info')?.textContent || ''), { timeout: 120000, polling: 20 });
-    firstViews.push(Date.now() - s);
-    console.log(`first view ${firstViews.at(-1)} ms: ${await page.$eval('#explorer-info', (e) => e.textContent)}`);
+  return page;
+}
+
+// From opening #explorer to Figure 7's two point clouds drawn (`fig7`, one frame after), and on
+// to the plane of incidence's polar plot drawn as well (`full`: plotly is loaded for it).
+async function firstView(page, url) {
+  await page.bringToFront(); // a tab in the background gets no animation frames
+  await page.goto('about:blank'); // a real page load each time (sessionStorage stays)
+  const s = Date.now();
+  await page.goto(`${url}#explorer`);
+  await page.waitForFunction(() => /sample readings loaded/.test(document.getElementById('explorer-info')?.textContent || ''), { timeout: 120000, polling: 10 });
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => r())));
+  const fig7 = Date.now() - s;
+  await page.waitForFunction(() => document.querySelector('#polar .trace'), { timeout: 120000, polling: 10 });
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => r())));
+  return { fig7, full: Date.now() - s };
+}
+
+try {
+  const page = await signedIn(big.url);
+  const smallPage = await signedIn(small.url);
+  const views = [];
+  const smallViews = [];
+  for (let i = 0; i < Number(process.env.BRDF_BENCH_VIEWS || 5); i++) {
+    views.push(await firstView(page, big.url));
+    smallViews.push(await firstView(smallPage, small.url));
+    console.log(`first view: Figure 7 ${views.at(-1).fig7} ms, with the polar plot ${views.at(-1).full} ms (${await page.$eval('#explorer-info', (e) => e.textContent)}); small session ${smallViews.at(-1).fig7} / ${smallViews.at(-1).full} ms`);
   }
+  await page.bringToFront();
+  const points = await page.evaluate(async () => {
+    const s = performance.now();
+    const r = await fetch('/api/brdf.v1.Data/StreamReadingPoints', { method: 'POST', headers: { 'Content-Type': 'application/json', Authorization: `Bearer ${sessionStorage.getItem('brdfd.token')}` }, body: JSON.stringify({ session_id: '1', kinds: ['READING_KIND_SAMPLE'] }) });
+    const text = await r.text();
+    return { ms: performance.now() - s, bytes: text.length, events: text.split('\n\n').length - 1 };
+  });
+  console.log(`Figure 7's gateway call alone (Data.StreamReadingPoints, ${readings} readings): ${points.ms.toFixed(0)} ms, ${(points.bytes / 1e6).toFixed(2)} MB in ${points.events} events`);
   await page.screenshot({ path: join(dir, 'explorer-50k.png'), fullPage: true });
   const spectra = [];
   const noop = [];
@@ -92,9 +155,15 @@ try {
   }
   console.log(`a new direction's spectrum (click → interpolated and vertex spectra drawn): median ${median(spectra).toFixed(1)} ms, max ${Math.max(...spectra).toFixed(1)} ms over ${spectra.length}`);
   console.log(`gateway no-op round trip: median ${median(noop).toFixed(1)} ms; ratio spectrum/no-op ${(median(spectra) / median(noop)).toFixed(1)}`);
-  console.log(`first view: median ${median(firstViews)} ms over ${firstViews.length} (target < 2000 ms); new direction target < 100 ms`);
+  for (const [key, what] of [['fig7', "Figure 7's point clouds drawn"], ['full', 'and the polar plot drawn']]) {
+    const b = median(views.map((v) => v[key]));
+    const sm = median(smallViews.map((v) => v[key]));
+    console.log(`first view (${what}): median ${b} ms over ${views.length} (target < 2000 ms); small session (${smallReadings} readings) ${sm} ms; ratio 50k/small ${(b / sm).toFixed(2)}`);
+  }
+  console.log(`new direction: median ${median(spectra).toFixed(1)} ms (target < 100 ms)`);
   console.log(`screenshot: ${join(dir, 'explorer-50k.png')}`);
 } finally {
   await browser.close();
-  daemon.kill('SIGTERM');
+  big.daemon.kill('SIGTERM');
+  small.daemon.kill('SIGTERM');
 }

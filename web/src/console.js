@@ -2,7 +2,7 @@
 // their field paths, the estimated time), the operator verbs, live progress with ETA and the
 // coverage of the hemisphere (WatchSession), prompts, the rig and the session's events.
 // Analysts see the same pages without any control (and the server refuses control anyway).
-import Plotly from 'plotly.js-strict-dist-min';
+import { plotly } from './plotly.js';
 import { call, stream } from './api.js';
 import { el, clear, stateName, duration } from './dom.js';
 
@@ -162,7 +162,8 @@ export function createConsole(root, role, report) {
       await stream('Data/StreamReadings', { session_id: id, kinds: ['READING_KIND_SAMPLE'], after_id: String(lastReadingId) }, (r) => {
         lastReadingId = Math.max(lastReadingId, Number(r.id));
         covered.push(r.directions);
-      });
+      }, undefined, ['radiance']);
+      const Plotly = await plotly();
       Plotly.react(coverage, [{
         type: 'scatterpolar', mode: 'markers',
         r: covered.map((d) => d.theta_o), theta: covered.map((d) => d.phi_o),

@@ -1,12 +1,14 @@
 // The explorer: the paper's Figure 7 (a session's readings in (α, β, δ) and in (θi, θo, φ),
-// rotatable), a reading's spectrum on click, the interpolated spectrum at a chosen direction with
+// rotatable WebGL point clouds, points3d.js), a reading's spectrum on click, the interpolated spectrum at a chosen direction with
 // its vertices and weights (Figure 8, method switch), a polar plot in the plane of incidence
 // with a wavelength slider, and downloads of every export (Data.Export).
-import Plotly from 'plotly.js-strict-dist-min';
+import { plotly } from './plotly.js';
 import { call, stream } from './api.js';
 import { el, clear, stateName } from './dom.js';
+import { createPoints3d } from './points3d.js';
 
 const PLOT = { displaylogo: false, responsive: true };
+const POINT_COLUMNS = ['ids', 'alpha', 'beta', 'delta', 'theta_i', 'theta_o', 'phi', 'flagged'];
 
 function wavelengths(grid, n) {
   const count = n ?? grid.count;
@@ -23,8 +25,8 @@ function fromBase64(s) {
 export function createExplorer(root, report) {
   const sessionSelect = el('select', { id: 'explorer-session' });
   const loadInfo = el('span', { id: 'explorer-info' });
-  const fig7a = el('div', { id: 'fig7-pose', class: 'plot half' });
-  const fig7b = el('div', { id: 'fig7-iso', class: 'plot half' });
+  const fig7aBox = el('div', { id: 'fig7-pose', class: 'plot half' });
+  const fig7bBox = el('div', { id: 'fig7-iso', class: 'plot half' });
   const spectrum = el('div', { id: 'reading-spectrum', class: 'plot' });
   const readingInfo = el('p', { id: 'reading-info' }, 'Click a reading in either plot.');
   const quantity = el('select', { id: 'quantity' }, el('option', { value: 'QUANTITY_BRDF' }, 'BRDF (sr⁻¹)'), el('option', { value: 'QUANTITY_REFLECTANCE' }, 'reflectance'), el('option', { value: 'QUANTITY_RADIANCE' }, 'radiance'));
@@ -40,15 +42,15 @@ export function createExplorer(root, report) {
   const downloads = el('div', { id: 'downloads', class: 'buttons' });
   const downloadInfo = el('p', { id: 'download-info' });
 
-  let readings = [];
-  let byId = new Map();
+  let Plotly = null; // once loaded (plotly.js)
+  let points = null; // columns of ReadingPoints over the whole session
   let session = '';
   let polarData = null;
 
   root.append(
     el('div', { class: 'buttons' }, el('label', {}, 'Session ', sessionSelect), el('button', { id: 'explorer-load', onclick: () => load(sessionSelect.value) }, 'Load'), loadInfo),
     el('h2', {}, 'Figure 7: the readings'),
-    el('div', { class: 'row' }, fig7a, fig7b),
+    el('div', { class: 'row' }, fig7aBox, fig7bBox),
     readingInfo, spectrum,
     el('h2', {}, 'Figure 8: a direction between the readings'),
     el('form', { id: 'direction-form', class: 'buttons', onsubmit: (e) => { e.preventDefault(); interpolate(); } },
@@ -61,6 +63,10 @@ export function createExplorer(root, report) {
     polar,
     el('h2', {}, 'Downloads'), downloads, downloadInfo);
 
+  const fig7a = createPoints3d(fig7aBox, { title: '(α, β, δ)', axes: ['α °', 'β °', 'δ °'] });
+  const fig7b = createPoints3d(fig7bBox, { title: '(θi, θo, φ)', axes: ['θi °', 'θo °', 'φ °'] });
+  for (const f of [fig7a, fig7b]) f.onPick(showReading);
+
   async function listSessions() {
     const r = await call('Control/ListSessions', { page_size: 100 });
     clear(sessionSelect);
@@ -70,55 +76,62 @@ export function createExplorer(root, report) {
     if (measured) sessionSelect.value = measured.session_id;
   }
 
+  // Figure 7: the readings' poses and directions as columns (Data.StreamReadingPoints, a few
+  // messages of up to 8,192 readings, no spectra: 50,000 readings are ~4 MB of JSON), drawn as
+  // WebGL point clouds; a reading's spectra are fetched on a click.
   async function load(id) {
     if (!id) return;
     session = id;
     const t0 = performance.now();
-    readings = [];
-    let first = 0;
-    // Where each reading was taken, without its spectrum (fetched on a click): a 50,000-reading
-    // session is then a few MB instead of 150.
-    await stream('Data/StreamReadings', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (r) => { if (!first) first = performance.now() - t0; readings.push(r); }, undefined, ['radiance']);
+    const chunks = [];
+    await stream('Data/StreamReadingPoints', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (c) => chunks.push(c));
     const streamed = performance.now() - t0;
-    byId = new Map(readings.map((r) => [r.id, r]));
-    if (readings.length === 0) {
+    points = joinColumns(chunks);
+    if (points.ids.length === 0) {
       loadInfo.textContent = 'this session has no sample readings yet';
-      for (const p of [fig7a, fig7b, spectrum, polar]) Plotly.purge(p);
+      for (const f of [fig7a, fig7b]) f.setPoints({ x: [], y: [], z: [], value: [] });
+      Plotly = await plotly();
+      for (const p of [spectrum, polar]) Plotly.purge(p);
       return;
     }
-    const custom = readings.map((r) => r.id);
-    const marker = { size: 3, color: readings.map((r) => r.iso.theta_i), colorscale: 'Viridis' };
-    Plotly.react(fig7a, [{ type: 'scatter3d', mode: 'markers', x: readings.map((r) => r.pose.alpha), y: readings.map((r) => r.pose.beta), z: readings.map((r) => r.pose.delta), customdata: custom, marker }],
-      { title: { text: '(α, β, δ)' }, height: 420, margin: { l: 0, r: 0, t: 30, b: 0 }, scene: { xaxis: { title: { text: 'α °' } }, yaxis: { title: { text: 'β °' } }, zaxis: { title: { text: 'δ °' } } } }, PLOT);
-    Plotly.react(fig7b, [{ type: 'scatter3d', mode: 'markers', x: readings.map((r) => r.iso.theta_i), y: readings.map((r) => r.iso.theta_o), z: readings.map((r) => r.iso.phi), customdata: custom, marker }],
-      { title: { text: '(θi, θo, φ)' }, height: 420, margin: { l: 0, r: 0, t: 30, b: 0 }, scene: { xaxis: { title: { text: 'θi °' } }, yaxis: { title: { text: 'θo °' } }, zaxis: { title: { text: 'φ °' } } } }, PLOT);
-    for (const fig of [fig7a, fig7b]) {
-      fig.removeAllListeners?.('plotly_click');
-      fig.on('plotly_click', (ev) => showReading(ev.points[0].customdata));
-    }
-    loadInfo.textContent = `${readings.length} sample readings loaded in ${Math.round(streamed)} ms (first after ${Math.round(first)} ms), plotted in ${Math.round(performance.now() - t0 - streamed)} ms`;
+    fig7a.setPoints({ x: points.alpha, y: points.beta, z: points.delta, value: points.theta_i });
+    fig7b.setPoints({ x: points.theta_i, y: points.theta_o, z: points.phi, value: points.theta_i });
+    loadInfo.textContent = `${points.ids.length} sample readings loaded in ${Math.round(streamed)} ms, plotted in ${Math.round(performance.now() - t0 - streamed)} ms`;
     renderDownloads();
+    // plotly (the 2D plots) only once Figure 7 is on screen: parsing it blocks the page for most
+    // of a second, which would hold up the readings' messages and the point clouds' first frame.
+    await new Promise((r) => requestAnimationFrame(r));
+    Plotly = await plotly();
     await planeOfIncidence();
   }
 
-  async function showReading(id) {
-    const r = byId.get(id);
-    if (!r) return;
-    readingInfo.textContent = `reading ${r.id}: α ${r.pose.alpha}°, β ${r.pose.beta}°, δ ${r.pose.delta}°; θi ${r.iso.theta_i.toFixed(1)}°, θo ${r.iso.theta_o.toFixed(1)}°, φ ${r.iso.phi.toFixed(1)}°; quality ${r.quality_code}${r.flagged ? ' (flagged)' : ''}`;
+  function joinColumns(chunks) {
+    const out = {};
+    for (const name of POINT_COLUMNS) out[name] = chunks.length === 1 ? chunks[0][name] : [].concat(...chunks.map((c) => c[name]));
+    return out;
+  }
+
+  async function showReading(k) {
+    Plotly = await plotly();
+    const p = points;
+    const iso = { theta_i: p.theta_i[k], theta_o: p.theta_o[k], phi: p.phi[k] };
+    readingInfo.textContent = `reading ${p.ids[k]}: α ${p.alpha[k]}°, β ${p.beta[k]}°, δ ${p.delta[k]}°; θi ${iso.theta_i.toFixed(1)}°, θo ${iso.theta_o.toFixed(1)}°, φ ${iso.phi.toFixed(1)}°${p.flagged[k] ? ' (flagged)' : ''}`;
+    for (const f of [fig7a, fig7b]) f.mark(k);
     // The reading's own spectrum in each quantity: the nearest reading to its own direction is
     // itself (the daemon converts radiance to reflectance and BRDF with its reference).
+    const quantities = [['QUANTITY_RADIANCE', 'radiance (W·m⁻²·sr⁻¹·nm⁻¹)', 'y'], ['QUANTITY_REFLECTANCE', 'reflectance', 'y2'], ['QUANTITY_BRDF', 'BRDF (sr⁻¹)', 'y2']];
+    const answers = await Promise.all(quantities.map(([q]) => call('Interpolation/Interpolate', { session_id: session, method: 'INTERPOLATION_METHOD_NEAREST', quantity: q, direction: { iso } }).catch((e) => { report(e.message); return null; })));
     const traces = [];
-    for (const [q, label, axis] of [['QUANTITY_RADIANCE', 'radiance (W·m⁻²·sr⁻¹·nm⁻¹)', 'y'], ['QUANTITY_REFLECTANCE', 'reflectance', 'y2'], ['QUANTITY_BRDF', 'BRDF (sr⁻¹)', 'y2']]) {
-      try {
-        const res = (await call('Interpolation/Interpolate', { session_id: session, method: 'INTERPOLATION_METHOD_NEAREST', quantity: q, direction: { iso: r.iso } })).result;
-        if (res.status === 'INTERPOLATION_STATUS_OK') traces.push({ x: wavelengths(res.grid, res.spectrum.length), y: res.spectrum, name: label, yaxis: axis });
-      } catch (e) { report(e.message); }
-    }
+    answers.forEach((a, i) => {
+      const res = a?.result;
+      if (res?.status === 'INTERPOLATION_STATUS_OK') traces.push({ x: wavelengths(res.grid, res.spectrum.length), y: res.spectrum, name: quantities[i][1], yaxis: quantities[i][2] });
+    });
     Plotly.react(spectrum, traces, { height: 320, margin: { t: 20 }, xaxis: { title: { text: 'wavelength nm' } }, yaxis: { title: { text: 'radiance' } }, yaxis2: { overlaying: 'y', side: 'right', title: { text: 'reflectance, BRDF' } } }, PLOT);
   }
 
   async function interpolate() {
     if (!session) { report('load a session first'); return; }
+    Plotly = await plotly();
     const t0 = performance.now();
     try {
       const res = (await call('Interpolation/Interpolate', { session_id: session, method: method.value, quantity: quantity.value, direction: { iso: { theta_i: Number(ti.value), theta_o: Number(to.value), phi: Number(phi.value) } } })).result;

@@ -122,19 +122,26 @@ try {
   await shot(page, '05-console-completed');
 
   // --- explorer ---------------------------------------------------------------------------------
+  // Figure 7 gets its points through the compact listing (Data.StreamReadingPoints: poses and
+  // directions as columns, no spectra), never one full reading per event.
+  const apiCalls = [];
+  const onRequest = (r) => { const m = /\/api\/brdf\.v1\.([A-Za-z]+\/[A-Za-z]+)/.exec(r.url()); if (m) apiCalls.push(m[1]); };
+  page.on('request', onRequest);
   await page.goto(`${rig.url}#explorer`);
   const t0 = Date.now();
   await page.waitForFunction(() => /sample readings loaded/.test(document.getElementById('explorer-info')?.textContent || ''), { timeout: 30000 });
-  await page.waitForSelector('#fig7-iso .gl-container canvas, #fig7-iso canvas');
+  await page.waitForSelector('#fig7-iso canvas');
   console.log(`explorer: first view in ${Date.now() - t0} ms (${await text(page, '#explorer-info')})`);
-  const readingId = await page.evaluate(() => {
-    const gd = document.getElementById('fig7-iso');
-    const id = gd.data[0].customdata[5];
-    gd.emit('plotly_click', { points: [{ customdata: id }] });
-    return id;
-  });
+  page.off('request', onRequest);
+  check(apiCalls.includes('Data/StreamReadingPoints') && !apiCalls.includes('Data/StreamReadings'), `Figure 7's readings come from Data/StreamReadingPoints (calls: ${[...new Set(apiCalls)].join(', ')})`);
+  const loaded = Number(/^(\d+) sample readings/.exec(await text(page, '#explorer-info'))[1]);
+  const plotted = await page.evaluate(() => [document.getElementById('fig7-pose').points3d.count, document.getElementById('fig7-iso').points3d.count]);
+  check(loaded > 0 && plotted[0] === loaded && plotted[1] === loaded, `both Figure 7 plots hold every sample reading (${plotted.join(', ')} of ${loaded})`);
+  // A real click on a reading's point in the (θi, θo, φ) plot (where the camera projects it).
+  const at = await page.evaluate(() => document.getElementById('fig7-iso').points3d.screenPosition(5));
+  await page.mouse.click(at.x, at.y);
   await page.waitForFunction(() => document.querySelectorAll('#reading-spectrum .scatterlayer .trace').length >= 2, { timeout: 15000 });
-  check((await text(page, '#reading-info')).startsWith(`reading ${readingId}`), `a reading's spectrum shows (${await text(page, '#reading-info')})`);
+  check(/^reading \d+: α/.test(await text(page, '#reading-info')), `a click on a point shows its reading's spectrum (${await text(page, '#reading-info')})`);
   await shot(page, '06-explorer-figure7');
 
   for (const method of ['INTERPOLATION_METHOD_OCTANT', 'INTERPOLATION_METHOD_DELAUNAY']) {

@@ -58,6 +58,12 @@ try {
 
   r = await post('Data/StreamReadings?omit=radiance,nonsense', { session_id: '1' }, rig.analystToken);
   check(r.status === 400 && /no field "nonsense"/.test(r.json.message), `?omit= of an unknown field → 400 (${r.json?.message})`);
+  r = await post('Data/StreamReadingPoints', { session_id: '1' }, '');
+  check(r.status === 401 && r.json.code === 'UNAUTHENTICATED', `the compact readings listing without a token → 401 (${r.status})`);
+  r = await post('Data/StreamReadingPoints', { session_id: '999999' }, rig.analystToken);
+  check(r.status === 404, `the compact readings listing of an unknown session → 404 (${r.status} ${r.text})`);
+  r = await post('Data/StreamReadingPoints', { session_id: '1', after_id: '-1' }, rig.analystToken);
+  check(r.status === 400 && /after_id/.test(r.json.message), `the compact listing checks its request as StreamReadings does (${r.json?.message})`);
   r = await post('Control/WatchSession', { session_id: '1' }, '');
   check(r.status === 401 && !(r.headers.get('content-type') || '').includes('event-stream'), 'a stream without a token → 401, not an event stream');
   r = await post('Control/WatchSession', { session_id: '999999' }, rig.analystToken);
