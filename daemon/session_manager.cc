@@ -524,8 +524,8 @@ void SessionManager::Shutdown(std::chrono::milliseconds timeout) {
   rig_->Stop();
 }
 
-plan::PlanAnalysis SessionManager::ValidatePlan(const v1::Plan& plan) const {
-  return plan::AnalyzePlan(plan, options_.rig_description);
+plan::PlanAnalysis SessionManager::ValidatePlan(const v1::Plan& plan, double time_scale) const {
+  return plan::AnalyzePlan(plan, options_.rig_description, time_scale);
 }
 
 Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor& actor,
