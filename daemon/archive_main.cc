@@ -12,7 +12,6 @@
 // SIGINT: health NOT_SERVING, streams end, exit 0. Exit 2: a bad command line or configuration;
 // 1: the archive cannot be read (unreachable, refused, wrong schema) or the address not bound.
 #include <signal.h>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -24,6 +23,7 @@
 #include "daemon/auth.h"
 #include "daemon/config.h"
 #include "daemon/server.h"
+#include "daemon/startup.h"
 #include "storage/archive_reader.h"
 #include "storage/archive_schema.h"
 #include "storage/pg.h"
@@ -40,12 +40,7 @@ int main(int argc, char** argv) {
   using namespace brdf;
   using namespace brdf::daemon;
 
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGTERM);
-  sigaddset(&stop_signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
-  signal(SIGPIPE, SIG_IGN);
+  sigset_t stop_signals = BlockStopSignals();
 
   std::string config_path;
   std::string log_level;
@@ -71,16 +66,13 @@ int main(int argc, char** argv) {
     return kExitConfiguration;
   }
 
-  auto logger = spdlog::stderr_color_mt("brdf-archive");
-  spdlog::set_default_logger(logger);
-  spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ %v");
-  Result<Config> loaded = LoadConfig(config_path);
+  StartLogging("brdf-archive");
+  Result<Config> loaded = LoadConfigAndLogLevel(config_path, log_level);
   if (!loaded.ok()) {
     std::fprintf(stderr, "brdf-archive: %s\n", loaded.status().message().c_str());
     return kExitConfiguration;
   }
   const Config& config = *loaded;
-  spdlog::set_level(spdlog::level::from_str(log_level.empty() ? config.log.level : log_level));
   if (!config.archive.enabled()) {
     std::fprintf(stderr,
                  "brdf-archive: config %s: [archive] credentials is missing; give the path of a "

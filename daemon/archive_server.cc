@@ -49,24 +49,14 @@ Result<std::unique_ptr<ArchiveServer>> ArchiveServer::Start(
 
   std::unique_ptr<ArchiveServer> server(
       new ArchiveServer(config, std::move(archive), auth, options));
-  grpc::ServerBuilder builder;
-  int selected_port = 0;
-  PrepareServerBuilder(builder, config, *credentials, auth, &selected_port);
-  builder.RegisterService(&server->health_);
-  builder.RegisterService(&server->control_);
-  builder.RegisterService(&server->data_);
-  builder.RegisterService(&server->interpolation_);
-  builder.RegisterService(&server->reflection_v1_);
-  builder.RegisterService(&server->reflection_v1alpha_);
-  server->interpolate_loop_.AddQueues(builder);
   server->health_.ServeOn(server->control_loop_);
-  server->control_loop_.AddQueue(builder);
-  server->server_ = builder.BuildAndStart();
-  Result<std::string> address =
-      BoundAddress(config, server->server_ != nullptr, selected_port, tls);
+  int selected_port = 0;
+  Result<std::string> address = BuildAndStartServer(
+      config, *credentials, tls, auth,
+      {&server->health_, &server->control_, &server->data_, &server->interpolation_,
+       &server->reflection_v1_, &server->reflection_v1alpha_},
+      server->interpolate_loop_, server->control_loop_, &server->server_, &selected_port);
   if (!address.ok()) return address.status();
-  server->interpolate_loop_.Start();
-  server->control_loop_.Start();
   server->tls_ = tls;
   server->address_ = *address;
   server->refresher_ = std::thread([s = server.get()] { s->Refresh(); });

@@ -62,18 +62,10 @@ v1::Session ArchivedSession(const storage::SessionRecord& rec,
   progress->set_total_steps(static_cast<std::uint32_t>(rec.total_steps));
   int first_pending = -1;
   if (steps != nullptr) {
-    std::uint32_t samples = 0, done_samples = 0;
-    for (std::size_t i = 0; i < steps->size(); ++i) {
-      const storage::StepRecord& step = (*steps)[i];
-      const bool pending = step.state == storage::StepState::kPending;
-      if (step.kind == storage::StepKind::kSample) {
-        ++samples;
-        if (!pending) ++done_samples;
-      }
-      if (pending && first_pending < 0) first_pending = static_cast<int>(i);
-    }
-    progress->set_done_samples(done_samples);
-    progress->set_total_samples(samples);
+    const storage::StepTally tally = storage::TallySteps(*steps);
+    first_pending = tally.first_pending;
+    progress->set_done_samples(tally.done_samples);
+    progress->set_total_samples(tally.samples);
   }
   const bool never_started = rec.state == SessionState::kQueued && !rec.started_at.has_value();
   s.set_current_step(never_started || IsTerminal(rec.state) ? -1 : first_pending);

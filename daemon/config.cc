@@ -648,9 +648,17 @@ plan::RigDescription ToRigDescription(const Config& config) {
                     convention(s.delta)};
   // The D5 report is ~1,730 bytes; 10 bits per byte on the wire (8N1).
   rig.meter_transfer_s = 1730.0 * 10.0 / config.meter.baud;
-  // Paced commands per reading (M5; or M0 and D5) plus ~0.3 s of meter processing.
-  const int commands = config.meter.measure_with_spectrum ? 1 : 2;
-  rig.reading_overhead_s = commands * config.meter.pacing_ms / 1000.0 + 0.3;
+  // ~0.3 s of meter processing per reading; the daemon's own waits per exchange (M5; or M0
+  // and D5): the pacing before the command and the quiet gap that ends the reply. The move
+  // after a reading starts once the measurement is held: after M5's status line, or M0's reply.
+  rig.reading_overhead_s = 0.3;
+  const double pacing_s = config.meter.pacing_ms / 1000.0;
+  const double gap_s = config.meter.quiet_gap_ms / 1000.0;
+  const int exchanges = config.meter.measure_with_spectrum ? 1 : 2;
+  rig.reading_host_s = exchanges * (pacing_s + gap_s);
+  rig.reading_host_after_s = config.meter.measure_with_spectrum ? gap_s : pacing_s + gap_s;
+  // stage_poll_s keeps RigDescription's default: the stage driver's poll_interval, which the
+  // configuration does not set (tests/config checks they agree).
   return rig;
 }
 

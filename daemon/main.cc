@@ -16,7 +16,6 @@
 // server stops, exit 0. A second signal during that wait exits at once (exit 1); the database is
 // crash-safe, so that loses nothing that was committed.
 #include <signal.h>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -37,8 +36,9 @@
 #include "daemon/one_owner.h"
 #include "daemon/rig.h"
 #include "daemon/server.h"
-#include "daemon/web_gateway.h"
 #include "daemon/session_manager.h"
+#include "daemon/startup.h"
+#include "daemon/web_gateway.h"
 #include "drivers/exclusive_open.h"
 #include "storage/session_store.h"
 
@@ -79,12 +79,7 @@ int main(int argc, char** argv) {
 
   // Block the stop signals before any thread starts: every thread inherits the mask and only
   // the main thread takes them, in sigtimedwait. A client that hangs up must not kill us.
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGTERM);
-  sigaddset(&stop_signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
-  signal(SIGPIPE, SIG_IGN);
+  sigset_t stop_signals = BlockStopSignals();
   // A file-size limit (ulimit -f, a quota) must not kill us in the middle of a session: ignored,
   // a write past it fails with EFBIG, storage reports it and the session pauses.
   signal(SIGXFSZ, SIG_IGN);
@@ -108,17 +103,13 @@ int main(int argc, char** argv) {
     return kExitConfiguration;
   }
 
-  auto logger = spdlog::stderr_color_mt("brdfd");
-  spdlog::set_default_logger(logger);
-  spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ %v");
-
-  Result<Config> loaded = LoadConfig(config_path);
+  StartLogging("brdfd");
+  Result<Config> loaded = LoadConfigAndLogLevel(config_path, log_level);
   if (!loaded.ok()) {
     std::fprintf(stderr, "brdfd: %s\n", loaded.status().message().c_str());
     return kExitConfiguration;
   }
   const Config& config = *loaded;
-  spdlog::set_level(spdlog::level::from_str(log_level.empty() ? config.log.level : log_level));
   spdlog::info("brdfd starting: config {}, database {}, meter {}, stage {} {}:{}", config_path,
                config.storage.database, config.meter.port, config.stage.transport,
                config.stage.transport == "rtu" ? config.stage.device : config.stage.host,

@@ -184,6 +184,26 @@ Result<std::string> BoundAddress(const ServerConfig& config, bool built, int sel
   return config.listen.substr(0, config.listen.rfind(':') + 1) + std::to_string(selected_port);
 }
 
+Result<std::string> BuildAndStartServer(const ServerConfig& config,
+                                        const std::shared_ptr<grpc::ServerCredentials>& credentials,
+                                        bool tls, const Authenticator& auth,
+                                        std::initializer_list<grpc::Service*> services,
+                                        InterpolateLoop& interpolate_loop,
+                                        ControlLoop& control_loop,
+                                        std::unique_ptr<grpc::Server>* server, int* selected_port) {
+  grpc::ServerBuilder builder;
+  PrepareServerBuilder(builder, config, credentials, auth, selected_port);
+  for (grpc::Service* service : services) builder.RegisterService(service);
+  interpolate_loop.AddQueues(builder);
+  control_loop.AddQueue(builder);
+  *server = builder.BuildAndStart();
+  Result<std::string> address = BoundAddress(config, *server != nullptr, *selected_port, tls);
+  if (!address.ok()) return address.status();
+  interpolate_loop.Start();
+  control_loop.Start();
+  return address;
+}
+
 int InterpolateLoopThreads(unsigned cores) {
   return static_cast<int>(std::clamp(cores / 2, 1U, 8U));
 }
@@ -222,25 +242,15 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
 
   if (Status st = CheckCpusAvailable(config.interpolate_cpus); !st.ok()) return st;
   std::unique_ptr<Server> server(new Server(config, manager, cache, auth));
-  grpc::ServerBuilder builder;
-  int selected_port = 0;
-  PrepareServerBuilder(builder, config, credentials, auth, &selected_port);
-  builder.RegisterService(&server->health_);
-  builder.RegisterService(&server->control_);
-  builder.RegisterService(&server->data_);
-  builder.RegisterService(&server->interpolation_);
-  builder.RegisterService(&server->reflection_v1_);
-  builder.RegisterService(&server->reflection_v1alpha_);
-  server->interpolate_loop_.AddQueues(builder);
   server->health_.ServeOn(server->control_loop_);
   server->control_.ServeOn(server->control_loop_);
-  server->control_loop_.AddQueue(builder);
-  server->server_ = builder.BuildAndStart();
-  Result<std::string> address =
-      BoundAddress(config, server->server_ != nullptr, selected_port, tls);
+  int selected_port = 0;
+  Result<std::string> address = BuildAndStartServer(
+      config, credentials, tls, auth,
+      {&server->health_, &server->control_, &server->data_, &server->interpolation_,
+       &server->reflection_v1_, &server->reflection_v1alpha_},
+      server->interpolate_loop_, server->control_loop_, &server->server_, &selected_port);
   if (!address.ok()) return address.status();
-  server->interpolate_loop_.Start();
-  server->control_loop_.Start();
   server->tls_ = tls;
   server->port_ = selected_port;
   server->address_ = *address;

@@ -17,6 +17,7 @@
 #include <grpcpp/server_builder.h>
 
 #include <chrono>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <vector>
@@ -71,6 +72,19 @@ void PrepareServerBuilder(grpc::ServerBuilder& builder, const ServerConfig& conf
 // ("127.0.0.1:43123", "unix:/run/brdfd.sock"); kIoError naming the address when nothing was bound.
 Result<std::string> BoundAddress(const ServerConfig& config, bool built, int selected_port,
                                  bool tls);
+
+// Everything else brdfd and brdf-archive do alike to serve: prepares a builder
+// (PrepareServerBuilder), registers `services`, adds the completion queues of their Interpolate
+// and control-plane loops, builds and starts the server into `*server` (null when gRPC could not
+// build it), then, once the address is bound, starts both loops. Returns the address served
+// (BoundAddress) and sets `*selected_port`. The loops' handlers (ServeOn) must be set first.
+Result<std::string> BuildAndStartServer(const ServerConfig& config,
+                                        const std::shared_ptr<grpc::ServerCredentials>& credentials,
+                                        bool tls, const Authenticator& auth,
+                                        std::initializer_list<grpc::Service*> services,
+                                        InterpolateLoop& interpolate_loop,
+                                        ControlLoop& control_loop,
+                                        std::unique_ptr<grpc::Server>* server, int* selected_port);
 
 class Server {
  public:

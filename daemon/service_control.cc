@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -80,7 +81,12 @@ grpc::Status ControlService::ValidatePlan(grpc::ServerContext* context,
   if (!request->has_plan()) {
     return InvalidField("plan", "missing; give the plan to check");
   }
-  *response = plan::ToValidatePlanResponse(manager_.ValidatePlan(request->plan()));
+  const double time_scale = request->time_scale();
+  if (!std::isfinite(time_scale) || time_scale < 0) {
+    return InvalidField("time_scale", "must be a positive number (0 or unset: 1, a real rig)");
+  }
+  *response = plan::ToValidatePlanResponse(
+      manager_.ValidatePlan(request->plan(), time_scale > 0 ? time_scale : 1));
   return grpc::Status::OK;
 }
 

@@ -282,25 +282,16 @@ struct SessionManager::Impl final : public ExecutorHost {
     const std::vector<plan::StepTime> times =
         plan::EstimateSteps(plan_steps, owner.options_.rig_description, settings.measurement);
     double eta = 0;
-    int first_pending = -1;
-    std::uint32_t samples = 0, done_samples = 0;
-    for (std::size_t i = 0; i < steps->size(); ++i) {
-      const storage::StepRecord& step = (*steps)[i];
-      const bool pending = step.state == storage::StepState::kPending;
-      if (step.kind == storage::StepKind::kSample) {
-        ++samples;
-        if (!pending) ++done_samples;
-      }
-      if (pending) {
-        if (first_pending < 0) first_pending = static_cast<int>(i);
-        if (i < times.size()) eta += times[i].estimate_s;
-      }
+    for (std::size_t i = 0; i < steps->size() && i < times.size(); ++i) {
+      if ((*steps)[i].state == storage::StepState::kPending) eta += times[i].estimate_s;
     }
+    const storage::StepTally tally = storage::TallySteps(*steps);
+    const int first_pending = tally.first_pending;
     v1::Progress* progress = s.mutable_progress();
     progress->set_done_steps(static_cast<std::uint32_t>(rec->done_steps));
     progress->set_total_steps(static_cast<std::uint32_t>(rec->total_steps));
-    progress->set_done_samples(done_samples);
-    progress->set_total_samples(samples);
+    progress->set_done_samples(tally.done_samples);
+    progress->set_total_samples(tally.samples);
     // A queued session has no running ETA: it has not started (or waits for another session).
     s.set_eta_s(IsTerminal(state) || state == SessionState::kQueued ? 0 : eta);
     const bool never_started = state == SessionState::kQueued && !rec->started_at.has_value();
@@ -524,8 +515,8 @@ void SessionManager::Shutdown(std::chrono::milliseconds timeout) {
   rig_->Stop();
 }
 
-plan::PlanAnalysis SessionManager::ValidatePlan(const v1::Plan& plan) const {
-  return plan::AnalyzePlan(plan, options_.rig_description);
+plan::PlanAnalysis SessionManager::ValidatePlan(const v1::Plan& plan, double time_scale) const {
+  return plan::AnalyzePlan(plan, options_.rig_description, time_scale);
 }
 
 Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor& actor,

@@ -131,8 +131,9 @@ class SessionManager {
   // --- Plans ----------------------------------------------------------------------------------
 
   // Checks and summarises a plan against this rig; stores nothing. The gRPC layer turns it into
-  // a ValidatePlanResponse with plan::ToValidatePlanResponse.
-  plan::PlanAnalysis ValidatePlan(const v1::Plan& plan) const;
+  // a ValidatePlanResponse with plan::ToValidatePlanResponse. The summary's times are for a rig
+  // whose devices run `time_scale` (> 0) times faster (plan::AnalyzePlan).
+  plan::PlanAnalysis ValidatePlan(const v1::Plan& plan, double time_scale = 1) const;
 
   // Validates, expands and stores the plan as a new QUEUED session (then starts it when
   // `start_now`, as Start would). A plan with problems: kInvalidArgument whose message lists

@@ -16,11 +16,9 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${BUILD_DIR:-$root/build}"
 run="${LAB_RUN_DIR:-$root/lab-run}"
 time_scale="${LAB_TIME_SCALE:-8}"
-case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
-case "$run" in /*) ;; *) run="$PWD/$run" ;; esac
-brdfd="$build/daemon/brdfd"
-sim="$build/tools/brdf-sim/brdf-sim"
-ctl="$build/tools/brdfctl/brdfctl"
+# shellcheck source=deploy/lib.sh
+source "$root/deploy/lib.sh"
+resolve_build_and_run
 archive_server="$build/daemon/brdf-archive"
 pgbin="$(ls -d /usr/lib/postgresql/*/bin 2>/dev/null | sort -V | tail -n 1)"
 

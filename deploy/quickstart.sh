@@ -31,12 +31,9 @@ time_scale="${QUICKSTART_TIME_SCALE:-8}"
 first_port="${QUICKSTART_PORT:-50051}"
 first_web_port="${QUICKSTART_WEB_PORT:-8080}"
 
-case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
-case "$run" in /*) ;; *) run="$PWD/$run" ;; esac
-
-brdfd="$build/daemon/brdfd"
-sim="$build/tools/brdf-sim/brdf-sim"
-ctl="$build/tools/brdfctl/brdfctl"
+# shellcheck source=deploy/lib.sh
+source "$root/deploy/lib.sh"
+resolve_build_and_run
 
 # A direction between the demo grid's samples (θi, θo, φ in degrees; φ = 180 is the specular
 # side): interpolated at the end.

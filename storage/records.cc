@@ -94,4 +94,17 @@ std::optional<ReadingKind> ReadingKindFor(StepKind kind) {
   return std::nullopt;
 }
 
+StepTally TallySteps(std::span<const StepRecord> steps) {
+  StepTally tally;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const bool pending = steps[i].state == StepState::kPending;
+    if (steps[i].kind == StepKind::kSample) {
+      ++tally.samples;
+      if (!pending) ++tally.done_samples;
+    }
+    if (pending && tally.first_pending < 0) tally.first_pending = static_cast<int>(i);
+  }
+  return tally;
+}
+
 }  // namespace brdf::storage

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -98,6 +99,15 @@ struct StepRecord {
   std::optional<std::string> note;          // why it was skipped
   std::optional<UnixSeconds> completed_at;  // when it became done or skipped
 };
+
+// What a session's steps add up to, for its progress: sample readings planned and finished (done
+// or skipped), and the index of the first pending step (-1 when none is pending).
+struct StepTally {
+  std::uint32_t samples = 0;
+  std::uint32_t done_samples = 0;
+  int first_pending = -1;
+};
+StepTally TallySteps(std::span<const StepRecord> steps);
 
 // One measured spectrum and everything needed to use it again: where the rig was, what the meter
 // said, and which reference (and dark) reading it is to be divided by.

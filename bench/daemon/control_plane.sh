@@ -35,17 +35,8 @@ cleanup() {
   if [[ "${BENCH_KEEP:-0}" == 1 ]]; then echo "kept: $work" >&2; else rm -rf "$work"; fi
 }
 trap cleanup EXIT
-wait_line() {
-  local i
-  for ((i = 0; i < $3 * 10; i++)); do
-    if grep -q "$2" "$1" 2>/dev/null; then return 0; fi
-    sleep 0.1
-  done
-  echo "control_plane.sh: no '$2' in $1 after $3 s" >&2
-  return 1
-}
-operator_token="bench-operator-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
-analyst_token="bench-analyst-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
+# shellcheck source=bench/daemon/lib.sh
+source "$here/lib.sh"
 
 echo "== a 10,000-reading session (bench_storage), brdf-sim, brdfd" >&2
 "$bin/bench_storage" create --db "$work/bench.db" --readings 10000 >/dev/null
@@ -55,36 +46,10 @@ pids+=("$!")
 wait_line "$work/sim.out" '^ready' 20
 modbus="$(awk '$1 == "modbus-tcp" { print $2 }' "$work/sim.out")"
 pr650="$(awk '$1 == "pr650" { print $2 }' "$work/sim.out")"
-cat >"$work/brdfd.toml" <<EOF
-[server]
-listen = "127.0.0.1:0"
 # One analyst token holds all the streams: the per-token cap is raised to let it.
-max_streams_per_token = $((streams + 24))
+write_config "$work/bench.db" "$pr650" "$modbus" "max_streams_per_token = $((streams + 24))
 max_streams_analyst = $((streams + 24))
-stream_stall_timeout_s = 600
-[storage]
-database = "$work/bench.db"
-[meter]
-port = "$pr650"
-pacing_ms = 5
-quiet_gap_ms = 10
-[stage]
-transport = "tcp"
-address = "$modbus"
-detector_arm_motorized = true
-[stage.axes.delta]
-present = true
-[[auth.tokens]]
-name = "bench-operator"
-token = "$operator_token"
-role = "operator"
-[[auth.tokens]]
-name = "bench-analyst"
-token = "$analyst_token"
-role = "analyst"
-[log]
-level = "warn"
-EOF
+stream_stall_timeout_s = 600" >"$work/brdfd.toml"
 "$brdfd" --config "$work/brdfd.toml" >"$work/brdfd.out" 2>"$work/brdfd.log" </dev/null &
 brdfd_pid=$!
 pids+=("$brdfd_pid")

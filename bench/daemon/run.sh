@@ -61,57 +61,10 @@ cleanup() {
 }
 trap cleanup EXIT
 
-operator_token="bench-operator-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
-analyst_token="bench-analyst-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
-
-# Waits up to $3 s for a line matching $2 in file $1.
-wait_line() {
-  local i
-  for ((i = 0; i < $3 * 10; i++)); do
-    if grep -q "$2" "$1" 2>/dev/null; then return 0; fi
-    sleep 0.1
-  done
-  echo "bench/daemon: no '$2' in $1 after $3 s" >&2
-  return 1
-}
-
-# brdfd's configuration: $1 database, $2 meter port, $3 Modbus host:port, $4 more [server] lines.
-write_config() {
-  cat <<EOF
-[server]
-listen = "127.0.0.1:0"
-${4:-}
-[storage]
-database = "$1"
-[meter]
-port = "$2"
-pacing_ms = 5
-quiet_gap_ms = 10
-[meter.quality]
-"10" = "accept_and_flag"
-[stage]
-transport = "tcp"
-address = "$3"
-detector_arm_motorized = true
-[stage.axes.alpha]
-speed_deg_s = 30
-[stage.axes.beta]
-speed_deg_s = 30
-[stage.axes.delta]
-present = true
-speed_deg_s = 30
-[[auth.tokens]]
-name = "bench-operator"
-token = "$operator_token"
-role = "operator"
-[[auth.tokens]]
-name = "bench-analyst"
-token = "$analyst_token"
-role = "analyst"
-[log]
-level = "warn"
-EOF
-}
+# shellcheck source=bench/daemon/lib.sh
+source "$here/lib.sh"
+config_axis_speed=30
+config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
 
 # Starts brdfd on config $1 (log $2); sets brdfd_pid and address.
 start_brdfd() {

@@ -9,7 +9,7 @@
 
 namespace brdf::plan {
 
-PlanAnalysis AnalyzePlan(const v1::Plan& plan, const RigDescription& rig) {
+PlanAnalysis AnalyzePlan(const v1::Plan& plan, const RigDescription& rig, double time_scale) {
   PlanAnalysis out;
   ProblemSink sink;
   CheckPlanFields(plan, rig, sink);
@@ -28,7 +28,9 @@ PlanAnalysis AnalyzePlan(const v1::Plan& plan, const RigDescription& rig) {
   }
   out.problems = sink.Take();
   if (!out.problems.empty()) return out;
-  out.summary = SummarizeSteps(steps, rig, ResolveSettings(plan).measurement);
+  RigDescription timed = rig;
+  timed.time_scale = time_scale;
+  out.summary = SummarizeSteps(steps, timed, ResolveSettings(plan).measurement);
   out.steps = std::move(steps);
   return out;
 }

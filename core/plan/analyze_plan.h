@@ -50,7 +50,10 @@ struct PlanAnalysis {
 // inverse kinematics; explicit poses with lamp and detector above the surface), reference poses
 // within kReferenceThetaMaxDeg of the white's normal, meter and retry settings, and the cap of
 // kMaxSteps steps. Every problem is reported, each with its JSON field path (problem.h).
-PlanAnalysis AnalyzePlan(const v1::Plan& plan, const RigDescription& rig);
+// The steps are expanded as the daemon runs them (the "every M minutes" reference rule by
+// `rig`'s own timing); the summary's times are for the rig's devices running `time_scale` times
+// faster (a simulated rig, timing.h), which changes no step.
+PlanAnalysis AnalyzePlan(const v1::Plan& plan, const RigDescription& rig, double time_scale = 1);
 
 // AnalyzePlan's problems.
 std::vector<Problem> ValidatePlan(const v1::Plan& plan, const RigDescription& rig);

@@ -39,13 +39,29 @@ struct RigDescription {
   double meter_transfer_s = 1.8;        // D5 spectrum report, ~1,730 bytes at 9600 baud
   double adaptive_integration_s = 2.0;  // expected integration when the plan says adaptive
   double min_integration_s = 0.010;     // the meter's shortest integration (lower bound)
-  double reading_overhead_s = 0.5;      // command pacing and meter processing per reading
+  double reading_overhead_s = 0.3;      // the meter's processing per reading
   // The meter's own time per measurement beyond the integration (shutter, dark and processing
   // inside M0), which nothing can overlap: part of the physical lower bound. 0 unless known for
   // the instrument (pr650.md gives none; brdf-sim models 1.0 s: [optics.detector] overhead_s).
   double meter_measure_overhead_s = 0;
-  double move_settle_s = 0.25;    // in-position polling and settling per move
+  double move_settle_s = 0.25;    // the stage's settling after the motion, per move
   double operator_action_s = 30;  // one manual action (a prompt) by the operator
+
+  // The daemon's own waits (host time). Unlike everything above they do not shrink when the
+  // rig runs faster (`time_scale`): at brdf-sim's time scale 32 they are a large part of a step.
+  // Per reading: command pacing and the quiet gap that ends each reply (defaults: one M5
+  // exchange at the default pacing_ms = 100 and quiet_gap_ms = 50).
+  double reading_host_s = 0.15;
+  // The part of reading_host_s after the meter holds the measurement (the last reply's quiet
+  // gap; with M0 then D5 also D5's pacing): a pipelined move overlaps it with the transfer.
+  double reading_host_after_s = 0.05;
+  // The stage driver's in-position polling interval: a move is seen finished at the first poll
+  // after it ends, so a move takes a whole number (>= 1) of polls. 0: seen at once.
+  double stage_poll_s = 0.1;
+
+  // The rig's devices run this many times faster than real ones (brdf-sim --time-scale): the
+  // device times above are divided by it, host time and operator time are not. > 0; 1 = real.
+  double time_scale = 1;
 };
 
 }  // namespace brdf::plan

@@ -6,7 +6,17 @@
 namespace brdf::plan {
 
 StepTimer::StepTimer(const RigDescription& rig, const MeasurementChoice& measurement)
-    : rig_(rig), measurement_(measurement) {}
+    : rig_(rig), measurement_(measurement), scale_(rig.time_scale > 0 ? rig.time_scale : 1) {}
+
+namespace {
+
+// `seconds` rounded up to a whole number (>= 1) of `poll` (unchanged when poll is 0).
+double ToWholePolls(double seconds, double poll) {
+  if (poll <= 0) return seconds;
+  return std::max(1.0, std::ceil(seconds / poll - 1e-9)) * poll;
+}
+
+}  // namespace
 
 double StepTimer::MotionSeconds(const Pose& from, const Pose& to) const {
   auto axis = [](double a, double b, const AxisTravel& travel) {
@@ -26,17 +36,22 @@ StepTime StepTimer::Advance(const Step& step) {
                                                        : measurement_.integration_ms / 1000.0;
     const double integration_min =
         measurement_.adaptive() ? rig_.min_integration_s : measurement_.integration_ms / 1000.0;
-    t.estimate_s = rig_.reading_overhead_s + integration * averages + rig_.meter_transfer_s;
+    t.estimate_s =
+        (rig_.reading_overhead_s + integration * averages + rig_.meter_transfer_s) / scale_ +
+        rig_.reading_host_s;
     t.lower_bound_s =
-        integration_min * averages + rig_.meter_measure_overhead_s + rig_.meter_transfer_s;
+        (integration_min * averages + rig_.meter_measure_overhead_s + rig_.meter_transfer_s) /
+        scale_;
     after_reading_ = true;
   } else if (step.kind == v1::STEP_KIND_MOVE) {
-    const double motion = MotionSeconds(stage_, step.pose);
-    double estimate = motion > 0 ? motion + rig_.move_settle_s : 0.0;
+    const double motion = MotionSeconds(stage_, step.pose) / scale_;
+    double estimate =
+        motion > 0 ? ToWholePolls(motion + rig_.move_settle_s / scale_, rig_.stage_poll_s) : 0.0;
     double lower = motion;
     if (after_reading_) {
-      estimate = std::max(0.0, estimate - rig_.meter_transfer_s);
-      lower = std::max(0.0, lower - rig_.meter_transfer_s);
+      const double transfer = rig_.meter_transfer_s / scale_;
+      estimate = std::max(0.0, estimate - transfer - rig_.reading_host_after_s);
+      lower = std::max(0.0, lower - transfer);
     }
     t = {estimate, lower};
     stage_ = step.pose;

@@ -2,19 +2,25 @@
 // bound (what no scheduling can beat). Used for the plan summary, the "every M minutes"
 // reference rule, and the executor's ETA.
 //
-// The model, per step (times in seconds, RigDescription's parameters):
+// The model, per step (times in seconds, RigDescription's parameters). Device times (the meter's
+// and the stage's) are divided by rig.time_scale (written "/ k" below); the daemon's own waits
+// (host time) and the operator's time are not, so a simulated rig at time scale 32 is estimated
+// as it runs, not as a 32nd of a real one.
 //   reading (REFERENCE, DARK, SAMPLE):
-//     estimate    = reading_overhead_s + integration · averages + meter_transfer_s
-//     lower bound = integration_min · averages + meter_measure_overhead_s + meter_transfer_s
+//     estimate    = (reading_overhead_s + integration · averages + meter_transfer_s) / k
+//                   + reading_host_s
+//     lower bound = (integration_min · averages + meter_measure_overhead_s + meter_transfer_s) / k
 //     where integration is integration_ms / 1000, or adaptive_integration_s when adaptive
 //     (for the lower bound: min_integration_s, the meter's shortest, when adaptive).
 //   move: the motorized axes (α, β, and γ / δ when present) move at the same time, so
-//     motion = max over moving axes of |Δ reading| / speed_deg_s.
-//     estimate    = motion + move_settle_s      (0 when nothing moves)
+//     motion = max over moving axes of |Δ reading| / speed_deg_s / k.
+//     estimate    = motion + move_settle_s / k, rounded up to a whole number (>= 1) of
+//                   stage_poll_s (the driver sees the end at a poll); 0 when nothing moves
 //     lower bound = motion
 //     A move right after a reading overlaps that reading's data transfer (the executor starts
 //     the move once the meter has measured, while the spectrum comes down the serial line), so
-//     meter_transfer_s is taken off both: max(0, … − meter_transfer_s).
+//     that is taken off: the estimate loses meter_transfer_s / k + reading_host_after_s, the
+//     lower bound meter_transfer_s / k (never below 0).
 //   prompt: estimate = operator_action_s; lower bound = 0 (operator time is not physics).
 // The lower bound therefore sums exactly what cannot overlap: integration and the meter's own
 // measuring time, data transfer not hidden behind motion, and motion not hidden behind a
@@ -55,6 +61,7 @@ class StepTimer {
   MeasurementChoice measurement_;
   Pose stage_;                  // where the motorized axes are
   bool after_reading_ = false;  // the previous step was a reading
+  double scale_ = 1;            // rig_.time_scale, 1 when not positive
   StepTime elapsed_;
 };
 

@@ -11,7 +11,7 @@
 #include "storage/session_store.h"
 #include "tests/archive/archive_compare.h"
 #include "tests/daemon/daemon_test_rig.h"
-#include "tests/support/pg_server.h"
+#include "tests/support/pg_server_fixture.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
@@ -19,13 +19,11 @@ namespace {
 
 using namespace std::chrono_literals;
 
-class ArchiveRigTest : public ::testing::Test {
+class ArchiveRigTest : public PgServerTest {
  protected:
   void SetUp() override {
-    if (std::string why = PgServer::Unavailable(); !why.empty()) GTEST_SKIP() << why;
-    Result<std::unique_ptr<PgServer>> pg = PgServer::Start();
-    ASSERT_TRUE(pg.ok()) << pg.status().ToString();
-    pg_ = std::move(*pg);
+    PgServerTest::SetUp();
+    if (!PgReady()) return;
     for (int i = 0; i < 2; ++i) {
       rigs_[i] = std::make_unique<DaemonRig>();
       Status sim = rigs_[i]->StartSim();
@@ -49,15 +47,13 @@ class ArchiveRigTest : public ::testing::Test {
 
   std::string Name(int i) const { return i == 0 ? "rig-a" : "rig-b"; }
   std::string Toml(int i, int batch = 20) const {
-    return DaemonConfigToml(rigs_[i]->sim(), rigs_[i]->database()) + "[rig]\nname = \"" +
-           Name(i) + "\"\n[archive]\ncredentials = \"" +
-           rigs_[i]->dir().file("archive.conninfo").string() +
+    return DaemonConfigToml(rigs_[i]->sim(), rigs_[i]->database()) + "[rig]\nname = \"" + Name(i) +
+           "\"\n[archive]\ncredentials = \"" + rigs_[i]->dir().file("archive.conninfo").string() +
            "\"\nretry_ms = 100\nbatch_readings = " + std::to_string(batch) + "\n";
   }
   v1::ArchiveStatus Archive(int i) {
     v1::RigStatus status;
-    grpc::Status st =
-        rigs_[i]->control().GetRigStatus(DaemonRig::Context().get(), {}, &status);
+    grpc::Status st = rigs_[i]->control().GetRigStatus(DaemonRig::Context().get(), {}, &status);
     EXPECT_TRUE(st.ok()) << st.error_message();
     return status.archive();
   }
@@ -88,7 +84,6 @@ class ArchiveRigTest : public ::testing::Test {
     }
   }
 
-  std::unique_ptr<PgServer> pg_;
   std::unique_ptr<DaemonRig> rigs_[2];
   std::vector<std::unique_ptr<GrpcOperator>> operators_;
 };
@@ -142,7 +137,8 @@ TEST_F(ArchiveRigTest, BrdfdKilledWhileShippingLeavesEachReadingOnceInTheArchive
     std::this_thread::sleep_for(2ms);
   }
   ASSERT_GT(at_kill.shipped_readings(), 0u) << at_kill.DebugString();
-  EXPECT_GT(at_kill.lag_readings(), 0u) << "shipping finished before the kill: " << at_kill.DebugString();
+  EXPECT_GT(at_kill.lag_readings(), 0u)
+      << "shipping finished before the kill: " << at_kill.DebugString();
   operators_.front()->Stop();
   rigs_[0]->KillDaemon();
   std::cerr << "killed with " << at_kill.shipped_readings() << " shipped, "

@@ -1,15 +1,16 @@
 // The archive's schema on a real PostgreSQL: a new database gets the latest version, migrating
 // again changes nothing, a newer archive is refused, and the libpq layer reports a wrong password
 // and an unreachable server as what they are -- without the password in the message.
+#include "storage/archive_schema.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <thread>
 
-#include "storage/archive_schema.h"
 #include "storage/pg.h"
-#include "tests/support/pg_server.h"
+#include "tests/support/pg_server_fixture.h"
 
 namespace brdf::storage {
 namespace {
@@ -17,21 +18,19 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::Not;
 using testing::PgServer;
+using testing::PgServerTest;
 
-class ArchiveSchemaTest : public ::testing::Test {
+class ArchiveSchemaTest : public PgServerTest {
  protected:
   void SetUp() override {
-    if (std::string why = PgServer::Unavailable(); !why.empty()) GTEST_SKIP() << why;
-    Result<std::unique_ptr<PgServer>> pg = PgServer::Start();
-    ASSERT_TRUE(pg.ok()) << pg.status().ToString();
-    pg_ = std::move(*pg);
+    PgServerTest::SetUp();
+    if (!PgReady()) return;
   }
   std::unique_ptr<PgConnection> Connect() {
     Result<std::unique_ptr<PgConnection>> c = PgConnection::Open(pg_->conninfo());
     EXPECT_TRUE(c.ok()) << c.status().ToString();
     return c.ok() ? std::move(*c) : nullptr;
   }
-  std::unique_ptr<PgServer> pg_;
 };
 
 TEST_F(ArchiveSchemaTest, NewArchiveGetsTheLatestSchemaAndMigratingAgainIsANoOp) {
@@ -65,8 +64,8 @@ TEST_F(ArchiveSchemaTest, TwoConnectionsMigratingAtOnceBothSucceed) {
 TEST_F(ArchiveSchemaTest, NewerArchiveIsRefused) {
   auto conn = Connect();
   ASSERT_TRUE(MigrateArchive(*conn).ok());
-  ASSERT_TRUE(pg_->Psql("INSERT INTO archive_schema (version, description) VALUES (99, 'later')")
-                  .ok());
+  ASSERT_TRUE(
+      pg_->Psql("INSERT INTO archive_schema (version, description) VALUES (99, 'later')").ok());
   Status s = MigrateArchive(*conn);
   EXPECT_EQ(s.code(), StatusCode::kFailedPrecondition);
   EXPECT_THAT(s.message(), HasSubstr("schema version 99"));

@@ -19,7 +19,7 @@
 #include "daemon/config.h"
 #include "tests/brdfctl/ctl_runner.h"
 #include "tests/daemon/daemon_test_rig.h"
-#include "tests/support/pg_server.h"
+#include "tests/support/pg_server_fixture.h"
 #include "tests/support/plan_fixtures.h"
 #include "tests/support/process_launcher.h"
 
@@ -116,13 +116,11 @@ std::vector<v1::DirectionQuery> Directions() {
   return out;
 }
 
-class ArchiveServerTest : public ::testing::Test {
+class ArchiveServerTest : public PgServerTest {
  protected:
   void SetUp() override {
-    if (std::string why = PgServer::Unavailable(); !why.empty()) GTEST_SKIP() << why;
-    Result<std::unique_ptr<PgServer>> pg = PgServer::Start();
-    ASSERT_TRUE(pg.ok()) << pg.status().ToString();
-    pg_ = std::move(*pg);
+    PgServerTest::SetUp();
+    if (!PgReady()) return;
     rig_ = std::make_unique<DaemonRig>();
     ASSERT_TRUE(rig_->StartSim().ok());
     const std::string cred = rig_->dir().file("archive.conninfo").string();
@@ -282,7 +280,6 @@ class ArchiveServerTest : public ::testing::Test {
     return out;
   }
 
-  std::unique_ptr<PgServer> pg_;
   std::unique_ptr<DaemonRig> rig_;
   std::vector<std::unique_ptr<GrpcOperator>> operators_;
   std::vector<std::unique_ptr<ArchiveProcess>> archives_;

@@ -19,13 +19,14 @@
 #include "storage/spectrum_blob.h"
 #include "tests/archive/archive_compare.h"
 #include "tests/storage/storage_test_util.h"
-#include "tests/support/pg_server.h"
+#include "tests/support/pg_server_fixture.h"
 
 namespace brdf::storage {
 namespace {
 
 using namespace std::chrono_literals;
 using brdf::testing::PgServer;
+using brdf::testing::PgServerTest;
 using daemon::ArchiveShipper;
 using ::testing::HasSubstr;
 using testing::MakeNewSession;
@@ -48,13 +49,11 @@ Status RecordStep(SessionStore& store, std::int64_t session, int i,
   return Status::Ok();
 }
 
-class ArchiveShipperTest : public ::testing::Test {
+class ArchiveShipperTest : public PgServerTest {
  protected:
   void SetUp() override {
-    if (std::string why = PgServer::Unavailable(); !why.empty()) GTEST_SKIP() << why;
-    Result<std::unique_ptr<PgServer>> pg = PgServer::Start();
-    ASSERT_TRUE(pg.ok()) << pg.status().ToString();
-    pg_ = std::move(*pg);
+    PgServerTest::SetUp();
+    if (!PgReady()) return;
     credentials_ = *PgServer::WriteCredentials(dir_.File("archive.conninfo"), pg_->conninfo());
   }
   void TearDown() override {
@@ -104,7 +103,6 @@ class ArchiveShipperTest : public ::testing::Test {
   }
 
   TempDir dir_;
-  std::unique_ptr<PgServer> pg_;
   std::string credentials_;
 };
 

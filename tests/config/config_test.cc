@@ -4,9 +4,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <fstream>
 #include <string>
 
+#include "drivers/stage/modbus_stage.h"
 #include "tests/support/test_env.h"
 
 namespace brdf::daemon {
@@ -179,12 +181,22 @@ level = "debug"
   slow.meter.baud = 9600;
   EXPECT_NEAR(ToRigDescription(slow).meter_transfer_s, 2 * rig.meter_transfer_s, 1e-12);
   EXPECT_NEAR(ToRigDescription(slow).meter_transfer_s, 1.8, 0.05);  // pr650.md: ~1.8 s
-  // The estimate's per-reading overhead: one paced command with M5 (pacing_ms = 50), two with
-  // M0 then D5 (this file sets measure_with_spectrum = false).
-  EXPECT_NEAR(rig.reading_overhead_s, 0.3 + 2 * 0.050, 1e-12);
+  // The estimate's host time per reading: pacing and quiet gap per exchange, two exchanges with
+  // M0 then D5 (this file sets measure_with_spectrum = false), one with M5; the part after the
+  // measurement (which a pipelined move overlaps) is D5's exchange, or M5's quiet gap.
+  const double exchange = (c.meter.pacing_ms + c.meter.quiet_gap_ms) / 1000.0;
+  EXPECT_NEAR(rig.reading_overhead_s, 0.3, 1e-12);
+  EXPECT_NEAR(rig.reading_host_s, 2 * exchange, 1e-12);
+  EXPECT_NEAR(rig.reading_host_after_s, exchange, 1e-12);
   Config m5 = c;
   m5.meter.measure_with_spectrum = true;
-  EXPECT_NEAR(ToRigDescription(m5).reading_overhead_s, 0.3 + 0.050, 1e-12);
+  EXPECT_NEAR(ToRigDescription(m5).reading_host_s, exchange, 1e-12);
+  EXPECT_NEAR(ToRigDescription(m5).reading_host_after_s, c.meter.quiet_gap_ms / 1000.0, 1e-12);
+  // The stage is polled at the driver's interval, which the configuration does not change.
+  EXPECT_NEAR(
+      rig.stage_poll_s,
+      std::chrono::duration<double>(drivers::stage::ModbusStageConfig{}.poll_interval).count(),
+      1e-12);
 }
 
 TEST(ConfigTest, StreamCapsAndStallTimeout) {
@@ -292,7 +304,8 @@ TEST(ConfigTest, ValuesOutOfRange) {
   EXPECT_THAT(Refusal("[stage]\nprofile = \"arcus\"\n"), HasSubstr("stage.profile"));
   EXPECT_THAT(Refusal("[stage]\nprofile = \"az\"\nprofile_file = \"/etc/brdfd/s.toml\"\n"),
               HasSubstr("stage.profile_file: given with profile; keep one"));
-  EXPECT_THAT(Refusal("[stage]\nprofile_file = \"\"\n"), HasSubstr("stage.profile_file: must not be empty"));
+  EXPECT_THAT(Refusal("[stage]\nprofile_file = \"\"\n"),
+              HasSubstr("stage.profile_file: must not be empty"));
   EXPECT_THAT(Refusal("[stage.axes.alpha]\nunit_id = 0\n"), HasSubstr("stage.axes.alpha.unit_id"));
   EXPECT_THAT(Refusal("[stage.axes.alpha]\ncounts_per_degree = 0\n"),
               HasSubstr("stage.axes.alpha.counts_per_degree"));

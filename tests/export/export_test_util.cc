@@ -5,6 +5,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/export/synthetic_session.h"
+
 namespace brdf::exports::testing {
 
 std::string ReadFile(const std::string& path) {
@@ -66,6 +68,21 @@ std::vector<std::string> CommentLines(const std::string& text) {
     if (!line.empty() && line[0] == '#') out.push_back(line);
   }
   return out;
+}
+
+std::optional<PaintGridSamples> PaintLikeGridSamples() {
+  SyntheticSessionOptions o;
+  o.grid = {380, 40, 11};
+  Result<Session> session = SyntheticSession(AnalyticBrdf::PaintLike(), o);
+  EXPECT_TRUE(session.ok()) << session.status().ToString();
+  if (!session.ok()) return std::nullopt;
+  Result<DerivedSamples> derived = DeriveSamples(*session, Quantity::kBrdf);
+  EXPECT_TRUE(derived.ok()) << derived.status().ToString();
+  if (!derived.ok()) return std::nullopt;
+  Result<std::shared_ptr<const interp::SampleSet>> set = ToSampleSet(*derived);
+  EXPECT_TRUE(set.ok()) << set.status().ToString();
+  if (!set.ok()) return std::nullopt;
+  return PaintGridSamples{std::move(*derived), std::move(*set)};
 }
 
 }  // namespace brdf::exports::testing

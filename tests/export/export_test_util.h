@@ -1,10 +1,13 @@
 // Shared by the export tests: the CIE tables from colord-data, small CSV parsing.
 #pragma once
 
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/colorimetry.h"
+#include "core/export/session_data.h"
 #include "core/export/spectral_rgb.h"
 
 namespace brdf::exports::testing {
@@ -25,5 +28,14 @@ SpectralRgbWeights D65Weights(const WavelengthGrid& grid);
 std::vector<std::vector<std::string>> CsvRows(const std::string& text);
 // Lines that start with '#'.
 std::vector<std::string> CommentLines(const std::string& text);
+
+// The synthetic paper-grid session of a paint-like sample as BRDF samples in 11 bands (380 nm
+// every 40 nm), and the same as an interpolation sample set. Fails the test (nullopt) when a step
+// fails.
+struct PaintGridSamples {
+  DerivedSamples derived;
+  std::shared_ptr<const interp::SampleSet> set;
+};
+std::optional<PaintGridSamples> PaintLikeGridSamples();
 
 }  // namespace brdf::exports::testing

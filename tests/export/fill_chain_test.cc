@@ -93,22 +93,18 @@ TEST(FillChain, ModelSourceEvaluatesTheFittedBands) {
 
 // The product chain on the synthetic paper-grid session: octant, Delaunay, Cook-Torrance.
 TEST(FillChain, PaperGridSessionLeavesNoHoleAboveTheHorizon) {
-  SyntheticSessionOptions o;
-  o.grid = {380, 40, 11};
-  Result<Session> session = SyntheticSession(AnalyticBrdf::PaintLike(), o);
-  ASSERT_TRUE(session.ok());
-  Result<DerivedSamples> derived = DeriveSamples(*session, Quantity::kBrdf);
-  ASSERT_TRUE(derived.ok());
-  Result<std::shared_ptr<const interp::SampleSet>> set = ToSampleSet(*derived);
-  ASSERT_TRUE(set.ok());
+  const std::optional<testing::PaintGridSamples> samples = testing::PaintLikeGridSamples();
+  ASSERT_TRUE(samples.has_value());
+  const DerivedSamples& derived = samples->derived;
+  const std::shared_ptr<const interp::SampleSet>& set = samples->set;
   interp::Options options;
   options.mirror_phi = true;
   options.reciprocity = true;
-  auto octant = interp::MakeInterpolator(interp::Method::kOctant, *set, options);
-  auto delaunay = interp::MakeInterpolator(interp::Method::kDelaunay, *set, options);
+  auto octant = interp::MakeInterpolator(interp::Method::kOctant, set, options);
+  auto delaunay = interp::MakeInterpolator(interp::Method::kDelaunay, set, options);
   ASSERT_TRUE(octant.ok() && delaunay.ok());
-  fit::Observations data(derived->grid);
-  for (const DerivedSample& s : derived->samples) ASSERT_TRUE(data.Add(s.iso, s.values).ok());
+  fit::Observations data(derived.grid);
+  for (const DerivedSample& s : derived.samples) ASSERT_TRUE(data.Add(s.iso, s.values).ok());
   Result<fit::CookTorranceFit> model = fit::FitCookTorrance(data, {}, LongContext());
   ASSERT_TRUE(model.ok());
 
@@ -118,13 +114,13 @@ TEST(FillChain, PaperGridSessionLeavesNoHoleAboveTheHorizon) {
                                          {Provenance::kFallback, InterpolatorSource(**delaunay)},
                                          {Provenance::kModel, ModelSource(*model)}});
   };
-  const SpectralRgbWeights w = testing::D65Weights(derived->grid);
+  const SpectralRgbWeights w = testing::D65Weights(derived.grid);
   auto none = chain_of(FillPolicy::kNone);
   Result<MerlExport> holes =
-      BuildMerlTable(none->Source(), derived->grid, w, RunControl{2, {}}, LongContext());
+      BuildMerlTable(none->Source(), derived.grid, w, RunControl{2, {}}, LongContext());
   auto chain = chain_of(FillPolicy::kChain);
   Result<MerlExport> full =
-      BuildMerlTable(chain->Source(), derived->grid, w, RunControl{2, {}}, LongContext());
+      BuildMerlTable(chain->Source(), derived.grid, w, RunControl{2, {}}, LongContext());
   ASSERT_TRUE(holes.ok() && full.ok());
   EXPECT_GT(holes->report.unfilled_total(), 0u);  // the octant method alone leaves holes
   EXPECT_EQ(none->Tally().empty, holes->report.unfilled_total());
@@ -140,7 +136,7 @@ TEST(FillChain, PaperGridSessionLeavesNoHoleAboveTheHorizon) {
   ASSERT_TRUE(grid.ok());
   auto grid_chain = chain_of(FillPolicy::kChain);
   MemoryGrid sink;
-  Result<GridReport> r = ResampleOnGrid(grid_chain->Source(), *grid, derived->grid,
+  Result<GridReport> r = ResampleOnGrid(grid_chain->Source(), *grid, derived.grid,
                                         RunControl{2, {}}, LongContext(), sink);
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r->nan_cells, 0u);
@@ -148,13 +144,13 @@ TEST(FillChain, PaperGridSessionLeavesNoHoleAboveTheHorizon) {
 
   // The sidecar says how the grid was made: symmetry options, axis scales, the fill and its counts.
   const std::string json = GridDescriptionJson(
-      *grid, derived->grid, GridExportInfo{1, "demo", Quantity::kBrdf, "octant", 2320, 0}, *r,
+      *grid, derived.grid, GridExportInfo{1, "demo", Quantity::kBrdf, "octant", 2320, 0}, *r,
       InterpolantInfo{true, true, {1, 1, 0.5}, grid_chain->Tally().Json()});
   EXPECT_NE(json.find("\"mirror_phi\": true"), std::string::npos) << json;
   EXPECT_NE(json.find("\"reciprocity\": true"), std::string::npos);
   EXPECT_NE(json.find("\"axis_scale\": [1, 1, 0.5]"), std::string::npos);
   EXPECT_NE(json.find("\"fill\": {\"policy\": \"chain\""), std::string::npos);
-  EXPECT_NE(GridDescriptionJson(*grid, derived->grid, {}, *r).find("\"axis_scale\": null"),
+  EXPECT_NE(GridDescriptionJson(*grid, derived.grid, {}, *r).find("\"axis_scale\": null"),
             std::string::npos);
 }
 

@@ -200,29 +200,25 @@ TEST_F(AnalyticMerl, CellsBelowTheHorizonHoldMinusOneAndAreCounted) {
 TEST(MerlExport, InterpolatorSourceSortsItsBatchesWithTheOneByOneAnswers) {
   // The export's product path: a session's octant interpolator answers the table's cells in
   // batches sorted by cell (SpectraAt), and the table is the one a cell-by-cell source makes.
-  SyntheticSessionOptions o;
-  o.grid = {380, 40, 11};
-  Result<Session> session = SyntheticSession(AnalyticBrdf::PaintLike(), o);
-  ASSERT_TRUE(session.ok());
-  Result<DerivedSamples> derived = DeriveSamples(*session, Quantity::kBrdf);
-  ASSERT_TRUE(derived.ok());
-  Result<std::shared_ptr<const interp::SampleSet>> set = ToSampleSet(*derived);
-  ASSERT_TRUE(set.ok());
-  auto octant = interp::OctantInterpolator::Create(*set);
+  const std::optional<testing::PaintGridSamples> samples = testing::PaintLikeGridSamples();
+  ASSERT_TRUE(samples.has_value());
+  const DerivedSamples& derived = samples->derived;
+  const std::shared_ptr<const interp::SampleSet>& set = samples->set;
+  auto octant = interp::OctantInterpolator::Create(set);
   ASSERT_TRUE(octant.ok());
   const interp::OctantInterpolator& in = **octant;
   const SpectrumSource one_by_one = [&in](const IsoDirection& at, std::span<double> out) {
     const double q[3] = {at.theta_i, at.theta_o, at.phi};
     return in.SpectrumAt(q, out);
   };
-  const SpectralRgbWeights w = testing::D65Weights(derived->grid);
+  const SpectralRgbWeights w = testing::D65Weights(derived.grid);
   Result<MerlExport> batched =
-      BuildMerlTable(InterpolatorSource(in), derived->grid, w, RunControl{2, {}}, LongContext());
+      BuildMerlTable(InterpolatorSource(in), derived.grid, w, RunControl{2, {}}, LongContext());
   ASSERT_TRUE(batched.ok()) << batched.status().ToString();
   const std::uint64_t sorted = in.sorted_queries();
   EXPECT_GT(sorted, kMerlCells / 4);  // every cell above the horizon, in batches of a chunk
   Result<MerlExport> single =
-      BuildMerlTable(one_by_one, derived->grid, w, RunControl{2, {}}, LongContext());
+      BuildMerlTable(one_by_one, derived.grid, w, RunControl{2, {}}, LongContext());
   ASSERT_TRUE(single.ok());
   EXPECT_EQ(in.sorted_queries(), sorted);
   EXPECT_EQ(std::memcmp(batched->table.stored.data(), single->table.stored.data(),

@@ -179,16 +179,10 @@ TEST(Grid, CellsTheSourceCannotFillAreNaNAndCounted) {
 class InterpolatedGrid : public ::testing::Test {
  protected:
   void SetUp() override {
-    SyntheticSessionOptions o;
-    o.grid = {380, 40, 11};
-    Result<Session> s = SyntheticSession(AnalyticBrdf::PaintLike(), o);
-    ASSERT_TRUE(s.ok());
-    Result<DerivedSamples> d = DeriveSamples(*s, Quantity::kBrdf);
-    ASSERT_TRUE(d.ok());
-    bands_ = d->grid;
-    Result<std::shared_ptr<const interp::SampleSet>> set = ToSampleSet(*d);
-    ASSERT_TRUE(set.ok());
-    auto interpolator = interp::MakeInterpolator(interp::Method::kOctant, *set);
+    const std::optional<testing::PaintGridSamples> samples = testing::PaintLikeGridSamples();
+    ASSERT_TRUE(samples.has_value());
+    bands_ = samples->derived.grid;
+    auto interpolator = interp::MakeInterpolator(interp::Method::kOctant, samples->set);
     ASSERT_TRUE(interpolator.ok());
     interpolator_ = std::move(*interpolator);
   }

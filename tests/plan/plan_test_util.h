@@ -40,4 +40,17 @@ inline std::vector<Step> Prompts(const std::vector<Step>& steps, PromptKind kind
   return out;
 }
 
+// A step of `kind` at pose 0 (a reading or a prompt), and a move of α and β to (alpha, beta).
+inline Step StepOfKind(StepKind kind) {
+  Step s;
+  s.kind = kind;
+  return s;
+}
+inline Step MoveTo(double alpha, double beta) {
+  Step s = StepOfKind(v1::STEP_KIND_MOVE);
+  s.pose.alpha = alpha;
+  s.pose.beta = beta;
+  return s;
+}
+
 }  // namespace brdf::plan::testing

@@ -7,23 +7,13 @@
 #include <vector>
 
 #include "core/plan/timing.h"
+#include "tests/plan/plan_test_util.h"
 
 namespace brdf::plan {
 namespace {
 
-Step Move(double alpha, double beta) {
-  Step s;
-  s.kind = v1::STEP_KIND_MOVE;
-  s.pose.alpha = alpha;
-  s.pose.beta = beta;
-  return s;
-}
-
-Step Sample() {
-  Step s;
-  s.kind = v1::STEP_KIND_SAMPLE;
-  return s;
-}
+Step Move(double alpha, double beta) { return testing::MoveTo(alpha, beta); }
+Step Sample() { return testing::StepOfKind(v1::STEP_KIND_SAMPLE); }
 
 RigDescription Rig() {
   RigDescription rig;

@@ -18,6 +18,7 @@
 #include <memory>
 #include <string>
 
+#include "daemon/startup.h"
 #include "tools/brdf-sim/optics.h"
 #include "tools/brdf-sim/pr650_endpoint.h"
 #include "tools/brdf-sim/rig_manual_detector.h"
@@ -144,12 +145,7 @@ int main(int argc, char** argv) {
   // Block the stop signals before any thread starts, so every thread inherits the mask and the
   // main thread alone receives them in sigwait. Writes to a closed socket or pty must fail with
   // EPIPE, not kill the process.
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGTERM);
-  sigaddset(&stop_signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
-  signal(SIGPIPE, SIG_IGN);
+  const sigset_t stop_signals = brdf::daemon::BlockStopSignals();
 
   SimConfig config;
   TruthQuery truth;

@@ -38,10 +38,21 @@ int RunValidate(CommandContext& ctx, const std::string& plan_path, double time_s
   if (!plan.ok()) return ReportLocalError(ctx.err, plan.status());
   v1::ValidatePlanRequest request;
   *request.mutable_plan() = *plan;
+  request.set_time_scale(time_scale);
   v1::ValidatePlanResponse reply;
   const grpc::Status status =
       ctx.client.control().ValidatePlan(ctx.client.UnaryContext().get(), request, &reply);
   if (!status.ok()) return RpcFailed(ctx, status, "ValidatePlan");
+  // For a simulated rig, the same plan on a real one too (the daemon's waits do not scale).
+  double real_rig_s = 0;
+  if (time_scale != 1.0 && reply.valid() && !ctx.json) {
+    request.set_time_scale(1);
+    v1::ValidatePlanResponse real;
+    const grpc::Status st =
+        ctx.client.control().ValidatePlan(ctx.client.UnaryContext().get(), request, &real);
+    if (!st.ok()) return RpcFailed(ctx, st, "ValidatePlan");
+    real_rig_s = RigSeconds(real.summary());
+  }
   if (ctx.json) {
     PrintJsonLine(ctx.out, reply);
     return reply.valid() ? kExitOk : kExitInvalid;
@@ -49,7 +60,7 @@ int RunValidate(CommandContext& ctx, const std::string& plan_path, double time_s
   if (reply.valid()) {
     ctx.out << plan_path << ": valid\n";
     if (reply.has_summary()) {
-      ctx.out << "  " << PlanSummaryText(reply.summary(), time_scale) << "\n";
+      ctx.out << "  " << PlanSummaryText(reply.summary(), time_scale, real_rig_s) << "\n";
     } else {
       ctx.out << "  " << reply.step_count() << " steps, " << reply.operator_interventions()
               << " operator actions, about " << Duration(reply.estimated_duration_s()) << "\n";

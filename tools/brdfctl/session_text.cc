@@ -28,25 +28,31 @@ std::string SessionLine(const v1::Session& s) {
   return out;
 }
 
-std::string PlanSummaryText(const v1::PlanSummary& summary, double time_scale) {
+double RigSeconds(const v1::PlanSummary& summary) {
+  const double actions_s =
+      summary.operator_interventions() * plan::RigDescription{}.operator_action_s;
+  return std::max(0.0, summary.estimated_duration_s() - actions_s);
+}
+
+std::string PlanSummaryText(const v1::PlanSummary& summary, double time_scale, double real_rig_s) {
   std::string out = std::to_string(summary.step_count()) +
                     " steps: " + std::to_string(summary.sample_readings()) + " sample, " +
                     std::to_string(summary.reference_readings()) + " reference, " +
                     std::to_string(summary.dark_readings()) + " dark readings; " +
                     std::to_string(summary.operator_interventions()) + " operator actions";
   if (summary.estimated_duration_s() > 0) {
-    const double operator_s = plan::RigDescription{}.operator_action_s;
-    const double actions_s = summary.operator_interventions() * operator_s;
-    const double rig_s = std::max(0.0, summary.estimated_duration_s() - actions_s);
-    const bool scaled = time_scale != 1.0;
-    out += "; about " + Duration(rig_s / time_scale) + " of measuring";
-    if (scaled) out += " at time scale " + Num(time_scale) + " (" + Duration(rig_s) + " real)";
+    out += "; rig time about " + Duration(RigSeconds(summary));
+    if (time_scale != 1.0) {
+      out += " at time scale " + Num(time_scale);
+      if (real_rig_s > 0) out += " (" + Duration(real_rig_s) + " on a real rig)";
+    }
     if (summary.physical_lower_bound_s() > 0) {
-      out += ", at least " + Duration(summary.physical_lower_bound_s() / time_scale);
+      out += ", at least " + Duration(summary.physical_lower_bound_s());
     }
     if (summary.operator_interventions() > 0) {
-      out += ", + the operator's " + std::to_string(summary.operator_interventions()) +
-             " actions (about " + Duration(operator_s) + " each by hand)";
+      out += "; plus the operator's " + std::to_string(summary.operator_interventions()) +
+             " prompts, not counted (about " + Duration(plan::RigDescription{}.operator_action_s) +
+             " each by hand)";
     }
   }
   return out;

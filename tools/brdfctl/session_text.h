@@ -26,12 +26,17 @@ void PrintPrompt(std::ostream& out, const v1::Prompt& prompt);
 // "fault at step 12 (attempt 3): timeout: <reason> — will retry" (or "— session paused").
 std::string FaultText(const v1::Fault& fault);
 
-// "120 steps: 90 sample, 12 reference, 6 dark readings; 12 operator actions; about 5:00
-// (at least 3:10)".
-// The estimate is split in two: the rig's time (readings and moves; divided by `time_scale` for a
-// simulated rig that runs that many times faster, e.g. brdf-sim --time-scale 8) and the operator's
-// manual actions (about core/plan's operator_action_s each on a real rig; a script answering
-// them on brdf-sim takes about none).
-std::string PlanSummaryText(const v1::PlanSummary& summary, double time_scale = 1.0);
+// "120 steps: 90 sample, 12 reference, 6 dark readings; 12 operator actions; rig time about 5:00
+// (at least 3:10); plus the operator's 12 prompts, not counted (about 30 s each by hand)".
+// The estimate is split in two: the rig's time (readings, moves and the daemon's own waits, as
+// the daemon estimated them; for a simulated rig running `time_scale` times faster when the
+// summary was asked for at that scale, with `real_rig_s`, when > 0, the same plan's rig time on a
+// real rig) and the operator's prompts, which the estimate cannot know (a person at the rig:
+// about core/plan's operator_action_s each; a script answering them on brdf-sim: about none).
+std::string PlanSummaryText(const v1::PlanSummary& summary, double time_scale = 1.0,
+                            double real_rig_s = 0);
+
+// The rig's part of a summary's estimate: estimated_duration_s without the operator's prompts.
+double RigSeconds(const v1::PlanSummary& summary);
 
 }  // namespace brdf::ctl

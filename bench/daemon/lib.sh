@@ -1,0 +1,59 @@
+# shellcheck shell=bash
+# Shared by bench/daemon's scripts (sourced, not run): fresh bearer tokens, waiting for a line in
+# a log, and brdfd's configuration for a rig on brdf-sim.
+
+# shellcheck disable=SC2034  # used by the scripts that source this file
+operator_token="bench-operator-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
+analyst_token="bench-analyst-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
+
+# Waits up to $3 s for a line matching $2 in file $1.
+wait_line() {
+  local i
+  for ((i = 0; i < $3 * 10; i++)); do
+    if grep -q "$2" "$1" 2>/dev/null; then return 0; fi
+    sleep 0.1
+  done
+  echo "bench/daemon: no '$2' in $1 after $3 s" >&2
+  return 1
+}
+
+# brdfd's configuration on stdout, with both tokens: $1 database, $2 meter port, $3 Modbus
+# host:port, $4 more [server] lines. A script may set config_axis_speed (deg/s of α, β and δ;
+# unset: the defaults) and config_extra (TOML appended at the end, in tables of its own).
+write_config() {
+  cat <<EOT
+[server]
+listen = "127.0.0.1:0"
+${4:-}
+[storage]
+database = "$1"
+[meter]
+port = "$2"
+pacing_ms = 5
+quiet_gap_ms = 10
+[stage]
+transport = "tcp"
+address = "$3"
+detector_arm_motorized = true
+EOT
+  if [[ -n "${config_axis_speed:-}" ]]; then
+    printf '[stage.axes.alpha]\nspeed_deg_s = %s\n[stage.axes.beta]\nspeed_deg_s = %s\n' \
+      "$config_axis_speed" "$config_axis_speed"
+    printf '[stage.axes.delta]\npresent = true\nspeed_deg_s = %s\n' "$config_axis_speed"
+  else
+    printf '[stage.axes.delta]\npresent = true\n'
+  fi
+  cat <<EOT
+[[auth.tokens]]
+name = "bench-operator"
+token = "$operator_token"
+role = "operator"
+[[auth.tokens]]
+name = "bench-analyst"
+token = "$analyst_token"
+role = "analyst"
+[log]
+level = "warn"
+${config_extra:-}
+EOT
+}
