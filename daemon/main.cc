@@ -110,10 +110,11 @@ int main(int argc, char** argv) {
     return kExitConfiguration;
   }
   const Config& config = *loaded;
-  spdlog::info("brdfd starting: config {}, database {}, meter {}, stage {} {}:{}", config_path,
+  spdlog::info("brdfd starting: config {}, database {}, meter {}, stage {} {}", config_path,
                config.storage.database, config.meter.port, config.stage.transport,
-               config.stage.transport == "rtu" ? config.stage.device : config.stage.host,
-               config.stage.port);
+               config.stage.transport == "rtu"
+                   ? config.stage.device
+                   : config.stage.host + ":" + std::to_string(config.stage.port));
 
   // One owner: refuse, before touching anything, a database, address or meter port that another
   // process holds (daemon/one_owner.h). The database lock is held until exit.

@@ -1,7 +1,8 @@
 // brdf-sim's Modbus TCP endpoint through a raw socket, byte by byte: requests are framed by the
 // MBAP length (a malformed PDU gets an exception and the connection stays in step), a non-zero
 // protocol id is dropped, an unframeable length closes the connection; the drives answer only the
-// function codes the AZ documents (FC04 refused, FC08 echoed); exception 04 can be injected.
+// function codes the AZ documents (FC04 refused, FC08 echoed); exception 04 can be injected; the
+// control unit's outage refuses connections for a while and its word-order swap takes effect.
 // The drives' own settings (word order, ramp unit) are in stage_drive_settings_test.cc.
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
@@ -244,6 +245,53 @@ TEST_F(StageTcpFramingTest, InjectedException04BurstsThenTheDriveAnswers) {
   EXPECT_EQ(Ask(2, 1, kReadStatus), (Bytes{0x83, 0x04}));
   EXPECT_EQ(Ask(3, 1, kReadStatus)[0], 0x03);
   EXPECT_EQ(control_.modbus().exception_count, 0);
+}
+
+// The control unit's outage (register 28): at the next axis request that connection closes and
+// the port refuses connections for the outage's length, while a connection that only talks to
+// the control unit stays served; then the same port accepts and the drives answer again.
+TEST_F(StageTcpFramingTest, AnOutageRefusesConnectionsThenTheSamePortAnswersAgain) {
+  Start();
+  RawModbusClient control_link(stage_->tcp_port());
+  ASSERT_TRUE(control_link.ok());
+  // Register 28 = 600 ms, through the control unit as a test or an operator sets it.
+  EXPECT_EQ(Ask(1, 100, {0x06, 0x00, 0x1C, 0x02, 0x58}), (Bytes{0x06, 0x00, 0x1C, 0x02, 0x58}));
+  EXPECT_EQ(control_.modbus().outage_ms, 600);
+
+  const auto began = SteadyClock::now();
+  ASSERT_TRUE(client_->Send(Adu(2, 1, kReadStatus)));
+  EXPECT_TRUE(client_->ReadAdu().empty());
+  EXPECT_TRUE(client_->closed());
+  EXPECT_EQ(control_.modbus().outage_ms, 0);  // fired
+  EXPECT_FALSE(RawModbusClient(stage_->tcp_port()).ok()) << "a connection was accepted";
+
+  // The control unit still answers on a connection opened before.
+  ASSERT_TRUE(control_link.Send(Adu(3, 100, {0x03, 0x00, 0x1C, 0x00, 0x01})));
+  EXPECT_EQ(PduOf(control_link.ReadAdu()), (Bytes{0x03, 0x02, 0x00, 0x00}));
+  // ... but an axis request on it is dropped with its connection while the outage lasts.
+  ASSERT_TRUE(control_link.Send(Adu(4, 2, kReadStatus)));
+  EXPECT_TRUE(control_link.ReadAdu().empty());
+  EXPECT_TRUE(control_link.closed());
+
+  const auto give_up = SteadyClock::now() + std::chrono::seconds(5);
+  do {
+    client_ = std::make_unique<RawModbusClient>(stage_->tcp_port());
+  } while (!client_->ok() && SteadyClock::now() < give_up);
+  ASSERT_TRUE(client_->ok()) << "the port did not accept connections again";
+  EXPECT_GE(SteadyClock::now() - began, std::chrono::milliseconds(550));
+  EXPECT_EQ(Ask(5, 1, kReadStatus), (Bytes{0x03, 4, 0x00, 0x00, 0x40, 0x20}));
+}
+
+// The control unit's word-order swap (register 27): the drives lay their registers in the other
+// order until it is cleared, as after a change of the drive's parameter.
+TEST_F(StageTcpFramingTest, TheControlUnitSwapsTheDrivesWordOrder) {
+  Start();
+  EXPECT_EQ(Ask(1, 1, kReadStatus), (Bytes{0x03, 4, 0x00, 0x00, 0x40, 0x20}));
+  EXPECT_EQ(Ask(2, 100, {0x06, 0x00, 0x1B, 0x00, 0x01})[0], 0x06);
+  EXPECT_EQ(Ask(3, 1, kReadStatus), (Bytes{0x03, 4, 0x40, 0x20, 0x00, 0x00}));
+  EXPECT_EQ(Ask(4, 100, {0x06, 0x00, 0x1B, 0x00, 0x02}), (Bytes{0x86, 0x03}));  // a flag: 0 or 1
+  EXPECT_EQ(Ask(5, 100, {0x06, 0x00, 0x1B, 0x00, 0x00})[0], 0x06);
+  EXPECT_EQ(Ask(6, 1, kReadStatus), (Bytes{0x03, 4, 0x00, 0x00, 0x40, 0x20}));
 }
 
 TEST(StageRtuFraming, AnFc08DiagnosisIsOneEightByteFrame) {

@@ -122,10 +122,11 @@ Status ModbusControl::SetSerialFaults(const sim::SerialFaults& f) {
 
 Status ModbusControl::SetModbusFaults(const sim::ModbusFaults& f) {
   const std::uint16_t regs[] = {
-      Word(f.exception_code),  Word(f.exception_count), Word(f.late_reply_ms), Word(f.late_count),
-      Flag(f.drop_connection), Flag(f.alarm_mid_move),  Flag(f.stall),
+      Word(f.exception_code), Word(f.exception_count), Word(f.late_reply_ms),
+      Word(f.late_count),     Flag(f.drop_connection), Flag(f.alarm_mid_move),
+      Flag(f.stall),          Flag(f.swap_word_order), Word(f.outage_ms),
   };
-  static_assert(map::kModbusStall - map::kModbusExceptionCode == 6, "Modbus fault block layout");
+  static_assert(map::kModbusOutageMs - map::kModbusExceptionCode == 8, "Modbus fault block layout");
   return WriteRegisters(map::kModbusExceptionCode, regs);
 }
 
@@ -146,7 +147,7 @@ Result<sim::SerialFaults> ModbusControl::SerialFaults() {
 }
 
 Result<sim::ModbusFaults> ModbusControl::ModbusFaults() {
-  auto r = ReadRegisters(map::kModbusExceptionCode, 7);
+  auto r = ReadRegisters(map::kModbusExceptionCode, 9);
   if (!r.ok()) return r.status();
   const auto& v = *r;
   sim::ModbusFaults f;
@@ -157,6 +158,8 @@ Result<sim::ModbusFaults> ModbusControl::ModbusFaults() {
   f.drop_connection = v[4] != 0;
   f.alarm_mid_move = v[5] != 0;
   f.stall = v[6] != 0;
+  f.swap_word_order = v[7] != 0;
+  f.outage_ms = v[8];
   return f;
 }
 

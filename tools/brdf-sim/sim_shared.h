@@ -76,6 +76,13 @@ struct ModbusFaults {
   bool drop_connection = false;  // close the TCP connection at the next request
   bool alarm_mid_move = false;   // the next move raises an alarm half-way
   bool stall = false;            // the next move never clears MOVE
+  // A persistent setting, not a "next N" fault: the drives lay 32-bit values in the other word
+  // order than configured (as if someone changed the drives' word-order parameter).
+  bool swap_word_order = false;
+  // >0: at the next axis request the drives go away for this many real ms: that TCP connection
+  // closes and the listener closes too (new connections are refused), every axis request
+  // meanwhile is dropped (RTU: left unanswered); then the endpoint listens on the same port again.
+  int outage_ms = 0;
 };
 
 // Mutable shared state, thread-safe. Set from flags at start-up and at runtime through the

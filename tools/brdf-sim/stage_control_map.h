@@ -27,8 +27,15 @@
 //                                   leave that request unanswered)
 //     25  modbus.alarm_mid_move     1: the next move raises an alarm (code 0x30) half-way
 //     26  modbus.stall              1: the next move never clears MOVE (until STOP or ALM-RST)
+//     27  modbus.swap_word_order    0/1: the drives lay 32-bit values in the other word order than
+//                                   configured (a setting that stays, as the drive's parameter)
+//     28  modbus.outage_ms          N: at the next axis request the drives go away for N real ms:
+//                                   that TCP connection closes, the listener closes (connections
+//                                   are refused), axis requests meanwhile are dropped (RTU: left
+//                                   unanswered); then the same port listens again. Reads N until
+//                                   the outage starts, then 0
 //
-// Registers 2–9 and 19 read 0 and refuse writes (exception 02), as do addresses past 26.
+// Registers 2–9 and 19 read 0 and refuse writes (exception 02), as do addresses past 28.
 // A value out of range (mounted 3, a flag of 2, exception code 12) is refused with exception 03
 // and nothing of that write is applied. Faults apply to the axis unit ids only, never to the
 // control unit itself, so setting a fault cannot consume it.
@@ -60,7 +67,9 @@ inline constexpr std::uint16_t kModbusLateCount = 23;
 inline constexpr std::uint16_t kModbusDropConnection = 24;
 inline constexpr std::uint16_t kModbusAlarmMidMove = 25;
 inline constexpr std::uint16_t kModbusStall = 26;
+inline constexpr std::uint16_t kModbusSwapWordOrder = 27;
+inline constexpr std::uint16_t kModbusOutageMs = 28;
 
-inline constexpr std::uint16_t kRegisterCount = 27;  // addresses 0–26
+inline constexpr std::uint16_t kRegisterCount = 29;  // addresses 0–28
 
 }  // namespace brdf::sim::control_map

@@ -15,12 +15,12 @@ namespace cm = control_map;
 bool Defined(std::uint16_t a) {
   return a == cm::kMountedTarget || a == cm::kPowerCycleMeter ||
          (a >= cm::kSerialSilent && a <= cm::kSerialUnitsCode) ||
-         (a >= cm::kModbusExceptionCode && a <= cm::kModbusStall);
+         (a >= cm::kModbusExceptionCode && a <= cm::kModbusOutageMs);
 }
 
 bool IsFlag(std::uint16_t a) {
   return a == cm::kSerialSilent || a == cm::kModbusDropConnection || a == cm::kModbusAlarmMidMove ||
-         a == cm::kModbusStall;
+         a == cm::kModbusStall || a == cm::kModbusSwapWordOrder;
 }
 
 std::uint16_t Clamp16(long v) {
@@ -51,6 +51,8 @@ std::vector<std::uint16_t> Snapshot(const SimControl& control) {
   r[cm::kModbusDropConnection] = m.drop_connection ? 1 : 0;
   r[cm::kModbusAlarmMidMove] = m.alarm_mid_move ? 1 : 0;
   r[cm::kModbusStall] = m.stall ? 1 : 0;
+  r[cm::kModbusSwapWordOrder] = m.swap_word_order ? 1 : 0;
+  r[cm::kModbusOutageMs] = Clamp16(m.outage_ms);
   return r;
 }
 
@@ -104,7 +106,7 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
       if (written(cm::kSerialUnitsCode)) s.units_code = image[cm::kSerialUnitsCode];
     });
   }
-  if (address <= cm::kModbusStall && address + values.size() > cm::kModbusExceptionCode) {
+  if (address <= cm::kModbusOutageMs && address + values.size() > cm::kModbusExceptionCode) {
     control_.UpdateModbus([&](ModbusFaults& m) {
       if (written(cm::kModbusExceptionCode)) m.exception_code = image[cm::kModbusExceptionCode];
       if (written(cm::kModbusExceptionCount)) m.exception_count = image[cm::kModbusExceptionCount];
@@ -115,6 +117,10 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
       }
       if (written(cm::kModbusAlarmMidMove)) m.alarm_mid_move = image[cm::kModbusAlarmMidMove] != 0;
       if (written(cm::kModbusStall)) m.stall = image[cm::kModbusStall] != 0;
+      if (written(cm::kModbusSwapWordOrder)) {
+        m.swap_word_order = image[cm::kModbusSwapWordOrder] != 0;
+      }
+      if (written(cm::kModbusOutageMs)) m.outage_ms = image[cm::kModbusOutageMs];
     });
   }
   if (written(cm::kPowerCycleMeter) && image[cm::kPowerCycleMeter] == 1 && power_cycle_meter_) {

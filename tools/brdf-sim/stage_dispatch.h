@@ -21,6 +21,9 @@ struct StageReply {
   Kind kind = Kind::kReply;
   std::vector<std::uint8_t> pdu;
   std::chrono::milliseconds delay{0};  // real time
+  // kDrop only: the drives went away; a TCP endpoint also stops listening for this long (new
+  // connections are refused), then listens on the same port again.
+  std::chrono::milliseconds refuse_connections{0};
 };
 
 class StageDispatcher {

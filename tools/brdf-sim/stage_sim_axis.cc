@@ -62,15 +62,19 @@ double MoveDuration(double distance, double speed, double accel, double decel) {
 
 }  // namespace
 
+bool SimAxis::HighWordFirst() const {
+  return (config_.word_order == SimWordOrder::kHighFirst) != control_.modbus().swap_word_order;
+}
+
 std::int32_t SimAxis::Join(std::uint16_t first, std::uint16_t second) const {
-  const bool high_first = config_.word_order == SimWordOrder::kHighFirst;
+  const bool high_first = HighWordFirst();
   const std::uint32_t high = high_first ? first : second;
   const std::uint32_t low = high_first ? second : first;
   return static_cast<std::int32_t>((high << 16) | low);
 }
 
 std::uint16_t SimAxis::WordOf(std::uint32_t value, std::uint32_t offset) const {
-  const bool upper = (offset == 0) == (config_.word_order == SimWordOrder::kHighFirst);
+  const bool upper = (offset == 0) == HighWordFirst();
   return static_cast<std::uint16_t>(upper ? value >> 16 : value & 0xFFFFu);
 }
 

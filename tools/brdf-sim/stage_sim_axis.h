@@ -134,6 +134,8 @@ class SimAxis final : public RegisterUnit {
   std::uint32_t StatusWord() const;
   std::uint16_t RegisterAt(std::uint16_t address, double now) const;
   std::int32_t BlockInt32(std::uint16_t address) const;
+  // The configured word order, or the other one while the control unit swaps it.
+  bool HighWordFirst() const;
   // A 32-bit value from the registers at its lower and higher address, in the word order.
   std::int32_t Join(std::uint16_t lower_address_word, std::uint16_t higher_address_word) const;
   // The register at `offset` (0: lower address, 1: higher) of a 32-bit value, in the word order.

@@ -84,9 +84,21 @@ StageReply StageSimulator::Handle(std::uint8_t unit, std::span<const std::uint8_
     bool drop = false;
     int exception = 0;
     int delay_ms = 0;
+    int outage_ms = 0;
   };
-  const Fired fired = control_.UpdateModbus([](ModbusFaults& f) {
+  const auto now = std::chrono::steady_clock::now();
+  const bool in_outage = now.time_since_epoch().count() < outage_until_.load();
+  const Fired fired = control_.UpdateModbus([in_outage](ModbusFaults& f) {
     Fired r;
+    if (in_outage) {
+      r.drop = true;
+      return r;
+    }
+    if (f.outage_ms > 0) {
+      r.outage_ms = std::exchange(f.outage_ms, 0);
+      r.drop = true;
+      return r;
+    }
     if (f.drop_connection) {
       f.drop_connection = false;
       r.drop = true;
@@ -102,6 +114,13 @@ StageReply StageSimulator::Handle(std::uint8_t unit, std::span<const std::uint8_
     }
     return r;
   });
+  if (fired.outage_ms > 0) {
+    const std::chrono::milliseconds outage(fired.outage_ms);
+    outage_until_ = (now + outage).time_since_epoch().count();
+    if (transport == StageTransport::kTcp) {
+      return StageReply{StageReply::Kind::kDrop, {}, {}, outage};
+    }
+  }
   if (fired.drop) {
     return StageReply{
         transport == StageTransport::kTcp ? StageReply::Kind::kDrop : StageReply::Kind::kSilent,

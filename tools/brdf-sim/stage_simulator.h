@@ -7,10 +7,12 @@
 // Injected Modbus faults (SimControl::modbus(), consumed as they fire, axis unit ids only):
 // exception 02/04/06 (any code) for the next N requests, replies held back by late_reply_ms for the
 // next N requests, a dropped TCP connection, an alarm half-way through the next move, a stall where
-// MOVE never clears.
+// MOVE never clears; the drives' word order swapped (a setting that stays); an outage where the
+// drives go away for a while (TCP: connections refused) and come back.
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <memory>
@@ -85,6 +87,8 @@ class StageSimulator final : public StagePoseSource, private StageDispatcher {
   SimControl& control_;
   const std::chrono::steady_clock::time_point epoch_;
   StageControlUnit control_unit_;
+  // While an injected outage lasts (ModbusFaults::outage_ms): its end, on the steady clock.
+  std::atomic<std::chrono::steady_clock::rep> outage_until_{0};
   mutable std::mutex mu_;  // guards the axes
   std::array<std::unique_ptr<SimAxis>, 4> axes_;
   StageTcpEndpoint tcp_{*this};

@@ -45,6 +45,7 @@ bool StageTcpEndpoint::Start(const std::string& host, int port, std::string* err
     ctx_ = nullptr;
     return false;
   }
+  host_ = host;
   sockaddr_in addr{};
   socklen_t len = sizeof addr;
   if (::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&addr), &len) == 0) {
@@ -88,13 +89,19 @@ void StageTcpEndpoint::Stop() {
 
 void StageTcpEndpoint::Run() {
   while (!stopping_) {
+    ListenAgainWhenDue();
     fd_set readable;
     FD_ZERO(&readable);
-    FD_SET(listen_fd_, &readable);
+    if (listen_fd_ >= 0) FD_SET(listen_fd_, &readable);
     FD_SET(wake_[0], &readable);
     int max_fd = std::max(listen_fd_, wake_[0]);
     std::chrono::milliseconds wait(1000);
     const auto now = SteadyClock::now();
+    if (listen_fd_ < 0) {
+      wait = std::clamp(std::chrono::duration_cast<std::chrono::milliseconds>(refuse_until_ - now) +
+                            std::chrono::milliseconds(1),
+                        std::chrono::milliseconds(1), wait);
+    }
     for (const auto& [fd, client] : clients_) {
       FD_SET(fd, &readable);
       max_fd = std::max(max_fd, fd);
@@ -116,7 +123,7 @@ void StageTcpEndpoint::Run() {
         }
       }
       if (stopping_) break;
-      if (FD_ISSET(listen_fd_, &readable)) Accept();
+      if (listen_fd_ >= 0 && FD_ISSET(listen_fd_, &readable)) Accept();
       std::vector<int> ready;
       for (const auto& [fd, client] : clients_) {
         if (FD_ISSET(fd, &readable)) ready.push_back(fd);
@@ -133,6 +140,29 @@ void StageTcpEndpoint::Accept() {
   if (fd < 0) return;
   clients_[fd];
   clients_count_ = static_cast<int>(clients_.size());
+}
+
+void StageTcpEndpoint::RefuseUntil(SteadyClock::time_point until) {
+  refuse_until_ = std::max(refuse_until_, until);
+  if (listen_fd_ >= 0) ::close(listen_fd_);
+  listen_fd_ = -1;
+}
+
+void StageTcpEndpoint::ListenAgainWhenDue() {
+  if (listen_fd_ >= 0 || SteadyClock::now() < refuse_until_) return;
+  // A context for the port first chosen (the first one may have asked for port 0).
+  modbus_t* ctx = modbus_new_tcp(host_.c_str(), port_);
+  if (ctx == nullptr) return;
+  const int fd = modbus_tcp_listen(ctx, 16);
+  if (fd < 0) {
+    modbus_free(ctx);
+    refuse_until_ = SteadyClock::now() + std::chrono::milliseconds(100);  // try again shortly
+    return;
+  }
+  modbus_set_socket(ctx_, -1);
+  modbus_free(ctx_);
+  ctx_ = ctx;
+  listen_fd_ = fd;
 }
 
 void StageTcpEndpoint::CloseClient(int fd) {
@@ -175,6 +205,9 @@ bool StageTcpEndpoint::ServeFramed(Client& client) {
     switch (reply.kind) {
       case StageReply::Kind::kDrop:
         keep = false;
+        if (reply.refuse_connections.count() > 0) {
+          RefuseUntil(SteadyClock::now() + reply.refuse_connections);
+        }
         break;
       case StageReply::Kind::kSilent:
         break;

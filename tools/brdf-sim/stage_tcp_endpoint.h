@@ -13,7 +13,9 @@
 // Each request is dispatched on its unit id through a StageDispatcher (every unit id has its own
 // registers); replies are framed here (the request's transaction id and unit id, protocol 0) so
 // that an injected delay holds back only that client's replies, in order, while the other clients
-// are served.
+// are served. An injected outage (StageReply::refuse_connections) closes the listening socket for
+// a while, so that clients are refused as by a drive or gateway that is switched off, then listens
+// on the same port again.
 #pragma once
 
 #include <modbus.h>
@@ -63,12 +65,18 @@ class StageTcpEndpoint {
   bool ServeFramed(Client& client);
   void SendDue();
   void CloseClient(int fd);
+  // An injected outage: stop listening until `until` (connections are refused meanwhile).
+  void RefuseUntil(std::chrono::steady_clock::time_point until);
+  // Listens again on the same port once the outage is over (retried each turn if that fails).
+  void ListenAgainWhenDue();
 
   StageDispatcher& dispatcher_;
   modbus_t* ctx_ = nullptr;
   int listen_fd_ = -1;
   int wake_[2] = {-1, -1};
   int port_ = 0;
+  std::string host_;
+  std::chrono::steady_clock::time_point refuse_until_{};  // while listen_fd_ is closed
   std::thread thread_;
   std::atomic<bool> stopping_{false};
   std::map<int, Client> clients_;  // by socket; owned by the serving thread
