@@ -50,16 +50,6 @@ constexpr int kReadingsPerPage = 4096;
 
 }  // namespace
 
-Result<SessionReadings> LoadSessionReadings(SessionStore& store, std::int64_t session_id) {
-  Result<SessionReadings> session = LoadSessionRecord(store, session_id);
-  if (!session.ok()) return session;
-  BRDF_RETURN_IF_ERROR(store.ForEachReading(session_id, [&](const ReadingRecord& r) {
-    session->readings.push_back(ToReading(r));
-    return Status::Ok();
-  }));
-  return session;
-}
-
 Result<SessionReadings> LoadSessionReadings(SessionReader& reader, std::int64_t session_id) {
   Result<SessionReadings> session = LoadSessionRecord(reader, session_id);
   if (!session.ok()) return session;

@@ -1,8 +1,8 @@
 // A stored session handed out as core/readings' values: the session record's ρw and name, and
 // every reading (sample, reference, dark) converted from its ReadingRecord. The exports (brdfd's
 // Data.Export, brdf-export) load whole sessions so; the daemon's interpolation index converts
-// each committed record as it lands. Read-only use of the store: only GetSession and
-// ForEachReading (a SessionReader's GetReadings) are called.
+// each committed record as it lands. Read-only: only the reader's GetSession and GetReadings are
+// called.
 #pragma once
 
 #include <cstdint>
@@ -11,7 +11,6 @@
 #include "core/status.h"
 #include "storage/records.h"
 #include "storage/session_reader.h"
-#include "storage/session_store.h"
 
 namespace brdf::storage {
 
@@ -19,11 +18,9 @@ namespace brdf::storage {
 // time stay in the record).
 Reading ToReading(const ReadingRecord& r);
 
-// The session and all its readings, in id order. kNotFound for an unknown session (naming it and
-// the database), and the store's errors.
-Result<SessionReadings> LoadSessionReadings(SessionStore& store, std::int64_t session_id);
-// The same from any SessionReader (the lab archive: brdf-archive's exports), read a page at a
-// time.
+// The session and all its readings, in id order, read a page at a time from any SessionReader
+// (the rig's store: brdfd's and brdf-export's exports; the lab archive: brdf-archive's).
+// kNotFound for an unknown session (naming it), and the reader's errors.
 Result<SessionReadings> LoadSessionReadings(SessionReader& reader, std::int64_t session_id);
 
 }  // namespace brdf::storage

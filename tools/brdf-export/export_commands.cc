@@ -26,6 +26,7 @@
 #include "core/fit/models.h"
 #include "data/cie_tables.h"
 #include "storage/session_readings.h"
+#include "storage/session_store.h"
 #include "tools/brdf-export/output_file.h"
 #include "tools/brdf-export/progress_line.h"
 
