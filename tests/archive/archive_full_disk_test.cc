@@ -12,6 +12,7 @@
 
 #include "storage/session_store.h"
 #include "tests/archive/archive_compare.h"
+#include "tests/archive/archive_status.h"
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/support/pg_server.h"
 #include "tests/support/plan_fixtures.h"
@@ -52,20 +53,9 @@ class ArchiveFullDiskTest : public ::testing::Test {
     if (HasFailure() && pg_ != nullptr) std::cerr << "---- postgres log ----\n" << pg_->log();
   }
 
-  v1::ArchiveStatus Archive() {
-    v1::RigStatus status;
-    grpc::Status st = rig_->control().GetRigStatus(DaemonRig::Context().get(), {}, &status);
-    EXPECT_TRUE(st.ok()) << st.error_message();
-    return status.archive();
-  }
-  bool WaitArchive(const std::function<bool(const v1::ArchiveStatus&)>& done,
-                   std::chrono::seconds timeout = 30s) {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < deadline) {
-      if (done(Archive())) return true;
-      std::this_thread::sleep_for(50ms);
-    }
-    return false;
+  v1::ArchiveStatus Archive() { return RigArchiveStatus(*rig_); }
+  bool WaitArchive(const std::function<bool(const v1::ArchiveStatus&)>& done) {
+    return WaitRigArchiveStatus(*rig_, done);
   }
 
   std::unique_ptr<PgServer> pg_;

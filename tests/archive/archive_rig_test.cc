@@ -10,6 +10,7 @@
 
 #include "storage/session_store.h"
 #include "tests/archive/archive_compare.h"
+#include "tests/archive/archive_status.h"
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/support/pg_server_fixture.h"
 #include "tests/support/plan_fixtures.h"
@@ -51,20 +52,10 @@ class ArchiveRigTest : public PgServerTest {
            "\"\n[archive]\ncredentials = \"" + rigs_[i]->dir().file("archive.conninfo").string() +
            "\"\nretry_ms = 100\nbatch_readings = " + std::to_string(batch) + "\n";
   }
-  v1::ArchiveStatus Archive(int i) {
-    v1::RigStatus status;
-    grpc::Status st = rigs_[i]->control().GetRigStatus(DaemonRig::Context().get(), {}, &status);
-    EXPECT_TRUE(st.ok()) << st.error_message();
-    return status.archive();
-  }
+  v1::ArchiveStatus Archive(int i) { return RigArchiveStatus(*rigs_[i]); }
   bool WaitArchive(int i, const std::function<bool(const v1::ArchiveStatus&)>& done,
                    std::chrono::seconds timeout = 30s) {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < deadline) {
-      if (done(Archive(i))) return true;
-      std::this_thread::sleep_for(50ms);
-    }
-    return false;
+    return WaitRigArchiveStatus(*rigs_[i], done, timeout);
   }
   std::string Submit(int i) {
     Result<v1::Session> s = rigs_[i]->Submit(plans::SmallRotation());

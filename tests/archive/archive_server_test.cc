@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "daemon/config.h"
+#include "tests/archive/archive_status.h"
 #include "tests/brdfctl/ctl_runner.h"
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/support/pg_server_fixture.h"
@@ -153,17 +154,9 @@ class ArchiveServerTest : public PgServerTest {
     return *s;
   }
   bool WaitCaughtUp() {
-    const auto deadline = Clock::now() + 30s;
-    while (Clock::now() < deadline) {
-      v1::RigStatus status;
-      if (rig_->control().GetRigStatus(DaemonRig::Context().get(), {}, &status).ok() &&
-          status.archive().state() == v1::ARCHIVE_STATE_CAUGHT_UP &&
-          status.archive().lag_readings() == 0) {
-        return true;
-      }
-      std::this_thread::sleep_for(50ms);
-    }
-    return false;
+    return WaitRigArchiveStatus(*rig_, [](const v1::ArchiveStatus& s) {
+      return s.state() == v1::ARCHIVE_STATE_CAUGHT_UP && s.lag_readings() == 0;
+    });
   }
   ArchiveProcess& StartArchive() {
     const std::size_t i = archives_.size();
