@@ -157,8 +157,15 @@ int FuzzStageRtu(const std::uint8_t* data, std::size_t size) {
                     "counters overflowed");
   }
 
-  // The driver's view of the alpha drive (AZ map) must match the drive's own state.
-  const auto profile = drivers::stage::RegisterProfile::AzDefault();
+  // The driver's view of the alpha drive (AZ map) must match the drive's own state, read in the
+  // word order the drive lays values in now (the control unit's register 27 swaps it, as a lab
+  // may set a drive to the other order than the profile's).
+  auto profile = drivers::stage::RegisterProfile::AzDefault();
+  if (control.modbus().swap_word_order) {
+    profile.word_order = profile.word_order == drivers::stage::WordOrder::kHighFirst
+                             ? drivers::stage::WordOrder::kLowFirst
+                             : drivers::stage::WordOrder::kHighFirst;
+  }
   const auto status =
       ReadOverPdu(alpha, profile.status.address, static_cast<std::uint16_t>(profile.status.words));
   const auto position = ReadOverPdu(alpha, profile.feedback_position.address,
