@@ -32,21 +32,7 @@ grpc::Status ParseSettings(int method, int quantity, const v1::InterpolationOpti
                            Settings* out) {
   if (grpc::Status st = ParseMethodField(method, &out->method); !st.ok()) return st;
   if (grpc::Status st = ParseQuantityField(quantity, &out->quantity); !st.ok()) return st;
-  if (options.axis_scale_size() > 4) {
-    return InvalidField("options.axis_scale", "at most 4 values (one per axis), got " +
-                                                  std::to_string(options.axis_scale_size()));
-  }
-  for (int i = 0; i < options.axis_scale_size(); ++i) {
-    const double s = options.axis_scale(i);
-    if (!std::isfinite(s) || s <= 0) {
-      return InvalidField("options.axis_scale[" + std::to_string(i) + "]",
-                          "must be a finite number > 0 (got " + std::to_string(s) + ")");
-    }
-  }
-  out->options.axis_scale.assign(options.axis_scale().begin(), options.axis_scale().end());
-  out->options.mirror_phi = options.mirror_phi();
-  out->options.reciprocity = options.reciprocity();
-  return ParseCoordinatesField(options.coordinates(), &out->options.coordinates);
+  return ParseInterpolationOptions(options, &out->options);
 }
 
 // Ranges and finiteness, independent of the session. `field` is the DirectionQuery's path.
@@ -173,6 +159,25 @@ grpc::Status SessionOf(const std::string& text, SessionId* id) {
 }
 
 }  // namespace
+
+grpc::Status ParseInterpolationOptions(const v1::InterpolationOptions& options,
+                                       interp::Options* out) {
+  if (options.axis_scale_size() > 4) {
+    return InvalidField("options.axis_scale", "at most 4 values (one per axis), got " +
+                                                  std::to_string(options.axis_scale_size()));
+  }
+  for (int i = 0; i < options.axis_scale_size(); ++i) {
+    const double s = options.axis_scale(i);
+    if (!std::isfinite(s) || s <= 0) {
+      return InvalidField("options.axis_scale[" + std::to_string(i) + "]",
+                          "must be a finite number > 0 (got " + std::to_string(s) + ")");
+    }
+  }
+  out->axis_scale.assign(options.axis_scale().begin(), options.axis_scale().end());
+  out->mirror_phi = options.mirror_phi();
+  out->reciprocity = options.reciprocity();
+  return ParseCoordinatesField(options.coordinates(), &out->coordinates);
+}
 
 std::optional<grpc::Status> InterpolationService::AnswerIfReady(
     const grpc::ServerContextBase& context, const v1::InterpolateRequest& request,

@@ -18,8 +18,18 @@
 // previous one has been taken by the transport, so the server holds about one chunk per stream
 // (plus what HTTP/2's flow-control window lets through), never the whole answer. A client that
 // cancels stops the batch at the next chunk.
+//
+// RenderAppearance (service_appearance.cc) renders the sample's colour and a lit sphere under
+// CIE illuminants (core/appearance.h) from the session's BRDF index in this cache, behind the
+// exports' fill chain: the chosen method, then Delaunay (the cache's index, built only when a
+// pixel needs it), then the Cook-Torrance model fitted to the index's samples (only when a pixel
+// needs it). Isotropic sessions only: an anisotropic one is FAILED_PRECONDITION. Checked like a
+// batch: sphere_size at most kMaxAppearanceSphere (INVALID_ARGUMENT naming it), light 0 or 3
+// finite values not all 0, illuminants known and each at most once. It holds a work permit of the
+// stream registry while it computes (as InterpolateBatch and Export do).
 #pragma once
 
+#include <cstdint>
 #include <optional>
 
 #include "brdf/v1/brdf.grpc.pb.h"
@@ -29,6 +39,16 @@
 #include "daemon/stream_registry.h"
 
 namespace brdf::daemon {
+
+// RenderAppearance's default and largest sphere, pixels per side (512² RGBA is 1 MiB per
+// illuminant, under a client's default 4 MiB receive limit for both).
+inline constexpr std::uint32_t kDefaultAppearanceSphere = 128;
+inline constexpr std::uint32_t kMaxAppearanceSphere = 512;
+
+// InterpolationOptions checked (INVALID_ARGUMENT naming options.axis_scale[i] or
+// options.coordinates) into the interpolator's options.
+grpc::Status ParseInterpolationOptions(const v1::InterpolationOptions& options,
+                                       interp::Options* out);
 
 // Interpolate is served on gRPC's completion-queue API by InterpolateLoop (interpolate_loop.h),
 // from threads of brdfd's own: the answer takes microseconds, so a loop thread computes it where
@@ -45,6 +65,8 @@ class InterpolationService final
   grpc::Status InterpolateBatch(grpc::ServerContext* context,
                                 const v1::InterpolateBatchRequest* request,
                                 grpc::ServerWriter<v1::InterpolateBatchChunk>* writer) override;
+  grpc::Status RenderAppearance(grpc::ServerContext* context, const v1::AppearanceRequest* request,
+                                v1::AppearanceResponse* response) override;
 
   // Interpolate's answer (or its error) when the cache holds a current index for the request
   // (IndexCache::FreshHit): never reads the store nor builds. nullopt when the index must first be

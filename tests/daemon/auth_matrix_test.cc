@@ -48,6 +48,7 @@ const std::map<std::string, Needs>& Classification() {
       {"brdf.v1.Data.StreamReadingPoints", Needs::kRead},
       {"brdf.v1.Interpolation.Interpolate", Needs::kRead},
       {"brdf.v1.Interpolation.InterpolateBatch", Needs::kRead},
+      {"brdf.v1.Interpolation.RenderAppearance", Needs::kRead},
   };
   return table;
 }
