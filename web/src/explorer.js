@@ -6,6 +6,7 @@ import { plotly } from './plotly.js';
 import { call, stream } from './api.js';
 import { el, clear, stateName } from './dom.js';
 import { createPoints3d } from './points3d.js';
+import { createAppearance } from './appearance.js';
 
 const PLOT = { displaylogo: false, responsive: true };
 const POINT_COLUMNS = ['ids', 'alpha', 'beta', 'delta', 'theta_i', 'theta_o', 'phi', 'flagged'];
@@ -63,6 +64,7 @@ export function createExplorer(root, report) {
     polar,
     el('h2', {}, 'Downloads'), downloads, downloadInfo);
 
+  const appearance = createAppearance(root, report);
   const fig7a = createPoints3d(fig7aBox, { title: '(α, β, δ)', axes: ['α °', 'β °', 'δ °'] });
   const fig7b = createPoints3d(fig7bBox, { title: '(θi, θo, φ)', axes: ['θi °', 'θo °', 'φ °'] });
   for (const f of [fig7a, fig7b]) f.onPick(showReading);
@@ -103,6 +105,8 @@ export function createExplorer(root, report) {
     await new Promise((r) => requestAnimationFrame(r));
     Plotly = await plotly();
     await planeOfIncidence();
+    // After the first view: the server renders it with the same work permits as the plots.
+    await appearance.load(id);
   }
 
   function joinColumns(chunks) {

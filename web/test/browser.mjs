@@ -3,9 +3,9 @@
 // from its file (validated, with the estimated time), watch progress move, answer the prompts
 // (doing on the simulator what the prompt asks), pause and resume, then the explorer: Figure 7,
 // a reading's spectrum, a direction's interpolated spectrum with its vertices (two methods), the
-// plane of incidence, an export downloaded. As an analyst: no control anywhere, and the server
-// refuses one sent anyway. No errors in the browser console. Screenshots of every view go to
-// $BRDF_TEST_OUTPUT_DIR.
+// plane of incidence, the sample's colour and lit spheres (D65, A), an export downloaded. As an
+// analyst: no control anywhere, and the server refuses one sent anyway. No errors in the browser
+// console. Screenshots of every view go to $BRDF_TEST_OUTPUT_DIR.
 import puppeteer from 'puppeteer-core';
 import { readFileSync, readdirSync, existsSync } from 'node:fs';
 import { join, dirname } from 'node:path';
@@ -160,6 +160,30 @@ try {
   await page.$eval('#wavelength', (e) => { e.value = '5'; e.dispatchEvent(new Event('input')); });
   check((await text(page, '#wavelength-label')) !== nm0, `the wavelength slider redraws the polar plot (${nm0} → ${await text(page, '#wavelength-label')})`);
   await shot(page, '07-explorer-direction-polar');
+
+  // The sample's colour and lit spheres under D65 and A (Interpolation/RenderAppearance), drawn
+  // to canvases from the session's BRDF.
+  await page.waitForSelector('#appearance-sphere-D65', { timeout: 30000 });
+  await page.waitForSelector('#appearance-sphere-A');
+  const look = await page.evaluate(() => {
+    const pixels = (id) => { const c = document.getElementById(id); return c.getContext('2d').getImageData(0, 0, c.width, c.height).data; };
+    const sphere = (id) => {
+      const d = pixels(id);
+      let lit = 0, transparent = 0, r = 0, b = 0;
+      for (let i = 0; i < d.length; i += 4) {
+        if (d[i + 3] === 0) transparent++;
+        else if (d[i] + d[i + 1] + d[i + 2] > 30) { lit++; r += d[i]; b += d[i + 2]; }
+      }
+      return { lit, transparent, redOverBlue: r / b, size: document.getElementById(id).width };
+    };
+    const swatch = Array.from(pixels('appearance-swatch-D65').slice(0, 3));
+    return { d65: sphere('appearance-sphere-D65'), a: sphere('appearance-sphere-A'), swatch, caption: document.getElementById('appearance-colour-D65').textContent };
+  });
+  console.log(`appearance: ${look.caption}; D65 sphere ${look.d65.lit} lit pixels, r/b ${look.d65.redOverBlue.toFixed(2)}; A r/b ${look.a.redOverBlue.toFixed(2)}`);
+  check(look.swatch.some((v) => v > 10) && !/#000000/.test(look.caption) && /x 0\.\d+, y 0\.\d+/.test(look.caption), `the D65 swatch is not black (${look.swatch.join(', ')}; ${look.caption})`);
+  check(look.d65.lit > look.d65.size * look.d65.size / 8 && look.d65.transparent > 0, `the D65 sphere has lit pixels (${look.d65.lit}) and is transparent outside its disc`);
+  check(look.a.redOverBlue > look.d65.redOverBlue, `the sphere is redder under illuminant A (r/b ${look.a.redOverBlue.toFixed(2)} > ${look.d65.redOverBlue.toFixed(2)})`);
+  await (await page.$('#appearance')).screenshot({ path: join(out, '10-explorer-appearance.png') });
 
   const cdp = await page.createCDPSession();
   await cdp.send('Browser.setDownloadBehavior', { behavior: 'allow', downloadPath: out });

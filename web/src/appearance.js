@@ -1,0 +1,85 @@
+// The explorer's appearance panel: the sample's colour (CIE 45°:0°) and a sphere of it lit by a
+// distant light, in sRGB under CIE D65 and illuminant A, rendered by brdfd from the session's BRDF
+// (Interpolation/RenderAppearance: the chosen method, filled where it has no value by Delaunay,
+// then the fitted model). The spheres arrive as RGBA bytes (base64 in JSON) and are drawn to
+// <canvas> through ImageData; the swatches are canvases too (no inline style: the CSP is strict).
+import { call } from './api.js';
+import { el, clear } from './dom.js';
+
+function bytesOf(base64) {
+  const bin = atob(base64);
+  const out = new Uint8ClampedArray(bin.length);
+  for (let i = 0; i < bin.length; i++) out[i] = bin.charCodeAt(i);
+  return out;
+}
+
+function drawSphere(canvas, image) {
+  const n = image.sphere_size;
+  canvas.width = n;
+  canvas.height = n;
+  const ctx = canvas.getContext('2d');
+  ctx.putImageData(new ImageData(bytesOf(image.sphere_rgba), n, n), 0, 0);
+}
+
+function drawSwatch(canvas, hex) {
+  const ctx = canvas.getContext('2d');
+  ctx.fillStyle = hex;
+  ctx.fillRect(0, 0, canvas.width, canvas.height);
+}
+
+export function createAppearance(root, report) {
+  const method = el('select', { id: 'appearance-method' },
+    el('option', { value: 'INTERPOLATION_METHOD_OCTANT' }, 'octant (paper)'),
+    el('option', { value: 'INTERPOLATION_METHOD_DELAUNAY' }, 'Delaunay'),
+    el('option', { value: 'INTERPOLATION_METHOD_NEAREST' }, 'nearest'));
+  const info = el('p', { id: 'appearance-info', class: 'muted' }, 'Load a session.');
+  const images = el('div', { id: 'appearance-images', class: 'row appearance' });
+  let session = '';
+
+  root.append(
+    el('section', { id: 'appearance' },
+      el('h2', {}, 'Colour and lit sphere'),
+      el('div', { class: 'buttons' }, el('label', {}, 'method ', method),
+        el('button', { id: 'appearance-render', onclick: () => render() }, 'Render')),
+      info, images));
+
+  function figure(image) {
+    const name = image.name;
+    const sphere = el('canvas', { id: `appearance-sphere-${name}`, class: 'appearance-sphere' });
+    const swatch = el('canvas', { id: `appearance-swatch-${name}`, class: 'appearance-swatch', width: 48, height: 48 });
+    drawSphere(sphere, image);
+    drawSwatch(swatch, image.colour.srgb_hex);
+    const c = image.colour;
+    const lit = image.disc_pixels - image.unlit_pixels;
+    return el('figure', { class: 'appearance-figure' }, sphere,
+      el('figcaption', {},
+        el('div', { class: 'buttons' }, swatch,
+          el('span', { id: `appearance-colour-${name}` },
+            `${name === 'A' ? 'illuminant A' : 'D65'}: ${c.srgb_hex}, x ${c.x.toFixed(4)}, y ${c.y.toFixed(4)}, Y ${c.y_tristimulus.toFixed(3)}`)),
+        el('div', { class: 'muted' },
+          `${lit} lit pixels: ${image.interpolated_pixels} interpolated, ${image.fallback_pixels} Delaunay, ${image.model_pixels} model` +
+          (image.peak_y > 1 ? `; highlight clipped (peak Y ${image.peak_y.toFixed(2)})` : ''))));
+  }
+
+  async function render() {
+    if (!session) { report('load a session first'); return; }
+    info.textContent = 'rendering…';
+    const t0 = performance.now();
+    try {
+      // Mirror images and reciprocity: exact for an isotropic sample, and what the RGL and MERL
+      // exports use, so the chosen method answers more of the sphere itself.
+      const r = await call('Interpolation/RenderAppearance', { session_id: session, method: method.value, options: { mirror_phi: true, reciprocity: true } });
+      clear(images);
+      for (const image of r.images) images.append(figure(image));
+      info.textContent = `sample colour at 45°:0° (reflectance factor π·f_r) and a sphere lit from the upper left, sRGB, readings mirrored in φ and swapped θi↔θo; a white Lambertian lit head-on would be Y = 1 (${Math.round(performance.now() - t0)} ms)${r.detail ? `. ${r.detail}` : ''}`;
+    } catch (e) {
+      clear(images);
+      info.textContent = e.message;
+    }
+  }
+
+  return {
+    // A session was loaded in the explorer.
+    load(id) { session = id; return render(); },
+  };
+}
