@@ -2,7 +2,7 @@
 // with an analyst token, on a small session measured once in the test. The files it writes are
 // checked on their own terms: the MERL file's size, the .npy loaded by NumPy (/usr/bin/python3),
 // whose NaN cells must be the count brdfctl reports, the CSV's rows, the RGL .bsdf read by
-// tools/check/rgl_read.py, the fill counts.
+// tools/check/rgl_read.py, the fill counts; `brdfctl appearance`'s colours and PPM spheres.
 #include <google/protobuf/util/json_util.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -212,6 +212,49 @@ TEST_F(BrdfctlExportTest, RglReadsBackAndTheFillIsReported) {
   const CommandResult bad = Ctl({"export", id_, "grid", "--rgb", "-o", Path("rgb.npy")});
   EXPECT_EQ(bad.exit_code, 2) << Describe(bad);
   EXPECT_FALSE(std::filesystem::exists(Path("rgb.npy")));
+}
+
+// appearance: the colours under both illuminants, and the spheres as PPM files whose header and
+// size are a PPM's (P6, 24 × 24 pixels, 255) with lit (not white, not black) pixels; the JSON
+// form parses as the AppearanceResponse; an unknown illuminant is the user's error.
+TEST_F(BrdfctlExportTest, AppearancePrintsTheColoursAndWritesTheSpheres) {
+  const std::string ppm = Path("sphere.ppm");
+  const CommandResult r = Ctl({"appearance", id_, "--size", "24", "-o", ppm});
+  ASSERT_EQ(r.exit_code, 0) << Describe(r);
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(D65  #[0-9a-f]{6}  X [0-9.]+  Y [0-9.]+)")))
+      << Describe(r);
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(A    #[0-9a-f]{6} )"))) << Describe(r);
+  for (const char* name : {"sphere-D65.ppm", "sphere-A.ppm"}) {
+    std::ifstream in(Path(name), std::ios::binary);
+    ASSERT_TRUE(in.good()) << name << "\n" << Describe(r);
+    std::string magic;
+    int w = 0, h = 0, max = 0;
+    in >> magic >> w >> h >> max;
+    in.get();
+    EXPECT_EQ(magic, "P6");
+    EXPECT_EQ(w, 24);
+    EXPECT_EQ(h, 24);
+    EXPECT_EQ(max, 255);
+    std::string pixels((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_EQ(pixels.size(), 24U * 24U * 3U) << name;
+    int lit = 0;
+    for (std::size_t i = 0; i < pixels.size(); i += 3) {
+      const int sum = static_cast<unsigned char>(pixels[i]) +
+                      static_cast<unsigned char>(pixels[i + 1]) +
+                      static_cast<unsigned char>(pixels[i + 2]);
+      if (sum > 30 && sum < 765) ++lit;
+    }
+    EXPECT_GT(lit, 24 * 24 / 4) << name;
+  }
+  const CommandResult json = Ctl({"appearance", id_, "--illuminant", "A", "--json"});
+  ASSERT_EQ(json.exit_code, 0) << Describe(json);
+  v1::AppearanceResponse reply;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(Lines(json.out).at(0), &reply).ok());
+  ASSERT_EQ(reply.images_size(), 1);
+  EXPECT_EQ(reply.images(0).name(), "A");
+  EXPECT_EQ(reply.reflectance_size(), 101);
+  const CommandResult bad = Ctl({"appearance", id_, "--illuminant", "F2"});
+  EXPECT_EQ(bad.exit_code, 2) << Describe(bad);
 }
 
 }  // namespace

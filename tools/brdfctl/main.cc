@@ -1,7 +1,7 @@
 // brdfctl: the command line for brdfd. Every API call is a subcommand (README.md):
 //   brdfctl validate|submit PLAN.json, start|pause|resume|abort|get|watch|readings ID,
 //   answer ID STEP, list, rig, interpolate ID --theta-i A --theta-o B --phi C,
-//   export ID csv|grid|merl|rgl [-o FILE]
+//   export ID csv|grid|merl|rgl [-o FILE], appearance ID [--illuminant D65|A] [-o FILE.ppm]
 // plus `sim-mount` for the simulated rig only. Address and token from --address/--token or
 // BRDF_ADDRESS/BRDF_TOKEN. Exit status: exit_codes.h.
 #include <sys/ioctl.h>
@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "tools/brdfctl/appearance_command.h"
 #include "tools/brdfctl/client.h"
 #include "tools/brdfctl/control_commands.h"
 #include "tools/brdfctl/exit_codes.h"
@@ -225,6 +226,22 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"incidence", "half-diff"}))
       ->capture_default_str();
 
+  AppearanceOptions appearance_options;
+  CLI::App* appearance = app.add_subcommand(
+      "appearance",
+      "the sample's colour (45°:0°) and a lit sphere in sRGB under D65 and illuminant A");
+  add_id(appearance);
+  appearance->add_option("--illuminant", appearance_options.illuminant, "D65 or A (default both)")
+      ->check(CLI::IsMember({"D65", "A"}));
+  appearance
+      ->add_option("--method", appearance_options.method, "octant (the paper's), delaunay, nearest")
+      ->check(CLI::IsMember({"octant", "delaunay", "nearest"}))
+      ->capture_default_str();
+  appearance->add_option("--size", appearance_options.size,
+                         "the sphere's pixels per side, at most 512 (default 128)");
+  appearance->add_option("-o,--output", appearance_options.output,
+                         "write the sphere as a PPM (both illuminants: NAME-D65.ppm, NAME-A.ppm)");
+
   ExportOptions export_options;
   bool export_no_progress = false;
   CLI::App* export_cmd = app.add_subcommand(
@@ -341,6 +358,10 @@ int main(int argc, char** argv) {
   if (readings->parsed()) {
     readings_options.session_id = session_id;
     return RunReadings(ctx, readings_options);
+  }
+  if (appearance->parsed()) {
+    appearance_options.session_id = session_id;
+    return RunAppearance(ctx, appearance_options);
   }
   if (export_cmd->parsed()) {
     export_options.session_id = session_id;
