@@ -244,6 +244,30 @@ class LiveSession(unittest.TestCase):
         if delaunay.ok:
             self.assertAlmostEqual(float(delaunay.weights.sum()), 1.0, places=9)
 
+    def test_appearance_colour_and_sphere(self):
+        sid = self.session.session_id
+        look = self.client.appearance(sid, sphere_size=32, mirror_phi=True, reciprocity=True)
+        self.assertEqual([i.name for i in look.images], ["D65", "A"])
+        d65, a = look["D65"], look["A"]
+        self.assertEqual(d65.sphere.shape, (32, 32, 4))
+        self.assertEqual(d65.sphere[0, 0, 3], 0)  # a corner: outside the disc
+        self.assertRegex(d65.hex, r"^#[0-9a-f]{6}$")
+        self.assertNotEqual(d65.hex, "#000000")
+        self.assertGreater(d65.xyz[1], 0)
+        lit = d65.counts["disc"] - d65.counts["unlit"]
+        self.assertEqual(sum(d65.counts[k] for k in ("interpolated", "fallback", "model", "empty")),
+                         lit)
+        self.assertEqual(len(look.reflectance), 101)
+        self.assertEqual(look.wavelengths[0], 380)
+        # Under A the colour sits toward red: larger x than under D65.
+        self.assertGreater(a.xy[0], d65.xy[0] + 0.05)
+        with self.assertRaises(ValueError):
+            self.client.appearance(sid, "F2")
+        with self.assertRaises(BrdfError) as e:
+            self.client.appearance(sid, sphere_size=600)
+        self.assertEqual(e.exception.code, grpc.StatusCode.INVALID_ARGUMENT)
+        self.assertIn("sphere_size", str(e.exception))
+
     def test_interpolate_batch_matches_single_calls(self):
         sid = self.session.session_id
         cands = _common.candidate_queries(self.readings.of_kind("sample").iso, limit=5)

@@ -22,6 +22,7 @@ import time
 import grpc
 
 from . import names
+from .appearance import Appearance, illuminant_enums
 from ._stubs import brdf_pb2, brdf_pb2_grpc
 from .errors import BrdfError
 from .events import Event
@@ -470,6 +471,23 @@ class BrdfClient:
             options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates))
         response = self._unary(self._interp.Interpolate, request, "Interpolation.Interpolate")
         return InterpolationResult.from_proto(response.result)
+
+    def appearance(self, session_id, illuminants=None, *, method="octant", sphere_size=0,
+                   light=None, axis_scale=None, mirror_phi=False, reciprocity=False,
+                   coordinates=None):
+        """The sample's colour (CIE 45°:0°) and a lit sphere in sRGB
+        (Interpolation.RenderAppearance, docs/appearance.md). illuminants: "D65", "A", a list of them, or None for both.
+        sphere_size: pixels per side, at most 512 (0: 128). light: (x, y, z) towards the light
+        (x right, y up, z towards the viewer), None for the default (upper left, in front).
+        Returns an Appearance (appearance["D65"].hex, .xy, .sphere as an (n, n, 4) uint8 array)."""
+        request = brdf_pb2.AppearanceRequest(
+            session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
+            options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates),
+            sphere_size=sphere_size, light=list(light or []),
+            illuminants=illuminant_enums(illuminants))
+        response = self._unary(self._interp.RenderAppearance, request,
+                               "Interpolation.RenderAppearance")
+        return Appearance.from_proto(response)
 
     def interpolate_batch(self, session_id, directions, method="octant", quantity="brdf",
                           axis_scale=None, mirror_phi=False, reciprocity=False, chunk_size=0,
