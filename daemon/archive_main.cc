@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   bool migrate = false;
   CLI::App app(
       "brdf-archive: serves the lab archive (PostgreSQL) with brdfd's read API: sessions of every "
-      "rig, their readings, Interpolate and InterpolateBatch");
+      "rig, their readings, Interpolate, InterpolateBatch and RenderAppearance");
   app.add_option("--config", config_path,
                  "TOML configuration file (brdfd's format: [server], [[auth.tokens]], [log], "
                  "[archive] credentials)")

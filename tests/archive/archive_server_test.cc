@@ -358,6 +358,23 @@ TEST_F(ArchiveServerTest, TwoReplicasAnswerBitForBitWhatTheRigAnswers) {
           << "direction " << i;
     }
   }
+  // The colour and lit sphere (RenderAppearance, the same service code): the rig's images,
+  // byte for byte.
+  {
+    v1::AppearanceRequest look;
+    look.set_sphere_size(32);
+    look.set_session_id(paint.session_id());
+    v1::AppearanceResponse on_rig_look, archived_look;
+    grpc::Status st = rig_->interpolation().RenderAppearance(
+        DaemonRig::Context(kAnalystToken).get(), look, &on_rig_look);
+    ASSERT_TRUE(st.ok()) << st.error_message();
+    look.set_session_id(id_a);
+    st = a.interpolation().RenderAppearance(DaemonRig::Context(kAnalystToken).get(), look,
+                                            &archived_look);
+    ASSERT_TRUE(st.ok()) << st.error_message();
+    ASSERT_EQ(on_rig_look.images_size(), 2);
+    EXPECT_EQ(archived_look.SerializeAsString(), on_rig_look.SerializeAsString());
+  }
   // In half/difference coordinates too (the same service code): the rig's answers, which are
   // not the incidence ones.
   const std::vector<v1::InterpolationResult> rig_half = Batch(
