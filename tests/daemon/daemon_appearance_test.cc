@@ -5,6 +5,7 @@
 //   - the colour is core/colorimetry's of the reflectance factor the response gives, and that
 //     reflectance is π times Interpolate's BRDF at 45°:0° (when the chosen method has one);
 //   - illuminant A is redder than D65;
+//   - an anisotropic session is refused (FAILED_PRECONDITION, saying so);
 //   - bad requests name the field (sphere_size over the cap, light, an illuminant twice); an
 //     unknown session is NOT_FOUND; no token is UNAUTHENTICATED.
 #include <gtest/gtest.h>
@@ -132,6 +133,30 @@ TEST_F(DaemonAppearanceTest, ColourAndSphereOfARecordedSession) {
   EXPECT_EQ(response.images(0).name(), "A");
   EXPECT_EQ(response.images(0).sphere_rgba().size(), 16U * 16U * 4U);
   EXPECT_EQ(response.images(0).unlit_pixels(), 0U);
+}
+
+TEST_F(DaemonAppearanceTest, AnAnisotropicSessionIsRefusedSayingSo) {
+  // Three poses with a white reference, measured as an anisotropic sample (four angles).
+  std::string plan = PlanFixture("anisotropic appearance")
+                         .PoseList({{0, 10, 40}, {10, 20, 40}, {20, 30, 40}})
+                         .Reference(true)
+                         .Json();
+  plan.insert(plan.find('{') + 1, "\"anisotropic\": true, ");
+  Result<v1::Session> submitted = rig_.Submit(plan);
+  ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
+  const std::string id = submitted->session_id();
+  op_ = std::make_unique<GrpcOperator>(rig_, id);
+  const v1::Session done = rig_.WaitForState(id, v1::SESSION_STATE_COMPLETED, 60s);
+  ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED) << done.DebugString();
+
+  v1::AppearanceRequest request;
+  request.set_session_id(id);
+  v1::AppearanceResponse response;
+  const grpc::Status st = Render(request, &response);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << st.error_message();
+  EXPECT_NE(st.error_message().find("anisotropic"), std::string::npos) << st.error_message();
+  EXPECT_NE(st.error_message().find("isotropic sessions only"), std::string::npos)
+      << st.error_message();
 }
 
 TEST_F(DaemonAppearanceTest, BadRequestsNameTheField) {
