@@ -11,7 +11,8 @@
 //   BRDF_BUILD_DIR=build node web/bench/explorer_50k.mjs [readings]    (from web/: node bench/…)
 //   BRDF_BENCH_DB=<50k db> BRDF_BENCH_SMALL_DB=<500 db>: reuse sessions made before (creating the
 //   big one takes minutes; the bench prints where it kept them). BRDF_BENCH_VIEWS: first views
-//   per session (default 5).
+//   per session (default 5). BRDF_BENCH_WEB_ROOT: serve another build of the front end (e.g.
+//   main's, built with vite --outDir) to compare two builds on the same sessions.
 //
 // Measured (2026-12-04, this machine, load average 5–7 from two other builds; chromium with
 // SwiftShader, no GPU):
@@ -69,6 +70,7 @@ token = "${token}"
 role = "analyst"
 [web]
 listen = "127.0.0.1:0"
+${process.env.BRDF_BENCH_WEB_ROOT ? `root = "${process.env.BRDF_BENCH_WEB_ROOT}"` : ''}
 [log]
 level = "warn"
 `);

@@ -46,6 +46,7 @@ export function createExplorer(root, report) {
   let points = null; // columns of ReadingPoints over the whole session
   let session = '';
   let polarData = null;
+  const measured = new Set(); // sessions the listing showed with sample readings
 
   root.append(
     el('div', { class: 'buttons' }, el('label', {}, 'Session ', sessionSelect), el('button', { id: 'explorer-load', onclick: () => load(sessionSelect.value) }, 'Load'), loadInfo),
@@ -72,18 +73,24 @@ export function createExplorer(root, report) {
     clear(sessionSelect);
     for (const s of r.sessions) sessionSelect.append(el('option', { value: s.session_id }, `${s.name || s.session_id} (${stateName(s.state)})`));
     // The newest session with readings first.
-    const measured = r.sessions.find((s) => Number(s.progress?.done_samples) > 0);
-    if (measured) sessionSelect.value = measured.session_id;
+    for (const s of r.sessions) if (Number(s.progress?.done_samples) > 0) measured.add(s.session_id);
+    const newest = r.sessions.find((s) => measured.has(s.session_id));
+    if (newest) sessionSelect.value = newest.session_id;
   }
 
   // Figure 7: the readings' poses and directions as columns (Data.StreamReadingPoints, a few
   // messages of up to 8,192 readings, no spectra: 50,000 readings are ~4 MB of JSON), drawn as
-  // WebGL point clouds; a reading's spectra are fetched on a click.
+  // WebGL point clouds; a reading's spectra are fetched on a click. The plane of incidence's BRDF
+  // is asked for at the same time when the listing showed readings (the daemon answers it while
+  // the readings stream), else once they are there.
   async function load(id) {
     if (!id) return;
     session = id;
+    polarData = null;
     const t0 = performance.now();
     const chunks = [];
+    const thetaI = Number(ti.value);
+    let plane = measured.has(id) ? planeOfIncidence(id, thetaI) : null;
     await stream('Data/StreamReadingPoints', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (c) => chunks.push(c));
     const streamed = performance.now() - t0;
     points = joinColumns(chunks);
@@ -98,11 +105,18 @@ export function createExplorer(root, report) {
     fig7b.setPoints({ x: points.theta_i, y: points.theta_o, z: points.phi, value: points.theta_i });
     loadInfo.textContent = `${points.ids.length} sample readings loaded in ${Math.round(streamed)} ms, plotted in ${Math.round(performance.now() - t0 - streamed)} ms`;
     renderDownloads();
-    // plotly (the 2D plots) only once Figure 7 is on screen: parsing it blocks the page for most
-    // of a second, which would hold up the readings' messages and the point clouds' first frame.
+    // plotly (the 2D plots) only once Figure 7 is on screen: parsing it blocks the page, which
+    // would hold up the readings' messages and the point clouds' first frame.
     await new Promise((r) => requestAnimationFrame(r));
     Plotly = await plotly();
-    await planeOfIncidence();
+    plane ??= planeOfIncidence(id, thetaI);
+    const data = await plane;
+    if (session !== id) return;
+    polarData = data;
+    if (!polarData) { clear(polar).append(el('p', { class: 'muted' }, `no BRDF in the plane of incidence at θi ${thetaI}°`)); return; }
+    slider.max = String(polarData.count - 1);
+    slider.value = String(Math.floor(polarData.count / 2));
+    drawPolar();
   }
 
   function joinColumns(chunks) {
@@ -154,9 +168,9 @@ export function createExplorer(root, report) {
   }
 
   // BRDF along the plane of incidence at θi: θo from −85° (φ 0, the lamp's side) to 85° (φ 180,
-  // the specular side), one batch; the slider picks the wavelength.
-  async function planeOfIncidence() {
-    const thetaI = Number(ti.value);
+  // the specular side), one batch; the slider picks the wavelength. Null when too little of it is
+  // covered.
+  async function planeOfIncidence(id, thetaI) {
     const angles = [];
     for (let a = -85; a <= 85; a += 5) angles.push(a);
     const directions = angles.map((a) => ({ iso: { theta_i: thetaI, theta_o: Math.abs(a), phi: a >= 0 ? 180 : 0 } }));
@@ -167,19 +181,16 @@ export function createExplorer(root, report) {
     for (const m of ['INTERPOLATION_METHOD_OCTANT', 'INTERPOLATION_METHOD_NEAREST']) {
       results = new Array(angles.length);
       try {
-        await stream('Interpolation/InterpolateBatch', { session_id: session, method: m, quantity: 'QUANTITY_BRDF', directions }, (chunk) => {
+        await stream('Interpolation/InterpolateBatch', { session_id: id, method: m, quantity: 'QUANTITY_BRDF', directions }, (chunk) => {
           chunk.results.forEach((r, i) => { results[chunk.first_index + i] = r; });
         });
-      } catch (e) { report(e.message); return; }
+      } catch (e) { report(e.message); return null; }
       used = m.replace('INTERPOLATION_METHOD_', '').toLowerCase();
       if (results.filter((r) => r && r.status === 'INTERPOLATION_STATUS_OK').length >= 5) break;
     }
     const grid = results.find((r) => r && r.status === 'INTERPOLATION_STATUS_OK');
-    if (!grid) { clear(polar).append(el('p', { class: 'muted' }, `no BRDF in the plane of incidence at θi ${thetaI}°`)); return; }
-    polarData = { angles, results, grid: grid.grid, count: grid.spectrum.length, thetaI, used };
-    slider.max = String(polarData.count - 1);
-    slider.value = String(Math.floor(polarData.count / 2));
-    drawPolar();
+    if (!grid) return null;
+    return { angles, results, grid: grid.grid, count: grid.spectrum.length, thetaI, used };
   }
 
   function drawPolar() {
