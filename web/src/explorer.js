@@ -148,7 +148,8 @@ export function createExplorer(root, report) {
     Plotly = await plotly();
     const t0 = performance.now();
     try {
-      const res = (await call('Interpolation/Interpolate', { session_id: session, method: method.value, quantity: quantity.value, direction: { iso: { theta_i: Number(ti.value), theta_o: Number(to.value), phi: Number(phi.value) } } })).result;
+      // One call: the vertices come with their own spectra (include_vertex_spectra).
+      const res = (await call('Interpolation/Interpolate', { session_id: session, method: method.value, quantity: quantity.value, direction: { iso: { theta_i: Number(ti.value), theta_o: Number(to.value), phi: Number(phi.value) } }, include_vertex_spectra: true })).result;
       const ms = performance.now() - t0;
       clear(interpInfo);
       if (res.status !== 'INTERPOLATION_STATUS_OK') {
@@ -161,8 +162,9 @@ export function createExplorer(root, report) {
           res.vertices.map((v) => el('tr', {}, el('td', {}, v.reading_id), el('td', {}, v.coords.map((c) => c.toFixed(1)).join(', ')), el('td', {}, v.weight.toFixed(3))))));
       const x = wavelengths(res.grid, res.spectrum.length);
       const traces = [{ x, y: res.spectrum, name: 'interpolated', line: { width: 3, color: 'black' } }];
-      const verts = await Promise.all(res.vertices.map((v) => call('Interpolation/Interpolate', { session_id: session, method: 'INTERPOLATION_METHOD_NEAREST', quantity: quantity.value, direction: { iso: { theta_i: v.coords[0], theta_o: v.coords[1], phi: v.coords[2] } } }).catch(() => null)));
-      verts.forEach((vr, i) => { if (vr?.result?.status === 'INTERPOLATION_STATUS_OK') traces.push({ x, y: vr.result.spectrum, name: `reading ${res.vertices[i].reading_id} (w ${res.vertices[i].weight.toFixed(2)})`, line: { dash: 'dot' } }); });
+      for (const v of res.vertices) {
+        if (v.spectrum?.length) traces.push({ x, y: v.spectrum, name: `reading ${v.reading_id} (w ${v.weight.toFixed(2)})`, line: { dash: 'dot' } });
+      }
       Plotly.react(interp, traces, { height: 340, margin: { t: 20 }, xaxis: { title: { text: 'wavelength nm' } }, yaxis: { title: { text: quantity.selectedOptions[0].textContent } } }, PLOT);
     } catch (e) { report(e.message); }
   }
