@@ -224,7 +224,7 @@ grpc::Status ArchiveDataService::StreamReadings(grpc::ServerContext* context,
                                                 const v1::StreamReadingsRequest* request,
                                                 grpc::ServerWriter<v1::Reading>* writer) {
   return Serve(
-      *context, *request,
+      *context, *request, "StreamReadings",
       [&](StreamReadingsCall& call, const ReadingExtras& extras, const ReadingSource& source) {
         return StreamSessionReadings(*context, *request, call, extras, source, writer);
       });
@@ -233,17 +233,18 @@ grpc::Status ArchiveDataService::StreamReadings(grpc::ServerContext* context,
 grpc::Status ArchiveDataService::StreamReadingPoints(
     grpc::ServerContext* context, const v1::StreamReadingsRequest* request,
     grpc::ServerWriter<v1::ReadingPoints>* writer) {
-  return Serve(*context, *request,
+  return Serve(*context, *request, "StreamReadingPoints",
                [&](StreamReadingsCall& call, const ReadingExtras&, const ReadingSource& source) {
                  return StreamSessionReadingPoints(*context, *request, call, source, writer);
                });
 }
 
 grpc::Status ArchiveDataService::Serve(grpc::ServerContext& context,
-                                       const v1::StreamReadingsRequest& request,
+                                       const v1::StreamReadingsRequest& request, const char* rpc,
                                        const ReadingStreamBody& body) {
   StreamReadingsCall call;
-  if (grpc::Status st = CheckStreamReadings(context, request, auth_, streams_, &call); !st.ok()) {
+  if (grpc::Status st = CheckStreamReadings(context, request, rpc, auth_, streams_, &call);
+      !st.ok()) {
     return st;
   }
   Result<storage::SessionRecord> session = archive_->GetSession(call.session);

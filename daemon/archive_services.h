@@ -87,10 +87,10 @@ class ArchiveDataService final : public v1::Data::Service {
                       grpc::ServerWriter<v1::ExportChunk>* writer) override;
 
  private:
-  // Both readings streams: the request checked, the session looked up, then `body` with the
-  // archive as the source (polled for newly shipped readings).
+  // Both readings streams (`rpc`: which one, for its errors): the request checked, the session
+  // looked up, then `body` with the archive as the source (polled for newly shipped readings).
   grpc::Status Serve(grpc::ServerContext& context, const v1::StreamReadingsRequest& request,
-                     const ReadingStreamBody& body);
+                     const char* rpc, const ReadingStreamBody& body);
   std::shared_ptr<storage::ArchiveReader> archive_;
   const Authenticator& auth_;
   const StopSignal& stopping_;

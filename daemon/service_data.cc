@@ -37,7 +37,7 @@ grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
                                          const v1::StreamReadingsRequest* request,
                                          grpc::ServerWriter<v1::Reading>* writer) {
   return Serve(
-      *context, *request,
+      *context, *request, "StreamReadings",
       [&](StreamReadingsCall& call, const ReadingExtras& extras, const ReadingSource& source) {
         return StreamSessionReadings(*context, *request, call, extras, source, writer);
       });
@@ -46,17 +46,18 @@ grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
 grpc::Status DataService::StreamReadingPoints(grpc::ServerContext* context,
                                               const v1::StreamReadingsRequest* request,
                                               grpc::ServerWriter<v1::ReadingPoints>* writer) {
-  return Serve(*context, *request,
+  return Serve(*context, *request, "StreamReadingPoints",
                [&](StreamReadingsCall& call, const ReadingExtras&, const ReadingSource& source) {
                  return StreamSessionReadingPoints(*context, *request, call, source, writer);
                });
 }
 
 grpc::Status DataService::Serve(grpc::ServerContext& context,
-                                const v1::StreamReadingsRequest& request,
+                                const v1::StreamReadingsRequest& request, const char* rpc,
                                 const ReadingStreamBody& body) {
   StreamReadingsCall call;
-  if (grpc::Status st = CheckStreamReadings(context, request, auth_, streams_, &call); !st.ok()) {
+  if (grpc::Status st = CheckStreamReadings(context, request, rpc, auth_, streams_, &call);
+      !st.ok()) {
     return st;
   }
   storage::SessionStore& store = *manager_.store();

@@ -40,10 +40,11 @@ class DataService final : public v1::Data::Service {
                       grpc::ServerWriter<v1::ExportChunk>* writer) override;
 
  private:
-  // Both readings streams: the request checked, the session looked up, then `body` with the
-  // store as the source (following new readings through the listener).
+  // Both readings streams (`rpc`: which one, for its errors): the request checked, the session
+  // looked up, then `body` with the store as the source (following new readings through the
+  // listener).
   grpc::Status Serve(grpc::ServerContext& context, const v1::StreamReadingsRequest& request,
-                     const ReadingStreamBody& body);
+                     const char* rpc, const ReadingStreamBody& body);
 
   // Woken whenever any reading is committed; followers re-read the store then.
   std::uint64_t Generation() const;

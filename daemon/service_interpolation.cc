@@ -120,9 +120,13 @@ v1::InterpolationMethod ToProtoMethod(interp::Method m) {
   return v1::INTERPOLATION_METHOD_UNSPECIFIED;
 }
 
+// Whether each vertex carries its sample's spectrum (InterpolateRequest.include_vertex_spectra).
+enum class VertexSpectra { kOmit, kInclude };
+
 // One answer as the API gives it.
 void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const Settings& settings,
-              const IndexSnapshot& index, v1::InterpolationResult* out) {
+              const IndexSnapshot& index, VertexSpectra vertex_spectra,
+              v1::InterpolationResult* out) {
   *out->mutable_query() = query;
   out->set_status(ToProtoStatus(r.status));
   out->set_method(ToProtoMethod(r.method));
@@ -134,6 +138,12 @@ void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const 
     vertex->set_reading_id(v.id);
     vertex->mutable_coords()->Add(v.coords.begin(), v.coords.end());
     vertex->set_weight(v.weight);
+    if (vertex_spectra == VertexSpectra::kInclude) {
+      // The sample the vertex blends, from the snapshot the answer came from (v.index is its
+      // position in that set), in the answer's quantity.
+      const std::span<const double> spectrum = index.samples->spectrum(v.index);
+      vertex->mutable_spectrum()->Add(spectrum.begin(), spectrum.end());
+    }
   }
   std::string detail = std::move(r.detail);
   if (index.skipped > 0) {
@@ -144,11 +154,12 @@ void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const 
 }
 
 void Evaluate(const v1::DirectionQuery& query, const std::array<double, 4>& coords,
-              const Settings& settings, const IndexSnapshot& index, v1::InterpolationResult* out) {
+              const Settings& settings, const IndexSnapshot& index, VertexSpectra vertex_spectra,
+              v1::InterpolationResult* out) {
   ToResult(query,
            index.interpolator->Evaluate(
                std::span<const double>(coords.data(), static_cast<std::size_t>(index.dims))),
-           settings, index, out);
+           settings, index, vertex_spectra, out);
 }
 
 grpc::Status SessionOf(const std::string& text, SessionId* id) {
@@ -223,7 +234,9 @@ std::optional<grpc::Status> InterpolationService::Respond(const grpc::ServerCont
   if (grpc::Status st = ToCoords(request.direction(), *index, "direction", &coords); !st.ok()) {
     return st;
   }
-  Evaluate(request.direction(), coords, settings, *index, response->mutable_result());
+  Evaluate(request.direction(), coords, settings, *index,
+           request.include_vertex_spectra() ? VertexSpectra::kInclude : VertexSpectra::kOmit,
+           response->mutable_result());
   return grpc::Status::OK;
 }
 
@@ -318,7 +331,8 @@ grpc::Status InterpolationService::InterpolateBatch(
   index.interpolator->EvaluateEach(coords, [&](std::size_t k, interp::Interpolation&& answer) {
     const int i = static_cast<int>(k);
     if (i % chunk == 0 && !start_chunk(i)) return false;
-    ToResult(request->directions(i), std::move(answer), settings, index, out.add_results());
+    ToResult(request->directions(i), std::move(answer), settings, index, VertexSpectra::kOmit,
+             out.add_results());
     if (out.results_size() < chunk && i + 1 < n) return true;
     // Blocks while the client is slow to read (flow control); false: the client went away.
     if (!slot->Write(writer, out)) {

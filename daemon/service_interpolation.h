@@ -11,6 +11,8 @@
 // Isotropic sessions take `iso` directions (φ folded into [0, 180], exact for an isotropic
 // sample) or `four` (reduced to iso); anisotropic sessions take `four` only (φ wrapped into
 // (−180, 180], the range of the stored readings).
+// Interpolate with include_vertex_spectra also gives each vertex its sample's own spectrum, from
+// the snapshot the answer came from, in the answer's quantity (the paper's Figure 8 in one call).
 //
 // A batch is answered from ONE snapshot of the index, so all its results see the same readings
 // even while the session goes on. Chunks are written with the synchronous writer, which blocks

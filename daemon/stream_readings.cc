@@ -1,6 +1,7 @@
 #include "daemon/stream_readings.h"
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "core/geometry.h"
@@ -18,15 +19,14 @@ constexpr int kPointsPerMessage = 8192;
 }  // namespace
 
 grpc::Status CheckStreamReadings(grpc::ServerContext& context,
-                                 const v1::StreamReadingsRequest& request,
+                                 const v1::StreamReadingsRequest& request, const char* rpc,
                                  const Authenticator& auth, StreamRegistry& streams,
                                  StreamReadingsCall* call) {
-  if (grpc::Status st = auth.Authorize(context, Access::kRead, "StreamReadings", &call->caller);
-      !st.ok()) {
+  call->rpc = rpc;
+  if (grpc::Status st = auth.Authorize(context, Access::kRead, rpc, &call->caller); !st.ok()) {
     return st;
   }
-  if (grpc::Status st = streams.Open(context, &call->caller, "StreamReadings", &call->slot);
-      !st.ok()) {
+  if (grpc::Status st = streams.Open(context, &call->caller, rpc, &call->slot); !st.ok()) {
     return st;
   }
   if (grpc::Status st = ParseSessionIdField(request.session_id(), "session_id", &call->session);
@@ -66,7 +66,8 @@ grpc::Status ForEachReadingPage(
   std::vector<const storage::ReadingRecord*> kept;
   for (;;) {
     if (context.IsCancelled()) {
-      return grpc::Status(grpc::StatusCode::CANCELLED, "StreamReadings: cancelled by the client");
+      return grpc::Status(grpc::StatusCode::CANCELLED,
+                          std::string(call.rpc) + ": cancelled by the client");
     }
     bool ended = !request.follow();
     if (!ended) {
@@ -84,13 +85,14 @@ grpc::Status ForEachReadingPage(
     }
     const bool more_stored = static_cast<int>(page->size()) == page_size;
     if (!on_page(kept, more_stored)) {
-      return grpc::Status(grpc::StatusCode::CANCELLED, "StreamReadings: the client went away");
+      return grpc::Status(grpc::StatusCode::CANCELLED,
+                          std::string(call.rpc) + ": the client went away");
     }
     if (more_stored) continue;  // next page now
     if (ended) return grpc::Status::OK;
     if (source.wait()) {
       return grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                          "StreamReadings: " + source.server +
+                          std::string(call.rpc) + ": " + source.server +
                               " is shutting down; resume with after_id = " + std::to_string(last) +
                               " once it is back");
     }

@@ -19,15 +19,18 @@
 namespace brdf::daemon {
 
 // A checked StreamReadings request: the caller authorized (kRead), a stream slot taken, the
-// session id, kinds and after_id valid (else the status names the field).
+// session id, kinds and after_id valid (else the status names the field). `rpc` is the method
+// the client called ("StreamReadings" or "StreamReadingPoints", which take the same request):
+// the stream's errors and the authorization and stream-limit messages name it.
 struct StreamReadingsCall {
+  const char* rpc = "StreamReadings";
   Caller caller;
   std::unique_ptr<StreamRegistry::Slot> slot;
   std::int64_t session = 0;
   std::set<storage::ReadingKind> kinds;  // empty: every kind
 };
 grpc::Status CheckStreamReadings(grpc::ServerContext& context,
-                                 const v1::StreamReadingsRequest& request,
+                                 const v1::StreamReadingsRequest& request, const char* rpc,
                                  const Authenticator& auth, StreamRegistry& streams,
                                  StreamReadingsCall* call);
 

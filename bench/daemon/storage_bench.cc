@@ -6,26 +6,39 @@
 //     and done mark), synchronous=FULL (storage/sqlite.cc), 101-band PR-650 spectra, on the disk
 //     FILE is on. Stops after N readings or S seconds, whichever first.
 //   create --db FILE --readings N
-//     a COMPLETED isotropic session of N sample readings (plus its white reference and dark) at
-//     random directions, as brdfd would have stored it: what the memory figure loads into brdfd.
-//     Put FILE on a tmpfs (the one-fsync-per-reading cost is what `ingest` measures, not this).
+//     a COMPLETED isotropic session of N sample readings (plus its white reference and dark) as
+//     brdfd would have stored it: what the memory figure loads into brdfd and the web explorer's
+//     bench (web/bench/explorer_50k.mjs) shows. Put FILE on a tmpfs (the one-fsync-per-reading
+//     cost is what `ingest` measures, not this).
+//
+// The readings are at the rig's poses (RigPoses: the paper's sample-rotation grid, passes after
+// the first jittered), their directions from the pose by the rig's kinematics, their radiance
+// that of a paint-like sample (core/analytic_brdf.h) under the reference's lamp.
 //
 // Output: one "key=value" line (bench/daemon/run.sh parses it).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "core/analytic_brdf.h"
+#include "core/geometry.h"
 #include "core/wavelength_grid.h"
 #include "storage/session_store.h"
 
 namespace {
 
 using namespace brdf;
+
+// The session's white standard (Session.white_reflectance), ρw in the readings' derivation.
+constexpr double kWhiteReflectance = 0.99;
 
 // A session of `samples` sample steps after a reference and a dark; returns its id.
 Result<std::int64_t> NewSessionWith(storage::SessionStore& store, int samples) {
@@ -34,7 +47,7 @@ Result<std::int64_t> NewSessionWith(storage::SessionStore& store, int samples) {
   s.plan_kind = "pose_list";
   s.plan_json = R"({"poseList": {"poses": [{"alpha": 0, "beta": 0, "delta": 0}]}})";
   s.created_by_role = "operator";
-  s.white_reflectance = 0.99;
+  s.white_reflectance = kWhiteReflectance;
   std::vector<storage::StepRecord> steps;
   auto add = [&](storage::StepKind kind) {
     storage::StepRecord r;
@@ -51,37 +64,94 @@ Result<std::int64_t> NewSessionWith(storage::SessionStore& store, int samples) {
   return id;
 }
 
-// Writes the reference, the dark and `samples` sample readings at random iso directions
-// (θi, θo in [0, 80], φ in [0, 180]); calls `tick` after each sample (false: stop).
+// The poses of a long session on the rig: the paper's sample-rotation grid (GridSpec's defaults,
+// 2,320 poses over α 0…70°, δ 0…146.25°, β every 5° where lamp and detector are above the
+// surface), pass after pass; every pass after the first is jittered by up to ±2° in α, β and δ
+// (within the stages' travel; a jittered pose whose lamp or detector would leave the surface is
+// taken as on the grid), so N readings fill the hemisphere in (θi, θo, φ) rather than repeat
+// 2,320 points.
+class RigPoses {
+ public:
+  static Result<RigPoses> Make() {
+    Result<std::vector<Pose>> grid = ExpandSampleRotationGrid(GridSpec{});
+    if (!grid.ok()) return grid.status();
+    return RigPoses(*std::move(grid));
+  }
+  // The pose of the i-th sample reading, with its directions.
+  std::pair<Pose, Directions> Next(std::size_t i) {
+    const Pose on_grid = grid_[i % grid_.size()];
+    if (i < grid_.size()) return {on_grid, PoseToDirections(on_grid)};
+    Pose jittered = on_grid;
+    // α and δ stay within the rig's travel (PoseLimits' defaults).
+    const PoseLimits limits;
+    jittered.alpha =
+        std::clamp(on_grid.alpha + jitter_(rng_), limits.alpha_min_deg, limits.alpha_max_deg);
+    jittered.beta += jitter_(rng_);
+    jittered.delta =
+        std::clamp(on_grid.delta + jitter_(rng_), limits.delta_min_deg, limits.delta_max_deg);
+    const Directions d = PoseToDirections(jittered);
+    if (IsValid(d, GridSpec{}.theta_max_deg)) return {jittered, d};
+    return {on_grid, PoseToDirections(on_grid)};
+  }
+
+ private:
+  explicit RigPoses(std::vector<Pose> grid) : grid_(std::move(grid)) {}
+  std::vector<Pose> grid_;
+  std::mt19937_64 rng_{7};
+  std::uniform_real_distribution<double> jitter_{-2, 2};
+};
+
+// Writes the reference, the dark and `samples` sample readings at the rig's poses (RigPoses);
+// calls `tick` after each sample (false: stop).
 template <typename Tick>
 Result<int> Fill(storage::SessionStore& store, std::int64_t session, int samples, Tick tick) {
   const WavelengthGrid grid = WavelengthGrid::Pr650();
-  std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> theta(0, 80);
-  std::uniform_real_distribution<double> phi(0, 180);
-  std::uniform_real_distribution<double> level(0.01, 0.2);
-  auto reading = [&](storage::ReadingKind kind, const Directions& d, double value) {
+  Result<RigPoses> poses = RigPoses::Make();
+  if (!poses.ok()) return poses.status();
+  // The white reference's spectrum I0 (lamp and detector 10° off the normal), the dark D; a
+  // sample's radiance is D + (I0 − D)·f·π/ρw·cos θi/cos θi,ref for the paint's BRDF f, i.e. what
+  // the daemon's derivation (core/readings/derive.h) turns back into f.
+  const Directions reference_at{10, 0, 10, 180};
+  auto lamp = [&](std::size_t b) { return 1 + 0.002 * static_cast<double>(b); };
+  const double dark_level = 0.001;
+  const AnalyticBrdf paint = AnalyticBrdf::PaintLike();
+  constexpr double kPi = std::numbers::pi;
+  auto reading = [&](storage::ReadingKind kind, const Pose& pose, const Directions& d) {
     storage::ReadingRecord r;
     r.kind = kind;
+    r.pose = pose;
     r.directions = d;
     r.grid = grid;
     r.spectrum.resize(static_cast<std::size_t>(grid.count));
+    const double cos_ratio =
+        std::cos(d.theta_i * kPi / 180) / std::cos(reference_at.theta_i * kPi / 180);
     for (std::size_t b = 0; b < r.spectrum.size(); ++b) {
-      r.spectrum[b] = value * (1 + 0.002 * static_cast<double>(b));
+      const double dark = dark_level * lamp(b);
+      switch (kind) {
+        case storage::ReadingKind::kReference:
+          r.spectrum[b] = lamp(b);
+          break;
+        case storage::ReadingKind::kDark:
+          r.spectrum[b] = dark;
+          break;
+        default:
+          r.spectrum[b] = dark + (lamp(b) - dark) * paint.Evaluate(d, grid.at(b)) * kPi /
+                                     kWhiteReflectance * cos_ratio;
+      }
     }
     r.integration_ms = 100;
     return r;
   };
   Result<std::int64_t> reference = store.CompleteStepWithReading(
-      session, 0, reading(storage::ReadingKind::kReference, {10, 0, 10, 180}, 1.0));
+      session, 0, reading(storage::ReadingKind::kReference, {}, reference_at));
   if (!reference.ok()) return reference.status();
   Result<std::int64_t> dark =
-      store.CompleteStepWithReading(session, 1, reading(storage::ReadingKind::kDark, {}, 0.001));
+      store.CompleteStepWithReading(session, 1, reading(storage::ReadingKind::kDark, {}, {}));
   if (!dark.ok()) return dark.status();
   int written = 0;
   for (int i = 0; i < samples; ++i) {
-    storage::ReadingRecord r =
-        reading(storage::ReadingKind::kSample, {theta(rng), 0, theta(rng), phi(rng)}, level(rng));
+    const auto [pose, directions] = poses->Next(static_cast<std::size_t>(i));
+    storage::ReadingRecord r = reading(storage::ReadingKind::kSample, pose, directions);
     r.reference_reading_id = *reference;
     r.dark_reading_id = *dark;
     Result<std::int64_t> id = store.CompleteStepWithReading(session, 2 + i, r);

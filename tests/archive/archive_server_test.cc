@@ -207,11 +207,13 @@ class ArchiveServerTest : public PgServerTest {
   }
 
   // Interpolate at every direction: the responses (or the statuses, as "code: message").
+  // `base`: the request's other fields (method, options, include_vertex_spectra).
   static std::vector<std::string> InterpolateAll(v1::Interpolation::Stub& stub,
-                                                 const std::string& id, v1::Quantity quantity) {
+                                                 const std::string& id, v1::Quantity quantity,
+                                                 const v1::InterpolateRequest& base = {}) {
     std::vector<std::string> out;
     for (const v1::DirectionQuery& d : Directions()) {
-      v1::InterpolateRequest request;
+      v1::InterpolateRequest request = base;
       request.set_session_id(id);
       request.set_quantity(quantity);
       *request.mutable_direction() = d;
@@ -346,6 +348,23 @@ TEST_F(ArchiveServerTest, TwoReplicasAnswerBitForBitWhatTheRigAnswers) {
     EXPECT_GT(answered, 20) << "the grid should mostly be answerable";
     EXPECT_EQ(InterpolateAll(a.interpolation(), id_a, quantity), rig_answers);
     EXPECT_EQ(InterpolateAll(b.interpolation(), id_a, quantity), rig_answers);
+  }
+  // With the vertices' own spectra (Figure 8 in one call; Delaunay, which answers most of the
+  // grid): the rig's bytes too, spectra and all.
+  {
+    v1::InterpolateRequest figure8;
+    figure8.set_method(v1::INTERPOLATION_METHOD_DELAUNAY);
+    const std::vector<std::string> without =
+        InterpolateAll(rig_->interpolation(), paint.session_id(), v1::QUANTITY_BRDF, figure8);
+    figure8.set_include_vertex_spectra(true);
+    const std::vector<std::string> with =
+        InterpolateAll(rig_->interpolation(), paint.session_id(), v1::QUANTITY_BRDF, figure8);
+    int longer = 0;  // answers that gained their vertices' spectra
+    for (std::size_t i = 0; i < with.size() && i < without.size(); ++i) {
+      longer += with[i].size() > without[i].size();
+    }
+    EXPECT_GT(longer, 20);
+    EXPECT_TRUE(InterpolateAll(a.interpolation(), id_a, v1::QUANTITY_BRDF, figure8) == with);
   }
   const std::vector<v1::InterpolationResult> rig_batch =
       Batch(rig_->interpolation(), paint.session_id());

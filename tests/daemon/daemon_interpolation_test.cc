@@ -186,6 +186,39 @@ TEST_F(DaemonInterpolationTest, InterpolatedSpectraFollowTheirProvenanceAndMatch
                   1e-9 * std::abs(blend[static_cast<std::size_t>(b)]));
     }
 
+    // Figure 8 in one call: asked with include_vertex_spectra, each vertex carries its reading's
+    // own spectrum in the quantity asked for (as recomputed from the raw readings), and the
+    // answer is their blend with its weights; asked without (above), the vertices carry none.
+    for (const auto& v : brdf.vertices()) EXPECT_EQ(v.spectrum_size(), 0);
+    {
+      v1::InterpolateRequest request;
+      request.set_session_id(id);
+      request.set_method(v1::INTERPOLATION_METHOD_DELAUNAY);
+      request.set_quantity(v1::QUANTITY_REFLECTANCE);
+      *request.mutable_direction() = Iso(q);
+      request.set_include_vertex_spectra(true);
+      v1::InterpolateResponse response;
+      const grpc::Status called = rig_.interpolation().Interpolate(
+          DaemonRig::Context(kAnalystToken).get(), request, &response);
+      ASSERT_TRUE(called.ok()) << called.error_message();
+      const v1::InterpolationResult& with = response.result();
+      ASSERT_EQ(with.vertices_size(), 4);
+      ASSERT_EQ(with.spectrum_size(), 101);
+      std::vector<double> blended(101, 0.0);
+      for (const auto& v : with.vertices()) {
+        ASSERT_EQ(v.spectrum_size(), 101) << "vertex " << v.reading_id();
+        const Derived& d = derived[v.reading_id()];
+        for (int b = 0; b < 101; ++b) {
+          EXPECT_NEAR(v.spectrum(b), d.reflectance[b], 1e-9 * std::abs(d.reflectance[b]));
+          blended[static_cast<std::size_t>(b)] += v.weight() * v.spectrum(b);
+        }
+      }
+      for (int b = 0; b < 101; ++b) {
+        EXPECT_NEAR(with.spectrum(b), blended[static_cast<std::size_t>(b)],
+                    1e-9 * std::abs(blended[static_cast<std::size_t>(b)]));
+      }
+    }
+
     // The weights reproduce the query from the vertices (barycentric coordinates): the simplex
     // encloses the query.
     for (int axis = 0; axis < 3; ++axis) {

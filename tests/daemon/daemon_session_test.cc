@@ -221,6 +221,18 @@ TEST_F(DaemonSessionTest, SampleRotationPlanRunsToCompletionWithEveryReadingAndE
     EXPECT_TRUE(reader->Finish().ok());
     EXPECT_EQ(k, samples.size());
   }
+  // Its errors name the method the client called, not StreamReadings whose request it shares.
+  {
+    v1::StreamReadingsRequest request;
+    request.set_session_id(id);
+    auto context = DaemonRig::Context("");
+    auto reader = rig_.data().StreamReadingPoints(context.get(), request);
+    v1::ReadingPoints points;
+    EXPECT_FALSE(reader->Read(&points));
+    const grpc::Status st = reader->Finish();
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+    EXPECT_EQ(st.error_message().rfind("StreamReadingPoints: ", 0), 0u) << st.error_message();
+  }
 
   // The watcher: a snapshot first, sequence numbers increasing, step completions with progress,
   // the prompts the plan needs, and the stream closed after the session completed.

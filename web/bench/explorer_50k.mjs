@@ -6,12 +6,13 @@
 // session (500 readings, its own brdfd) and the gateway's no-op round trip (an Interpolate
 // without a direction: authorized, parsed and refused before any index lookup). Also printed:
 // the gateway call behind Figure 7 alone (Data.StreamReadingPoints from the page: time, bytes).
-// The sessions are bench_storage's (completed isotropic sessions of N sample readings at random
-// directions); brdfd runs without a rig.
+// The sessions are bench_storage's (completed isotropic sessions of N sample readings at the
+// rig's poses, the paper's grid repeated and jittered); brdfd runs without a rig.
 //   BRDF_BUILD_DIR=build node web/bench/explorer_50k.mjs [readings]    (from web/: node bench/…)
 //   BRDF_BENCH_DB=<50k db> BRDF_BENCH_SMALL_DB=<500 db>: reuse sessions made before (creating the
 //   big one takes minutes; the bench prints where it kept them). BRDF_BENCH_VIEWS: first views
-//   per session (default 5).
+//   per session (default 5). BRDF_BENCH_WEB_ROOT: serve another build of the front end (e.g.
+//   main's, built with vite --outDir) to compare two builds on the same sessions.
 //
 // Measured (2026-12-04, this machine, load average 5–7 from two other builds; chromium with
 // SwiftShader, no GPU):
@@ -23,6 +24,10 @@
 //   (500-reading session 769 ms, ratio 1.89); with the polar plot 3758 ms (small 2910 ms, ratio
 //   1.29: plotly's load and parse, ~2 s under that load, is most of it); new direction median
 //   90.0 ms, no-op 8.6 ms, ratio 10.5; StreamReadingPoints alone 872 ms.
+//   2026-12-05 (plotly partial bundle, polar batch beside the readings' stream, vertex spectra
+//   in the interpolation's answer; the sessions now at the rig's poses, 6.01 MB of points):
+//   with the polar plot median 1646 ms (small 718 ms, ratio 2.29; main's build on the same
+//   sessions just before: 4689 ms), new direction 98.1 ms (main's 104.1 ms); bench/README.md.
 import puppeteer from 'puppeteer-core';
 import { spawn, execFileSync } from 'node:child_process';
 import { mkdtempSync, writeFileSync, openSync, readFileSync, copyFileSync, existsSync } from 'node:fs';
@@ -69,6 +74,7 @@ token = "${token}"
 role = "analyst"
 [web]
 listen = "127.0.0.1:0"
+${process.env.BRDF_BENCH_WEB_ROOT ? `root = "${process.env.BRDF_BENCH_WEB_ROOT}"` : ''}
 [log]
 level = "warn"
 `);

@@ -47,6 +47,7 @@ export function createExplorer(root, report) {
   let points = null; // columns of ReadingPoints over the whole session
   let session = '';
   let polarData = null;
+  const measured = new Set(); // sessions the listing showed with sample readings
 
   root.append(
     el('div', { class: 'buttons' }, el('label', {}, 'Session ', sessionSelect), el('button', { id: 'explorer-load', onclick: () => load(sessionSelect.value) }, 'Load'), loadInfo),
@@ -74,18 +75,24 @@ export function createExplorer(root, report) {
     clear(sessionSelect);
     for (const s of r.sessions) sessionSelect.append(el('option', { value: s.session_id }, `${s.name || s.session_id} (${stateName(s.state)})`));
     // The newest session with readings first.
-    const measured = r.sessions.find((s) => Number(s.progress?.done_samples) > 0);
-    if (measured) sessionSelect.value = measured.session_id;
+    for (const s of r.sessions) if (Number(s.progress?.done_samples) > 0) measured.add(s.session_id);
+    const newest = r.sessions.find((s) => measured.has(s.session_id));
+    if (newest) sessionSelect.value = newest.session_id;
   }
 
   // Figure 7: the readings' poses and directions as columns (Data.StreamReadingPoints, a few
   // messages of up to 8,192 readings, no spectra: 50,000 readings are ~4 MB of JSON), drawn as
-  // WebGL point clouds; a reading's spectra are fetched on a click.
+  // WebGL point clouds; a reading's spectra are fetched on a click. The plane of incidence's BRDF
+  // is asked for at the same time when the listing showed readings (the daemon answers it while
+  // the readings stream), else once they are there.
   async function load(id) {
     if (!id) return;
     session = id;
+    polarData = null;
     const t0 = performance.now();
     const chunks = [];
+    const thetaI = Number(ti.value);
+    let plane = measured.has(id) ? planeOfIncidence(id, thetaI) : null;
     await stream('Data/StreamReadingPoints', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (c) => chunks.push(c));
     const streamed = performance.now() - t0;
     points = joinColumns(chunks);
@@ -100,11 +107,21 @@ export function createExplorer(root, report) {
     fig7b.setPoints({ x: points.theta_i, y: points.theta_o, z: points.phi, value: points.theta_i });
     loadInfo.textContent = `${points.ids.length} sample readings loaded in ${Math.round(streamed)} ms, plotted in ${Math.round(performance.now() - t0 - streamed)} ms`;
     renderDownloads();
-    // plotly (the 2D plots) only once Figure 7 is on screen: parsing it blocks the page for most
-    // of a second, which would hold up the readings' messages and the point clouds' first frame.
+    // plotly (the 2D plots) only once Figure 7 is on screen: parsing it blocks the page, which
+    // would hold up the readings' messages and the point clouds' first frame.
     await new Promise((r) => requestAnimationFrame(r));
     Plotly = await plotly();
-    await planeOfIncidence();
+    plane ??= planeOfIncidence(id, thetaI);
+    const data = await plane;
+    if (session !== id) return;
+    polarData = data;
+    if (!polarData) {
+      clear(polar).append(el('p', { class: 'muted' }, `no BRDF in the plane of incidence at θi ${thetaI}°`));
+    } else {
+      slider.max = String(polarData.count - 1);
+      slider.value = String(Math.floor(polarData.count / 2));
+      drawPolar();
+    }
     // After the first view: the server renders it with the same work permits as the plots.
     await appearance.load(id);
   }
@@ -138,7 +155,8 @@ export function createExplorer(root, report) {
     Plotly = await plotly();
     const t0 = performance.now();
     try {
-      const res = (await call('Interpolation/Interpolate', { session_id: session, method: method.value, quantity: quantity.value, direction: { iso: { theta_i: Number(ti.value), theta_o: Number(to.value), phi: Number(phi.value) } } })).result;
+      // One call: the vertices come with their own spectra (include_vertex_spectra).
+      const res = (await call('Interpolation/Interpolate', { session_id: session, method: method.value, quantity: quantity.value, direction: { iso: { theta_i: Number(ti.value), theta_o: Number(to.value), phi: Number(phi.value) } }, include_vertex_spectra: true })).result;
       const ms = performance.now() - t0;
       clear(interpInfo);
       if (res.status !== 'INTERPOLATION_STATUS_OK') {
@@ -151,16 +169,17 @@ export function createExplorer(root, report) {
           res.vertices.map((v) => el('tr', {}, el('td', {}, v.reading_id), el('td', {}, v.coords.map((c) => c.toFixed(1)).join(', ')), el('td', {}, v.weight.toFixed(3))))));
       const x = wavelengths(res.grid, res.spectrum.length);
       const traces = [{ x, y: res.spectrum, name: 'interpolated', line: { width: 3, color: 'black' } }];
-      const verts = await Promise.all(res.vertices.map((v) => call('Interpolation/Interpolate', { session_id: session, method: 'INTERPOLATION_METHOD_NEAREST', quantity: quantity.value, direction: { iso: { theta_i: v.coords[0], theta_o: v.coords[1], phi: v.coords[2] } } }).catch(() => null)));
-      verts.forEach((vr, i) => { if (vr?.result?.status === 'INTERPOLATION_STATUS_OK') traces.push({ x, y: vr.result.spectrum, name: `reading ${res.vertices[i].reading_id} (w ${res.vertices[i].weight.toFixed(2)})`, line: { dash: 'dot' } }); });
+      for (const v of res.vertices) {
+        if (v.spectrum?.length) traces.push({ x, y: v.spectrum, name: `reading ${v.reading_id} (w ${v.weight.toFixed(2)})`, line: { dash: 'dot' } });
+      }
       Plotly.react(interp, traces, { height: 340, margin: { t: 20 }, xaxis: { title: { text: 'wavelength nm' } }, yaxis: { title: { text: quantity.selectedOptions[0].textContent } } }, PLOT);
     } catch (e) { report(e.message); }
   }
 
   // BRDF along the plane of incidence at θi: θo from −85° (φ 0, the lamp's side) to 85° (φ 180,
-  // the specular side), one batch; the slider picks the wavelength.
-  async function planeOfIncidence() {
-    const thetaI = Number(ti.value);
+  // the specular side), one batch; the slider picks the wavelength. Null when too little of it is
+  // covered.
+  async function planeOfIncidence(id, thetaI) {
     const angles = [];
     for (let a = -85; a <= 85; a += 5) angles.push(a);
     const directions = angles.map((a) => ({ iso: { theta_i: thetaI, theta_o: Math.abs(a), phi: a >= 0 ? 180 : 0 } }));
@@ -171,19 +190,16 @@ export function createExplorer(root, report) {
     for (const m of ['INTERPOLATION_METHOD_OCTANT', 'INTERPOLATION_METHOD_NEAREST']) {
       results = new Array(angles.length);
       try {
-        await stream('Interpolation/InterpolateBatch', { session_id: session, method: m, quantity: 'QUANTITY_BRDF', directions }, (chunk) => {
+        await stream('Interpolation/InterpolateBatch', { session_id: id, method: m, quantity: 'QUANTITY_BRDF', directions }, (chunk) => {
           chunk.results.forEach((r, i) => { results[chunk.first_index + i] = r; });
         });
-      } catch (e) { report(e.message); return; }
+      } catch (e) { report(e.message); return null; }
       used = m.replace('INTERPOLATION_METHOD_', '').toLowerCase();
       if (results.filter((r) => r && r.status === 'INTERPOLATION_STATUS_OK').length >= 5) break;
     }
     const grid = results.find((r) => r && r.status === 'INTERPOLATION_STATUS_OK');
-    if (!grid) { clear(polar).append(el('p', { class: 'muted' }, `no BRDF in the plane of incidence at θi ${thetaI}°`)); return; }
-    polarData = { angles, results, grid: grid.grid, count: grid.spectrum.length, thetaI, used };
-    slider.max = String(polarData.count - 1);
-    slider.value = String(Math.floor(polarData.count / 2));
-    drawPolar();
+    if (!grid) return null;
+    return { angles, results, grid: grid.grid, count: grid.spectrum.length, thetaI, used };
   }
 
   function drawPolar() {

@@ -154,6 +154,8 @@ try {
     const rows = await page.$$eval('#vertices tr', (r) => r.length - 1);
     check(rows >= 1, `${method}: ${rows} vertices with weights`);
     await page.waitForFunction(() => document.querySelectorAll('#interp-spectrum .scatterlayer .trace').length >= 2, { timeout: 15000 });
+    const traces = await page.$$eval('#interp-spectrum .scatterlayer .trace', (t) => t.length);
+    check(traces === rows + 1, `${method}: the interpolated spectrum and each vertex's own spectrum drawn (${traces} traces for ${rows} vertices)`);
   }
   await page.waitForSelector('#polar .scatterlayer .trace, #polar .trace');
   const nm0 = await text(page, '#wavelength-label');
