@@ -11,6 +11,7 @@
 
 #include "core/appearance.h"
 #include "core/export/fill_chain.h"
+#include "core/export/session_interpolant.h"
 #include "core/export/spectrum_source.h"
 #include "core/fit/fit.h"
 #include "daemon/service_interpolation.h"
@@ -107,18 +108,6 @@ class LazyStage {
   std::string error_;
 };
 
-Result<fit::CookTorranceFit> FitSamples(const IndexSnapshot& index, const CallContext& ctx) {
-  fit::Observations data(index.grid);
-  const interp::SampleSet& samples = *index.samples;
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    const std::span<const double> c = samples.coords(i);
-    if (Status st = data.Add(IsoDirection{c[0], c[1], c[2]}, samples.spectrum(i)); !st.ok()) {
-      return st.WithContext("reading " + std::to_string(samples.id(i)));
-    }
-  }
-  return fit::FitCookTorrance(data, {}, ctx);
-}
-
 CallContext FitContext(const grpc::ServerContext& context) {
   const auto remaining = context.deadline() - std::chrono::system_clock::now();
   const auto timeout = std::min<std::chrono::steady_clock::duration>(
@@ -183,7 +172,8 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
   });
   std::optional<fit::CookTorranceFit> model_fit;
   LazyStage model([&]() -> Result<exports::SpectrumSource> {
-    Result<fit::CookTorranceFit> fitted = FitSamples(*index, FitContext(*context));
+    Result<fit::CookTorranceFit> fitted =
+        exports::FitSampleModel(*index->samples, index->grid, FitContext(*context));
     if (!fitted.ok()) return fitted.status().WithContext("the fill chain's model");
     model_fit = *std::move(fitted);
     return exports::ModelSource(*model_fit);

@@ -1,6 +1,8 @@
 #include "core/export/session_interpolant.h"
 
 #include <algorithm>
+#include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -9,16 +11,6 @@
 
 namespace brdf::exports {
 namespace {
-
-Result<fit::CookTorranceFit> FitModel(const DerivedSamples& derived, const CallContext& ctx) {
-  fit::Observations data(derived.grid);
-  for (const DerivedSample& s : derived.samples) {
-    if (Status st = data.Add(s.iso, s.values); !st.ok()) {
-      return st.WithContext("reading " + std::to_string(s.reading_id));
-    }
-  }
-  return fit::FitCookTorrance(data, {}, ctx);
-}
 
 // Retro-reflection f(θ, θ, 0) of a Cook-Torrance fit (band means of kd, ks; shared α, F0): the
 // microfacet source when a session has no δ = 0 readings.
@@ -41,6 +33,18 @@ RetroProfile RetroFromModel(const fit::CookTorranceFit& model) {
 }
 
 }  // namespace
+
+Result<fit::CookTorranceFit> FitSampleModel(const interp::SampleSet& samples,
+                                            const WavelengthGrid& grid, const CallContext& ctx) {
+  fit::Observations data(grid);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const std::span<const double> c = samples.coords(i);
+    if (Status st = data.Add(IsoDirection{c[0], c[1], c[2]}, samples.spectrum(i)); !st.ok()) {
+      return st.WithContext("reading " + std::to_string(samples.id(i)));
+    }
+  }
+  return fit::FitCookTorrance(data, {}, ctx);
+}
 
 InterpolantInfo SessionInterpolant::Info() const {
   return {options.mirror_phi, options.reciprocity, options.axis_scale,
@@ -73,7 +77,7 @@ Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, inter
       in.fallback = std::move(*d);
       stages.push_back({Provenance::kFallback, InterpolatorSource(*in.fallback)});
     }
-    Result<fit::CookTorranceFit> model = FitModel(in.derived, ctx);
+    Result<fit::CookTorranceFit> model = FitSampleModel(*in.samples, in.derived.grid, ctx);
     if (!model.ok()) return model.status().WithContext("the fill chain's model");
     in.model = std::move(*model);
     stages.push_back({Provenance::kModel, ModelSource(*in.model)});
@@ -103,7 +107,7 @@ Result<RglExport> BuildSessionRgl(const Session& session, const SessionInterpola
     if (in.model) {
       retro = RetroFromModel(*in.model);
     } else {
-      Result<fit::CookTorranceFit> model = FitModel(in.derived, ctx);
+      Result<fit::CookTorranceFit> model = FitSampleModel(*in.samples, in.derived.grid, ctx);
       if (!model.ok()) {
         return model.status().WithContext(retro.status().message() +
                                           "; fitting Cook-Torrance (GGX) instead");

@@ -47,6 +47,12 @@ Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, inter
                                                    const interp::Options& options,
                                                    FillPolicy policy, const CallContext& ctx);
 
+// The fill chain's model: the Cook-Torrance (GGX) model fitted to every sample of `samples`
+// (coordinates θi, θo, φ; spectra on `grid`), in the set's order. Errors: a sample the fit refuses
+// (naming its reading), a failed fit, kCancelled / kTimeout from `ctx`.
+Result<fit::CookTorranceFit> FitSampleModel(const interp::SampleSet& samples,
+                                            const WavelengthGrid& grid, const CallContext& ctx);
+
 struct SessionRglOptions {
   std::size_t theta_i_count = 24;  // θi slices
   std::size_t sample_res = 48;     // nodes per side of the warped square
