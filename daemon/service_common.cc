@@ -56,18 +56,6 @@ std::string BoundedMessage(std::string message) {
   return message + "... (" + std::to_string(full) + " bytes)";
 }
 
-std::string PrintablePrefix(std::string_view text, std::size_t max) {
-  std::string out;
-  const std::size_t n = std::min(text.size(), max);
-  out.reserve(n + 24);
-  for (std::size_t i = 0; i < n; ++i) {
-    const char c = text[i];
-    out += (c >= 0x20 && c < 0x7f) ? c : '?';
-  }
-  if (text.size() > max) out += "... (" + std::to_string(text.size()) + " bytes)";
-  return out;
-}
-
 grpc::Status InvalidField(const std::string& field, const std::string& what) {
   return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, BoundedMessage(field + ": " + what));
 }

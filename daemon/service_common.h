@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "brdf/v1/brdf.pb.h"
+#include "core/client_text.h"
 #include "core/interp/interpolator.h"
 #include "core/mutex.h"
 #include "core/readings/quantity.h"
@@ -55,10 +56,9 @@ inline constexpr std::chrono::milliseconds kStreamPollInterval{200};
 // and kConfigurationError → INTERNAL. The message is kept, up to kMaxErrorMessageBytes.
 grpc::Status ToGrpcStatus(const Status& status);
 
-// A client's string as an error message may quote it: at most `max` bytes, each byte outside
-// printable ASCII as '?', a longer one cut and marked ("abc... (102400 bytes)"). gRPC carries
-// an error message in a trailer, which clients cap at a few KiB.
-std::string PrintablePrefix(std::string_view text, std::size_t max = 64);
+// A client's string as an error message may quote it: PrintablePrefix (core/client_text.h).
+// gRPC carries an error message in a trailer, which clients cap at a few KiB.
+using brdf::PrintablePrefix;
 
 // Longest error message brdfd sends (BoundedMessage); the trailer that carries it stays small.
 inline constexpr std::size_t kMaxErrorMessageBytes = 1024;

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <set>
 
+#include "core/client_text.h"
 #include "core/mutex.h"
 #include "daemon/web_rpc.h"
 
@@ -202,7 +203,7 @@ void ServeApi(const std::shared_ptr<JsonRpc>& rpc, const std::shared_ptr<WebStre
   const WebMethod* method = FindWebMethod(name);
   if (method == nullptr) {
     ReplyError(res, grpc::Status(grpc::UNIMPLEMENTED,
-                                 "no method " + name +
+                                 "no method " + PrintablePrefix(name) +
                                      " in brdf.v1; see brdf.proto (e.g. brdf.v1.Control/"
                                      "ListSessions)"));
     res.status = 404;

@@ -10,6 +10,7 @@
 #include <map>
 
 #include "brdf/v1/brdf.grpc.pb.h"
+#include "core/client_text.h"
 
 namespace brdf::daemon {
 namespace {
@@ -142,7 +143,7 @@ grpc::Status ParseJsonRequest(std::string_view json, pb::Message* message) {
   if (!st.ok()) {
     return grpc::Status(grpc::INVALID_ARGUMENT,
                         "invalid JSON for " + message->GetDescriptor()->full_name() + ": " +
-                            std::string(st.message()) +
+                            PrintablePrefix(std::string(st.message()), 200) +
                             "; send the request message as protobuf JSON (brdf.proto's field "
                             "names, enums by name)");
   }

@@ -48,6 +48,13 @@ try {
   check(r.status === 400, 'wrong type → 400');
   r = await post('Control/Explode', {}, rig.operatorToken);
   check(r.status === 404 && r.json.code === 'UNIMPLEMENTED', 'unknown method → 404');
+  // A client's strings come back as a short printable prefix, never whole (issue 20: errors echo
+  // at most a short prefix of any client string).
+  const longName = 'y'.repeat(20000);
+  r = await post(`Control/${longName.slice(0, 5000)}`, {}, rig.operatorToken);
+  check(r.status === 404 && r.text.length < 1024 && /\.\.\. \(\d+ bytes\)/.test(r.json?.message), `a 5 kB method name is quoted cut (${r.status}, ${r.text.length} bytes)`);
+  r = await post('Control/ListSessions', `{"${longName}": 1}`, rig.operatorToken);
+  check(r.status === 400 && r.text.length < 1024 && /yyyy/.test(r.json.message), `a 20 kB unknown field is quoted cut (${r.text.length} bytes)`);
   r = await post('Control/ListSessions', '{}', rig.operatorToken, { headers: { 'Content-Type': 'text/plain' } });
   check(r.status === 415, 'a text/plain body → 415 (no form posts)');
   const big = JSON.stringify({ plan: { name: 'x'.repeat(2 * 1024 * 1024) } });
