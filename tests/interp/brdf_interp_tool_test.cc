@@ -289,4 +289,40 @@ TEST_F(BrdfInterpToolTest, AccuracyComparesBothCoordinates) {
   EXPECT_EQ(Exec("accuracy --sample velvet").status, 2);
 }
 
+// The lines of `text` that start with `prefix`.
+std::vector<std::string> LinesStartingWith(const std::string& text, const std::string& prefix) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind(prefix, 0) == 0) out.push_back(line);
+  }
+  return out;
+}
+
+TEST_F(BrdfInterpToolTest, AccuracyLogBlendChangesTheBlendingMethodsOnly) {
+  const ToolRun linear = Exec("accuracy --sample glossy --queries 2000");
+  const ToolRun log = Exec("accuracy --sample glossy --queries 2000 --blend log");
+  ASSERT_EQ(linear.status, 0) << linear.err;
+  ASSERT_EQ(log.status, 0) << log.err;
+  EXPECT_THAT(linear.out, HasSubstr("; linear blend"));
+  EXPECT_THAT(log.out, HasSubstr("; log blend (floor 1e-6 of each band's largest value)"));
+  // Nearest neighbour blends nothing: its rows are the same either way.
+  const auto nearest_linear = LinesStartingWith(linear.out, "| nearest |");
+  ASSERT_EQ(nearest_linear.size(), 2u);
+  EXPECT_EQ(LinesStartingWith(log.out, "| nearest |"), nearest_linear);
+  // The blending methods answer the same queries (same ok counts) with other values.
+  for (const char* method : {"| octant | θh, θd, φd |", "| delaunay | θi, θo, φ |"}) {
+    const auto a = LinesStartingWith(linear.out, method);
+    const auto b = LinesStartingWith(log.out, method);
+    ASSERT_EQ(a.size(), 1u) << method;
+    ASSERT_EQ(b.size(), 1u) << method;
+    EXPECT_NE(a[0], b[0]) << method;
+    const std::string ok_a = a[0].substr(0, a[0].find('|', std::string(method).size()));
+    EXPECT_EQ(b[0].substr(0, ok_a.size()), ok_a) << method;
+  }
+  const ToolRun bad = Exec("accuracy --blend cubic");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_THAT(bad.err, HasSubstr("--blend"));
+}
+
 }  // namespace

@@ -1,5 +1,6 @@
 #include "tools/brdf-interp/accuracy_command.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -47,6 +48,27 @@ struct Row {
   std::size_t ok = 0;
 };
 
+// The same samples with every value replaced by log(max(f, floor_b)), floor_b = 1e-6 of band b's
+// largest value (see the header): a linear blend of these, exponentiated, is the log blend.
+std::shared_ptr<interp::SampleSet> LogSamples(const interp::SampleSet& set) {
+  const auto bands = static_cast<std::size_t>(set.bands());
+  std::vector<double> floor(bands, 0.0);
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    for (std::size_t b = 0; b < bands; ++b) floor[b] = std::max(floor[b], set.spectrum(i)[b]);
+  }
+  for (double& f : floor) f = f > 0 ? 1e-6 * f : 1e-300;
+  auto out = std::make_shared<interp::SampleSet>(set.dims(), set.bands());
+  std::vector<double> logs(bands);
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    for (std::size_t b = 0; b < bands; ++b) {
+      logs[b] = std::log(std::max(set.spectrum(i)[b], floor[b]));
+    }
+    const Status added = out->Add(set.id(i), set.coords(i), logs);
+    if (!added.ok()) return nullptr;  // cannot happen: same dims and bands
+  }
+  return out;
+}
+
 std::string Percent(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%+.2f %%", 100 * v);
@@ -71,6 +93,10 @@ int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream&
     return fail(InvalidArgument("--sample '" + request.sample + "': use paint, glossy or both"));
   }
   if (request.queries == 0) return fail(InvalidArgument("--queries: give at least one query"));
+  if (request.blend != "linear" && request.blend != "log") {
+    return fail(InvalidArgument("--blend '" + request.blend + "': use linear or log"));
+  }
+  const bool log_blend = request.blend == "log";
   interp::Options incidence;
   incidence.mirror_phi = request.mirror_phi;
   incidence.reciprocity = request.reciprocity;
@@ -100,12 +126,15 @@ int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream&
       << request.seed << ")" << (request.mirror_phi ? "; mirror φ" : "")
       << (request.reciprocity ? "; reciprocity" : "") << "; scales (θi, θo, φ) "
       << (request.scale.empty() ? "1,1,1" : request.scale) << ", (θh·cos φd, θh·sin φd, θd) "
-      << (request.half_scale.empty() ? "1,1,1 (default)" : request.half_scale) << "\n";
+      << (request.half_scale.empty() ? "1,1,1 (default)" : request.half_scale) << "; "
+      << (log_blend ? "log blend (floor 1e-6 of each band's largest value)" : "linear blend")
+      << "\n";
   out << "peak: (" << kPeakQuery[0] << ", " << kPeakQuery[1] << ", " << kPeakQuery[2] << ") at "
       << wavelengths.at(peak_band) << " nm; RMS over the queries every row answered\n";
 
   for (const auto& [name, brdf] : samples) {
     const auto set = SyntheticSamples(*grid, wavelengths, brdf);
+    const auto log_set = log_blend ? LogSamples(*set) : nullptr;
     std::vector<double> truth(n * bands);
     for (std::size_t q = 0; q < n; ++q) {
       brdf.EvaluateSpectrum({queries[3 * q], 0, queries[3 * q + 1], queries[3 * q + 2]},
@@ -119,12 +148,19 @@ int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream&
       for (const interp::Options* o : {&incidence, &half}) {
         Row row{method, o->coordinates, std::vector<interp::InterpStatus>(n),
                 std::vector<double>(n * bands)};
-        auto made = MakeNamedInterpolator(method, set, *o);
+        const bool in_logs = log_blend && std::string(method) != "nearest";
+        auto made = MakeNamedInterpolator(method, in_logs ? log_set : set, *o);
         if (!made.ok()) return fail(made.status());
         (*made)->SpectraAt(queries, row.status, row.spectra);
         for (interp::InterpStatus s : row.status) row.ok += s == interp::InterpStatus::kOk;
+        if (in_logs) {
+          for (double& v : row.spectra) v = std::exp(v);  // NaN rows stay NaN
+        }
         std::vector<double> peak(bands);
         if ((*made)->SpectrumAt(kPeakQuery, peak) == interp::InterpStatus::kOk) {
+          if (in_logs) {
+            for (double& v : peak) v = std::exp(v);
+          }
           row.peak = (peak[peak_band] - peak_truth) / peak_truth;
         }
         rows.push_back(std::move(row));

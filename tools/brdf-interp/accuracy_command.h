@@ -12,6 +12,10 @@
 //             configuration (the half vector within 10° of the normal);
 //   peak      the relative error at the specular-peak query (42.5°, 42.5°, 177.5°) in the band
 //             nearest 550 nm ("failed" when the method has no answer there).
+// blend "log" blends the vertices' spectra geometrically, band by band: the interpolators run on
+// log(max(f, floor_b)) and their answers are exponentiated, i.e. f = exp(Σ w_k · log(max(f_k,
+// floor_b))), where floor_b is 1e-6 of band b's largest sampled value (a zero or negative
+// reading then pulls the blend down hard but stays finite). Nearest neighbour is unaffected.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +32,7 @@ struct AccuracyRequest {
   std::string half_scale;  // axis scales for (θh·cos φd, θh·sin φd, θd); "" = the default
   bool mirror_phi = false;
   bool reciprocity = false;
+  std::string blend = "linear";  // linear | log (see above)
 };
 
 int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream& err);

@@ -90,6 +90,12 @@ int main(int argc, char** argv) {
                            "axis scales for (θh·cos φd, θh·sin φd, θd) (default 1,1,1)");
   accuracy_cmd->add_flag("--mirror-phi", accuracy.mirror_phi, "add the mirrored copies");
   accuracy_cmd->add_flag("--reciprocity", accuracy.reciprocity, "add the swapped copies");
+  accuracy_cmd
+      ->add_option("--blend", accuracy.blend,
+                   "linear (Σ w·f) or log (exp Σ w·log f, floored at 1e-6 of each band's "
+                   "largest value) blend of the vertices' spectra; nearest is unaffected")
+      ->check(CLI::IsMember({"linear", "log"}))
+      ->capture_default_str();
 
   SynthRequest synth;
   std::vector<std::string> grid_args;
