@@ -12,14 +12,19 @@
 namespace brdf::daemon {
 
 bool IndexKey::operator==(const IndexKey& o) const {
-  return std::tie(quantity, method, axis_scale, mirror_phi, reciprocity, coordinates) ==
-         std::tie(o.quantity, o.method, o.axis_scale, o.mirror_phi, o.reciprocity, o.coordinates);
+  return std::tie(quantity, method, axis_scale, mirror_phi, reciprocity, coordinates, trend) ==
+         std::tie(o.quantity, o.method, o.axis_scale, o.mirror_phi, o.reciprocity, o.coordinates,
+                  o.trend);
 }
 
 IndexKey MakeIndexKey(Quantity quantity, interp::Method method, const interp::Options& options) {
-  IndexKey key{
-      quantity,           method, options.axis_scale, options.mirror_phi, options.reciprocity,
-      options.coordinates};
+  IndexKey key{quantity,
+               method,
+               options.axis_scale,
+               options.mirror_phi,
+               options.reciprocity,
+               options.coordinates,
+               options.trend};
   if (std::all_of(key.axis_scale.begin(), key.axis_scale.end(), [](double s) { return s == 1; })) {
     key.axis_scale.clear();
   }
@@ -43,6 +48,13 @@ Status CheckIndexOptions(const interp::Options& options, int dims, std::int64_t 
         std::to_string(session) +
         " is anisotropic (its BRDF depends on the azimuth the half/difference angles drop): "
         "interpolate it in incidence coordinates (leave options.coordinates unset or INCIDENCE)");
+  }
+  if (dims == 4 && options.trend == interp::Trend::kBivariate) {
+    return InvalidArgument(
+        "options.trend: the bivariate trend is only for isotropic sessions; session " +
+        std::to_string(session) +
+        " is anisotropic (its BRDF is not a function of θh and θd alone): leave options.trend "
+        "unset or NONE");
   }
   if (!options.axis_scale.empty()) {
     if (static_cast<int>(options.axis_scale.size()) != dims) {
@@ -89,7 +101,8 @@ Result<MadeIndex> MakeIndex(std::shared_ptr<const interp::SampleSet> samples, in
   // Extending fails only if the set did not grow by Add (it always does); then a fresh build.
   // Only the octant method in incidence coordinates extends: a half/difference index is no
   // OctantInterpolator (it wraps one over the images of the samples, made in blocks) and is
-  // rebuilt; the key keeps the coordinates apart, so `stale` is always one of the same kind.
+  // rebuilt, and so is one over a trend's residuals (the trend is refitted to every reading); the
+  // key keeps the coordinates and trends apart, so `stale` is always one of the same kind.
   const auto* base =
       stale != nullptr ? dynamic_cast<const interp::OctantInterpolator*>(stale->interpolator.get())
                        : nullptr;

@@ -24,13 +24,15 @@ struct IndexKey {
   bool mirror_phi;
   bool reciprocity;
   interp::Coordinates coordinates;  // an index never answers in the other coordinates
+  interp::Trend trend;
   bool operator==(const IndexKey& o) const;
 };
 
 IndexKey MakeIndexKey(Quantity quantity, interp::Method method, const interp::Options& options);
 
 // kInvalidArgument (naming "options.axis_scale", "options.mirror_phi", "options.reciprocity",
-// "options.coordinates": half/difference on an anisotropic session) when the options do not fit
+// "options.coordinates": half/difference on an anisotropic session; "options.trend": a trend on
+// an anisotropic session) when the options do not fit
 // a session of `dims` coordinates.
 Status CheckIndexOptions(const interp::Options& options, int dims, std::int64_t session);
 

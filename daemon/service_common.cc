@@ -112,6 +112,21 @@ grpc::Status ParseCoordinatesField(int coordinates, interp::Coordinates* out) {
   }
 }
 
+grpc::Status ParseTrendField(int trend, interp::Trend* out) {
+  switch (trend) {
+    case v1::INTERPOLATION_TREND_UNSPECIFIED:
+    case v1::INTERPOLATION_TREND_NONE:
+      *out = interp::Trend::kNone;
+      return grpc::Status::OK;
+    case v1::INTERPOLATION_TREND_BIVARIATE:
+      *out = interp::Trend::kBivariate;
+      return grpc::Status::OK;
+    default:
+      return InvalidField("options.trend",
+                          "unknown trend " + std::to_string(trend) + "; use NONE or BIVARIATE");
+  }
+}
+
 v1::Quantity ToProtoQuantity(Quantity quantity) {
   switch (quantity) {
     case Quantity::kRadiance:

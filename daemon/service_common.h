@@ -83,6 +83,8 @@ grpc::Status ParseMethodField(int method, interp::Method* out);
 // "options.coordinates" for a value the API does not have. Whether the session can take half/
 // difference coordinates is the index's check (index_build.h: CheckIndexOptions).
 grpc::Status ParseCoordinatesField(int coordinates, interp::Coordinates* out);
+// InterpolationOptions.trend: unset is NONE; an unknown value names options.trend.
+grpc::Status ParseTrendField(int trend, interp::Trend* out);
 v1::Quantity ToProtoQuantity(Quantity quantity);
 
 // Checks a finite angle within [lo, hi]; the message names `field` and the range.

@@ -288,6 +288,7 @@ grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
       !st.ok()) {
     return st;
   }
+  if (grpc::Status st = ParseTrendField(o.trend(), &out->options.trend); !st.ok()) return st;
   // 0 means the default 1°; MakeRegularGrid checks the rest and names the axis.
   const double steps[3] = {r.step_theta_i(), r.step_theta_o(), r.step_phi()};
   for (int k = 0; k < 3; ++k) out->steps[k] = steps[k] == 0 ? 1.0 : steps[k];

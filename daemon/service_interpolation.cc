@@ -187,6 +187,7 @@ grpc::Status ParseInterpolationOptions(const v1::InterpolationOptions& options,
   out->axis_scale.assign(options.axis_scale().begin(), options.axis_scale().end());
   out->mirror_phi = options.mirror_phi();
   out->reciprocity = options.reciprocity();
+  if (grpc::Status st = ParseTrendField(options.trend(), &out->trend); !st.ok()) return st;
   return ParseCoordinatesField(options.coordinates(), &out->coordinates);
 }
 

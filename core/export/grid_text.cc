@@ -145,6 +145,7 @@ std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& b
   j += std::string("  \"mirror_phi\": ") + (how.mirror_phi ? "true" : "false") + ",\n";
   j += std::string("  \"reciprocity\": ") + (how.reciprocity ? "true" : "false") + ",\n";
   j += "  \"coordinates\": " + JsonString(how.coordinates) + ",\n";
+  j += "  \"trend\": " + JsonString(how.trend) + ",\n";
   std::string scale = "null";
   if (!how.axis_scale.empty()) {
     scale = "[";

@@ -32,6 +32,8 @@ struct InterpolantInfo {
   // Where the method measured and blended (interp::CoordinatesName): "incidence" or
   // "half_difference" (axis_scale then multiplies the half/difference axes).
   std::string coordinates = "incidence";
+  // What the method blended (interp::TrendName): "none" or "bivariate".
+  std::string trend = "none";
 };
 
 // A GridSink writing CSV: '#' comment lines documenting the quantity, unit, angles and axes, then
@@ -56,7 +58,8 @@ class CsvGridWriter : public GridSink {
 
 // A JSON object describing an .npy grid export: shape and axis order, each axis (start, step,
 // count, in degrees), the wavelengths, quantity, unit, method, symmetry options ("mirror_phi",
-// "reciprocity"), "coordinates" ("incidence" or "half_difference"), "axis_scale" (null: all 1),
+// "reciprocity"), "coordinates" ("incidence" or "half_difference"), "trend" ("none" or
+// "bivariate"), "axis_scale" (null: all 1),
 // "fill" (policy and per-provenance counts), and the counts per status.
 std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& bands,
                                 const GridExportInfo& info, const GridReport& report,

@@ -47,9 +47,12 @@ Result<fit::CookTorranceFit> FitSampleModel(const interp::SampleSet& samples,
 }
 
 InterpolantInfo SessionInterpolant::Info() const {
-  return {options.mirror_phi, options.reciprocity, options.axis_scale,
+  return {options.mirror_phi,
+          options.reciprocity,
+          options.axis_scale,
           chain ? chain->Tally().Json() : std::string(),
-          interp::CoordinatesName(options.coordinates)};
+          interp::CoordinatesName(options.coordinates),
+          interp::TrendName(options.trend)};
 }
 
 Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, interp::Method method,

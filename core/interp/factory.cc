@@ -5,12 +5,16 @@
 #include "core/interp/interpolator.h"
 #include "core/interp/nearest.h"
 #include "core/interp/octant.h"
+#include "core/interp/trend.h"
 
 namespace brdf::interp {
 
 Result<std::unique_ptr<Interpolator>> MakeInterpolator(Method method,
                                                        std::shared_ptr<const SampleSet> samples,
                                                        const Options& options) {
+  if (options.trend == Trend::kBivariate) {
+    return MakeTrendInterpolator(method, std::move(samples), options);
+  }
   if (options.coordinates == Coordinates::kHalfDifference) {
     return MakeHalfDifferenceInterpolator(method, std::move(samples), options);
   }

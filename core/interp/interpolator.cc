@@ -36,6 +36,18 @@ Result<Coordinates> ParseCoordinates(const std::string& name) {
                          "'; use incidence (θi, θo, φ) or half-diff (θh, θd, φd)");
 }
 
+const char* TrendName(Trend t) {
+  return t == Trend::kBivariate ? "bivariate" : "none";
+}
+
+Result<Trend> ParseTrend(const std::string& name) {
+  if (name == "none") return Trend::kNone;
+  if (name == "bivariate") return Trend::kBivariate;
+  return InvalidArgument("unknown trend '" + name +
+                         "'; use none (blend the spectra) or bivariate (blend the residuals from "
+                         "a fitted T(θh, θd))");
+}
+
 const char* InterpStatusName(InterpStatus s) {
   switch (s) {
     case InterpStatus::kOk:

@@ -41,6 +41,13 @@ const char* CoordinatesName(Coordinates c);  // "incidence", "half_difference"
 // Accepts "incidence", "half_difference" and "half-diff" (the command lines' spelling).
 Result<Coordinates> ParseCoordinates(const std::string& name);
 
+// What a method blends (trend.h). kNone: the samples' spectra, as the paper does. kBivariate
+// (isotropic data only): the residuals from a smooth trend T(θh, θd) fitted to all samples, T
+// added back at the query.
+enum class Trend { kNone, kBivariate };
+const char* TrendName(Trend t);  // "none", "bivariate"
+Result<Trend> ParseTrend(const std::string& name);
+
 // Options shared by all methods.
 struct Options {
   // Per-axis multipliers applied to coordinates before distances are measured (empty = all 1).
@@ -57,6 +64,9 @@ struct Options {
   // (θh·cos φd, θh·sin φd, θd); axis_scale then multiplies those three (default all 1); the
   // mirror images are always added there, reciprocity adds its own (half_difference.h).
   Coordinates coordinates = Coordinates::kIncidence;
+  // kBivariate: blend residuals from a bivariate trend (trend.h; 3D data only). Works with either
+  // coordinates.
+  Trend trend = Trend::kNone;
 };
 
 // Scattered samples: N points of `dims` coordinates, each with a spectrum of `bands` values and

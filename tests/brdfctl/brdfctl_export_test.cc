@@ -169,6 +169,38 @@ TEST_F(BrdfctlExportTest, AnAnalystExportsMerlGridAndCsvFilesThatTheirReadersLoa
   const CommandResult unknown = interpolate({"--coordinates", "polar"});
   EXPECT_EQ(unknown.exit_code, 2) << Describe(unknown);
 
+  // --trend bivariate: interpolate says so and answers otherwise; the grid's sidecar records it.
+  const CommandResult trend_text = interpolate({"--trend", "bivariate"});
+  ASSERT_EQ(trend_text.exit_code, 0) << Describe(trend_text);
+  EXPECT_NE(trend_text.out.find("delaunay over the bivariate trend: ok"), std::string::npos)
+      << Describe(trend_text);
+  EXPECT_NE(trend_text.out.find("bivariate trend T(θh, θd)"), std::string::npos)
+      << Describe(trend_text);
+  const CommandResult trend_json = interpolate({"--trend", "bivariate", "--json"});
+  ASSERT_EQ(trend_json.exit_code, 0) << Describe(trend_json);
+  v1::InterpolateResponse trend_reply;
+  ASSERT_TRUE(
+      google::protobuf::util::JsonStringToMessage(Lines(trend_json.out).at(0), &trend_reply).ok());
+  ASSERT_EQ(trend_reply.result().spectrum_size(), 101);
+  EXPECT_NE(trend_reply.result().spectrum(45), incidence_reply.result().spectrum(45));
+  EXPECT_EQ(interpolate({"--trend", "quadratic"}).exit_code, 2);
+  const std::string trend_npy = Path("grid-trend.npy");
+  const CommandResult t =
+      Ctl({"export", id_, "grid", "--steps", "10,10,20", "--trend", "bivariate", "-o", trend_npy});
+  ASSERT_EQ(t.exit_code, 0) << Describe(t);
+  const CommandResult trend_cmp = RunShell(
+      "/usr/bin/python3 -c \"import json, sys; d = "
+      "json.load(open(sys.argv[1])); print(d['trend'], "
+      "d['coordinates'])\" '" +
+      trend_npy + ".json' 2>&1");
+  ASSERT_EQ(trend_cmp.exit_code, 0) << Describe(trend_cmp);
+  EXPECT_EQ(Lines(trend_cmp.out).at(0), "bivariate incidence") << trend_cmp.out;
+  const CommandResult csv_trend =
+      Ctl({"export", id_, "csv", "--trend", "bivariate", "-o", Path("trend.csv")});
+  EXPECT_EQ(csv_trend.exit_code, 2) << Describe(csv_trend);
+  EXPECT_NE(csv_trend.err.find("--trend is for grid, merl and rgl exports"), std::string::npos)
+      << Describe(csv_trend);
+
   // A grid step that does not divide 90° is the user's error (exit 2), and leaves no file.
   const std::string bad = Path("bad.npy");
   const CommandResult b = Ctl({"export", id_, "grid", "--steps", "7", "-o", bad});

@@ -46,12 +46,8 @@ double RedOverBlue(const std::string& rgba) {
 }
 
 TEST_F(DaemonAppearanceTest, ColourAndSphereOfARecordedSession) {
-  Result<v1::Session> submitted = rig_.Submit(plans::InterpolationGrid().Retry(2, 0));
-  ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
-  const std::string id = submitted->session_id();
-  op_ = std::make_unique<GrpcOperator>(rig_, id);
-  const v1::Session done = rig_.WaitForState(id, v1::SESSION_STATE_COMPLETED, 60s);
-  ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED) << done.DebugString();
+  std::string id;
+  ASSERT_NO_FATAL_FAILURE(Record(plans::InterpolationGrid().Retry(2, 0), &id));
 
   v1::AppearanceRequest request;
   request.set_session_id(id);
@@ -142,12 +138,8 @@ TEST_F(DaemonAppearanceTest, AnAnisotropicSessionIsRefusedSayingSo) {
                          .Reference(true)
                          .Json();
   plan.insert(plan.find('{') + 1, "\"anisotropic\": true, ");
-  Result<v1::Session> submitted = rig_.Submit(plan);
-  ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
-  const std::string id = submitted->session_id();
-  op_ = std::make_unique<GrpcOperator>(rig_, id);
-  const v1::Session done = rig_.WaitForState(id, v1::SESSION_STATE_COMPLETED, 60s);
-  ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED) << done.DebugString();
+  std::string id;
+  ASSERT_NO_FATAL_FAILURE(Record(plan, &id));
 
   v1::AppearanceRequest request;
   request.set_session_id(id);

@@ -29,13 +29,8 @@ using namespace std::chrono_literals;
 
 const std::string kGridPlan = plans::InterpolationGrid().Retry(2, 0);
 
-// Two poses of an anisotropic plan; no reference (radiance only).
-const char* const kAnisotropicPlan = R"({
-  "name": "anisotropic half/difference refusal",
-  "anisotropic": true,
-  "poseList": {"poses": [{"alpha": 0, "beta": 10, "delta": 40}, {"alpha": 10, "beta": 20, "delta": 40}]},
-  "measurement": {"integrationMs": 100, "averages": 1}
-})";
+const std::string kAnisotropicPlan =
+    plans::TwoAnisotropicPoses("anisotropic half/difference refusal");
 
 // `symmetries`: mirror_phi and reciprocity too (the grid plan's cloud is thin, and the octant
 // method needs the copies to fill octants in (θi, θo, φ)); not on anisotropic sessions.
@@ -58,16 +53,6 @@ interp::InterpStatus FromProto(v1::InterpolationStatus s) {
     default:
       return interp::InterpStatus::kOk;
   }
-}
-
-// max_b |a_b − b_b| / max_b |b_b|.
-double RelativeGap(const google::protobuf::RepeatedField<double>& a, const std::vector<double>& b) {
-  double diff = 0, scale = 0;
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    diff = std::max(diff, std::abs(a[static_cast<int>(i)] - b[i]));
-    scale = std::max(scale, std::abs(b[i]));
-  }
-  return diff / scale;
 }
 
 class DaemonHalfDifferenceTest : public InterpolationRigTest {};
@@ -109,14 +94,7 @@ TEST_F(DaemonHalfDifferenceTest, AnswersAreCoresInBothCoordinatesAndTheCacheNeve
   ASSERT_NE(set, nullptr);
   ASSERT_GE(set->size(), 20u);
 
-  // Queries half-way between consecutive readings (inside the data), and near the mirror
-  // direction, where the coordinates matter most.
-  std::vector<IsoDirection> queries;
-  for (std::size_t i = 1; i < set->size(); ++i) {
-    const auto a = set->coords(i - 1), b = set->coords(i);
-    queries.push_back({(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2});
-  }
-  for (double t : {15.0, 18.0, 22.0}) queries.push_back({t, t + 1, 176});
+  const std::vector<IsoDirection> queries = MidpointQueries(*set);
 
   for (v1::InterpolationMethod method :
        {v1::INTERPOLATION_METHOD_OCTANT, v1::INTERPOLATION_METHOD_DELAUNAY,
@@ -230,18 +208,9 @@ TEST_F(DaemonHalfDifferenceTest, AnswersAreCoresInBothCoordinatesAndTheCacheNeve
 }
 
 TEST_F(DaemonHalfDifferenceTest, AnisotropicSessionIsRefusedWithWhatToDo) {
-  Result<v1::Session> submitted = rig_.Submit(kAnisotropicPlan);
-  ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
-  const std::string id = submitted->session_id();
-  op_ = std::make_unique<GrpcOperator>(rig_, id);
-  const v1::Session done = rig_.WaitForState(id, v1::SESSION_STATE_COMPLETED, 60s);
-  ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED) << done.DebugString();
-
-  v1::DirectionQuery four;
-  four.mutable_four()->set_theta_i(20);
-  four.mutable_four()->set_phi_i(0);
-  four.mutable_four()->set_theta_o(30);
-  four.mutable_four()->set_phi_o(150);
+  std::string id;
+  ASSERT_NO_FATAL_FAILURE(Record(kAnisotropicPlan, &id));
+  const v1::DirectionQuery four = Four(20, 0, 30, 150);
   v1::InterpolationResult result;
   // Incidence coordinates work on the session…
   grpc::Status st =

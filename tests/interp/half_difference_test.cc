@@ -20,6 +20,7 @@ namespace {
 using testing::MakeSamples;
 using testing::PaperGrid;
 using testing::Point;
+using testing::RigPoseQueries;
 
 constexpr double kTol = 1e-9;
 
@@ -203,22 +204,6 @@ TEST(HalfDifferenceInterpolator, RefusesWhatItCannotDo) {
 
 // Random rig poses (α in [0, 70], β in [−175, 180], δ in [0, 146.25]) by geometry.md's closed
 // forms, as interp_test_data.cc builds the grid.
-std::vector<Point> RigPoseQueries(std::size_t n, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0, 1);
-  constexpr double r = std::numbers::pi / 180;
-  std::vector<Point> out;
-  while (out.size() < n) {
-    const double a = 70 * u(rng) * r, b = (-175 + 355 * u(rng)) * r, d = 146.25 * u(rng) * r;
-    const double ci = std::cos(a) * std::cos(b), co = std::cos(a) * std::cos(b - d);
-    const double ti = std::acos(ci) / r, to = std::acos(co) / r;
-    if (ti > 89.999 || to > 89.999 || ti < 1e-6 || to < 1e-6) continue;
-    const double c = (std::cos(d) - ci * co) / (std::sin(ti * r) * std::sin(to * r));
-    out.push_back({ti, to, std::acos(std::clamp(c, -1.0, 1.0)) / r});
-  }
-  return out;
-}
-
 TEST(HalfDifferenceInterpolator, BeatsIncidenceCoordinatesOnAGlossySample) {
   // The reason for the option: on the glossy sample the lobe lies along θh, so every blending
   // method's RMS error against the analytic truth drops (measured: ×0.54 octant, ×0.67 Delaunay;

@@ -23,6 +23,22 @@ double Uniform(std::mt19937_64& rng) {
 
 }  // namespace
 
+std::vector<Point> RigPoseQueries(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Point> out;
+  while (out.size() < n) {
+    const double a = 70 * u(rng) * kRad, b = (-175 + 355 * u(rng)) * kRad,
+                 d = 146.25 * u(rng) * kRad;
+    const double ci = std::cos(a) * std::cos(b), co = std::cos(a) * std::cos(b - d);
+    const double ti = Deg(std::acos(ci)), to = Deg(std::acos(co));
+    if (ti > 89.999 || to > 89.999 || ti < 1e-6 || to < 1e-6) continue;
+    const double c = (std::cos(d) - ci * co) / (std::sin(ti * kRad) * std::sin(to * kRad));
+    out.push_back({ti, to, Deg(std::acos(std::clamp(c, -1.0, 1.0)))});
+  }
+  return out;
+}
+
 std::vector<Point> PaperGrid(int* poses) {
   std::vector<Point> out;
   int count = 0;

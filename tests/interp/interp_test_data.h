@@ -22,6 +22,10 @@ using Point = std::vector<double>;
 // (first seen kept). `poses` receives the number of poses before removing duplicates.
 std::vector<Point> PaperGrid(int* poses = nullptr);
 
+// n random rig poses (α in [0°, 70°], β in [−175°, 180°], δ in [0°, 146.25°], uniform) as
+// (θi, θo, φ), both directions within 89.999° of the normal, from geometry.md's closed forms.
+std::vector<Point> RigPoseQueries(std::size_t n, std::uint64_t seed);
+
 // n points uniform in the box [lo[j], hi[j]).
 std::vector<Point> RandomPoints(std::size_t n, const std::vector<double>& lo,
                                 const std::vector<double>& hi, std::uint64_t seed);

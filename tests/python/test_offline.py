@@ -146,6 +146,24 @@ class Names(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "coordinates are for grid, MERL and RGL"):
             export_request("3", "csv", coordinates="half-diff")
 
+    def test_trend_in_options_and_export_requests(self):
+        from brdf_client.export import export_request
+        from brdf_client.interpolation import interpolation_options
+        bivariate = brdf_pb2.INTERPOLATION_TREND_BIVARIATE
+        self.assertEqual(interpolation_options(trend="bivariate").trend, bivariate)
+        self.assertEqual(interpolation_options(trend="Bivariate").trend, bivariate)
+        self.assertEqual(interpolation_options(trend="none").trend,
+                         brdf_pb2.INTERPOLATION_TREND_NONE)
+        # Both options travel together.
+        both = interpolation_options(coordinates="half-diff", trend="bivariate")
+        self.assertEqual(both.coordinates, brdf_pb2.INTERPOLATION_COORDINATES_HALF_DIFFERENCE)
+        self.assertEqual(both.trend, bivariate)
+        with self.assertRaisesRegex(ValueError, "unknown trend 'quadratic'"):
+            interpolation_options(trend="quadratic")
+        self.assertEqual(export_request("3", "rgl", trend="bivariate").options.trend, bivariate)
+        with self.assertRaisesRegex(ValueError, "trend is for grid, MERL and RGL"):
+            export_request("3", "csv", trend="bivariate")
+
 
 def reading_proto(rid, kind, radiance, theta_i=10.0, grid=(380.0, 4.0, 101)):
     r = brdf_pb2.Reading(id=rid, session_id="1", kind=kind, radiance=radiance,

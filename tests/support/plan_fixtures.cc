@@ -134,5 +134,15 @@ PlanFixture InterpolationGrid() {
       .DarkWithEachReference();
 }
 
+std::string TwoAnisotropicPoses(const std::string& name) {
+  return R"({
+  "name": ")" +
+         name + R"(",
+  "anisotropic": true,
+  "poseList": {"poses": [{"alpha": 0, "beta": 10, "delta": 40}, {"alpha": 10, "beta": 20, "delta": 40}]},
+  "measurement": {"integrationMs": 100, "averages": 1}
+})";
+}
+
 }  // namespace plans
 }  // namespace brdf::testing

@@ -79,5 +79,9 @@ PlanFixture OnePose();
 // dark with each: enough readings to interpolate and export.
 PlanFixture InterpolationGrid();
 
+// An anisotropic plan of two poses at γ = 0 ((α, β, δ) = (0, 10, 40), (10, 20, 40)), 100 ms × 1,
+// no reference (radiance only): the smallest session an anisotropic refusal is tested on. JSON.
+std::string TwoAnisotropicPoses(const std::string& name);
+
 }  // namespace plans
 }  // namespace brdf::testing

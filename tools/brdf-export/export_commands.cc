@@ -115,8 +115,11 @@ Result<Interpolation> BuildInterpolator(const exports::Session& session, exports
   if (!policy.ok()) return policy.status();
   Result<interp::Coordinates> coordinates = interp::ParseCoordinates(choice.coordinates);
   if (!coordinates.ok()) return coordinates.status();
+  Result<interp::Trend> trend = interp::ParseTrend(choice.trend);
+  if (!trend.ok()) return trend.status().WithContext("--trend");
   interp::Options options;
   options.coordinates = *coordinates;
+  options.trend = *trend;
   options.mirror_phi = choice.mirror_phi;
   options.reciprocity = choice.reciprocity;
   if (!choice.scale.empty()) {

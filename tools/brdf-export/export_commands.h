@@ -34,6 +34,7 @@ struct InterpChoice {
   bool reciprocity = false;
   // incidence or half-diff (interp::ParseCoordinates): where the method measures and blends.
   std::string coordinates = "incidence";
+  std::string trend = "none";  // none or bivariate (core/interp/trend.h)
   // none: the method alone (holes stay NaN / −1); chain: then Delaunay, then the fitted
   // Cook-Torrance model (core/export/fill_chain.h).
   std::string fill = "chain";

@@ -33,6 +33,11 @@ void AddInterpOptions(CLI::App& app, InterpChoice& c, bool reciprocity_by_defaul
                  "half/difference angles) coordinates")
       ->check(CLI::IsMember({"incidence", "half-diff"}))
       ->capture_default_str();
+  app.add_option("--trend", c.trend,
+                 "none, or bivariate: blend the readings' residuals from a fitted smooth "
+                 "f(θh, θd) and add it back")
+      ->check(CLI::IsMember({"none", "bivariate"}))
+      ->capture_default_str();
   app.add_option("--fill", c.fill,
                  "cells the method cannot fill: none (left NaN / −1) or chain (Delaunay, then the "
                  "fitted Cook-Torrance model)")

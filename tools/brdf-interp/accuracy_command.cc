@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <random>
 #include <vector>
 
 #include "core/analytic_brdf.h"
+#include "core/fit/models.h"
 #include "core/geometry.h"
 #include "core/interp/half_difference.h"
 #include "tools/brdf-interp/synthetic_samples.h"
@@ -69,6 +71,54 @@ std::shared_ptr<interp::SampleSet> LogSamples(const interp::SampleSet& set) {
   return out;
 }
 
+// A sample whose BRDF is known: its spectrum at (θi, θo, φ).
+struct KnownSample {
+  std::string name;
+  std::function<void(const IsoDirection&, std::span<double>)> spectrum;
+};
+
+KnownSample Analytic(std::string name, AnalyticBrdf brdf, const WavelengthGrid& grid) {
+  return {std::move(name), [brdf, grid](const IsoDirection& at, std::span<double> out) {
+            brdf.EvaluateSpectrum({at.theta_i, 0, at.theta_o, at.phi}, grid, out);
+          }};
+}
+
+// The paint's diffuse base under a Cook-Torrance (GGX) lobe with Fresnel and shadowing (see the
+// header): not a function of (θh, θd) alone.
+KnownSample GlossyCookTorrance(const WavelengthGrid& grid) {
+  AnalyticBrdfParams diffuse = AnalyticBrdf::PaintLike().params();
+  diffuse.specular_weight = 0;
+  const AnalyticBrdf base(diffuse);
+  return {"glossy-ct (paint base + Cook-Torrance GGX α 0.1, F0 0.04, ks 4)",
+          [base, grid](const IsoDirection& at, std::span<double> out) {
+            base.EvaluateSpectrum({at.theta_i, 0, at.theta_o, at.phi}, grid, out);
+            const double lobe = 4.0 * fit::CookTorranceSpecular(at, 0.1, 0.04);
+            for (double& v : out) v += lobe;
+          }};
+}
+
+// The sample "measured" at the points; with noise > 0 each reading is scaled by (1 + noise · z),
+// z standard normal, one z per reading (a meter's gain noise), seeded.
+std::shared_ptr<interp::SampleSet> KnownSamples(const SyntheticPoints& points,
+                                                const WavelengthGrid& grid,
+                                                const KnownSample& sample, double noise,
+                                                std::uint64_t seed) {
+  auto set = std::make_shared<interp::SampleSet>(3, static_cast<int>(grid.count));
+  std::vector<double> f(grid.count);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> z(0.0, 1.0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const std::span<const double> c(points.coords.data() + 3 * i, 3);
+    sample.spectrum({c[0], c[1], c[2]}, f);
+    if (noise > 0) {
+      const double gain = 1 + noise * z(rng);
+      for (double& v : f) v *= gain;
+    }
+    if (!set->Add(static_cast<std::int64_t>(i), c, f).ok()) return nullptr;  // same dims, bands
+  }
+  return set;
+}
+
 std::string Percent(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%+.2f %%", 100 * v);
@@ -82,17 +132,28 @@ int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream&
     err << "brdf-interp accuracy: " << s.message() << "\n";
     return ExitCodeFor(s);
   };
-  std::vector<std::pair<std::string, AnalyticBrdf>> samples;
-  if (request.sample == "paint" || request.sample == "both") {
-    samples.emplace_back("paint (AnalyticBrdf::PaintLike)", AnalyticBrdf::PaintLike());
+  const WavelengthGrid wavelengths = WavelengthGrid::Pr650();
+  const std::string& which = request.sample;
+  std::vector<KnownSample> samples;
+  if (which == "paint" || which == "both" || which == "all") {
+    samples.push_back(
+        Analytic("paint (AnalyticBrdf::PaintLike)", AnalyticBrdf::PaintLike(), wavelengths));
   }
-  if (request.sample == "glossy" || request.sample == "both") {
-    samples.emplace_back("glossy (AnalyticBrdf::Glossy)", AnalyticBrdf::Glossy());
+  if (which == "glossy" || which == "both" || which == "all") {
+    samples.push_back(
+        Analytic("glossy (AnalyticBrdf::Glossy)", AnalyticBrdf::Glossy(), wavelengths));
   }
+  if (which == "glossy-ct" || which == "all") samples.push_back(GlossyCookTorrance(wavelengths));
   if (samples.empty()) {
-    return fail(InvalidArgument("--sample '" + request.sample + "': use paint, glossy or both"));
+    return fail(InvalidArgument("--sample '" + which +
+                                "': use paint, glossy, glossy-ct, both (paint and glossy) or all"));
   }
+  Result<interp::Trend> trend = interp::ParseTrend(request.trend);
+  if (!trend.ok()) return fail(trend.status().WithContext("--trend"));
   if (request.queries == 0) return fail(InvalidArgument("--queries: give at least one query"));
+  if (!(request.noise >= 0 && request.noise < 1)) {
+    return fail(InvalidArgument("--noise: a relative standard deviation in [0, 1), e.g. 0.01"));
+  }
   if (request.blend != "linear" && request.blend != "log") {
     return fail(InvalidArgument("--blend '" + request.blend + "': use linear or log"));
   }
@@ -100,6 +161,7 @@ int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream&
   interp::Options incidence;
   incidence.mirror_phi = request.mirror_phi;
   incidence.reciprocity = request.reciprocity;
+  incidence.trend = *trend;
   interp::Options half = incidence;
   half.coordinates = interp::Coordinates::kHalfDifference;
   if (!request.scale.empty()) {
@@ -115,7 +177,6 @@ int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream&
 
   Result<SyntheticPoints> grid = PaperGridPoints();
   if (!grid.ok()) return fail(grid.status());
-  const WavelengthGrid wavelengths = WavelengthGrid::Pr650();
   const std::size_t bands = wavelengths.count;
   const auto peak_band =
       static_cast<std::size_t>(std::lround((550.0 - wavelengths.start_nm) / wavelengths.step_nm));
@@ -128,20 +189,24 @@ int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream&
       << (request.scale.empty() ? "1,1,1" : request.scale) << ", (θh·cos φd, θh·sin φd, θd) "
       << (request.half_scale.empty() ? "1,1,1 (default)" : request.half_scale) << "; "
       << (log_blend ? "log blend (floor 1e-6 of each band's largest value)" : "linear blend")
-      << "\n";
+      << (*trend == interp::Trend::kBivariate ? "; bivariate trend" : "");
+  if (request.noise > 0) out << "; readings × (1 + " << request.noise << " · N(0, 1))";
+  out << "\n";
   out << "peak: (" << kPeakQuery[0] << ", " << kPeakQuery[1] << ", " << kPeakQuery[2] << ") at "
       << wavelengths.at(peak_band) << " nm; RMS over the queries every row answered\n";
 
-  for (const auto& [name, brdf] : samples) {
-    const auto set = SyntheticSamples(*grid, wavelengths, brdf);
+  for (const KnownSample& sample : samples) {
+    const std::string& name = sample.name;
+    const auto set = KnownSamples(*grid, wavelengths, sample, request.noise, request.seed + 1);
     const auto log_set = log_blend ? LogSamples(*set) : nullptr;
     std::vector<double> truth(n * bands);
     for (std::size_t q = 0; q < n; ++q) {
-      brdf.EvaluateSpectrum({queries[3 * q], 0, queries[3 * q + 1], queries[3 * q + 2]},
-                            wavelengths, std::span<double>(truth).subspan(q * bands, bands));
+      sample.spectrum({queries[3 * q], queries[3 * q + 1], queries[3 * q + 2]},
+                      std::span<double>(truth).subspan(q * bands, bands));
     }
-    const double peak_truth =
-        brdf.Evaluate({kPeakQuery[0], 0, kPeakQuery[1], kPeakQuery[2]}, wavelengths.at(peak_band));
+    std::vector<double> peak_spectrum(bands);
+    sample.spectrum({kPeakQuery[0], kPeakQuery[1], kPeakQuery[2]}, peak_spectrum);
+    const double peak_truth = peak_spectrum[peak_band];
 
     std::vector<Row> rows;
     for (const char* method : {"octant", "delaunay", "nearest"}) {

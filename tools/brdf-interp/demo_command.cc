@@ -56,6 +56,9 @@ int RunDemo(const DemoRequest& request, std::ostream& out, std::ostream& err) {
   Result<interp::Coordinates> coordinates = interp::ParseCoordinates(request.coordinates);
   if (!coordinates.ok()) return fail(coordinates.status().WithContext("--coordinates"));
   options.coordinates = *coordinates;
+  Result<interp::Trend> trend = interp::ParseTrend(request.trend);
+  if (!trend.ok()) return fail(trend.status().WithContext("--trend"));
+  options.trend = *trend;
   if (!request.scale.empty()) {
     Result<std::vector<double>> scale = ParseNumberList(request.scale, "--scale");
     if (!scale.ok()) return fail(scale.status());

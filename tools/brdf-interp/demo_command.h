@@ -17,6 +17,7 @@ struct DemoRequest {
   bool mirror_phi = false;
   bool reciprocity = false;
   std::string coordinates = "incidence";  // or "half-diff"
+  std::string trend = "none";             // or "bivariate" (interp::ParseTrend)
 };
 
 // The built-in query: between samples, inside the rig's range.

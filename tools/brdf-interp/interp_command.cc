@@ -26,6 +26,9 @@ int RunInterp(const InterpRequest& request, std::ostream& err) {
   Result<interp::Coordinates> coordinates = interp::ParseCoordinates(request.coordinates);
   if (!coordinates.ok()) return Fail(err, coordinates.status().WithContext("--coordinates"));
   options.coordinates = *coordinates;
+  Result<interp::Trend> trend = interp::ParseTrend(request.trend);
+  if (!trend.ok()) return Fail(err, trend.status().WithContext("--trend"));
+  options.trend = *trend;
   if (!request.scale.empty()) {
     Result<std::vector<double>> scale = ParseNumberList(request.scale, "--scale");
     if (!scale.ok()) return Fail(err, scale.status());

@@ -17,6 +17,7 @@ struct InterpRequest {
   bool mirror_phi = false;
   bool reciprocity = false;
   std::string coordinates = "incidence";  // or "half-diff" (interp::ParseCoordinates)
+  std::string trend = "none";             // or "bivariate" (interp::ParseTrend)
   bool explain = false;
 };
 

@@ -27,7 +27,7 @@ Exit status: 0 done (per-query failures are in the status column), 2 bad argumen
 (the message names file, line and column), 1 system failure.)";
 
 void AddMethodOptions(CLI::App& app, std::string& method, std::string& scale, bool& mirror,
-                      bool& reciprocity, std::string& coordinates) {
+                      bool& reciprocity, std::string& coordinates, std::string& trend) {
   app.add_option("--method", method,
                  "octant (the paper's), octant-reference (its O(N) scan), "
                  "delaunay, nearest")
@@ -41,6 +41,11 @@ void AddMethodOptions(CLI::App& app, std::string& method, std::string& scale, bo
                  "incidence: interpolate in (θi, θo, φ); half-diff: in Rusinkiewicz's (θh, θd, "
                  "φd) (3D data only; --scale then scales (θh·cos φd, θh·sin φd, θd))")
       ->check(CLI::IsMember({"incidence", "half-diff"}))
+      ->capture_default_str();
+  app.add_option("--trend", trend,
+                 "none, or bivariate: blend the samples' residuals from a fitted smooth "
+                 "f(θh, θd) and add it back (3D data only)")
+      ->check(CLI::IsMember({"none", "bivariate"}))
       ->capture_default_str();
 }
 
@@ -57,7 +62,7 @@ int main(int argc, char** argv) {
   app.add_option("samples", interp.samples_path, "samples CSV");
   app.add_option("queries", interp.queries_path, "queries CSV");
   AddMethodOptions(app, interp.method, interp.scale, interp.mirror_phi, interp.reciprocity,
-                   interp.coordinates);
+                   interp.coordinates, interp.trend);
   app.add_option("--threads", interp.threads, "threads evaluating queries (output order is fixed)")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
@@ -70,7 +75,7 @@ int main(int argc, char** argv) {
       "demo",
       "interpolate the analytic paint sample on the paper's rig grid and explain one answer");
   AddMethodOptions(*demo_cmd, demo.method, demo.scale, demo.mirror_phi, demo.reciprocity,
-                   demo.coordinates);
+                   demo.coordinates, demo.trend);
   demo_cmd->add_option("--query", demo.query, "θi,θo,φ in degrees (default 37,52,128)");
 
   AccuracyRequest accuracy;
@@ -78,8 +83,10 @@ int main(int argc, char** argv) {
       "accuracy",
       "RMS and specular-peak error of every method, in (θi, θo, φ) and in (θh, θd, φd), against "
       "the analytic samples on the paper's rig grid");
-  accuracy_cmd->add_option("--sample", accuracy.sample, "paint, glossy or both")
-      ->check(CLI::IsMember({"paint", "glossy", "both"}))
+  accuracy_cmd
+      ->add_option("--sample", accuracy.sample,
+                   "paint, glossy, glossy-ct, both (paint and glossy) or all")
+      ->check(CLI::IsMember({"paint", "glossy", "glossy-ct", "both", "all"}))
       ->capture_default_str();
   accuracy_cmd->add_option("--queries", accuracy.queries, "random rig poses")
       ->check(CLI::Range(1, 10000000))
@@ -88,6 +95,17 @@ int main(int argc, char** argv) {
   accuracy_cmd->add_option("--scale", accuracy.scale, "axis scales for (θi, θo, φ)");
   accuracy_cmd->add_option("--half-scale", accuracy.half_scale,
                            "axis scales for (θh·cos φd, θh·sin φd, θd) (default 1,1,1)");
+  accuracy_cmd
+      ->add_option("--trend", accuracy.trend,
+                   "none, or bivariate: every method blends the residuals from a fitted "
+                   "T(θh, θd) and adds T back")
+      ->check(CLI::IsMember({"none", "bivariate"}))
+      ->capture_default_str();
+  accuracy_cmd
+      ->add_option("--noise", accuracy.noise,
+                   "scale each reading by (1 + NOISE · N(0, 1)), one draw per reading (a "
+                   "meter's gain noise); the truth stays noiseless")
+      ->capture_default_str();
   accuracy_cmd->add_flag("--mirror-phi", accuracy.mirror_phi, "add the mirrored copies");
   accuracy_cmd->add_flag("--reciprocity", accuracy.reciprocity, "add the swapped copies");
   accuracy_cmd
@@ -137,6 +155,7 @@ int main(int argc, char** argv) {
     demo.mirror_phi = interp.mirror_phi;
     demo.reciprocity = interp.reciprocity;
     demo.coordinates = interp.coordinates;
+    demo.trend = interp.trend;
     return RunDemo(demo, std::cout, std::cerr);
   }
   if (interp.samples_path.empty() || interp.queries_path.empty()) {

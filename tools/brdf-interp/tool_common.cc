@@ -22,6 +22,11 @@ Result<std::unique_ptr<interp::Interpolator>> MakeNamedInterpolator(
     const std::string& method, std::shared_ptr<const interp::SampleSet> samples,
     const interp::Options& options) {
   if (method == "octant-reference") {
+    if (options.trend != interp::Trend::kNone) {
+      return InvalidArgument(
+          "--trend: octant-reference is the paper's method as published; use "
+          "--method octant with a trend");
+    }
     return interp::MakeOctantReferenceInterpolator(std::move(samples), options);
   }
   Result<interp::Method> m = interp::ParseMethod(method);

@@ -105,6 +105,14 @@ int BuildRequest(const ExportOptions& o, std::ostream& err, v1::ExportRequest* r
     return Invalid(err, "--coordinates is for grid, merl and rgl exports");
   }
   options->set_coordinates(coordinates);
+  v1::InterpolationTrend trend{};
+  if (!ParseTrendName(o.trend, &trend)) {
+    return Invalid(err, "--trend '" + o.trend + "': use none or bivariate");
+  }
+  if (o.what == "csv" && trend != v1::INTERPOLATION_TREND_NONE) {
+    return Invalid(err, "--trend is for grid, merl and rgl exports");
+  }
+  options->set_trend(trend);
   for (double s : o.axis_scale) options->add_axis_scale(s);
   options->set_mirror_phi(o.mirror_phi);
   // A MERL or RGL cell stands for a pair of directions and its swap alike (as brdf-export).

@@ -36,6 +36,7 @@ struct ExportOptions {
   std::vector<double> axis_scale;
   bool mirror_phi = false;
   std::string coordinates = "incidence";  // grid, merl, rgl: incidence or half-diff
+  std::string trend = "none";             // grid, merl, rgl: none or bivariate
   bool reciprocity = false;               // grid: also the θi↔θo swapped readings
   bool no_reciprocity = false;  // merl, rgl: reciprocity is on by default; this turns it off
   std::string fill = "chain";   // grid, merl, rgl: chain or none

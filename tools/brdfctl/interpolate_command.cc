@@ -111,6 +111,12 @@ int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
     return kExitInvalid;
   }
   options->set_coordinates(coordinates);
+  v1::InterpolationTrend trend{};
+  if (!ParseTrendName(o.trend, &trend)) {
+    ctx.err << "brdfctl: --trend " << o.trend << ": use none or bivariate\n";
+    return kExitInvalid;
+  }
+  options->set_trend(trend);
   options->set_mirror_phi(o.mirror_phi);
   options->set_reciprocity(o.reciprocity);
   for (double s : o.axis_scale) options->add_axis_scale(s);
@@ -162,7 +168,8 @@ int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
         << (coordinates == v1::INTERPOLATION_COORDINATES_HALF_DIFFERENCE
                 ? " in half/difference coordinates"
                 : "")
-        << ": " << InterpolationStatusName(result.status()) << "\n";
+        << (trend == v1::INTERPOLATION_TREND_BIVARIATE ? " over the bivariate trend" : "") << ": "
+        << InterpolationStatusName(result.status()) << "\n";
     if (!result.detail().empty()) out << "  " << result.detail() << "\n";
     if (o.explain && result.vertices_size() > 0) {
       out << "\nvertices (blended readings):\n";

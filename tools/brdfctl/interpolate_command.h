@@ -30,6 +30,7 @@ struct InterpolateOptions {
   bool reciprocity = false;
   std::vector<double> axis_scale;
   std::string coordinates = "incidence";  // incidence or half-diff (isotropic sessions)
+  std::string trend = "none";             // none or bivariate (isotropic sessions)
   int every = 1;                          // print every Nth band
 };
 

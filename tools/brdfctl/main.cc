@@ -225,6 +225,12 @@ int main(int argc, char** argv) {
                    "isotropic sessions)")
       ->check(CLI::IsMember({"incidence", "half-diff"}))
       ->capture_default_str();
+  interpolate
+      ->add_option("--trend", interp.trend,
+                   "none, or bivariate: blend the readings' residuals from a fitted smooth "
+                   "f(θh, θd) and add it back (isotropic sessions)")
+      ->check(CLI::IsMember({"none", "bivariate"}))
+      ->capture_default_str();
 
   AppearanceOptions appearance_options;
   CLI::App* appearance = app.add_subcommand(
@@ -280,6 +286,12 @@ int main(int argc, char** argv) {
                    "grid, merl, rgl: interpolate in incidence (θi, θo, φ) or half-diff "
                    "(Rusinkiewicz's half/difference angles) coordinates")
       ->check(CLI::IsMember({"incidence", "half-diff"}))
+      ->capture_default_str();
+  export_cmd
+      ->add_option("--trend", export_options.trend,
+                   "grid, merl, rgl: none, or bivariate (blend the readings' residuals from a "
+                   "fitted smooth f(θh, θd) and add it back)")
+      ->check(CLI::IsMember({"none", "bivariate"}))
       ->capture_default_str();
   export_cmd->add_flag("--reciprocity", export_options.reciprocity,
                        "grid: also use readings with θi and θo swapped (merl, rgl: always, see "

@@ -40,6 +40,17 @@ std::string QuantityName(v1::Quantity quantity) {
   return ShortEnumName(v1::Quantity_Name(quantity), "QUANTITY_");
 }
 
+bool ParseTrendName(std::string_view name, v1::InterpolationTrend* trend) {
+  if (name == "none") {
+    *trend = v1::INTERPOLATION_TREND_NONE;
+  } else if (name == "bivariate") {
+    *trend = v1::INTERPOLATION_TREND_BIVARIATE;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 bool ParseCoordinatesName(std::string_view name, v1::InterpolationCoordinates* coordinates) {
   if (name == "incidence") {
     *coordinates = v1::INTERPOLATION_COORDINATES_INCIDENCE;

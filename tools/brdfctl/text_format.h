@@ -29,6 +29,8 @@ std::string QuantityUnit(v1::Quantity quantity);
 // The command lines' --coordinates value ("incidence", "half-diff") as the API's; false for an
 // unknown name.
 bool ParseCoordinatesName(std::string_view name, v1::InterpolationCoordinates* coordinates);
+// The command lines' --trend value ("none", "bivariate") as the API's; false for another.
+bool ParseTrendName(std::string_view name, v1::InterpolationTrend* trend);
 
 // Inverse of StateName ("running" → SESSION_STATE_RUNNING); false for an unknown name.
 bool ParseStateName(std::string_view name, v1::SessionState* state);

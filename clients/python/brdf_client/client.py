@@ -338,7 +338,7 @@ class BrdfClient:
                mirror_phi=False, reciprocity=None, step_theta_i=0.0, step_theta_o=0.0,
                step_phi=0.0, grid_nodes=False, exclude_flagged=False, chunk_bytes=0,
                fill="chain", rgb=False, rgl_theta_i_count=0, rgl_resolution=0,
-               on_progress=None, timeout=None, coordinates=None):
+               on_progress=None, timeout=None, coordinates=None, trend=None):
         """Has the daemon export the session as a file and saves it at `path`; returns an
         ExportResult (file name, bytes, summary, rows, cells, filled_cells, shape, ...).
 
@@ -354,7 +354,7 @@ class BrdfClient:
             leaves a truncated file (the partial file is removed).
         quantity: csv and grids: "brdf" (sr⁻¹; None: the daemon's default, BRDF), "reflectance"
             or "radiance" (csv: every reading, raw). MERL is always the BRDF.
-        method, axis_scale, mirror_phi, coordinates: grids, MERL and RGL, as interpolate() (a
+        method, axis_scale, mirror_phi, coordinates, trend: grids, MERL and RGL, as interpolate() (a
             grid's .json sidecar records them). reciprocity: also
             use the θi↔θo swapped readings; None: on for MERL and RGL (a cell stands for a pair of
             directions and its swap alike, as `brdfctl export merl`), off otherwise.
@@ -384,7 +384,7 @@ class BrdfClient:
         request = export_request(session_id, fmt, "" if into_folder else path,
                                  quantity=quantity, method=method, axis_scale=axis_scale,
                                  mirror_phi=mirror_phi, reciprocity=reciprocity,
-                                 coordinates=coordinates,
+                                 coordinates=coordinates, trend=trend,
                                  step_theta_i=step_theta_i, step_theta_o=step_theta_o,
                                  step_phi=step_phi, grid_nodes=grid_nodes,
                                  exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes,
@@ -438,7 +438,7 @@ class BrdfClient:
 
     def interpolate(self, session_id, theta_i, theta_o, phi=None, *, phi_i=None, phi_o=None,
                     method="octant", quantity="brdf", axis_scale=None, mirror_phi=False,
-                    reciprocity=False, coordinates=None):
+                    reciprocity=False, coordinates=None, trend=None):
         """The spectrum at one direction, from the session's SAMPLE readings.
 
         Direction, degrees: (theta_i, theta_o, phi) for isotropic sessions (φ = |φo − φi| in
@@ -450,6 +450,9 @@ class BrdfClient:
             daemon's default, incidence) or "half_difference" / "half-diff" (Rusinkiewicz's
             half/difference angles; isotropic sessions only, else BrdfError INVALID_ARGUMENT).
             Directions and the vertices' coordinates stay (θi, θo, φ) either way.
+        trend: "bivariate" blends the readings' residuals from a smooth f(θh, θd) fitted to all
+            of them and adds it back (closer near a sharp specular peak; isotropic sessions only;
+            docs/interpolation.md, "Bivariate trend"); None or "none": the readings' spectra.
 
         Returns an InterpolationResult. A direction the method cannot fill is not an error: check
         result.ok / result.status ("empty_octant", "outside_hull", ...).
@@ -468,13 +471,14 @@ class BrdfClient:
             session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
             quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"),
             direction=direction_query(direction),
-            options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates))
+            options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates,
+                                          trend))
         response = self._unary(self._interp.Interpolate, request, "Interpolation.Interpolate")
         return InterpolationResult.from_proto(response.result)
 
     def appearance(self, session_id, illuminants=None, *, method="octant", sphere_size=0,
                    light=None, axis_scale=None, mirror_phi=False, reciprocity=False,
-                   coordinates=None):
+                   coordinates=None, trend=None):
         """The sample's colour (CIE 45°:0°) and a lit sphere in sRGB
         (Interpolation.RenderAppearance, docs/appearance.md). illuminants: "D65", "A", a list of them, or None for both.
         sphere_size: pixels per side, at most 512 (0: 128). light: (x, y, z) towards the light
@@ -482,7 +486,8 @@ class BrdfClient:
         Returns an Appearance (appearance["D65"].hex, .xy, .sphere as an (n, n, 4) uint8 array)."""
         request = brdf_pb2.AppearanceRequest(
             session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
-            options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates),
+            options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates,
+                                          trend),
             sphere_size=sphere_size, light=list(light or []),
             illuminants=illuminant_enums(illuminants))
         response = self._unary(self._interp.RenderAppearance, request,
@@ -491,7 +496,7 @@ class BrdfClient:
 
     def interpolate_batch(self, session_id, directions, method="octant", quantity="brdf",
                           axis_scale=None, mirror_phi=False, reciprocity=False, chunk_size=0,
-                          timeout=None, coordinates=None):
+                          timeout=None, coordinates=None, trend=None):
         """Spectra at many directions: `directions` is (N, 3) (θi, θo, φ) or (N, 4)
         (θi, φi, θo, φo), degrees. Returns an InterpolationBatch in the order asked (spectra
         (N, m) with NaN rows where the method could not fill the direction)."""
@@ -499,7 +504,8 @@ class BrdfClient:
         request = brdf_pb2.InterpolateBatchRequest(
             session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
             quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"), directions=queries,
-            options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates),
+            options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates,
+                                          trend),
             chunk_size=chunk_size)
         results = [None] * len(queries)
         for chunk in self._stream(self._interp.InterpolateBatch, request,

@@ -68,7 +68,7 @@ def export_request(session_id, fmt, path="", *, quantity=None, method="octant",
                    axis_scale=None, mirror_phi=False, reciprocity=None, step_theta_i=0.0,
                    step_theta_o=0.0, step_phi=0.0, grid_nodes=False, exclude_flagged=False,
                    chunk_bytes=0, fill="chain", rgb=False, rgl_theta_i_count=0, rgl_resolution=0,
-                   coordinates=None):
+                   coordinates=None, trend=None):
     """The ExportRequest for BrdfClient.export's arguments (which document them).
 
     As brdfctl: reciprocity None means on for MERL and RGL (a cell stands for a pair of
@@ -97,9 +97,12 @@ def export_request(session_id, fmt, path="", *, quantity=None, method="octant",
             0, brdf_pb2.INTERPOLATION_COORDINATES_INCIDENCE):
         raise ValueError(f"coordinates are for grid, MERL and RGL exports, not "
                          f"{format_name(value)}")
+    trend = names.to_enum(trend, names.TRENDS, "trend")
+    if value not in FILLED_FORMATS and trend not in (0, brdf_pb2.INTERPOLATION_TREND_NONE):
+        raise ValueError(f"trend is for grid, MERL and RGL exports, not {format_name(value)}")
     options = brdf_pb2.InterpolationOptions(axis_scale=list(axis_scale or ()),
                                             mirror_phi=mirror_phi, reciprocity=reciprocity,
-                                            coordinates=coordinates)
+                                            coordinates=coordinates, trend=trend)
     return brdf_pb2.ExportRequest(
         session_id=str(session_id), format=value,
         quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"),

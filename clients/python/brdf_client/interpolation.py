@@ -170,15 +170,18 @@ def direction_query(direction):
 
 
 def interpolation_options(axis_scale=None, mirror_phi=False, reciprocity=False,
-                          coordinates=None):
+                          coordinates=None, trend=None):
     """A brdf.v1.InterpolationOptions, or None when every option is at its default.
 
     coordinates: "incidence" (θi, θo, φ), "half_difference" (or "half-diff": Rusinkiewicz's
     half/difference angles, isotropic sessions only) or None (the daemon's default, incidence).
-    An unknown name raises ValueError."""
+    trend: "none" (blend the readings' spectra), "bivariate" (blend their residuals from a
+    smooth f(θh, θd) fitted to all of them and add it back; isotropic sessions only) or None
+    (none). An unknown name raises ValueError."""
     coordinates = names.to_enum(coordinates, names.COORDINATES, "coordinates")
-    if not axis_scale and not mirror_phi and not reciprocity and not coordinates:
+    trend = names.to_enum(trend, names.TRENDS, "trend")
+    if not axis_scale and not mirror_phi and not reciprocity and not coordinates and not trend:
         return None
     return brdf_pb2.InterpolationOptions(axis_scale=list(axis_scale or []),
                                          mirror_phi=mirror_phi, reciprocity=reciprocity,
-                                         coordinates=coordinates)
+                                         coordinates=coordinates, trend=trend)

@@ -19,6 +19,11 @@ COORDINATES = {
     "half_difference": brdf_pb2.INTERPOLATION_COORDINATES_HALF_DIFFERENCE,
     "half_diff": brdf_pb2.INTERPOLATION_COORDINATES_HALF_DIFFERENCE,
 }
+# What a method blends (InterpolationOptions.trend).
+TRENDS = {
+    "none": brdf_pb2.INTERPOLATION_TREND_NONE,
+    "bivariate": brdf_pb2.INTERPOLATION_TREND_BIVARIATE,
+}
 QUANTITIES = {
     "radiance": brdf_pb2.QUANTITY_RADIANCE,
     "reflectance": brdf_pb2.QUANTITY_REFLECTANCE,
