@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/analytic_brdf.h"
 #include "tools/brdf-sim/optics.h"
 #include "tools/brdf-sim/rig_truth.h"
 
@@ -62,6 +63,22 @@ TEST(TruthFormatTest, JsonCarriesDirectionsAndSpectrum) {
   ASSERT_EQ(nm.size(), 101u);
   EXPECT_EQ(nm.front(), 380);
   EXPECT_EQ(nm.back(), 780);
+}
+
+TEST(TruthFormatTest, GlossySampleIsAnalyticGlossyAndNamesItself) {
+  TruthQuery q;
+  q.directions = {42.5, 0, 42.5, 177.5};
+  q.glossy = true;
+  q.json = true;
+  const std::string json = FormatTruth(q);
+  EXPECT_NE(json.find("\"sample\":\"glossy\""), std::string::npos) << json;
+  const auto brdf = JsonArray(json, "brdf");
+  EXPECT_EQ(brdf, AnalyticBrdf::Glossy().EvaluateSpectrum(q.directions, WavelengthGrid::Pr650()));
+  // Near the mirror direction the glossy lobe is several times the paint's.
+  EXPECT_GT(brdf[43], 3 * TrueBrdf(q.directions)[43]);
+  q.anisotropic = true;
+  EXPECT_EQ(ValidateTruthQuery(q).code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(ValidateTruthQuery(q).message().find("--glossy"), std::string::npos);
 }
 
 TEST(TruthFormatTest, RejectsNonFiniteAngles) {

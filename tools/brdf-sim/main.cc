@@ -111,7 +111,7 @@ int Run(const SimConfig& config, const sigset_t& stop_signals) {
       "{} mounted",
       meter.path(), meter.slave_path(), config.modbus_host, stage.tcp_port(),
       config.rtu ? ", Modbus RTU on " : "", config.rtu ? stage.rtu_path() : "", config.time_scale,
-      config.optics.seed, config.optics.anisotropic ? "brushed (anisotropic)" : "paint-like",
+      config.optics.seed, SampleName(config.optics.anisotropic, config.optics.glossy),
       MountedTargetName(config.mounted));
 
   Announce("pr650 " + meter.path());

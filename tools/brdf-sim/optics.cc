@@ -20,12 +20,18 @@ double CosAbove(double theta_deg) {
 
 }  // namespace
 
-AnalyticBrdf SampleBrdf(bool anisotropic) {
-  return anisotropic ? AnalyticBrdf::Brushed() : AnalyticBrdf::PaintLike();
+AnalyticBrdf SampleBrdf(bool anisotropic, bool glossy) {
+  if (anisotropic) return AnalyticBrdf::Brushed();
+  return glossy ? AnalyticBrdf::Glossy() : AnalyticBrdf::PaintLike();
 }
 
-std::vector<double> TrueBrdf(const Directions& directions, bool anisotropic) {
-  return SampleBrdf(anisotropic).EvaluateSpectrum(directions, WavelengthGrid::Pr650());
+const char* SampleName(bool anisotropic, bool glossy) {
+  if (anisotropic) return "brushed (anisotropic)";
+  return glossy ? "glossy" : "paint-like";
+}
+
+std::vector<double> TrueBrdf(const Directions& directions, bool anisotropic, bool glossy) {
+  return SampleBrdf(anisotropic, glossy).EvaluateSpectrum(directions, WavelengthGrid::Pr650());
 }
 
 RigOptics::RigOptics(const StagePoseSource& stage, SimControl& control, OpticsConfig config)
@@ -34,7 +40,7 @@ RigOptics::RigOptics(const StagePoseSource& stage, SimControl& control, OpticsCo
       config_(config),
       lamp_(config.lamp),
       detector_(config.detector),
-      sample_(SampleBrdf(config.anisotropic)),
+      sample_(SampleBrdf(config.anisotropic, config.glossy)),
       lamp_spectrum_(lamp_.Spectrum(Grid())),
       rng_(config.seed) {}
 

@@ -34,20 +34,24 @@ struct OpticsConfig {
   // Stray light and detector dark signal, spectrally flat (W·m⁻²·sr⁻¹·nm⁻¹). Seen in every reading;
   // alone with the shutter closed. Low enough that a dark reading earns quality 10 or 18.
   double ambient_radiance = 5e-6;
-  // The virtual sample: AnalyticBrdf::PaintLike(), or Brushed() when anisotropic.
+  // The virtual sample: AnalyticBrdf::PaintLike(), Brushed() when anisotropic, Glossy() when
+  // glossy (not both).
   bool anisotropic = false;
+  bool glossy = false;
   // Seeds the noise: the same seed and the same sequence of measurements give the same readings.
   std::uint64_t seed = 1;
   // Standard deviations scale by this (0 = noiseless, for tests that want exact values).
   double noise_scale = 1.0;
 };
 
-// The virtual sample's BRDF model.
-AnalyticBrdf SampleBrdf(bool anisotropic);
+// The virtual sample's BRDF model, and its name ("paint-like", "brushed (anisotropic)", "glossy").
+AnalyticBrdf SampleBrdf(bool anisotropic, bool glossy = false);
+const char* SampleName(bool anisotropic, bool glossy);
 
 // Ground truth: the virtual sample's BRDF (sr⁻¹) on the PR-650 grid (380–780 nm every 4 nm) for
 // directions in the sample frame (degrees). Zero where either direction is below the surface.
-std::vector<double> TrueBrdf(const Directions& directions, bool anisotropic = false);
+std::vector<double> TrueBrdf(const Directions& directions, bool anisotropic = false,
+                             bool glossy = false);
 
 class RigOptics final : public MeterBackend {
  public:

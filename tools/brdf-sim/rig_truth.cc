@@ -24,26 +24,29 @@ Status ValidateTruthQuery(const TruthQuery& q) {
   if (!std::isfinite(d.phi_i) || !std::isfinite(d.phi_o)) {
     return InvalidArgument("truth: --phi, --phi-i and --phi-o must be finite angles");
   }
+  if (q.anisotropic && q.glossy) {
+    return InvalidArgument("truth: --anisotropic and --glossy name two samples; give one");
+  }
   return Status::Ok();
 }
 
 std::string FormatTruth(const TruthQuery& q) {
   const WavelengthGrid grid = WavelengthGrid::Pr650();
-  const std::vector<double> f = TrueBrdf(q.directions, q.anisotropic);
+  const std::vector<double> f = TrueBrdf(q.directions, q.anisotropic, q.glossy);
   const Directions& d = q.directions;
   std::string out;
   if (q.json) {
     out += "{\"theta_i\":" + Number(d.theta_i) + ",\"phi_i\":" + Number(d.phi_i) +
            ",\"theta_o\":" + Number(d.theta_o) + ",\"phi_o\":" + Number(d.phi_o) +
-           ",\"anisotropic\":" + (q.anisotropic ? "true" : "false") +
-           ",\"unit\":\"sr^-1\",\"wavelength_nm\":[";
+           ",\"anisotropic\":" + (q.anisotropic ? "true" : "false") + ",\"sample\":\"" +
+           SampleName(q.anisotropic, q.glossy) + "\"" + ",\"unit\":\"sr^-1\",\"wavelength_nm\":[";
     for (std::size_t k = 0; k < grid.count; ++k) out += (k ? "," : "") + Number(grid.at(k));
     out += "],\"brdf\":[";
     for (std::size_t k = 0; k < f.size(); ++k) out += (k ? "," : "") + Number(f[k]);
     out += "]}\n";
     return out;
   }
-  out += "# true BRDF (sr^-1) of the " + std::string(q.anisotropic ? "brushed" : "paint-like") +
+  out += "# true BRDF (sr^-1) of the " + std::string(SampleName(q.anisotropic, q.glossy)) +
          " sample at theta_i " + Number(d.theta_i) + " phi_i " + Number(d.phi_i) + " theta_o " +
          Number(d.theta_o) + " phi_o " + Number(d.phi_o) + " (deg)\n";
   for (std::size_t k = 0; k < f.size(); ++k) out += Number(grid.at(k)) + " " + Number(f[k]) + "\n";

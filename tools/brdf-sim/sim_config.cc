@@ -191,11 +191,12 @@ Status ReadOptics(const TomlReader& r, const toml::table& o, OpticsConfig& c) {
 
 Status ReadTable(const TomlReader& r, const toml::table& root, SimConfig& c) {
   BRDF_RETURN_IF_ERROR(r.CheckKeys(root, "",
-                                   {"time_scale", "seed", "anisotropic", "mounted", "log_level",
-                                    "modbus", "pr650", "stage", "faults", "optics"}));
+                                   {"time_scale", "seed", "anisotropic", "glossy", "mounted",
+                                    "log_level", "modbus", "pr650", "stage", "faults", "optics"}));
   BRDF_RETURN_IF_ERROR(r.Read(root, "", "time_scale", c.time_scale));
   BRDF_RETURN_IF_ERROR(r.Read(root, "", "seed", c.optics.seed));
   BRDF_RETURN_IF_ERROR(r.Read(root, "", "anisotropic", c.optics.anisotropic));
+  BRDF_RETURN_IF_ERROR(r.Read(root, "", "glossy", c.optics.glossy));
   BRDF_RETURN_IF_ERROR(r.Read(root, "", "log_level", c.log_level));
   std::string mounted;
   BRDF_RETURN_IF_ERROR(r.Read(root, "", "mounted", mounted));
@@ -367,6 +368,9 @@ void AddRunFlags(CLI::App& app, SimConfig& c) {
   app.add_option("--stage-ramp-unit", c.stage_ramp_unit,
                  "Unit of the drives' ramp rates: khz_per_s (AZ default), s or ms_per_khz");
   app.add_flag("--anisotropic", c.optics.anisotropic, "Mount the brushed (anisotropic) sample");
+  app.add_flag("--glossy", c.optics.glossy,
+               "Mount the glossy isotropic sample (AnalyticBrdf::Glossy: the paint's base under a "
+               "lobe of exponent 200)");
   const std::map<std::string, MountedTarget> targets = {{"sample", MountedTarget::kSample},
                                                         {"white", MountedTarget::kWhite},
                                                         {"dark", MountedTarget::kDark}};
@@ -428,6 +432,7 @@ void AddTruthFlags(CLI::App& truth, TruthQuery& q) {
   auto* phi_o = truth.add_option("--phi-o", q.directions.phi_o, "Outgoing azimuth, deg");
   phi->excludes(phi_i)->excludes(phi_o);
   truth.add_flag("--anisotropic", q.anisotropic, "The brushed (anisotropic) sample");
+  truth.add_flag("--glossy", q.glossy, "The glossy isotropic sample");
   truth.add_flag("--json", q.json, "Print JSON instead of two columns");
 }
 
@@ -465,6 +470,10 @@ Status ValidateConfig(const SimConfig& c) {
                            " is out of range; use 0 (any free port) to 65535");
   }
   if (c.modbus_host.empty()) return InvalidArgument("Modbus host is empty; use --modbus-host");
+  if (c.optics.anisotropic && c.optics.glossy) {
+    return InvalidArgument(
+        "--anisotropic and --glossy name two samples; mount one (the glossy sample is isotropic)");
+  }
   if (!Finite(c.manual_delta_deg) || c.manual_delta_deg < 0 || c.manual_delta_deg > 180) {
     return InvalidArgument("manual detector angle must be 0–180 deg; fix --manual-delta");
   }

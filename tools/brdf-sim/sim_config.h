@@ -80,6 +80,7 @@ struct SimConfig {
 struct TruthQuery {
   Directions directions;
   bool anisotropic = false;
+  bool glossy = false;
   bool json = false;
 };
 
