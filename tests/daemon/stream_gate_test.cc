@@ -109,8 +109,11 @@ TEST_F(StreamGateTest, UnauthenticatedLargeRequestsAreRefusedBeforeTheyAreRead) 
     EXPECT_EQ(r.error_code(), StatusCode::UNAUTHENTICATED) << r.error_message();
   }
   const long after = RssKb(pid);
-  // Reading them would cost 8 × 15 MiB (and their parsing as much again): 120 MB and more.
-  EXPECT_LT(after - before, 16 * 1024) << "VmRSS " << before << " kB → " << after << " kB";
+  // Reading them would cost 8 × 15 MiB (and their parsing as much again): 120 MB and more. The
+  // transport still takes in part of each body before the refusal goes out (HTTP/2 flow-control
+  // windows): 1.4 to 19 MB in six runs on a loaded machine (2026-12-05), so the bound is a quarter
+  // of the bodies, well apart from both.
+  EXPECT_LT(after - before, 30 * 1024) << "VmRSS " << before << " kB → " << after << " kB";
   std::cout << "8 unauthenticated 15 MiB calls: VmRSS " << before << " kB → " << after << " kB\n";
 }
 
