@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <spdlog/spdlog.h>
+
 #include "core/geometry.h"
 
 namespace brdf::sim {
@@ -89,6 +91,11 @@ SimMeasurement RigOptics::Measure(const MeterSetup& setup) {
   }
   const double step = Grid().step_nm;
   for (double r : m.radiance) m.integrated += r * step;
+  // What the meter chose, for timing the rig (bench/daemon/estimate.sh reads these lines).
+  static constexpr const char* kTargetNames[] = {"sample", "white", "dark"};
+  spdlog::debug("measure {}: integration {} ms x {}, {:.3f} s simulated, quality {}",
+                kTargetNames[static_cast<int>(target)], m.integration_ms, averages, m.duration_s,
+                m.quality_code);
 
   return m;
 }
