@@ -317,9 +317,9 @@ TEST(ConfigTest, ValuesOutOfRange) {
   EXPECT_THAT(Refusal("[meter]\nadaptive_sample_ms = \"650\"\n"),
               HasSubstr("meter.adaptive_sample_ms: must be an integer"));
   // The old single time is not a key: a misspelt or merged key is refused, naming the known ones.
-  EXPECT_THAT(Refusal("[meter]\nadaptive_integration_ms = 2000\n"),
-              AllOf(HasSubstr("unknown key meter.adaptive_integration_ms"),
-                    HasSubstr("adaptive_dark_ms")));
+  EXPECT_THAT(
+      Refusal("[meter]\nadaptive_integration_ms = 2000\n"),
+      AllOf(HasSubstr("unknown key meter.adaptive_integration_ms"), HasSubstr("adaptive_dark_ms")));
   EXPECT_THAT(Refusal("[meter.quality]\n123 = \"retry\"\n"), HasSubstr("not a quality code"));
   EXPECT_THAT(Refusal("[meter.quality]\n18 = \"ignore\"\n"), HasSubstr("\"ignore\" is not one of"));
   EXPECT_THAT(Refusal("[meter.quality]\n18 = {}\n"), HasSubstr("meter.quality.18.action: missing"));

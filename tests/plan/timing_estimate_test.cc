@@ -152,8 +152,8 @@ TEST(TimingEstimateTest, AdaptiveIntegrationIsPerKindAndOverheadIsPerReading) {
   // averaging (integration × averages) does not multiply it.
   RigDescription slower = rig;
   slower.reading_overhead_s += 1.0;
-  EXPECT_NEAR(total(EstimateSteps(sample_heavy, slower, Adaptive())) - sample_heavy_s,
-              10 * 1.0 / 8, 1e-12);
+  EXPECT_NEAR(total(EstimateSteps(sample_heavy, slower, Adaptive())) - sample_heavy_s, 10 * 1.0 / 8,
+              1e-12);
   MeasurementChoice averaged;
   averaged.averages = 4;
   const std::vector<StepTime> four = EstimateSteps(one_of_each, slower, averaged);

@@ -1,10 +1,10 @@
 #include "tools/brdf-sim/optics.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-
-#include <spdlog/spdlog.h>
 
 #include "core/geometry.h"
 
