@@ -353,6 +353,11 @@ void ReadMeter(TableReader& root, Config& c, Issues& issues) {
   t.Int("wake_attempts", m.wake_attempts, 1, 20);
   t.Bool("measure_with_spectrum", m.measure_with_spectrum);
   t.Int("rts_settle_ms", m.rts_settle_ms, 0, 10000);
+  t.Int("overhead_ms", m.overhead_ms, 0, 60000);
+  // The PR-650's integration range (S command: 10 … 6000 ms).
+  t.Int("adaptive_reference_ms", m.adaptive_reference_ms, 10, 6000);
+  t.Int("adaptive_dark_ms", m.adaptive_dark_ms, 10, 6000);
+  t.Int("adaptive_sample_ms", m.adaptive_sample_ms, 10, 6000);
   if (const toml::table* q = t.Table("quality")) {
     for (const auto& [key, node] : *q) {
       const std::string code_text(key.str());
@@ -648,10 +653,14 @@ plan::RigDescription ToRigDescription(const Config& config) {
                     convention(s.delta)};
   // The D5 report is ~1,730 bytes; 10 bits per byte on the wire (8N1).
   rig.meter_transfer_s = 1730.0 * 10.0 / config.meter.baud;
-  // ~0.3 s of meter processing per reading; the daemon's own waits per exchange (M5; or M0
-  // and D5): the pacing before the command and the quiet gap that ends the reply. The move
-  // after a reading starts once the measurement is held: after M5's status line, or M0's reply.
-  rig.reading_overhead_s = 0.3;
+  // The meter's own time per reading and the integration it is expected to choose when adaptive
+  // ([meter] overhead_ms, adaptive_*_ms); the daemon's own waits per exchange (M5; or M0 and
+  // D5): the pacing before the command and the quiet gap that ends the reply. The move after a
+  // reading starts once the measurement is held: after M5's status line, or M0's reply.
+  rig.reading_overhead_s = config.meter.overhead_ms / 1000.0;
+  rig.adaptive_integration = {.reference_s = config.meter.adaptive_reference_ms / 1000.0,
+                              .dark_s = config.meter.adaptive_dark_ms / 1000.0,
+                              .sample_s = config.meter.adaptive_sample_ms / 1000.0};
   const double pacing_s = config.meter.pacing_ms / 1000.0;
   const double gap_s = config.meter.quiet_gap_ms / 1000.0;
   const int exchanges = config.meter.measure_with_spectrum ? 1 : 2;

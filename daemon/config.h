@@ -28,6 +28,10 @@
 //   wake_attempts = 5                   # remote-mode wake-up tries before asking for a power cycle
 //   measure_with_spectrum = true        # M5 (one exchange per reading); false: M0 then D5
 //   rts_settle_ms = 1000                # wait after RTS drop/raise before the first command
+//   overhead_ms = 300                   # the meter's own time per reading (for estimates)
+//   adaptive_reference_ms = 2000        # integration the meter is expected to choose when the
+//   adaptive_dark_ms = 6000             #   plan says adaptive, by kind of reading (for
+//   adaptive_sample_ms = 2000           #   estimates); 10 … 6000 ms, the meter's range
 //   [meter.quality]                     # overrides of the quality policy, by code
 //   "18" = "accept_and_flag"            # accept, accept_and_flag, retry, retry_then_flag,
 //   "30" = { action = "retry", accept_flagged_when_exhausted = true }  # adapt_integration,
@@ -134,6 +138,13 @@ struct MeterConfig {
   int wake_attempts = 5;
   bool measure_with_spectrum = true;
   int rts_settle_ms = 1000;  // wake-up: wait after RTS is raised again (manual: > 0.5 s)
+  // For plan-time estimates only (core/plan/timing.h): the meter's own time per reading beyond
+  // integration and transfer, and the integration it is expected to choose when the plan says
+  // adaptive, by kind of reading (the white reference is bright, a dark reading runs to 6 s).
+  int overhead_ms = 300;
+  int adaptive_reference_ms = 2000;
+  int adaptive_dark_ms = 6000;
+  int adaptive_sample_ms = 2000;
   // Rules that replace the driver's defaults for these quality codes (0–99).
   std::map<int, drivers::pr650::QualityRule> quality_overrides;
 };
@@ -234,7 +245,8 @@ Result<Config> LoadConfig(const std::string& path);
 std::string RigName(const Config& config);
 
 // What core/plan needs to know about this rig: motorized axes, travel, speeds, the convention
-// (zero offsets and signs), and the meter's transfer time at the configured baud rate.
+// (zero offsets and signs), the meter's transfer time at the configured baud rate, its overhead
+// per reading and the adaptive integration times by kind of reading.
 plan::RigDescription ToRigDescription(const Config& config);
 
 }  // namespace brdf::daemon

@@ -142,6 +142,11 @@ database = "$d/brdfd.db"
 port = "$d/pr650"
 pacing_ms = 10
 quiet_gap_ms = 20
+# brdf-sim's meter, for the estimates (docs/pr650.md, "How long a reading takes")
+overhead_ms = 1000
+adaptive_reference_ms = 150
+adaptive_dark_ms = 6000
+adaptive_sample_ms = 650
 [meter.quality]
 "10" = "accept_and_flag"
 [stage]

@@ -249,6 +249,13 @@ database = "$run/brdfd.db"
 port = "$run/pr650"
 pacing_ms = 10
 quiet_gap_ms = 20
+# brdf-sim's meter, for the estimates (validate, the ETA): 1 s of its own per measurement, and
+# the integration its adaptive mode picks by kind of reading (docs/pr650.md, "How long a reading
+# takes").
+overhead_ms = 1000
+adaptive_reference_ms = 150
+adaptive_dark_ms = 6000
+adaptive_sample_ms = 650
 
 [meter.quality]
 # A dark reading (lamp shuttered) is weak by nature: the meter reports quality 10. Keep such

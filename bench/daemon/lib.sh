@@ -31,6 +31,11 @@ database = "$1"
 port = "$2"
 pacing_ms = 5
 quiet_gap_ms = 10
+# brdf-sim's meter, for the estimates (docs/pr650.md, "How long a reading takes")
+overhead_ms = 1000
+adaptive_reference_ms = 150
+adaptive_dark_ms = 6000
+adaptive_sample_ms = 650
 [stage]
 transport = "tcp"
 address = "$3"

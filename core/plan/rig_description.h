@@ -19,6 +19,17 @@ struct AxisTravel {
   }
 };
 
+// The integration time the meter is expected to choose, by kind of reading, when the plan says
+// adaptive (seconds). Adaptive integration aims the brightest band at a fill of the detector, so
+// the time follows the light: the white standard is bright (short), a sample is dimmer and varies
+// with the pose, a dark reading (lamp shuttered) never fills the detector and runs to the meter's
+// longest time (the PR-650's 6 s). Defaults: [meter] adaptive_*_ms (daemon/config.h).
+struct AdaptiveIntegration {
+  double reference_s = 2.0;
+  double dark_s = 6.0;
+  double sample_s = 2.0;
+};
+
 struct RigDescription {
   // A motorized γ axis. Without it γ is a dial the operator turns (a prompt per change).
   bool has_gamma_axis = false;
@@ -36,10 +47,13 @@ struct RigDescription {
   HolderConvention convention;
 
   // Timing model (core/plan/timing.h). Seconds.
-  double meter_transfer_s = 1.8;        // D5 spectrum report, ~1,730 bytes at 9600 baud
-  double adaptive_integration_s = 2.0;  // expected integration when the plan says adaptive
-  double min_integration_s = 0.010;     // the meter's shortest integration (lower bound)
-  double reading_overhead_s = 0.3;      // the meter's processing per reading
+  double meter_transfer_s = 1.8;  // D5 spectrum report, ~1,730 bytes at 9600 baud
+  // Expected integration by kind of reading when the plan says adaptive ([meter] adaptive_*_ms).
+  AdaptiveIntegration adaptive_integration;
+  double min_integration_s = 0.010;  // the meter's shortest integration (lower bound)
+  // The meter's own time per reading beyond integration and transfer (shutter, dark scan,
+  // processing), counted once per reading whatever the averages ([meter] overhead_ms).
+  double reading_overhead_s = 0.3;
   // The meter's own time per measurement beyond the integration (shutter, dark and processing
   // inside M0), which nothing can overlap: part of the physical lower bound. 0 unless known for
   // the instrument (pr650.md gives none; brdf-sim models 1.0 s: [optics.detector] overhead_s).

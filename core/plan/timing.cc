@@ -16,6 +16,18 @@ double ToWholePolls(double seconds, double poll) {
   return std::max(1.0, std::ceil(seconds / poll - 1e-9)) * poll;
 }
 
+// The adaptive integration expected for a reading of `kind`.
+double AdaptiveSeconds(const AdaptiveIntegration& adaptive, StepKind kind) {
+  switch (kind) {
+    case v1::STEP_KIND_REFERENCE:
+      return adaptive.reference_s;
+    case v1::STEP_KIND_DARK:
+      return adaptive.dark_s;
+    default:
+      return adaptive.sample_s;
+  }
+}
+
 }  // namespace
 
 double StepTimer::MotionSeconds(const Pose& from, const Pose& to) const {
@@ -32,8 +44,9 @@ StepTime StepTimer::Advance(const Step& step) {
   StepTime t;
   if (step.is_reading()) {
     const double averages = std::max<double>(1, measurement_.averages);
-    const double integration = measurement_.adaptive() ? rig_.adaptive_integration_s
-                                                       : measurement_.integration_ms / 1000.0;
+    const double integration = measurement_.adaptive()
+                                   ? AdaptiveSeconds(rig_.adaptive_integration, step.kind)
+                                   : measurement_.integration_ms / 1000.0;
     const double integration_min =
         measurement_.adaptive() ? rig_.min_integration_s : measurement_.integration_ms / 1000.0;
     t.estimate_s =

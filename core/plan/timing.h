@@ -10,8 +10,11 @@
 //     estimate    = (reading_overhead_s + integration · averages + meter_transfer_s) / k
 //                   + reading_host_s
 //     lower bound = (integration_min · averages + meter_measure_overhead_s + meter_transfer_s) / k
-//     where integration is integration_ms / 1000, or adaptive_integration_s when adaptive
-//     (for the lower bound: min_integration_s, the meter's shortest, when adaptive).
+//     where integration is integration_ms / 1000, or when adaptive the time expected for the
+//     reading's kind (adaptive_integration.reference_s, .dark_s or .sample_s: the meter picks it
+//     from the light, so a dark reading takes far longer than a reference); for the lower bound,
+//     min_integration_s (the meter's shortest) when adaptive. reading_overhead_s counts once per
+//     reading, however many averages.
 //   move: the motorized axes (α, β, and γ / δ when present) move at the same time, so
 //     motion = max over moving axes of |Δ reading| / speed_deg_s / k.
 //     estimate    = motion + move_settle_s / k, rounded up to a whole number (>= 1) of

@@ -235,6 +235,10 @@ TEST(ExampleConfig, LoadsAndHoldsTheDefaults) {
   EXPECT_EQ(config->meter.port, defaults.meter.port);
   EXPECT_EQ(config->meter.pacing_ms, defaults.meter.pacing_ms);
   EXPECT_EQ(config->meter.measurement_timeout_ms, defaults.meter.measurement_timeout_ms);
+  EXPECT_EQ(config->meter.overhead_ms, defaults.meter.overhead_ms);
+  EXPECT_EQ(config->meter.adaptive_reference_ms, defaults.meter.adaptive_reference_ms);
+  EXPECT_EQ(config->meter.adaptive_dark_ms, defaults.meter.adaptive_dark_ms);
+  EXPECT_EQ(config->meter.adaptive_sample_ms, defaults.meter.adaptive_sample_ms);
   EXPECT_TRUE(config->meter.quality_overrides.empty());
   EXPECT_EQ(config->stage.profile, defaults.stage.profile);
   EXPECT_EQ(config->stage.detector_arm_motorized, defaults.stage.detector_arm_motorized);

@@ -36,6 +36,9 @@ Status CtlRig::Start() {
        << "[meter]\nport = \"" << sim_->pr650_path() << "\"\n"
        << "pacing_ms = 5\nquiet_gap_ms = 20\nreply_timeout_ms = 1000\n"
        << "measurement_timeout_ms = 5000\nwake_attempts = 3\nrts_settle_ms = 20\n"
+       // brdf-sim's meter, for the estimates (docs/pr650.md, "How long a reading takes").
+       << "overhead_ms = 1000\nadaptive_reference_ms = 150\n"
+       << "adaptive_dark_ms = 6000\nadaptive_sample_ms = 650\n"
        << "[meter.quality]\n\"10\" = \"accept_and_flag\"\n"
        << "[stage]\ntransport = \"tcp\"\naddress = \"" << modbus() << "\"\n"
        << "response_timeout_ms = 300\ndetector_arm_motorized = true\n"

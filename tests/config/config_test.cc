@@ -14,6 +14,7 @@
 namespace brdf::daemon {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
@@ -47,6 +48,12 @@ TEST(ConfigTest, EmptyFileGivesTheDefaults) {
   EXPECT_DOUBLE_EQ(c.sample.white_reflectance, 0.99);
   EXPECT_TRUE(c.tokens.empty());
   EXPECT_EQ(c.log.level, "info");
+  // The estimate's meter times: 0.3 s overhead, adaptive 2 s reference and sample, 6 s dark.
+  const plan::RigDescription rig = ToRigDescription(c);
+  EXPECT_NEAR(rig.reading_overhead_s, 0.3, 1e-12);
+  EXPECT_NEAR(rig.adaptive_integration.reference_s, 2.0, 1e-12);
+  EXPECT_NEAR(rig.adaptive_integration.dark_s, 6.0, 1e-12);
+  EXPECT_NEAR(rig.adaptive_integration.sample_s, 2.0, 1e-12);
 }
 
 // [rig] names the sessions (default: the host name); [archive] ships them to the lab's PostgreSQL
@@ -96,6 +103,10 @@ measurement_timeout_ms = 20000
 wake_attempts = 3
 measure_with_spectrum = false
 rts_settle_ms = 700
+overhead_ms = 1000
+adaptive_reference_ms = 150
+adaptive_dark_ms = 6000
+adaptive_sample_ms = 650
 [meter.quality]
 18 = "fail"
 "30" = { action = "retry", accept_flagged_when_exhausted = true }
@@ -185,7 +196,11 @@ level = "debug"
   // M0 then D5 (this file sets measure_with_spectrum = false), one with M5; the part after the
   // measurement (which a pipelined move overlaps) is D5's exchange, or M5's quiet gap.
   const double exchange = (c.meter.pacing_ms + c.meter.quiet_gap_ms) / 1000.0;
-  EXPECT_NEAR(rig.reading_overhead_s, 0.3, 1e-12);
+  // The meter's overhead and adaptive integration by kind, as set above.
+  EXPECT_NEAR(rig.reading_overhead_s, 1.0, 1e-12);
+  EXPECT_NEAR(rig.adaptive_integration.reference_s, 0.150, 1e-12);
+  EXPECT_NEAR(rig.adaptive_integration.dark_s, 6.0, 1e-12);
+  EXPECT_NEAR(rig.adaptive_integration.sample_s, 0.650, 1e-12);
   EXPECT_NEAR(rig.reading_host_s, 2 * exchange, 1e-12);
   EXPECT_NEAR(rig.reading_host_after_s, exchange, 1e-12);
   Config m5 = c;
@@ -293,6 +308,18 @@ TEST(ConfigTest, ValuesOutOfRange) {
   EXPECT_THAT(Refusal("[meter]\nmeasurement_timeout_ms = 10\n"),
               HasSubstr("meter.measurement_timeout_ms"));
   EXPECT_THAT(Refusal("[meter]\nrts_settle_ms = 20000\n"), HasSubstr("meter.rts_settle_ms"));
+  EXPECT_THAT(Refusal("[meter]\noverhead_ms = -5\n"),
+              HasSubstr("meter.overhead_ms: -5 is outside 0 … 60000"));
+  EXPECT_THAT(Refusal("[meter]\nadaptive_dark_ms = 9000\n"),
+              HasSubstr("meter.adaptive_dark_ms: 9000 is outside 10 … 6000"));
+  EXPECT_THAT(Refusal("[meter]\nadaptive_reference_ms = 0\n"),
+              HasSubstr("meter.adaptive_reference_ms: 0 is outside 10 … 6000"));
+  EXPECT_THAT(Refusal("[meter]\nadaptive_sample_ms = \"650\"\n"),
+              HasSubstr("meter.adaptive_sample_ms: must be an integer"));
+  // The old single time is not a key: a misspelt or merged key is refused, naming the known ones.
+  EXPECT_THAT(
+      Refusal("[meter]\nadaptive_integration_ms = 2000\n"),
+      AllOf(HasSubstr("unknown key meter.adaptive_integration_ms"), HasSubstr("adaptive_dark_ms")));
   EXPECT_THAT(Refusal("[meter.quality]\n123 = \"retry\"\n"), HasSubstr("not a quality code"));
   EXPECT_THAT(Refusal("[meter.quality]\n18 = \"ignore\"\n"), HasSubstr("\"ignore\" is not one of"));
   EXPECT_THAT(Refusal("[meter.quality]\n18 = {}\n"), HasSubstr("meter.quality.18.action: missing"));

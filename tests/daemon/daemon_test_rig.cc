@@ -24,6 +24,9 @@ std::string DaemonConfigToml(const SimProcess& sim, const std::string& database)
     << "measurement_timeout_ms = 3000\n"
     << "wake_attempts = 3\n"
     << "rts_settle_ms = 20\n"
+    // brdf-sim's meter, for the estimates (docs/pr650.md, "How long a reading takes").
+    << "overhead_ms = 1000\nadaptive_reference_ms = 150\n"
+    << "adaptive_dark_ms = 6000\nadaptive_sample_ms = 650\n"
     // Dark readings are weak by nature (the simulator's earn quality 10): accept them flagged,
     // as a lab that takes darks configures it.
     << "[meter.quality]\n"

@@ -26,7 +26,7 @@ RigDescription Rig(double time_scale) {
   rig.beta.speed_deg_s = 20;
   rig.meter_transfer_s = 1.8;
   rig.reading_overhead_s = 0.3;
-  rig.adaptive_integration_s = 2.0;
+  rig.adaptive_integration = {.reference_s = 0.15, .dark_s = 6.0, .sample_s = 2.0};
   rig.move_settle_s = 0.25;
   rig.reading_host_s = 0.030;  // pacing_ms = 10, quiet_gap_ms = 20, M5
   rig.reading_host_after_s = 0.020;
@@ -104,6 +104,60 @@ TEST(TimingEstimateTest, PromptsAndStepsDoNotChangeWithTheTimeScale) {
   EXPECT_LT(fast_rig, real_rig / 8);
   EXPECT_GT(fast_rig, real_rig / 32);
   EXPECT_NEAR(fast.summary.physical_lower_bound_s, real.summary.physical_lower_bound_s / 32, 1e-9);
+}
+
+// Adaptive integration follows the light, so each kind of reading has its own expected time: a
+// dark reading (nothing to fill the detector) runs to the meter's longest, a reference on the
+// white standard is short. The meter's overhead is paid once per reading.
+TEST(TimingEstimateTest, AdaptiveIntegrationIsPerKindAndOverheadIsPerReading) {
+  const RigDescription rig = Rig(8);
+  auto readings = [](int darks, int samples) {
+    std::vector<Step> steps;
+    for (int i = 0; i < darks; ++i) steps.push_back(StepOfKind(v1::STEP_KIND_DARK));
+    for (int i = 0; i < samples; ++i) steps.push_back(StepOfKind(v1::STEP_KIND_SAMPLE));
+    return steps;
+  };
+  auto total = [](const std::vector<StepTime>& times) {
+    double sum = 0;
+    for (const StepTime& t : times) sum += t.estimate_s;
+    return sum;
+  };
+  const std::vector<Step> dark_heavy = readings(8, 2);
+  const std::vector<Step> sample_heavy = readings(2, 8);
+  const double dark_heavy_s = total(EstimateSteps(dark_heavy, rig, Adaptive()));
+  const double sample_heavy_s = total(EstimateSteps(sample_heavy, rig, Adaptive()));
+  // Same ten readings; six of them swap 2 s of sample integration for 6 s of dark.
+  EXPECT_GT(dark_heavy_s, sample_heavy_s);
+  EXPECT_NEAR(dark_heavy_s - sample_heavy_s, 6 * (6.0 - 2.0) / 8, 1e-12);
+
+  // Each kind uses its own time: (overhead + integration + transfer) / k + host.
+  const std::vector<Step> one_of_each = {StepOfKind(v1::STEP_KIND_REFERENCE),
+                                         StepOfKind(v1::STEP_KIND_DARK),
+                                         StepOfKind(v1::STEP_KIND_SAMPLE)};
+  const std::vector<StepTime> each = EstimateSteps(one_of_each, rig, Adaptive());
+  ASSERT_EQ(each.size(), 3u);
+  EXPECT_NEAR(each[0].estimate_s, (0.3 + 0.15 + 1.8) / 8 + 0.030, 1e-12);
+  EXPECT_NEAR(each[1].estimate_s, (0.3 + 6.0 + 1.8) / 8 + 0.030, 1e-12);
+  EXPECT_NEAR(each[2].estimate_s, (0.3 + 2.0 + 1.8) / 8 + 0.030, 1e-12);
+  // The lower bound still counts the meter's shortest integration, whatever the kind.
+  for (const StepTime& t : each) EXPECT_NEAR(t.lower_bound_s, (0.010 + 1.8) / 8, 1e-12);
+
+  // A fixed integration time overrides the per-kind times.
+  MeasurementChoice fixed;
+  fixed.integration_ms = 500;
+  EXPECT_NEAR(total(EstimateSteps(dark_heavy, rig, fixed)),
+              total(EstimateSteps(sample_heavy, rig, fixed)), 1e-12);
+
+  // The overhead counts once per reading: 1 s more of it adds 10 s (÷ k) to ten readings, and
+  // averaging (integration × averages) does not multiply it.
+  RigDescription slower = rig;
+  slower.reading_overhead_s += 1.0;
+  EXPECT_NEAR(total(EstimateSteps(sample_heavy, slower, Adaptive())) - sample_heavy_s, 10 * 1.0 / 8,
+              1e-12);
+  MeasurementChoice averaged;
+  averaged.averages = 4;
+  const std::vector<StepTime> four = EstimateSteps(one_of_each, slower, averaged);
+  EXPECT_NEAR(four[2].estimate_s, (1.3 + 4 * 2.0 + 1.8) / 8 + 0.030, 1e-12);
 }
 
 }  // namespace

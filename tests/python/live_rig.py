@@ -158,6 +158,11 @@ pacing_ms = 5
 quiet_gap_ms = 20
 reply_timeout_ms = 1000
 measurement_timeout_ms = 5000
+# brdf-sim's meter, for the estimates (docs/pr650.md, "How long a reading takes")
+overhead_ms = 1000
+adaptive_reference_ms = 150
+adaptive_dark_ms = 6000
+adaptive_sample_ms = 650
 [meter.quality]
 # A dark reading (lamp shuttered) is weak light by nature: the simulator, like a PR-650, answers
 # quality 10 there. Keep it, flagged, instead of failing the step.

@@ -1,5 +1,7 @@
 #include "tools/brdf-sim/optics.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -95,6 +97,11 @@ SimMeasurement RigOptics::Measure(const MeterSetup& setup) {
   }
   const double step = Grid().step_nm;
   for (double r : m.radiance) m.integrated += r * step;
+  // What the meter chose, for timing the rig (bench/daemon/estimate.sh reads these lines).
+  static constexpr const char* kTargetNames[] = {"sample", "white", "dark"};
+  spdlog::debug("measure {}: integration {} ms x {}, {:.3f} s simulated, quality {}",
+                kTargetNames[static_cast<int>(target)], m.integration_ms, averages, m.duration_s,
+                m.quality_code);
 
   return m;
 }

@@ -159,6 +159,10 @@ quiet_gap_ms = 20
 reply_timeout_ms = 1000
 measurement_timeout_ms = 3000
 wake_attempts = 3
+overhead_ms = 1000
+adaptive_reference_ms = 150
+adaptive_dark_ms = 6000
+adaptive_sample_ms = 650
 [stage]
 transport = "tcp"
 address = "{host}:{port}"
