@@ -232,6 +232,10 @@ Result<ShipLag> SessionStore::ShippingLag() {
   }
   BRDF_STORAGE_ASSIGN_OR_RETURN(lag.pending_changes,
                                 db->QueryInt64("SELECT count(*) FROM archive_outbox"));
+  BRDF_STORAGE_ASSIGN_OR_RETURN(std::int64_t events_mark, Mark(*db, "events"));
+  BRDF_STORAGE_ASSIGN_OR_RETURN(lag.events,
+                                db->QueryInt64("SELECT count(*) FROM session_events WHERE id > " +
+                                               std::to_string(events_mark)));
   return lag;
 }
 

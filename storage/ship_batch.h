@@ -40,6 +40,7 @@ struct ShipLag {
   double oldest_unshipped = 0;        // recorded_at of the oldest of them (0 when none)
   std::int64_t shipped_readings = 0;  // the readings mark
   std::int64_t pending_changes = 0;   // outbox entries
+  std::int64_t events = 0;            // session events not yet shipped (v4)
 };
 
 }  // namespace brdf::storage
