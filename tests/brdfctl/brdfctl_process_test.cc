@@ -241,7 +241,8 @@ void BrdfctlProcessTest::CheckSubmitAndWatch() {
   EXPECT_NE(text_lines.back().find("  completed"), std::string::npos) << history_text.out;
   // "YYYY-MM-DD hh:mm:ss ±hhmm  state  reason".
   EXPECT_TRUE(text_lines.front().size() > 25 && text_lines.front()[4] == '-' &&
-              text_lines.front()[13] == ':' && text_lines.front()[20] == ' ')
+              text_lines.front()[13] == ':' && text_lines.front()[19] == ' ' &&
+              (text_lines.front()[20] == '+' || text_lines.front()[20] == '-'))
       << "a local time first: " << text_lines.front();
 
   // Watching a finished session: the snapshot, then the stream ends; plain lines off a terminal.
