@@ -3,7 +3,8 @@
 // (MakeServerCredentials), the same limits and stream caps (stream_registry.h), the standard
 // health service and server reflection.
 //
-//   Control        archive_services.h: GetSession, ListSessions; the rig's verbs refused
+//   Control        archive_services.h: GetSession, ListSessions, ListSessionEvents; the rig's verbs
+//                  refused
 //   Data           archive_services.h: StreamReadings; Export not yet
 //   Interpolation  brdfd's own InterpolationService and InterpolateLoop over an IndexCache whose
 //                  store is the archive (storage/archive_reader.h): the same code, over the same

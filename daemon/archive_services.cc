@@ -108,6 +108,17 @@ grpc::Status ArchiveControlService::GetSession(grpc::ServerContext* context,
   return grpc::Status::OK;
 }
 
+grpc::Status ArchiveControlService::ListSessionEvents(grpc::ServerContext* context,
+                                                      const v1::ListSessionEventsRequest* request,
+                                                      v1::ListSessionEventsResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "ListSessionEvents", &caller);
+      !st.ok()) {
+    return st;
+  }
+  return ServeListSessionEvents(*archive_, *request, response);
+}
+
 grpc::Status ArchiveControlService::ListSessions(grpc::ServerContext* context,
                                                  const v1::ListSessionsRequest* request,
                                                  v1::ListSessionsResponse* response) {

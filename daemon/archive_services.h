@@ -3,7 +3,8 @@
 // daemon's own InterpolationService over an IndexCache that reads the archive.
 //
 //   Control  GetSession, ListSessions (across rigs, with the catalogue filters of
-//            ListSessionsRequest and paging, newest first). The rig's verbs (SubmitPlan,
+//            ListSessionsRequest and paging, newest first), ListSessionEvents (the history the
+//            rig shipped; the same code as brdfd's, service_common.h). The rig's verbs (SubmitPlan,
 //            ValidatePlan, Start/Pause/Resume/Abort, AnswerPrompt), GetRigStatus and WatchSession
 //            answer FAILED_PRECONDITION saying that this is the archive and naming the rig's brdfd
 //            as the place to ask (the session's rig when the request names a session).
@@ -43,6 +44,9 @@ class ArchiveControlService final : public v1::Control::Service {
                           v1::Session* response) override;
   grpc::Status ListSessions(grpc::ServerContext* context, const v1::ListSessionsRequest* request,
                             v1::ListSessionsResponse* response) override;
+  grpc::Status ListSessionEvents(grpc::ServerContext* context,
+                                 const v1::ListSessionEventsRequest* request,
+                                 v1::ListSessionEventsResponse* response) override;
 
   grpc::Status SubmitPlan(grpc::ServerContext* context, const v1::SubmitPlanRequest* request,
                           v1::SubmitPlanResponse* response) override;

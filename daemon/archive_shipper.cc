@@ -126,8 +126,7 @@ void ArchiveShipper::Run() {
       if (!Wait(options_.retry)) return;
       continue;
     }
-    if (batch->sessions.empty() && batch->steps.empty() && batch->readings.empty() &&
-        batch->devices.empty() && batch->audit.empty() && batch->outbox_through == 0) {
+    if (batch->empty()) {
       SetState(v1::ARCHIVE_STATE_CAUGHT_UP, "");
       if (!Wait(options_.poll)) return;
       continue;
@@ -149,7 +148,8 @@ void ArchiveShipper::Run() {
       shipped_ += batch->readings.size();
       last_shipped_at_ = NowSeconds();
     }
-    const bool full = static_cast<int>(batch->readings.size()) >= options_.batch_readings;
+    const bool full = static_cast<int>(batch->readings.size()) >= options_.batch_readings ||
+                      static_cast<int>(batch->events.size()) >= options_.batch_readings;
     SetState(full ? v1::ARCHIVE_STATE_SHIPPING : v1::ARCHIVE_STATE_CAUGHT_UP, "");
   }
 }
@@ -167,7 +167,7 @@ v1::ArchiveStatus ArchiveShipper::Snapshot() const {
     s.set_lag_readings(static_cast<std::uint64_t>(lag->readings));
     if (lag->readings > 0) s.set_lag_seconds(std::max(0.0, NowSeconds() - lag->oldest_unshipped));
     if (s.state() == v1::ARCHIVE_STATE_CAUGHT_UP &&
-        (lag->readings > 0 || lag->pending_changes > 0)) {
+        (lag->readings > 0 || lag->pending_changes > 0 || lag->events > 0)) {
       s.set_state(v1::ARCHIVE_STATE_SHIPPING);
     }
   }

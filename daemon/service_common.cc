@@ -152,6 +152,26 @@ grpc::Status ParseSessionIdField(const std::string& text, const std::string& fie
   return grpc::Status::OK;
 }
 
+grpc::Status ServeListSessionEvents(storage::SessionReader& reader,
+                                    const v1::ListSessionEventsRequest& request,
+                                    v1::ListSessionEventsResponse* response) {
+  std::int64_t id = 0;
+  if (grpc::Status st = ParseSessionIdField(request.session_id(), "session_id", &id); !st.ok()) {
+    return st;
+  }
+  Result<std::vector<storage::SessionEventRecord>> events = reader.ListSessionEvents(id);
+  if (!events.ok()) return ToGrpcStatus(events.status());
+  response->mutable_events()->Reserve(static_cast<int>(events->size()));
+  for (const storage::SessionEventRecord& e : *events) {
+    v1::SessionStateEvent* out = response->add_events();
+    out->set_id(e.id);
+    out->set_state(ToProtoState(e.state));
+    out->set_reason(e.reason);
+    *out->mutable_at() = ToTimestamp(e.at);
+  }
+  return grpc::Status::OK;
+}
+
 namespace {
 std::string Num(double v) {
   std::ostringstream out;

@@ -24,6 +24,7 @@
 #include "core/status.h"
 #include "core/wavelength_grid.h"
 #include "storage/records.h"
+#include "storage/session_reader.h"
 
 namespace brdf::daemon {
 
@@ -101,6 +102,13 @@ struct ReadingExtras {
   std::uint32_t averages = 1;
 };
 v1::Reading ToProtoReading(const storage::ReadingRecord& record, const ReadingExtras& extras);
+
+// Control.ListSessionEvents, for brdfd (its store) and brdf-archive (the archive) alike, after
+// the caller's role was checked: the session id parsed (INVALID_ARGUMENT naming session_id), the
+// session's history read from `reader` (NOT_FOUND naming the session), oldest first.
+grpc::Status ServeListSessionEvents(storage::SessionReader& reader,
+                                    const v1::ListSessionEventsRequest& request,
+                                    v1::ListSessionEventsResponse* response);
 
 // StreamReadingsRequest.kinds as a set (empty: every kind); INVALID_ARGUMENT naming "kinds[i]"
 // for a kind the API does not have.

@@ -210,6 +210,17 @@ grpc::Status ControlService::GetSession(grpc::ServerContext* context,
   return grpc::Status::OK;
 }
 
+grpc::Status ControlService::ListSessionEvents(grpc::ServerContext* context,
+                                               const v1::ListSessionEventsRequest* request,
+                                               v1::ListSessionEventsResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.Authorize(*context, Access::kRead, "ListSessionEvents", &caller);
+      !st.ok()) {
+    return st;
+  }
+  return ServeListSessionEvents(*manager_.store(), *request, response);
+}
+
 grpc::Status ControlService::ListSessions(grpc::ServerContext* context,
                                           const v1::ListSessionsRequest* request,
                                           v1::ListSessionsResponse* response) {

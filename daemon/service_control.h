@@ -47,6 +47,9 @@ class ControlService final : public ControlServiceBase {
                           v1::Session* response) override;
   grpc::Status ListSessions(grpc::ServerContext* context, const v1::ListSessionsRequest* request,
                             v1::ListSessionsResponse* response) override;
+  grpc::Status ListSessionEvents(grpc::ServerContext* context,
+                                 const v1::ListSessionEventsRequest* request,
+                                 v1::ListSessionEventsResponse* response) override;
   grpc::Status GetRigStatus(grpc::ServerContext* context, const v1::GetRigStatusRequest* request,
                             v1::RigStatus* response) override;
   // A snapshot, then every event until the session ends, the client cancels, or the daemon stops

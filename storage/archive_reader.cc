@@ -33,6 +33,12 @@ FROM readings WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id =
 ORDER BY rig_reading_id LIMIT $3
 )sql";
 
+constexpr std::string_view kEventsOfSession = R"sql(
+SELECT rig_event_id, at, state, reason
+FROM session_events WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id = $1)
+ORDER BY rig_event_id
+)sql";
+
 std::string SessionName(std::int64_t id) {
   return "session " + std::to_string(id);
 }
@@ -195,6 +201,33 @@ Result<std::vector<StepRecord>> ArchiveReader::GetSteps(std::int64_t session) {
     return Status::Ok();
   }));
   return steps;
+}
+
+Result<std::vector<SessionEventRecord>> ArchiveReader::ListSessionEvents(std::int64_t session) {
+  BRDF_RETURN_IF_ERROR(GetSession(session).status());
+  std::vector<SessionEventRecord> events;
+  BRDF_RETURN_IF_ERROR(WithConnection([&](PgConnection& conn) -> Status {
+    Result<PgResult> r =
+        conn.QueryPrepared("archive_events", kEventsOfSession, PgParams().Add(session));
+    if (!r.ok()) return r.status();
+    events.clear();
+    for (int i = 0; i < r->rows(); ++i) {
+      SessionEventRecord e;
+      e.id = r->Int64(i, 0);
+      e.session_id = session;
+      e.at = r->Double(i, 1);
+      Result<SessionState> state = ParseSessionState(std::string(r->Text(i, 2)));
+      if (!state.ok()) {
+        return state.status().WithContext("archived event " + std::to_string(e.id) + " of " +
+                                          SessionName(session));
+      }
+      e.state = *state;
+      e.reason = std::string(r->Text(i, 3));
+      events.push_back(std::move(e));
+    }
+    return Status::Ok();
+  }));
+  return events;
 }
 
 Result<std::vector<ReadingRecord>> ArchiveReader::GetReadings(std::int64_t session,

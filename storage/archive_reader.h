@@ -55,6 +55,8 @@ class ArchiveReader final : public SessionReader {
   Result<std::vector<StepRecord>> GetSteps(std::int64_t session) override;
   Result<std::vector<ReadingRecord>> GetReadings(std::int64_t session, std::int64_t after_id,
                                                  int limit) override;
+  // The events shipped so far (schema v3's session_events), in the rig's order.
+  Result<std::vector<SessionEventRecord>> ListSessionEvents(std::int64_t session) override;
   // True when the session has ended (completed, aborted, failed) and the reading of every
   // measuring step it did is in the archive: nothing more will arrive.
   Result<bool> Finished(std::int64_t session);

@@ -132,9 +132,25 @@ ALTER TABLE sessions ADD COLUMN archive_id bigserial;
 CREATE UNIQUE INDEX sessions_by_archive_id ON sessions (archive_id);
 )sql";
 
-constexpr std::array<ArchiveMigration, 2> kArchiveMigrations{{
+// Version 3: each session's history of states, as the rig recorded it (its schema v4), keyed by
+// the session's global id and the event's id on the rig.
+constexpr std::string_view kArchiveV3 = R"sql(
+CREATE TABLE session_events (
+  session_uuid uuid NOT NULL REFERENCES sessions (uuid),
+  rig_event_id bigint NOT NULL,
+  at           double precision NOT NULL,
+  state        text NOT NULL CHECK (state IN ('queued', 'running', 'pausing', 'paused',
+                 'awaiting_operator', 'completed', 'aborted', 'failed')),
+  reason       text NOT NULL DEFAULT '',
+  archived_at  timestamptz NOT NULL DEFAULT now(),
+  PRIMARY KEY (session_uuid, rig_event_id)
+);
+)sql";
+
+constexpr std::array<ArchiveMigration, 3> kArchiveMigrations{{
     {1, "create sessions, steps, readings, devices and audit", kArchiveV1},
     {2, "number the sessions for brdf-archive (sessions.archive_id)", kArchiveV2},
+    {3, "keep each session's history of states (session_events)", kArchiveV3},
 }};
 
 // "BRDF": the advisory lock key that serialises migrations across rigs and servers.

@@ -51,6 +51,14 @@ INSERT INTO audit (rig, rig_audit_id, at, role, actor, action, session_uuid, det
 VALUES ($1, $2, $3, $4, $5, $6, $7, $8) ON CONFLICT DO NOTHING
 )sql";
 
+// Events never change on the rig: a batch sent again rewrites the same values.
+constexpr std::string_view kUpsertEvent = R"sql(
+INSERT INTO session_events (session_uuid, rig_event_id, at, state, reason)
+VALUES ($1, $2, $3, $4, $5)
+ON CONFLICT (session_uuid, rig_event_id) DO UPDATE SET at = EXCLUDED.at, state = EXCLUDED.state,
+  reason = EXCLUDED.reason
+)sql";
+
 // A PostgreSQL array literal of text values: {"a","b \"c\""}.
 std::string TextArray(const google::protobuf::RepeatedPtrField<std::string>& values) {
   std::string out = "{";
@@ -192,6 +200,16 @@ Status WriteToArchive(PgConnection& conn, const std::string& rig, const ShipBatc
     p.Add(rig).Add(a.id).Add(a.at).Add(a.role).Add(a.actor).Add(a.action);
     p.Add(UuidOf(batch, a.session_id)).Add(a.detail);
     BRDF_RETURN_IF_ERROR(conn.QueryPrepared("insert_audit", kInsertAudit, std::move(p)).status());
+  }
+  for (const SessionEventRecord& e : batch.events) {
+    std::optional<std::string> uuid = UuidOf(batch, e.session_id);
+    if (!uuid) return Internal("event " + std::to_string(e.id) + "'s session has no uuid");
+    PgParams p;
+    p.Add(*uuid).Add(e.id).Add(e.at).Add(std::string(ToString(e.state))).Add(e.reason);
+    BRDF_RETURN_IF_ERROR(
+        conn.QueryPrepared("upsert_event", kUpsertEvent, std::move(p))
+            .status()
+            .WithContext("archiving event " + std::to_string(e.id) + " of session " + *uuid));
   }
   return tx->Commit();
 }

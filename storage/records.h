@@ -152,4 +152,14 @@ struct AuditRecord {
   std::string detail;
 };
 
+// One entry of a session's history (schema v4's session_events): the session entered `state`, or
+// its reason changed, at `at`. Written by the database's triggers, never by hand.
+struct SessionEventRecord {
+  std::int64_t id = 0;
+  std::int64_t session_id = 0;
+  UnixSeconds at = 0;
+  SessionState state = SessionState::kQueued;
+  std::string reason;
+};
+
 }  // namespace brdf::storage

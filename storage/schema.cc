@@ -156,10 +156,44 @@ CREATE TRIGGER archive_step_changed AFTER UPDATE ON steps
   END;
 )sql";
 
-constexpr std::array<Migration, 3> kMigrations{{
+// Version 4: the events history. Triggers append an event to session_events whenever a session is
+// created or its state or reason changes -- whoever writes it (the store, start-up recovery, a
+// hand-run UPDATE) -- in the same transaction as the change. brdfd stamps the time of a change in
+// sessions.state_changed_at; a change made without it gets SQLite's clock. Existing sessions get
+// one event each: their current state, at their last known time. Events ship to the archive by id
+// above the 'events' mark.
+constexpr std::string_view kV4 = R"sql(
+ALTER TABLE sessions ADD COLUMN state_changed_at REAL;
+CREATE TABLE session_events (
+  id         INTEGER PRIMARY KEY,
+  session_id INTEGER NOT NULL REFERENCES sessions (id),
+  at         REAL    NOT NULL,
+  state      TEXT    NOT NULL CHECK (state IN ('queued', 'running', 'pausing', 'paused',
+               'awaiting_operator', 'completed', 'aborted', 'failed')),
+  reason     TEXT    NOT NULL DEFAULT ''
+);
+CREATE INDEX session_events_by_session ON session_events (session_id, id);
+INSERT INTO session_events (session_id, at, state, reason)
+  SELECT id, coalesce(finished_at, started_at, created_at), state, state_reason
+  FROM sessions ORDER BY id;
+CREATE TRIGGER session_event_created AFTER INSERT ON sessions
+  BEGIN INSERT INTO session_events (session_id, at, state, reason)
+    VALUES (NEW.id, NEW.created_at, NEW.state, NEW.state_reason); END;
+CREATE TRIGGER session_event_changed AFTER UPDATE OF state, state_reason ON sessions
+  WHEN NEW.state IS NOT OLD.state OR NEW.state_reason IS NOT OLD.state_reason
+  BEGIN INSERT INTO session_events (session_id, at, state, reason)
+    VALUES (NEW.id, CASE WHEN NEW.state_changed_at IS NOT OLD.state_changed_at
+                         THEN NEW.state_changed_at
+                         ELSE (julianday('now') - 2440587.5) * 86400.0 END,
+            NEW.state, NEW.state_reason); END;
+INSERT INTO archive_marks (name, value) VALUES ('events', 0);
+)sql";
+
+constexpr std::array<Migration, 4> kMigrations{{
     {1, "create sessions, steps, readings, devices and audit", kV1},
     {2, "give every session a UUID and its rig's name", kV2},
     {3, "keep an outbox and marks for shipping to the lab archive", kV3},
+    {4, "keep every session's history of states (session_events)", kV4},
 }};
 
 std::string Hex(std::int64_t v) {

@@ -1,10 +1,11 @@
 // The database schema and its migrations. The full description is in storage/schema.md; in short
-// (schema version 3):
+// (schema version 4):
 //
 //   sessions  id, name, plan_kind, plan_json (the plan as submitted), state, state_reason,
 //             created_at, started_at, finished_at, created_by_role, total_steps, done_steps
 //             (steps done or skipped), white_reflectance, meter_serial, config_json, uuid (v2:
-//             global identity, unique), rig (v2: the recording rig's name)
+//             global identity, unique), rig (v2: the recording rig's name), state_changed_at
+//             (v4: when brdfd last changed state or state_reason)
 //   steps     (session_id, step_index) primary key; kind (move|prompt|reference|dark|sample),
 //             alpha beta gamma delta (degrees), prompt, prompt_kind, expected_action,
 //             target_theta_i target_phi_i target_theta_o target_phi_o (all or none), label,
@@ -20,7 +21,9 @@
 //   audit     id, at, role, actor (a token's name, never the token), action, session_id, detail
 //   archive_outbox, archive_marks (v3): what the shipper to the lab archive has still to send
 //             (triggers note session and step changes while shipping is on; marks for readings,
-//             devices, audit)
+//             devices, audit; v4: events)
+//   session_events (v4)  id, session_id, at, state, reason: one row when a session is created
+//             and one per change of its state or reason, written by triggers
 //
 // Timestamps are Unix seconds (REAL, UTC). Angles are degrees. Enumerations are lower-case words
 // guarded by CHECK constraints.

@@ -8,6 +8,7 @@
 //   - ids are the reader's own session ids (positive); readings keep the ids they were recorded
 //     with, and a reading's reference_reading_id / dark_reading_id name readings of the same
 //     session by those ids;
+//   - events keep the ids they were recorded with on the rig;
 //   - GetReadings pages in ascending reading id: up to `limit` (> 0) readings with id > after_id;
 //     readings are append-only, so paging never skips or repeats one;
 //   - kNotFound for an unknown session; kIoError (or kDisconnected) when the data cannot be read.
@@ -30,6 +31,9 @@ class SessionReader {
   virtual Result<std::vector<StepRecord>> GetSteps(std::int64_t session) = 0;
   virtual Result<std::vector<ReadingRecord>> GetReadings(std::int64_t session,
                                                          std::int64_t after_id, int limit) = 0;
+  // The session's history of states: one event when it was created and one per change of its
+  // state or reason, in the order they happened (ascending event id).
+  virtual Result<std::vector<SessionEventRecord>> ListSessionEvents(std::int64_t session) = 0;
 };
 
 }  // namespace brdf::storage

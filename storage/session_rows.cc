@@ -20,6 +20,8 @@ const std::string_view kReadingColumns =
     "wl_start_nm, wl_step_nm, wl_count, spectrum, quality_code, flagged, integration_ms, attempts, "
     "note, reference_reading_id, dark_reading_id, meter_serial, recorded_at";
 
+const std::string_view kEventColumns = "id, session_id, at, state, reason";
+
 namespace {
 
 std::string SessionName(std::int64_t session) {
@@ -52,6 +54,18 @@ Result<SessionRecord> ReadSession(const Statement& st, const std::string& path) 
   s.uuid = st.Text(15);
   s.rig = st.Text(16);
   return s;
+}
+
+Result<SessionEventRecord> ReadEvent(const Statement& st, const std::string& path) {
+  SessionEventRecord e;
+  e.id = st.Int64(0);
+  e.session_id = st.Int64(1);
+  e.at = st.Double(2);
+  BRDF_STORAGE_ASSIGN_OR_RETURN(
+      e.state, FromColumn(ParseSessionState(st.Text(3)), path,
+                          "event " + std::to_string(e.id) + " of " + SessionName(e.session_id)));
+  e.reason = st.Text(4);
+  return e;
 }
 
 Result<StepRecord> ReadStep(const Statement& st, const std::string& path) {

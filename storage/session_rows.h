@@ -1,6 +1,7 @@
-// How storage reads its rows back into records: the column lists of sessions, steps and readings
-// and the functions that turn a row (selected with those columns, in that order) into a record.
-// Shared by SessionStore and its archive shipping (session_store_archive.cc); internal to storage/.
+// How storage reads its rows back into records: the column lists of sessions, steps, readings and
+// events, and the functions that turn a row (selected with those columns, in that order) into a
+// record. Shared by SessionStore and its archive shipping (session_store_archive.cc); internal to
+// storage/.
 #pragma once
 
 #include <string>
@@ -24,11 +25,13 @@ Result<T> FromColumn(Result<T> parsed, const std::string& path, const std::strin
 extern const std::string_view kSessionColumns;
 extern const std::string_view kStepColumns;
 extern const std::string_view kReadingColumns;
+extern const std::string_view kEventColumns;  // session_events (v4)
 
 // A row whose enumeration text does not parse has been damaged outside brdfd: kIoError naming
 // `path` and what to run.
 Result<SessionRecord> ReadSession(const Statement& st, const std::string& path);
 Result<StepRecord> ReadStep(const Statement& st, const std::string& path);
 Result<ReadingRecord> ReadReading(const Statement& st, const std::string& path);
+Result<SessionEventRecord> ReadEvent(const Statement& st, const std::string& path);
 
 }  // namespace brdf::storage

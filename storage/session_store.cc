@@ -279,7 +279,7 @@ Status SessionStore::SetSessionState(std::int64_t session, SessionState state, s
   }
   BRDF_STORAGE_ASSIGN_OR_RETURN(
       Statement st,
-      db.Prepare("UPDATE sessions SET state = ?1, state_reason = ?2, "
+      db.Prepare("UPDATE sessions SET state = ?1, state_reason = ?2, state_changed_at = ?3, "
                  "started_at = CASE WHEN ?1 = 'running' AND started_at IS NULL THEN ?3 "
                  "ELSE started_at END, "
                  "finished_at = CASE WHEN ?4 THEN ?3 ELSE finished_at END WHERE id = ?5"));
@@ -365,11 +365,11 @@ Result<std::vector<std::int64_t>> SessionStore::RecoverInterruptedSessions() {
     }
   }
   if (ids.empty()) return ids;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db.Prepare("UPDATE sessions SET state = 'paused', state_reason = ? "
-                                           "WHERE state IN " +
-                                           std::string(kInterrupted)));
-  st.Bind(1, kRecoveredReason);
+  BRDF_STORAGE_ASSIGN_OR_RETURN(
+      Statement st, db.Prepare("UPDATE sessions SET state = 'paused', state_reason = ?, "
+                               "state_changed_at = ? WHERE state IN " +
+                               std::string(kInterrupted)));
+  st.Bind(1, kRecoveredReason).Bind(2, Now());
   BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
   BRDF_RETURN_IF_ERROR(tx.Commit().WithContext(what));
   return ids;
@@ -392,6 +392,24 @@ Result<std::vector<StepRecord>> SessionStore::GetSteps(std::int64_t session) {
     if (!row) break;
     BRDF_STORAGE_ASSIGN_OR_RETURN(StepRecord s, ReadStep(st, path_));
     out.push_back(std::move(s));
+  }
+  return out;
+}
+
+Result<std::vector<SessionEventRecord>> SessionStore::ListSessionEvents(std::int64_t session) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
+  BRDF_RETURN_IF_ERROR(RequireSession(*db, session));
+  BRDF_STORAGE_ASSIGN_OR_RETURN(
+      Statement st, db->Prepare("SELECT " + std::string(kEventColumns) +
+                                " FROM session_events WHERE session_id = ? ORDER BY id"));
+  st.Bind(1, session);
+  std::vector<SessionEventRecord> out;
+  while (true) {
+    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    if (!row) break;
+    BRDF_STORAGE_ASSIGN_OR_RETURN(SessionEventRecord e, ReadEvent(st, path_));
+    out.push_back(std::move(e));
   }
   return out;
 }

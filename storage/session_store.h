@@ -113,6 +113,8 @@ class SessionStore final : public SessionReader {
   // --- Steps ------------------------------------------------------------------------------------
 
   Result<std::vector<StepRecord>> GetSteps(std::int64_t session) override;
+  // The session's history of states (schema v4's session_events), oldest first.
+  Result<std::vector<SessionEventRecord>> ListSessionEvents(std::int64_t session) override;
   // The lowest-numbered pending step; nullopt when every step is done or skipped.
   Result<std::optional<int>> FirstUnfinishedStep(std::int64_t session);
 

@@ -1,5 +1,5 @@
-// SessionStore's side of shipping to the lab archive: the outbox and marks of schema v3
-// (schema.md, archive-schema.md). The archive side is archive_writer.h.
+// SessionStore's side of shipping to the lab archive: the outbox and marks of schema v3 (and the
+// events mark of v4; schema.md, archive-schema.md). The archive side is archive_writer.h.
 #include <set>
 #include <string>
 #include <utility>
@@ -128,6 +128,7 @@ Result<ShipBatch> SessionStore::NextShipBatch(int max_readings, int max_changes)
   BRDF_STORAGE_ASSIGN_OR_RETURN(batch.readings_through, Mark(*db, "readings"));
   BRDF_STORAGE_ASSIGN_OR_RETURN(batch.devices_through, Mark(*db, "devices"));
   BRDF_STORAGE_ASSIGN_OR_RETURN(batch.audit_through, Mark(*db, "audit"));
+  BRDF_STORAGE_ASSIGN_OR_RETURN(batch.events_through, Mark(*db, "events"));
   if (changes >= max_changes) return batch;  // rows may name sessions not shipped yet: next time
 
   std::set<std::int64_t> named;
@@ -173,6 +174,20 @@ Result<ShipBatch> SessionStore::NextShipBatch(int max_readings, int max_changes)
       if (batch.audit.back().session_id) named.insert(*batch.audit.back().session_id);
     }
   }
+  {
+    BRDF_STORAGE_ASSIGN_OR_RETURN(
+        Statement st, db->Prepare("SELECT " + std::string(kEventColumns) +
+                                  " FROM session_events WHERE id > ? ORDER BY id LIMIT ?"));
+    st.Bind(1, batch.events_through).Bind(2, max_readings);
+    while (true) {
+      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+      if (!row) break;
+      BRDF_STORAGE_ASSIGN_OR_RETURN(SessionEventRecord e, ReadEvent(st, path_));
+      batch.events_through = e.id;
+      named.insert(e.session_id);
+      batch.events.push_back(std::move(e));
+    }
+  }
   BRDF_RETURN_IF_ERROR(FillUuids(*db, named, batch.uuids));
   return batch;
 }
@@ -187,7 +202,8 @@ Status SessionStore::MarkShipped(const ShipBatch& batch) {
   for (const auto& [name, value] :
        {std::pair<const char*, std::int64_t>{"readings", batch.readings_through},
         {"devices", batch.devices_through},
-        {"audit", batch.audit_through}}) {
+        {"audit", batch.audit_through},
+        {"events", batch.events_through}}) {
     st.Bind(1, value).Bind(2, name);
     BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
     st.Reset();
@@ -216,6 +232,10 @@ Result<ShipLag> SessionStore::ShippingLag() {
   }
   BRDF_STORAGE_ASSIGN_OR_RETURN(lag.pending_changes,
                                 db->QueryInt64("SELECT count(*) FROM archive_outbox"));
+  BRDF_STORAGE_ASSIGN_OR_RETURN(std::int64_t events_mark, Mark(*db, "events"));
+  BRDF_STORAGE_ASSIGN_OR_RETURN(lag.events,
+                                db->QueryInt64("SELECT count(*) FROM session_events WHERE id > " +
+                                               std::to_string(events_mark)));
   return lag;
 }
 

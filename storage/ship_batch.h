@@ -1,8 +1,8 @@
 // What the rig ships to the lab archive in one transaction (SessionStore::NextShipBatch): the
 // current rows of the sessions and steps changed since they were last shipped, and the readings,
-// devices and audit entries above their high-water marks, all read from one snapshot of the
-// rig's database. The marks the batch reaches move only once the archive has committed it
-// (SessionStore::MarkShipped).
+// devices, audit entries and session events above their high-water marks, all read from one
+// snapshot of the rig's database. The marks the batch reaches move only once the archive has
+// committed it (SessionStore::MarkShipped).
 #pragma once
 
 #include <cstdint>
@@ -21,14 +21,16 @@ struct ShipBatch {
   std::vector<ReadingRecord> readings;
   std::vector<DeviceRecord> devices;
   std::vector<AuditRecord> audit;
-  std::int64_t readings_through = 0;  // marks after this batch
+  std::vector<SessionEventRecord> events;  // (v4) of sessions in `uuids`
+  std::int64_t readings_through = 0;       // marks after this batch
   std::int64_t devices_through = 0;
   std::int64_t audit_through = 0;
+  std::int64_t events_through = 0;
   std::map<std::int64_t, std::string> uuids;  // session id → uuid, for every session named
 
   bool empty() const {
     return sessions.empty() && steps.empty() && readings.empty() && devices.empty() &&
-           audit.empty() && outbox_through == 0;
+           audit.empty() && events.empty() && outbox_through == 0;
   }
 };
 
@@ -38,6 +40,7 @@ struct ShipLag {
   double oldest_unshipped = 0;        // recorded_at of the oldest of them (0 when none)
   std::int64_t shipped_readings = 0;  // the readings mark
   std::int64_t pending_changes = 0;   // outbox entries
+  std::int64_t events = 0;            // session events not yet shipped (v4)
 };
 
 }  // namespace brdf::storage

@@ -7,8 +7,8 @@
 
 namespace brdf::storage::testing {
 
-// Every reading of every session of `store` is in the archive exactly once with the same
-// content, and the archive holds no other reading of those sessions.
+// Every reading and every event of every session of `store` is in the archive exactly once with
+// the same content, and the archive holds no other reading or event of those sessions.
 void ExpectArchiveHoldsExactly(const std::string& conninfo, SessionStore& store,
                                const std::string& rig) {
   Result<std::unique_ptr<PgConnection>> conn = PgConnection::Open(conninfo);
@@ -16,6 +16,7 @@ void ExpectArchiveHoldsExactly(const std::string& conninfo, SessionStore& store,
   Result<std::vector<SessionRecord>> sessions = store.ListSessions();
   ASSERT_TRUE(sessions.ok());
   std::int64_t total = 0;
+  std::int64_t total_events = 0;
   for (const SessionRecord& s : *sessions) {
     SCOPED_TRACE("session " + std::to_string(s.id) + " " + s.uuid);
     Result<PgResult> row = (*conn)->Query(
@@ -61,6 +62,25 @@ void ExpectArchiveHoldsExactly(const std::string& conninfo, SessionStore& store,
       EXPECT_EQ(theirs->Int64(i, 8), r.quality_code);
     }
     total += theirs->rows();
+
+    // The session's history of states, event by event.
+    Result<std::vector<SessionEventRecord>> events = store.ListSessionEvents(s.id);
+    ASSERT_TRUE(events.ok()) << events.status().ToString();
+    EXPECT_FALSE(events->empty());
+    Result<PgResult> archived = (*conn)->Query(
+        "SELECT rig_event_id, at, state, reason FROM session_events WHERE session_uuid = $1 "
+        "ORDER BY rig_event_id",
+        PgParams().Add(s.uuid));
+    ASSERT_TRUE(archived.ok()) << archived.status().ToString();
+    ASSERT_EQ(archived->rows(), static_cast<int>(events->size()));
+    for (int i = 0; i < archived->rows(); ++i) {
+      const SessionEventRecord& e = (*events)[static_cast<std::size_t>(i)];
+      EXPECT_EQ(archived->Int64(i, 0), e.id);
+      EXPECT_EQ(archived->Double(i, 1), e.at);
+      EXPECT_EQ(archived->Text(i, 2), ToString(e.state));
+      EXPECT_EQ(archived->Text(i, 3), e.reason);
+    }
+    total_events += archived->rows();
   }
   Result<PgResult> all = (*conn)->Query(
       "SELECT count(*) FROM readings r JOIN sessions s ON s.uuid = r.session_uuid WHERE s.rig = "
@@ -68,6 +88,12 @@ void ExpectArchiveHoldsExactly(const std::string& conninfo, SessionStore& store,
       PgParams().Add(rig));
   ASSERT_TRUE(all.ok());
   EXPECT_EQ(all->Int64(0, 0), total);
+  Result<PgResult> all_events = (*conn)->Query(
+      "SELECT count(*) FROM session_events e JOIN sessions s ON s.uuid = e.session_uuid "
+      "WHERE s.rig = $1",
+      PgParams().Add(rig));
+  ASSERT_TRUE(all_events.ok()) << all_events.status().ToString();
+  EXPECT_EQ(all_events->Int64(0, 0), total_events);
 }
 
 }  // namespace brdf::storage::testing

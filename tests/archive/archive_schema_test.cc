@@ -45,7 +45,7 @@ TEST_F(ArchiveSchemaTest, NewArchiveGetsTheLatestSchemaAndMigratingAgainIsANoOp)
             std::to_string(LatestArchiveVersion()));
   EXPECT_EQ(*pg_->Psql("SELECT string_agg(table_name, ',' ORDER BY table_name) FROM "
                        "information_schema.tables WHERE table_schema = 'public'"),
-            "archive_schema,audit,devices,readings,sessions,steps");
+            "archive_schema,audit,devices,readings,session_events,sessions,steps");
 }
 
 TEST_F(ArchiveSchemaTest, TwoConnectionsMigratingAtOnceBothSucceed) {

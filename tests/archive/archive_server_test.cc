@@ -337,6 +337,32 @@ TEST_F(ArchiveServerTest, TwoReplicasAnswerBitForBitWhatTheRigAnswers) {
   EXPECT_TRUE(MessageDifferencer::Equals(archived.sample(), on_rig.sample()));
   EXPECT_TRUE(MessageDifferencer::Equals(archived.progress(), on_rig.progress()));
   EXPECT_TRUE(MessageDifferencer::Equals(archived.created_at(), on_rig.created_at()));
+  // The session's history of states: the rig's, byte for byte (the same ids and times), on both
+  // replicas, for the analyst too; an unknown archive id is NOT_FOUND.
+  {
+    v1::ListSessionEventsRequest ask;
+    ask.set_session_id(paint.session_id());
+    v1::ListSessionEventsResponse rig_events, a_events, b_events;
+    grpc::Status st =
+        rig_->control().ListSessionEvents(DaemonRig::Context().get(), ask, &rig_events);
+    ASSERT_TRUE(st.ok()) << st.error_message();
+    ASSERT_GE(rig_events.events_size(), 3);  // queued, running, …, completed
+    EXPECT_EQ(rig_events.events(0).state(), v1::SESSION_STATE_QUEUED);
+    EXPECT_EQ(rig_events.events(rig_events.events_size() - 1).state(), v1::SESSION_STATE_COMPLETED);
+    ask.set_session_id(id_a);
+    st = a.control().ListSessionEvents(DaemonRig::Context(kAnalystToken).get(), ask, &a_events);
+    ASSERT_TRUE(st.ok()) << st.error_message();
+    st = b.control().ListSessionEvents(DaemonRig::Context().get(), ask, &b_events);
+    ASSERT_TRUE(st.ok()) << st.error_message();
+    EXPECT_EQ(a_events.SerializeAsString(), rig_events.SerializeAsString())
+        << a_events.DebugString() << "\nrig:\n"
+        << rig_events.DebugString();
+    EXPECT_EQ(b_events.SerializeAsString(), rig_events.SerializeAsString());
+    ask.set_session_id("987654");
+    st = a.control().ListSessionEvents(DaemonRig::Context().get(), ask, &a_events);
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::NOT_FOUND) << st.error_message();
+    EXPECT_THAT(st.error_message(), HasSubstr("987654"));
+  }
 
   // Interpolate in every quantity: byte for byte the rig's responses, on both replicas.
   for (v1::Quantity quantity :

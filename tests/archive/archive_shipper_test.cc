@@ -13,6 +13,7 @@
 #include <cstring>
 #include <thread>
 
+#include "storage/archive_reader.h"
 #include "storage/archive_schema.h"
 #include "storage/archive_writer.h"
 #include "storage/pg.h"
@@ -130,6 +131,25 @@ TEST_F(ArchiveShipperTest, ShipsEverythingRecordedWithTheCatalogue) {
   EXPECT_EQ(*pg_->Psql("SELECT kind || '/' || serial FROM devices"), "spectroradiometer/60954201");
   EXPECT_EQ(*pg_->Psql("SELECT action || '/' || actor FROM audit"), "session.start/lab-pc");
   EXPECT_EQ(shipper->Snapshot().shipped_readings(), 36u);  // 40 steps less 4 moves
+  EXPECT_EQ(*pg_->Psql("SELECT string_agg(state, ',' ORDER BY rig_event_id) FROM session_events"),
+            "queued,running,completed");
+  // brdf-archive's reader answers a session's events as the rig's store does.
+  auto reader = ArchiveReader::Open(pg_->conninfo());
+  ASSERT_TRUE(reader.ok()) << reader.status().ToString();
+  const std::int64_t archive_id = std::stoll(*pg_->Psql("SELECT archive_id FROM sessions"));
+  auto archived = (*reader)->ListSessionEvents(archive_id);
+  ASSERT_TRUE(archived.ok()) << archived.status().ToString();
+  auto recorded = store->ListSessionEvents(*id);
+  ASSERT_TRUE(recorded.ok());
+  ASSERT_EQ(archived->size(), recorded->size());
+  for (std::size_t i = 0; i < archived->size(); ++i) {
+    EXPECT_EQ((*archived)[i].id, (*recorded)[i].id);
+    EXPECT_EQ((*archived)[i].session_id, archive_id);
+    EXPECT_EQ((*archived)[i].at, (*recorded)[i].at);
+    EXPECT_EQ((*archived)[i].state, (*recorded)[i].state);
+    EXPECT_EQ((*archived)[i].reason, (*recorded)[i].reason);
+  }
+  EXPECT_EQ((*reader)->ListSessionEvents(archive_id + 1000).status().code(), StatusCode::kNotFound);
 }
 
 // The archive commits a batch and the rig dies before it records its marks: the batch is sent
@@ -159,6 +179,7 @@ TEST_F(ArchiveShipperTest, ABatchShippedTwiceChangesNothing) {
   ASSERT_TRUE(store->MarkShipped(*again).ok());
   EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM readings"), "27");
   EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM steps"), "30");
+  EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM session_events"), "2");  // queued, running
   Result<ShipBatch> after = store->NextShipBatch(1000, 1000);
   ASSERT_TRUE(after.ok());
   EXPECT_TRUE(after->empty());

@@ -219,6 +219,32 @@ void BrdfctlProcessTest::CheckSubmitAndWatch() {
   ASSERT_TRUE(session.has_value()) << get.out;
   EXPECT_EQ(session->state(), v1::SESSION_STATE_COMPLETED);
 
+  // Its history (ListSessionEvents): one JSON object per event, oldest first, queued to
+  // completed; the text shows one line per event with the state's word, for an analyst too.
+  const CommandResult history = Ctl({"events", w.id, "--json"}, kCtlAnalystToken);
+  ASSERT_EQ(history.exit_code, 0) << Describe(history);
+  const std::vector<std::string> history_lines = Lines(history.out);
+  ASSERT_GE(history_lines.size(), 3u) << history.out;
+  std::vector<v1::SessionStateEvent> states;
+  for (const std::string& line : history_lines) {
+    const auto event = ParseJson<v1::SessionStateEvent>(line);
+    ASSERT_TRUE(event.has_value()) << "not a SessionStateEvent: " << line;
+    states.push_back(*event);
+  }
+  EXPECT_EQ(states.front().state(), v1::SESSION_STATE_QUEUED);
+  EXPECT_EQ(states.back().state(), v1::SESSION_STATE_COMPLETED);
+  const CommandResult history_text = Ctl({"events", w.id});
+  ASSERT_EQ(history_text.exit_code, 0) << Describe(history_text);
+  const std::vector<std::string> text_lines = Lines(history_text.out);
+  ASSERT_EQ(text_lines.size(), history_lines.size()) << history_text.out;
+  EXPECT_NE(text_lines.front().find("  queued"), std::string::npos) << history_text.out;
+  EXPECT_NE(text_lines.back().find("  completed"), std::string::npos) << history_text.out;
+  // "YYYY-MM-DD hh:mm:ss ±hhmm  state  reason".
+  EXPECT_TRUE(text_lines.front().size() > 25 && text_lines.front()[4] == '-' &&
+              text_lines.front()[13] == ':' && text_lines.front()[19] == ' ' &&
+              (text_lines.front()[20] == '+' || text_lines.front()[20] == '-'))
+      << "a local time first: " << text_lines.front();
+
   // Watching a finished session: the snapshot, then the stream ends; plain lines off a terminal.
   const CommandResult again = Ctl({"watch", w.id}, kCtlAnalystToken);
   EXPECT_EQ(again.exit_code, 0) << Describe(again);
@@ -403,6 +429,10 @@ TEST_F(BrdfctlProcessTest, VerbsOnAnUnknownSessionExitOneWithNotFound) {
   const CommandResult r = Ctl({"get", "999999"});
   EXPECT_EQ(r.exit_code, 1) << Describe(r);
   EXPECT_NE(r.err.find("NOT_FOUND"), std::string::npos) << Describe(r);
+  const CommandResult events = Ctl({"events", "999999"});
+  EXPECT_EQ(events.exit_code, 1) << Describe(events);
+  EXPECT_NE(events.err.find("NOT_FOUND"), std::string::npos) << Describe(events);
+  EXPECT_NE(events.err.find("ListSessionEvents"), std::string::npos) << Describe(events);
 }
 
 TEST_F(BrdfctlProcessTest, UnreachableDaemonExitsOneWithAHint) {

@@ -177,6 +177,25 @@ int RunGet(CommandContext& ctx, const std::string& session_id) {
   return kExitOk;
 }
 
+int RunEvents(CommandContext& ctx, const std::string& session_id) {
+  v1::ListSessionEventsRequest request;
+  request.set_session_id(session_id);
+  v1::ListSessionEventsResponse reply;
+  const grpc::Status status =
+      ctx.client.control().ListSessionEvents(ctx.client.UnaryContext().get(), request, &reply);
+  if (!status.ok()) return RpcFailed(ctx, status, "ListSessionEvents");
+  for (const v1::SessionStateEvent& e : reply.events()) {
+    if (ctx.json) {
+      PrintJsonLine(ctx.out, e);
+    } else {
+      ctx.out << LocalTimeText(e.at()) << "  " << StateName(e.state());
+      if (!e.reason().empty()) ctx.out << "  " << e.reason();
+      ctx.out << "\n";
+    }
+  }
+  return kExitOk;
+}
+
 int RunList(CommandContext& ctx, const std::vector<std::string>& states, unsigned limit,
             const ListFilters& filters) {
   v1::ListSessionsRequest request;

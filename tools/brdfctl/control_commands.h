@@ -25,6 +25,9 @@ int RunAbort(CommandContext& ctx, const std::string& session_id, const std::stri
 int RunAnswer(CommandContext& ctx, const std::string& session_id, int step_index,
               const std::string& note);
 int RunGet(CommandContext& ctx, const std::string& session_id);
+// ListSessionEvents: the session's history of states, oldest first; one line per event,
+// "<local time>  <state>  <reason>" (--json: one object per line).
+int RunEvents(CommandContext& ctx, const std::string& session_id);
 
 // ListSessions, every page (newest first), only `states` when given ("running", "paused", …);
 // at most `limit` sessions (0: all).

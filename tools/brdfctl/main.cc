@@ -137,6 +137,9 @@ int main(int argc, char** argv) {
   // Views.
   CLI::App* get = app.add_subcommand("get", "one session: state, progress, prompt, fault, plan");
   add_id(get);
+  CLI::App* events = app.add_subcommand(
+      "events", "a session's history of states, oldest first: time, state, reason");
+  add_id(events);
   std::vector<std::string> states;
   unsigned limit = 0;
   CLI::App* list = app.add_subcommand("list", "sessions, newest first");
@@ -356,6 +359,7 @@ int main(int argc, char** argv) {
   if (abort_cmd->parsed()) return RunAbort(ctx, session_id, reason);
   if (answer->parsed()) return RunAnswer(ctx, session_id, step_index, note);
   if (get->parsed()) return RunGet(ctx, session_id);
+  if (events->parsed()) return RunEvents(ctx, session_id);
   if (list->parsed()) return RunList(ctx, states, limit, list_filters);
   if (rig->parsed()) return RunRig(ctx);
   if (watch->parsed()) {

@@ -128,4 +128,14 @@ std::string TimeText(const google::protobuf::Timestamp& time) {
   return buf;
 }
 
+std::string LocalTimeText(const google::protobuf::Timestamp& time) {
+  if (time.seconds() == 0 && time.nanos() == 0) return "-";
+  const std::time_t t = static_cast<std::time_t>(time.seconds());
+  std::tm local{};
+  localtime_r(&t, &local);
+  char buf[40];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S %z", &local);
+  return buf;
+}
+
 }  // namespace brdf::ctl

@@ -50,5 +50,7 @@ std::string IsoText(const v1::IsoDirection& iso);
 
 // "2026-11-21 22:31:25Z"; "-" when unset (seconds and nanos both 0).
 std::string TimeText(const google::protobuf::Timestamp& time);
+// The same in the local time zone (TZ), with its offset: "2026-11-21 23:31:25 +0100".
+std::string LocalTimeText(const google::protobuf::Timestamp& time);
 
 }  // namespace brdf::ctl

@@ -91,6 +91,12 @@ try {
   check(r.status === 200 && r.json.session.state === 'SESSION_STATE_ABORTED', 'operator aborts it');
   r = await post('Control/ResumeSession', { session_id: id }, rig.operatorToken);
   check(r.status === 409 && r.json.code === 'FAILED_PRECONDITION', 'resuming an aborted session → 409');
+  r = await post('Control/ListSessionEvents', { session_id: id }, rig.analystToken);
+  const states = (r.json?.events || []).map((e) => e.state);
+  check(r.status === 200 && states[0] === 'SESSION_STATE_QUEUED' && states[states.length - 1] === 'SESSION_STATE_ABORTED' &&
+    /gateway test/.test(r.json.events[states.length - 1].reason), `analyst reads its history, queued … aborted (${states.join(', ')})`);
+  r = await post('Control/ListSessionEvents', { session_id: '999999' }, rig.analystToken);
+  check(r.status === 404 && /999999/.test(r.json.message), `the history of an unknown session → 404 (${r.status} ${r.text})`);
 
   const page = await fetch(rig.url);
   const html = await page.text();

@@ -196,6 +196,14 @@ class BrdfClient:
         return self._unary(self._control.GetSession,
                            brdf_pb2.GetSessionRequest(session_id=session_id), "Control.GetSession")
 
+    def list_session_events(self, session_id):
+        """The session's history of states, oldest first: SessionStateEvent (id, state, reason,
+        at) messages, one when it was created and one per change of its state or reason."""
+        reply = self._unary(self._control.ListSessionEvents,
+                            brdf_pb2.ListSessionEventsRequest(session_id=session_id),
+                            "Control.ListSessionEvents")
+        return list(reply.events)
+
     def list_sessions(self, states=None, page_size=0, limit=None, *, rig=None, sample=None,
                       material=None, tag=None, created_after=None, created_before=None):
         """Sessions, newest first, optionally only those in `states` ("running", ...).
