@@ -240,6 +240,23 @@ grpc::Status ParseRglFields(const v1::ExportRequest& r, ExportSettings* out) {
   return grpc::Status::OK;
 }
 
+// A grid's steps, checked before the export starts streaming: a refusal then reaches the
+// caller as the call's status (a browser's HTTP status), naming the request's field.
+grpc::Status CheckGridSteps(const ExportSettings& s) {
+  if (s.format != v1::EXPORT_FORMAT_GRID_NPY && s.format != v1::EXPORT_FORMAT_GRID_CSV) {
+    return grpc::Status::OK;
+  }
+  static constexpr const char* kFields[3] = {"step_theta_i", "step_theta_o", "step_phi"};
+  for (int k = 0; k < 3; ++k) {
+    double alone[3] = {1.0, 1.0, 1.0};
+    alone[k] = s.steps[k];
+    Result<exports::RegularGrid> grid = exports::MakeRegularGrid(
+        alone[0], alone[1], alone[2], exports::GridPlacement::kCellCentres);
+    if (!grid.ok()) return InvalidField(kFields[k], grid.status().message());
+  }
+  return grpc::Status::OK;
+}
+
 grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
   Result<SessionId> id = ParseSessionId(r.session_id(), "session_id");
   if (!id.ok()) return ToGrpcStatus(id.status());
@@ -292,6 +309,7 @@ grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
   // 0 means the default 1°; MakeRegularGrid checks the rest and names the axis.
   const double steps[3] = {r.step_theta_i(), r.step_theta_o(), r.step_phi()};
   for (int k = 0; k < 3; ++k) out->steps[k] = steps[k] == 0 ? 1.0 : steps[k];
+  if (grpc::Status st = CheckGridSteps(*out); !st.ok()) return st;
   out->nodes = r.grid_nodes();
   out->exclude_flagged = r.exclude_flagged();
   if (r.chunk_bytes() > kMaxExportChunkBytes) {

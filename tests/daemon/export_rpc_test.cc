@@ -457,6 +457,10 @@ TEST_F(ExportRpcTest, BadRequestsFailWithTheCodeAndNameTheField) {
   const ExportResult bad_steps = Export(steps);
   EXPECT_EQ(bad_steps.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT)
       << bad_steps.status.error_message();
+  EXPECT_NE(bad_steps.status.error_message().find("step_theta_i"), std::string::npos)
+      << bad_steps.status.error_message();
+  // Refused before anything streams (the web gateway then answers with the HTTP status).
+  EXPECT_TRUE(bad_steps.progress.empty());
   EXPECT_TRUE(bad_steps.file.empty());
 
   v1::ExportRequest merl_radiance = Request(v1::EXPORT_FORMAT_MERL_BINARY);

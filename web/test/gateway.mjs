@@ -97,6 +97,10 @@ try {
     /gateway test/.test(r.json.events[states.length - 1].reason), `analyst reads its history, queued … aborted (${states.join(', ')})`);
   r = await post('Control/ListSessionEvents', { session_id: '999999' }, rig.analystToken);
   check(r.status === 404 && /999999/.test(r.json.message), `the history of an unknown session → 404 (${r.status} ${r.text})`);
+  // The explorer's grid step goes to Data.Export as it is: a step that does not divide 90 is
+  // refused naming the field, before anything is streamed.
+  r = await post('Data/Export', { session_id: id, format: 'EXPORT_FORMAT_GRID_NPY', step_theta_i: 7 }, rig.analystToken);
+  check(r.status === 400 && /step_theta_i/.test(r.json?.message), `an export grid step of 7° → 400 naming step_theta_i (${r.status} ${r.json?.message})`);
 
   const page = await fetch(rig.url);
   const html = await page.text();
