@@ -26,6 +26,7 @@ export function createConsole(root, role, report) {
   const rig = el('div', { id: 'rig' });
   const coverage = el('div', { id: 'coverage', class: 'plot' });
   const eventList = el('ol', { id: 'events' });
+  const history = el('div', { id: 'history' });
   let plan = null;
 
   root.append(
@@ -41,7 +42,8 @@ export function createConsole(root, role, report) {
       el('div', { class: 'col wide' },
         el('h2', {}, 'Session'), detail,
         el('h3', {}, 'Hemisphere coverage (measured outgoing directions)'), coverage,
-        el('h3', {}, 'Events'), eventList)));
+        el('h3', {}, 'History (the states the session went through, as the rig recorded them)'), history,
+        el('h3', {}, 'Live events (since this page opened the session)'), eventList)));
 
   planFile.addEventListener('change', async () => {
     clear(validation);
@@ -92,11 +94,11 @@ export function createConsole(root, role, report) {
   async function refreshRig() {
     try {
       const r = await call('Control/GetRigStatus', {});
-      clear(rig).append(
+      clear(rig).append(...[
         el('ul', {}, r.devices.map((d) => el('li', {}, `${d.name}: ${String(d.state).replace('CONNECTION_STATE_', '').toLowerCase()} ${d.model} ${d.address} ${d.detail}`))),
         el('p', {}, r.live_pose_valid ? `pose α ${r.live_pose.alpha.toFixed(2)}°, β ${r.live_pose.beta.toFixed(2)}°, γ ${r.live_pose.gamma.toFixed(2)}°, δ ${r.live_pose.delta.toFixed(2)}°` : 'pose unknown'),
         el('p', {}, `meter serial: ${r.meter_serial || '—'}`),
-        r.active_session_id ? el('p', {}, `active session: ${r.active_session_id}`) : null);
+        r.active_session_id ? el('p', {}, `active session: ${r.active_session_id}`) : null].filter(Boolean));
     } catch (e) { clear(rig).append(el('p', { class: 'error' }, e.message)); }
   }
 
@@ -155,6 +157,28 @@ export function createConsole(root, role, report) {
     clear(eventList).append(...events.map((t) => el('li', {}, t)));
   }
 
+  // The session's durable history (Control.ListSessionEvents): every state it entered, why and
+  // when, also for a session that ran before this page was opened. Each row says how long the
+  // session stayed in that state (the last one: until now, while the session is active).
+  let historyAsk = 0; // only the latest answer is drawn
+  async function refreshHistory(id) {
+    const ask = ++historyAsk;
+    let r;
+    try { r = await call('Control/ListSessionEvents', { session_id: id }); } catch (e) { report(e.message); return; }
+    if (selected !== id || ask !== historyAsk) return;
+    const rows = r.events || [];
+    const times = rows.map((ev) => Date.parse(ev.at));
+    const last = rows.length ? rows[rows.length - 1].state : '';
+    const until = (i) => (i + 1 < rows.length ? times[i + 1] : ACTIVE.includes(last) ? Date.now() : NaN);
+    clear(history).append(el('table', { id: 'history-table' },
+      el('tr', {}, el('th', {}, 'at'), el('th', {}, 'state'), el('th', {}, 'for'), el('th', {}, 'reason')),
+      rows.map((ev, i) => el('tr', { 'data-state': stateName(ev.state) },
+        el('td', {}, (ev.at || '').replace('T', ' ').slice(0, 19)),
+        el('td', { class: `state ${stateName(ev.state)}` }, stateName(ev.state)),
+        el('td', {}, Number.isFinite(until(i) - times[i]) ? duration((until(i) - times[i]) / 1000) : ''),
+        el('td', {}, ev.reason || '')))));
+  }
+
   async function updateCoverage(id) {
     if (coverageBusy) return;
     coverageBusy = true;
@@ -183,6 +207,8 @@ export function createConsole(root, role, report) {
     covered = [];
     lastReadingId = 0;
     clear(eventList);
+    clear(history);
+    refreshHistory(id);
     for (const tr of sessionsBody.children) tr.classList.toggle('selected', tr.dataset.id === id);
     const controller = new AbortController();
     watch = controller;
@@ -200,6 +226,7 @@ export function createConsole(root, role, report) {
         if (ev.state_changed || ev.prompt || ev.fault) {
           try { session = await call('Control/GetSession', { session_id: id }); } catch (e) { report(e.message); }
           refreshSessions();
+          if (ev.state_changed) refreshHistory(id);
         }
       }
       if (session && selected === id) renderSession(session);
@@ -208,6 +235,7 @@ export function createConsole(root, role, report) {
       if (selected !== id) return;
       try { renderSession(await call('Control/GetSession', { session_id: id })); } catch (e) { report(e.message); }
       updateCoverage(id);
+      refreshHistory(id);
       refreshSessions();
     }).catch((e) => { if (e.name !== 'AbortError' && selected === id) report(e.message); });
   }

@@ -1,7 +1,8 @@
 // The explorer: the paper's Figure 7 (a session's readings in (α, β, δ) and in (θi, θo, φ),
-// rotatable WebGL point clouds, points3d.js), a reading's spectrum on click, the interpolated spectrum at a chosen direction with
-// its vertices and weights (Figure 8, method switch), a polar plot in the plane of incidence
-// with a wavelength slider, and downloads of every export (Data.Export).
+// rotatable WebGL point clouds, points3d.js), a reading's spectrum on click, the interpolated
+// spectrum at a chosen direction with its vertices and weights (Figure 8; method, coordinates
+// and trend switches), a polar plot in the plane of incidence with a wavelength slider, and
+// downloads of every export (Data.Export: readings CSV, grids at a chosen step, MERL, RGL).
 import { plotly } from './plotly.js';
 import { call, stream } from './api.js';
 import { el, clear, stateName } from './dom.js';
@@ -32,6 +33,9 @@ export function createExplorer(root, report) {
   const readingInfo = el('p', { id: 'reading-info' }, 'Click a reading in either plot.');
   const quantity = el('select', { id: 'quantity' }, el('option', { value: 'QUANTITY_BRDF' }, 'BRDF (sr⁻¹)'), el('option', { value: 'QUANTITY_REFLECTANCE' }, 'reflectance'), el('option', { value: 'QUANTITY_RADIANCE' }, 'radiance'));
   const method = el('select', { id: 'method' }, el('option', { value: 'INTERPOLATION_METHOD_OCTANT' }, 'octant (paper)'), el('option', { value: 'INTERPOLATION_METHOD_DELAUNAY' }, 'Delaunay'), el('option', { value: 'INTERPOLATION_METHOD_NEAREST' }, 'nearest'));
+  const trend = el('select', { id: 'trend' }, el('option', { value: 'INTERPOLATION_TREND_NONE' }, 'none (the paper)'), el('option', { value: 'INTERPOLATION_TREND_BIVARIATE' }, 'bivariate (θh, θd)'));
+  const coordinates = el('select', { id: 'coordinates' }, el('option', { value: 'INTERPOLATION_COORDINATES_INCIDENCE' }, '(θi, θo, φ) (the paper)'), el('option', { value: 'INTERPOLATION_COORDINATES_HALF_DIFFERENCE' }, 'half/difference'));
+  const gridStep = el('select', { id: 'grid-step' }, [10, 5, 2, 1].map((d) => el('option', { value: d, selected: d === 5 }, `${d}°`)));
   const ti = el('input', { id: 'q-theta-i', type: 'number', value: 35, min: 0, max: 90, step: 'any' });
   const to = el('input', { id: 'q-theta-o', type: 'number', value: 40, min: 0, max: 90, step: 'any' });
   const phi = el('input', { id: 'q-phi', type: 'number', value: 40, min: 0, max: 180, step: 'any' });
@@ -57,13 +61,16 @@ export function createExplorer(root, report) {
     el('h2', {}, 'Figure 8: a direction between the readings'),
     el('form', { id: 'direction-form', class: 'buttons', onsubmit: (e) => { e.preventDefault(); interpolate(); } },
       el('label', {}, 'θi ', ti), el('label', {}, 'θo ', to), el('label', {}, 'φ ', phi),
-      el('label', {}, 'method ', method), el('label', {}, 'quantity ', quantity),
+      el('label', {}, 'method ', method), el('label', {}, 'coordinates ', coordinates), el('label', {}, 'trend ', trend), el('label', {}, 'quantity ', quantity),
       el('button', { id: 'interpolate', type: 'submit' }, 'Interpolate')),
     interpInfo, interp,
     el('h2', {}, 'Plane of incidence'),
     el('div', { class: 'buttons' }, el('label', {}, 'wavelength ', slider), sliderLabel),
     polar,
-    el('h2', {}, 'Downloads'), downloads, downloadInfo);
+    el('h2', {}, 'Downloads'),
+    el('p', { class: 'muted' }, 'Grids, MERL and RGL files are built with the method, coordinates and trend chosen above; cells the method cannot fill come from Delaunay, then a fitted Cook-Torrance model.'),
+    el('div', { class: 'buttons' }, el('label', {}, 'grid step ', gridStep), el('span', { id: 'grid-size', class: 'muted' })),
+    downloads, downloadInfo);
 
   const appearance = createAppearance(root, report);
   const fig7a = createPoints3d(fig7aBox, { title: '(α, β, δ)', axes: ['α °', 'β °', 'δ °'] });
@@ -121,6 +128,7 @@ export function createExplorer(root, report) {
       slider.max = String(polarData.count - 1);
       slider.value = String(Math.floor(polarData.count / 2));
       drawPolar();
+      showGridSize();
     }
     // After the first view: the server renders it with the same work permits as the plots.
     await appearance.load(id);
@@ -150,13 +158,18 @@ export function createExplorer(root, report) {
     Plotly.react(spectrum, traces, { height: 320, margin: { t: 20 }, xaxis: { title: { text: 'wavelength nm' } }, yaxis: { title: { text: 'radiance' } }, yaxis2: { overlaying: 'y', side: 'right', title: { text: 'reflectance, BRDF' } } }, PLOT);
   }
 
+  // The choices of the Figure 8 form as InterpolationOptions (exports add reciprocity).
+  function options() {
+    return { coordinates: coordinates.value, trend: trend.value };
+  }
+
   async function interpolate() {
     if (!session) { report('load a session first'); return; }
     Plotly = await plotly();
     const t0 = performance.now();
     try {
       // One call: the vertices come with their own spectra (include_vertex_spectra).
-      const res = (await call('Interpolation/Interpolate', { session_id: session, method: method.value, quantity: quantity.value, direction: { iso: { theta_i: Number(ti.value), theta_o: Number(to.value), phi: Number(phi.value) } }, include_vertex_spectra: true })).result;
+      const res = (await call('Interpolation/Interpolate', { session_id: session, method: method.value, quantity: quantity.value, options: options(), direction: { iso: { theta_i: Number(ti.value), theta_o: Number(to.value), phi: Number(phi.value) } }, include_vertex_spectra: true })).result;
       const ms = performance.now() - t0;
       clear(interpInfo);
       if (res.status !== 'INTERPOLATION_STATUS_OK') {
@@ -164,7 +177,9 @@ export function createExplorer(root, report) {
         Plotly.purge(interp);
         return;
       }
-      interpInfo.append(el('p', { id: 'interp-status' }, `${res.spectrum.length} wavelengths from ${res.vertices.length} readings in ${Math.round(ms)} ms`),
+      const residuals = trend.value === 'INTERPOLATION_TREND_BIVARIATE';
+      interpInfo.append(el('p', { id: 'interp-status' }, `${res.spectrum.length} wavelengths from ${res.vertices.length} readings in ${Math.round(ms)} ms` +
+        (residuals ? ' (trend + the blend of the vertices\' residuals, so not Σ weight · vertex spectrum)' : '')),
         el('table', { id: 'vertices' }, el('tr', {}, el('th', {}, 'reading'), el('th', {}, '(θi, θo, φ)'), el('th', {}, 'weight')),
           res.vertices.map((v) => el('tr', {}, el('td', {}, v.reading_id), el('td', {}, v.coords.map((c) => c.toFixed(1)).join(', ')), el('td', {}, v.weight.toFixed(3))))));
       const x = wavelengths(res.grid, res.spectrum.length);
@@ -218,20 +233,44 @@ export function createExplorer(root, report) {
     ['EXPORT_FORMAT_GRID_NPY', 'grid .npy'],
     ['EXPORT_FORMAT_GRID_CSV', 'grid CSV'],
     ['EXPORT_FORMAT_MERL_BINARY', 'MERL .binary'],
+    ['EXPORT_FORMAT_RGL_BSDF', 'RGL .bsdf (spectral)'],
+    ['EXPORT_FORMAT_RGL_BSDF', 'RGL .bsdf (sRGB)', { rgb: true }, 'rgl_bsdf_rgb'],
   ];
   function renderDownloads() {
     clear(downloads);
-    for (const [format, label] of EXPORTS) {
-      downloads.append(el('button', { id: `export-${format.replace('EXPORT_FORMAT_', '').toLowerCase()}`, onclick: () => download(format) }, label));
+    for (const [format, label, extra, id] of EXPORTS) {
+      downloads.append(el('button', { id: `export-${id || format.replace('EXPORT_FORMAT_', '').toLowerCase()}`, onclick: () => download(format, extra) }, label));
     }
+    showGridSize();
   }
 
-  async function download(format) {
+  // A grid's size before it is asked for: cells of the chosen step × bands × 8 bytes (.npy).
+  function showGridSize() {
+    const d = Number(gridStep.value);
+    const cells = (90 / d) * (90 / d) * (180 / d);
+    const bands = polarData?.count;
+    document.getElementById('grid-size').textContent = `${cells.toLocaleString('en')} cells` + (bands ? `, .npy ≈ ${(cells * bands * 8 / 1e6).toFixed(1)} MB` : '');
+  }
+  gridStep.addEventListener('change', showGridSize);
+
+  // An export as the daemon streams it (Data.Export), kept in memory and handed to the browser
+  // as a download. Grids use the step chosen; grids, MERL and RGL the Figure 8 form's options,
+  // with reciprocity for MERL and RGL (a cell there stands for a pair of directions and its
+  // swap alike, as brdfctl export does).
+  async function download(format, extra = {}) {
     const parts = [];
     let reportMsg = null;
+    const d = Number(gridStep.value);
+    const gridded = format !== 'EXPORT_FORMAT_READINGS_CSV';
+    const request = { session_id: session, format, ...extra };
+    if (gridded) {
+      request.method = method.value;
+      request.options = { ...options(), reciprocity: format === 'EXPORT_FORMAT_MERL_BINARY' || format === 'EXPORT_FORMAT_RGL_BSDF' };
+    }
+    if (format === 'EXPORT_FORMAT_GRID_NPY' || format === 'EXPORT_FORMAT_GRID_CSV') Object.assign(request, { step_theta_i: d, step_theta_o: d, step_phi: d });
     downloadInfo.textContent = 'exporting…';
     try {
-      await stream('Data/Export', { session_id: session, format }, (chunk) => {
+      await stream('Data/Export', request, (chunk) => {
         if (chunk.progress) downloadInfo.textContent = `${chunk.progress.stage} ${Math.round(100 * chunk.progress.fraction)} %`;
         if (chunk.data) parts.push(fromBase64(chunk.data.content));
         if (chunk.report) reportMsg = chunk.report;
@@ -243,6 +282,7 @@ export function createExplorer(root, report) {
     a.click();
     a.remove();
     downloadInfo.textContent = `${reportMsg?.file_name}: ${blob.size} bytes. ${reportMsg?.summary || ''}`;
+    downloadInfo.dataset.file = reportMsg?.file_name || '';
   }
 
   return {

@@ -41,6 +41,27 @@ const shot = (page, name) => page.screenshot({ path: join(out, `${name}.png`), f
 // A click through the DOM: the console re-renders its session panel on every event, so an
 // element handle may be stale by the time a mouse click would land.
 const clickId = (page, id) => page.evaluate((i) => { const e = document.getElementById(i); if (!e) throw new Error(`no #${i}`); e.click(); }, id);
+// The field names of an RGL tensor_file (docs/rgl-format.md: magic, version, count, then per
+// field its name, dimensions, dtype, offset and shape).
+function rglFields(b) {
+  const names = [];
+  let at = 14;
+  const count = b.readUInt32LE(at);
+  at += 4;
+  for (let i = 0; i < count && at < b.length; i++) {
+    const len = b.readUInt16LE(at);
+    names.push(b.subarray(at + 2, at + 2 + len).toString('utf8'));
+    const dims = b.readUInt16LE(at + 2 + len);
+    at += 2 + len + 2 + 1 + 8 + 8 * dims;
+  }
+  return names;
+}
+// Text a view must never show: a value the page failed to fill in.
+async function checkNoPlaceholders(page, view) {
+  const shown = await page.evaluate(() => document.querySelector('main').innerText);
+  const bad = /\b(null|undefined|NaN|\[object Object\])\b/.exec(shown);
+  check(!bad, `${view}: no "null", "undefined", "NaN" or "[object Object]" shown${bad ? ` (found "${bad[0]}" in …${shown.slice(Math.max(0, bad.index - 60), bad.index + 20)}…)` : ''}`);
+}
 const text = (page, sel) => page.$eval(sel, (e) => e.textContent).catch(() => null);
 
 let failed = false;
@@ -119,6 +140,16 @@ try {
   await page.waitForFunction(() => document.querySelectorAll('#coverage .scatterlayer .point, #coverage .point').length > 0, { timeout: 15000 });
   check((await page.$$eval('#events li', (l) => l.length)) > 5, 'the session\'s events are listed');
   check(/connected/.test(await text(page, '#rig')), 'the rig status shows the devices');
+  // The durable history (Control.ListSessionEvents), in the order the rig recorded it.
+  await page.waitForFunction(() => [...document.querySelectorAll('#history-table tr[data-state]')].at(-1)?.dataset.state === 'completed', { timeout: 15000 });
+  const history = await page.$$eval('#history-table tr[data-state]', (rows) => rows.map((r) => r.dataset.state));
+  const order = (s) => history.indexOf(s);
+  check(history[0] === 'queued' && order('running') > 0 && order('awaiting_operator') > order('running') &&
+        order('paused') > order('awaiting_operator') && history.lastIndexOf('running') > order('paused'),
+  `the session's history lists its states in order (${history.join(' → ')})`);
+  // The rig's status once it has no active session (it is polled every 2 s).
+  await page.waitForFunction(() => !/active session/.test(document.getElementById('rig').textContent), { timeout: 15000 });
+  await checkNoPlaceholders(page, 'console');
   await shot(page, '05-console-completed');
 
   // --- explorer ---------------------------------------------------------------------------------
@@ -157,6 +188,14 @@ try {
     const traces = await page.$$eval('#interp-spectrum .scatterlayer .trace', (t) => t.length);
     check(traces === rows + 1, `${method}: the interpolated spectrum and each vertex's own spectrum drawn (${traces} traces for ${rows} vertices)`);
   }
+  // The bivariate trend: the same direction, the vertices' residuals blended on top of the trend.
+  await page.select('#trend', 'INTERPOLATION_TREND_BIVARIATE');
+  await page.evaluate(() => { document.getElementById('interp-status')?.remove(); });
+  await clickId(page, 'interpolate');
+  await page.waitForSelector('#interp-status');
+  const trended = await text(page, '#interp-status');
+  check(/wavelengths from \d+ readings.*trend/.test(trended), `Delaunay with the bivariate trend: ${trended}`);
+  await page.select('#trend', 'INTERPOLATION_TREND_NONE');
   await page.waitForSelector('#polar .scatterlayer .trace, #polar .trace');
   const nm0 = await text(page, '#wavelength-label');
   await page.$eval('#wavelength', (e) => { e.value = '5'; e.dispatchEvent(new Event('input')); });
@@ -197,6 +236,21 @@ try {
     if (!csv) await sleep(100);
   }
   check(csv && readFileSync(join(out, csv), 'utf8').split('\n').length > 10, `the readings CSV export downloaded (${csv})`);
+  // The spectral RGL material, for Mitsuba 3 and pbrt-v4: a tensor_file with the spectral fields.
+  await page.evaluate(() => { document.getElementById('download-info').dataset.file = ''; });
+  await clickId(page, 'export-rgl_bsdf');
+  await page.waitForFunction(() => /\.bsdf$/.test(document.getElementById('download-info').dataset.file || ''), { timeout: 120000 });
+  const bsdfName = await page.$eval('#download-info', (e) => e.dataset.file);
+  let bsdf = null;
+  for (let i = 0; i < 100 && !bsdf; i++) {
+    if (existsSync(join(out, bsdfName))) bsdf = readFileSync(join(out, bsdfName));
+    else await sleep(100);
+  }
+  const fields = bsdf ? rglFields(bsdf) : [];
+  check(bsdf && bsdf.subarray(0, 12).toString('latin1') === 'tensor_file\0' && ['wavelengths', 'spectra', 'ndf', 'vndf'].every((f) => fields.includes(f)),
+    `the spectral RGL .bsdf downloaded (${bsdfName}, ${bsdf?.length} bytes; fields ${fields.join(', ')})`);
+  await checkNoPlaceholders(page, 'explorer');
+  await shot(page, '11-explorer-downloads');
 
   // --- analyst ----------------------------------------------------------------------------------
   const queued = await fetch(new URL('/api/brdf.v1.Control/SubmitPlan', rig.url), { method: 'POST', headers: { 'Content-Type': 'application/json', Authorization: `Bearer ${rig.operatorToken}` }, body: JSON.stringify({ plan: JSON.parse(readFileSync(demo, 'utf8')) }) }).then((r) => r.json());
