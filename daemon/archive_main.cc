@@ -5,12 +5,16 @@
 // The configuration is brdfd's format (config.h); brdf-archive reads [server] (listen, TLS,
 // stream caps, interpolate threads), [[auth.tokens]], [log] and [archive] credentials: the file
 // holding the archive's libpq conninfo, so that the password is neither on the command line nor
-// in the configuration or the log. Other tables are ignored. With --migrate it first brings the
-// archive's schema up to date (a role that may alter it), as a rig does when it connects.
+// in the configuration or the log; [web] listen and root. Other tables are ignored. With --migrate
+// it first brings the archive's schema up to date (a role that may alter it), as a rig does when it
+// connects.
 //
-// Once serving it prints one line on stdout, "brdf-archive listening on <address>". SIGTERM /
-// SIGINT: health NOT_SERVING, streams end, exit 0. Exit 2: a bad command line or configuration;
-// 1: the archive cannot be read (unreachable, refused, wrong schema) or the address not bound.
+// With [web] listen set it also serves the web explorer and a read-only console over the same
+// services (web_gateway.h; TLS from [server.tls]) and prints "brdf-archive web explorer on
+// <url>" first. Once serving it prints one line on stdout, "brdf-archive listening on <address>".
+// SIGTERM / SIGINT: health NOT_SERVING, streams end, exit 0. Exit 2: a bad command line or
+// configuration; 1: the archive cannot be read (unreachable, refused, wrong schema) or the address
+// not bound.
 #include <signal.h>
 #include <spdlog/spdlog.h>
 
@@ -24,6 +28,7 @@
 #include "daemon/config.h"
 #include "daemon/server.h"
 #include "daemon/startup.h"
+#include "daemon/web_gateway.h"
 #include "storage/archive_reader.h"
 #include "storage/archive_schema.h"
 #include "storage/pg.h"
@@ -115,12 +120,26 @@ int main(int argc, char** argv) {
   }
   spdlog::info("serving the archive (credentials from {}) on {} ({})", config.archive.credentials,
                (*server)->address(), (*server)->tls() ? "TLS" : "plaintext");
+  std::unique_ptr<WebGateway> web;
+  if (!config.web.listen.empty()) {
+    Result<std::unique_ptr<WebGateway>> started =
+        WebGateway::Start(config.web, config.server.tls, DefaultWebRoot(config.web),
+                          (*server)->InProcessChannel(), "brdf-archive");
+    if (!started.ok()) {
+      spdlog::critical("{}", started.status().ToString());
+      (*server)->Shutdown(std::chrono::seconds(1));
+      return kExitFailure;
+    }
+    web = std::move(*started);
+    std::printf("brdf-archive web explorer on %s\n", web->url().c_str());
+  }
   std::printf("brdf-archive listening on %s\n", (*server)->address().c_str());
   std::fflush(stdout);
 
   int signal_number = 0;
   while (signal_number <= 0) signal_number = sigwaitinfo(&stop_signals, nullptr);
   spdlog::info("{}: stopping", signal_number == SIGINT ? "SIGINT" : "SIGTERM");
+  if (web) web->Stop();
   (*server)->Shutdown(std::chrono::seconds(2));
   spdlog::info("stopped");
   return kExitOk;

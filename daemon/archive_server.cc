@@ -92,6 +92,12 @@ void ArchiveServer::Refresh() {
   }
 }
 
+std::shared_ptr<grpc::Channel> ArchiveServer::InProcessChannel() {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(-1);  // answers are limited by the services themselves
+  return server_->InProcessChannel(args);
+}
+
 void ArchiveServer::Shutdown(std::chrono::milliseconds grace) {
   if (shut_down_ || !server_) return;
   shut_down_ = true;

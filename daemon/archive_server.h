@@ -5,10 +5,13 @@
 //
 //   Control        archive_services.h: GetSession, ListSessions, ListSessionEvents; the rig's verbs
 //                  refused
-//   Data           archive_services.h: StreamReadings; Export not yet
+//   Data           archive_services.h: StreamReadings, StreamReadingPoints, Export
 //   Interpolation  brdfd's own InterpolationService and InterpolateLoop over an IndexCache whose
 //                  store is the archive (storage/archive_reader.h): the same code, over the same
 //                  records, answers as on the rig, bit for bit
+//
+// brdf-archive's [web] listen puts the web gateway (web_gateway.h) in front of InProcessChannel():
+// the browser explorer and a read-only console over these same services.
 //
 // Stateless: nothing but caches lives here, so several ArchiveServers (processes, machines) can
 // serve one archive behind a load balancer. The index cache is kept current without commit
@@ -17,6 +20,7 @@
 // grows here as it is shipped.
 #pragma once
 
+#include <grpcpp/channel.h>
 #include <grpcpp/server.h>
 
 #include <chrono>
@@ -59,6 +63,11 @@ class ArchiveServer {
   const std::string& address() const { return address_; }
   bool tls() const { return tls_; }
   IndexCache::Stats cache_stats() const { return cache_.stats(); }
+
+  // A channel to this server inside the process: calls through it get the same authentication,
+  // roles, validation and limits as calls from the network (the web gateway forwards the
+  // browser's calls through it, as brdfd's does).
+  std::shared_ptr<grpc::Channel> InProcessChannel();
 
   // Health → NOT_SERVING, streams end, calls in flight get `grace`. Idempotent.
   void Shutdown(std::chrono::milliseconds grace);

@@ -24,7 +24,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <thread>
@@ -56,18 +55,6 @@ constexpr int kExitConfiguration = 2;  // a bad command line or configuration fi
 void Notify([[maybe_unused]] const std::string& state) {
 #ifdef BRDF_HAVE_SYSTEMD
   sd_notify(0, state.c_str());
-#endif
-}
-
-// The built front end: [web] root, else the installed one, else the build tree's (a daemon run
-// from its build directory, as the quick start and the tests do).
-std::string WebRoot(const brdf::daemon::WebConfig& web) {
-  if (!web.root.empty()) return web.root;
-#if defined(BRDF_WEB_INSTALL_DIR) && defined(BRDF_WEB_BUILD_DIR)
-  if (std::ifstream(std::string(BRDF_WEB_INSTALL_DIR) + "/index.html")) return BRDF_WEB_INSTALL_DIR;
-  return BRDF_WEB_BUILD_DIR;
-#else
-  return {};
 #endif
 }
 
@@ -227,9 +214,8 @@ int main(int argc, char** argv) {
   spdlog::info("serving on {} ({})", (*server)->address(), (*server)->tls() ? "TLS" : "plaintext");
   std::unique_ptr<WebGateway> web;
   if (!config.web.listen.empty()) {
-    Result<std::unique_ptr<WebGateway>> started =
-        WebGateway::Start(config.web, config.server.tls, WebRoot(config.web),
-                          (*server)->InProcessChannel());
+    Result<std::unique_ptr<WebGateway>> started = WebGateway::Start(
+        config.web, config.server.tls, DefaultWebRoot(config.web), (*server)->InProcessChannel());
     if (!started.ok()) {
       spdlog::critical("{}", started.status().ToString());
       (*server)->Shutdown(std::chrono::seconds(1));

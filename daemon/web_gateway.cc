@@ -232,10 +232,21 @@ void ServeApi(const std::shared_ptr<JsonRpc>& rpc, const std::shared_ptr<WebStre
 
 }  // namespace
 
+std::string DefaultWebRoot(const WebConfig& web) {
+  if (!web.root.empty()) return web.root;
+#if defined(BRDF_WEB_INSTALL_DIR) && defined(BRDF_WEB_BUILD_DIR)
+  if (std::ifstream(std::string(BRDF_WEB_INSTALL_DIR) + "/index.html")) return BRDF_WEB_INSTALL_DIR;
+  return BRDF_WEB_BUILD_DIR;
+#else
+  return {};
+#endif
+}
+
 Result<std::unique_ptr<WebGateway>> WebGateway::Start(const WebConfig& config,
                                                       const std::optional<TlsConfig>& tls,
                                                       const std::string& root,
-                                                      std::shared_ptr<grpc::Channel> channel) {
+                                                      std::shared_ptr<grpc::Channel> channel,
+                                                      const std::string& server) {
   std::string host;
   int port = 0;
   if (!ParseListen(config.listen, &host, &port)) {
@@ -293,6 +304,11 @@ Result<std::unique_ptr<WebGateway>> WebGateway::Start(const WebConfig& config,
             [rpc, streams](const httplib::Request& req, httplib::Response& res) {
               ServeApi(rpc, streams, req, res);
             });
+  // Registered before the catch-all below: the first matching route answers.
+  const std::string about = R"({"server":")" + server + R"("})";
+  http.Get("/api/about", [about](const httplib::Request&, httplib::Response& res) {
+    res.set_content(about, kJson);
+  });
   http.Get(R"(/api/.*)", [](const httplib::Request&, httplib::Response& res) {
     ReplyError(res, grpc::Status(grpc::INVALID_ARGUMENT,
                                  "API calls are POST /api/brdf.v1.<Service>/<Method> with a "

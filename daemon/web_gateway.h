@@ -9,11 +9,14 @@
 //        stream methods  → 200 text/event-stream: one "data: <json>" event per message, then
 //                          "event: end" with {"code","message"} (OK or why the stream ended);
 //                          a call refused before its first message is answered as a unary error.
+//   GET  /api/about                         {"server": "brdfd" | "brdf-archive"}: which program
+//                                           answers (the front end shows a rig's console or the
+//                                           archive's read-only one); no token needed.
 //   GET  /…                                 the built front end from the web root (index.html).
 //
-// Every API call is forwarded to brdfd's own gRPC server over an in-process channel with the
-// request's "Authorization" header as the "authorization" metadata: authentication, roles,
-// validation and limits are the gRPC server's own, call for call.
+// Every API call is forwarded to the program's own gRPC server (brdfd's, or brdf-archive's) over an
+// in-process channel with the request's "Authorization" header as the "authorization" metadata:
+// authentication, roles, validation and limits are the gRPC server's own, call for call.
 //
 // Safety: bodies over kMaxBodyBytes are refused unread (413), reads and writes time out, at most
 // kMaxStreams streams at a time (more: 429), a stream whose browser went away is cancelled within
@@ -43,6 +46,10 @@ namespace brdf::daemon {
 
 class WebStreams;  // web_gateway.cc
 
+// The built front end: [web] root, else the installed one, else this build tree's (a program
+// run from its build directory, as the quick start and the tests do).
+std::string DefaultWebRoot(const WebConfig& web);
+
 class WebGateway {
  public:
   static constexpr std::size_t kMaxBodyBytes = 1 << 20;  // a plan is far smaller
@@ -53,12 +60,14 @@ class WebGateway {
 
   // Serves config.listen ("host:port"; port 0: any free port, see url()). `root` is the built
   // front end (a directory with index.html; missing: the API alone, GET / says how to build it).
-  // `channel` leads to brdfd's own gRPC server. kConfigurationError for an unreadable TLS file,
+  // `channel` leads to the program's own gRPC server; `server` is its name ("brdfd" or
+  // "brdf-archive", as GET /api/about says). kConfigurationError for an unreadable TLS file,
   // kIoError when the address cannot be bound.
   static Result<std::unique_ptr<WebGateway>> Start(const WebConfig& config,
                                                    const std::optional<TlsConfig>& tls,
                                                    const std::string& root,
-                                                   std::shared_ptr<grpc::Channel> channel);
+                                                   std::shared_ptr<grpc::Channel> channel,
+                                                   const std::string& server = "brdfd");
 
   ~WebGateway();
   WebGateway(const WebGateway&) = delete;

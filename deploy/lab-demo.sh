@@ -227,11 +227,14 @@ say "starting brdf-archive (the read API over the archive; stateless, so several
 d="$run/archive"
 (umask 077 && cp "$run/rig-a/archive.conninfo" "$d/archive.conninfo")
 archive_address="127.0.0.1:$(free_port)"
+archive_web="127.0.0.1:$(free_port)"
 cat >"$d/brdf-archive.toml" <<EOF
 [server]
 listen = "$archive_address"
 [archive]
 credentials = "$d/archive.conninfo"
+[web]
+listen = "$archive_web"
 [[auth.tokens]]
 name = "lab-demo"
 token = "$token"
@@ -242,6 +245,8 @@ start_detached "$d/brdf-archive.pid" "$d/brdf-archive.out" "$d/brdf-archive.log"
   "$archive_server" --config "$d/brdf-archive.toml"
 wait_for_line "$d/brdf-archive.out" '^brdf-archive listening on' 20
 echo "lab-demo: brdf-archive on $archive_address"
+archive_url="$(awk '/^brdf-archive web explorer on/ { print $NF }' "$d/brdf-archive.out")"
+echo "lab-demo: the archive in the browser (every rig's sessions, read only): $archive_url"
 
 say "every session of both rigs, through brdf-archive (brdfctl list)"
 BRDF_ADDRESS="$archive_address" "$ctl" list
@@ -269,6 +274,7 @@ cat <<EOF
 
 lab-demo: done; everything keeps running. Stop it all: deploy/lab-demo.sh --stop
   archive: BRDF_TOKEN=$token BRDF_ADDRESS=$archive_address $ctl list   (brdf-archive)
+           $archive_url in a browser, with the token above
            PGPASSWORD=… $pgbin/psql -h $run/pg -p $pg_port -U brdf -d postgres
            (the password is in $run/rig-a/archive.conninfo)
   rigs:    BRDF_TOKEN=$token BRDF_ADDRESS=${address[rig-a]} (rig-a) / ${address[rig-b]} (rig-b) $ctl rig

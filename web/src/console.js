@@ -2,14 +2,18 @@
 // their field paths, the estimated time), the operator verbs, live progress with ETA and the
 // coverage of the hemisphere (WatchSession), prompts, the rig and the session's events.
 // Analysts see the same pages without any control (and the server refuses control anyway).
+// Served by brdf-archive, it is the archive's read-only console: every rig's sessions (with the
+// rig's name), their history, progress and coverage, refreshed as the rigs ship; no plan, no rig,
+// no control.
 import { plotly } from './plotly.js';
 import { call, stream } from './api.js';
 import { el, clear, stateName, duration } from './dom.js';
 
 const ACTIVE = ['SESSION_STATE_QUEUED', 'SESSION_STATE_RUNNING', 'SESSION_STATE_PAUSING', 'SESSION_STATE_PAUSED', 'SESSION_STATE_AWAITING_OPERATOR'];
 
-export function createConsole(root, role, report) {
-  const operator = role === 'operator';
+export function createConsole(root, role, report, server = 'brdfd') {
+  const archive = server === 'brdf-archive';
+  const operator = role === 'operator' && !archive;
   let selected = null;          // session id
   let watch = null;             // AbortController of the WatchSession stream
   let events = [];
@@ -29,21 +33,24 @@ export function createConsole(root, role, report) {
   const history = el('div', { id: 'history' });
   let plan = null;
 
+  const rigSide = archive
+    ? [el('p', { class: 'muted', id: 'archive-note' }, 'brdf-archive: the lab\'s archive of every rig\'s sessions, read only. Plans, prompts and the rig verbs belong to each rig\'s own brdfd.')]
+    : [el('h2', {}, 'Plan'),
+      el('p', {}, 'Choose a plan file (JSON); it is checked against this rig before anything is stored.'),
+      planFile, validation,
+      operator ? el('div', { class: 'buttons' }, submitButton, submitStartButton) : el('p', { class: 'muted' }, 'Analyst token: read only.'),
+      el('h2', {}, 'Rig'), rig];
   root.append(
     el('div', { class: 'columns' },
       el('div', { class: 'col' },
         el('h2', {}, 'Sessions'),
-        el('table', { id: 'sessions' }, el('thead', {}, el('tr', {}, el('th', {}, 'name'), el('th', {}, 'state'), el('th', {}, 'progress'), el('th', {}, 'created'))), sessionsBody),
-        el('h2', {}, 'Plan'),
-        el('p', {}, 'Choose a plan file (JSON); it is checked against this rig before anything is stored.'),
-        planFile, validation,
-        operator ? el('div', { class: 'buttons' }, submitButton, submitStartButton) : el('p', { class: 'muted' }, 'Analyst token: read only.'),
-        el('h2', {}, 'Rig'), rig),
+        el('table', { id: 'sessions' }, el('thead', {}, el('tr', {}, el('th', {}, 'name'), archive ? el('th', {}, 'rig') : null, el('th', {}, 'state'), el('th', {}, 'progress'), el('th', {}, 'created'))), sessionsBody),
+        ...rigSide),
       el('div', { class: 'col wide' },
         el('h2', {}, 'Session'), detail,
         el('h3', {}, 'Hemisphere coverage (measured outgoing directions)'), coverage,
         el('h3', {}, 'History (the states the session went through, as the rig recorded them)'), history,
-        el('h3', {}, 'Live events (since this page opened the session)'), eventList)));
+        archive ? null : [el('h3', {}, 'Live events (since this page opened the session)'), eventList])));
 
   planFile.addEventListener('change', async () => {
     clear(validation);
@@ -85,7 +92,7 @@ export function createConsole(root, role, report) {
       sessionsBody.append(el('tr', {
         class: s.session_id === selected ? 'selected' : '', 'data-id': s.session_id,
         onclick: () => select(s.session_id),
-      }, el('td', {}, s.name || s.session_id), el('td', { class: `state ${stateName(s.state)}` }, stateName(s.state)),
+      }, el('td', {}, s.name || s.session_id), archive ? el('td', { class: 'rig' }, s.rig || '') : null, el('td', { class: `state ${stateName(s.state)}` }, stateName(s.state)),
       el('td', {}, `${p.done_steps}/${p.total_steps}`), el('td', {}, (s.created_at || '').replace('T', ' ').slice(0, 19))));
     }
     return r.sessions;
@@ -111,12 +118,12 @@ export function createConsole(root, role, report) {
     const fraction = p.total_steps ? p.done_steps / p.total_steps : 0;
     const state = s.state;
     const items = [
-      el('p', {}, el('strong', {}, s.name || ''), ' ', el('code', {}, s.session_id)),
+      el('p', {}, el('strong', {}, s.name || ''), ' ', el('code', {}, s.session_id), archive && s.rig ? ` recorded by rig ${s.rig}` : ''),
       el('p', {}, 'state: ', el('span', { id: 'session-state', class: `state ${stateName(state)}` }, stateName(state)), s.end_reason ? ` — ${s.end_reason}` : ''),
       el('progress', { id: 'session-progress', max: 1, value: fraction }),
       el('p', { id: 'progress-text' }, `${p.done_steps}/${p.total_steps} steps, ${p.done_samples}/${p.total_samples} sample readings` +
         (ACTIVE.includes(state) && state !== 'SESSION_STATE_QUEUED' ? `, ETA ${duration(s.eta_s)}` : '')),
-      s.last_quality_code ? el('p', {}, `last meter quality code: ${s.last_quality_code}`) : null,
+      Number(s.last_quality_code) > 0 ? el('p', {}, `last meter quality code: ${s.last_quality_code}`) : null,
       s.last_fault ? el('p', { class: 'error' }, `fault at step ${s.last_fault.step_index}: ${s.last_fault.code} ${s.last_fault.reason}${s.last_fault.will_retry ? ' (retrying)' : ''}`) : null,
     ];
     if (s.pending_prompt) {
@@ -210,10 +217,11 @@ export function createConsole(root, role, report) {
     clear(history);
     refreshHistory(id);
     for (const tr of sessionsBody.children) tr.classList.toggle('selected', tr.dataset.id === id);
+    updateCoverage(id);
+    if (archive) { refreshArchived(id); return; }
     const controller = new AbortController();
     watch = controller;
     let session = null;
-    updateCoverage(id);
     stream('Control/WatchSession', { session_id: id }, async (ev) => {
       addEvent(ev);
       if (ev.snapshot) session = ev.snapshot;
@@ -240,12 +248,27 @@ export function createConsole(root, role, report) {
     }).catch((e) => { if (e.name !== 'AbortError' && selected === id) report(e.message); });
   }
 
+  // The archive has no live events: the selected session is read again as the rigs ship it.
+  async function refreshArchived(id) {
+    try {
+      const s = await call('Control/GetSession', { session_id: id });
+      if (selected === id) renderSession(s);
+    } catch (e) { report(e.message); }
+  }
+
   const timers = [];
   return {
     async show() {
       const sessions = await refreshSessions();
-      refreshRig();
-      timers.push(setInterval(refreshRig, 2000), setInterval(() => refreshSessions().catch(() => {}), 5000));
+      if (archive) {
+        timers.push(setInterval(() => {
+          refreshSessions().catch(() => {});
+          if (selected) { refreshArchived(selected); updateCoverage(selected); refreshHistory(selected); }
+        }, 5000));
+      } else {
+        refreshRig();
+        timers.push(setInterval(refreshRig, 2000), setInterval(() => refreshSessions().catch(() => {}), 5000));
+      }
       if (!selected && sessions.length) select(sessions[0].session_id);
     },
     hide() { while (timers.length) clearInterval(timers.pop()); },

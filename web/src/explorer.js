@@ -82,7 +82,11 @@ export function createExplorer(root, report) {
     clear(sessionSelect);
     for (const s of r.sessions) sessionSelect.append(el('option', { value: s.session_id }, `${s.name || s.session_id} (${stateName(s.state)})`));
     // The newest session with readings first.
-    for (const s of r.sessions) if (Number(s.progress?.done_samples) > 0) measured.add(s.session_id);
+    // (brdf-archive's listing has no sample counts: there, a session with steps done.)
+    for (const s of r.sessions) {
+      const p = s.progress || {};
+      if (Number(p.done_samples) > 0 || (!Number(p.total_samples) && Number(p.done_steps) > 0)) measured.add(s.session_id);
+    }
     const newest = r.sessions.find((s) => measured.has(s.session_id));
     if (newest) sessionSelect.value = newest.session_id;
   }

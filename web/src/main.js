@@ -1,5 +1,6 @@
 // brdfd's web front end: sign in with a bearer token (kept in this tab's sessionStorage only),
-// then the console (#console) or the explorer (#explorer).
+// then the console (#console) or the explorer (#explorer). Served by brdfd (a rig's console) or
+// by brdf-archive (GET /api/about says which): the archive's console is read-only, with no rig.
 import './style.css';
 import { call, getToken, setToken, probeRole } from './api.js';
 import { createConsole } from './console.js';
@@ -7,6 +8,7 @@ import { createExplorer } from './explorer.js';
 
 const $ = (id) => document.getElementById(id);
 let role = null;
+let server = 'brdfd';
 let views = null;
 let current = null;
 
@@ -35,7 +37,8 @@ async function route() {
 async function signIn() {
   try {
     await call('Control/ListSessions', { page_size: 1 });
-    role = await probeRole();
+    // The archive has no rig and no control for anyone.
+    role = server === 'brdf-archive' ? 'reader' : await probeRole();
   } catch (e) {
     setToken('');
     $('login-view').hidden = false;
@@ -48,7 +51,7 @@ async function signIn() {
   $('who').textContent = role;
   $('who').className = `role ${role}`;
   document.body.dataset.role = role;
-  views = { console: createConsole($('console-view'), role, report), explorer: createExplorer($('explorer-view'), report) };
+  views = { console: createConsole($('console-view'), role, report, server), explorer: createExplorer($('explorer-view'), report) };
   await route();
 }
 
@@ -61,4 +64,15 @@ $('login-form').addEventListener('submit', (e) => {
 $('logout').addEventListener('click', () => { setToken(''); location.hash = ''; location.reload(); });
 window.addEventListener('hashchange', route);
 
-if (getToken()) signIn(); else $('login-view').hidden = false;
+// Which program serves this page; an older brdfd without /api/about is a rig's.
+async function identify() {
+  try {
+    const r = await fetch('/api/about');
+    if (r.ok) server = (await r.json()).server || server;
+  } catch { /* a rig's brdfd */ }
+  document.body.dataset.server = server;
+  document.querySelector('header h1').textContent = server;
+  document.title = server === 'brdf-archive' ? 'brdf-archive: the lab archive' : 'brdfd';
+}
+
+identify().then(() => { if (getToken()) signIn(); else $('login-view').hidden = false; });

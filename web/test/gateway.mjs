@@ -62,6 +62,10 @@ try {
   check(r.status === 413, `a 2 MiB body → 413 (${r.status})`);
   const g = await fetch(api('Control/ListSessions'));
   check(g.status === 405, 'GET on the API → 405');
+  const about = await fetch(new URL('/api/about', rig.url));
+  const aboutJson = await about.json();
+  check(about.status === 200 && aboutJson.server === 'brdfd' && Object.keys(aboutJson).length === 1 &&
+    /default-src 'none'/.test(about.headers.get('content-security-policy') || ''), `GET /api/about → ${JSON.stringify(aboutJson)} with the security headers, no token needed`);
 
   r = await post('Data/StreamReadings?omit=radiance,nonsense', { session_id: '1' }, rig.analystToken);
   check(r.status === 400 && /no field "nonsense"/.test(r.json.message), `?omit= of an unknown field → 400 (${r.json?.message})`);

@@ -36,7 +36,8 @@ function tail(file) {
   try { return readFileSync(file, 'utf8').slice(-3000); } catch { return ''; }
 }
 
-export async function startRig({ timeScale = 40 } = {}) {
+// `extraConfig`: TOML appended to brdfd's configuration (e.g. [rig] name and [archive]).
+export async function startRig({ timeScale = 40, extraConfig = '' } = {}) {
   const dir = mkdtempSync(join(tmpdir(), 'brdf-web-'));
   const operatorToken = 'op-' + Math.random().toString(36).slice(2) + 'xxxxxxxxxxxxxxxx';
   const analystToken = 'an-' + Math.random().toString(36).slice(2) + 'yyyyyyyyyyyyyyyy';
@@ -77,7 +78,7 @@ role = "analyst"
 listen = "127.0.0.1:0"
 [log]
 level = "info"
-`);
+${extraConfig}`);
   const daemonLog = join(dir, 'brdfd.log');
   const daemon = spawn(brdfd, ['--config', config, '--shutdown-timeout', '3'], { stdio: ['ignore', 'pipe', openSync(daemonLog, 'w')] });
   const info = await waitFor(daemon, 'brdfd', { web: /^brdfd web console on (\S+)/, grpc: /^brdfd listening on (\S+)/ }, 20, daemonLog);
@@ -98,6 +99,44 @@ level = "info"
     },
   };
   return rig;
+}
+
+// brdf-archive over `conninfo` (a libpq conninfo, written to a credentials file readable by
+// its owner only) with the rig's two tokens and its web explorer on a free port.
+export async function startArchive({ conninfo, operatorToken, analystToken }) {
+  const dir = mkdtempSync(join(tmpdir(), 'brdf-web-archive-'));
+  const { openSync } = await import('node:fs');
+  const credentials = join(dir, 'archive.conninfo');
+  writeFileSync(credentials, `${conninfo}\n`, { mode: 0o600 });
+  const config = join(dir, 'brdf-archive.toml');
+  writeFileSync(config, `[server]
+listen = "127.0.0.1:0"
+[archive]
+credentials = "${credentials}"
+[[auth.tokens]]
+name = "web-operator"
+token = "${operatorToken}"
+role = "operator"
+[[auth.tokens]]
+name = "web-analyst"
+token = "${analystToken}"
+role = "analyst"
+[web]
+listen = "127.0.0.1:0"
+[log]
+level = "info"
+`, { mode: 0o600 });
+  const log = join(dir, 'brdf-archive.log');
+  const proc = spawn(join(build, 'daemon/brdf-archive'), ['--config', config], { stdio: ['ignore', 'pipe', openSync(log, 'w')] });
+  const info = await waitFor(proc, 'brdf-archive', { web: /^brdf-archive web explorer on (\S+)/, grpc: /^brdf-archive listening on (\S+)/ }, 20, log);
+  return {
+    url: info.web, grpc: info.grpc, log,
+    async stop() {
+      if (proc.exitCode !== null) return;
+      proc.kill('SIGTERM');
+      await new Promise((r) => { const t = setTimeout(() => { proc.kill('SIGKILL'); r(); }, 8000); proc.on('exit', () => { clearTimeout(t); r(); }); });
+    },
+  };
 }
 
 export function outputDir() {
