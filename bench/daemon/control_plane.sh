@@ -26,17 +26,9 @@ sim="$build/tools/brdf-sim/brdf-sim"
 ctl="$build/tools/brdfctl/brdfctl"
 bin="$build/bench/daemon"
 
-work="$(mktemp -d /tmp/brdfd-ctlbench.XXXXXX)"
-pids=()
-cleanup() {
-  local p
-  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
-  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
-  if [[ "${BENCH_KEEP:-0}" == 1 ]]; then echo "kept: $work" >&2; else rm -rf "$work"; fi
-}
-trap cleanup EXIT
 # shellcheck source=bench/daemon/lib.sh
 source "$here/lib.sh"
+bench_workdir_and_cleanup /tmp/brdfd-ctlbench.XXXXXX
 
 echo "== a 10,000-reading session (bench_storage), brdf-sim, brdfd" >&2
 "$bin/bench_storage" create --db "$work/bench.db" --readings 10000 >/dev/null

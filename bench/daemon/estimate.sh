@@ -31,18 +31,9 @@ brdfd="$build/daemon/brdfd"
 sim="$build/tools/brdf-sim/brdf-sim"
 ctl="$build/tools/brdfctl/brdfctl"
 
-work="$(mktemp -d /tmp/brdfd-estimate.XXXXXX)"
-pids=()
-cleanup() {
-  local p
-  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
-  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
-  if [[ "${BENCH_KEEP:-0}" == 1 ]]; then echo "kept: $work" >&2; else rm -rf "$work"; fi
-}
-trap cleanup EXIT
-
 # shellcheck source=bench/daemon/lib.sh
 source "$here/lib.sh"
+bench_workdir_and_cleanup /tmp/brdfd-estimate.XXXXXX
 config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
 stop_pid() { kill -TERM "$1" 2>/dev/null || true; wait "$1" 2>/dev/null || true; }
 
@@ -72,11 +63,7 @@ for entry in $plans; do
   export BRDF_ADDRESS
   BRDF_ADDRESS="$(awk '/^brdfd listening on/ { print $4 }' "$dir/brdfd.out")"
   export BRDF_TOKEN="$operator_token"
-  for ((i = 0; i < 200; i++)); do
-    rig="$("$ctl" rig 2>/dev/null || true)"
-    if grep -q '^meter: connected' <<<"$rig" && grep -q '^stage: connected' <<<"$rig"; then break; fi
-    sleep 0.1
-  done
+  wait_for_rig_connected "$ctl"
 
   "$ctl" validate "$plan" --time-scale "$scale" | sed 's/^/   /' >&2
   summary="$("$ctl" --json validate "$plan" --time-scale "$scale")"

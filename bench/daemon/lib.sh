@@ -1,10 +1,31 @@
 # shellcheck shell=bash
-# Shared by bench/daemon's scripts (sourced, not run): fresh bearer tokens, waiting for a line in
-# a log, and brdfd's configuration for a rig on brdf-sim.
+# Shared by bench/daemon's scripts (sourced, not run): fresh bearer tokens, the work directory
+# and the processes to stop on exit, waiting for a line in a log or for the rig to connect, and
+# brdfd's configuration for a rig on brdf-sim.
 
 # shellcheck disable=SC2034  # used by the scripts that source this file
 operator_token="bench-operator-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
 analyst_token="bench-analyst-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
+
+# Makes the work directory (mktemp -d on template $1) in `work`, starts `pids` empty, and traps
+# EXIT to bench_cleanup: a script adds the pid of each process it starts to `pids`, and any other
+# directory to remove on exit to `cleanup_dirs`.
+bench_workdir_and_cleanup() {
+  work="$(mktemp -d "$1")"
+  pids=()
+  cleanup_dirs=()
+  trap bench_cleanup EXIT
+}
+
+# Stops every process in `pids` (SIGTERM, then waits for each), removes `cleanup_dirs`, and removes
+# `work` unless BENCH_KEEP=1.
+bench_cleanup() {
+  local p
+  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+  if ((${#cleanup_dirs[@]} > 0)); then rm -rf "${cleanup_dirs[@]}"; fi
+  if [[ "${BENCH_KEEP:-0}" == 1 ]]; then echo "kept: $work" >&2; else rm -rf "$work"; fi
+}
 
 # Waits up to $3 s for a line matching $2 in file $1.
 wait_line() {
@@ -14,6 +35,22 @@ wait_line() {
     sleep 0.1
   done
   echo "bench/daemon: no '$2' in $1 after $3 s" >&2
+  return 1
+}
+
+# Waits up to $2 s (default 20) until `$1 rig` (brdfctl, with BRDF_ADDRESS and BRDF_TOKEN set)
+# shows both the meter and the stage connected; the devices connect in the background.
+wait_for_rig_connected() {
+  local i rig=""
+  for ((i = 0; i < ${2:-20} * 10; i++)); do
+    rig="$("$1" rig 2>/dev/null || true)"
+    if grep -q '^meter: connected' <<<"$rig" && grep -q '^stage: connected' <<<"$rig"; then
+      return 0
+    fi
+    sleep 0.1
+  done
+  echo "bench/daemon: the rig at ${BRDF_ADDRESS:-?} did not connect within ${2:-20} s (brdfctl rig:" \
+    "$(tr '\n' ' ' <<<"$rig")); see brdfd's log" >&2
   return 1
 }
 

@@ -46,23 +46,14 @@ sim="$build/tools/brdf-sim/brdf-sim"
 ctl="$build/tools/brdfctl/brdfctl"
 bin="$build/bench/daemon"
 
-work="$(mktemp -d /tmp/brdfd-bench.XXXXXX)"
+# shellcheck source=bench/daemon/lib.sh
+source "$here/lib.sh"
+bench_workdir_and_cleanup /tmp/brdfd-bench.XXXXXX
 # Sessions for the memory figure are written on a tmpfs (their fsyncs are not what is measured).
 shm_parent=/dev/shm
 [[ -d "$shm_parent" && -w "$shm_parent" ]] || shm_parent="$work"
 shm="$(mktemp -d "$shm_parent/brdfd-bench.XXXXXX")"
-pids=()
-cleanup() {
-  local p
-  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
-  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
-  rm -rf "$shm"
-  if [[ "${BENCH_KEEP:-0}" == 1 ]]; then echo "kept: $work" >&2; else rm -rf "$work"; fi
-}
-trap cleanup EXIT
-
-# shellcheck source=bench/daemon/lib.sh
-source "$here/lib.sh"
+cleanup_dirs+=("$shm")
 config_axis_speed=30
 config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
 
@@ -110,11 +101,7 @@ write_config "$work/live.db" "$pr650" "$modbus" "$loop_pin" >"$work/live.toml"
 start_brdfd "$work/live.toml" "$work/live.log"
 live_pid=$brdfd_pid
 export BRDF_ADDRESS="$address" BRDF_TOKEN="$operator_token"
-for ((i = 0; i < 200; i++)); do
-  rig="$("$ctl" rig 2>/dev/null || true)"
-  if grep -q '^meter: connected' <<<"$rig" && grep -q '^stage: connected' <<<"$rig"; then break; fi
-  sleep 0.1
-done
+wait_for_rig_connected "$ctl"
 # Long enough to go on recording through both windows (a) and (b): steps_recorded > 0 in each.
 cat >"$work/live-plan.json" <<'EOF'
 {"name": "bench: recording while queried",

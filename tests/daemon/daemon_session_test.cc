@@ -15,8 +15,8 @@
 #include <thread>
 
 #include "storage/session_store.h"
-#include "tests/daemon/daemon_test_rig.h"
 #include "tests/daemon/daemon_test_util.h"
+#include "tests/daemon/session_rig_test.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
@@ -44,37 +44,8 @@ std::int64_t IdOf(const v1::Session& s) {
   return std::stoll(s.session_id());
 }
 
-class DaemonSessionTest : public ::testing::Test {
+class DaemonSessionTest : public SessionRigTest {
  protected:
-  void SetUp() override {
-    Status sim = rig_.StartSim();
-    ASSERT_TRUE(sim.ok()) << sim.ToString();
-    Status daemon = rig_.StartDaemon();
-    ASSERT_TRUE(daemon.ok()) << daemon.ToString();
-  }
-
-  void TearDown() override {
-    for (auto& op : operators_) {
-      op->Stop();
-      for (const std::string& e : op->errors()) ADD_FAILURE() << "operator: " << e;
-    }
-    operators_.clear();
-    if (rig_.daemon() != nullptr) {
-      // A clean stop is part of every test: SIGTERM → exit 0.
-      Result<int> code = rig_.StopDaemon();
-      EXPECT_TRUE(code.ok() && *code == 0)
-          << (code.ok() ? "exit code " + std::to_string(*code) : code.status().ToString());
-    }
-    if (HasFailure() || std::getenv("BRDF_TEST_SHOW_LOG") != nullptr) {
-      std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n----\n";
-    }
-  }
-
-  GrpcOperator& Watch(const std::string& session_id, bool answering = true) {
-    operators_.push_back(std::make_unique<GrpcOperator>(rig_, session_id, answering));
-    return *operators_.back();
-  }
-
   v1::Session SubmitAndWatch(const std::string& plan) {
     Result<v1::Session> s = rig_.Submit(plan);
     EXPECT_TRUE(s.ok()) << s.status().ToString();
@@ -109,9 +80,6 @@ class DaemonSessionTest : public ::testing::Test {
     return static_cast<int>(s.summary().sample_readings() + s.summary().reference_readings() +
                             s.summary().dark_readings());
   }
-
-  DaemonRig rig_;
-  std::vector<std::unique_ptr<GrpcOperator>> operators_;
 };
 
 TEST_F(DaemonSessionTest, SampleRotationPlanRunsToCompletionWithEveryReadingAndEvent) {

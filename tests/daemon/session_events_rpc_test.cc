@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "google/protobuf/util/time_util.h"
-#include "tests/daemon/daemon_test_rig.h"
+#include "tests/daemon/session_rig_test.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
@@ -17,38 +17,14 @@ namespace {
 using namespace std::chrono_literals;
 using google::protobuf::util::TimeUtil;
 
-class SessionEventsRpcTest : public ::testing::Test {
+class SessionEventsRpcTest : public SessionRigTest {
  protected:
-  void SetUp() override {
-    Status sim = rig_.StartSim();
-    ASSERT_TRUE(sim.ok()) << sim.ToString();
-    Status daemon = rig_.StartDaemon();
-    ASSERT_TRUE(daemon.ok()) << daemon.ToString();
-  }
-
-  void TearDown() override {
-    for (auto& op : operators_) {
-      op->Stop();
-      for (const std::string& e : op->errors()) ADD_FAILURE() << "operator: " << e;
-    }
-    operators_.clear();
-    if (rig_.daemon() != nullptr) {
-      Result<int> code = rig_.StopDaemon();
-      EXPECT_TRUE(code.ok() && *code == 0)
-          << (code.ok() ? "exit code " + std::to_string(*code) : code.status().ToString());
-    }
-    if (HasFailure()) std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n----\n";
-  }
-
   grpc::Status List(const std::string& id, v1::ListSessionEventsResponse* out,
                     const std::string& token = kOperatorToken) {
     v1::ListSessionEventsRequest request;
     request.set_session_id(id);
     return rig_.control().ListSessionEvents(DaemonRig::Context(token).get(), request, out);
   }
-
-  DaemonRig rig_;
-  std::vector<std::unique_ptr<GrpcOperator>> operators_;
 };
 
 std::string Names(const std::vector<v1::SessionState>& states) {
@@ -63,7 +39,7 @@ TEST_F(SessionEventsRpcTest, PauseResumeCompleteIsTheHistoryInOrderWithReasons) 
       rig_.Submit(plans::SlowRotation(/*alpha_stop=*/10, /*beta_step=*/45, /*averages=*/10));
   ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
   const std::string id = submitted->session_id();
-  operators_.push_back(std::make_unique<GrpcOperator>(rig_, id, /*answering=*/true));
+  Watch(id);
 
   rig_.WaitFor(id, [](const v1::Session& x) {
     return x.progress().done_samples() >= 1 && x.state() == v1::SESSION_STATE_RUNNING;

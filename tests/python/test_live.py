@@ -135,6 +135,33 @@ class LiveSession(unittest.TestCase):
         self.assertEqual(states.get("meter"), brdf_pb2.CONNECTION_STATE_CONNECTED, rig)
         self.assertEqual(states.get("stage"), brdf_pb2.CONNECTION_STATE_CONNECTED, rig)
 
+    def test_session_events_history(self):
+        """list_session_events: the completed session's states oldest first (QUEUED, RUNNING, the
+        prompts' AWAITING_OPERATOR, COMPLETED), ids increasing, times set and not going back."""
+        sid = self.session.session_id
+        events = self.client.list_session_events(sid)
+        self.assertGreaterEqual(len(events), 3, events)
+        self.assertEqual(collapsed_states(events), ["queued", "running", "completed"], events)
+        self.assertIn("awaiting_operator", [names.state_name(e.state) for e in events])
+        self.assertEqual(names.state_name(events[0].state), "queued")
+        self.assertEqual(events[0].at.ToMilliseconds(),
+                         self.session.created_at.ToMilliseconds())
+        for before, after in zip(events, events[1:]):
+            self.assertGreater(after.id, before.id)
+            self.assertGreaterEqual(after.at.ToNanoseconds(), before.at.ToNanoseconds())
+        for e in events:
+            self.assertTrue(e.HasField("at") and e.at.seconds > 0, e)
+        now = self.client.get_session(sid)
+        self.assertEqual(events[-1].reason, now.state_reason)
+        # An analyst reads the same history; an unknown or malformed id is refused.
+        with BrdfClient(self.rig.address, self.rig.analyst_token) as analyst:
+            self.assertEqual(analyst.list_session_events(sid), events)
+        e = self.assertCode(grpc.StatusCode.NOT_FOUND, self.client.list_session_events, "987654")
+        self.assertEqual(e.method, "Control.ListSessionEvents")
+        self.assertIn("987654", e.message)
+        self.assertCode(grpc.StatusCode.INVALID_ARGUMENT, self.client.list_session_events,
+                        "not-a-session")
+
     # --- readings --------------------------------------------------------------------------------
 
     def test_readings_arrays(self):
@@ -371,6 +398,11 @@ class LiveSession(unittest.TestCase):
         s = self.client.abort(sid, reason="test over")
         self.assertEqual(names.state_name(s.state), "aborted")
         self.assertIn("test over", self.client.get_session(sid).end_reason)
+        # The history has the pause and the resume (an immediate pause: no PAUSING), in order.
+        events = self.client.list_session_events(sid)
+        self.assertEqual(collapsed_states(events),
+                         ["queued", "running", "paused", "running", "aborted"], events)
+        self.assertEqual([e.id for e in events], sorted({e.id for e in events}))
 
     # --- figures -----------------------------------------------------------------------------------
 
@@ -404,6 +436,17 @@ def wait_for_state(client, session_id, wanted, timeout=30.0):
             raise AssertionError(f"session {session_id} is {names.state_name(s.state)}, "
                                  f"not {wanted}, after {timeout} s")
         time.sleep(0.05)
+
+
+def collapsed_states(events):
+    """The short state names of SessionStateEvents in order, without the prompts'
+    AWAITING_OPERATOR and without repeats of a state (a changed reason)."""
+    states = []
+    for e in events:
+        name = names.state_name(e.state)
+        if name != "awaiting_operator" and (not states or states[-1] != name):
+            states.append(name)
+    return states
 
 
 def simulator_truth(theta_i, phi_i, theta_o, phi_o):

@@ -1,0 +1,55 @@
+// The fixture of the session tests over gRPC: brdf-sim and brdfd as processes, and the gRPC
+// operators a test starts (Watch), stopped at its end with their errors as failures. A clean stop
+// of brdfd is part of every test (SIGTERM → exit 0). brdfd's log goes to standard error when a
+// test fails (or with BRDF_TEST_SHOW_LOG set).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tests/daemon/daemon_test_rig.h"
+
+namespace brdf::testing {
+
+class SessionRigTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    Status sim = rig_.StartSim();
+    ASSERT_TRUE(sim.ok()) << sim.ToString();
+    Status daemon = rig_.StartDaemon();
+    ASSERT_TRUE(daemon.ok()) << daemon.ToString();
+  }
+
+  void TearDown() override {
+    for (auto& op : operators_) {
+      op->Stop();
+      for (const std::string& e : op->errors()) ADD_FAILURE() << "operator: " << e;
+    }
+    operators_.clear();
+    if (rig_.daemon() != nullptr) {
+      Result<int> code = rig_.StopDaemon();
+      EXPECT_TRUE(code.ok() && *code == 0)
+          << (code.ok() ? "exit code " + std::to_string(*code) : code.status().ToString());
+    }
+    if (HasFailure() || std::getenv("BRDF_TEST_SHOW_LOG") != nullptr) {
+      std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n----\n";
+    }
+  }
+
+  // A gRPC operator watching the session (and answering its prompts unless `answering` is false)
+  // until the test ends.
+  GrpcOperator& Watch(const std::string& session_id, bool answering = true) {
+    operators_.push_back(std::make_unique<GrpcOperator>(rig_, session_id, answering));
+    return *operators_.back();
+  }
+
+  DaemonRig rig_;
+  std::vector<std::unique_ptr<GrpcOperator>> operators_;
+};
+
+}  // namespace brdf::testing
