@@ -282,8 +282,6 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
   AppearanceSettings s;
   if (grpc::Status st = ParseAppearance(*request, &s); !st.ok()) return st;
 
-  Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir);
-  if (!cie.ok()) return ToGrpcStatus(cie.status());
   Result<std::shared_ptr<const IndexSnapshot>> got =
       cache_.Get(s.session, Quantity::kBrdf, s.method, s.options);
   if (!got.ok()) return ToGrpcStatus(got.status());
@@ -342,7 +340,10 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
   auto rendered = std::make_shared<v1::AppearanceResponse>();
   bool lasting = false;
   grpc::Status st(grpc::StatusCode::CANCELLED, "RenderAppearance: cancelled");
-  if (slot->Work()) {
+  if (Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir); !cie.ok()) {
+    st = ToGrpcStatus(cie.status());
+    lasting = true;  // the installation's: the same for every call
+  } else if (slot->Work()) {
     ++appearance_renders_;
     st = Render(cache_, stopping_, *context, s, *cie, index, rendered.get(), &lasting);
   }
