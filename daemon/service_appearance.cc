@@ -265,6 +265,11 @@ std::shared_ptr<const v1::AppearanceResponse> InterpolationService::CachedAppear
   return nullptr;
 }
 
+std::size_t InterpolationService::appearance_flights() const {
+  MutexLock lock(appearance_mu_);
+  return appearance_flights_.size();
+}
+
 grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context,
                                                     const v1::AppearanceRequest* request,
                                                     v1::AppearanceResponse* response) {
@@ -343,7 +348,7 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
   if (Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir); !cie.ok()) {
     st = ToGrpcStatus(cie.status());
     lasting = true;  // the installation's: the same for every call
-  } else if (slot->Work()) {
+  } else if (slot->Work() && !context->IsCancelled()) {
     ++appearance_renders_;
     st = Render(cache_, stopping_, *context, s, *cie, index, rendered.get(), &lasting);
   }

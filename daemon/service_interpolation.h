@@ -98,6 +98,8 @@ class InterpolationService final
   // served from the cache or from an identical request's render.
   std::uint64_t appearance_renders() const { return appearance_renders_.load(); }
   std::uint64_t appearance_reuses() const { return appearance_reuses_.load(); }
+  // RenderAppearance's renders under way (each with the identical calls that wait for it).
+  std::size_t appearance_flights() const;
 
  private:
   // What a RenderAppearance answer depends on: the index snapshot (its address, alive while
@@ -139,7 +141,7 @@ class InterpolationService final
   const StopSignal& stopping_;
   StreamRegistry& streams_;
 
-  Mutex appearance_mu_;
+  mutable Mutex appearance_mu_;
   CondVar appearance_done_;                                                 // a flight ended
   std::list<AppearanceEntry> appearance_cache_ GUARDED_BY(appearance_mu_);  // most recent first
   std::list<std::shared_ptr<AppearanceFlight>> appearance_flights_ GUARDED_BY(appearance_mu_);

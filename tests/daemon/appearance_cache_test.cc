@@ -8,13 +8,16 @@
 //     used answer goes once more than kAppearanceCacheEntries are kept;
 //   - a reading that lands (handed over as the rig does, IndexCache::OnReading) makes the same
 //     request render again, over the grown snapshot;
-//   - identical requests at the same time render once, all answered with the same bytes.
+//   - identical requests at the same time render once, all answered with the same bytes;
+//   - a call whose render is cancelled before it starts (every work permit taken) leaves it to
+//     an identical call, which renders it.
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <functional>
 #include <map>
 #include <memory>
 #include <random>
@@ -270,6 +273,55 @@ TEST_F(AppearanceCacheTest, IdenticalRequestsAtTheSameTimeRenderOnce) {
   for (int i = 1; i < kCalls; ++i) {
     EXPECT_TRUE(answers[static_cast<std::size_t>(i)] == answers[0]) << "answer " << i;
   }
+}
+
+TEST_F(AppearanceCacheTest, ARenderCancelledBeforeItStartsIsLeftToTheIdenticalCall) {
+  const std::int64_t session = MakeSession(150, 0);
+  const v1::AppearanceRequest request = Request(session, 48);
+  auto until = [](const std::function<bool()>& done) {
+    for (int i = 0; i < 3000 && !done(); ++i) std::this_thread::sleep_for(10ms);
+    return done();
+  };
+
+  // Every work permit taken: a render cannot start.
+  grpc::ServerContext idle;
+  std::vector<std::unique_ptr<StreamRegistry::Slot>> held;
+  for (int i = 0; i < streams_.work_permits(); ++i) {
+    std::unique_ptr<StreamRegistry::Slot> slot;
+    ASSERT_TRUE(streams_.Open(idle, nullptr, "test", &slot, /*computes=*/true).ok());
+    held.push_back(std::move(slot));
+  }
+  const int open = streams_.open();
+
+  // The first call would render (its flight is up), waiting for a permit; an identical one comes.
+  grpc::ClientContext first_context;
+  first_context.set_deadline(std::chrono::system_clock::now() + 60s);
+  v1::AppearanceResponse first_response;
+  grpc::Status first_status;
+  std::thread first(
+      [&] { first_status = stub_->RenderAppearance(&first_context, request, &first_response); });
+  ASSERT_TRUE(until([&] { return service_->appearance_flights() == 1; }));
+  std::string second;
+  std::thread second_call([&] { second = RenderBytes(request); });
+  ASSERT_TRUE(until([&] { return streams_.open() == open + 2; }));
+
+  // The first is cancelled before it could render: the second renders, once the permits are free.
+  first_context.TryCancel();
+  first.join();
+  EXPECT_EQ(first_status.error_code(), grpc::StatusCode::CANCELLED) << first_status.error_message();
+  ASSERT_TRUE(until([&] { return streams_.open() == open + 1; }))
+      << "the cancelled call's handler did not return";
+  // Its flight is gone with it; the one up now is the second call's.
+  EXPECT_TRUE(until([&] { return service_->appearance_flights() == 1; }))
+      << "the second call did not take the render over";
+  EXPECT_EQ(renders(), 0u);
+  held.clear();
+  second_call.join();
+  EXPECT_EQ(renders(), 1u);
+  EXPECT_EQ(service_->appearance_flights(), 0u);
+  ASSERT_FALSE(second.empty());
+  EXPECT_TRUE(RenderBytes(request) == second);
+  EXPECT_EQ(renders(), 1u);
 }
 
 }  // namespace
