@@ -29,12 +29,24 @@
 // batch: sphere_size at most kMaxAppearanceSphere (INVALID_ARGUMENT naming it), light 0 or 3
 // finite values not all 0, illuminants known and each at most once. It holds a work permit of the
 // stream registry while it computes (as InterpolateBatch and Export do).
+// Its answers are cached: the last kAppearanceCacheEntries of them, keyed by the index snapshot
+// they were rendered from and the request's bytes (deterministic serialization), so the same
+// request on a session that has not grown since is answered with the same bytes without
+// rendering, and a reading that lands makes the next one render anew. A request identical to one
+// being rendered waits for that answer instead of rendering it too (it renders itself only if the
+// first was cancelled or its answer depended on the first's deadline). Only cache misses take a
+// work permit.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <list>
+#include <memory>
 #include <optional>
+#include <string>
 
 #include "brdf/v1/brdf.grpc.pb.h"
+#include "core/mutex.h"
 #include "daemon/auth.h"
 #include "daemon/index_cache.h"
 #include "daemon/service_common.h"
@@ -46,6 +58,8 @@ namespace brdf::daemon {
 // illuminant, under a client's default 4 MiB receive limit for both).
 inline constexpr std::uint32_t kDefaultAppearanceSphere = 128;
 inline constexpr std::uint32_t kMaxAppearanceSphere = 512;
+// RenderAppearance's answers kept (at most 2 MiB each: two spheres of kMaxAppearanceSphere²).
+inline constexpr std::size_t kAppearanceCacheEntries = 8;
 
 // InterpolationOptions checked (INVALID_ARGUMENT naming options.axis_scale[i] or
 // options.coordinates) into the interpolator's options.
@@ -80,7 +94,43 @@ class InterpolationService final
   grpc::Status Answer(const grpc::ServerContextBase& context, const v1::InterpolateRequest& request,
                       v1::InterpolateResponse* response);
 
+  // RenderAppearance's renders since the start (cache misses that rendered), and its answers
+  // served from the cache or from an identical request's render.
+  std::uint64_t appearance_renders() const { return appearance_renders_.load(); }
+  std::uint64_t appearance_reuses() const { return appearance_reuses_.load(); }
+  // RenderAppearance's renders under way (each with the identical calls that wait for it).
+  std::size_t appearance_flights() const;
+
  private:
+  // What a RenderAppearance answer depends on: the index snapshot (its address, alive while
+  // `index` is: a later snapshot at a freed one's address never matches) and the request.
+  struct AppearanceKey {
+    const IndexSnapshot* index = nullptr;
+    SessionId session = 0;
+    std::int64_t through_reading_id = 0;
+    std::string request;  // AppearanceRequest, serialized deterministically
+    bool operator==(const AppearanceKey&) const = default;
+  };
+  struct AppearanceEntry {
+    AppearanceKey key;
+    std::weak_ptr<const IndexSnapshot> index;
+    std::shared_ptr<const v1::AppearanceResponse> response;
+  };
+  // A render under way; its waiters read the outcome once `done`.
+  struct AppearanceFlight {
+    AppearanceKey key;
+    bool done = false;
+    // The outcome holds for any caller (false: cancelled, or a stage of the fill chain failed for
+    // a reason of this call, its deadline): a waiter then renders itself.
+    bool shared = false;
+    grpc::Status status;
+    std::shared_ptr<const v1::AppearanceResponse> response;
+  };
+  // The cached answer for `key` (moved to the front), or null; drops entries whose snapshot is
+  // gone.
+  std::shared_ptr<const v1::AppearanceResponse> CachedAppearance(const AppearanceKey& key)
+      REQUIRES(appearance_mu_);
+
   // Both of the above; with `may_load` false, returns nullopt where it would load.
   std::optional<grpc::Status> Respond(const grpc::ServerContextBase& context,
                                       const v1::InterpolateRequest& request,
@@ -90,6 +140,13 @@ class InterpolationService final
   const Authenticator& auth_;
   const StopSignal& stopping_;
   StreamRegistry& streams_;
+
+  mutable Mutex appearance_mu_;
+  CondVar appearance_done_;                                                 // a flight ended
+  std::list<AppearanceEntry> appearance_cache_ GUARDED_BY(appearance_mu_);  // most recent first
+  std::list<std::shared_ptr<AppearanceFlight>> appearance_flights_ GUARDED_BY(appearance_mu_);
+  std::atomic<std::uint64_t> appearance_renders_{0};
+  std::atomic<std::uint64_t> appearance_reuses_{0};
 };
 
 }  // namespace brdf::daemon

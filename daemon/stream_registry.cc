@@ -192,6 +192,11 @@ void StreamRegistry::Slot::Close() {
   holding_ = false;
 }
 
+bool StreamRegistry::Slot::Work() {
+  if (!holding_) holding_ = registry_->AcquireWork(*entry_->context);
+  return holding_;
+}
+
 void StreamRegistry::Slot::BeginWrite() {
   Close();
   entry_->write_since_ns.store(NowNs());

@@ -10,8 +10,9 @@
 // cannot exhaust it, and the control plane is not on it at all (control_loop.h).
 //
 // Bounded work: a stream that computes what it sends (Export, InterpolateBatch: opened with
-// `computes`) works only while it holds one of a few work permits (one per two cores), and gives
-// its permit back while a write waits for the client. A thousand exports then take turns on the
+// `computes`; RenderAppearance takes one with Slot::Work once it knows it must render) works only
+// while it holds one of a few work permits (one per two cores), and gives its permit back while a
+// write waits for the client. A thousand exports then take turns on the
 // cores instead of all running at once. Every stream's thread runs at nice 10 while the stream is
 // open (back to 0 after), below the control plane's threads and Interpolate's loop, which get a
 // core when they need one.
@@ -66,6 +67,10 @@ class StreamRegistry {
     }
     // Releases the work permit (if any) before it goes away.
     void Close();
+    // Takes a work permit now if it holds none: for a call that learns only after Open whether it
+    // has work to do (RenderAppearance, on a cache miss). Waits for one; false when the call was
+    // cancelled meanwhile.
+    bool Work();
 
    private:
     friend class StreamRegistry;
