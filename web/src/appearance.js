@@ -27,6 +27,9 @@ function drawSwatch(canvas, hex) {
   ctx.fillRect(0, 0, canvas.width, canvas.height);
 }
 
+// Above this many sample readings the panel renders only when asked (see load()).
+const AUTO_RENDER_READINGS = 20000;
+
 export function createAppearance(root, report) {
   const method = el('select', { id: 'appearance-method' },
     el('option', { value: 'INTERPOLATION_METHOD_OCTANT' }, 'octant (paper)'),
@@ -79,7 +82,18 @@ export function createAppearance(root, report) {
   }
 
   return {
-    // A session was loaded in the explorer.
-    load(id) { session = id; return render(); },
+    // A session of `readings` sample readings was loaded in the explorer: rendered at once, but
+    // for a large session only on request. Its first render builds the fill chain's indexes over
+    // every reading (mirrored and swapped: 4×), which on 50,000 readings takes the daemon close to
+    // a minute and its one work permit; the plots must stay interactive meanwhile.
+    load(id, readings) {
+      session = id;
+      if (readings > AUTO_RENDER_READINGS) {
+        clear(images);
+        info.textContent = `${readings} sample readings: press Render for the colour and lit spheres (on a session this large the daemon needs up to a minute the first time; the answer is then kept).`;
+        return Promise.resolve();
+      }
+      return render();
+    },
   };
 }

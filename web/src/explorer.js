@@ -135,7 +135,7 @@ export function createExplorer(root, report) {
       showGridSize();
     }
     // After the first view: the server renders it with the same work permits as the plots.
-    await appearance.load(id);
+    await appearance.load(id, points.ids.length);
   }
 
   function joinColumns(chunks) {
