@@ -28,6 +28,12 @@
 //   in the interpolation's answer; the sessions now at the rig's poses, 6.01 MB of points):
 //   with the polar plot median 1646 ms (small 718 ms, ratio 2.29; main's build on the same
 //   sessions just before: 4689 ms), new direction 98.1 ms (main's 104.1 ms); bench/README.md.
+//   2026-12-05, later (the lit sphere rendered at load then): views after the first took 20–60 s,
+//   each reload asking the daemon for the same ~50 s render again. With RenderAppearance's answer
+//   cache and no render at load above 20,000 readings: 5 views, Figure 7 median 1693 ms (small
+//   1096 ms, ratio 1.54), with the polar plot 2009 ms (small 1374 ms, ratio 1.46); new direction
+//   112.2 ms, no-op 11.6 ms. A second run (3 views, load 2–3): Figure 7 2475 ms, with the polar
+//   plot 2925 ms (ratios 2.04, 2.25); new direction 74.0 ms, of which the Interpolate call 16.0 ms.
 import puppeteer from 'puppeteer-core';
 import { spawn, execFileSync } from 'node:child_process';
 import { mkdtempSync, writeFileSync, openSync, readFileSync, copyFileSync, existsSync } from 'node:fs';
