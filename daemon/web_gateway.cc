@@ -114,8 +114,34 @@ class WebStreams {
 
 namespace {
 
+// ?timeout_s=N: a unary call's deadline instead of kUnaryDeadline.
+grpc::Status ParseTimeout(const httplib::Request& req, std::chrono::seconds* deadline) {
+  if (!req.has_param("timeout_s")) return grpc::Status::OK;
+  const std::string value = req.get_param_value("timeout_s");
+  const long longest = static_cast<long>(WebGateway::kLongestUnaryDeadline.count());
+  long seconds = 0;
+  bool digits = !value.empty() && value.size() <= 4;
+  for (const char c : value) {
+    digits = digits && c >= '0' && c <= '9';
+    if (digits) seconds = seconds * 10 + (c - '0');
+  }
+  if (!digits || seconds < 1 || seconds > longest) {
+    return grpc::Status(grpc::INVALID_ARGUMENT, "timeout_s: give whole seconds from 1 to " +
+                                                    std::to_string(longest) + " (got \"" +
+                                                    PrintablePrefix(value) + "\")");
+  }
+  *deadline = std::chrono::seconds(seconds);
+  return grpc::Status::OK;
+}
+
 void ServeStream(const std::shared_ptr<JsonRpc>& rpc, const std::shared_ptr<WebStreams>& streams,
                  const WebMethod& method, const httplib::Request& req, httplib::Response& res) {
+  if (req.has_param("timeout_s")) {
+    ReplyError(res, grpc::Status(grpc::INVALID_ARGUMENT,
+                                 "timeout_s: a stream has no deadline (it ends when its answer "
+                                 "does or the page goes away); leave it out"));
+    return;
+  }
   OmitFields omit;
   if (grpc::Status st = ParseOmit(method, req.get_param_value("omit"), &omit); !st.ok()) {
     ReplyError(res, st);
@@ -220,9 +246,14 @@ void ServeApi(const std::shared_ptr<JsonRpc>& rpc, const std::shared_ptr<WebStre
     ServeStream(rpc, streams, *method, req, res);
     return;
   }
+  std::chrono::seconds deadline = WebGateway::kUnaryDeadline;
+  if (grpc::Status st = ParseTimeout(req, &deadline); !st.ok()) {
+    ReplyError(res, st);
+    return;
+  }
   std::string out;
-  const grpc::Status st = rpc->Unary(*method, req.body, req.get_header_value("Authorization"),
-                                     WebGateway::kUnaryDeadline, &out);
+  const grpc::Status st =
+      rpc->Unary(*method, req.body, req.get_header_value("Authorization"), deadline, &out);
   if (!st.ok()) {
     ReplyError(res, st);
     return;

@@ -6,6 +6,9 @@
 //                          401 (no or unknown token), 403 (role), 400 (bad request or JSON),
 //                          404, 409 (not in this state), 413 (body over kMaxBodyBytes), 429, 503…
 //        ?omit=f1,f2     → (streams) those top-level fields of every answer left out
+//        ?timeout_s=N    → (unary) the call's deadline, whole seconds from 1 to
+//                          kLongestUnaryDeadline (default kUnaryDeadline), e.g. a lit sphere's
+//                          first render on a large session
 //        stream methods  → 200 text/event-stream: one "data: <json>" event per message, then
 //                          "event: end" with {"code","message"} (OK or why the stream ended);
 //                          a call refused before its first message is answered as a unary error.
@@ -57,6 +60,7 @@ class WebGateway {
   static constexpr int kThreads = 24;  // HTTP worker threads (streams hold one each)
   static constexpr std::chrono::seconds kKeepAlive{5};
   static constexpr std::chrono::seconds kUnaryDeadline{60};
+  static constexpr std::chrono::seconds kLongestUnaryDeadline{600};
 
   // Serves config.listen ("host:port"; port 0: any free port, see url()). `root` is the built
   // front end (a directory with index.html; missing: the API alone, GET / says how to build it).

@@ -23,8 +23,10 @@ async function errorOf(r) {
   catch { return new ApiError(`HTTP_${r.status}`, text.trim(), r.status); }
 }
 
-export async function call(method, body = {}) {
-  const r = await fetch(`/api/brdf.v1.${method}`, { method: 'POST', headers: headers(), body: JSON.stringify(body) });
+// `timeoutS`: the call's deadline in seconds when the gateway's default (60 s) is too short.
+export async function call(method, body = {}, timeoutS = 0) {
+  const query = timeoutS ? `?timeout_s=${timeoutS}` : '';
+  const r = await fetch(`/api/brdf.v1.${method}${query}`, { method: 'POST', headers: headers(), body: JSON.stringify(body) });
   if (!r.ok) throw await errorOf(r);
   return r.json();
 }

@@ -71,7 +71,9 @@ export function createAppearance(root, report) {
     try {
       // Mirror images and reciprocity: exact for an isotropic sample, and what the RGL and MERL
       // exports use, so the chosen method answers more of the sphere itself.
-      const r = await call('Interpolation/RenderAppearance', { session_id: session, method: method.value, options: { mirror_phi: true, reciprocity: true } });
+      // Up to 10 minutes: the first render of a large session builds its indexes (the answer is
+      // then kept by the daemon, and the same render again is immediate).
+      const r = await call('Interpolation/RenderAppearance', { session_id: session, method: method.value, options: { mirror_phi: true, reciprocity: true } }, 600);
       clear(images);
       for (const image of r.images) images.append(figure(image));
       info.textContent = `sample colour at 45°:0° (reflectance factor π·f_r) and a sphere lit from the upper left, sRGB, readings mirrored in φ and swapped θi↔θo; a white Lambertian lit head-on would be Y = 1 (${Math.round(performance.now() - t0)} ms)${r.detail ? `. ${r.detail}` : ''}`;
@@ -90,7 +92,7 @@ export function createAppearance(root, report) {
       session = id;
       if (readings > AUTO_RENDER_READINGS) {
         clear(images);
-        info.textContent = `${readings} sample readings: press Render for the colour and lit spheres (on a session this large the daemon needs up to a minute the first time; the answer is then kept).`;
+        info.textContent = `${readings} sample readings: press Render for the colour and lit spheres (on a session this large the daemon needs a minute or more the first time; the answer is then kept).`;
         return Promise.resolve();
       }
       return render();

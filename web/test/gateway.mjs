@@ -62,6 +62,14 @@ try {
   check(r.status === 413, `a 2 MiB body → 413 (${r.status})`);
   const g = await fetch(api('Control/ListSessions'));
   check(g.status === 405, 'GET on the API → 405');
+  r = await post('Control/ListSessions?timeout_s=5', {}, rig.analystToken);
+  check(r.status === 200, `?timeout_s=5 on a unary call is accepted (${r.status})`);
+  for (const bad of ['0', '601', 'abc', '1e3', '']) {
+    r = await post(`Control/ListSessions?timeout_s=${bad}`, {}, rig.analystToken);
+    check(r.status === 400 && /timeout_s: give whole seconds from 1 to 600/.test(r.json?.message), `?timeout_s=${bad} → 400 naming it (${r.json?.message})`);
+  }
+  r = await post('Control/WatchSession?timeout_s=5', { session_id: '1' }, rig.analystToken);
+  check(r.status === 400 && /timeout_s: a stream has no deadline/.test(r.json?.message), `?timeout_s on a stream → 400 (${r.json?.message})`);
   const about = await fetch(new URL('/api/about', rig.url));
   const aboutJson = await about.json();
   check(about.status === 200 && aboutJson.server === 'brdfd' && Object.keys(aboutJson).length === 1 &&
