@@ -36,6 +36,31 @@ function tail(file) {
   try { return readFileSync(file, 'utf8').slice(-3000); } catch { return ''; }
 }
 
+// The part of brdfd's and brdf-archive's configurations the web tests share: an operator and an
+// analyst token, the web console on a free port, the log level.
+function tokensWebAndLog(operatorToken, analystToken) {
+  return `[[auth.tokens]]
+name = "web-operator"
+token = "${operatorToken}"
+role = "operator"
+[[auth.tokens]]
+name = "web-analyst"
+token = "${analystToken}"
+role = "analyst"
+[web]
+listen = "127.0.0.1:0"
+[log]
+level = "info"
+`;
+}
+
+// SIGTERM, then SIGKILL after 8 s; resolves once the process has exited.
+async function stopProcess(p) {
+  if (p.exitCode !== null) return;
+  p.kill('SIGTERM');
+  await new Promise((r) => { const t = setTimeout(() => { p.kill('SIGKILL'); r(); }, 8000); p.on('exit', () => { clearTimeout(t); r(); }); });
+}
+
 // `extraConfig`: TOML appended to brdfd's configuration (e.g. [rig] name and [archive]).
 export async function startRig({ timeScale = 40, extraConfig = '' } = {}) {
   const dir = mkdtempSync(join(tmpdir(), 'brdf-web-'));
@@ -66,19 +91,7 @@ detector_arm_motorized = true
 present = true
 [sample]
 white_reflectance = 0.99
-[[auth.tokens]]
-name = "web-operator"
-token = "${operatorToken}"
-role = "operator"
-[[auth.tokens]]
-name = "web-analyst"
-token = "${analystToken}"
-role = "analyst"
-[web]
-listen = "127.0.0.1:0"
-[log]
-level = "info"
-${extraConfig}`);
+${tokensWebAndLog(operatorToken, analystToken)}${extraConfig}`);
   const daemonLog = join(dir, 'brdfd.log');
   const daemon = spawn(brdfd, ['--config', config, '--shutdown-timeout', '3'], { stdio: ['ignore', 'pipe', openSync(daemonLog, 'w')] });
   const info = await waitFor(daemon, 'brdfd', { web: /^brdfd web console on (\S+)/, grpc: /^brdfd listening on (\S+)/ }, 20, daemonLog);
@@ -91,11 +104,7 @@ ${extraConfig}`);
       return new Promise((resolve, reject) => execFile(ctl, ['sim-mount', target, '--modbus', simInfo.modbus], (err, so, se) => (err ? reject(new Error(se)) : resolve())));
     },
     async stop() {
-      for (const p of [daemon, simProc]) {
-        if (p.exitCode !== null) continue;
-        p.kill('SIGTERM');
-        await new Promise((r) => { const t = setTimeout(() => { p.kill('SIGKILL'); r(); }, 8000); p.on('exit', () => { clearTimeout(t); r(); }); });
-      }
+      for (const p of [daemon, simProc]) await stopProcess(p);
     },
   };
   return rig;
@@ -113,29 +122,13 @@ export async function startArchive({ conninfo, operatorToken, analystToken }) {
 listen = "127.0.0.1:0"
 [archive]
 credentials = "${credentials}"
-[[auth.tokens]]
-name = "web-operator"
-token = "${operatorToken}"
-role = "operator"
-[[auth.tokens]]
-name = "web-analyst"
-token = "${analystToken}"
-role = "analyst"
-[web]
-listen = "127.0.0.1:0"
-[log]
-level = "info"
-`, { mode: 0o600 });
+${tokensWebAndLog(operatorToken, analystToken)}`, { mode: 0o600 });
   const log = join(dir, 'brdf-archive.log');
   const proc = spawn(join(build, 'daemon/brdf-archive'), ['--config', config], { stdio: ['ignore', 'pipe', openSync(log, 'w')] });
   const info = await waitFor(proc, 'brdf-archive', { web: /^brdf-archive web explorer on (\S+)/, grpc: /^brdf-archive listening on (\S+)/ }, 20, log);
   return {
     url: info.web, grpc: info.grpc, log,
-    async stop() {
-      if (proc.exitCode !== null) return;
-      proc.kill('SIGTERM');
-      await new Promise((r) => { const t = setTimeout(() => { proc.kill('SIGKILL'); r(); }, 8000); proc.on('exit', () => { clearTimeout(t); r(); }); });
-    },
+    stop() { return stopProcess(proc); },
   };
 }
 
