@@ -234,18 +234,17 @@ ArchiveDataService::ArchiveDataService(std::shared_ptr<storage::ArchiveReader> a
 grpc::Status ArchiveDataService::StreamReadings(grpc::ServerContext* context,
                                                 const v1::StreamReadingsRequest* request,
                                                 grpc::ServerWriter<v1::Reading>* writer) {
-  return Serve(
-      *context, *request, "StreamReadings",
-      [&](StreamReadingsCall& call, const ReadingExtras& extras, const ReadingSource& source) {
-        return StreamSessionReadings(*context, *request, call, extras, source, writer);
-      });
+  return Serve(*context, *request, "StreamReadings",
+               [&](StreamReadingsCall& call, const ReadingSource& source) {
+                 return StreamSessionReadings(*context, *request, call, source, writer);
+               });
 }
 
 grpc::Status ArchiveDataService::StreamReadingPoints(
     grpc::ServerContext* context, const v1::StreamReadingsRequest* request,
     grpc::ServerWriter<v1::ReadingPoints>* writer) {
   return Serve(*context, *request, "StreamReadingPoints",
-               [&](StreamReadingsCall& call, const ReadingExtras&, const ReadingSource& source) {
+               [&](StreamReadingsCall& call, const ReadingSource& source) {
                  return StreamSessionReadingPoints(*context, *request, call, source, writer);
                });
 }
@@ -260,17 +259,20 @@ grpc::Status ArchiveDataService::Serve(grpc::ServerContext& context,
   }
   Result<storage::SessionRecord> session = archive_->GetSession(call.session);
   if (!session.ok()) return ToGrpcStatus(session.status());
-  std::uint32_t averages = 0;
-  if (Result<SessionPlan> plan = ParseSessionPlan(*session); plan.ok()) {
-    averages = plan->plan.measurement().averages();
-  }
   ReadingSource source;
   source.reader = archive_.get();
   // Ended is not enough: a rig ships a session's state before its last readings.
   source.ended = [&] { return archive_->Finished(call.session); };
   source.wait = [&] { return stopping_.WaitFor(kArchivePollInterval); };
   source.server = "brdf-archive";
-  return body(call, ReadingExtrasOf(*archive_, call.session, averages), source);
+  source.extras = [&] {
+    std::uint32_t averages = 0;
+    if (Result<SessionPlan> plan = ParseSessionPlan(*session); plan.ok()) {
+      averages = plan->plan.measurement().averages();
+    }
+    return ReadingExtrasOf(*archive_, call.session, averages);
+  };
+  return body(call, source);
 }
 
 grpc::Status ArchiveDataService::Export(grpc::ServerContext* context,

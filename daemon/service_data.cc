@@ -36,18 +36,17 @@ void DataService::WaitForReading(std::uint64_t seen, std::chrono::steady_clock::
 grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
                                          const v1::StreamReadingsRequest* request,
                                          grpc::ServerWriter<v1::Reading>* writer) {
-  return Serve(
-      *context, *request, "StreamReadings",
-      [&](StreamReadingsCall& call, const ReadingExtras& extras, const ReadingSource& source) {
-        return StreamSessionReadings(*context, *request, call, extras, source, writer);
-      });
+  return Serve(*context, *request, "StreamReadings",
+               [&](StreamReadingsCall& call, const ReadingSource& source) {
+                 return StreamSessionReadings(*context, *request, call, source, writer);
+               });
 }
 
 grpc::Status DataService::StreamReadingPoints(grpc::ServerContext* context,
                                               const v1::StreamReadingsRequest* request,
                                               grpc::ServerWriter<v1::ReadingPoints>* writer) {
   return Serve(*context, *request, "StreamReadingPoints",
-               [&](StreamReadingsCall& call, const ReadingExtras&, const ReadingSource& source) {
+               [&](StreamReadingsCall& call, const ReadingSource& source) {
                  return StreamSessionReadingPoints(*context, *request, call, source, writer);
                });
 }
@@ -63,13 +62,6 @@ grpc::Status DataService::Serve(grpc::ServerContext& context,
   storage::SessionStore& store = *manager_.store();
   Result<storage::SessionRecord> session = store.GetSession(call.session);
   if (!session.ok()) return ToGrpcStatus(session.status());
-
-  // Labels and averaging are fixed at submission: read them once.
-  std::uint32_t averages = 0;
-  if (Result<std::shared_ptr<const SessionPlan>> plan = manager_.Plan(call.session); plan.ok()) {
-    averages = (*plan)->plan.measurement().averages();
-  }
-  const ReadingExtras extras = ReadingExtrasOf(store, call.session, averages);
 
   std::uint64_t generation = 0;
   ReadingSource source;
@@ -87,7 +79,15 @@ grpc::Status DataService::Serve(grpc::ServerContext& context,
     WaitForReading(generation, kStreamPollInterval);
     return false;
   };
-  return body(call, extras, source);
+  // Labels and averaging are fixed at submission.
+  source.extras = [&] {
+    std::uint32_t averages = 0;
+    if (Result<std::shared_ptr<const SessionPlan>> plan = manager_.Plan(call.session); plan.ok()) {
+      averages = (*plan)->plan.measurement().averages();
+    }
+    return ReadingExtrasOf(store, call.session, averages);
+  };
+  return body(call, source);
 }
 
 }  // namespace brdf::daemon

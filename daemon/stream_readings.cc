@@ -1,5 +1,6 @@
 #include "daemon/stream_readings.h"
 
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -11,8 +12,8 @@ namespace {
 
 // Readings per page read from the store (and written before the next page is read).
 constexpr int kPageSize = 256;
-// StreamReadingPoints reads larger pages (fewer queries; a page is still a few MB).
-constexpr int kPointsPageSize = 2048;
+// StreamReadingPoints reads larger pages (fewer queries; its readings carry no spectrum).
+constexpr int kPointsPageSize = 8192;
 // Readings per StreamReadingPoints message (8 numbers each: well under gRPC's 4 MB).
 constexpr int kPointsPerMessage = 8192;
 
@@ -53,17 +54,18 @@ ReadingExtras ReadingExtrasOf(storage::SessionReader& reader, std::int64_t sessi
 
 namespace {
 
-// The page loop both streams share: the session's readings in id order a page at a time, and
-// with `follow` those that arrive later. on_page gets each page's readings of the asked kinds and
-// whether more are stored right now (false before the stream waits or ends); it returns false
-// when the client went away.
+// The page loop both streams share: the session's readings in id order a page at a time (read by
+// `read_page`: whole readings, or only where they were taken), and with `follow` those that
+// arrive later. on_page gets each page's readings of the asked kinds and whether more are stored
+// right now (false before the stream waits or ends); it returns false when the client went away.
+template <typename Record>
 grpc::Status ForEachReadingPage(
     grpc::ServerContext& context, const v1::StreamReadingsRequest& request,
     StreamReadingsCall& call, const ReadingSource& source, int page_size,
-    const std::function<bool(const std::vector<const storage::ReadingRecord*>&, bool more_stored)>&
-        on_page) {
+    const std::function<Result<std::vector<Record>>(std::int64_t after_id, int limit)>& read_page,
+    const std::function<bool(const std::vector<const Record*>&, bool more_stored)>& on_page) {
   std::int64_t last = request.after_id();
-  std::vector<const storage::ReadingRecord*> kept;
+  std::vector<const Record*> kept;
   for (;;) {
     if (context.IsCancelled()) {
       return grpc::Status(grpc::StatusCode::CANCELLED,
@@ -75,11 +77,10 @@ grpc::Status ForEachReadingPage(
       if (!now.ok()) return ToGrpcStatus(now.status());
       ended = *now;
     }
-    Result<std::vector<storage::ReadingRecord>> page =
-        source.reader->GetReadings(call.session, last, page_size);
+    Result<std::vector<Record>> page = read_page(last, page_size);
     if (!page.ok()) return ToGrpcStatus(page.status());
     kept.clear();
-    for (const storage::ReadingRecord& r : *page) {
+    for (const Record& r : *page) {
       last = r.id;
       if (call.kinds.empty() || call.kinds.count(r.kind) != 0) kept.push_back(&r);
     }
@@ -99,15 +100,23 @@ grpc::Status ForEachReadingPage(
   }
 }
 
-void AddPoint(const storage::ReadingRecord& r, v1::ReadingPoints* points) {
+// ReadingPoints' angles are for plotting and picking: rounded to a micro-degree, far below any
+// stage's resolution. A computed direction's 17 digits (59.999999999999993) become a few (60), so
+// the JSON the web gateway prints for 50,000 readings is about half as long and printed faster.
+// StreamReadings keeps the exact values.
+double MicroDegrees(double degrees) {
+  return std::round(degrees * 1e6) / 1e6;
+}
+
+void AddPoint(const storage::ReadingPointRecord& r, v1::ReadingPoints* points) {
   points->add_ids(r.id);
-  points->add_alpha(r.pose.alpha);
-  points->add_beta(r.pose.beta);
-  points->add_delta(r.pose.delta);
+  points->add_alpha(MicroDegrees(r.pose.alpha));
+  points->add_beta(MicroDegrees(r.pose.beta));
+  points->add_delta(MicroDegrees(r.pose.delta));
   const IsoDirection iso = ToIsotropic(r.directions);
-  points->add_theta_i(iso.theta_i);
-  points->add_theta_o(iso.theta_o);
-  points->add_phi(iso.phi);
+  points->add_theta_i(MicroDegrees(iso.theta_i));
+  points->add_theta_o(MicroDegrees(iso.theta_o));
+  points->add_phi(MicroDegrees(iso.phi));
   points->add_flagged(r.flagged);
 }
 
@@ -115,17 +124,20 @@ void AddPoint(const storage::ReadingRecord& r, v1::ReadingPoints* points) {
 
 grpc::Status StreamSessionReadings(grpc::ServerContext& context,
                                    const v1::StreamReadingsRequest& request,
-                                   StreamReadingsCall& call, const ReadingExtras& extras,
-                                   const ReadingSource& source,
+                                   StreamReadingsCall& call, const ReadingSource& source,
                                    grpc::ServerWriter<v1::Reading>* writer) {
-  return ForEachReadingPage(context, request, call, source, kPageSize,
-                            [&](const std::vector<const storage::ReadingRecord*>& page, bool) {
-                              for (const storage::ReadingRecord* r : page) {
-                                if (!call.slot->Write(writer, ToProtoReading(*r, extras)))
-                                  return false;
-                              }
-                              return true;
-                            });
+  const ReadingExtras extras = source.extras();
+  return ForEachReadingPage<storage::ReadingRecord>(
+      context, request, call, source, kPageSize,
+      [&](std::int64_t after_id, int limit) {
+        return source.reader->GetReadings(call.session, after_id, limit);
+      },
+      [&](const std::vector<const storage::ReadingRecord*>& page, bool) {
+        for (const storage::ReadingRecord* r : page) {
+          if (!call.slot->Write(writer, ToProtoReading(*r, extras))) return false;
+        }
+        return true;
+      });
 }
 
 grpc::Status StreamSessionReadingPoints(grpc::ServerContext& context,
@@ -133,10 +145,13 @@ grpc::Status StreamSessionReadingPoints(grpc::ServerContext& context,
                                         StreamReadingsCall& call, const ReadingSource& source,
                                         grpc::ServerWriter<v1::ReadingPoints>* writer) {
   v1::ReadingPoints points;
-  return ForEachReadingPage(
+  return ForEachReadingPage<storage::ReadingPointRecord>(
       context, request, call, source, kPointsPageSize,
-      [&](const std::vector<const storage::ReadingRecord*>& page, bool more_stored) {
-        for (const storage::ReadingRecord* r : page) {
+      [&](std::int64_t after_id, int limit) {
+        return source.reader->GetReadingPoints(call.session, after_id, limit);
+      },
+      [&](const std::vector<const storage::ReadingPointRecord*>& page, bool more_stored) {
+        for (const storage::ReadingPointRecord* r : page) {
           AddPoint(*r, &points);
           if (points.ids_size() == kPointsPerMessage) {
             if (!call.slot->Write(writer, points)) return false;

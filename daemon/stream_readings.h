@@ -44,12 +44,16 @@ struct ReadingSource {
   // the server is stopping (the stream then ends with UNAVAILABLE).
   std::function<bool()> wait;
   std::string server = "the daemon";  // in the stopping message
+  // The session's step labels and averaging (ReadingExtrasOf), for the readings that carry them:
+  // StreamReadings asks once, before its first page; StreamReadingPoints never (a session of
+  // 50,000 steps is 50,000 labels read for nothing).
+  std::function<ReadingExtras()> extras;
 };
 
 // What a readings stream does once its request is checked and its source set up (the rig's and
 // the archive's Data services share their set-up between StreamReadings and StreamReadingPoints).
-using ReadingStreamBody = std::function<grpc::Status(
-    StreamReadingsCall& call, const ReadingExtras& extras, const ReadingSource& source)>;
+using ReadingStreamBody =
+    std::function<grpc::Status(StreamReadingsCall& call, const ReadingSource& source)>;
 
 // The session's step labels from `reader`, with the plan's averaging count (0: 1).
 ReadingExtras ReadingExtrasOf(storage::SessionReader& reader, std::int64_t session,
@@ -58,8 +62,7 @@ ReadingExtras ReadingExtrasOf(storage::SessionReader& reader, std::int64_t sessi
 // Streams the readings (the session is known to exist).
 grpc::Status StreamSessionReadings(grpc::ServerContext& context,
                                    const v1::StreamReadingsRequest& request,
-                                   StreamReadingsCall& call, const ReadingExtras& extras,
-                                   const ReadingSource& source,
+                                   StreamReadingsCall& call, const ReadingSource& source,
                                    grpc::ServerWriter<v1::Reading>* writer);
 
 // The same readings as columns (StreamReadingPoints): up to 8,192 a message, and what is held is

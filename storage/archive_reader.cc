@@ -33,6 +33,13 @@ FROM readings WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id =
 ORDER BY rig_reading_id LIMIT $3
 )sql";
 
+constexpr std::string_view kReadingPointsOfSession = R"sql(
+SELECT rig_reading_id, kind, alpha, beta, gamma, delta, theta_i, phi_i, theta_o, phi_o, flagged
+FROM readings WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id = $1)
+  AND rig_reading_id > $2
+ORDER BY rig_reading_id LIMIT $3
+)sql";
+
 constexpr std::string_view kEventsOfSession = R"sql(
 SELECT rig_event_id, at, state, reason
 FROM session_events WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id = $1)
@@ -119,6 +126,21 @@ Result<ReadingRecord> ReadingAt(const PgResult& r, int row, std::int64_t session
   g.dark_reading_id = r.OptionalInt64(row, 21);
   g.meter_serial = std::string(r.Text(row, 22));
   g.recorded_at = r.Double(row, 23);
+  return g;
+}
+
+Result<ReadingPointRecord> ReadingPointAt(const PgResult& r, int row, std::int64_t session) {
+  ReadingPointRecord g;
+  g.id = r.Int64(row, 0);
+  Result<ReadingKind> kind = ParseReadingKind(r.Text(row, 1));
+  if (!kind.ok()) {
+    return kind.status().WithContext("archived reading " + std::to_string(g.id) + " of " +
+                                     SessionName(session));
+  }
+  g.kind = *kind;
+  g.pose = {r.Double(row, 2), r.Double(row, 3), r.Double(row, 4), r.Double(row, 5)};
+  g.directions = {r.Double(row, 6), r.Double(row, 7), r.Double(row, 8), r.Double(row, 9)};
+  g.flagged = r.Text(row, 10) == "t";
   return g;
 }
 
@@ -230,21 +252,23 @@ Result<std::vector<SessionEventRecord>> ArchiveReader::ListSessionEvents(std::in
   return events;
 }
 
-Result<std::vector<ReadingRecord>> ArchiveReader::GetReadings(std::int64_t session,
-                                                              std::int64_t after_id, int limit) {
+template <typename Record>
+Result<std::vector<Record>> ArchiveReader::ReadingPage(
+    std::int64_t session, std::int64_t after_id, int limit, const char* statement,
+    std::string_view query, Result<Record> (*read)(const PgResult&, int, std::int64_t)) {
   if (limit <= 0) {
     return InvalidArgument("reading the readings of " + SessionName(session) + ": limit " +
                            std::to_string(limit) + " must be positive");
   }
-  std::vector<ReadingRecord> readings;
+  std::vector<Record> readings;
   bool known = true;
   BRDF_RETURN_IF_ERROR(WithConnection([&](PgConnection& conn) -> Status {
-    Result<PgResult> r = conn.QueryPrepared("archive_readings", kReadingsOfSession,
-                                            PgParams().Add(session).Add(after_id).Add(limit));
+    Result<PgResult> r =
+        conn.QueryPrepared(statement, query, PgParams().Add(session).Add(after_id).Add(limit));
     if (!r.ok()) return r.status();
     readings.clear();
     for (int i = 0; i < r->rows(); ++i) {
-      Result<ReadingRecord> reading = ReadingAt(*r, i, session);
+      Result<Record> reading = read(*r, i, session);
       if (!reading.ok()) return reading.status();
       readings.push_back(std::move(*reading));
     }
@@ -259,6 +283,19 @@ Result<std::vector<ReadingRecord>> ArchiveReader::GetReadings(std::int64_t sessi
   }));
   if (!known) return NotFound("no " + SessionName(session) + " in the archive");
   return readings;
+}
+
+Result<std::vector<ReadingRecord>> ArchiveReader::GetReadings(std::int64_t session,
+                                                              std::int64_t after_id, int limit) {
+  return ReadingPage<ReadingRecord>(session, after_id, limit, "archive_readings",
+                                    kReadingsOfSession, &ReadingAt);
+}
+
+Result<std::vector<ReadingPointRecord>> ArchiveReader::GetReadingPoints(std::int64_t session,
+                                                                        std::int64_t after_id,
+                                                                        int limit) {
+  return ReadingPage<ReadingPointRecord>(session, after_id, limit, "archive_reading_points",
+                                         kReadingPointsOfSession, &ReadingPointAt);
 }
 
 Result<bool> ArchiveReader::Finished(std::int64_t session) {

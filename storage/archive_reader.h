@@ -20,6 +20,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/mutex.h"
@@ -55,6 +56,9 @@ class ArchiveReader final : public SessionReader {
   Result<std::vector<StepRecord>> GetSteps(std::int64_t session) override;
   Result<std::vector<ReadingRecord>> GetReadings(std::int64_t session, std::int64_t after_id,
                                                  int limit) override;
+  Result<std::vector<ReadingPointRecord>> GetReadingPoints(std::int64_t session,
+                                                           std::int64_t after_id,
+                                                           int limit) override;
   // The events shipped so far (schema v3's session_events), in the rig's order.
   Result<std::vector<SessionEventRecord>> ListSessionEvents(std::int64_t session) override;
   // True when the session has ended (completed, aborted, failed) and the reading of every
@@ -65,6 +69,13 @@ class ArchiveReader final : public SessionReader {
 
  private:
   explicit ArchiveReader(std::string conninfo) : conninfo_(std::move(conninfo)) {}
+  // A page of `session`'s readings (GetReadings, GetReadingPoints): the prepared `statement`'s
+  // rows, each turned into a Record by `read`; kNotFound when the session is not archived.
+  template <typename Record>
+  Result<std::vector<Record>> ReadingPage(std::int64_t session, std::int64_t after_id, int limit,
+                                          const char* statement, std::string_view query,
+                                          Result<Record> (*read)(const PgResult&, int,
+                                                                 std::int64_t));
   // Runs `work` on a pooled connection; once more on a fresh one when the connection broke.
   Status WithConnection(const std::function<Status(PgConnection&)>& work);
 

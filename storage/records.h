@@ -131,6 +131,16 @@ struct ReadingRecord {
   UnixSeconds recorded_at = 0;  // 0: the store uses its clock
 };
 
+// Where a reading was taken, without its spectrum: what a plot of a session's readings needs
+// (SessionReader::GetReadingPoints; Figure 7).
+struct ReadingPointRecord {
+  std::int64_t id = 0;
+  ReadingKind kind = ReadingKind::kSample;
+  Pose pose;
+  Directions directions;
+  bool flagged = false;
+};
+
 // A device seen by the daemon; recorded once per (session, kind, model, serial).
 struct DeviceRecord {
   std::int64_t id = 0;

@@ -11,6 +11,8 @@
 //   - events keep the ids they were recorded with on the rig;
 //   - GetReadings pages in ascending reading id: up to `limit` (> 0) readings with id > after_id;
 //     readings are append-only, so paging never skips or repeats one;
+//   - GetReadingPoints pages exactly as GetReadings, the same readings, without reading their
+//     spectra (a 50,000-reading session's spectra are 40 MB a plot of it does not need);
 //   - kNotFound for an unknown session; kIoError (or kDisconnected) when the data cannot be read.
 // Thread-safe.
 #pragma once
@@ -31,6 +33,9 @@ class SessionReader {
   virtual Result<std::vector<StepRecord>> GetSteps(std::int64_t session) = 0;
   virtual Result<std::vector<ReadingRecord>> GetReadings(std::int64_t session,
                                                          std::int64_t after_id, int limit) = 0;
+  virtual Result<std::vector<ReadingPointRecord>> GetReadingPoints(std::int64_t session,
+                                                                   std::int64_t after_id,
+                                                                   int limit) = 0;
   // The session's history of states: one event when it was created and one per change of its
   // state or reason, in the order they happened (ascending event id).
   virtual Result<std::vector<SessionEventRecord>> ListSessionEvents(std::int64_t session) = 0;

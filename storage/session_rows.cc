@@ -22,6 +22,9 @@ const std::string_view kReadingColumns =
 
 const std::string_view kEventColumns = "id, session_id, at, state, reason";
 
+const std::string_view kReadingPointColumns =
+    "id, kind, alpha, beta, gamma, delta, theta_i, phi_i, theta_o, phi_o, flagged";
+
 namespace {
 
 std::string SessionName(std::int64_t session) {
@@ -111,6 +114,17 @@ Result<ReadingRecord> ReadReading(const Statement& st, const std::string& path) 
   r.dark_reading_id = st.OptionalInt64(22);
   r.meter_serial = st.Text(23);
   r.recorded_at = st.Double(24);
+  return r;
+}
+
+Result<ReadingPointRecord> ReadReadingPoint(const Statement& st, const std::string& path) {
+  ReadingPointRecord r;
+  r.id = st.Int64(0);
+  BRDF_STORAGE_ASSIGN_OR_RETURN(
+      r.kind, FromColumn(ParseReadingKind(st.Text(1)), path, "reading " + std::to_string(r.id)));
+  r.pose = Pose{st.Double(2), st.Double(3), st.Double(4), st.Double(5)};
+  r.directions = Directions{st.Double(6), st.Double(7), st.Double(8), st.Double(9)};
+  r.flagged = st.Int(10) != 0;
   return r;
 }
 

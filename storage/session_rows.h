@@ -25,13 +25,15 @@ Result<T> FromColumn(Result<T> parsed, const std::string& path, const std::strin
 extern const std::string_view kSessionColumns;
 extern const std::string_view kStepColumns;
 extern const std::string_view kReadingColumns;
-extern const std::string_view kEventColumns;  // session_events (v4)
+extern const std::string_view kEventColumns;         // session_events (v4)
+extern const std::string_view kReadingPointColumns;  // readings, without the spectrum
 
 // A row whose enumeration text does not parse has been damaged outside brdfd: kIoError naming
 // `path` and what to run.
 Result<SessionRecord> ReadSession(const Statement& st, const std::string& path);
 Result<StepRecord> ReadStep(const Statement& st, const std::string& path);
 Result<ReadingRecord> ReadReading(const Statement& st, const std::string& path);
+Result<ReadingPointRecord> ReadReadingPoint(const Statement& st, const std::string& path);
 Result<SessionEventRecord> ReadEvent(const Statement& st, const std::string& path);
 
 }  // namespace brdf::storage

@@ -568,28 +568,51 @@ Status SessionStore::MarkStepFinished(std::int64_t session, int step_index, Step
 // --- Readings
 // -------------------------------------------------------------------------------------
 
-Result<std::vector<ReadingRecord>> SessionStore::GetReadings(std::int64_t session,
-                                                             std::int64_t after_id, int limit) {
+namespace {
+
+// A page of `session`'s readings with id > after_id, ascending, each row (`columns`) turned into a
+// Record by `read`: GetReadings and GetReadingPoints.
+template <typename Record>
+Result<std::vector<Record>> ReadingPage(ReaderPool& readers, const std::string& path,
+                                        std::int64_t session, std::int64_t after_id, int limit,
+                                        std::string_view columns,
+                                        Result<Record> (*read)(const Statement&,
+                                                               const std::string&)) {
   if (limit <= 0) {
     return InvalidArgument("reading the readings of " + SessionName(session) + ": limit " +
                            std::to_string(limit) + " must be positive");
   }
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers.Acquire());
   BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   BRDF_RETURN_IF_ERROR(RequireSession(*db, session));
   BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db->Prepare("SELECT " + std::string(kReadingColumns) +
+                                db->Prepare("SELECT " + std::string(columns) +
                                             " FROM readings WHERE session_id = ? AND id > ? "
                                             "ORDER BY id LIMIT ?"));
   st.Bind(1, session).Bind(2, after_id).Bind(3, limit);
-  std::vector<ReadingRecord> out;
+  std::vector<Record> out;
   while (true) {
     BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
-    BRDF_STORAGE_ASSIGN_OR_RETURN(ReadingRecord r, ReadReading(st, path_));
+    BRDF_STORAGE_ASSIGN_OR_RETURN(Record r, read(st, path));
     out.push_back(std::move(r));
   }
   return out;
+}
+
+}  // namespace
+
+Result<std::vector<ReadingRecord>> SessionStore::GetReadings(std::int64_t session,
+                                                             std::int64_t after_id, int limit) {
+  return ReadingPage<ReadingRecord>(*readers_, path_, session, after_id, limit, kReadingColumns,
+                                    &ReadReading);
+}
+
+Result<std::vector<ReadingPointRecord>> SessionStore::GetReadingPoints(std::int64_t session,
+                                                                       std::int64_t after_id,
+                                                                       int limit) {
+  return ReadingPage<ReadingPointRecord>(*readers_, path_, session, after_id, limit,
+                                         kReadingPointColumns, &ReadReadingPoint);
 }
 
 Result<ReadingRecord> SessionStore::GetReading(std::int64_t reading_id) {

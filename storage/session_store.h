@@ -143,6 +143,10 @@ class SessionStore final : public SessionReader {
   // id seen. Readings are append-only, so paging never skips or repeats one.
   Result<std::vector<ReadingRecord>> GetReadings(std::int64_t session, std::int64_t after_id,
                                                  int limit) override;
+  // The same pages as GetReadings without the spectra (SessionReader).
+  Result<std::vector<ReadingPointRecord>> GetReadingPoints(std::int64_t session,
+                                                           std::int64_t after_id,
+                                                           int limit) override;
   Result<ReadingRecord> GetReading(std::int64_t reading_id);
   // Calls `visit` for every reading of `session` in id order, a page at a time (memory bounded by
   // one page; no lock or read transaction is held while `visit` runs, so it may be slow). A

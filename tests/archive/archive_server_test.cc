@@ -257,6 +257,19 @@ class ArchiveServerTest : public PgServerTest {
     EXPECT_TRUE(st.ok()) << st.error_message();
     return out;
   }
+  // Every ReadingPoints message of the session's readings, serialized and concatenated.
+  static std::string Points(v1::Data::Stub& data, const std::string& id) {
+    v1::StreamReadingsRequest request;
+    request.set_session_id(id);
+    auto context = DaemonRig::Context(kAnalystToken);
+    auto reader = data.StreamReadingPoints(context.get(), request);
+    std::string out;
+    v1::ReadingPoints points;
+    while (reader->Read(&points)) out += points.SerializeAsString();
+    grpc::Status st = reader->Finish();
+    EXPECT_TRUE(st.ok()) << st.error_message();
+    return out;
+  }
   // An exported file's bytes and the export's report.
   static std::pair<std::string, v1::ExportReport> Export(v1::Data::Stub& data,
                                                          v1::ExportRequest request,
@@ -449,6 +462,11 @@ TEST_F(ArchiveServerTest, TwoReplicasAnswerBitForBitWhatTheRigAnswers) {
     EXPECT_EQ(archive_readings[i].SerializeAsString(), rig_readings[i].SerializeAsString())
         << "reading " << rig_readings[i].id();
   }
+  // And as columns (StreamReadingPoints, read without the spectra): the rig's bytes.
+  const std::string rig_points = Points(rig_->data(), paint.session_id());
+  EXPECT_GT(rig_points.size(), 100U);
+  EXPECT_EQ(Points(a.data(), id_a), rig_points);
+  EXPECT_EQ(Points(b.data(), id_a), rig_points);
 
   // Every export format: the rig's file byte for byte (the readings CSV names the session by
   // the server's id in its first line, and the file name carries it).

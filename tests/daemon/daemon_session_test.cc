@@ -177,12 +177,18 @@ TEST_F(DaemonSessionTest, SampleRotationPlanRunsToCompletionWithEveryReadingAndE
         ASSERT_LT(k, samples.size());
         const v1::Reading& r = *samples[k];
         EXPECT_EQ(points.ids(j), r.id());
-        EXPECT_EQ(points.alpha(j), r.pose().alpha());
-        EXPECT_EQ(points.beta(j), r.pose().beta());
-        EXPECT_EQ(points.delta(j), r.pose().delta());
-        EXPECT_EQ(points.theta_i(j), r.iso().theta_i());
-        EXPECT_EQ(points.theta_o(j), r.iso().theta_o());
-        EXPECT_EQ(points.phi(j), r.iso().phi());
+        // Angles to the micro-degree (the nearest multiple of 1e-6°, so 59.999999999999993
+        // becomes 60).
+        constexpr double kMicro = 0.5e-6 + 1e-12;
+        EXPECT_NEAR(points.alpha(j), r.pose().alpha(), kMicro);
+        EXPECT_NEAR(points.beta(j), r.pose().beta(), kMicro);
+        EXPECT_NEAR(points.delta(j), r.pose().delta(), kMicro);
+        EXPECT_NEAR(points.theta_i(j), r.iso().theta_i(), kMicro);
+        EXPECT_NEAR(points.theta_o(j), r.iso().theta_o(), kMicro);
+        EXPECT_NEAR(points.phi(j), r.iso().phi(), kMicro);
+        for (double v : {points.alpha(j), points.theta_i(j), points.theta_o(j), points.phi(j)}) {
+          EXPECT_NEAR(v * 1e6, std::round(v * 1e6), 1e-6) << v << " is not a whole micro-degree";
+        }
         EXPECT_EQ(points.flagged(j), r.flagged());
       }
     }

@@ -15,11 +15,11 @@ namespace {
 
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
-using ::testing::Not;
 using testing::KindOfStep;
 using testing::MakeNewSession;
 using testing::MakeReading;
 using testing::MakeSteps;
+using ::testing::Not;
 using testing::ReadingKindOfStep;
 using testing::TempDir;
 
@@ -474,6 +474,32 @@ TEST_F(SessionStoreTest, ReadingsStreamInPagesAndForEachVisitsEveryOneOnce) {
     }
   }
   EXPECT_EQ(seen, expected);
+
+  // GetReadingPoints pages the same readings, each where it was taken, without its spectrum.
+  after = 0;
+  seen = 0;
+  while (true) {
+    auto points = store_->GetReadingPoints(session, after, 41);
+    ASSERT_TRUE(points.ok()) << points.status().ToString();
+    if (points->empty()) break;
+    auto readings = store_->GetReadings(session, after, 41);
+    ASSERT_TRUE(readings.ok());
+    ASSERT_EQ(points->size(), readings->size());
+    for (std::size_t i = 0; i < points->size(); ++i) {
+      const ReadingPointRecord& p = (*points)[i];
+      const ReadingRecord& r = (*readings)[i];
+      EXPECT_EQ(p.id, r.id);
+      EXPECT_EQ(p.kind, r.kind);
+      EXPECT_EQ(p.pose, r.pose);
+      EXPECT_EQ(p.directions, r.directions);
+      EXPECT_EQ(p.flagged, r.flagged);
+      after = p.id;
+      ++seen;
+    }
+  }
+  EXPECT_EQ(seen, expected);
+  EXPECT_EQ(store_->GetReadingPoints(777, 0, 10).status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(store_->GetReadingPoints(session, 0, 0).status().code(), StatusCode::kInvalidArgument);
 
   std::vector<int> steps;
   ASSERT_TRUE(store_

@@ -100,6 +100,7 @@ const browser = await puppeteer.launch({ executablePath: process.env.BRDF_CHROMI
 async function signedIn(url) {
   const page = await browser.newPage();
   await page.goto(url);
+  await page.waitForSelector('#login-view:not([hidden])'); // shown once the page knows its server
   await page.type('#token', token);
   await page.click('#login-button');
   await page.waitForFunction(() => document.getElementById('who').textContent === 'analyst');

@@ -73,12 +73,22 @@ export function createExplorer(root, report) {
     downloads, downloadInfo);
 
   const appearance = createAppearance(root, report);
-  const fig7a = createPoints3d(fig7aBox, { title: '(α, β, δ)', axes: ['α °', 'β °', 'δ °'] });
-  const fig7b = createPoints3d(fig7bBox, { title: '(θi, θo, φ)', axes: ['θi °', 'θo °', 'φ °'] });
-  for (const f of [fig7a, fig7b]) f.onPick(showReading);
+  // Figure 7's two WebGL plots, made once the first session's readings are asked for: their
+  // set-up (two GL contexts, their shaders) then runs while the readings are on their way.
+  let fig7a = null;
+  let fig7b = null;
+  function figure7() {
+    if (!fig7a) {
+      fig7a = createPoints3d(fig7aBox, { title: '(α, β, δ)', axes: ['α °', 'β °', 'δ °'] });
+      fig7b = createPoints3d(fig7bBox, { title: '(θi, θo, φ)', axes: ['θi °', 'θo °', 'φ °'] });
+      for (const f of [fig7a, fig7b]) f.onPick(showReading);
+    }
+    return [fig7a, fig7b];
+  }
 
-  async function listSessions() {
-    const r = await call('Control/ListSessions', { page_size: 100 });
+  // `listing`: Control.ListSessions's answer when the caller has it already.
+  async function listSessions(listing) {
+    const r = listing || await call('Control/ListSessions', { page_size: 100 });
     clear(sessionSelect);
     for (const s of r.sessions) sessionSelect.append(el('option', { value: s.session_id }, `${s.name || s.session_id} (${stateName(s.state)})`));
     // The newest session with readings first.
@@ -103,19 +113,21 @@ export function createExplorer(root, report) {
     const t0 = performance.now();
     const chunks = [];
     const thetaI = Number(ti.value);
+    const readings = stream('Data/StreamReadingPoints', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (c) => chunks.push(c));
     let plane = measured.has(id) ? planeOfIncidence(id, thetaI) : null;
-    await stream('Data/StreamReadingPoints', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, (c) => chunks.push(c));
+    const [poses, directions] = figure7();
+    await readings;
     const streamed = performance.now() - t0;
     points = joinColumns(chunks);
     if (points.ids.length === 0) {
       loadInfo.textContent = 'this session has no sample readings yet';
-      for (const f of [fig7a, fig7b]) f.setPoints({ x: [], y: [], z: [], value: [] });
+      for (const f of [poses, directions]) f.setPoints({ x: [], y: [], z: [], value: [] });
       Plotly = await plotly();
       for (const p of [spectrum, polar]) Plotly.purge(p);
       return;
     }
-    fig7a.setPoints({ x: points.alpha, y: points.beta, z: points.delta, value: points.theta_i });
-    fig7b.setPoints({ x: points.theta_i, y: points.theta_o, z: points.phi, value: points.theta_i });
+    poses.setPoints({ x: points.alpha, y: points.beta, z: points.delta, value: points.theta_i });
+    directions.setPoints({ x: points.theta_i, y: points.theta_o, z: points.phi, value: points.theta_i });
     loadInfo.textContent = `${points.ids.length} sample readings loaded in ${Math.round(streamed)} ms, plotted in ${Math.round(performance.now() - t0 - streamed)} ms`;
     renderDownloads();
     // plotly (the 2D plots) only once Figure 7 is on screen: parsing it blocks the page, which
@@ -149,7 +161,7 @@ export function createExplorer(root, report) {
     const p = points;
     const iso = { theta_i: p.theta_i[k], theta_o: p.theta_o[k], phi: p.phi[k] };
     readingInfo.textContent = `reading ${p.ids[k]}: α ${p.alpha[k]}°, β ${p.beta[k]}°, δ ${p.delta[k]}°; θi ${iso.theta_i.toFixed(1)}°, θo ${iso.theta_o.toFixed(1)}°, φ ${iso.phi.toFixed(1)}°${p.flagged[k] ? ' (flagged)' : ''}`;
-    for (const f of [fig7a, fig7b]) f.mark(k);
+    for (const f of figure7()) f.mark(k);
     // The reading's own spectrum in each quantity: the nearest reading to its own direction is
     // itself (the daemon converts radiance to reflectance and BRDF with its reference).
     const quantities = [['QUANTITY_RADIANCE', 'radiance (W·m⁻²·sr⁻¹·nm⁻¹)', 'y'], ['QUANTITY_REFLECTANCE', 'reflectance', 'y2'], ['QUANTITY_BRDF', 'BRDF (sr⁻¹)', 'y2']];
@@ -290,8 +302,8 @@ export function createExplorer(root, report) {
   }
 
   return {
-    async show() {
-      await listSessions();
+    async show(listing) {
+      await listSessions(listing);
       if (!session && sessionSelect.value) await load(sessionSelect.value);
     },
     hide() {},

@@ -9,8 +9,9 @@ import { createExplorer } from './explorer.js';
 const $ = (id) => document.getElementById(id);
 let role = null;
 let server = 'brdfd';
-let views = null;
+const views = {};
 let current = null;
+let firstListing = null; // Control.ListSessions as signing in read it
 
 function report(message) {
   let bar = $('error-bar');
@@ -31,14 +32,27 @@ async function route() {
   current = name;
   $(`${name}-view`).hidden = false;
   for (const n of ['console', 'explorer']) $(`nav-${n}`).classList.toggle('active', n === name);
-  try { await views[name].show(); } catch (e) { report(e.message); }
+  // The sign-in's listing is handed to the first view that opens (one round trip fewer).
+  const listing = firstListing;
+  firstListing = null;
+  try { await view(name).show(listing); } catch (e) { report(e.message); }
 }
 
+// A view is built the first time it opens: the explorer's WebGL plots cost nothing to a console.
+function view(name) {
+  views[name] ??= name === 'console' ? createConsole($('console-view'), role, report, server) : createExplorer($('explorer-view'), report);
+  return views[name];
+}
+
+// Signing in asks for the sessions (which checks the token) while the page is still asking which
+// server it is on, then for the token's role (a token the server does not know is refused once):
+// the first view waits for two round trips, not four.
 async function signIn() {
   try {
-    await call('Control/ListSessions', { page_size: 1 });
+    const listing = call('Control/ListSessions', { page_size: 100 });
     // The archive has no rig and no control for anyone.
-    role = server === 'brdf-archive' ? 'reader' : await probeRole();
+    const roleOf = Promise.all([listing, identified]).then(() => (server === 'brdf-archive' ? 'reader' : probeRole()));
+    [firstListing, role] = await Promise.all([listing, roleOf]);
   } catch (e) {
     setToken('');
     $('login-view').hidden = false;
@@ -51,7 +65,6 @@ async function signIn() {
   $('who').textContent = role;
   $('who').className = `role ${role}`;
   document.body.dataset.role = role;
-  views = { console: createConsole($('console-view'), role, report, server), explorer: createExplorer($('explorer-view'), report) };
   await route();
 }
 
@@ -75,4 +88,6 @@ async function identify() {
   document.title = server === 'brdf-archive' ? 'brdf-archive: the lab archive' : 'brdfd';
 }
 
-identify().then(() => { if (getToken()) signIn(); else $('login-view').hidden = false; });
+const identified = identify();
+if (getToken()) signIn();
+else identified.then(() => { $('login-view').hidden = false; });
