@@ -34,6 +34,11 @@
 //   1096 ms, ratio 1.54), with the polar plot 2009 ms (small 1374 ms, ratio 1.46); new direction
 //   112.2 ms, no-op 11.6 ms. A second run (3 views, load 2–3): Figure 7 2475 ms, with the polar
 //   plot 2925 ms (ratios 2.04, 2.25); new direction 74.0 ms, of which the Interpolate call 16.0 ms.
+//   2026-12-05, stop 34 (ReadingPoints read without spectra and rounded to 1e-6°, 3.52 MB; the
+//   page's sign-in and the readings asked for sooner): three runs, Figure 7 median 1031, 1290,
+//   1087 ms (ratios to the small session 1.30, 1.37, 1.26; before, in the same hour, 1718 ms and
+//   1.92), with the polar plot 1288, 1621, 1358 ms (before 2044 ms); new direction 58.4, 73.2,
+//   81.7 ms (before 55.3 ms). bench/README.md has the table.
 import puppeteer from 'puppeteer-core';
 import { spawn, execFileSync } from 'node:child_process';
 import { mkdtempSync, writeFileSync, openSync, readFileSync, copyFileSync, existsSync } from 'node:fs';
