@@ -35,7 +35,6 @@ ctl="$build/tools/brdfctl/brdfctl"
 source "$here/lib.sh"
 bench_workdir_and_cleanup /tmp/brdfd-estimate.XXXXXX
 config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
-stop_pid() { kill -TERM "$1" 2>/dev/null || true; wait "$1" 2>/dev/null || true; }
 
 echo "validate's estimate against brdf-sim — $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) CPUs"
 echo "load at start: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -27,6 +27,9 @@ bench_cleanup() {
   if [[ "${BENCH_KEEP:-0}" == 1 ]]; then echo "kept: $work" >&2; else rm -rf "$work"; fi
 }
 
+# Stops one process now (SIGTERM, then waits for it); bench_cleanup stops the rest on exit.
+stop_pid() { kill -TERM "$1" 2>/dev/null || true; wait "$1" 2>/dev/null || true; }
+
 # Waits up to $3 s for a line matching $2 in file $1.
 wait_line() {
   local i

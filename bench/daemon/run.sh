@@ -65,7 +65,6 @@ start_brdfd() {
   wait_line "$2.out" '^brdfd listening on' 20
   address="$(awk '/^brdfd listening on/ { print $4 }' "$2.out")"
 }
-stop_pid() { kill -TERM "$1" 2>/dev/null || true; wait "$1" 2>/dev/null || true; }
 kb() { awk -v k="$2:" '$1 == k { print $2 }' "/proc/$1/status"; }
 field() { tr ' ' '\n' <<<"$1" | awk -F= -v k="$2" '$1 == k { print $2 }'; }
 

@@ -32,96 +32,19 @@
 #include "daemon/service_common.h"
 #include "daemon/service_interpolation.h"
 #include "storage/session_store.h"
-#include "tests/support/test_env.h"
+#include "tests/daemon/interpolation_service_test.h"
 
 namespace brdf::daemon {
 namespace {
 
 using namespace std::chrono_literals;
 
-class AppearanceCacheTest : public ::testing::Test {
+class AppearanceCacheTest : public testing::InterpolationServiceTest {
  protected:
-  void SetUp() override {
-    auto store = storage::SessionStore::Open(dir_.file("appearance.db").string());
-    ASSERT_TRUE(store.ok()) << store.status().ToString();
-    store_ = std::move(*store);
-    cache_ = std::make_unique<IndexCache>(store_);
-    service_ = std::make_unique<InterpolationService>(*cache_, auth_, stopping_, streams_);
+  AppearanceCacheTest() : InterpolationServiceTest("appearance-cache-test", 7) {}
 
-    grpc::ServerBuilder builder;
-    int port = 0;
-    builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
-    builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
-    builder.RegisterService(service_.get());
-    loop_ = std::make_unique<InterpolateLoop>(*service_, 1);
-    loop_->AddQueues(builder);
-    server_ = builder.BuildAndStart();
-    ASSERT_TRUE(server_ != nullptr && port > 0);
-    loop_->Start();
-    grpc::ChannelArguments args;
-    args.SetMaxReceiveMessageSize(-1);
-    stub_ = v1::Interpolation::NewStub(grpc::CreateCustomChannel(
-        "127.0.0.1:" + std::to_string(port), grpc::InsecureChannelCredentials(), args));
-  }
-
-  void TearDown() override {
-    stopping_.Stop();
-    loop_->BeginShutdown();
-    if (server_) server_->Shutdown(std::chrono::system_clock::now() + 2s);
-    loop_->Stop();
-  }
-
-  // A session: a white reference, a dark, then `samples` sample readings at random directions
-  // (θi, θo in [0, 80], φ in [0, 180]), room for `extra` more. Returns its id.
-  std::int64_t MakeSession(int samples, int extra) {
-    storage::NewSession s;
-    s.name = "appearance cache test";
-    s.plan_kind = "pose_list";
-    s.plan_json = R"({"poseList": {"poses": [{"alpha": 0, "beta": 0, "delta": 0}]}})";
-    s.created_by_role = "operator";
-    s.white_reflectance = 0.99;
-    std::vector<storage::StepRecord> steps;
-    for (int i = 0; i < samples + 2 + extra; ++i) {
-      storage::StepRecord r;
-      r.step_index = i;
-      r.kind = i == 0   ? storage::StepKind::kReference
-               : i == 1 ? storage::StepKind::kDark
-                        : storage::StepKind::kSample;
-      steps.push_back(r);
-    }
-    Result<std::int64_t> id = store_->CreateSession(s, steps);
-    EXPECT_TRUE(id.ok()) << id.status().ToString();
-    EXPECT_TRUE(store_->SetSessionState(*id, SessionState::kRunning, "test").ok());
-    reference_ = AddReading(*id, storage::ReadingKind::kReference, {10, 0, 10, 180}, 1.0).id;
-    dark_ = AddReading(*id, storage::ReadingKind::kDark, {}, 0.001).id;
-    for (int i = 0; i < samples; ++i) AddSample(*id);
-    return *id;
-  }
-
-  // Stores a reading at the session's next step; returns it with its id.
-  storage::ReadingRecord AddReading(std::int64_t session, storage::ReadingKind kind,
-                                    const Directions& d, double level) {
-    storage::ReadingRecord r;
-    r.kind = kind;
-    r.directions = d;
-    r.grid = WavelengthGrid::Pr650();
-    r.spectrum.assign(static_cast<std::size_t>(r.grid.count), level);
-    if (kind == storage::ReadingKind::kSample) {
-      r.reference_reading_id = reference_;
-      r.dark_reading_id = dark_;
-    }
-    Result<std::int64_t> id = store_->CompleteStepWithReading(session, next_step_[session]++, r);
-    EXPECT_TRUE(id.ok()) << id.status().ToString();
-    r.id = id.ok() ? *id : 0;
-    r.session_id = session;
-    return r;
-  }
-  storage::ReadingRecord AddSample(std::int64_t session) {
-    std::uniform_real_distribution<double> theta(0, 80);
-    std::uniform_real_distribution<double> phi(0, 180);
-    const double ti = theta(rng_), to = theta(rng_), p = phi(rng_);
-    return AddReading(session, storage::ReadingKind::kSample, {ti, 0, to, p}, 0.05 + 0.1 * ti / 80);
-  }
+  // Brighter towards grazing incidence: a session's renders differ with its readings.
+  double SampleLevel(double theta_i) const override { return 0.05 + 0.1 * theta_i / 80; }
 
   grpc::Status Render(const v1::AppearanceRequest& request, v1::AppearanceResponse* response) {
     grpc::ClientContext context;
@@ -159,21 +82,6 @@ class AppearanceCacheTest : public ::testing::Test {
 
   std::uint64_t renders() const { return service_->appearance_renders(); }
   std::uint64_t reuses() const { return service_->appearance_reuses(); }
-
-  testing::TempDir dir_{"appearance-cache-test"};
-  std::shared_ptr<storage::SessionStore> store_;
-  std::unique_ptr<IndexCache> cache_;
-  Authenticator auth_{{}};
-  StopSignal stopping_;
-  StreamRegistry streams_{daemon::ServerConfig{}, false};
-  std::unique_ptr<InterpolationService> service_;
-  std::unique_ptr<InterpolateLoop> loop_;
-  std::unique_ptr<grpc::Server> server_;
-  std::unique_ptr<v1::Interpolation::Stub> stub_;
-  std::mt19937_64 rng_{7};
-  std::map<std::int64_t, int> next_step_;
-  std::int64_t reference_ = 0;
-  std::int64_t dark_ = 0;
 };
 
 TEST_F(AppearanceCacheTest, TheSameRequestAgainIsServedFromTheCacheWithTheSameBytes) {

@@ -19,6 +19,7 @@
 #include "core/plan/plan_json.h"
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/daemon/daemon_test_util.h"
+#include "tests/daemon/rig_teardown.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
@@ -55,16 +56,7 @@ class DaemonApiTest : public ::testing::Test {
     Status st = rig_.StartDaemon(AbsentDevicesToml(rig_.database(), dead_port_));
     ASSERT_TRUE(st.ok()) << st.ToString();
   }
-  void TearDown() override {
-    if (rig_.daemon() != nullptr) {
-      Result<int> code = rig_.StopDaemon();
-      EXPECT_TRUE(code.ok() && *code == 0)
-          << (code.ok() ? "exit code " + std::to_string(*code) : code.status().ToString());
-    }
-    if (HasFailure() || std::getenv("BRDF_TEST_SHOW_LOG") != nullptr) {
-      std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n----\n";
-    }
-  }
+  void TearDown() override { StopDaemonExpectingCleanExit(rig_); }
 
   std::string SubmitQueued() {
     Result<v1::Session> s = rig_.Submit(kSmallPlan, /*start_now=*/false);

@@ -25,6 +25,7 @@
 #include "daemon/service_common.h"
 #include "daemon/service_interpolation.h"
 #include "storage/session_store.h"
+#include "tests/daemon/interpolation_service_test.h"
 #include "tests/support/test_env.h"
 
 namespace brdf::daemon {
@@ -60,97 +61,19 @@ class CountingFactory final : public grpc::experimental::ServerInterceptorFactor
   std::atomic<int>& sent_;
 };
 
-class InterpStreamTest : public ::testing::Test {
+class InterpStreamTest : public testing::InterpolationServiceTest {
  protected:
-  void SetUp() override {
-    auto store = storage::SessionStore::Open(dir_.file("interp.db").string());
-    ASSERT_TRUE(store.ok()) << store.status().ToString();
-    store_ = std::move(*store);
-    cache_ = std::make_unique<IndexCache>(store_);
-    service_ = std::make_unique<InterpolationService>(*cache_, auth_, stopping_, streams_);
+  InterpStreamTest() : InterpolationServiceTest("interp-stream-test", 5) {}
 
-    grpc::ServerBuilder builder;
-    int port = 0;
-    builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
-    builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
-    builder.RegisterService(service_.get());
-    loop_ = std::make_unique<InterpolateLoop>(*service_, 1);
-    loop_->AddQueues(builder);
-    std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> creators;
+  InterceptorFactories ServerInterceptors() override {
+    InterceptorFactories creators;
     creators.push_back(std::make_unique<CountingFactory>(sent_));
-    builder.experimental().SetInterceptorCreators(std::move(creators));
-    server_ = builder.BuildAndStart();
-    ASSERT_TRUE(server_ != nullptr && port > 0);
-    loop_->Start();
-    // No BDP probing: the stream's flow-control window stays at its initial 64 KiB, so a client
-    // that stops reading holds the server back after a few chunks.
-    grpc::ChannelArguments args;
+    return creators;
+  }
+  // No BDP probing: the stream's flow-control window stays at its initial 64 KiB, so a client
+  // that stops reading holds the server back after a few chunks.
+  void ChannelArgumentsFor(grpc::ChannelArguments& args) override {
     args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
-    args.SetMaxReceiveMessageSize(-1);
-    channel_ = grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(port),
-                                         grpc::InsecureChannelCredentials(), args);
-    stub_ = v1::Interpolation::NewStub(channel_);
-  }
-
-  void TearDown() override {
-    stopping_.Stop();
-    loop_->BeginShutdown();
-    if (server_) server_->Shutdown(std::chrono::system_clock::now() + 2s);
-    loop_->Stop();
-  }
-
-  // A session: a white reference, a dark, then `samples` sample readings at random directions
-  // (θi, θo in [0, 80], φ in [0, 180]) on the PR-650 grid. Returns its id.
-  std::int64_t MakeSession(int samples, int extra_steps = 0) {
-    storage::NewSession s;
-    s.name = "stream test";
-    s.plan_kind = "pose_list";
-    s.plan_json = R"({"poseList": {"poses": [{"alpha": 0, "beta": 0, "delta": 0}]}})";
-    s.created_by_role = "operator";
-    s.white_reflectance = 0.99;
-    std::vector<storage::StepRecord> steps;
-    for (int i = 0; i < samples + 2 + extra_steps; ++i) {
-      storage::StepRecord r;
-      r.step_index = i;
-      r.kind = i == 0   ? storage::StepKind::kReference
-               : i == 1 ? storage::StepKind::kDark
-                        : storage::StepKind::kSample;
-      steps.push_back(r);
-    }
-    Result<std::int64_t> id = store_->CreateSession(s, steps);
-    EXPECT_TRUE(id.ok()) << id.status().ToString();
-    EXPECT_TRUE(store_->SetSessionState(*id, SessionState::kRunning, "test").ok());
-    reference_ = Add(*id, storage::ReadingKind::kReference, {10, 0, 10, 180}, 1.0);
-    dark_ = Add(*id, storage::ReadingKind::kDark, {}, 0.001);
-    std::uniform_real_distribution<double> theta(0, 80);
-    std::uniform_real_distribution<double> phi(0, 180);
-    for (int i = 0; i < samples; ++i) {
-      Add(*id, storage::ReadingKind::kSample, {theta(rng_), 0, theta(rng_), phi(rng_)}, 0.1);
-    }
-    return *id;
-  }
-
-  // Stores a reading at the session's next step; returns it with its id.
-  storage::ReadingRecord AddReading(std::int64_t session, storage::ReadingKind kind,
-                                    const Directions& d, double level) {
-    storage::ReadingRecord r;
-    r.kind = kind;
-    r.directions = d;
-    r.grid = WavelengthGrid::Pr650();
-    r.spectrum.assign(static_cast<std::size_t>(r.grid.count), level);
-    if (kind == storage::ReadingKind::kSample) {
-      r.reference_reading_id = reference_;
-      r.dark_reading_id = dark_;
-    }
-    Result<std::int64_t> id = store_->CompleteStepWithReading(session, next_step_[session]++, r);
-    EXPECT_TRUE(id.ok()) << id.status().ToString();
-    r.id = id.ok() ? *id : 0;
-    r.session_id = session;
-    return r;
-  }
-  std::int64_t Add(std::int64_t session, storage::ReadingKind kind, const Directions& d,
-                   double level) {
-    return AddReading(session, kind, d, level).id;
   }
 
   static std::unique_ptr<grpc::ClientContext> Context(std::chrono::milliseconds deadline = 20s) {
@@ -203,22 +126,7 @@ class InterpStreamTest : public ::testing::Test {
     return reader->Finish();
   }
 
-  testing::TempDir dir_{"interp-stream-test"};
-  std::shared_ptr<storage::SessionStore> store_;
-  std::unique_ptr<IndexCache> cache_;
-  Authenticator auth_{{}};
-  StopSignal stopping_;
-  StreamRegistry streams_{daemon::ServerConfig{}, false};
-  std::unique_ptr<InterpolationService> service_;
-  std::unique_ptr<InterpolateLoop> loop_;  // serves service_'s Interpolate
-  std::atomic<int> sent_{0};
-  std::unique_ptr<grpc::Server> server_;
-  std::shared_ptr<grpc::Channel> channel_;
-  std::unique_ptr<v1::Interpolation::Stub> stub_;
-  std::mt19937_64 rng_{5};
-  std::map<std::int64_t, int> next_step_;
-  std::int64_t reference_ = 0;
-  std::int64_t dark_ = 0;
+  std::atomic<int> sent_{0};  // messages the service handlers started to write
 };
 
 TEST_F(InterpStreamTest, BatchStreamsChunkByChunkUnderTheClientsFlowControl) {

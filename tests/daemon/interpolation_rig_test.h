@@ -18,6 +18,7 @@
 #include "core/interp/interpolator.h"
 #include "core/pose.h"
 #include "tests/daemon/daemon_test_rig.h"
+#include "tests/daemon/rig_teardown.h"
 
 namespace brdf::testing {
 
@@ -34,12 +35,7 @@ class InterpolationRigTest : public ::testing::Test {
       op_->Stop();
       for (const std::string& e : op_->errors()) ADD_FAILURE() << "operator: " << e;
     }
-    if (rig_.daemon() != nullptr) {
-      EXPECT_TRUE(rig_.StopDaemon().ok());
-    }
-    if (HasFailure() || std::getenv("BRDF_TEST_SHOW_LOG") != nullptr) {
-      std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n----\n";
-    }
+    StopDaemonExpectingCleanExit(rig_);
   }
 
   grpc::Status Interpolate(const std::string& id, const v1::DirectionQuery& direction,

@@ -6,13 +6,12 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "tests/daemon/daemon_test_rig.h"
+#include "tests/daemon/rig_teardown.h"
 
 namespace brdf::testing {
 
@@ -31,14 +30,7 @@ class SessionRigTest : public ::testing::Test {
       for (const std::string& e : op->errors()) ADD_FAILURE() << "operator: " << e;
     }
     operators_.clear();
-    if (rig_.daemon() != nullptr) {
-      Result<int> code = rig_.StopDaemon();
-      EXPECT_TRUE(code.ok() && *code == 0)
-          << (code.ok() ? "exit code " + std::to_string(*code) : code.status().ToString());
-    }
-    if (HasFailure() || std::getenv("BRDF_TEST_SHOW_LOG") != nullptr) {
-      std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n----\n";
-    }
+    StopDaemonExpectingCleanExit(rig_);
   }
 
   // A gRPC operator watching the session (and answering its prompts unless `answering` is false)

@@ -38,6 +38,7 @@
 
 #include "tests/daemon/daemon_test_rig.h"
 #include "tests/daemon/daemon_test_util.h"
+#include "tests/daemon/rig_teardown.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
@@ -489,14 +490,7 @@ class FaultMatrixTest : public ::testing::TestWithParam<FaultCase> {
       op_->Stop();
       for (const std::string& e : op_->errors()) ADD_FAILURE() << "operator: " << e;
     }
-    if (rig_.daemon() != nullptr) {
-      Result<int> code = rig_.StopDaemon();
-      EXPECT_TRUE(code.ok() && *code == 0)
-          << (code.ok() ? "exit code " + std::to_string(*code) : code.status().ToString());
-    }
-    if (HasFailure() || std::getenv("BRDF_TEST_SHOW_LOG") != nullptr) {
-      std::cerr << "---- brdfd log ----\n" << rig_.log() << "\n----\n";
-    }
+    StopDaemonExpectingCleanExit(rig_);
   }
 
   // The daemon process is still there (not exited, not a zombie) and answers.
