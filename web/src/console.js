@@ -258,6 +258,7 @@ export function createConsole(root, role, report, server = 'brdfd') {
 
   const timers = [];
   return {
+    // (The sign-in's listing, main.js passes to a first view, is not used: this page has its own.)
     async show() {
       const sessions = await refreshSessions();
       if (archive) {

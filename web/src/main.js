@@ -32,7 +32,8 @@ async function route() {
   current = name;
   $(`${name}-view`).hidden = false;
   for (const n of ['console', 'explorer']) $(`nav-${n}`).classList.toggle('active', n === name);
-  // The sign-in's listing is handed to the first view that opens (one round trip fewer).
+  // The sign-in's listing is handed to the first view that opens: the explorer lists from it (one
+  // round trip fewer); the console reads its own page of 50 (it refreshes that every 5 s).
   const listing = firstListing;
   firstListing = null;
   try { await view(name).show(listing); } catch (e) { report(e.message); }
