@@ -28,16 +28,16 @@
 #include <string>
 #include <thread>
 
-#include "daemon/archive_shipper.h"
-#include "daemon/auth.h"
-#include "daemon/config.h"
-#include "daemon/index_cache.h"
-#include "daemon/one_owner.h"
-#include "daemon/rig.h"
-#include "daemon/server.h"
-#include "daemon/session_manager.h"
-#include "daemon/startup.h"
-#include "daemon/web_gateway.h"
+#include "daemon/api/server.h"
+#include "daemon/config/config.h"
+#include "daemon/config/startup.h"
+#include "daemon/engine/one_owner.h"
+#include "daemon/engine/rig.h"
+#include "daemon/engine/session_manager.h"
+#include "daemon/engine/shipper.h"
+#include "daemon/gateway/http_server.h"
+#include "daemon/index/cache.h"
+#include "daemon/rpc/auth.h"
 #include "drivers/exclusive_open.h"
 #include "storage/session_store.h"
 
@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
                    : config.stage.host + ":" + std::to_string(config.stage.port));
 
   // One owner: refuse, before touching anything, a database, address or meter port that another
-  // process holds (daemon/one_owner.h). The database lock is held until exit.
+  // process holds (daemon/engine/one_owner.h). The database lock is held until exit.
   Result<std::unique_ptr<DatabaseLock>> database_lock =
       DatabaseLock::Acquire(config.storage.database);
   if (!database_lock.ok()) {
@@ -214,8 +214,9 @@ int main(int argc, char** argv) {
   spdlog::info("serving on {} ({})", (*server)->address(), (*server)->tls() ? "TLS" : "plaintext");
   std::unique_ptr<WebGateway> web;
   if (!config.web.listen.empty()) {
-    Result<std::unique_ptr<WebGateway>> started = WebGateway::Start(
-        config.web, config.server.tls, DefaultWebRoot(config.web), (*server)->InProcessChannel());
+    Result<std::unique_ptr<WebGateway>> started =
+        WebGateway::Start(config.web, config.server.tls, DefaultWebRoot(config.web),
+                          (*server)->InProcessChannel(), auth);
     if (!started.ok()) {
       spdlog::critical("{}", started.status().ToString());
       (*server)->Shutdown(std::chrono::seconds(1));

@@ -1,5 +1,5 @@
-// Fuzz target: brdfd's configuration file (daemon/config.h: ParseConfig), then what the daemon
-// derives from it (ToRigDescription) and a small plan analysed against that rig, so that any
+// Fuzz target: brdfd's configuration file (daemon/config/config.h: ParseConfig), then what the
+// daemon derives from it (ToRigDescription) and a small plan analysed against that rig, so that any
 // configuration the parser accepts is one the rest of the daemon can use.
 //
 // Promises checked: a refused file is kConfigurationError with a message; an accepted one keeps
@@ -14,7 +14,7 @@
 
 #include "core/plan/analyze_plan.h"
 #include "core/plan/plan_json.h"
-#include "daemon/config.h"
+#include "daemon/config/config.h"
 #include "fuzz/fuzz_check.h"
 
 namespace brdf::fuzz {

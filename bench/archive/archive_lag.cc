@@ -12,7 +12,7 @@
 // inside PostgreSQL (generate_series), and the ListSessions-style catalogue query (filter by
 // material and tag, newest first, a page of 100) timed --queries times: p50 and p99, against the
 // same query without a filter as the baseline (SQL over libpq). Then the same through a
-// brdf-archive server (daemon/archive_server.h, in this process, over gRPC on a loopback port):
+// brdf-archive server (daemon/archive/server.h, in this process, over gRPC on a loopback port):
 // ListSessions with the filter against ListSessions without one, and the first Interpolate on a
 // cold session (its 1,000 readings read from PostgreSQL, the index built) against the next
 // Interpolate on the same session (warm), each over --cold sessions. Last, InterpolateBatch
@@ -30,12 +30,12 @@
 #include <vector>
 
 #include "brdf/v1/brdf.grpc.pb.h"
-#include "daemon/archive_server.h"
-#include "daemon/archive_shipper.h"
-#include "daemon/auth.h"
-#include "storage/archive_reader.h"
-#include "storage/archive_schema.h"
-#include "storage/pg.h"
+#include "daemon/archive/server.h"
+#include "daemon/engine/shipper.h"
+#include "daemon/rpc/auth.h"
+#include "storage/archive/pg.h"
+#include "storage/archive/reader.h"
+#include "storage/archive/schema.h"
 #include "storage/session_store.h"
 #include "tests/support/pg_server.h"
 

@@ -333,7 +333,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_daemon_load: --rate needs --api sync\n");
     return 2;
   }
-  // As brdfd does (daemon/server.cc): Debian's Abseil keeps absl::Mutex's debug-only deadlock
+  // As brdfd does (daemon/api/server.cc): Debian's Abseil keeps absl::Mutex's debug-only deadlock
   // graph on, a cost on every lock gRPC takes that upstream release builds do not pay.
   absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
 

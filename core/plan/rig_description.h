@@ -1,6 +1,6 @@
 // What the plan code needs to know about the rig: which axes are motorized, how far and how
 // fast they go, and how long the meter and the operator take. The daemon fills it from its
-// configuration (daemon/config.h: ToRigDescription); tests and tools build it by hand.
+// configuration (daemon/config/config.h: ToRigDescription); tests and tools build it by hand.
 // Defaults describe the paper's rig: α/β stages, a manual detector and γ dial, a PR-650 at
 // 9600 baud.
 #pragma once
@@ -23,7 +23,7 @@ struct AxisTravel {
 // adaptive (seconds). Adaptive integration aims the brightest band at a fill of the detector, so
 // the time follows the light: the white standard is bright (short), a sample is dimmer and varies
 // with the pose, a dark reading (lamp shuttered) never fills the detector and runs to the meter's
-// longest time (the PR-650's 6 s). Defaults: [meter] adaptive_*_ms (daemon/config.h).
+// longest time (the PR-650's 6 s). Defaults: [meter] adaptive_*_ms (daemon/config/config.h).
 struct AdaptiveIntegration {
   double reference_s = 2.0;
   double dark_s = 6.0;

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "storage/pg.h"
+#include "storage/archive/pg.h"
 #include "storage/spectrum_blob.h"
 
 namespace brdf::storage::testing {

@@ -1,15 +1,14 @@
 // The archive's schema on a real PostgreSQL: a new database gets the latest version, migrating
 // again changes nothing, a newer archive is refused, and the libpq layer reports a wrong password
 // and an unreachable server as what they are -- without the password in the message.
-#include "storage/archive_schema.h"
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <thread>
 
-#include "storage/pg.h"
+#include "storage/archive/pg.h"
+#include "storage/archive/schema.h"
 #include "tests/support/pg_server_fixture.h"
 
 namespace brdf::storage {

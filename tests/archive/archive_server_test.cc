@@ -16,10 +16,10 @@
 #include <stdexcept>
 #include <thread>
 
-#include "daemon/config.h"
+#include "daemon/config/config.h"
 #include "tests/archive/archive_status.h"
 #include "tests/brdfctl/ctl_runner.h"
-#include "tests/daemon/daemon_test_rig.h"
+#include "tests/support/daemon_test_rig.h"
 #include "tests/support/pg_server_fixture.h"
 #include "tests/support/plan_fixtures.h"
 #include "tests/support/process_launcher.h"

@@ -3,8 +3,6 @@
 // the daemon's ArchiveShipper thread. After every fault the archive is compared with the rig's
 // database reading by reading (ids, steps, every spectrum byte, timestamps): each reading is in
 // the archive exactly once, and recording never waited for the archive.
-#include "daemon/archive_shipper.h"
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -13,10 +11,11 @@
 #include <cstring>
 #include <thread>
 
-#include "storage/archive_reader.h"
-#include "storage/archive_schema.h"
-#include "storage/archive_writer.h"
-#include "storage/pg.h"
+#include "daemon/engine/shipper.h"
+#include "storage/archive/pg.h"
+#include "storage/archive/reader.h"
+#include "storage/archive/schema.h"
+#include "storage/archive/writer.h"
 #include "storage/spectrum_blob.h"
 #include "tests/archive/archive_compare.h"
 #include "tests/storage/storage_test_util.h"

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "daemon/config.h"
+#include "daemon/config/config.h"
 #include "tests/support/test_env.h"
 #include "tools/brdfctl/eta_calibrator.h"
 #include "tools/brdfctl/exit_codes.h"

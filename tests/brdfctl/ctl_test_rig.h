@@ -1,5 +1,5 @@
 // What the brdfctl tests stand on: brdf-sim and brdfd as real processes (brdfd through
-// tests/daemon/daemon_process.h), a generated configuration with an operator and an analyst
+// tests/support/daemon_process.h), a generated configuration with an operator and an analyst
 // token, and the environment a user of brdfctl would set (BRDF_ADDRESS, BRDF_TOKEN).
 #pragma once
 
@@ -8,7 +8,7 @@
 
 #include "core/status.h"
 #include "tests/brdfctl/ctl_runner.h"
-#include "tests/daemon/daemon_process.h"
+#include "tests/support/daemon_process.h"
 #include "tests/support/modbus_control.h"
 #include "tests/support/sim_process.h"
 #include "tests/support/test_env.h"

@@ -1,5 +1,5 @@
 // brdfd's TOML configuration: defaults, every key, and every way a file can be refused.
-#include "daemon/config.h"
+#include "daemon/config/config.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -13,12 +13,12 @@
 #include <set>
 #include <sstream>
 
-#include "daemon/config.h"
-#include "daemon/server.h"
-#include "tests/daemon/daemon_test_rig.h"
-#include "tests/daemon/daemon_test_util.h"
-#include "tests/daemon/raw_call.h"
+#include "daemon/api/server.h"
+#include "daemon/config/config.h"
+#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon_test_util.h"
 #include "tests/support/plan_fixtures.h"
+#include "tests/support/raw_call.h"
 
 namespace brdf::testing {
 namespace {
@@ -44,6 +44,7 @@ const std::map<std::string, Needs>& Classification() {
       {"brdf.v1.Control.ListSessionEvents", Needs::kRead},
       {"brdf.v1.Control.GetRigStatus", Needs::kRead},
       {"brdf.v1.Control.WatchSession", Needs::kRead},
+      {"brdf.v1.Control.WhoAmI", Needs::kRead},
       {"brdf.v1.Data.StreamReadings", Needs::kRead},
       {"brdf.v1.Data.Export", Needs::kRead},
       {"brdf.v1.Data.StreamReadingPoints", Needs::kRead},
@@ -98,8 +99,8 @@ TEST(AuthMatrixClassificationTest, EveryRpcOfTheProtoIsClassified) {
     seen.insert(m->full_name());
     EXPECT_EQ(Classification().count(m->full_name()), 1u)
         << m->full_name()
-        << " is a new RPC: classify it in auth_matrix_test.cc (control or read) and make its "
-           "service call Authenticator::Authorize first";
+        << " is a new RPC: classify it in auth_matrix_test.cc (control or read) and, if it "
+           "changes anything, in rpc/auth.cc's MethodAccess";
   }
   for (const auto& [name, needs] : Classification()) {
     EXPECT_EQ(seen.count(name), 1u) << name << " is no longer in brdf.proto";
@@ -172,6 +173,35 @@ TEST_F(AuthMatrixTest, AnalystsMayReadEverythingAndControlNothingOperatorsMayDoA
   Result<v1::Session> session = rig_.Get(session_id_);
   ASSERT_TRUE(session.ok());
   EXPECT_EQ(session->state(), v1::SESSION_STATE_QUEUED);
+}
+
+TEST_F(AuthMatrixTest, WhoAmITellsEachTokenItsNameAndRoleAndCannotBeTalkedInto) {
+  auto who = [&](const char* token, const std::vector<std::pair<std::string, std::string>>& extra) {
+    std::unique_ptr<grpc::ClientContext> context = DaemonRig::Context(token);
+    for (const auto& [key, value] : extra) context->AddMetadata(key, value);
+    v1::Caller caller;
+    grpc::Status st = rig_.control().WhoAmI(context.get(), v1::WhoAmIRequest(), &caller);
+    EXPECT_TRUE(st.ok()) << st.error_message();
+    return caller;
+  };
+  v1::Caller op = who(kOperatorToken, {});
+  EXPECT_EQ(op.name(), "test-operator");
+  EXPECT_EQ(op.role(), "operator");
+  EXPECT_EQ(op.server(), "brdfd");
+  v1::Caller analyst = who(kAnalystToken, {});
+  EXPECT_EQ(analyst.name(), "test-analyst");
+  EXPECT_EQ(analyst.role(), "analyst");
+  // The caller is its token's, not anything the client says about itself, and not the caller of
+  // an earlier call on the same connection.
+  v1::Caller pretending =
+      who(kAnalystToken, {{"brdf.caller.role", "operator"}, {"brdf.caller.name", "test-operator"}});
+  EXPECT_EQ(pretending.name(), "test-analyst");
+  EXPECT_EQ(pretending.role(), "analyst");
+  // Without a token: refused at the gate like every read.
+  grpc::ClientContext none;
+  v1::Caller nobody;
+  EXPECT_EQ(rig_.control().WhoAmI(&none, v1::WhoAmIRequest(), &nobody).error_code(),
+            StatusCode::UNAUTHENTICATED);
 }
 
 TEST_F(AuthMatrixTest, AuditLogNamesTheCallerAndRoleOfEveryControlAction) {

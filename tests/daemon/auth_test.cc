@@ -1,5 +1,5 @@
 // Bearer tokens → role, in process (the refusals over gRPC are in daemon_api_test.cc).
-#include "daemon/auth.h"
+#include "daemon/rpc/auth.h"
 
 #include <gtest/gtest.h>
 

@@ -23,7 +23,7 @@
 #include "core/export/merl_layout.h"
 #include "core/export/merl_reader.h"
 #include "core/export/rgl_reader.h"
-#include "tests/daemon/daemon_test_rig.h"
+#include "tests/support/daemon_test_rig.h"
 #include "tests/support/plan_fixtures.h"
 #include "tests/support/process_launcher.h"
 

@@ -1,14 +1,14 @@
 // The health service (grpc.health.v1.Health) in process, over gRPC on loopback, with the
 // generated stubs of proto/grpc/health/v1/health.proto: Check of known and unknown services, and
 // Watch streaming the status now and then each change, through to the server's shutdown.
-#include "daemon/health_service.h"
-
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <memory>
 #include <thread>
+
+#include "daemon/api/health.h"
 
 namespace brdf::daemon {
 namespace {

@@ -3,8 +3,8 @@
 // miss it), and a session's stored plan that no longer parses is reported as session_plan.h says.
 #include <gtest/gtest.h>
 
-#include "daemon/index_cache.h"
-#include "daemon/session_plan.h"
+#include "daemon/index/cache.h"
+#include "daemon/sessions/session_plan.h"
 #include "storage/session_store.h"
 #include "tests/support/test_env.h"
 

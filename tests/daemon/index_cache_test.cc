@@ -1,8 +1,6 @@
 // IndexCache in process, over a real SQLite store filled through storage's own API: the
 // quantities it derives from raw readings, snapshot consistency while readings land, cache keys,
 // the LRU bound, and its errors.
-#include "daemon/index_cache.h"
-
 #include <gtest/gtest.h>
 
 #include <array>
@@ -16,6 +14,7 @@
 #include <vector>
 
 #include "core/interp/octant.h"
+#include "daemon/index/cache.h"
 #include "storage/session_store.h"
 #include "tests/support/test_env.h"
 

@@ -19,11 +19,11 @@
 #include <thread>
 
 #include "brdf/v1/brdf.grpc.pb.h"
-#include "daemon/auth.h"
-#include "daemon/index_cache.h"
-#include "daemon/interpolate_loop.h"
-#include "daemon/service_common.h"
-#include "daemon/service_interpolation.h"
+#include "daemon/api/common.h"
+#include "daemon/api/interpolate_loop.h"
+#include "daemon/api/interpolation.h"
+#include "daemon/index/cache.h"
+#include "daemon/rpc/auth.h"
 #include "storage/session_store.h"
 #include "tests/daemon/interpolation_service_test.h"
 #include "tests/support/test_env.h"

@@ -12,10 +12,10 @@
 #include <set>
 
 #include "core/plan/plan_json.h"
-#include "daemon/service_common.h"
-#include "tests/daemon/daemon_test_rig.h"
-#include "tests/daemon/raw_call.h"
+#include "daemon/api/common.h"
+#include "tests/support/daemon_test_rig.h"
 #include "tests/support/plan_fixtures.h"
+#include "tests/support/raw_call.h"
 
 namespace brdf::testing {
 namespace {

@@ -11,9 +11,9 @@
 #include <thread>
 #include <vector>
 
-#include "daemon/service_common.h"
+#include "daemon/api/common.h"
 #include "grpc/health/v1/health.grpc.pb.h"
-#include "tests/daemon/daemon_test_rig.h"
+#include "tests/support/daemon_test_rig.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {

@@ -19,8 +19,8 @@
 
 #include "brdf/v1/brdf.pb.h"
 #include "core/plan/rig_description.h"
-#include "daemon/rig.h"
-#include "daemon/session_manager.h"
+#include "daemon/engine/rig.h"
+#include "daemon/engine/session_manager.h"
 #include "storage/session_store.h"
 #include "tests/support/fake_rig.h"
 #include "tests/support/test_env.h"

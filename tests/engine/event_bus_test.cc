@@ -1,6 +1,6 @@
 // The event bus on its own: bounded queues that drop the oldest event, late subscribers that get
 // the snapshot and the open prompt first, and subscriptions that end with the session.
-#include "daemon/event_bus.h"
+#include "daemon/engine/event_bus.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,8 @@
-// The reading step's handlers one by one (daemon/engine_retry.h, daemon/engine_reading_step.h),
+// The reading step's handlers one by one (daemon/engine/retry.h, daemon/engine/reading_step.h),
 // and the executor's commit of a reading, against an in-process scripted meter and stage behind
 // the driver interfaces (drivers/spectroradiometer.h, drivers/rotation_stage.h): no brdf-sim.
+#include "daemon/engine/reading_step.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -11,10 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "daemon/engine_reading_step.h"
-#include "daemon/engine_retry.h"
-#include "daemon/executor.h"
-#include "daemon/session_plan.h"
+#include "daemon/engine/executor.h"
+#include "daemon/engine/retry.h"
+#include "daemon/sessions/session_plan.h"
 #include "storage/session_store.h"
 #include "tests/support/test_env.h"
 

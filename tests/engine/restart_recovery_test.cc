@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "core/plan/plan_json.h"
-#include "daemon/session_manager.h"
+#include "daemon/engine/session_manager.h"
 #include "storage/session_store.h"
 #include "tests/engine/engine_test_rig.h"
 #include "tests/support/plan_fixtures.h"

@@ -8,8 +8,8 @@
 #include <fstream>
 #include <string>
 
-#include "daemon/config.h"
-#include "daemon/rig.h"
+#include "daemon/config/config.h"
+#include "daemon/engine/rig.h"
 #include "drivers/stage/profile_file.h"
 
 namespace brdf::daemon {

@@ -2,7 +2,7 @@
 // and stage (tests/support/fake_rig.h), with a real SQLite file. The test plays the operator
 // (tests/engine/engine_test_rig.h). The same sessions on the real drivers and brdf-sim run in
 // tests/daemon/daemon_session_test.cc.
-#include "daemon/session_manager.h"
+#include "daemon/engine/session_manager.h"
 
 #include <gtest/gtest.h>
 

@@ -140,7 +140,7 @@ class LiveRig:
             raise RuntimeError(f"brdfd did not start listening ({e}): {self.log('brdfd')}") from e
 
     def config_text(self):
-        """brdfd's configuration for this simulator (daemon/config.h documents the keys)."""
+        """brdfd's configuration for this simulator (daemon/config/config.h documents the keys)."""
         axes = ""
         for name, unit in (("alpha", 1), ("beta", 2), ("delta", 4)):
             axes += (f"[stage.axes.{name}]\nunit_id = {unit}\nspeed_deg_s = 30\n"

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "core/plan/rig_description.h"
-#include "daemon/rig.h"
+#include "daemon/engine/rig.h"
 #include "tests/support/fake_devices.h"
 
 namespace brdf::testing {

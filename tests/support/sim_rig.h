@@ -1,7 +1,7 @@
 // The simulator rig the process tests stand on: brdf-sim started for a fast, deterministic run
 // (simulated time kSimTimeScale× faster, no 9600-baud pacing, no wake window, Modbus on a free
 // port) and the test's hand on its control unit (what is mounted, the meter's power, faults).
-// brdfd then drives it through the real drivers (tests/daemon/daemon_test_rig.h,
+// brdfd then drives it through the real drivers (tests/support/daemon_test_rig.h,
 // tests/brdfctl/ctl_test_rig.h). Tests that need instruments but not their wire protocols use
 // the in-process fakes instead (tests/support/fake_rig.h).
 #pragma once

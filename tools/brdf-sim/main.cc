@@ -18,7 +18,7 @@
 #include <memory>
 #include <string>
 
-#include "daemon/startup.h"
+#include "daemon/config/startup.h"
 #include "tools/brdf-sim/optics.h"
 #include "tools/brdf-sim/pr650_endpoint.h"
 #include "tools/brdf-sim/rig_manual_detector.h"

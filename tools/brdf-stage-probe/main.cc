@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/config.h"
+#include "daemon/config/config.h"
 #include "drivers/stage/profile_file.h"
 #include "tools/brdf-stage-probe/stage_probe.h"
 

@@ -66,14 +66,8 @@ export async function stream(method, body, onMessage, signal, omit = []) {
   }
 }
 
-// The token's role, asked of the server itself: a control call with an empty session id is
-// refused for its role (PERMISSION_DENIED) before its body is looked at; an operator gets a
-// complaint about the id instead.
-export async function probeRole() {
-  try { await call('Control/PauseSession', { session_id: '' }); return 'operator'; }
-  catch (e) {
-    if (e.code === 'PERMISSION_DENIED') return 'analyst';
-    if (e.code === 'UNAUTHENTICATED') throw e;
-    return 'operator';
-  }
+// Who the token is, asked of the server itself (Control.WhoAmI): { name, role, server }, role
+// "operator" or "analyst". UNAUTHENTICATED for a token the server does not know.
+export function whoAmI() {
+  return call('Control/WhoAmI', {});
 }

@@ -2,12 +2,13 @@
 // then the console (#console) or the explorer (#explorer). Served by brdfd (a rig's console) or
 // by brdf-archive (GET /api/about says which): the archive's console is read-only, with no rig.
 import './style.css';
-import { call, getToken, setToken, probeRole } from './api.js';
+import { call, getToken, setToken, whoAmI } from './api.js';
 import { createConsole } from './console.js';
 import { createExplorer } from './explorer.js';
 
 const $ = (id) => document.getElementById(id);
 let role = null;
+let me = null; // Control.WhoAmI: the token's name and role
 let server = 'brdfd';
 const views = {};
 let current = null;
@@ -46,14 +47,16 @@ function view(name) {
 }
 
 // Signing in asks for the sessions (which checks the token) while the page is still asking which
-// server it is on, then for the token's role (a token the server does not know is refused once):
+// server it is on, then who the token is (Control.WhoAmI; a token the server does not know is
+// refused once):
 // the first view waits for two round trips, not four.
 async function signIn() {
   try {
     const listing = call('Control/ListSessions', { page_size: 100 });
+    const caller = Promise.all([listing, identified]).then(() => whoAmI());
+    [firstListing, me] = await Promise.all([listing, caller]);
     // The archive has no rig and no control for anyone.
-    const roleOf = Promise.all([listing, identified]).then(() => (server === 'brdf-archive' ? 'reader' : probeRole()));
-    [firstListing, role] = await Promise.all([listing, roleOf]);
+    role = server === 'brdf-archive' ? 'reader' : me.role;
   } catch (e) {
     setToken('');
     $('login-view').hidden = false;
@@ -64,6 +67,7 @@ async function signIn() {
   $('nav').hidden = false;
   $('logout').hidden = false;
   $('who').textContent = role;
+  $('who').title = `token "${me.name}"`;
   $('who').className = `role ${role}`;
   document.body.dataset.role = role;
   await route();

@@ -33,6 +33,13 @@ try {
   check(r.status === 403 && r.json.code === 'PERMISSION_DENIED', `analyst SubmitPlan → 403 PERMISSION_DENIED (${r.status} ${r.text})`);
   r = await post('Control/PauseSession', { session_id: '' }, rig.analystToken);
   check(r.status === 403, 'analyst PauseSession → 403 before the body is looked at');
+  // Who a token is, through the gateway's door as through the token gate.
+  r = await post('Control/WhoAmI', {}, rig.analystToken);
+  check(r.status === 200 && r.json.role === 'analyst' && r.json.server === 'brdfd' && r.json.name.length > 0, `analyst WhoAmI → analyst on brdfd (${r.text})`);
+  r = await post('Control/WhoAmI', {}, rig.operatorToken);
+  check(r.status === 200 && r.json.role === 'operator' && r.json.name !== (await post('Control/WhoAmI', {}, rig.analystToken)).json.name, `operator WhoAmI → operator, another name (${r.text})`);
+  r = await post('Control/WhoAmI', {}, '');
+  check(r.status === 401 && r.json.code === 'UNAUTHENTICATED', `WhoAmI without a token → 401 (${r.status})`);
 
   r = await post('Control/ValidatePlan', { plan: { name: 'x', sampleRotation: { delta: { start: 0, stop: 400, step: 0 } } } }, rig.operatorToken);
   check(r.status === 200 && r.json.valid === false && r.json.problems.length > 0 && r.json.problems.every((p) => typeof p.field_path === 'string'),

@@ -1,0 +1,370 @@
+// Interpolation.RenderAppearance: the sample's colour and a lit sphere under CIE illuminants from
+// the session's BRDF index (service_interpolation.h; core/appearance.h), and the cache of its
+// answers.
+#include "core/appearance.h"
+
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/io/zero_copy_stream_impl_lite.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/export/fill_chain.h"
+#include "core/export/session_interpolant.h"
+#include "core/export/spectrum_source.h"
+#include "core/fit/fit.h"
+#include "daemon/api/interpolation.h"
+#include "data/cie_tables.h"
+
+namespace brdf::daemon {
+namespace {
+
+// The longest a model fit may take when a pixel needs it (the client's deadline, if shorter).
+constexpr std::chrono::seconds kLongestFit{120};
+
+struct AppearanceSettings {
+  SessionId session = 0;
+  interp::Method method = interp::Method::kOctant;
+  interp::Options options;
+  SphereOptions sphere;
+  std::vector<v1::Illuminant> illuminants;
+};
+
+grpc::Status ParseAppearance(const v1::AppearanceRequest& r, AppearanceSettings* out) {
+  if (grpc::Status st = ParseSessionIdField(r.session_id(), "session_id", &out->session);
+      !st.ok()) {
+    return st;
+  }
+  if (grpc::Status st = ParseMethodField(r.method(), &out->method); !st.ok()) return st;
+  if (grpc::Status st = ParseInterpolationOptions(r.options(), &out->options); !st.ok()) return st;
+  if (r.sphere_size() > kMaxAppearanceSphere) {
+    return InvalidField("sphere_size",
+                        std::to_string(r.sphere_size()) + " pixels per side; at most " +
+                            std::to_string(kMaxAppearanceSphere) +
+                            " (0: " + std::to_string(kDefaultAppearanceSphere) + ")");
+  }
+  out->sphere.size =
+      static_cast<int>(r.sphere_size() == 0 ? kDefaultAppearanceSphere : r.sphere_size());
+  if (r.light_size() != 0) {
+    if (r.light_size() != 3) {
+      return InvalidField("light",
+                          "give 3 values (x right, y up, z towards the viewer) or none, "
+                          "got " +
+                              std::to_string(r.light_size()));
+    }
+    bool all_zero = true;
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(r.light(k))) {
+        return InvalidField("light[" + std::to_string(k) + "]", "must be a finite number");
+      }
+      all_zero = all_zero && r.light(k) == 0;
+      out->sphere.light[static_cast<std::size_t>(k)] = r.light(k);
+    }
+    if (all_zero) return InvalidField("light", "must not be (0, 0, 0): it is a direction");
+  }
+  for (int k = 0; k < r.illuminants_size(); ++k) {
+    const auto i = static_cast<v1::Illuminant>(r.illuminants(k));
+    const std::string field = "illuminants[" + std::to_string(k) + "]";
+    if (i != v1::ILLUMINANT_D65 && i != v1::ILLUMINANT_A) {
+      return InvalidField(field, "give D65 or A (got " + std::to_string(r.illuminants(k)) + ")");
+    }
+    if (std::find(out->illuminants.begin(), out->illuminants.end(), i) != out->illuminants.end()) {
+      return InvalidField(field, std::string(v1::Illuminant_Name(i)) + " is asked twice");
+    }
+    out->illuminants.push_back(i);
+  }
+  if (out->illuminants.empty()) out->illuminants = {v1::ILLUMINANT_D65, v1::ILLUMINANT_A};
+  return grpc::Status::OK;
+}
+
+// A stage of the fill chain that is only made when a direction first needs it (the Delaunay
+// index, the fitted model): most sessions' spheres never ask. A stage that cannot be made answers
+// no value, and says why in `error`.
+class LazyStage {
+ public:
+  using Make = std::function<Result<exports::SpectrumSource>()>;
+  explicit LazyStage(Make make) : make_(std::move(make)) {}
+
+  exports::SpectrumSource Source() {
+    return [this](const IsoDirection& at, std::span<double> out) {
+      std::call_once(once_, [this] {
+        Result<exports::SpectrumSource> made = make_();
+        if (made.ok()) {
+          source_.emplace(*std::move(made));
+        } else {
+          error_ = made.status().message();
+          code_ = made.status().code();
+        }
+      });
+      return source_ ? (*source_)(at, out) : interp::InterpStatus::kOutsideHull;
+    };
+  }
+  const std::string& error() const { return error_; }
+  // Made, not needed, or failed for a reason of the readings (the same for every call on this
+  // snapshot), not of this call (its deadline, a cancellation, the store).
+  bool Lasting() const {
+    return error_.empty() || code_ == StatusCode::kFailedPrecondition ||
+           code_ == StatusCode::kInvalidArgument || code_ == StatusCode::kNotFound;
+  }
+
+ private:
+  Make make_;
+  std::once_flag once_;
+  std::optional<exports::SpectrumSource> source_;
+  std::string error_;
+  StatusCode code_ = StatusCode::kOk;
+};
+
+CallContext FitContext(const grpc::ServerContext& context) {
+  const auto remaining = context.deadline() - std::chrono::system_clock::now();
+  const auto timeout = std::min<std::chrono::steady_clock::duration>(
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::max(remaining, std::chrono::system_clock::duration::zero())),
+      kLongestFit);
+  return CallContext::WithTimeout(timeout);
+}
+
+void SetColour(const SampleColour& c, v1::AppearanceColour* out) {
+  out->set_x_tristimulus(c.xyz.X);
+  out->set_y_tristimulus(c.xyz.Y);
+  out->set_z_tristimulus(c.xyz.Z);
+  out->set_x(c.xy.x);
+  out->set_y(c.xy.y);
+  out->set_linear_r(c.linear_srgb.r);
+  out->set_linear_g(c.linear_srgb.g);
+  out->set_linear_b(c.linear_srgb.b);
+  out->set_srgb_hex(c.hex);
+}
+
+// The request's bytes, the same for equal requests (the cache's key).
+std::string DeterministicBytes(const google::protobuf::Message& message) {
+  std::string bytes;
+  {
+    google::protobuf::io::StringOutputStream stream(&bytes);
+    google::protobuf::io::CodedOutputStream coded(&stream);
+    coded.SetSerializationDeterministic(true);
+    message.SerializeToCodedStream(&coded);
+  }
+  return bytes;
+}
+
+// The answer from `index` (the request checked into `s`). *lasting: false when the outcome
+// depends on this call (a stage of the fill chain that failed for its deadline or the store), so
+// that it may be neither cached nor handed to another caller.
+grpc::Status Render(IndexCache& cache, const StopSignal& stopping, grpc::ServerContext& context,
+                    const AppearanceSettings& s, const data::CieTables& cie,
+                    const std::shared_ptr<const IndexSnapshot>& index,
+                    v1::AppearanceResponse* response, bool* lasting) {
+  // The exports' fill chain (core/export/fill_chain.h) over the cache's indexes.
+  std::shared_ptr<const IndexSnapshot> delaunay;
+  LazyStage fallback([&]() -> Result<exports::SpectrumSource> {
+    Result<std::shared_ptr<const IndexSnapshot>> d =
+        cache.Get(s.session, Quantity::kBrdf, interp::Method::kDelaunay, s.options);
+    if (!d.ok()) return d.status().WithContext("the fill chain's Delaunay fallback");
+    delaunay = *std::move(d);
+    return exports::InterpolatorSource(*delaunay->interpolator);
+  });
+  std::optional<fit::CookTorranceFit> model_fit;
+  LazyStage model([&]() -> Result<exports::SpectrumSource> {
+    Result<fit::CookTorranceFit> fitted =
+        exports::FitSampleModel(*index->samples, index->grid, FitContext(context));
+    if (!fitted.ok()) return fitted.status().WithContext("the fill chain's model");
+    model_fit = *std::move(fitted);
+    return exports::ModelSource(*model_fit);
+  });
+  std::vector<exports::FillChain::Stage> stages;
+  stages.push_back(
+      {exports::Provenance::kInterpolated, exports::InterpolatorSource(*index->interpolator)});
+  if (s.method != interp::Method::kDelaunay) {
+    stages.push_back({exports::Provenance::kFallback, fallback.Source()});
+  }
+  stages.push_back({exports::Provenance::kModel, model.Source()});
+  const exports::FillChain chain(exports::FillPolicy::kChain, std::move(stages));
+  const exports::SpectrumSource source = chain.Source();
+  const BrdfLookup brdf = [&source](const IsoDirection& at, std::span<double> out) {
+    return source(at, out) == interp::InterpStatus::kOk;
+  };
+
+  for (const v1::Illuminant which : s.illuminants) {
+    if (stopping.stopped()) {
+      return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                          "RenderAppearance: the daemon is shutting down; ask again once it is "
+                          "back");
+    }
+    if (context.IsCancelled()) {
+      return grpc::Status(grpc::StatusCode::CANCELLED, "RenderAppearance: cancelled");
+    }
+    const bool d65 = which == v1::ILLUMINANT_D65;
+    const Spectrum illuminant = d65 ? cie.d65 : CieIlluminantA(index->grid);
+    Result<SampleColour> colour = ComputeSampleColour(brdf, index->grid, illuminant, cie.cmf);
+    *lasting = fallback.Lasting() && model.Lasting();
+    if (!colour.ok()) {
+      std::string why = fallback.error().empty() ? model.error() : fallback.error();
+      return ToGrpcStatus(why.empty() ? colour.status() : colour.status().WithContext(why));
+    }
+    const exports::FillTally before = chain.Tally();
+    Result<LitSphere> sphere = RenderLitSphere(brdf, index->grid, illuminant, cie.cmf, s.sphere);
+    *lasting = fallback.Lasting() && model.Lasting();
+    if (!sphere.ok()) return ToGrpcStatus(sphere.status());
+    const exports::FillTally after = chain.Tally();
+
+    v1::AppearanceImage* image = response->add_images();
+    image->set_illuminant(which);
+    image->set_name(d65 ? "D65" : "A");
+    SetColour(*colour, image->mutable_colour());
+    image->set_sphere_size(static_cast<std::uint32_t>(sphere->size));
+    image->set_sphere_rgba(sphere->rgba.data(), sphere->rgba.size());
+    image->set_disc_pixels(static_cast<std::uint32_t>(sphere->disc_pixels));
+    image->set_unlit_pixels(static_cast<std::uint32_t>(sphere->unlit_pixels));
+    image->set_interpolated_pixels(
+        static_cast<std::uint32_t>(after.interpolated - before.interpolated));
+    image->set_fallback_pixels(static_cast<std::uint32_t>(after.fallback - before.fallback));
+    image->set_model_pixels(static_cast<std::uint32_t>(after.model - before.model));
+    image->set_empty_pixels(static_cast<std::uint32_t>(after.empty - before.empty));
+    image->set_peak_y(sphere->peak_y);
+    if (response->reflectance_size() == 0) {
+      *response->mutable_grid() = ToProtoGrid(index->grid);
+      response->mutable_reflectance()->Add(colour->reflectance.values.begin(),
+                                           colour->reflectance.values.end());
+    }
+  }
+
+  std::string detail;
+  if (index->skipped > 0) {
+    detail = std::to_string(index->skipped) +
+             " sample reading(s) of the session left out (first: " + index->skipped_detail + ")";
+  }
+  for (const std::string* error : {&fallback.error(), &model.error()}) {
+    if (!error->empty()) detail += (detail.empty() ? "" : "; ") + *error;
+  }
+  response->set_detail(std::move(detail));
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
+std::shared_ptr<const v1::AppearanceResponse> InterpolationService::CachedAppearance(
+    const AppearanceKey& key) {
+  for (auto it = appearance_cache_.begin(); it != appearance_cache_.end();) {
+    if (it->index.expired()) {  // its snapshot is gone: no call can ask for it again
+      it = appearance_cache_.erase(it);
+      continue;
+    }
+    if (it->key == key) {
+      appearance_cache_.splice(appearance_cache_.begin(), appearance_cache_, it);
+      return appearance_cache_.front().response;
+    }
+    ++it;
+  }
+  return nullptr;
+}
+
+std::size_t InterpolationService::appearance_flights() const {
+  MutexLock lock(appearance_mu_);
+  return appearance_flights_.size();
+}
+
+grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context,
+                                                    const v1::AppearanceRequest* request,
+                                                    v1::AppearanceResponse* response) {
+  Caller caller;
+  if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
+  // The work permit only once the answer must be rendered (Slot::Work below): a cached answer,
+  // or one an identical call is rendering, takes none.
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  if (grpc::Status st = streams_.Open(*context, &caller, "RenderAppearance", &slot); !st.ok()) {
+    return st;
+  }
+  AppearanceSettings s;
+  if (grpc::Status st = ParseAppearance(*request, &s); !st.ok()) return st;
+
+  Result<std::shared_ptr<const IndexSnapshot>> got =
+      cache_.Get(s.session, Quantity::kBrdf, s.method, s.options);
+  if (!got.ok()) return ToGrpcStatus(got.status());
+  const std::shared_ptr<const IndexSnapshot> index = *std::move(got);
+  if (index->anisotropic) {
+    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
+                        "RenderAppearance: session " + request->session_id() +
+                            " is anisotropic (measured at several dial positions); the colour "
+                            "and lit sphere are rendered for isotropic sessions only");
+  }
+
+  // The cached answer, or the one an identical call is rendering, else a render of our own.
+  const AppearanceKey key{index.get(), s.session, index->through_reading_id,
+                          DeterministicBytes(*request)};
+  std::shared_ptr<AppearanceFlight> flight;
+  while (flight == nullptr) {
+    MutexLock lock(appearance_mu_);
+    if (std::shared_ptr<const v1::AppearanceResponse> hit = CachedAppearance(key)) {
+      lock.Unlock();
+      ++appearance_reuses_;
+      *response = *hit;
+      return grpc::Status::OK;
+    }
+    auto it = std::find_if(appearance_flights_.begin(), appearance_flights_.end(),
+                           [&key](const auto& f) { return f->key == key; });
+    if (it == appearance_flights_.end()) {
+      flight = std::make_shared<AppearanceFlight>();
+      flight->key = key;
+      appearance_flights_.push_back(flight);
+      break;
+    }
+    const std::shared_ptr<const AppearanceFlight> other = *it;
+    while (!other->done) {
+      // The synchronous API has no wake-up for a cancelled call: look now and then.
+      if (context->IsCancelled()) {
+        return grpc::Status(grpc::StatusCode::CANCELLED, "RenderAppearance: cancelled");
+      }
+      if (stopping_.stopped()) {
+        return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                            "RenderAppearance: the daemon is shutting down; ask again once it is "
+                            "back");
+      }
+      appearance_done_.WaitFor(appearance_mu_, std::chrono::milliseconds(100));
+    }
+    // Done: the flight's outcome no longer changes.
+    if (other->shared) {
+      lock.Unlock();
+      ++appearance_reuses_;
+      if (other->status.ok()) *response = *other->response;
+      return other->status;
+    }
+    // The other call was cancelled, or its answer held only for it: look again (a third call
+    // may render it by now), else render here.
+  }
+
+  auto rendered = std::make_shared<v1::AppearanceResponse>();
+  bool lasting = false;
+  grpc::Status st(grpc::StatusCode::CANCELLED, "RenderAppearance: cancelled");
+  if (Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir); !cie.ok()) {
+    st = ToGrpcStatus(cie.status());
+    lasting = true;  // the installation's: the same for every call
+  } else if (slot->Work() && !context->IsCancelled()) {
+    ++appearance_renders_;
+    st = Render(cache_, stopping_, *context, s, *cie, index, rendered.get(), &lasting);
+  }
+  {
+    MutexLock lock(appearance_mu_);
+    flight->done = true;
+    flight->shared = lasting && st.error_code() != grpc::StatusCode::CANCELLED;
+    flight->status = st;
+    if (st.ok()) flight->response = rendered;
+    appearance_flights_.remove(flight);
+    if (st.ok() && flight->shared) {
+      appearance_cache_.push_front(AppearanceEntry{key, index, rendered});
+      if (appearance_cache_.size() > kAppearanceCacheEntries) appearance_cache_.pop_back();
+    }
+  }
+  appearance_done_.NotifyAll();
+  if (st.ok()) *response = *rendered;
+  return st;
+}
+
+}  // namespace brdf::daemon

@@ -1,0 +1,155 @@
+// What the three gRPC services share: the limits every request is checked against, the mapping
+// of brdfd's Status codes onto gRPC codes (session_manager.h's table), argument checks that name
+// the offending field, storage records as the API's messages, and the daemon-wide "stopping"
+// signal that ends long-lived streams at shutdown.
+#pragma once
+
+#include <grpcpp/support/status.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "brdf/v1/brdf.pb.h"
+#include "core/client_text.h"
+#include "core/interp/interpolator.h"
+#include "core/mutex.h"
+#include "core/readings/quantity.h"
+#include "core/status.h"
+#include "core/wavelength_grid.h"
+#include "daemon/rpc/auth.h"
+#include "storage/records.h"
+#include "storage/session_reader.h"
+
+namespace brdf::daemon {
+
+// Largest request the server accepts (a plan at core/plan's step cap is ~8 MB of JSON; a batch of
+// kMaxBatchDirections iso directions is ~3 MB). Larger ones fail with RESOURCE_EXHAUSTED.
+inline constexpr int kMaxReceiveMessageBytes = 16 * 1024 * 1024;
+// Directions per InterpolateBatch request.
+inline constexpr int kMaxBatchDirections = 100000;
+// Results per InterpolateBatch chunk: default, and the most a client may ask (1,024 results of
+// 101 bands with provenance are ~1.2 MB, well under a client's default 4 MiB receive limit).
+inline constexpr std::uint32_t kDefaultChunkSize = 256;
+inline constexpr std::uint32_t kMaxChunkSize = 1024;
+// Free texts (abort reason, prompt note) are stored in the audit log; longer ones are refused.
+inline constexpr std::size_t kMaxNoteBytes = 4096;
+// A session id is a positive decimal number of at most 18 digits; ids and page tokens longer than
+// this are refused without being echoed back (an error message must stay small: gRPC carries it
+// in a trailer, which clients cap at a few KiB).
+inline constexpr std::size_t kMaxSessionIdBytes = 32;
+// ListSessions: default and largest page.
+inline constexpr std::uint32_t kDefaultPageSize = 100;
+inline constexpr std::uint32_t kMaxPageSize = 1000;
+// How often a long-lived stream (WatchSession, StreamReadings with follow) looks whether its
+// client went away or the daemon is stopping.
+inline constexpr std::chrono::milliseconds kStreamPollInterval{200};
+
+// brdfd Status → gRPC status (message through BoundedMessage), code per session_manager.h:
+// kInvalidArgument → INVALID_ARGUMENT,
+// kNotFound → NOT_FOUND, kFailedPrecondition → FAILED_PRECONDITION, kIoError → UNAVAILABLE,
+// kTimeout → DEADLINE_EXCEEDED, kCancelled → CANCELLED, device errors → UNAVAILABLE, kInternal
+// and kConfigurationError → INTERNAL. The message is kept, up to kMaxErrorMessageBytes.
+grpc::Status ToGrpcStatus(const Status& status);
+
+// A client's string as an error message may quote it: PrintablePrefix (core/client_text.h).
+// gRPC carries an error message in a trailer, which clients cap at a few KiB.
+using brdf::PrintablePrefix;
+
+// Longest error message brdfd sends (BoundedMessage); the trailer that carries it stays small.
+inline constexpr std::size_t kMaxErrorMessageBytes = 1024;
+// `message` cut to kMaxErrorMessageBytes at a character boundary, marked with its full length:
+// the last guard in case a message quotes more of a client's string than it should.
+std::string BoundedMessage(std::string message);
+
+// INVALID_ARGUMENT "<field>: <what>".
+grpc::Status InvalidField(const std::string& field, const std::string& what);
+
+// A session id field ("session_id", "page_token") as a number: INVALID_ARGUMENT naming `field`
+// when it is empty, too long (kMaxSessionIdBytes: the value is not echoed) or not a positive
+// number. Never NOT_FOUND: whether the session exists is the caller's next question.
+grpc::Status ParseSessionIdField(const std::string& text, const std::string& field,
+                                 std::int64_t* id);
+
+// The API's quantity (UNSPECIFIED: BRDF) and interpolation method (UNSPECIFIED: octant) as
+// brdfd's; INVALID_ARGUMENT naming "quantity" / "method" for a value the API does not have.
+grpc::Status ParseQuantityField(int quantity, Quantity* out);
+grpc::Status ParseMethodField(int method, interp::Method* out);
+// InterpolationOptions.coordinates (UNSPECIFIED: incidence) as brdfd's; INVALID_ARGUMENT naming
+// "options.coordinates" for a value the API does not have. Whether the session can take half/
+// difference coordinates is the index's check (index_build.h: CheckIndexOptions).
+grpc::Status ParseCoordinatesField(int coordinates, interp::Coordinates* out);
+// InterpolationOptions.trend: unset is NONE; an unknown value names options.trend.
+grpc::Status ParseTrendField(int trend, interp::Trend* out);
+v1::Quantity ToProtoQuantity(Quantity quantity);
+
+// Checks a finite angle within [lo, hi]; the message names `field` and the range.
+Status CheckAngle(double value, double lo, double hi, const std::string& field);
+
+// The API's messages for storage's records.
+v1::WavelengthGrid ToProtoGrid(const WavelengthGrid& grid);
+v1::ReadingKind ToProtoReadingKind(storage::ReadingKind kind);
+
+// What a Reading message needs beyond the record: the step's label, and the plan's averaging
+// (the meter's averaging count is a plan setting, the same for every reading of a session).
+struct ReadingExtras {
+  std::map<int, std::string> step_labels;
+  std::uint32_t averages = 1;
+};
+v1::Reading ToProtoReading(const storage::ReadingRecord& record, const ReadingExtras& extras);
+
+// Control.WhoAmI, for brdfd and brdf-archive alike: the caller the call was admitted as
+// (Authenticator::CallerOf), and `server`, the program's name.
+grpc::Status ServeWhoAmI(const Authenticator& auth, const grpc::ServerContextBase& context,
+                         const char* server, v1::Caller* response);
+
+// Control.ListSessionEvents, for brdfd (its store) and brdf-archive (the archive) alike, after
+// the caller's role was checked: the session id parsed (INVALID_ARGUMENT naming session_id), the
+// session's history read from `reader` (NOT_FOUND naming the session), oldest first.
+grpc::Status ServeListSessionEvents(storage::SessionReader& reader,
+                                    const v1::ListSessionEventsRequest& request,
+                                    v1::ListSessionEventsResponse* response);
+
+// StreamReadingsRequest.kinds as a set (empty: every kind); INVALID_ARGUMENT naming "kinds[i]"
+// for a kind the API does not have.
+grpc::Status ParseReadingKinds(const v1::StreamReadingsRequest& request,
+                               std::set<storage::ReadingKind>* kinds);
+
+// ListSessions' catalogue filters (ListSessionsRequest fields 4-9), checked: brdfd applies them
+// to its sessions with Matches, brdf-archive in its SQL (storage/archive/reader.h), with the same
+// meaning. Timestamps as Unix seconds.
+struct CatalogueFilter {
+  std::vector<SessionState> states;  // ListSessionsRequest.states (Matches leaves them out)
+  std::string rig;
+  std::string sample;    // the sample's id, or its name ignoring case
+  std::string material;  // ignoring case
+  std::string tag;
+  std::optional<double> created_after;   // created_at ≥
+  std::optional<double> created_before;  // created_at <
+  bool Matches(const v1::Session& session) const;
+};
+// INVALID_ARGUMENT naming the field for an unknown state, a timestamp out of range (nanos outside
+// 0…999,999,999) or created_before not after created_after.
+grpc::Status ParseCatalogueFilter(const v1::ListSessionsRequest& request, CatalogueFilter* out);
+
+// Set once at shutdown; streams end when they see it. Waiters wake at once.
+class StopSignal {
+ public:
+  void Stop();
+  bool stopped() const { return stopped_.load(); }
+  // Waits up to `d` or until Stop(); true when stopped.
+  bool WaitFor(std::chrono::steady_clock::duration d) const;
+
+ private:
+  std::atomic<bool> stopped_{false};
+  mutable Mutex mu_;
+  mutable CondVar cv_;
+};
+
+}  // namespace brdf::daemon

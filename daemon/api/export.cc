@@ -1,0 +1,586 @@
+// Data.Export (brdf.proto): a session exported to a file by core/export, streamed to the caller so
+// that a remote client gets the file itself. The work runs on the handler's thread (and
+// core/export's worker threads): the session is loaded from the store, the requested export is
+// computed, and its bytes go out in ExportData chunks as the export writes them — a regular grid
+// is streamed slice by slice and never sits in memory whole (a 1° grid of 101 bands is 1.2 GB).
+// Progress messages are interleaved; a client that goes away, or the daemon stopping, cancels
+// the export (its CancelToken) at the next progress report or chunk.
+//
+// The exports are the same code as brdf-export's (storage/session_readings.h: the session;
+// data/cie_tables.h: the CIE tables; core/export: the formats; core/export/session_interpolant.h:
+// the interpolant behind the fill chain, and the RGL material), so a file from the daemon and one
+// from the tool are the same bytes for the same session and options. Grids, MERL and RGL fill
+// through the chain unless the request's fill is NONE, and the report counts each cell's
+// provenance (ExportReport.fill).
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <ostream>
+#include <streambuf>
+#include <string>
+#include <vector>
+
+#include "core/call_context.h"
+#include "core/export/fill_chain.h"
+#include "core/export/grid_text.h"
+#include "core/export/merl_export.h"
+#include "core/export/npy_writer.h"
+#include "core/export/readings_csv.h"
+#include "core/export/regular_grid.h"
+#include "core/export/rgl_export.h"
+#include "core/export/run_control.h"
+#include "core/export/session_data.h"
+#include "core/export/session_interpolant.h"
+#include "core/export/spectral_rgb.h"
+#include "core/export/spectrum_source.h"
+#include "daemon/api/data.h"
+#include "daemon/api/export_session.h"
+#include "data/cie_tables.h"
+#include "storage/session_readings.h"
+
+namespace brdf::daemon {
+namespace {
+
+// ExportRequest.chunk_bytes: default and largest (a chunk must stay under a client's default
+// 4 MiB receive limit together with its framing).
+constexpr std::uint32_t kDefaultExportChunkBytes = 1024 * 1024;
+constexpr std::uint32_t kMaxExportChunkBytes = 4 * 1024 * 1024 - 1024;
+// Exports have no deadline of their own beyond the client's; this caps a client without one.
+constexpr std::chrono::hours kLongestExport{24};
+// A progress message goes out when the fraction moved by this much (or the stage changed).
+constexpr double kProgressStep = 0.005;
+// RGL: the largest θi slice count and warped-square resolution a request may ask (the file is
+// built in memory: 4 · slices · nodes² · bands bytes of spectra).
+constexpr std::uint32_t kMaxRglThetaI = 90;
+constexpr std::uint32_t kMaxRglResolution = 128;
+
+// The stream of one Export call: progress messages, the file's bytes in chunks of at most
+// `chunk_bytes`, the report. Used from the handler's thread only (core/export calls progress on
+// its calling thread). A failed Write means the client went away: the export is cancelled.
+class ExportStream {
+ public:
+  ExportStream(grpc::ServerContext& context, grpc::ServerWriter<v1::ExportChunk>& writer,
+               StreamRegistry::Slot& slot, const StopSignal& stopping, std::size_t chunk_bytes,
+               CancelToken cancel)
+      : context_(context),
+        writer_(writer),
+        slot_(slot),
+        stopping_(stopping),
+        chunk_bytes_(chunk_bytes),
+        cancel_(std::move(cancel)) {}
+
+  void Progress(const std::string& stage, double fraction) {
+    CheckCancelled();
+    fraction = std::clamp(fraction, last_fraction_, 1.0);
+    if (stage == last_stage_ && fraction < last_fraction_ + kProgressStep && fraction < 1.0) {
+      return;
+    }
+    if (stage == last_stage_ && fraction == last_fraction_ && fraction > 0) return;
+    last_stage_ = stage;
+    last_fraction_ = fraction;
+    v1::ExportChunk chunk;
+    chunk.mutable_progress()->set_stage(stage);
+    chunk.mutable_progress()->set_fraction(fraction);
+    Send(chunk);
+  }
+
+  // Buffers `n` bytes of the file, sending full chunks. False once the stream is broken.
+  bool Append(const char* data, std::size_t n) {
+    CheckCancelled();
+    while (n > 0 && !broken_) {
+      const std::size_t take = std::min(n, chunk_bytes_ - buffer_.size());
+      buffer_.append(data, take);
+      data += take;
+      n -= take;
+      if (buffer_.size() == chunk_bytes_) SendBuffer();
+    }
+    return !broken_;
+  }
+
+  // Sends what is buffered. False once the stream is broken.
+  bool Flush() {
+    if (!buffer_.empty() && !broken_) SendBuffer();
+    return !broken_;
+  }
+
+  bool SendReport(v1::ExportReport report) {
+    if (!Flush()) return false;
+    report.set_bytes(offset_);
+    v1::ExportChunk chunk;
+    *chunk.mutable_report() = std::move(report);
+    Send(chunk);
+    return !broken_;
+  }
+
+  bool broken() const { return broken_; }
+  std::uint64_t bytes() const { return offset_ + buffer_.size(); }
+
+ private:
+  void CheckCancelled() {
+    if (cancel_.cancelled()) return;
+    if (broken_ || context_.IsCancelled()) {
+      cancel_.Cancel("Export: the client went away");
+    } else if (stopping_.stopped()) {
+      cancel_.Cancel("Export: the daemon is shutting down; ask again once it is back");
+    }
+  }
+
+  void SendBuffer() {
+    v1::ExportChunk chunk;
+    chunk.mutable_data()->set_offset(offset_);
+    chunk.mutable_data()->set_content(buffer_);
+    offset_ += buffer_.size();
+    buffer_.clear();
+    Send(chunk);
+  }
+
+  void Send(const v1::ExportChunk& chunk) {
+    if (broken_) return;
+    if (!slot_.Write(&writer_, chunk)) {
+      broken_ = true;
+      CheckCancelled();
+    }
+  }
+
+  grpc::ServerContext& context_;
+  grpc::ServerWriter<v1::ExportChunk>& writer_;
+  StreamRegistry::Slot& slot_;
+  const StopSignal& stopping_;
+  const std::size_t chunk_bytes_;
+  CancelToken cancel_;
+  std::string buffer_;
+  std::uint64_t offset_ = 0;  // bytes sent
+  bool broken_ = false;
+  std::string last_stage_;
+  double last_fraction_ = 0;
+};
+
+// An ostream's buffer that hands everything to an ExportStream, so that core/export's writers
+// (which take a std::ostream) stream straight to the client. A broken stream makes the writes
+// fail, which the writers report as kIoError.
+class ExportStreamBuf : public std::streambuf {
+ public:
+  explicit ExportStreamBuf(ExportStream& stream) : stream_(stream) {}
+
+ protected:
+  int_type overflow(int_type ch) override {
+    if (traits_type::eq_int_type(ch, traits_type::eof())) return traits_type::not_eof(ch);
+    const char c = traits_type::to_char_type(ch);
+    return stream_.Append(&c, 1) ? ch : traits_type::eof();
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    return stream_.Append(s, static_cast<std::size_t>(n)) ? n : 0;
+  }
+  int sync() override { return stream_.Flush() ? 0 : -1; }
+
+ private:
+  ExportStream& stream_;
+};
+
+// What the request asks for, checked.
+struct ExportSettings {
+  std::int64_t session_id = 0;
+  v1::ExportFormat format = v1::EXPORT_FORMAT_UNSPECIFIED;
+  exports::Quantity quantity = exports::Quantity::kBrdf;
+  interp::Method method = interp::Method::kOctant;
+  interp::Options options;
+  double steps[3] = {1, 1, 1};
+  bool nodes = false;
+  bool exclude_flagged = false;
+  std::size_t chunk_bytes = kDefaultExportChunkBytes;
+  exports::FillPolicy fill = exports::FillPolicy::kChain;
+  bool rgb = false;                // RGL
+  exports::SessionRglOptions rgl;  // RGL: θi slices and resolution (rgb weights added later)
+};
+
+grpc::Status ParseFillField(v1::ExportFill fill, exports::FillPolicy* out) {
+  switch (fill) {
+    case v1::EXPORT_FILL_UNSPECIFIED:
+    case v1::EXPORT_FILL_CHAIN:
+      *out = exports::FillPolicy::kChain;
+      return grpc::Status::OK;
+    case v1::EXPORT_FILL_NONE:
+      *out = exports::FillPolicy::kNone;
+      return grpc::Status::OK;
+    default:
+      return InvalidField("fill", "give NONE or CHAIN, or leave it unset for the chain (got " +
+                                      std::to_string(fill) + ")");
+  }
+}
+
+grpc::Status ParseRglFields(const v1::ExportRequest& r, ExportSettings* out) {
+  const bool rgl = r.format() == v1::EXPORT_FORMAT_RGL_BSDF;
+  if (!rgl && (r.rgb() || r.rgl_theta_i_count() != 0 || r.rgl_resolution() != 0)) {
+    return InvalidField(r.rgb()                      ? "rgb"
+                        : r.rgl_theta_i_count() != 0 ? "rgl_theta_i_count"
+                                                     : "rgl_resolution",
+                        "is for RGL exports (format RGL_BSDF); leave it unset for this format");
+  }
+  out->rgb = r.rgb();
+  if (r.rgl_theta_i_count() != 0) {
+    if (r.rgl_theta_i_count() < 2 || r.rgl_theta_i_count() > kMaxRglThetaI) {
+      return InvalidField("rgl_theta_i_count", "give 2 to " + std::to_string(kMaxRglThetaI) +
+                                                   " θi slices, or 0 for 24 (got " +
+                                                   std::to_string(r.rgl_theta_i_count()) + ")");
+    }
+    out->rgl.theta_i_count = r.rgl_theta_i_count();
+  }
+  if (r.rgl_resolution() != 0) {
+    if (r.rgl_resolution() < 2 || r.rgl_resolution() > kMaxRglResolution) {
+      return InvalidField("rgl_resolution", "give 2 to " + std::to_string(kMaxRglResolution) +
+                                                " nodes per side, or 0 for 48 (got " +
+                                                std::to_string(r.rgl_resolution()) + ")");
+    }
+    out->rgl.sample_res = r.rgl_resolution();
+  }
+  return grpc::Status::OK;
+}
+
+// A grid's steps, checked before the export starts streaming: a refusal then reaches the
+// caller as the call's status (a browser's HTTP status), naming the request's field.
+grpc::Status CheckGridSteps(const ExportSettings& s) {
+  if (s.format != v1::EXPORT_FORMAT_GRID_NPY && s.format != v1::EXPORT_FORMAT_GRID_CSV) {
+    return grpc::Status::OK;
+  }
+  static constexpr const char* kFields[3] = {"step_theta_i", "step_theta_o", "step_phi"};
+  for (int k = 0; k < 3; ++k) {
+    double alone[3] = {1.0, 1.0, 1.0};
+    alone[k] = s.steps[k];
+    Result<exports::RegularGrid> grid = exports::MakeRegularGrid(
+        alone[0], alone[1], alone[2], exports::GridPlacement::kCellCentres);
+    if (!grid.ok()) return InvalidField(kFields[k], grid.status().message());
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
+  Result<SessionId> id = ParseSessionId(r.session_id(), "session_id");
+  if (!id.ok()) return ToGrpcStatus(id.status());
+  out->session_id = static_cast<std::int64_t>(*id);
+  switch (r.format()) {
+    case v1::EXPORT_FORMAT_READINGS_CSV:
+    case v1::EXPORT_FORMAT_GRID_NPY:
+    case v1::EXPORT_FORMAT_GRID_CSV:
+    case v1::EXPORT_FORMAT_MERL_BINARY:
+    case v1::EXPORT_FORMAT_RGL_BSDF:
+      out->format = r.format();
+      break;
+    default:
+      return InvalidField("format",
+                          "give one of READINGS_CSV, GRID_NPY, GRID_CSV, MERL_BINARY, RGL_BSDF "
+                          "(got " +
+                              std::to_string(r.format()) + ")");
+  }
+  if (grpc::Status st = ParseQuantityField(r.quantity(), &out->quantity); !st.ok()) return st;
+  if (r.format() == v1::EXPORT_FORMAT_MERL_BINARY && out->quantity != exports::Quantity::kBrdf) {
+    return InvalidField("quantity", "a MERL file holds the BRDF; leave quantity unset or BRDF");
+  }
+  if (r.format() == v1::EXPORT_FORMAT_RGL_BSDF && out->quantity != exports::Quantity::kBrdf) {
+    return InvalidField("quantity", "an RGL file holds the BRDF; leave quantity unset or BRDF");
+  }
+  if (grpc::Status st = ParseFillField(r.fill(), &out->fill); !st.ok()) return st;
+  if (grpc::Status st = ParseRglFields(r, out); !st.ok()) return st;
+  if (grpc::Status st = ParseMethodField(r.method(), &out->method); !st.ok()) return st;
+  const v1::InterpolationOptions& o = r.options();
+  if (o.axis_scale_size() != 0 && o.axis_scale_size() != 3) {
+    return InvalidField("options.axis_scale",
+                        "exports are isotropic: give 3 values (θi, θo, φ) or none, got " +
+                            std::to_string(o.axis_scale_size()));
+  }
+  for (int i = 0; i < o.axis_scale_size(); ++i) {
+    if (!std::isfinite(o.axis_scale(i)) || o.axis_scale(i) <= 0) {
+      return InvalidField(
+          "options.axis_scale[" + std::to_string(i) + "]",
+          "must be a finite number > 0 (got " + std::to_string(o.axis_scale(i)) + ")");
+    }
+  }
+  out->options.axis_scale.assign(o.axis_scale().begin(), o.axis_scale().end());
+  out->options.mirror_phi = o.mirror_phi();
+  out->options.reciprocity = o.reciprocity();
+  if (grpc::Status st = ParseCoordinatesField(o.coordinates(), &out->options.coordinates);
+      !st.ok()) {
+    return st;
+  }
+  if (grpc::Status st = ParseTrendField(o.trend(), &out->options.trend); !st.ok()) return st;
+  // 0 means the default 1°; MakeRegularGrid checks the rest and names the axis.
+  const double steps[3] = {r.step_theta_i(), r.step_theta_o(), r.step_phi()};
+  for (int k = 0; k < 3; ++k) out->steps[k] = steps[k] == 0 ? 1.0 : steps[k];
+  if (grpc::Status st = CheckGridSteps(*out); !st.ok()) return st;
+  out->nodes = r.grid_nodes();
+  out->exclude_flagged = r.exclude_flagged();
+  if (r.chunk_bytes() > kMaxExportChunkBytes) {
+    return InvalidField("chunk_bytes", "at most " + std::to_string(kMaxExportChunkBytes) +
+                                           " (got " + std::to_string(r.chunk_bytes()) +
+                                           "); 0 means 1 MiB");
+  }
+  if (r.chunk_bytes() > 0) out->chunk_bytes = r.chunk_bytes();
+  return grpc::Status::OK;
+}
+
+// The client's deadline (capped), with the export's own cancel token.
+Result<CallContext> ExportContext(const grpc::ServerContext& context, CancelToken cancel) {
+  const auto remaining = context.deadline() - std::chrono::system_clock::now();
+  if (remaining <= std::chrono::system_clock::duration::zero()) {
+    return Timeout("Export: the client's deadline passed before it started");
+  }
+  const auto timeout = std::min<std::chrono::steady_clock::duration>(
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(remaining), kLongestExport);
+  return CallContext::WithTimeout(timeout, std::move(cancel));
+}
+
+std::string FileName(const ExportSettings& s) {
+  const std::string base = "session-" + std::to_string(s.session_id);
+  const std::string q = exports::QuantityName(s.quantity);
+  switch (s.format) {
+    case v1::EXPORT_FORMAT_READINGS_CSV:
+      return base + "-readings-" + q + ".csv";
+    case v1::EXPORT_FORMAT_GRID_NPY:
+      return base + "-grid-" + q + ".npy";
+    case v1::EXPORT_FORMAT_GRID_CSV:
+      return base + "-grid-" + q + ".csv";
+    case v1::EXPORT_FORMAT_RGL_BSDF:
+      return base + (s.rgb ? "-rgb" : "") + ".bsdf";
+    default:
+      return base + ".binary";
+  }
+}
+
+void AddSkipped(const std::vector<exports::SkippedReading>& skipped, v1::ExportReport* report) {
+  report->set_skipped_readings(skipped.size());
+  if (!skipped.empty()) report->set_first_skip_reason(skipped.front().reason);
+}
+
+// The session's interpolant over the derived quantity behind the fill chain (as brdf-export
+// builds it: session_interpolant.h).
+Result<exports::SessionInterpolant> BuildInterpolator(const exports::Session& session,
+                                                      exports::Quantity quantity,
+                                                      const ExportSettings& s,
+                                                      const CallContext& ctx) {
+  Result<exports::DerivedSamples> derived =
+      exports::DeriveSamples(session, quantity, {s.exclude_flagged});
+  if (!derived.ok()) return derived.status();
+  return exports::BuildSessionInterpolant(std::move(*derived), s.method, s.options, s.fill, ctx);
+}
+
+// The cell counts of a MERL or RGL table (unfilled: by the interpolation's why).
+void AddTableCounts(std::size_t cells, std::size_t filled,
+                    const std::map<interp::InterpStatus, std::size_t>& unfilled,
+                    std::size_t below_horizon, std::size_t clamped, v1::ExportReport* report) {
+  report->set_cells(cells);
+  report->set_filled_cells(filled);
+  std::size_t unfilled_total = 0;
+  for (const auto& [status, count] : unfilled) {
+    (*report->mutable_unfilled_by_status())[interp::InterpStatusName(status)] = count;
+    unfilled_total += count;
+  }
+  report->set_unfilled_cells(unfilled_total);
+  report->set_below_horizon_cells(below_horizon);
+  report->set_clamped_cells(clamped);
+}
+
+void AddFill(const exports::FillTally& tally, v1::ExportReport* report) {
+  v1::ExportFillCounts* fill = report->mutable_fill();
+  fill->set_policy(exports::FillPolicyName(tally.policy));
+  fill->set_interpolated(tally.interpolated);
+  fill->set_fallback(tally.fallback);
+  fill->set_model(tally.model);
+  fill->set_empty(tally.empty);
+  fill->set_model_fraction(tally.model_fraction());
+}
+
+// Each export writes its file to `out` (through the stream) and fills the report; progress runs
+// from `base` to 1 across the export's own work.
+Status ExportReadingsCsv(const exports::Session& session, const ExportSettings& s,
+                         ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
+  stream.Progress("writing readings", 0.1);
+  Result<exports::ReadingsCsvReport> csv =
+      exports::WriteReadingsCsv(session, s.quantity, out, {s.exclude_flagged});
+  if (!csv.ok()) return csv.status();
+  report->set_rows(csv->rows);
+  AddSkipped(csv->skipped, report);
+  report->set_summary(std::to_string(csv->rows) + " rows (" + exports::QuantityName(s.quantity) +
+                      "), " + std::to_string(csv->skipped.size()) + " sample readings left out");
+  return Status();
+}
+
+Status ExportGrid(const exports::Session& session, const ExportSettings& s, const CallContext& ctx,
+                  ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
+  Result<exports::RegularGrid> grid = exports::MakeRegularGrid(
+      s.steps[0], s.steps[1], s.steps[2],
+      s.nodes ? exports::GridPlacement::kNodes : exports::GridPlacement::kCellCentres);
+  if (!grid.ok()) return grid.status();
+  Result<exports::SessionInterpolant> in = BuildInterpolator(session, s.quantity, s, ctx);
+  if (!in.ok()) return in.status();
+  const WavelengthGrid bands = in->derived.grid;
+  const exports::GridExportInfo info{session.id,
+                                     session.name,
+                                     s.quantity,
+                                     interp::MethodName(s.method),
+                                     in->derived.samples.size(),
+                                     in->derived.skipped.size()};
+  exports::NpyGridWriter npy(out);
+  exports::CsvGridWriter csv(out, info);
+  const bool as_npy = s.format == v1::EXPORT_FORMAT_GRID_NPY;
+  exports::GridSink& sink = as_npy ? static_cast<exports::GridSink&>(npy) : csv;
+  exports::RunControl control;
+  control.threads = 0;  // every hardware thread: the executor waits on devices, not the CPU
+  control.progress = [&stream](double f) { stream.Progress("resampling", 0.05 + 0.95 * f); };
+  Result<exports::GridReport> r =
+      exports::ResampleOnGrid(in->chain->Source(), *grid, bands, control, ctx, sink);
+  if (!r.ok()) return r.status();
+  report->set_summary(r->Summary());
+  report->set_cells(r->cells);
+  report->set_filled_cells(r->filled);
+  report->set_unfilled_cells(r->nan_cells);
+  for (const auto& [status, count] : r->by_status) {
+    if (status != interp::InterpStatus::kOk) {
+      (*report->mutable_unfilled_by_status())[interp::InterpStatusName(status)] = count;
+    }
+  }
+  AddSkipped(in->derived.skipped, report);
+  AddFill(in->chain->Tally(), report);
+  if (as_npy) {
+    for (std::size_t n : {grid->theta_i.count, grid->theta_o.count, grid->phi.count}) {
+      report->add_shape(n);
+    }
+    report->add_shape(bands.count);
+    report->set_description_json(exports::GridDescriptionJson(*grid, bands, info, *r, in->Info()));
+  }
+  return Status();
+}
+
+Status ExportMerl(const exports::Session& session, const ExportSettings& s, const CallContext& ctx,
+                  ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
+  Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir);
+  if (!cie.ok()) return cie.status();
+  Result<exports::SessionInterpolant> in =
+      BuildInterpolator(session, exports::Quantity::kBrdf, s, ctx);
+  if (!in.ok()) return in.status();
+  const WavelengthGrid bands = in->derived.grid;
+  Result<exports::SpectralRgbWeights> rgb =
+      exports::SpectralRgbWeights::Make(bands, cie->d65, cie->cmf);
+  if (!rgb.ok()) return rgb.status();
+  exports::RunControl control;
+  control.threads = 0;
+  control.progress = [&stream](double f) {
+    stream.Progress("building the MERL table", 0.05 + 0.85 * f);
+  };
+  Result<exports::MerlExport> table =
+      exports::BuildMerlTable(in->chain->Source(), bands, *rgb, control, ctx);
+  if (!table.ok()) return table.status();
+  stream.Progress("sending", 0.9);
+  if (Status st = exports::WriteMerl(table->table, out); !st.ok()) return st;
+  const exports::MerlReport& m = table->report;
+  report->set_summary(m.Summary());
+  AddTableCounts(m.cells, m.filled, m.unfilled, m.below_horizon, m.clamped, report);
+  AddSkipped(in->derived.skipped, report);
+  AddFill(in->chain->Tally(), report);
+  return Status();
+}
+
+Status ExportRgl(const exports::Session& session, const ExportSettings& s, const CallContext& ctx,
+                 ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
+  exports::SessionRglOptions options = s.rgl;
+  Result<exports::SessionInterpolant> in =
+      BuildInterpolator(session, exports::Quantity::kBrdf, s, ctx);
+  if (!in.ok()) return in.status();
+  if (s.rgb) {
+    Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir);
+    if (!cie.ok()) return cie.status();
+    Result<exports::SpectralRgbWeights> rgb =
+        exports::SpectralRgbWeights::Make(in->derived.grid, cie->d65, cie->cmf);
+    if (!rgb.ok()) return rgb.status();
+    options.rgb = *rgb;
+  }
+  exports::RunControl control;
+  control.threads = 0;
+  control.progress = [&stream](double f) {
+    stream.Progress("building the RGL tables", 0.05 + 0.85 * f);
+  };
+  Result<exports::RglExport> table = exports::BuildSessionRgl(session, *in, options, control, ctx);
+  if (!table.ok()) return table.status();
+  stream.Progress("sending", 0.9);
+  if (Status st = exports::WriteRgl(table->fields, out); !st.ok()) return st;
+  const exports::RglReport& g = table->report;
+  report->set_summary(g.Summary());
+  AddTableCounts(g.cells, g.interpolated + g.fallback, g.unfilled, g.below_horizon, g.clamped,
+                 report);
+  AddSkipped(in->derived.skipped, report);
+  AddFill(in->chain->Tally(), report);
+  return Status();
+}
+
+}  // namespace
+
+grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportRequest* request,
+                                 grpc::ServerWriter<v1::ExportChunk>* writer) {
+  return ExportSession(*context, *request, *writer, auth_, streams_, stopping_, *manager_.store());
+}
+
+grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest& request,
+                           grpc::ServerWriter<v1::ExportChunk>& writer, const Authenticator& auth,
+                           StreamRegistry& streams, const StopSignal& stopping,
+                           storage::SessionReader& reader) {
+  Caller caller;
+  if (grpc::Status st = auth.CallerOf(context, &caller); !st.ok()) return st;
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  if (grpc::Status st = streams.Open(context, &caller, "Export", &slot, /*computes=*/true);
+      !st.ok())
+    return st;
+  ExportSettings settings;
+  if (grpc::Status st = ParseRequest(request, &settings); !st.ok()) return st;
+
+  CancelToken cancel;
+  Result<CallContext> ctx = ExportContext(context, cancel);
+  if (!ctx.ok()) return ToGrpcStatus(ctx.status());
+  ExportStream stream(context, writer, *slot, stopping, settings.chunk_bytes, cancel);
+  ExportStreamBuf buffer(stream);
+  std::ostream out(&buffer);
+
+  stream.Progress("loading readings", 0);
+  Result<exports::Session> session = storage::LoadSessionReadings(reader, settings.session_id);
+  if (!session.ok()) return ToGrpcStatus(session.status());
+  stream.Progress("loading readings", 0.05);
+
+  v1::ExportReport report;
+  report.set_file_name(FileName(settings));
+  if (settings.format != v1::EXPORT_FORMAT_READINGS_CSV &&
+      exports::HasSeveralDialPositions(*session)) {
+    report.add_warnings("session " + request.session_id() +
+                        " was measured at several dial positions γ (anisotropic); this export "
+                        "uses the isotropic reduction (θi, θo, φ) and folds them together");
+  }
+  Status st;
+  switch (settings.format) {
+    case v1::EXPORT_FORMAT_READINGS_CSV:
+      st = ExportReadingsCsv(*session, settings, stream, out, &report);
+      break;
+    case v1::EXPORT_FORMAT_MERL_BINARY:
+      st = ExportMerl(*session, settings, *ctx, stream, out, &report);
+      break;
+    case v1::EXPORT_FORMAT_RGL_BSDF:
+      st = ExportRgl(*session, settings, *ctx, stream, out, &report);
+      break;
+    default:
+      st = ExportGrid(*session, settings, *ctx, stream, out, &report);
+      break;
+  }
+  if (st.ok()) out.flush();
+  if (stream.broken() || (st.ok() && !out)) {
+    return grpc::Status(grpc::StatusCode::CANCELLED,
+                        "Export: the client went away before the file was sent; ask again");
+  }
+  if (!st.ok()) return ToGrpcStatus(st.WithContext("Export of session " + request.session_id()));
+  stream.Progress("done", 1.0);
+  if (!stream.SendReport(std::move(report))) {
+    return grpc::Status(grpc::StatusCode::CANCELLED,
+                        "Export: the client went away before the report was sent");
+  }
+  return grpc::Status::OK;
+}
+
+}  // namespace brdf::daemon

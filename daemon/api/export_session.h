@@ -1,0 +1,22 @@
+// Data.Export's work, shared by brdfd's Data service (service_data.h, over the rig's store) and
+// brdf-archive's (archive_services.h, over the archive): the caller authorized (kRead), a stream
+// slot taken, the request checked, the session loaded through `reader`, the requested export
+// computed by core/export, and its bytes streamed as progress, the file in chunks, then the
+// report. The same session gives the same file from either server. Defined in
+// service_export.cc.
+#pragma once
+
+#include "brdf/v1/brdf.grpc.pb.h"
+#include "daemon/api/common.h"
+#include "daemon/rpc/auth.h"
+#include "daemon/rpc/stream_registry.h"
+#include "storage/session_reader.h"
+
+namespace brdf::daemon {
+
+grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest& request,
+                           grpc::ServerWriter<v1::ExportChunk>& writer, const Authenticator& auth,
+                           StreamRegistry& streams, const StopSignal& stopping,
+                           storage::SessionReader& reader);
+
+}  // namespace brdf::daemon

@@ -1,0 +1,338 @@
+#include "daemon/api/interpolation.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/geometry.h"
+
+namespace brdf::daemon {
+
+InterpolationService::InterpolationService(IndexCache& cache, const Authenticator& auth,
+                                           const StopSignal& stopping, StreamRegistry& streams)
+    : cache_(cache), auth_(auth), stopping_(stopping), streams_(streams) {}
+
+namespace {
+
+// Azimuths may be given in any of the usual conventions; these are wide enough for all of them.
+constexpr double kPhiMin = -180;
+constexpr double kPhiMax = 360;
+
+struct Settings {
+  interp::Method method = interp::Method::kOctant;
+  Quantity quantity = Quantity::kBrdf;
+  interp::Options options;
+};
+
+grpc::Status ParseSettings(int method, int quantity, const v1::InterpolationOptions& options,
+                           Settings* out) {
+  if (grpc::Status st = ParseMethodField(method, &out->method); !st.ok()) return st;
+  if (grpc::Status st = ParseQuantityField(quantity, &out->quantity); !st.ok()) return st;
+  return ParseInterpolationOptions(options, &out->options);
+}
+
+// Ranges and finiteness, independent of the session. `field` is the DirectionQuery's path.
+grpc::Status CheckDirection(const v1::DirectionQuery& q, const std::string& field) {
+  // The field's name is only put together for an error (a valid query costs no allocation).
+  auto check = [&field](double v, double lo, double hi, const char* suffix) {
+    if (std::isfinite(v) && v >= lo && v <= hi) return grpc::Status::OK;
+    return ToGrpcStatus(CheckAngle(v, lo, hi, field + suffix));
+  };
+  grpc::Status st;
+  switch (q.direction_case()) {
+    case v1::DirectionQuery::kIso:
+      if (st = check(q.iso().theta_i(), 0, 90, ".iso.theta_i"); !st.ok()) return st;
+      if (st = check(q.iso().theta_o(), 0, 90, ".iso.theta_o"); !st.ok()) return st;
+      return check(q.iso().phi(), kPhiMin, kPhiMax, ".iso.phi");
+    case v1::DirectionQuery::kFour:
+      if (st = check(q.four().theta_i(), 0, 90, ".four.theta_i"); !st.ok()) return st;
+      if (st = check(q.four().phi_i(), kPhiMin, kPhiMax, ".four.phi_i"); !st.ok()) return st;
+      if (st = check(q.four().theta_o(), 0, 90, ".four.theta_o"); !st.ok()) return st;
+      return check(q.four().phi_o(), kPhiMin, kPhiMax, ".four.phi_o");
+    case v1::DirectionQuery::DIRECTION_NOT_SET:
+      break;
+  }
+  return InvalidField(field, "no direction; set iso (θi, θo, φ) or four (θi, φi, θo, φo)");
+}
+
+// (−180, 180], the range of the stored azimuths.
+double WrapAzimuth(double phi) {
+  double w = std::fmod(phi, 360.0);
+  if (w <= -180) w += 360;
+  if (w > 180) w -= 360;
+  return w;
+}
+
+// The query in the index's coordinates.
+grpc::Status ToCoords(const v1::DirectionQuery& q, const IndexSnapshot& index,
+                      const std::string& field, std::array<double, 4>* coords) {
+  if (index.anisotropic) {
+    if (q.direction_case() != v1::DirectionQuery::kFour) {
+      return InvalidField(field + ".iso", "session " + std::to_string(index.session) +
+                                              " is anisotropic; give four angles (" + field +
+                                              ".four: θi, φi, θo, φo)");
+    }
+    *coords = {q.four().theta_i(), WrapAzimuth(q.four().phi_i()), q.four().theta_o(),
+               WrapAzimuth(q.four().phi_o())};
+    return grpc::Status::OK;
+  }
+  IsoDirection iso;
+  if (q.direction_case() == v1::DirectionQuery::kFour) {
+    iso = ToIsotropic(
+        Directions{q.four().theta_i(), q.four().phi_i(), q.four().theta_o(), q.four().phi_o()});
+  } else {
+    // Fold φ into [0, 180] (φ and −φ, φ and φ + 360 are the same point of an isotropic sample),
+    // and φ = 0 at the normal, exactly as the readings were reduced.
+    iso = ToIsotropic(
+        CanonicalDirections(IsoDirection{q.iso().theta_i(), q.iso().theta_o(), q.iso().phi()}));
+  }
+  *coords = {iso.theta_i, iso.theta_o, iso.phi, 0};
+  return grpc::Status::OK;
+}
+
+v1::InterpolationStatus ToProtoStatus(interp::InterpStatus s) {
+  switch (s) {
+    case interp::InterpStatus::kOk:
+      return v1::INTERPOLATION_STATUS_OK;
+    case interp::InterpStatus::kEmptyOctant:
+      return v1::INTERPOLATION_STATUS_EMPTY_OCTANT;
+    case interp::InterpStatus::kNoEnclosingSimplex:
+      return v1::INTERPOLATION_STATUS_NO_ENCLOSING_SIMPLEX;
+    case interp::InterpStatus::kOutsideHull:
+      return v1::INTERPOLATION_STATUS_OUTSIDE_HULL;
+  }
+  return v1::INTERPOLATION_STATUS_UNSPECIFIED;
+}
+
+v1::InterpolationMethod ToProtoMethod(interp::Method m) {
+  switch (m) {
+    case interp::Method::kOctant:
+      return v1::INTERPOLATION_METHOD_OCTANT;
+    case interp::Method::kDelaunay:
+      return v1::INTERPOLATION_METHOD_DELAUNAY;
+    case interp::Method::kNearest:
+      return v1::INTERPOLATION_METHOD_NEAREST;
+  }
+  return v1::INTERPOLATION_METHOD_UNSPECIFIED;
+}
+
+// Whether each vertex carries its sample's spectrum (InterpolateRequest.include_vertex_spectra).
+enum class VertexSpectra { kOmit, kInclude };
+
+// One answer as the API gives it.
+void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const Settings& settings,
+              const IndexSnapshot& index, VertexSpectra vertex_spectra,
+              v1::InterpolationResult* out) {
+  *out->mutable_query() = query;
+  out->set_status(ToProtoStatus(r.status));
+  out->set_method(ToProtoMethod(r.method));
+  out->set_quantity(ToProtoQuantity(settings.quantity));
+  *out->mutable_grid() = ToProtoGrid(index.grid);
+  out->mutable_spectrum()->Add(r.spectrum.begin(), r.spectrum.end());
+  for (const interp::Vertex& v : r.vertices) {
+    v1::InterpolationVertex* vertex = out->add_vertices();
+    vertex->set_reading_id(v.id);
+    vertex->mutable_coords()->Add(v.coords.begin(), v.coords.end());
+    vertex->set_weight(v.weight);
+    if (vertex_spectra == VertexSpectra::kInclude) {
+      // The sample the vertex blends, from the snapshot the answer came from (v.index is its
+      // position in that set), in the answer's quantity.
+      const std::span<const double> spectrum = index.samples->spectrum(v.index);
+      vertex->mutable_spectrum()->Add(spectrum.begin(), spectrum.end());
+    }
+  }
+  std::string detail = std::move(r.detail);
+  if (index.skipped > 0) {
+    detail += (detail.empty() ? "" : "; ") + std::to_string(index.skipped) +
+              " sample reading(s) of the session left out (first: " + index.skipped_detail + ")";
+  }
+  out->set_detail(std::move(detail));
+}
+
+void Evaluate(const v1::DirectionQuery& query, const std::array<double, 4>& coords,
+              const Settings& settings, const IndexSnapshot& index, VertexSpectra vertex_spectra,
+              v1::InterpolationResult* out) {
+  ToResult(query,
+           index.interpolator->Evaluate(
+               std::span<const double>(coords.data(), static_cast<std::size_t>(index.dims))),
+           settings, index, vertex_spectra, out);
+}
+
+grpc::Status SessionOf(const std::string& text, SessionId* id) {
+  Result<SessionId> parsed = ParseSessionId(text, "session_id");
+  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
+  *id = *parsed;
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
+grpc::Status ParseInterpolationOptions(const v1::InterpolationOptions& options,
+                                       interp::Options* out) {
+  if (options.axis_scale_size() > 4) {
+    return InvalidField("options.axis_scale", "at most 4 values (one per axis), got " +
+                                                  std::to_string(options.axis_scale_size()));
+  }
+  for (int i = 0; i < options.axis_scale_size(); ++i) {
+    const double s = options.axis_scale(i);
+    if (!std::isfinite(s) || s <= 0) {
+      return InvalidField("options.axis_scale[" + std::to_string(i) + "]",
+                          "must be a finite number > 0 (got " + std::to_string(s) + ")");
+    }
+  }
+  out->axis_scale.assign(options.axis_scale().begin(), options.axis_scale().end());
+  out->mirror_phi = options.mirror_phi();
+  out->reciprocity = options.reciprocity();
+  if (grpc::Status st = ParseTrendField(options.trend(), &out->trend); !st.ok()) return st;
+  return ParseCoordinatesField(options.coordinates(), &out->coordinates);
+}
+
+std::optional<grpc::Status> InterpolationService::AnswerIfReady(
+    const v1::InterpolateRequest& request, v1::InterpolateResponse* response) {
+  return Respond(request, response, /*may_load=*/false);
+}
+
+grpc::Status InterpolationService::Answer(const v1::InterpolateRequest& request,
+                                          v1::InterpolateResponse* response) {
+  return *Respond(request, response, /*may_load=*/true);
+}
+
+std::optional<grpc::Status> InterpolationService::Respond(const v1::InterpolateRequest& request,
+                                                          v1::InterpolateResponse* response,
+                                                          bool may_load) {
+  SessionId id = 0;
+  if (grpc::Status st = SessionOf(request.session_id(), &id); !st.ok()) return st;
+  Settings settings;
+  if (grpc::Status st =
+          ParseSettings(request.method(), request.quantity(), request.options(), &settings);
+      !st.ok()) {
+    return st;
+  }
+  if (grpc::Status st = CheckDirection(request.direction(), "direction"); !st.ok()) return st;
+
+  std::shared_ptr<const IndexSnapshot> index;
+  if (may_load) {
+    Result<std::shared_ptr<const IndexSnapshot>> loaded =
+        cache_.Get(id, settings.quantity, settings.method, settings.options);
+    if (!loaded.ok()) return ToGrpcStatus(loaded.status());
+    index = *std::move(loaded);
+  } else {
+    index = cache_.FreshHit(id, settings.quantity, settings.method, settings.options);
+    if (!index) return std::nullopt;
+  }
+  std::array<double, 4> coords{};
+  if (grpc::Status st = ToCoords(request.direction(), *index, "direction", &coords); !st.ok()) {
+    return st;
+  }
+  Evaluate(request.direction(), coords, settings, *index,
+           request.include_vertex_spectra() ? VertexSpectra::kInclude : VertexSpectra::kOmit,
+           response->mutable_result());
+  return grpc::Status::OK;
+}
+
+grpc::Status InterpolationService::InterpolateBatch(
+    grpc::ServerContext* context, const v1::InterpolateBatchRequest* request,
+    grpc::ServerWriter<v1::InterpolateBatchChunk>* writer) {
+  Caller caller;
+  if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  if (grpc::Status st =
+          streams_.Open(*context, &caller, "InterpolateBatch", &slot, /*computes=*/true);
+      !st.ok())
+    return st;
+  SessionId id = 0;
+  if (grpc::Status st = SessionOf(request->session_id(), &id); !st.ok()) return st;
+  Settings settings;
+  if (grpc::Status st =
+          ParseSettings(request->method(), request->quantity(), request->options(), &settings);
+      !st.ok()) {
+    return st;
+  }
+  const int n = request->directions_size();
+  if (n == 0)
+    return InvalidField("directions",
+                        "empty; give 1 to " + std::to_string(kMaxBatchDirections) + " directions");
+  if (n > kMaxBatchDirections) {
+    // A limit of the server, not a malformed request: RESOURCE_EXHAUSTED, as for an oversized
+    // message.
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        "directions: " + std::to_string(n) + " directions; at most " +
+                            std::to_string(kMaxBatchDirections) +
+                            " per InterpolateBatch (split the request into several batches)");
+  }
+  if (request->chunk_size() > kMaxChunkSize) {
+    return InvalidField("chunk_size", std::to_string(request->chunk_size()) +
+                                          " results per chunk; at most " +
+                                          std::to_string(kMaxChunkSize) +
+                                          " (0: " + std::to_string(kDefaultChunkSize) + ")");
+  }
+  const int chunk =
+      static_cast<int>(request->chunk_size() == 0 ? kDefaultChunkSize : request->chunk_size());
+  for (int i = 0; i < n; ++i) {
+    if (grpc::Status st =
+            CheckDirection(request->directions(i), "directions[" + std::to_string(i) + "]");
+        !st.ok()) {
+      return st;
+    }
+  }
+
+  // One snapshot for the whole batch: every result sees the same readings.
+  Result<std::shared_ptr<const IndexSnapshot>> got =
+      cache_.Get(id, settings.quantity, settings.method, settings.options);
+  if (!got.ok()) return ToGrpcStatus(got.status());
+  const IndexSnapshot& index = **got;
+  const auto d = static_cast<std::size_t>(index.dims);
+  std::vector<double> coords(static_cast<std::size_t>(n) * d);  // row-major, the index's dims
+  for (int i = 0; i < n; ++i) {
+    std::array<double, 4> at{};
+    if (grpc::Status st =
+            ToCoords(request->directions(i), index, "directions[" + std::to_string(i) + "]", &at);
+        !st.ok()) {
+      return st;
+    }
+    std::copy_n(at.begin(), d, coords.begin() + static_cast<std::ptrdiff_t>(i * d));
+  }
+
+  // The whole batch in one EvaluateEach (the octant method sorts it by cell), its answers
+  // streamed chunk by chunk as they come, in order.
+  grpc::Status outcome = grpc::Status::OK;
+  v1::InterpolateBatchChunk out;
+  auto start_chunk = [&](int first) {
+    if (context->IsCancelled()) {
+      outcome = grpc::Status(grpc::StatusCode::CANCELLED,
+                             "InterpolateBatch: cancelled by the client after " +
+                                 std::to_string(first) + " of " + std::to_string(n) + " results");
+      return false;
+    }
+    if (stopping_.stopped()) {
+      outcome = grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                             "InterpolateBatch: the daemon is shutting down after " +
+                                 std::to_string(first) + " of " + std::to_string(n) +
+                                 " results; ask again for the rest once it is back");
+      return false;
+    }
+    out.Clear();
+    out.set_first_index(static_cast<std::uint32_t>(first));
+    return true;
+  };
+  index.interpolator->EvaluateEach(coords, [&](std::size_t k, interp::Interpolation&& answer) {
+    const int i = static_cast<int>(k);
+    if (i % chunk == 0 && !start_chunk(i)) return false;
+    ToResult(request->directions(i), std::move(answer), settings, index, VertexSpectra::kOmit,
+             out.add_results());
+    if (out.results_size() < chunk && i + 1 < n) return true;
+    // Blocks while the client is slow to read (flow control); false: the client went away.
+    if (!slot->Write(writer, out)) {
+      outcome = grpc::Status(grpc::StatusCode::CANCELLED, "InterpolateBatch: the client went away");
+      return false;
+    }
+    return true;
+  });
+  return outcome;
+}
+
+}  // namespace brdf::daemon

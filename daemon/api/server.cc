@@ -1,0 +1,293 @@
+#include "daemon/api/server.h"
+
+#include <absl/synchronization/mutex.h>
+#include <arpa/inet.h>
+#include <grpcpp/resource_quota.h>
+#include <grpcpp/security/server_credentials.h>
+#include <grpcpp/server_builder.h>
+#include <sched.h>
+#include <spdlog/spdlog.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include "daemon/rpc/token_gate.h"
+
+namespace brdf::daemon {
+namespace {
+
+// The control plane's threads (control_loop.h): one answers while the other may wait on the
+// store (SubmitPlan's commit).
+constexpr int kControlThreads = 2;
+
+constexpr const char* kBrdfServices[] = {"brdf.v1.Control", "brdf.v1.Data",
+                                         "brdf.v1.Interpolation"};
+
+// Reads a PEM file and checks that it holds a block of the expected kind ("CERTIFICATE",
+// "PRIVATE KEY": also matches "EC PRIVATE KEY", "RSA PRIVATE KEY"). gRPC itself only says that
+// the port could not be opened when a file is not PEM, so the check here names the file.
+Result<std::string> ReadPem(const std::string& path, const std::string& key,
+                            const std::string& block) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    return ConfigurationError("config " + key + ": cannot read \"" + path +
+                              "\"; check the path and that brdfd may read it");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (text.str().empty()) {
+    return ConfigurationError("config " + key + ": \"" + path + "\" is empty; give a PEM file");
+  }
+  if (text.str().find(block + "-----") == std::string::npos) {
+    return ConfigurationError("config " + key + ": \"" + path + "\" holds no PEM \"" + block +
+                              "\" block; give a PEM file (-----BEGIN " + block + "-----)");
+  }
+  return text.str();
+}
+
+// A private key others may read is a key others may copy.
+void WarnIfReadableByOthers(const std::string& path) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0 && (info.st_mode & (S_IRWXG | S_IRWXO)) != 0) {
+    spdlog::warn(
+        "the TLS private key {} is accessible to its group or others (mode {:o}); "
+        "chmod 600 it",
+        path, info.st_mode & 0777);
+  }
+}
+
+std::string HostOf(const std::string& listen) {
+  const std::size_t colon = listen.rfind(':');
+  std::string host = colon == std::string::npos ? listen : listen.substr(0, colon);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
+    host = host.substr(1, host.size() - 2);
+  }
+  return host;
+}
+
+// Every CPU of [server] interpolate_cpus must be one brdfd may run on (its affinity mask: the
+// machine's CPUs, narrowed by taskset or the service's CPUAffinity).
+Status CheckCpusAvailable(const std::vector<int>& cpus) {
+  if (cpus.empty()) return Status::Ok();
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (::sched_getaffinity(0, sizeof(allowed), &allowed) != 0) return Status::Ok();  // cannot tell
+  std::string available;
+  for (int c = 0; c < CPU_SETSIZE; ++c) {
+    if (CPU_ISSET(c, &allowed)) available += (available.empty() ? "" : ", ") + std::to_string(c);
+  }
+  for (int cpu : cpus) {
+    if (cpu < 0 || cpu >= CPU_SETSIZE || !CPU_ISSET(cpu, &allowed)) {
+      return ConfigurationError("config server.interpolate_cpus: CPU " + std::to_string(cpu) +
+                                " is not one brdfd may run on (it may use CPUs " + available +
+                                "); fix [server] interpolate_cpus");
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+bool IsLoopbackAddress(const std::string& listen) {
+  if (listen.rfind("unix:", 0) == 0) return true;
+  const std::string host = HostOf(listen);
+  if (host == "localhost") return true;
+  // Literal addresses only: a host NAME such as "127.example.org" may resolve anywhere.
+  in_addr v4{};
+  if (::inet_pton(AF_INET, host.c_str(), &v4) == 1) {
+    return (ntohl(v4.s_addr) >> 24) == 127;
+  }
+  in6_addr v6{};
+  if (::inet_pton(AF_INET6, host.c_str(), &v6) == 1) {
+    if (IN6_IS_ADDR_LOOPBACK(&v6)) return true;
+    return IN6_IS_ADDR_V4MAPPED(&v6) && v6.s6_addr[12] == 127;  // ::ffff:127.x.y.z
+  }
+  return false;
+}
+
+Result<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(const ServerConfig& config,
+                                                                       bool* tls) {
+  std::shared_ptr<grpc::ServerCredentials> credentials;
+  *tls = false;
+  if (config.tls.has_value()) {
+    Result<std::string> cert = ReadPem(config.tls->cert, "server.tls.cert", "CERTIFICATE");
+    if (!cert.ok()) return cert.status();
+    Result<std::string> key = ReadPem(config.tls->key, "server.tls.key", "PRIVATE KEY");
+    if (!key.ok()) return key.status();
+    WarnIfReadableByOthers(config.tls->key);
+    grpc::SslServerCredentialsOptions ssl(GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE);
+    ssl.pem_key_cert_pairs.push_back({*key, *cert});
+    if (!config.tls->client_ca.empty()) {
+      Result<std::string> ca =
+          ReadPem(config.tls->client_ca, "server.tls.client_ca", "CERTIFICATE");
+      if (!ca.ok()) return ca.status();
+      ssl.pem_root_certs = *ca;
+      ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
+    }
+    credentials = grpc::SslServerCredentials(ssl);
+    *tls = true;
+  } else {
+    // Plaintext as gRPC's xDS credentials with the insecure fallback (no xDS server here, so
+    // plaintext is all they do): unlike InsecureServerCredentials() they take the token gate.
+    credentials = grpc::XdsServerCredentials(grpc::InsecureServerCredentials());
+    if (!IsLoopbackAddress(config.listen)) {
+      spdlog::warn(
+          "serving {} in PLAINTEXT on a non-loopback address: bearer tokens and data cross the "
+          "network unencrypted; configure [server.tls] (cert, key) or listen on 127.0.0.1",
+          config.listen);
+    }
+  }
+  return credentials;
+}
+
+std::vector<std::string> BrdfServiceNames() {
+  return {std::begin(kBrdfServices), std::end(kBrdfServices)};
+}
+
+std::vector<std::string> ServedServices() {
+  std::vector<std::string> names = BrdfServiceNames();
+  names.push_back("grpc.health.v1.Health");
+  names.push_back("grpc.reflection.v1.ServerReflection");
+  names.push_back("grpc.reflection.v1alpha.ServerReflection");
+  return names;
+}
+
+void PrepareServerBuilder(grpc::ServerBuilder& builder, const ServerConfig& config,
+                          const std::shared_ptr<grpc::ServerCredentials>& credentials,
+                          const Authenticator& auth, int* selected_port) {
+  credentials->SetAuthMetadataProcessor(std::make_shared<TokenGate>(auth));
+  builder.AddListeningPort(config.listen, credentials, selected_port);
+  // One daemon per address: without SO_REUSEPORT a second brdfd's bind fails instead of sharing
+  // the port (and answering some of the first one's calls).
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
+  grpc::ResourceQuota quota("brdfd");
+  quota.SetMaxThreads(ServerThreadCap(config));
+  builder.SetResourceQuota(quota);
+}
+
+Result<std::string> BoundAddress(const ServerConfig& config, bool built, int selected_port,
+                                 bool tls) {
+  const bool unix_socket = config.listen.rfind("unix:", 0) == 0;
+  if (!built || (!unix_socket && selected_port == 0)) {
+    return IoError("cannot listen on " + config.listen +
+                   (tls ? " with TLS (address in use, not allowed, no such interface, or the "
+                          "certificate and key in [server.tls] do not form a valid pair)"
+                        : " (address in use, not allowed, or no such interface)") +
+                   "; change [server] listen or stop the process that holds it");
+  }
+  if (unix_socket) return config.listen;
+  return config.listen.substr(0, config.listen.rfind(':') + 1) + std::to_string(selected_port);
+}
+
+Result<std::string> BuildAndStartServer(const ServerConfig& config,
+                                        const std::shared_ptr<grpc::ServerCredentials>& credentials,
+                                        bool tls, const Authenticator& auth,
+                                        std::initializer_list<grpc::Service*> services,
+                                        InterpolateLoop& interpolate_loop,
+                                        ControlLoop& control_loop,
+                                        std::unique_ptr<grpc::Server>* server, int* selected_port) {
+  grpc::ServerBuilder builder;
+  PrepareServerBuilder(builder, config, credentials, auth, selected_port);
+  for (grpc::Service* service : services) builder.RegisterService(service);
+  interpolate_loop.AddQueues(builder);
+  control_loop.AddQueue(builder);
+  *server = builder.BuildAndStart();
+  Result<std::string> address = BoundAddress(config, *server != nullptr, *selected_port, tls);
+  if (!address.ok()) return address.status();
+  interpolate_loop.Start();
+  control_loop.Start();
+  return address;
+}
+
+int InterpolateLoopThreads(unsigned cores) {
+  return static_cast<int>(std::clamp(cores / 2, 1U, 8U));
+}
+
+Server::Server(const ServerConfig& config, SessionManager& manager, IndexCache& cache,
+               const Authenticator& auth)
+    : streams_(config, auth.enabled()),
+      control_loop_(kControlThreads),
+      health_(stopping_, streams_),
+      control_(manager, auth, stopping_, streams_),
+      data_(manager, auth, stopping_, streams_),
+      interpolation_(cache, auth, stopping_, streams_),
+      interpolate_loop_(interpolation_,
+                        config.interpolate_threads > 0
+                            ? config.interpolate_threads
+                            : InterpolateLoopThreads(std::thread::hardware_concurrency()),
+                        config.interpolate_cpus),
+      reflection_v1_(ServedServices(), streams_),
+      reflection_v1alpha_(ServedServices(), streams_) {}
+
+Server::~Server() {
+  Shutdown(std::chrono::seconds(1));
+}
+
+Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, SessionManager& manager,
+                                              IndexCache& cache, const Authenticator& auth) {
+  bool tls = false;
+  Result<std::shared_ptr<grpc::ServerCredentials>> made = MakeServerCredentials(config, &tls);
+  if (!made.ok()) return made.status();
+  std::shared_ptr<grpc::ServerCredentials> credentials = *made;
+
+  // Debian builds Abseil without NDEBUG, which leaves absl::Mutex's lock-order (deadlock) graph
+  // on: every lock gRPC takes records the lock in a global graph, about a tenth of the CPU of a
+  // small call. Upstream release builds have it off; so do we (process-wide, before any call).
+  absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
+
+  if (Status st = CheckCpusAvailable(config.interpolate_cpus); !st.ok()) return st;
+  std::unique_ptr<Server> server(new Server(config, manager, cache, auth));
+  server->health_.ServeOn(server->control_loop_);
+  server->control_.ServeOn(server->control_loop_);
+  int selected_port = 0;
+  Result<std::string> address = BuildAndStartServer(
+      config, credentials, tls, auth,
+      {&server->health_, &server->control_, &server->data_, &server->interpolation_,
+       &server->reflection_v1_, &server->reflection_v1alpha_},
+      server->interpolate_loop_, server->control_loop_, &server->server_, &selected_port);
+  if (!address.ok()) return address.status();
+  server->tls_ = tls;
+  server->port_ = selected_port;
+  server->address_ = *address;
+  spdlog::info(
+      "limits: requests up to {} bytes (larger: RESOURCE_EXHAUSTED), InterpolateBatch up to {} "
+      "directions in chunks of up to {} results, notes up to {} bytes, pages up to {} sessions, "
+      "open streams up to {} per token, {} analyst, {} operator, {} without a token (a stream "
+      "not read for {} s is cancelled), {} call threads, control plane on {} thread(s), "
+      "Interpolate on {} loop thread(s){}",
+      kMaxReceiveMessageBytes, kMaxBatchDirections, kMaxChunkSize, kMaxNoteBytes, kMaxPageSize,
+      config.max_streams_per_token, config.max_streams_analyst, config.max_streams_operator,
+      config.max_streams_unauthenticated, config.stream_stall_timeout_s, ServerThreadCap(config),
+      server->control_loop_.threads(), server->interpolate_loop_.threads(),
+      tls ? (config.tls->client_ca.empty() ? "; TLS" : "; TLS, client certificates required")
+          : "; plaintext");
+  server->health_.SetServingStatus("", true);
+  for (const std::string& name : BrdfServiceNames()) server->health_.SetServingStatus(name, true);
+  return server;
+}
+
+std::shared_ptr<grpc::Channel> Server::InProcessChannel() {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(-1);  // answers are limited by the services themselves
+  return server_->InProcessChannel(args);
+}
+
+void Server::Shutdown(std::chrono::milliseconds grace) {
+  if (shut_down_ || !server_) return;
+  shut_down_ = true;
+  health_.SetServingStatus(false);
+  stopping_.Stop();
+  interpolate_loop_.BeginShutdown();
+  control_loop_.BeginShutdown();
+  server_->Shutdown(std::chrono::system_clock::now() + grace);
+  interpolate_loop_.Stop();
+  control_loop_.Stop();
+  server_->Wait();
+}
+
+}  // namespace brdf::daemon

@@ -1,0 +1,168 @@
+#include "daemon/api/stream_readings.h"
+
+#include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/geometry.h"
+
+namespace brdf::daemon {
+namespace {
+
+// Readings per page read from the store (and written before the next page is read).
+constexpr int kPageSize = 256;
+// StreamReadingPoints reads larger pages (fewer queries; its readings carry no spectrum).
+constexpr int kPointsPageSize = 8192;
+// Readings per StreamReadingPoints message (8 numbers each: well under gRPC's 4 MB).
+constexpr int kPointsPerMessage = 8192;
+
+}  // namespace
+
+grpc::Status CheckStreamReadings(grpc::ServerContext& context,
+                                 const v1::StreamReadingsRequest& request, const char* rpc,
+                                 const Authenticator& auth, StreamRegistry& streams,
+                                 StreamReadingsCall* call) {
+  call->rpc = rpc;
+  if (grpc::Status st = auth.CallerOf(context, &call->caller); !st.ok()) return st;
+  if (grpc::Status st = streams.Open(context, &call->caller, rpc, &call->slot); !st.ok()) {
+    return st;
+  }
+  if (grpc::Status st = ParseSessionIdField(request.session_id(), "session_id", &call->session);
+      !st.ok()) {
+    return st;
+  }
+  if (grpc::Status st = ParseReadingKinds(request, &call->kinds); !st.ok()) return st;
+  if (request.after_id() < 0) {
+    return InvalidField("after_id", "must be ≥ 0 (got " + std::to_string(request.after_id()) +
+                                        "); 0 starts from the first reading");
+  }
+  return grpc::Status::OK;
+}
+
+ReadingExtras ReadingExtrasOf(storage::SessionReader& reader, std::int64_t session,
+                              std::uint32_t averages) {
+  ReadingExtras extras;
+  if (Result<std::vector<storage::StepRecord>> steps = reader.GetSteps(session); steps.ok()) {
+    for (const storage::StepRecord& step : *steps) extras.step_labels[step.step_index] = step.label;
+  }
+  if (averages > 0) extras.averages = averages;
+  return extras;
+}
+
+namespace {
+
+// The page loop both streams share: the session's readings in id order a page at a time (read by
+// `read_page`: whole readings, or only where they were taken), and with `follow` those that
+// arrive later. on_page gets each page's readings of the asked kinds and whether more are stored
+// right now (false before the stream waits or ends); it returns false when the client went away.
+template <typename Record>
+grpc::Status ForEachReadingPage(
+    grpc::ServerContext& context, const v1::StreamReadingsRequest& request,
+    StreamReadingsCall& call, const ReadingSource& source, int page_size,
+    const std::function<Result<std::vector<Record>>(std::int64_t after_id, int limit)>& read_page,
+    const std::function<bool(const std::vector<const Record*>&, bool more_stored)>& on_page) {
+  std::int64_t last = request.after_id();
+  std::vector<const Record*> kept;
+  for (;;) {
+    if (context.IsCancelled()) {
+      return grpc::Status(grpc::StatusCode::CANCELLED,
+                          std::string(call.rpc) + ": cancelled by the client");
+    }
+    bool ended = !request.follow();
+    if (!ended) {
+      Result<bool> now = source.ended();
+      if (!now.ok()) return ToGrpcStatus(now.status());
+      ended = *now;
+    }
+    Result<std::vector<Record>> page = read_page(last, page_size);
+    if (!page.ok()) return ToGrpcStatus(page.status());
+    kept.clear();
+    for (const Record& r : *page) {
+      last = r.id;
+      if (call.kinds.empty() || call.kinds.count(r.kind) != 0) kept.push_back(&r);
+    }
+    const bool more_stored = static_cast<int>(page->size()) == page_size;
+    if (!on_page(kept, more_stored)) {
+      return grpc::Status(grpc::StatusCode::CANCELLED,
+                          std::string(call.rpc) + ": the client went away");
+    }
+    if (more_stored) continue;  // next page now
+    if (ended) return grpc::Status::OK;
+    if (source.wait()) {
+      return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                          std::string(call.rpc) + ": " + source.server +
+                              " is shutting down; resume with after_id = " + std::to_string(last) +
+                              " once it is back");
+    }
+  }
+}
+
+// ReadingPoints' angles are for plotting and picking: rounded to a micro-degree, far below any
+// stage's resolution. A computed direction's 17 digits (59.999999999999993) become a few (60), so
+// the JSON the web gateway prints for 50,000 readings is about half as long and printed faster.
+// StreamReadings keeps the exact values.
+double MicroDegrees(double degrees) {
+  return std::round(degrees * 1e6) / 1e6;
+}
+
+void AddPoint(const storage::ReadingPointRecord& r, v1::ReadingPoints* points) {
+  points->add_ids(r.id);
+  points->add_alpha(MicroDegrees(r.pose.alpha));
+  points->add_beta(MicroDegrees(r.pose.beta));
+  points->add_delta(MicroDegrees(r.pose.delta));
+  const IsoDirection iso = ToIsotropic(r.directions);
+  points->add_theta_i(MicroDegrees(iso.theta_i));
+  points->add_theta_o(MicroDegrees(iso.theta_o));
+  points->add_phi(MicroDegrees(iso.phi));
+  points->add_flagged(r.flagged);
+}
+
+}  // namespace
+
+grpc::Status StreamSessionReadings(grpc::ServerContext& context,
+                                   const v1::StreamReadingsRequest& request,
+                                   StreamReadingsCall& call, const ReadingSource& source,
+                                   grpc::ServerWriter<v1::Reading>* writer) {
+  const ReadingExtras extras = source.extras();
+  return ForEachReadingPage<storage::ReadingRecord>(
+      context, request, call, source, kPageSize,
+      [&](std::int64_t after_id, int limit) {
+        return source.reader->GetReadings(call.session, after_id, limit);
+      },
+      [&](const std::vector<const storage::ReadingRecord*>& page, bool) {
+        for (const storage::ReadingRecord* r : page) {
+          if (!call.slot->Write(writer, ToProtoReading(*r, extras))) return false;
+        }
+        return true;
+      });
+}
+
+grpc::Status StreamSessionReadingPoints(grpc::ServerContext& context,
+                                        const v1::StreamReadingsRequest& request,
+                                        StreamReadingsCall& call, const ReadingSource& source,
+                                        grpc::ServerWriter<v1::ReadingPoints>* writer) {
+  v1::ReadingPoints points;
+  return ForEachReadingPage<storage::ReadingPointRecord>(
+      context, request, call, source, kPointsPageSize,
+      [&](std::int64_t after_id, int limit) {
+        return source.reader->GetReadingPoints(call.session, after_id, limit);
+      },
+      [&](const std::vector<const storage::ReadingPointRecord*>& page, bool more_stored) {
+        for (const storage::ReadingPointRecord* r : page) {
+          AddPoint(*r, &points);
+          if (points.ids_size() == kPointsPerMessage) {
+            if (!call.slot->Write(writer, points)) return false;
+            points.Clear();
+          }
+        }
+        // Whatever is held goes out before the stream waits for more or ends.
+        if (!more_stored && points.ids_size() > 0) {
+          if (!call.slot->Write(writer, points)) return false;
+          points.Clear();
+        }
+        return true;
+      });
+}
+
+}  // namespace brdf::daemon

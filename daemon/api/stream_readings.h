@@ -1,0 +1,75 @@
+// StreamReadings' (and StreamReadingPoints') work, shared by brdfd's Data service (service_data.h,
+// over the rig's store) and brdf-archive's (archive_services.h, over the archive): the request
+// checked, then the session's readings written in id order a page at a time (memory bounded by one
+// page), and with `follow` the readings that arrive later, until the session ends, the client
+// cancels or the server stops.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <set>
+#include <string>
+
+#include "brdf/v1/brdf.grpc.pb.h"
+#include "daemon/api/common.h"
+#include "daemon/rpc/auth.h"
+#include "daemon/rpc/stream_registry.h"
+#include "storage/session_reader.h"
+
+namespace brdf::daemon {
+
+// A checked StreamReadings request: the caller authorized (kRead), a stream slot taken, the
+// session id, kinds and after_id valid (else the status names the field). `rpc` is the method
+// the client called ("StreamReadings" or "StreamReadingPoints", which take the same request):
+// the stream's errors and the authorization and stream-limit messages name it.
+struct StreamReadingsCall {
+  const char* rpc = "StreamReadings";
+  Caller caller;
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  std::int64_t session = 0;
+  std::set<storage::ReadingKind> kinds;  // empty: every kind
+};
+grpc::Status CheckStreamReadings(grpc::ServerContext& context,
+                                 const v1::StreamReadingsRequest& request, const char* rpc,
+                                 const Authenticator& auth, StreamRegistry& streams,
+                                 StreamReadingsCall* call);
+
+// Where the readings come from, and how the stream learns that more may come.
+struct ReadingSource {
+  storage::SessionReader* reader = nullptr;
+  // With follow, asked BEFORE each page: true when the session will get no reading after what
+  // the next page reads (so a short page then ends the stream).
+  std::function<Result<bool>()> ended;
+  // With follow, after a short page of a session not ended: waits a while for more; true when
+  // the server is stopping (the stream then ends with UNAVAILABLE).
+  std::function<bool()> wait;
+  std::string server = "the daemon";  // in the stopping message
+  // The session's step labels and averaging (ReadingExtrasOf), for the readings that carry them:
+  // StreamReadings asks once, before its first page; StreamReadingPoints never (a session of
+  // 50,000 steps is 50,000 labels read for nothing).
+  std::function<ReadingExtras()> extras;
+};
+
+// What a readings stream does once its request is checked and its source set up (the rig's and
+// the archive's Data services share their set-up between StreamReadings and StreamReadingPoints).
+using ReadingStreamBody =
+    std::function<grpc::Status(StreamReadingsCall& call, const ReadingSource& source)>;
+
+// The session's step labels from `reader`, with the plan's averaging count (0: 1).
+ReadingExtras ReadingExtrasOf(storage::SessionReader& reader, std::int64_t session,
+                              std::uint32_t averages);
+
+// Streams the readings (the session is known to exist).
+grpc::Status StreamSessionReadings(grpc::ServerContext& context,
+                                   const v1::StreamReadingsRequest& request,
+                                   StreamReadingsCall& call, const ReadingSource& source,
+                                   grpc::ServerWriter<v1::Reading>* writer);
+
+// The same readings as columns (StreamReadingPoints): up to 8,192 a message, and what is held is
+// written before the stream waits (follow) or ends.
+grpc::Status StreamSessionReadingPoints(grpc::ServerContext& context,
+                                        const v1::StreamReadingsRequest& request,
+                                        StreamReadingsCall& call, const ReadingSource& source,
+                                        grpc::ServerWriter<v1::ReadingPoints>* writer);
+
+}  // namespace brdf::daemon

@@ -1,0 +1,136 @@
+// The streams brdfd holds open (WatchSession, StreamReadings, Export, InterpolateBatch, the
+// health service's Watch), with their caps and their stall deadline.
+//
+// Caps ([server] in the configuration, config.h): per token (max_streams_per_token), per role,
+// all tokens of the role together (max_streams_analyst, max_streams_operator), and for calls
+// without a token (max_streams_unauthenticated). Open() refuses a stream beyond a cap with
+// RESOURCE_EXHAUSTED naming the cap and its key. With no tokens configured every caller is the
+// operator "anonymous" and only the role cap applies. Each open stream holds a thread of gRPC's
+// synchronous pool, which server.cc sizes above the caps' sum (ServerThreadCap): the streams
+// cannot exhaust it, and the control plane is not on it at all (control_loop.h).
+//
+// Bounded work: a stream that computes what it sends (Export, InterpolateBatch: opened with
+// `computes`; RenderAppearance takes one with Slot::Work once it knows it must render) works only
+// while it holds one of a few work permits (one per two cores), and gives its permit back while a
+// write waits for the client. A thousand exports then take turns on the
+// cores instead of all running at once. Every stream's thread runs at nice 10 while the stream is
+// open (back to 0 after), below the control plane's threads and Interpolate's loop, which get a
+// core when they need one.
+//
+// Stall deadline (stream_stall_timeout_s): a stream writes through its Slot; a write that has
+// waited that long (the client read nothing meanwhile: HTTP/2 flow control holds the message)
+// gets the call cancelled by the registry's watchdog thread, so the write fails, the handler
+// returns and frees what it held (an export's whole file, ~35 MB for MERL).
+#pragma once
+
+#include <grpcpp/server_context.h>
+#include <grpcpp/support/status.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <thread>
+
+#include "core/mutex.h"
+#include "daemon/config/config.h"
+#include "daemon/rpc/auth.h"
+
+namespace brdf::daemon {
+
+// The synchronous pool's thread cap for these caps: their sum plus room for the short unary calls
+// the pool also serves (ValidatePlan, GetSession, ListSessions) and its pollers.
+int ServerThreadCap(const ServerConfig& config);
+
+class StreamRegistry {
+ public:
+  struct Entry;
+
+  // An open stream's place; released by its destructor. Write through it.
+  class Slot {
+   public:
+    ~Slot();
+    Slot(const Slot&) = delete;
+    Slot& operator=(const Slot&) = delete;
+
+    // writer->Write(message), timed for the stall deadline: false when the client went away or
+    // the stream was cancelled for not reading.
+    template <class Writer, class Message>
+    bool Write(Writer* writer, const Message& message) {
+      BeginWrite();
+      const bool ok = writer->Write(message);
+      EndWrite();
+      return ok;
+    }
+    // Releases the work permit (if any) before it goes away.
+    void Close();
+    // Takes a work permit now if it holds none: for a call that learns only after Open whether it
+    // has work to do (RenderAppearance, on a cache miss). Waits for one; false when the call was
+    // cancelled meanwhile.
+    bool Work();
+
+   private:
+    friend class StreamRegistry;
+    Slot(StreamRegistry* registry, std::uint64_t id, Entry* entry, bool computes)
+        : registry_(registry), id_(id), entry_(entry), computes_(computes) {}
+    void BeginWrite();  // gives the work permit back
+    void EndWrite();    // takes a work permit again
+    StreamRegistry* registry_;
+    std::uint64_t id_;
+    Entry* entry_;
+    const bool computes_;
+    bool holding_ = false;  // a work permit
+  };
+
+  // `tokens_configured`: false when the API is open (auth disabled): no per-token cap. Starts
+  // the watchdog thread.
+  StreamRegistry(const ServerConfig& config, bool tokens_configured);
+  ~StreamRegistry();  // stops the watchdog; every Slot must be gone
+  StreamRegistry(const StreamRegistry&) = delete;
+  StreamRegistry& operator=(const StreamRegistry&) = delete;
+
+  // Admits a stream of `rpc` for `caller` (nullptr: a call without a token) on `context`: OK with
+  // *slot set, or RESOURCE_EXHAUSTED naming the cap that is full and its configuration key. With
+  // `computes`, waits for a work permit first (returns without one if the call is cancelled).
+  grpc::Status Open(grpc::ServerContextBase& context, const Caller* caller, std::string_view rpc,
+                    std::unique_ptr<Slot>* slot, bool computes = false);
+
+  // Work permits: one per two cores, at least one.
+  int work_permits() const { return work_permits_; }
+
+  // Streams open now, and streams cancelled for not reading since the start.
+  int open() const;
+  std::uint64_t stalled() const { return stalled_.load(); }
+
+ private:
+  void Release(std::uint64_t id);
+  // Waits for a work permit (false: `context` was cancelled meanwhile); gives one back.
+  bool AcquireWork(const grpc::ServerContextBase& context);
+  void ReleaseWork();
+  void Watchdog();
+
+  const ServerConfig limits_;
+  const bool per_token_;
+  const std::chrono::steady_clock::duration stall_timeout_;
+
+  mutable Mutex mu_;
+  CondVar stop_cv_;
+  bool stop_ GUARDED_BY(mu_) = false;
+  std::uint64_t next_id_ GUARDED_BY(mu_) = 1;
+  std::map<std::uint64_t, std::unique_ptr<Entry>> entries_ GUARDED_BY(mu_);
+  std::map<std::string, int> per_token_open_ GUARDED_BY(mu_);
+  int analyst_open_ GUARDED_BY(mu_) = 0;
+  int operator_open_ GUARDED_BY(mu_) = 0;
+  int unauthenticated_open_ GUARDED_BY(mu_) = 0;
+  std::atomic<std::uint64_t> stalled_{0};
+  const int work_permits_;
+  Mutex work_mu_;
+  CondVar work_cv_;
+  int working_ GUARDED_BY(work_mu_) = 0;
+  std::thread watchdog_;
+};
+
+}  // namespace brdf::daemon
