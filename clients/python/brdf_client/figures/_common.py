@@ -5,6 +5,7 @@ data, and the choice of a query direction between the samples.
 import argparse
 import dataclasses
 import os
+from typing import Any
 
 import matplotlib
 
@@ -61,9 +62,9 @@ class SessionData:
     white_reflectance: ρw used to turn stored readings into BRDF (the daemon's [sample] setting).
     """
 
-    session: object
-    readings: object
-    query: object
+    session: Any
+    readings: Any
+    query: Any
     white_reflectance: float = 0.99
 
     @property
@@ -133,7 +134,8 @@ def pick_query(client, session_id, samples, method="octant", min_weight=0.1, rea
     return interior[int(np.argmax(spreads))]
 
 
-def gather(client, session_id, query=None, method="octant", white_reflectance=0.99):
+def gather(client: Any, session_id: str, query: Any = None, method: str = "octant",
+           white_reflectance: float = 0.99) -> SessionData:
     """Loads what the figures need from a live daemon: the session, all its readings, and an
     interpolation at `query` ((θi, θo, φ), degrees) or at a direction picked between samples."""
     session = client.get_session(session_id)
@@ -147,7 +149,7 @@ def gather(client, session_id, query=None, method="octant", white_reflectance=0.
     return SessionData(session, readings, result, white_reflectance)
 
 
-def latest_session(client):
+def latest_session(client: Any) -> str:
     """The id of the newest COMPLETED session, else the newest one; ValueError when none."""
     done = client.list_sessions(states=["completed"], page_size=1, limit=1)
     if done:
