@@ -40,6 +40,7 @@ from .interpolation import InterpolationBatch, InterpolationResult, Vertex
 from .netcdf import write_netcdf
 from .plans import to_plan
 from .readings import ReadingSet
+from .queries import candidate_queries, pick_query
 from .spectra import reading_spectrum, vertex_spectra
 
 
@@ -54,6 +55,7 @@ __all__ = [
     "BrdfClient", "BrdfError", "Cancelled", "DataLoss", "DeadlineExceeded", "Event",
     "ExportResult", "FailedPrecondition", "InterpolationBatch", "InterpolationResult",
     "InvalidArgument", "NotFound", "PROTO_PACKAGE", "PermissionDenied", "ReadingSet",
+    "candidate_queries", "pick_query",
     "Unauthenticated", "Unavailable", "Vertex", "__version__", "about", "brdf_pb2",
     "half_diff_from_incidence", "incidence_from_half_diff", "open_grid", "plan_pb2",
     "reading_spectrum", "to_plan", "vertex_spectra", "write_netcdf",

@@ -528,7 +528,7 @@ class BrdfClient:
         export(..., "grid")), as an xarray Dataset (brdf_client.grid_datasets documents it):
 
             ds = brdf.grid(sid, step=5)                        # 18 × 18 × 36 cells × bands
-            ds.brdf.sel(theta_i=32.5, wavelength=550).plot()   # sr⁻¹ over (θo, φ)
+            ds.brdf.sel(theta_i=32.5, wavelength=552).plot()   # sr⁻¹ over (θo, φ)
 
         step: degrees for all three axes, or (θi, θo, φ); each divides 90 (θ) or 180 (φ); 0 is
             1°, a 1.2 GB grid. The cells are at the centres (grid_nodes: 0, step, …, 90).
@@ -677,7 +677,7 @@ class BrdfClient:
 
             g = brdf.interpolate_grid(sid, theta_h=range(0, 90, 2), theta_d=[10, 30, 50],
                                       phi_d=[90])
-            g.brdf.sel(wavelength=550).plot.line(x="theta_h")
+            g.brdf.sel(wavelength=550, method="nearest").plot.line(x="theta_h")
         """
         axes = {"theta_i": theta_i, "theta_o": theta_o, "phi": phi, "theta_h": theta_h,
                 "theta_d": theta_d, "phi_d": phi_d}

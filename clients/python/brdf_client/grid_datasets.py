@@ -5,7 +5,7 @@ fill counts travel apart, in ExportResult.description (brdfctl writes it as GRID
 they come together, cell for cell the same numbers:
 
     ds = brdf_client.open_grid("grid.npy")          # reads grid.npy and grid.npy.json
-    ds.brdf.sel(theta_i=32.5, wavelength=550)        # a (θo, φ) slice, sr⁻¹
+    ds.brdf.sel(theta_i=32.5, wavelength=552)        # a (θo, φ) slice, sr⁻¹
     ds.provenance                                    # per cell: interpolated, fallback, model, ...
 
 Dataset layout (labels.py names the dimensions and units):
@@ -15,7 +15,7 @@ Dataset layout (labels.py names the dimensions and units):
   method, coordinates, trend, fill_policy: 0-d strings; mirror_phi, reciprocity: 0-d booleans;
   axis_scale   (scaled_axis): the method's axis weights (all 1 when the sidecar says null);
   fill_count   (fill_source): cells each stage of the fill chain filled, and those left empty;
-  status_count (status): cells the method could not fill, by why.
+  status_count (status): cells by the method's status (ok, or why not; the sidecar's by_status).
   attrs: session, session_name, quantity, unit, angles, samples, samples_left_out, cells,
   filled, nan_cells, model_fraction, sidecar (the description as JSON text), uncertainty.
 """
@@ -102,7 +102,8 @@ def _count_vars(description: Mapping[str, Any]) -> Dict[str, Any]:
                        {"long_name": "cells per fill stage (the sidecar's fill)"}),
         "status_count": (("status",), np.array([int(n) for n in by_status.values()],
                                                dtype=np.int64),
-                         {"long_name": "cells the method could not fill, by why"}),
+                         {"long_name": "cells by the method's status (ok, or why it could not "
+                                       "fill them; the sidecar's by_status)"}),
         "_statuses": list(by_status.keys()),
     }
 

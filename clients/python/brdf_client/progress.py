@@ -53,8 +53,10 @@ class Bar:
             from tqdm import tqdm  # pylint: disable=import-outside-toplevel
         except ImportError:
             return
+        # A percentage reads as one: no rate, no "n/total".
+        fmt = "{desc}: {percentage:3.0f}%|{bar}| {elapsed}" if unit == "%" else None
         self._bar = tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, leave=True,
-                         dynamic_ncols=True)
+                         dynamic_ncols=True, bar_format=fmt)
 
     @property
     def shown(self) -> bool:

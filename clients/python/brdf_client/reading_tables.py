@@ -5,7 +5,7 @@ DataArray (reading × wavelength). ReadingSet.to_dataframe / to_dataarray call t
     df[df.kind == "sample"].plot.scatter("theta_o", "phi")
     rad = data.to_dataarray()                  # radiance, W·m⁻²·sr⁻¹·nm⁻¹, every reading
     f = data.to_dataarray("brdf")              # sr⁻¹, the sample readings (ρw: white_reflectance)
-    f.sel(wavelength=550).plot.line(x="reading")
+    f.sel(wavelength=550, method="nearest").plot.line(x="reading")
 """
 
 from typing import TYPE_CHECKING, Any, Dict
