@@ -247,3 +247,15 @@ def run_demo(rig, timeout=240):
             raise RuntimeError(f"the demo session ended {names.state_name(final.state)}: "
                                f"{rig.log('brdfd')}")
         return session.session_id
+
+
+def venv_python():
+    """The python of the venv the README's install made (python_client_install, $BRDF_PY_VENV);
+    AssertionError when it is not there."""
+    venv = os.environ.get("BRDF_PY_VENV") or os.path.join(tempfile.gettempdir(),
+                                                          "brdf_client_venv")
+    python = os.path.join(venv, "bin", "python")
+    if not os.access(python, os.X_OK):
+        raise AssertionError(f"no venv at {venv}: run the test python_client_install first "
+                             "(ctest does, as this test's fixture)")
+    return venv, python

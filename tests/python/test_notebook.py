@@ -23,7 +23,6 @@ sys.path.insert(0, HERE)
 
 import live_rig  # noqa: E402
 
-VENV = os.environ.get("BRDF_PY_VENV") or os.path.join(tempfile.gettempdir(), "brdf_client_venv")
 NOTEBOOK = os.path.join(ROOT, "clients", "python", "examples", "quickstart.ipynb")
 
 # Run inside the venv's python: nbclient starts the kernel "python3", which
@@ -52,10 +51,7 @@ def outputs(nb, kind):
 
 class Notebook(unittest.TestCase):
     def test_runs_headless_and_draws_its_three_figures(self):
-        python = os.path.join(VENV, "bin", "python")
-        if not os.access(python, os.X_OK):
-            self.fail(f"no venv at {VENV}: run the test python_client_install first (ctest "
-                      "does, as this test's fixture)")
+        venv, python = live_rig.venv_python()
         base = os.environ.get("BRDF_TEST_OUTPUT_DIR") or tempfile.mkdtemp(prefix="brdf_nb_")
         out_dir = os.path.join(base, "notebook")
         os.makedirs(out_dir, exist_ok=True)
@@ -84,7 +80,7 @@ class Notebook(unittest.TestCase):
         text = "".join(outputs(nb, "text"))
         self.assertIn(f"session {session_id}: ", text)
         self.assertIn("'proto_package': 'brdf.v1'", text)
-        self.assertIn(os.path.realpath(VENV), os.path.realpath(re.search(
+        self.assertIn(os.path.realpath(venv), os.path.realpath(re.search(
             r"'stubs': '([^']+)'", text).group(1)))  # the installed package, not the checkout
         mismatch = float(re.search(r"max f: ([0-9.eE+-]+)", text).group(1))
         self.assertLess(mismatch, 1e-9)

@@ -24,17 +24,13 @@ sys.path.insert(0, HERE)
 
 import live_rig  # noqa: E402
 
-VENV = os.environ.get("BRDF_PY_VENV") or os.path.join(tempfile.gettempdir(), "brdf_client_venv")
 ANALYSIS = os.path.join(ROOT, "run", "analysis")
 FILES = ("grid.npy", "grid.npy.json", "grid.nc")
 
 
 class ReadmeExamples(unittest.TestCase):
     def test_examples_run_as_written_in_the_installed_package(self):
-        python = os.path.join(VENV, "bin", "python")
-        if not os.access(python, os.X_OK):
-            self.fail(f"no venv at {VENV}: run the test python_client_install first (ctest "
-                      "does, as this test's fixture)")
+        venv, python = live_rig.venv_python()
         sim, daemon = live_rig.binaries()
         out = tempfile.mkdtemp(prefix="brdf_readme_")
         self.addCleanup(shutil.rmtree, out, True)
@@ -72,7 +68,7 @@ class ReadmeExamples(unittest.TestCase):
         self.assertEqual(first["r_vertices"], 4)
         self.assertEqual(first["b_shape"], [2, 101])
         self.assertTrue(os.path.realpath(labelled["module_file"]).startswith(
-            os.path.realpath(VENV)), labelled["module_file"])
+            os.path.realpath(venv)), labelled["module_file"])
         self.assertGreater(labelled["rows"], 0)
         self.assertEqual(labelled["kinds"], ["dark", "reference", "sample"])
         self.assertEqual(labelled["f_dims"], ["reading", "wavelength"])

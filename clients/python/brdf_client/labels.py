@@ -22,6 +22,7 @@ of the same dimensions and unit as "brdf" once the daemon reports it; until then
 the Dataset's attr `uncertainty` says so.
 """
 
+import importlib
 from types import ModuleType
 from typing import Dict
 
@@ -79,21 +80,20 @@ def provenance_attrs() -> Dict[str, object]:
             "flag_values": list(range(len(PROVENANCE))), "flag_meanings": " ".join(PROVENANCE)}
 
 
+def _require(module: str, debian: str) -> ModuleType:
+    """`module` imported, or ImportError naming the Debian package that brings it."""
+    try:
+        return importlib.import_module(module)
+    except ImportError as e:
+        raise ImportError(f"brdf_client's labelled data needs {module}: sudo apt-get install "
+                          f"{debian} (or pip install {module})") from e
+
+
 def xarray() -> ModuleType:
     """The xarray module, or ImportError saying how to get it (Debian's python3-xarray)."""
-    try:
-        import xarray as xr  # pylint: disable=import-outside-toplevel
-    except ImportError as e:
-        raise ImportError("brdf_client's labelled data needs xarray: sudo apt-get install "
-                          "python3-xarray (or pip install xarray)") from e
-    return xr
+    return _require("xarray", "python3-xarray")
 
 
 def pandas() -> ModuleType:
     """The pandas module, or ImportError saying how to get it (Debian's python3-pandas)."""
-    try:
-        import pandas as pd  # pylint: disable=import-outside-toplevel
-    except ImportError as e:
-        raise ImportError("brdf_client's tables need pandas: sudo apt-get install python3-pandas "
-                          "(or pip install pandas)") from e
-    return pd
+    return _require("pandas", "python3-pandas")
