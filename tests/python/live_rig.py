@@ -225,3 +225,37 @@ level = "warn"
 
     def cleanup(self):
         shutil.rmtree(self.dir, ignore_errors=True)
+
+
+def run_demo(rig, timeout=240):
+    """Submits the quick start's plan (examples/plans/demo.json) on `rig`, answers its prompts on
+    the simulator and waits for it to complete; returns the session id. RuntimeError otherwise."""
+    sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
+    from brdf_client import BrdfClient, names  # pylint: disable=import-outside-toplevel
+
+    with BrdfClient(rig.address, token=rig.operator_token) as brdf:
+        session = brdf.submit_plan(os.path.join(ROOT, "examples", "plans", "demo.json"),
+                                   start_now=True)
+
+        def act(prompt):
+            kind = names.prompt_kind_name(prompt.kind)
+            rig.set_mounted("white" if kind == "mount_white" else
+                            "dark" if kind == "close_shutter" else "sample")
+
+        final = brdf.wait(session.session_id, on_prompt=act, timeout=timeout, progress=False)
+        if names.state_name(final.state) != "completed":
+            raise RuntimeError(f"the demo session ended {names.state_name(final.state)}: "
+                               f"{rig.log('brdfd')}")
+        return session.session_id
+
+
+def venv_python():
+    """The python of the venv the README's install made (python_client_install, $BRDF_PY_VENV);
+    AssertionError when it is not there."""
+    venv = os.environ.get("BRDF_PY_VENV") or os.path.join(tempfile.gettempdir(),
+                                                          "brdf_client_venv")
+    python = os.path.join(venv, "bin", "python")
+    if not os.access(python, os.X_OK):
+        raise AssertionError(f"no venv at {venv}: run the test python_client_install first "
+                             "(ctest does, as this test's fixture)")
+    return venv, python

@@ -3,6 +3,7 @@ colour at the CIE 45°:0° geometry and a sphere lit by a distant light, in sRGB
 illuminant A, computed by the daemon from the session's BRDF."""
 
 from dataclasses import dataclass
+from typing import Any, Dict, List, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -21,16 +22,17 @@ class AppearanceImage:
     counts: lit pixels by where their BRDF came from ("interpolated", "fallback", "model",
     "empty"), plus "disc" and "unlit". peak_y: the largest pixel Y (> 1: the highlight clips)."""
     name: str
-    xyz: tuple
-    xy: tuple
-    linear_srgb: tuple
+    xyz: Tuple[float, float, float]
+    xy: Tuple[float, float]
+    linear_srgb: Tuple[float, float, float]
     hex: str
     sphere: np.ndarray
-    counts: dict
+    counts: Dict[str, int]
     peak_y: float
 
     @classmethod
-    def from_proto(cls, m):
+    def from_proto(cls, m: Any) -> "AppearanceImage":
+        """From a brdf.v1.AppearanceImage."""
         c = m.colour
         n = m.sphere_size
         sphere = np.frombuffer(m.sphere_rgba, dtype=np.uint8).reshape(n, n, 4).copy()
@@ -49,19 +51,20 @@ class Appearance:
     """images: one AppearanceImage per illuminant, in the order asked (also by name through
     appearance["D65"]); wavelengths, reflectance: the reflectance factor π·f_r at 45°:0°;
     detail: readings left out, or what the fill chain could not do."""
-    images: list
+    images: List[AppearanceImage]
     wavelengths: np.ndarray
     reflectance: np.ndarray
     detail: str
 
-    def __getitem__(self, name):
+    def __getitem__(self, name: str) -> AppearanceImage:
         for image in self.images:
             if image.name == name:
                 return image
         raise KeyError(f"no image under {name!r}; have {[i.name for i in self.images]}")
 
     @classmethod
-    def from_proto(cls, m):
+    def from_proto(cls, m: Any) -> "Appearance":
+        """From a brdf.v1.AppearanceResponse."""
         g = m.grid
         count = len(m.reflectance)
         return cls(images=[AppearanceImage.from_proto(i) for i in m.images],
@@ -69,7 +72,7 @@ class Appearance:
                    reflectance=np.asarray(m.reflectance, dtype=float), detail=m.detail)
 
 
-def illuminant_enums(illuminants):
+def illuminant_enums(illuminants: Union[str, Sequence[str], None]) -> List[int]:
     """["D65", "A"] (or one name, or None for the daemon's default: both) as the API's enums;
     an unknown name raises ValueError."""
     if illuminants is None:

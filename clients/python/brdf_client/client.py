@@ -18,22 +18,30 @@ Units: degrees for angles, nm for wavelengths, sr⁻¹ for a BRDF, W·m⁻²·sr
 
 import os
 import time
+from typing import Any, Callable, Iterable, Iterator, List, Optional, Sequence, Tuple, Union
 
 import grpc
 
-from . import names
+from . import grid_calls, names
 from .appearance import Appearance, illuminant_enums
 from ._stubs import brdf_pb2, brdf_pb2_grpc
 from .errors import BrdfError
 from .events import Event
-from .export import ExportResult, export_request
+from .export import ExportResult, export_request, format_name
 from .interpolation import (InterpolationBatch, InterpolationResult, direction_query,
                             interpolation_options)
-from .plans import to_plan
+from .plans import PlanLike, to_plan
+from .progress import Bar
 from .readings import ReadingSet, kinds_to_enums
 
+# The API's messages (brdf_pb2.Session, Prompt, RigStatus, ...) are generated at run time and
+# carry no type information: they are Any here, and brdf.proto documents their fields.
+Message = Any
+PemSource = Union[bytes, str, "os.PathLike[str]", None]
+Kinds = Union[str, int, Sequence[Union[str, int]], None]
 
-def _read_pem(value, what):
+
+def _read_pem(value: PemSource, what: str) -> Optional[bytes]:
     """PEM bytes from bytes, or from a file path."""
     if value is None or isinstance(value, bytes):
         return value
@@ -42,6 +50,39 @@ def _read_pem(value, what):
             return f.read()
     except OSError as e:
         raise ValueError(f"cannot read the {what} {value}: {e.strerror}") from e
+
+
+def _save_export_stream(call: Iterable[Any], partial: str,
+                        on_progress: Callable[[str, float], None]) -> Message:
+    """Writes an Export stream's bytes to `partial`, checking that they come in order and add up
+    to the report's count; returns the report. BrdfError (the daemon's code, or DATA_LOSS)."""
+    rpc = "Data.Export"
+
+    def broken(message: str) -> BrdfError:
+        return BrdfError(grpc.StatusCode.DATA_LOSS, f"{message}; export again", rpc)
+
+    received, report = 0, None
+    with open(partial, "wb") as f:
+        try:
+            for chunk in call:
+                kind = chunk.WhichOneof("payload")
+                if kind == "progress":
+                    on_progress(chunk.progress.stage, chunk.progress.fraction)
+                elif kind == "data":
+                    if chunk.data.offset != received:
+                        raise broken(f"the daemon sent bytes at offset {chunk.data.offset} "
+                                     f"after {received} bytes")
+                    f.write(chunk.data.content)
+                    received += len(chunk.data.content)
+                elif kind == "report":
+                    report = chunk.report
+        except grpc.RpcError as e:
+            raise BrdfError.from_rpc_error(e, rpc) from None
+    if report is None:
+        raise broken(f"the stream ended without a report after {received} bytes")
+    if report.bytes != received:
+        raise broken(f"the report counts {report.bytes} bytes but {received} came")
+    return report
 
 
 class BrdfClient:
@@ -65,14 +106,17 @@ class BrdfClient:
       timeout: deadline of unary calls, seconds. Streams take their own `timeout` (default none).
     """
 
-    def __init__(self, address, token=None, *, tls=False, root_certificates=None,
-                 client_certificate=None, client_key=None, server_name=None, timeout=30.0):
+    def __init__(self, address: str, token: Optional[str] = None, *, tls: bool = False,
+                 root_certificates: PemSource = None, client_certificate: PemSource = None,
+                 client_key: PemSource = None, server_name: Optional[str] = None,
+                 timeout: float = 30.0) -> None:
         self.address = address
         self.timeout = timeout
         if token is None:
             token = os.environ.get("BRDF_TOKEN") or None
-        self._metadata = (("authorization", f"Bearer {token}"),) if token else ()
-        options = []
+        self._metadata: Tuple[Tuple[str, str], ...] = (
+            (("authorization", f"Bearer {token}"),) if token else ())
+        options: List[Tuple[str, str]] = []
         if server_name:
             options.append(("grpc.ssl_target_name_override", server_name))
         if tls or root_certificates or client_certificate or client_key:
@@ -91,17 +135,17 @@ class BrdfClient:
 
     # --- connection ----------------------------------------------------------------------------
 
-    def close(self):
+    def close(self) -> None:
         """Closes the channel (open streams end)."""
         self._channel.close()
 
-    def __enter__(self):
+    def __enter__(self) -> "BrdfClient":
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def wait_ready(self, timeout=10.0):
+    def wait_ready(self, timeout: float = 10.0) -> None:
         """Blocks until the channel is connected; BrdfError(UNAVAILABLE) after `timeout` s."""
         try:
             grpc.channel_ready_future(self._channel).result(timeout=timeout)
@@ -110,14 +154,16 @@ class BrdfClient:
                             f"brdfd at {self.address} did not answer within {timeout:g} s; check "
                             "the address and that the daemon runs", "connect") from None
 
-    def _unary(self, rpc, request, method, timeout=None):
+    def _unary(self, rpc: Callable[..., Any], request: Message, method: str,
+               timeout: Optional[float] = None) -> Any:
         try:
             return rpc(request, metadata=self._metadata,
                        timeout=self.timeout if timeout is None else timeout)
         except grpc.RpcError as e:
             raise BrdfError.from_rpc_error(e, method) from None
 
-    def _stream(self, rpc, request, method, timeout=None):
+    def _stream(self, rpc: Callable[..., Any], request: Message, method: str,
+                timeout: Optional[float] = None) -> Iterator[Any]:
         call = rpc(request, metadata=self._metadata, timeout=timeout)
         try:
             for item in call:
@@ -129,7 +175,7 @@ class BrdfClient:
 
     # --- Control: plans and sessions -----------------------------------------------------------
 
-    def validate_plan(self, plan):
+    def validate_plan(self, plan: PlanLike) -> Message:
         """Checks a plan (Plan, dict, JSON text or JSON file path) without storing it.
 
         Returns brdf_pb2.ValidatePlanResponse: .valid, .problems (field_path, message),
@@ -138,7 +184,7 @@ class BrdfClient:
         return self._unary(self._control.ValidatePlan,
                            brdf_pb2.ValidatePlanRequest(plan=to_plan(plan)), "Control.ValidatePlan")
 
-    def submit_plan(self, plan, start_now=False):
+    def submit_plan(self, plan: PlanLike, start_now: bool = False) -> Message:
         """Stores a plan as a new session; returns the brdf_pb2.Session (QUEUED, or RUNNING).
 
         `plan`: a Plan message, a dict (the JSON form), JSON text, or a path to a JSON plan file.
@@ -147,13 +193,13 @@ class BrdfClient:
         request = brdf_pb2.SubmitPlanRequest(plan=to_plan(plan), start_now=start_now)
         return self._unary(self._control.SubmitPlan, request, "Control.SubmitPlan").session
 
-    def start(self, session_id):
+    def start(self, session_id: str) -> Message:
         """Starts a QUEUED session (it stays QUEUED while another one holds the rig)."""
         return self._unary(self._control.StartSession,
                            brdf_pb2.StartSessionRequest(session_id=session_id),
                            "Control.StartSession").session
 
-    def pause(self, session_id, immediate=False):
+    def pause(self, session_id: str, immediate: bool = False) -> Message:
         """Pauses a running session: after the current step (default), or at once (immediate:
         the step in progress is cancelled and run again on resume)."""
         mode = brdf_pb2.PAUSE_MODE_IMMEDIATE if immediate else brdf_pb2.PAUSE_MODE_DEFERRED
@@ -161,19 +207,20 @@ class BrdfClient:
                            brdf_pb2.PauseSessionRequest(session_id=session_id, mode=mode),
                            "Control.PauseSession").session
 
-    def resume(self, session_id):
+    def resume(self, session_id: str) -> Message:
         """Resumes a PAUSED or PAUSING session."""
         return self._unary(self._control.ResumeSession,
                            brdf_pb2.ResumeSessionRequest(session_id=session_id),
                            "Control.ResumeSession").session
 
-    def abort(self, session_id, reason=""):
+    def abort(self, session_id: str, reason: str = "") -> Message:
         """Stops a session for good (its readings are kept)."""
         return self._unary(self._control.AbortSession,
                            brdf_pb2.AbortSessionRequest(session_id=session_id, reason=reason),
                            "Control.AbortSession").session
 
-    def answer_prompt(self, session_id, step_index=None, note=""):
+    def answer_prompt(self, session_id: str, step_index: Optional[int] = None,
+                      note: str = "") -> Message:
         """Confirms that the manual action of the pending prompt is done.
 
         step_index: the prompt's Prompt.step_index; None: the session's pending prompt (fetched
@@ -191,12 +238,12 @@ class BrdfClient:
                                                note=note)
         return self._unary(self._control.AnswerPrompt, request, "Control.AnswerPrompt").session
 
-    def get_session(self, session_id):
+    def get_session(self, session_id: str) -> Message:
         """One session, with its plan, progress, pending prompt and last fault."""
         return self._unary(self._control.GetSession,
                            brdf_pb2.GetSessionRequest(session_id=session_id), "Control.GetSession")
 
-    def list_session_events(self, session_id):
+    def list_session_events(self, session_id: str) -> List[Message]:
         """The session's history of states, oldest first: SessionStateEvent (id, state, reason,
         at) messages, one when it was created and one per change of its state or reason."""
         reply = self._unary(self._control.ListSessionEvents,
@@ -204,8 +251,11 @@ class BrdfClient:
                             "Control.ListSessionEvents")
         return list(reply.events)
 
-    def list_sessions(self, states=None, page_size=0, limit=None, *, rig=None, sample=None,
-                      material=None, tag=None, created_after=None, created_before=None):
+    def list_sessions(self, states: Union[str, int, Iterable[Union[str, int]], None] = None,
+                      page_size: int = 0, limit: Optional[int] = None, *,
+                      rig: Optional[str] = None, sample: Optional[str] = None,
+                      material: Optional[str] = None, tag: Optional[str] = None,
+                      created_after: Any = None, created_before: Any = None) -> List[Message]:
         """Sessions, newest first, optionally only those in `states` ("running", ...).
 
         Catalogue filters (brdfd for its own sessions, brdf-archive across the lab's rigs): `rig`
@@ -226,7 +276,8 @@ class BrdfClient:
             if when is not None:
                 seconds = when.timestamp() if hasattr(when, "timestamp") else float(when)
                 getattr(request, field).seconds = int(seconds)
-        sessions, token = [], ""
+        sessions: List[Message] = []
+        token = ""
         while True:
             request.page_token = token
             page = self._unary(self._control.ListSessions, request, "Control.ListSessions")
@@ -237,22 +288,29 @@ class BrdfClient:
             if not token:
                 return sessions
 
-    def rig_status(self):
+    def rig_status(self) -> Message:
         """brdf_pb2.RigStatus: devices' connection states, live pose, meter serial, active session."""
         return self._unary(self._control.GetRigStatus, brdf_pb2.GetRigStatusRequest(),
                            "Control.GetRigStatus")
 
-    def watch(self, session_id, timeout=None):
-        """Yields the session's events (Event): a snapshot, then state changes, prompts, step
-        completions and faults, until the session ends. `timeout`: deadline of the whole stream,
-        seconds (BrdfError DEADLINE_EXCEEDED when it passes); None: none."""
+    def watch(self, session_id: str, timeout: Optional[float] = None) -> Iterator[Event]:
+        """An iterator of the session's events (Event): a snapshot, then state changes, prompts,
+        step completions and faults, until the session ends. `timeout`: deadline of the whole
+        stream, seconds (BrdfError DEADLINE_EXCEEDED when it passes); None: none.
+
+            for event in brdf.watch(sid):          # Ctrl-C, break or .close() ends the stream
+                print(event.kind, event.describe())
+        """
         for event in self._stream(self._control.WatchSession,
                                   brdf_pb2.WatchSessionRequest(session_id=session_id),
                                   "Control.WatchSession", timeout):
             yield Event.from_proto(event)
 
-    def wait(self, session_id, on_event=None, on_prompt=None, timeout=None, poll_s=10.0,
-             stop_states=()):
+    def wait(self, session_id: str, on_event: Optional[Callable[[Event], Any]] = None,
+             on_prompt: Optional[Callable[[Message], Any]] = None,
+             timeout: Optional[float] = None, poll_s: float = 10.0,
+             stop_states: Iterable[Union[str, int]] = (),
+             progress: Optional[bool] = None) -> Message:
         """Follows a session until it is terminal; returns the final brdf_pb2.Session.
 
         on_event(event): called for every Event (progress displays).
@@ -265,11 +323,26 @@ class BrdfClient:
             a slow watcher (a renewed watch starts with a snapshot holding the pending prompt).
         stop_states: also return when the session enters one of these states (short names),
             e.g. ("paused",) to stop waiting when a fault pauses the session (see last_fault).
+        progress: a tqdm bar of the steps done (progress.py; None: when someone watches).
+        Ctrl-C stops waiting (the session goes on in the daemon).
         """
+        with Bar(progress, desc=f"session {session_id}", unit="step") as bar:
+            def show(event: Event) -> None:
+                p = (event.data.progress if event.kind in ("snapshot", "step_completed")
+                     else None)
+                if p is not None and p.total_steps:
+                    bar.moveto(p.done_steps, total=p.total_steps)
+                if on_event:
+                    on_event(event)
+            return self._wait(session_id, show, on_prompt, timeout, poll_s, stop_states)
+
+    def _wait(self, session_id: str, on_event: Callable[[Event], Any],
+              on_prompt: Optional[Callable[[Message], Any]], timeout: Optional[float],
+              poll_s: float, stop_states: Iterable[Union[str, int]]) -> Message:
         stop = {names.to_enum(s, names.STATES, "session state") for s in stop_states}
         stop |= names.TERMINAL_STATES
         until = None if timeout is None else time.monotonic() + timeout
-        answered = set()
+        answered: set = set()
         while True:
             left = None if until is None else until - time.monotonic()
             if left is not None and left <= 0:
@@ -279,8 +352,7 @@ class BrdfClient:
             span = poll_s if left is None else min(poll_s, left)
             try:
                 for event in self.watch(session_id, timeout=span):
-                    if on_event:
-                        on_event(event)
+                    on_event(event)
                     state = (event.data.to if event.kind == "state_changed" else
                              event.data.state if event.kind == "snapshot" else None)
                     if state in stop:
@@ -304,7 +376,7 @@ class BrdfClient:
             if session.state in stop:
                 return session
 
-    def _answer_if_pending(self, session_id, step_index):
+    def _answer_if_pending(self, session_id: str, step_index: int) -> None:
         try:
             self.answer_prompt(session_id, step_index, note="answered by brdf_client")
         except BrdfError as e:
@@ -314,39 +386,54 @@ class BrdfClient:
 
     # --- Data ----------------------------------------------------------------------------------
 
-    def readings(self, session_id, kinds=None, after_id=0, follow=False, batch_size=None,
-                 timeout=None):
+    def readings(self, session_id: str, kinds: Kinds = None, after_id: int = 0,
+                 follow: bool = False, batch_size: Optional[int] = None,
+                 timeout: Optional[float] = None,
+                 progress: Optional[bool] = None) -> Iterator[ReadingSet]:
         """Yields the session's readings in id order, as ReadingSet chunks (NumPy arrays).
 
         kinds: "sample", "reference", "dark" or a list of them; None: all.
         after_id: only readings with a larger id (to resume).
         follow: keep going as new readings are taken, until the session ends.
         batch_size: readings per chunk; None: 1 when following (each as it lands), else 500.
+        progress: a tqdm bar counting the readings (None: when someone watches).
+        Ctrl-C, a break or .close() cancels the stream.
         """
         if batch_size is None:
             batch_size = 1 if follow else 500
         request = brdf_pb2.StreamReadingsRequest(session_id=session_id,
                                                  kinds=kinds_to_enums(kinds), after_id=after_id,
                                                  follow=follow)
-        chunk = []
-        for reading in self._stream(self._data.StreamReadings, request, "Data.StreamReadings",
-                                    timeout):
-            chunk.append(reading)
-            if len(chunk) >= batch_size:
-                yield ReadingSet.from_protos(chunk)
-                chunk = []
+        chunk: List[Message] = []
+        with Bar(progress, desc=f"readings of session {session_id}", unit="reading") as bar:
+            for reading in self._stream(self._data.StreamReadings, request,
+                                        "Data.StreamReadings", timeout):
+                chunk.append(reading)
+                bar.update()
+                if len(chunk) >= batch_size:
+                    yield ReadingSet.from_protos(chunk)
+                    chunk = []
         if chunk:
             yield ReadingSet.from_protos(chunk)
 
-    def load_readings(self, session_id, kinds=None, timeout=None):
-        """Every stored reading of the session (of `kinds`) as one ReadingSet."""
-        return ReadingSet.concat(self.readings(session_id, kinds=kinds, timeout=timeout))
+    def load_readings(self, session_id: str, kinds: Kinds = None, timeout: Optional[float] = None,
+                      progress: Optional[bool] = None) -> ReadingSet:
+        """Every stored reading of the session (of `kinds`) as one ReadingSet; .to_dataframe()
+        and .to_dataarray() label it (pandas, xarray). progress: as readings()."""
+        return ReadingSet.concat(self.readings(session_id, kinds=kinds, timeout=timeout,
+                                               progress=progress))
 
-    def export(self, session_id, fmt, path, *, quantity=None, method="octant", axis_scale=None,
-               mirror_phi=False, reciprocity=None, step_theta_i=0.0, step_theta_o=0.0,
-               step_phi=0.0, grid_nodes=False, exclude_flagged=False, chunk_bytes=0,
-               fill="chain", rgb=False, rgl_theta_i_count=0, rgl_resolution=0,
-               on_progress=None, timeout=None, coordinates=None, trend=None):
+    def export(self, session_id: str, fmt: Union[str, int], path: "str | os.PathLike[str]", *,
+               quantity: Union[str, int, None] = None, method: Union[str, int] = "octant",
+               axis_scale: Optional[Sequence[float]] = None, mirror_phi: bool = False,
+               reciprocity: Optional[bool] = None, step_theta_i: float = 0.0,
+               step_theta_o: float = 0.0, step_phi: float = 0.0, grid_nodes: bool = False,
+               exclude_flagged: bool = False, chunk_bytes: int = 0, fill: str = "chain",
+               rgb: bool = False, rgl_theta_i_count: int = 0, rgl_resolution: int = 0,
+               on_progress: Optional[Callable[[str, float], Any]] = None,
+               timeout: Optional[float] = None, coordinates: Union[str, int, None] = None,
+               trend: Union[str, int, None] = None, progress: Optional[bool] = None,
+               sidecar: bool = False) -> ExportResult:
         """Has the daemon export the session as a file and saves it at `path`; returns an
         ExportResult (file name, bytes, summary, rows, cells, filled_cells, shape, ...).
 
@@ -379,6 +466,10 @@ class BrdfClient:
             "resampling", "building the MERL table", "sending", "done"; fraction in [0, 1],
             never decreasing).
         timeout: deadline of the whole export, seconds; None: none.
+        progress: a tqdm bar of the stages (None: when someone watches). Ctrl-C cancels the
+            export (the daemon stops) and removes the partial file.
+        sidecar: grid .npy: also write its description as `path`.json, as brdfctl does
+            (brdf_client.open_grid reads the pair).
 
         Raises BrdfError with the daemon's code and message (NOT_FOUND for an unknown session,
         INVALID_ARGUMENT for bad steps or options, FAILED_PRECONDITION for a session without
@@ -400,53 +491,73 @@ class BrdfClient:
                                  rgl_resolution=rgl_resolution)
         partial = (os.path.join(path, f"brdf_client-export-{session_id}") if into_folder
                    else path) + ".partial"
-        rpc = "Data.Export"
-
-        def broken(message):
-            return BrdfError(grpc.StatusCode.DATA_LOSS, f"{message}; export again", rpc)
-
         call = self._data.Export(request, metadata=self._metadata, timeout=timeout)
-        received, report = 0, None
         try:
-            with open(partial, "wb") as f:
-                try:
-                    for chunk in call:
-                        kind = chunk.WhichOneof("payload")
-                        if kind == "progress":
-                            if on_progress:
-                                on_progress(chunk.progress.stage, chunk.progress.fraction)
-                        elif kind == "data":
-                            if chunk.data.offset != received:
-                                raise broken(f"the daemon sent bytes at offset "
-                                             f"{chunk.data.offset} after {received} bytes")
-                            f.write(chunk.data.content)
-                            received += len(chunk.data.content)
-                        elif kind == "report":
-                            report = chunk.report
-                except grpc.RpcError as e:
-                    raise BrdfError.from_rpc_error(e, rpc) from None
-            if report is None:
-                raise broken(f"the stream ended without a report after {received} bytes")
-            if report.bytes != received:
-                raise broken(f"the report counts {report.bytes} bytes but {received} came")
+            with Bar(progress, total=100, desc=f"export {format_name(request.format)}",
+                     unit="%") as bar:
+                def show(stage: str, fraction: float) -> None:
+                    bar.moveto(round(100 * fraction, 1), desc=stage)
+                    if on_progress:
+                        on_progress(stage, fraction)
+                report = _save_export_stream(call, partial, show)
             # basename: the daemon names a file, never where it goes.
             final = (os.path.join(path, os.path.basename(report.file_name)) if into_folder
                      else path)
             os.replace(partial, final)
         except BaseException:
-            call.cancel()  # stops the daemon's work when we gave up early
+            call.cancel()  # stops the daemon's work when we gave up early (Ctrl-C included)
             try:
                 os.remove(partial)
             except OSError:
                 pass  # never created (or already gone); the error that matters is re-raised
             raise
-        return ExportResult.from_report(report, final, request.format)
+        result = ExportResult.from_report(report, final, request.format)
+        if sidecar and result.description is not None:
+            result.write_sidecar()
+        return result
+
+    def grid(self, session_id: str, step: grid_calls.Steps = 5.0, *,
+             quantity: Union[str, int] = "brdf", method: Union[str, int] = "octant",
+             fill: str = "chain", coordinates: Union[str, int, None] = None,
+             trend: Union[str, int, None] = None, axis_scale: Optional[Sequence[float]] = None,
+             mirror_phi: bool = False, reciprocity: Optional[bool] = None,
+             grid_nodes: bool = False, exclude_flagged: bool = False, provenance: bool = True,
+             path: Optional[str] = None, netcdf: Optional[str] = None,
+             progress: Optional[bool] = None, timeout: Optional[float] = None) -> Any:
+        """The session on a regular (θi, θo, φ) grid, exported by the daemon (Data.Export, as
+        export(..., "grid")), as an xarray Dataset (brdf_client.grid_datasets documents it):
+
+            ds = brdf.grid(sid, step=5)                        # 18 × 18 × 36 cells × bands
+            ds.brdf.sel(theta_i=32.5, wavelength=552).plot()   # sr⁻¹ over (θo, φ)
+
+        step: degrees for all three axes, or (θi, θo, φ); each divides 90 (θ) or 180 (φ); 0 is
+            1°, a 1.2 GB grid. The cells are at the centres (grid_nodes: 0, step, …, 90).
+        quantity, method, fill, coordinates, trend, axis_scale, mirror_phi, reciprocity,
+            exclude_flagged: as export().
+        provenance: with fill "chain", also export the grid with fill "none" by the method and
+            by Delaunay (up to two more exports) to tell each cell's provenance (interpolated,
+            fallback, model, empty); False: one export, the chain's cells "unrecorded".
+        path: keep the .npy there, with its description as path.json (open_grid reads them);
+            None: a temporary file, removed once the Dataset holds the values.
+        netcdf: also write the Dataset there (write_netcdf: xarray's writer).
+        progress: a tqdm bar per export (None: when someone watches). Ctrl-C cancels.
+        Errors: as export().
+        """
+        return grid_calls.export_grid(
+            self, session_id, step, method=method, fill=fill, provenance=provenance, path=path,
+            netcdf=netcdf, progress=progress, quantity=quantity, coordinates=coordinates,
+            trend=trend, axis_scale=axis_scale, mirror_phi=mirror_phi, reciprocity=reciprocity,
+            grid_nodes=grid_nodes, exclude_flagged=exclude_flagged, timeout=timeout)
 
     # --- Interpolation -------------------------------------------------------------------------
 
-    def interpolate(self, session_id, theta_i, theta_o, phi=None, *, phi_i=None, phi_o=None,
-                    method="octant", quantity="brdf", axis_scale=None, mirror_phi=False,
-                    reciprocity=False, coordinates=None, trend=None):
+    def interpolate(self, session_id: str, theta_i: float, theta_o: float,
+                    phi: Optional[float] = None, *, phi_i: Optional[float] = None,
+                    phi_o: Optional[float] = None, method: Union[str, int] = "octant",
+                    quantity: Union[str, int] = "brdf",
+                    axis_scale: Optional[Sequence[float]] = None, mirror_phi: bool = False,
+                    reciprocity: bool = False, coordinates: Union[str, int, None] = None,
+                    trend: Union[str, int, None] = None) -> InterpolationResult:
         """The spectrum at one direction, from the session's SAMPLE readings.
 
         Direction, degrees: (theta_i, theta_o, phi) for isotropic sessions (φ = |φo − φi| in
@@ -462,15 +573,17 @@ class BrdfClient:
             of them and adds it back (closer near a sharp specular peak; isotropic sessions only;
             docs/interpolation.md, "Bivariate trend"); None or "none": the readings' spectra.
 
-        Returns an InterpolationResult. A direction the method cannot fill is not an error: check
-        result.ok / result.status ("empty_octant", "outside_hull", ...).
+        Returns an InterpolationResult (.to_dataset(): labelled, xarray). A direction the method
+        cannot fill is not an error: check result.ok / result.status ("empty_octant",
+        "outside_hull", ...).
         """
+        direction: Tuple[float, ...]
         if (phi_i is None) != (phi_o is None):
             raise ValueError("give phi_i and phi_o together (four angles), or phi alone")
         if phi_i is not None:
             if phi is not None:
                 raise ValueError("give either phi (isotropic) or phi_i and phi_o, not both")
-            direction = (theta_i, phi_i, theta_o, phi_o)
+            direction = (theta_i, phi_i, theta_o, float(phi_o or 0.0))
         else:
             if phi is None:
                 raise ValueError("phi is missing: give (theta_i, theta_o, phi), degrees")
@@ -484,9 +597,12 @@ class BrdfClient:
         response = self._unary(self._interp.Interpolate, request, "Interpolation.Interpolate")
         return InterpolationResult.from_proto(response.result)
 
-    def appearance(self, session_id, illuminants=None, *, method="octant", sphere_size=0,
-                   light=None, axis_scale=None, mirror_phi=False, reciprocity=False,
-                   coordinates=None, trend=None):
+    def appearance(self, session_id: str, illuminants: Union[str, Sequence[str], None] = None, *,
+                   method: Union[str, int] = "octant", sphere_size: int = 0,
+                   light: Optional[Sequence[float]] = None,
+                   axis_scale: Optional[Sequence[float]] = None, mirror_phi: bool = False,
+                   reciprocity: bool = False, coordinates: Union[str, int, None] = None,
+                   trend: Union[str, int, None] = None) -> Appearance:
         """The sample's colour (CIE 45°:0°) and a lit sphere in sRGB
         (Interpolation.RenderAppearance, docs/appearance.md). illuminants: "D65", "A", a list of them, or None for both.
         sphere_size: pixels per side, at most 512 (0: 128). light: (x, y, z) towards the light
@@ -502,12 +618,19 @@ class BrdfClient:
                                "Interpolation.RenderAppearance")
         return Appearance.from_proto(response)
 
-    def interpolate_batch(self, session_id, directions, method="octant", quantity="brdf",
-                          axis_scale=None, mirror_phi=False, reciprocity=False, chunk_size=0,
-                          timeout=None, coordinates=None, trend=None):
+    def interpolate_batch(self, session_id: str, directions: Any,
+                          method: Union[str, int] = "octant", quantity: Union[str, int] = "brdf",
+                          axis_scale: Optional[Sequence[float]] = None, mirror_phi: bool = False,
+                          reciprocity: bool = False, chunk_size: int = 0,
+                          timeout: Optional[float] = None,
+                          coordinates: Union[str, int, None] = None,
+                          trend: Union[str, int, None] = None,
+                          progress: Optional[bool] = None) -> InterpolationBatch:
         """Spectra at many directions: `directions` is (N, 3) (θi, θo, φ) or (N, 4)
         (θi, φi, θo, φo), degrees. Returns an InterpolationBatch in the order asked (spectra
-        (N, m) with NaN rows where the method could not fill the direction)."""
+        (N, m) with NaN rows where the method could not fill the direction; .to_dataset():
+        labelled, xarray). progress: a tqdm bar of the directions answered (None: when someone
+        watches); Ctrl-C cancels the stream."""
         queries = [direction_query(d) for d in directions]
         request = brdf_pb2.InterpolateBatchRequest(
             session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
@@ -515,15 +638,51 @@ class BrdfClient:
             options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates,
                                           trend),
             chunk_size=chunk_size)
-        results = [None] * len(queries)
-        for chunk in self._stream(self._interp.InterpolateBatch, request,
-                                  "Interpolation.InterpolateBatch", timeout):
-            for k, r in enumerate(chunk.results):
-                results[chunk.first_index + k] = InterpolationResult.from_proto(r)
+        results: List[Optional[InterpolationResult]] = [None] * len(queries)
+        with Bar(progress, total=len(queries), desc=f"interpolating ({names.method_name(request.method)})",
+                 unit="direction") as bar:
+            for chunk in self._stream(self._interp.InterpolateBatch, request,
+                                      "Interpolation.InterpolateBatch", timeout):
+                for k, r in enumerate(chunk.results):
+                    results[chunk.first_index + k] = InterpolationResult.from_proto(r)
+                bar.update(len(chunk.results))
         missing = [i for i, r in enumerate(results) if r is None]
         if missing:
             raise BrdfError(grpc.StatusCode.INTERNAL,
                             f"the daemon answered {len(queries) - len(missing)} of {len(queries)} "
                             f"directions (first missing: index {missing[0]})",
                             "Interpolation.InterpolateBatch")
-        return InterpolationBatch(results)
+        return InterpolationBatch([r for r in results if r is not None])
+
+    def interpolate_grid(self, session_id: str, *, theta_i: Any = None, theta_o: Any = None,
+                         phi: Any = None, theta_h: Any = None, theta_d: Any = None,
+                         phi_d: Any = None, method: Union[str, int] = "octant",
+                         quantity: Union[str, int] = "brdf",
+                         axis_scale: Optional[Sequence[float]] = None, mirror_phi: bool = False,
+                         reciprocity: bool = False, coordinates: Union[str, int, None] = None,
+                         trend: Union[str, int, None] = None, chunk_size: int = 0,
+                         netcdf: Optional[str] = None, progress: Optional[bool] = None,
+                         timeout: Optional[float] = None) -> Any:
+        """A grid computed from interpolations (one InterpolateBatch), as an xarray Dataset.
+
+        Axes, degrees (any sequences): theta_i, theta_o, phi — the grid is (θi, θo, φ) — or
+        theta_h, theta_d, phi_d — Rusinkiewicz's half/difference angles (φh = 0); then every
+        cell also has its (θi, θo, φ) as coordinates, and cells below the surface are NaN with
+        status "below_horizon" (never asked). Each cell: the method's answer (status "ok",
+        provenance "interpolated") or NaN (its status says why; provenance "empty"): no fill
+        chain here (grid() has it).
+        method, quantity, axis_scale, mirror_phi, reciprocity, coordinates, trend: as
+        interpolate(). netcdf: also write the Dataset there. progress, timeout: as
+        interpolate_batch().
+
+            g = brdf.interpolate_grid(sid, theta_h=range(0, 90, 2), theta_d=[10, 30, 50],
+                                      phi_d=[90])
+            g.brdf.sel(wavelength=550, method="nearest").plot.line(x="theta_h")
+        """
+        axes = {"theta_i": theta_i, "theta_o": theta_o, "phi": phi, "theta_h": theta_h,
+                "theta_d": theta_d, "phi_d": phi_d}
+        return grid_calls.interpolate_grid(
+            self, session_id, axes=axes, method=method, quantity=quantity, progress=progress,
+            netcdf=netcdf, timeout=timeout, chunk_size=chunk_size, axis_scale=axis_scale,
+            mirror_phi=mirror_phi, reciprocity=reciprocity, coordinates=coordinates,
+            trend=trend)

@@ -6,6 +6,7 @@ completions (with progress and ETA) and faults in order, and ends when the sessi
 
 import dataclasses
 import datetime
+from typing import Any, Optional
 
 from . import names
 
@@ -27,12 +28,13 @@ class Event:
     kind: str
     session_id: str
     sequence: int
-    time: datetime.datetime
-    data: object
-    raw: object
+    time: Optional[datetime.datetime]
+    data: Any
+    raw: Any
 
     @classmethod
-    def from_proto(cls, event):
+    def from_proto(cls, event: Any) -> "Event":
+        """From a brdf.v1.SessionEvent."""
         kind = event.WhichOneof("event") or ""
         when = None
         if event.HasField("time"):
@@ -40,7 +42,7 @@ class Event:
         return cls(kind=kind, session_id=event.session_id, sequence=event.sequence, time=when,
                    data=getattr(event, kind) if kind else None, raw=event)
 
-    def describe(self):
+    def describe(self) -> str:
         """One line for a log or a progress display."""
         d = self.data
         if self.kind == "snapshot":

@@ -11,6 +11,9 @@ report into an ExportResult. The formats are described in tools/brdf-export/READ
 import dataclasses
 import json
 import os
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
 
 from . import names
 from ._stubs import brdf_pb2
@@ -35,13 +38,13 @@ FILLS = {"chain": brdf_pb2.EXPORT_FILL_CHAIN, "none": brdf_pb2.EXPORT_FILL_NONE}
 GRID_FORMATS = frozenset((brdf_pb2.EXPORT_FORMAT_GRID_NPY, brdf_pb2.EXPORT_FORMAT_GRID_CSV))
 
 
-def format_name(value):
+def format_name(value: int) -> str:
     """ExportFormat number → "readings_csv", "grid_npy", "grid_csv", "merl_binary", "rgl_bsdf"."""
     name = brdf_pb2.ExportFormat.Name(value)
     return name[len("EXPORT_FORMAT_"):].lower()
 
 
-def export_format(fmt, path=""):
+def export_format(fmt: Union[str, int], path: "str | os.PathLike[str]" = "") -> int:
     """`fmt` as an ExportFormat number.
 
     fmt: "csv" (the readings), "grid" (the regular grid: CSV when `path` ends in ".csv", else
@@ -64,11 +67,15 @@ def export_format(fmt, path=""):
     return value
 
 
-def export_request(session_id, fmt, path="", *, quantity=None, method="octant",
-                   axis_scale=None, mirror_phi=False, reciprocity=None, step_theta_i=0.0,
-                   step_theta_o=0.0, step_phi=0.0, grid_nodes=False, exclude_flagged=False,
-                   chunk_bytes=0, fill="chain", rgb=False, rgl_theta_i_count=0, rgl_resolution=0,
-                   coordinates=None, trend=None):
+def export_request(session_id: str, fmt: Union[str, int], path: str = "", *,
+                   quantity: Union[str, int, None] = None, method: Union[str, int] = "octant",
+                   axis_scale: Optional[Sequence[float]] = None, mirror_phi: bool = False,
+                   reciprocity: Optional[bool] = None, step_theta_i: float = 0.0,
+                   step_theta_o: float = 0.0, step_phi: float = 0.0, grid_nodes: bool = False,
+                   exclude_flagged: bool = False, chunk_bytes: int = 0, fill: str = "chain",
+                   rgb: bool = False, rgl_theta_i_count: int = 0, rgl_resolution: int = 0,
+                   coordinates: Union[str, int, None] = None,
+                   trend: Union[str, int, None] = None) -> Any:
     """The ExportRequest for BrdfClient.export's arguments (which document them).
 
     As brdfctl: reciprocity None means on for MERL and RGL (a cell stands for a pair of
@@ -151,18 +158,38 @@ class ExportResult:
     cells: int = 0
     filled_cells: int = 0
     unfilled_cells: int = 0
-    unfilled_by_status: dict = dataclasses.field(default_factory=dict)
+    unfilled_by_status: Dict[str, int] = dataclasses.field(default_factory=dict)
     below_horizon_cells: int = 0
     clamped_cells: int = 0
     skipped_readings: int = 0
     first_skip_reason: str = ""
-    shape: tuple = ()
-    description: dict = None
-    warnings: list = dataclasses.field(default_factory=list)
-    fill: dict = None
+    shape: Tuple[int, ...] = ()
+    description: Optional[Dict[str, Any]] = None
+    warnings: List[str] = dataclasses.field(default_factory=list)
+    fill: Optional[Dict[str, Any]] = None
+
+    def write_sidecar(self) -> str:
+        """Writes `description` as JSON next to the file (`path`.json, as brdfctl does);
+        returns that path. ValueError for an export without a description (not a .npy grid)."""
+        if self.description is None:
+            raise ValueError(f"{self.path} ({self.format}) has no description to write; only "
+                             ".npy grids have one")
+        sidecar = self.path + ".json"
+        with open(sidecar, "w", encoding="utf-8") as f:
+            json.dump(self.description, f, indent=2, ensure_ascii=False)
+            f.write("\n")
+        return sidecar
+
+    def to_dataset(self, provenance: Any = None) -> Any:
+        """A .npy grid export as an xarray Dataset (grid_datasets.grid_dataset), read from
+        `path` with `description`; ValueError for another format."""
+        if self.description is None:
+            raise ValueError(f"{self.path} ({self.format}) is not a .npy grid")
+        from .grid_datasets import grid_dataset  # pylint: disable=import-outside-toplevel
+        return grid_dataset(np.load(self.path), self.description, provenance, source=self.path)
 
     @classmethod
-    def from_report(cls, report, path, fmt):
+    def from_report(cls, report: Any, path: str, fmt: int) -> "ExportResult":
         """From a brdf_pb2.ExportReport, the saved file's path and the ExportFormat number."""
         return cls(path=path, format=format_name(fmt), file_name=report.file_name,
                    bytes=report.bytes, summary=report.summary, rows=report.rows,
@@ -179,7 +206,7 @@ class ExportResult:
                    fill=(_fill_counts(report.fill) if report.HasField("fill") else None))
 
 
-def _fill_counts(fill):
+def _fill_counts(fill: Any) -> Dict[str, Any]:
     """ExportFillCounts → the dict ExportResult.fill documents."""
     return {"policy": fill.policy, "interpolated": fill.interpolated,
             "fallback": fill.fallback, "model": fill.model, "empty": fill.empty,

@@ -7,6 +7,7 @@ weight), so a figure can draw the tetrahedron and the spectra that went into the
 """
 
 import dataclasses
+from typing import Any, Iterable, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -50,43 +51,43 @@ class InterpolationResult:
     """
 
     query: np.ndarray
-    axes: tuple
+    axes: Tuple[str, ...]
     status: str
     method: str
     quantity: str
     wavelengths: np.ndarray
     spectrum: np.ndarray
-    vertices: list
+    vertices: List[Vertex]
     detail: str
 
     @property
-    def ok(self):
+    def ok(self) -> bool:
         """True when a spectrum was built."""
         return self.status == "ok"
 
     @property
-    def unit(self):
+    def unit(self) -> str:
         """The unit of `spectrum`, for labels ("sr⁻¹" for a BRDF)."""
         return names.QUANTITY_UNITS.get(self.quantity, "")
 
     @property
-    def vertex_ids(self):
+    def vertex_ids(self) -> np.ndarray:
         """(k,) reading ids of the vertices."""
         return np.array([v.reading_id for v in self.vertices], dtype=np.int64)
 
     @property
-    def vertex_coords(self):
+    def vertex_coords(self) -> np.ndarray:
         """(k, d) positions of the vertices, degrees, in the order of `axes`."""
         if not self.vertices:
             return np.zeros((0, len(self.axes)))
         return np.array([v.coords for v in self.vertices], dtype=float)
 
     @property
-    def weights(self):
+    def weights(self) -> np.ndarray:
         """(k,) barycentric weights of the vertices."""
         return np.array([v.weight for v in self.vertices], dtype=float)
 
-    def at(self, wavelength_nm):
+    def at(self, wavelength_nm: float) -> float:
         """The spectrum at `wavelength_nm` (linear between bands; NaN when not ok)."""
         if not self.ok:
             return float("nan")
@@ -95,10 +96,18 @@ class InterpolationResult:
             raise ValueError(f"{wavelength_nm} nm is outside the spectrum's {lo:g}–{hi:g} nm")
         return float(np.interp(wavelength_nm, self.wavelengths, self.spectrum))
 
+    def to_dataset(self) -> Any:
+        """This answer as an xarray Dataset: the spectrum over wavelength, the vertices' reading
+        ids, weights and coordinates over vertex, status (interp_datasets.result_dataset)."""
+        from .interp_datasets import result_dataset  # pylint: disable=import-outside-toplevel
+        return result_dataset(self)
+
     @classmethod
-    def from_proto(cls, result):
+    def from_proto(cls, result: Any) -> "InterpolationResult":
         """Converts a brdf.v1.InterpolationResult."""
         which = result.query.WhichOneof("direction")
+        axes: Tuple[str, ...]
+        query: Tuple[float, ...]
         if which == "four":
             d = result.query.four
             query, axes = (d.theta_i, d.phi_i, d.theta_o, d.phi_o), FOUR_AXES
@@ -127,7 +136,7 @@ class InterpolationBatch:
       statuses:    (N,) str.
     """
 
-    def __init__(self, results):
+    def __init__(self, results: Iterable[InterpolationResult]) -> None:
         self.results = list(results)
         good = [r for r in self.results if r.ok]
         self.wavelengths = good[0].wavelengths if good else np.zeros(0)
@@ -139,16 +148,22 @@ class InterpolationBatch:
         self.ok = np.array([r.ok for r in self.results], dtype=bool)
         self.statuses = np.array([r.status for r in self.results], dtype=object)
 
-    def __len__(self):
+    def __len__(self) -> int:
         return len(self.results)
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[InterpolationResult]:
         return iter(self.results)
 
-    def __getitem__(self, i):
+    def __getitem__(self, i: int) -> InterpolationResult:
         return self.results[i]
 
-    def at(self, wavelength_nm):
+    def to_dataset(self) -> Any:
+        """The answers as an xarray Dataset over (direction, wavelength, vertex, axis): values,
+        status, detail, the directions' angles, the vertices (interp_datasets.batch_dataset)."""
+        from .interp_datasets import batch_dataset  # pylint: disable=import-outside-toplevel
+        return batch_dataset(self)
+
+    def at(self, wavelength_nm: float) -> np.ndarray:
         """(N,) the spectra at `wavelength_nm` (NaN where not OK)."""
         if len(self.wavelengths) == 0:
             return np.full(len(self.results), np.nan)
@@ -156,7 +171,7 @@ class InterpolationBatch:
                          else np.nan for s in self.spectra])
 
 
-def direction_query(direction):
+def direction_query(direction: Sequence[float]) -> Any:
     """A brdf.v1.DirectionQuery from (θi, θo, φ) or (θi, φi, θo, φo), degrees."""
     d = [float(x) for x in direction]
     if len(d) == 3:
@@ -169,8 +184,10 @@ def direction_query(direction):
                      f"not {len(d)} numbers")
 
 
-def interpolation_options(axis_scale=None, mirror_phi=False, reciprocity=False,
-                          coordinates=None, trend=None):
+def interpolation_options(axis_scale: Optional[Sequence[float]] = None,
+                          mirror_phi: bool = False, reciprocity: bool = False,
+                          coordinates: Union[str, int, None] = None,
+                          trend: Union[str, int, None] = None) -> Any:
     """A brdf.v1.InterpolationOptions, or None when every option is at its default.
 
     coordinates: "incidence" (θi, θo, φ), "half_difference" (or "half-diff": Rusinkiewicz's

@@ -5,6 +5,8 @@ Calls accept a method, quantity, state or reading kind either as the enum value 
 short names, which read well in prints and plot labels.
 """
 
+from typing import Any, Mapping
+
 from ._stubs import brdf_pb2, plan_pb2
 
 METHODS = {
@@ -51,11 +53,11 @@ READING_KINDS = {
 QUANTITY_UNITS = {"radiance": "W·m⁻²·sr⁻¹·nm⁻¹", "reflectance": "ratio", "brdf": "sr⁻¹"}
 
 
-def _short(enum_name, prefix):
+def _short(enum_name: str, prefix: str) -> str:
     return enum_name[len(prefix):].lower() if enum_name.startswith(prefix) else enum_name.lower()
 
 
-def to_enum(value, table, what):
+def to_enum(value: Any, table: Mapping[str, int], what: str) -> int:
     """`value` (a short name or an enum number) as the enum number of `table`.
 
     None gives 0 (UNSPECIFIED: the daemon's default). A name not in `table` raises ValueError
@@ -71,36 +73,36 @@ def to_enum(value, table, what):
     return int(value)
 
 
-def method_name(value):
+def method_name(value: int) -> str:
     """brdf_pb2 InterpolationMethod number → "octant", "delaunay", "nearest" (or "unspecified")."""
     return _short(brdf_pb2.InterpolationMethod.Name(value), "INTERPOLATION_METHOD_")
 
 
-def quantity_name(value):
+def quantity_name(value: int) -> str:
     """Quantity number → "radiance", "reflectance", "brdf"."""
     return _short(brdf_pb2.Quantity.Name(value), "QUANTITY_")
 
 
-def status_name(value):
+def status_name(value: int) -> str:
     """InterpolationStatus number → "ok", "empty_octant", "no_enclosing_simplex", "outside_hull"."""
     return _short(brdf_pb2.InterpolationStatus.Name(value), "INTERPOLATION_STATUS_")
 
 
-def state_name(value):
+def state_name(value: int) -> str:
     """SessionState number → "queued", "running", ..., "completed"."""
     return _short(brdf_pb2.SessionState.Name(value), "SESSION_STATE_")
 
 
-def reading_kind_name(value):
+def reading_kind_name(value: int) -> str:
     """ReadingKind number → "sample", "reference", "dark"."""
     return _short(brdf_pb2.ReadingKind.Name(value), "READING_KIND_")
 
 
-def prompt_kind_name(value):
+def prompt_kind_name(value: int) -> str:
     """PromptKind number → "mount_white", "relocate_detector", ..."""
     return _short(plan_pb2.PromptKind.Name(value), "PROMPT_KIND_")
 
 
-def step_kind_name(value):
+def step_kind_name(value: int) -> str:
     """StepKind number → "move", "prompt", "reference", "dark", "sample"."""
     return _short(plan_pb2.StepKind.Name(value), "STEP_KIND_")

@@ -7,14 +7,21 @@ never silently falls back to a default.
 """
 
 import json
+import os
 import pathlib
+from typing import Any, Dict, Union
 
 from google.protobuf import json_format
 
 from ._stubs import plan_pb2
 
 
-def to_plan(plan):
+# What the client takes as a plan: a brdf.v1.Plan, a dict (its JSON form), JSON text, or the path
+# of a JSON file.
+PlanLike = Union[Any, Dict[str, Any], str, "os.PathLike[str]"]
+
+
+def to_plan(plan: PlanLike) -> Any:
     """A brdf.v1.Plan from a Plan message, a dict, a JSON string or a path to a JSON file.
 
     Raises ValueError naming the source and the problem for unreadable JSON or unknown fields.
@@ -23,7 +30,8 @@ def to_plan(plan):
     if isinstance(plan, plan_pb2.Plan):
         return plan
     source = "plan"
-    if isinstance(plan, pathlib.Path) or (isinstance(plan, str) and not plan.lstrip().startswith("{")):
+    if isinstance(plan, os.PathLike) or (isinstance(plan, str)
+                                         and not plan.lstrip().startswith("{")):
         source = str(plan)
         try:
             plan = pathlib.Path(plan).read_text(encoding="utf-8")
@@ -43,6 +51,6 @@ def to_plan(plan):
         raise ValueError(f"{source}: {e} (plan fields: see proto/brdf/v1/plan.proto)") from e
 
 
-def to_dict(plan):
+def to_dict(plan: Any) -> Dict[str, Any]:
     """The JSON form of a Plan message (lowerCamelCase keys, unset fields left out)."""
     return json_format.MessageToDict(plan)

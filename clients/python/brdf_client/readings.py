@@ -7,13 +7,14 @@ radiance (brdf.proto).
 """
 
 import dataclasses
+from typing import Any, Iterable, Optional, Sequence, Union
 
 import numpy as np
 
 from . import names
 
 
-def grid_wavelengths(grid):
+def grid_wavelengths(grid: Any) -> np.ndarray:
     """The wavelengths (nm) of a brdf.v1.WavelengthGrid: start_nm + k · step_nm, k < count."""
     return grid.start_nm + grid.step_nm * np.arange(grid.count, dtype=float)
 
@@ -56,11 +57,24 @@ class ReadingSet:
     integration_ms: np.ndarray
     labels: np.ndarray
 
-    def __len__(self):
+    def __len__(self) -> int:
         return len(self.ids)
 
+    def to_dataframe(self) -> Any:
+        """One row per reading as a pandas DataFrame, indexed by reading id: kind, pose,
+        directions, quality, flags, ids (reading_tables.readings_dataframe)."""
+        from .reading_tables import readings_dataframe  # pylint: disable=import-outside-toplevel
+        return readings_dataframe(self)
+
+    def to_dataarray(self, quantity: str = "radiance", white_reflectance: float = 0.99) -> Any:
+        """The spectra as an xarray DataArray (reading × wavelength): "radiance" (every reading),
+        or "reflectance" / "brdf" (the sample readings, recomputed as the daemon does;
+        white_reflectance: ρw). See reading_tables.readings_dataarray."""
+        from .reading_tables import readings_dataarray  # pylint: disable=import-outside-toplevel
+        return readings_dataarray(self, quantity, white_reflectance)
+
     @classmethod
-    def empty(cls, wavelengths=None):
+    def empty(cls, wavelengths: Optional[Sequence[float]] = None) -> "ReadingSet":
         """A set of no readings (on `wavelengths`, default none)."""
         m = 0 if wavelengths is None else len(wavelengths)
         return cls(
@@ -74,7 +88,7 @@ class ReadingSet:
             integration_ms=np.zeros(0, dtype=int), labels=np.zeros(0, dtype=object))
 
     @classmethod
-    def from_protos(cls, readings):
+    def from_protos(cls, readings: Iterable[Any]) -> "ReadingSet":
         """Builds a set from brdf.v1.Reading messages (all on the same wavelength grid)."""
         readings = list(readings)
         if not readings:
@@ -111,7 +125,7 @@ class ReadingSet:
             labels=np.array([r.label for r in readings], dtype=object))
 
     @classmethod
-    def concat(cls, sets):
+    def concat(cls, sets: Iterable["ReadingSet"]) -> "ReadingSet":
         """One set holding the readings of `sets`, in order."""
         sets = [s for s in sets if len(s)]
         if not sets:
@@ -127,17 +141,17 @@ class ReadingSet:
                 fields[f.name] = np.concatenate([getattr(s, f.name) for s in sets])
         return cls(**fields)
 
-    def select(self, mask):
+    def select(self, mask: Any) -> "ReadingSet":
         """The readings where `mask` (a bool array or index array) holds."""
         fields = {f.name: (getattr(self, f.name) if f.name == "wavelengths" else
                            getattr(self, f.name)[mask]) for f in dataclasses.fields(self)}
         return ReadingSet(**fields)
 
-    def of_kind(self, kind):
+    def of_kind(self, kind: str) -> "ReadingSet":
         """Only the readings of `kind` ("sample", "reference" or "dark")."""
         return self.select(self.kinds == kind)
 
-    def index_of(self, reading_id):
+    def index_of(self, reading_id: int) -> int:
         """Row of the reading with this id; KeyError when it is not in the set."""
         rows = np.flatnonzero(self.ids == reading_id)
         if rows.size == 0:
@@ -146,7 +160,7 @@ class ReadingSet:
 
 
 # Reading kinds accepted by BrdfClient.readings(kinds=...).
-def kinds_to_enums(kinds):
+def kinds_to_enums(kinds: Union[str, int, Sequence[Union[str, int]], None]) -> list:
     """("sample", ...) or enum numbers → the ReadingKind numbers StreamReadings filters on."""
     if kinds is None:
         return []

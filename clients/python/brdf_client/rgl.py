@@ -7,7 +7,9 @@ f * cos(theta_o) = spectra(vndf^-1(u_wm)) * ndf(u_wm) / (4 sigma(u_wi)). Isotrop
     m = Material("sample.bsdf")
     f = m.brdf(theta_i, phi_i, theta_o, phi_o)   # radians, arrays -> (n, channels), sr^-1
 """
+import os
 import struct
+from typing import Any, Dict
 
 import numpy as np
 
@@ -15,14 +17,15 @@ DTYPES = {1: np.uint8, 2: np.int8, 3: np.uint16, 4: np.int16, 5: np.uint32, 6: n
           7: np.uint64, 8: np.int64, 9: np.float16, 10: np.float32, 11: np.float64}
 
 
-def read_tensor(path):
+def read_tensor(path: "str | os.PathLike[str]") -> Dict[str, np.ndarray]:
+    """The named arrays of a tensor_file; ValueError for another file or a truncated one."""
     raw = open(path, "rb").read()
     if raw[:12] != b"tensor_file\0":
         raise ValueError("not a tensor_file (header)")
     if raw[12:14] != bytes([1, 0]):
         raise ValueError("tensor_file version is not 1.0")
     (count,) = struct.unpack_from("<I", raw, 14)
-    at, fields = 18, {}
+    at, fields = 18, {}  # type: Any, Dict[str, np.ndarray]
     for _ in range(count):
         (n,) = struct.unpack_from("<H", raw, at)
         name = raw[at + 2:at + 2 + n].decode("utf8")
@@ -68,7 +71,7 @@ class Warp2D:
         n = len(param[0]) if param else 1
         corners = [(np.zeros(n, np.int64), np.ones(n))]
         stride = 1
-        strides = []
+        strides: list = []
         for size in reversed(self.shape):
             strides.insert(0, stride)
             stride *= size
@@ -116,7 +119,9 @@ class Warp2D:
 
 
 class Material:
-    def __init__(self, path):
+    """An isotropic RGL material file, ready to evaluate (brdf)."""
+
+    def __init__(self, path: "str | os.PathLike[str]") -> None:
         f = read_tensor(path)
         self.fields = f
         self.rgb = "rgb" in f and "spectra" not in f
@@ -131,7 +136,7 @@ class Material:
         self.vndf = Warp2D(f["vndf"], [pi, ti], True, True)
         self.values = Warp2D(values, [pi, ti, self.channels], False, False)
 
-    def brdf(self, ti, pi, to, po):
+    def brdf(self, ti: Any, pi: Any, to: Any, po: Any) -> np.ndarray:
         """f in sr^-1 (n queries x channels); angles in radians, arrays."""
         wi = np.stack([np.sin(ti) * np.cos(pi), np.sin(ti) * np.sin(pi), np.cos(ti)], -1)
         wo = np.stack([np.sin(to) * np.cos(po), np.sin(to) * np.sin(po), np.cos(to)], -1)

@@ -16,18 +16,25 @@ is a parameter here.
 Figure 8 uses this for the spectra of an interpolation's vertices.
 """
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .interpolation import InterpolationResult
+    from .readings import ReadingSet
 
 QUANTITIES = ("radiance", "reflectance", "brdf")
 
 
-def _dark(readings, dark_id):
+def _dark(readings: "ReadingSet", dark_id: int) -> Any:
     if dark_id == 0:
         return 0.0
     return readings.spectra[readings.index_of(dark_id)]
 
 
-def reading_spectrum(readings, reading_id, quantity="brdf", white_reflectance=0.99):
+def reading_spectrum(readings: "ReadingSet", reading_id: int, quantity: str = "brdf",
+                     white_reflectance: float = 0.99) -> np.ndarray:
     """The spectrum of SAMPLE reading `reading_id` in `quantity`, from the raw readings.
 
     `readings` is a ReadingSet holding that reading, its reference and its dark (load the
@@ -65,7 +72,8 @@ def reading_spectrum(readings, reading_id, quantity="brdf", white_reflectance=0.
     return reflectance * white_reflectance / np.pi * cos_ref / cos_i
 
 
-def vertex_spectra(readings, result, white_reflectance=0.99):
+def vertex_spectra(readings: "ReadingSet", result: "InterpolationResult",
+                   white_reflectance: float = 0.99) -> np.ndarray:
     """(k, m) the spectra of an interpolation's vertices, in the result's quantity."""
     return np.array([reading_spectrum(readings, v.reading_id, result.quantity, white_reflectance)
                      for v in result.vertices])

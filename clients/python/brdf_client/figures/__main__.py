@@ -4,6 +4,7 @@ behind Figures 7 and 8 (the query, its vertices with their weights, the spectrum
     python3 -m brdf_client.figures --address HOST:PORT --token T --session ID --out DIR
 """
 
+from typing import Any, List, Optional
 import sys
 
 import numpy as np
@@ -15,7 +16,7 @@ from ..spectra import vertex_spectra
 SHOWN_NM = (400, 450, 500, 550, 600, 650, 700, 750)
 
 
-def describe(data):
+def describe(data: Any) -> str:
     """The query's answer as text: status, vertices and weights, and a few bands of the
     interpolated spectrum next to its vertex spectra."""
     r = data.query
@@ -27,7 +28,7 @@ def describe(data):
         lines.append(f"  vertex reading {v.reading_id:>6} at {_common.fmt_direction(v.coords)}"
                      f"  weight {v.weight:.4f}")
     if r.ok:
-        spectra = vertex_spectra(data.readings, r, data.white_reflectance) if r.vertices else []
+        spectra: Any = vertex_spectra(data.readings, r, data.white_reflectance) if r.vertices else []
         header = "  λ (nm)  interpolated" + "".join(f"  v{v.reading_id:<9}" for v in r.vertices)
         lines.append(header)
         for nm in SHOWN_NM:
@@ -38,7 +39,7 @@ def describe(data):
     return "\n".join(lines)
 
 
-def main(argv=None):
+def main(argv: Optional[List[str]] = None) -> int:
     p = _common.parser("Writes the paper's Figures 7 and 8 and a polar plot of a session.")
     p.add_argument("--wavelength", type=float, default=550.0,
                    help="wavelength of the polar plot, nm (default 550)")

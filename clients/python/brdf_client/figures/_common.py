@@ -1,20 +1,20 @@
 """What the three figures share: matplotlib without a display, the command line, the session's
-data, and the choice of a query direction between the samples.
+data, and the choice of a query direction between the samples (queries.py, re-exported here).
 """
 
 import argparse
 import dataclasses
 import os
+from typing import Any
 
 import matplotlib
 
 matplotlib.use("Agg")  # files only: works without a display (ssh, CI, systemd)
 from matplotlib import pyplot as plt  # noqa: E402  pylint: disable=wrong-import-position
-import numpy as np  # noqa: E402  pylint: disable=wrong-import-position
 
 from .. import names  # noqa: E402  pylint: disable=wrong-import-position
 from ..client import BrdfClient  # noqa: E402  pylint: disable=wrong-import-position
-from ..spectra import vertex_spectra  # noqa: E402  pylint: disable=wrong-import-position
+from ..queries import candidate_queries, pick_query  # noqa: E402,F401  pylint: disable=wrong-import-position
 
 DPI = 150
 # Axis labels with units, in matplotlib's mathtext (renders with any font).
@@ -61,9 +61,9 @@ class SessionData:
     white_reflectance: ρw used to turn stored readings into BRDF (the daemon's [sample] setting).
     """
 
-    session: object
-    readings: object
-    query: object
+    session: Any
+    readings: Any
+    query: Any
     white_reflectance: float = 0.99
 
     @property
@@ -77,63 +77,8 @@ class SessionData:
         return f"session {sid}" + (f" — {name}" if name else "")
 
 
-def candidate_queries(iso, limit=400):
-    """Directions between measured points, most interior first.
-
-    For the `limit` distinct points nearest the centroid of all points, the centroid of that point
-    and its 3 nearest distinct neighbours (degrees, rounded to 0.1°), nearest the data's centre
-    first: there every octant around the candidate holds readings.
-    """
-    pts = np.unique(np.round(np.asarray(iso, float), 6), axis=0)
-    if len(pts) < 4:
-        return np.zeros((0, 3))
-    centre = pts.mean(axis=0)
-    seeds = pts[np.argsort(np.linalg.norm(pts - centre, axis=1), kind="stable")[:limit]]
-    d = np.linalg.norm(seeds[:, None, :] - pts[None, :, :], axis=2)  # limit × N
-    near = np.argsort(d, axis=1, kind="stable")[:, :4]  # the seed itself and its 3 nearest
-    cands = np.round(pts[near].mean(axis=1), 1)
-    _, first = np.unique(cands, axis=0, return_index=True)
-    return cands[np.sort(first)]
-
-
-def _spread(readings, result, white_reflectance):
-    """How much the vertex spectra of `result` differ: mean over bands of (max − min) / max."""
-    spectra = vertex_spectra(readings, result, white_reflectance)
-    top = np.max(np.abs(spectra), axis=0)
-    return float(np.mean((spectra.max(axis=0) - spectra.min(axis=0)) / np.where(top > 0, top, 1)))
-
-
-def pick_query(client, session_id, samples, method="octant", min_weight=0.1, readings=None,
-               white_reflectance=0.99):
-    """An InterpolationResult at a direction strictly between samples.
-
-    Tries candidate_queries in one InterpolateBatch. Among the OK answers whose every vertex
-    weighs at least `min_weight` (the blend visibly mixes its readings), keeps the first — or,
-    given `readings` (all kinds, for the vertex spectra), the one whose vertex spectra differ most,
-    which makes Figure 8 telling (near a highlight rather than on a flat diffuse stretch). Falls
-    back to the first OK answer; RuntimeError when none is OK (too few readings: give --query).
-    """
-    cands = candidate_queries(samples.iso)
-    if len(cands) == 0:
-        raise RuntimeError(f"session {session_id} has {len(samples)} sample readings: too few to "
-                           "interpolate between; run a larger plan or give --query")
-    batch = client.interpolate_batch(session_id, cands, method=method)
-    ok = [r for r in batch if r.ok]
-    if not ok:
-        statuses = ", ".join(sorted(set(batch.statuses)))
-        raise RuntimeError(f"no direction between the samples of session {session_id} could be "
-                           f"interpolated with {method} (statuses: {statuses}); give --query "
-                           "θi θo φ, or try --method delaunay")
-    interior = [r for r in ok if len(r.weights) and r.weights.min() >= min_weight]
-    if not interior:
-        return ok[0]
-    if readings is None:
-        return interior[0]
-    spreads = [_spread(readings, r, white_reflectance) for r in interior]
-    return interior[int(np.argmax(spreads))]
-
-
-def gather(client, session_id, query=None, method="octant", white_reflectance=0.99):
+def gather(client: Any, session_id: str, query: Any = None, method: str = "octant",
+           white_reflectance: float = 0.99) -> SessionData:
     """Loads what the figures need from a live daemon: the session, all its readings, and an
     interpolation at `query` ((θi, θo, φ), degrees) or at a direction picked between samples."""
     session = client.get_session(session_id)
@@ -147,7 +92,7 @@ def gather(client, session_id, query=None, method="octant", white_reflectance=0.
     return SessionData(session, readings, result, white_reflectance)
 
 
-def latest_session(client):
+def latest_session(client: Any) -> str:
     """The id of the newest COMPLETED session, else the newest one; ValueError when none."""
     done = client.list_sessions(states=["completed"], page_size=1, limit=1)
     if done:

@@ -5,6 +5,7 @@ of readings that encloses it (from the interpolation's provenance).
     python3 -m brdf_client.figures.fig7 --address HOST:PORT --token T --session ID --out DIR
 """
 
+from typing import Any, List, Optional
 import sys
 
 import numpy as np
@@ -23,7 +24,7 @@ def _normalised(values):
     return (values / top if top > 0 else values), top
 
 
-def plot(data, path):
+def plot(data: Any, path: str) -> str:
     """Draws Figure 7 from SessionData into the PNG file `path`."""
     plt = _common.pyplot()
     samples = data.samples
@@ -82,7 +83,7 @@ def plot(data, path):
     return _common.save(fig, path)
 
 
-def main(argv=None):
+def main(argv: Optional[List[str]] = None) -> int:
     args = _common.parser(__doc__.splitlines()[0]).parse_args(argv)
     client, session_id = _common.connect(args)
     with client:

@@ -5,6 +5,7 @@ non-negative barycentric weights the solid curve stays between the dotted ones a
     python3 -m brdf_client.figures.fig8 --address HOST:PORT --token T --session ID --out DIR
 """
 
+from typing import Any, List, Optional
 import sys
 
 import numpy as np
@@ -25,7 +26,7 @@ def blend_mismatch(result, spectra):
     return float(np.max(np.abs(blended - result.spectrum)) / scale)
 
 
-def plot(data, path):
+def plot(data: Any, path: str) -> str:
     """Draws Figure 8 from SessionData into the PNG file `path`."""
     plt = _common.pyplot()
     result = data.query
@@ -64,7 +65,7 @@ def plot(data, path):
     return _common.save(fig, path)
 
 
-def main(argv=None):
+def main(argv: Optional[List[str]] = None) -> int:
     args = _common.parser(__doc__.splitlines()[0]).parse_args(argv)
     client, session_id = _common.connect(args)
     with client:

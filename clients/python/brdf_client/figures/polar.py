@@ -9,6 +9,7 @@ method could not fill (an empty octant near the edge of the data).
     python3 -m brdf_client.figures.polar --address HOST:PORT --token T --session ID --out DIR
 """
 
+from typing import Any, List, Optional
 import dataclasses
 import sys
 
@@ -126,7 +127,7 @@ def gather(client, session_id, readings, wavelength_nm=550.0, thetas=None, metho
     return PolarData(title, float(wavelength_nm), method, symmetries, curves)
 
 
-def plot(pdata, path):
+def plot(pdata: Any, path: str) -> str:
     """Draws the polar plot into the PNG file `path`."""
     plt = _common.pyplot()
     from matplotlib.lines import Line2D  # pylint: disable=import-outside-toplevel
@@ -175,7 +176,7 @@ def plot(pdata, path):
     return _common.save(fig, path, tight=True)
 
 
-def main(argv=None):
+def main(argv: Optional[List[str]] = None) -> int:
     p = _common.parser(__doc__.splitlines()[0])
     p.set_defaults(method="delaunay")
     p.add_argument("--wavelength", type=float, default=550.0, help="nm (default 550)")

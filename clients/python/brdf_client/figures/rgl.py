@@ -6,6 +6,7 @@ the same session, looked up trilinearly).
     python3 -m brdf_client.figures.rgl FILE.bsdf [--grid G.npy] --out DIR
 """
 
+from typing import Any, List, Optional
 import argparse
 import os
 import sys
@@ -130,7 +131,7 @@ def plot_slices(m, path):
     plt.close(fig)
 
 
-def main(argv=None):
+def main(argv: Optional[List[str]] = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("file")
     ap.add_argument("--grid", help="a `brdf-export grid --nodes` .npy of the same session")

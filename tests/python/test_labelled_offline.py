@@ -1,0 +1,221 @@
+"""brdf_client's labelled structures without a daemon: readings as DataFrame / DataArray (a
+synthetic session, tests/python/synthetic.py), a grid Dataset from values and a description as the
+daemon writes them, per-cell provenance from the fill chain's stages, interpolation Datasets,
+half/difference angles, NetCDF, progress bars, and the BrdfError subclasses."""
+
+import contextlib
+import io
+import json
+import os
+import shutil
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
+sys.path.insert(0, HERE)
+
+import grpc  # noqa: E402
+import xarray as xr  # noqa: E402
+
+import synthetic  # noqa: E402
+import brdf_client  # noqa: E402
+from brdf_client import (BrdfError, InterpolationBatch, InterpolationResult, Vertex,  # noqa: E402
+                         open_grid, write_netcdf)
+from brdf_client.angles import half_diff_from_incidence, incidence_from_half_diff  # noqa: E402
+from brdf_client.grid_datasets import cell_provenance, grid_dataset  # noqa: E402
+from brdf_client.labels import PROVENANCE_CODE, uncertainty_name  # noqa: E402
+from brdf_client.progress import Bar  # noqa: E402
+from brdf_client.spectra import reading_spectrum  # noqa: E402
+
+WL = 380.0 + 4.0 * np.arange(5)
+
+
+def description(shape=(2, 3, 4, 5), fill=None, **extra):
+    """A grid description as GridDescriptionJson writes it (core/export/grid_text.cc)."""
+    d = {"format": "brdfd regular grid (.npy, float64, C order)",
+         "axes": ["theta_i", "theta_o", "phi", "band"], "shape": list(shape),
+         "theta_i_deg": {"start": 22.5, "step": 45, "count": shape[0]},
+         "theta_o_deg": {"start": 15, "step": 30, "count": shape[1]},
+         "phi_deg": {"start": 22.5, "step": 45, "count": shape[2]},
+         "wavelength_nm": {"start": 380, "step": 4, "count": shape[3]},
+         "angles": "…", "session": 3, "session_name": "paint", "quantity": "brdf",
+         "unit": "sr⁻¹", "definition": "BRDF f(λ) …", "method": "octant", "mirror_phi": False,
+         "reciprocity": True, "coordinates": "incidence", "trend": "none", "axis_scale": None,
+         "samples": 87, "samples_left_out": 0, "cells": int(np.prod(shape[:3])),
+         "filled": 0, "nan_cells": 0, "by_status": {"ok": 20, "empty_octant": 4}}
+    if fill is not None:
+        d["fill"] = fill
+    d.update(extra)
+    return d
+
+
+def answer(query, spectrum, status="ok", vertices=()):
+    return InterpolationResult(query=np.array(query, float), axes=("theta_i", "theta_o", "phi"),
+                               status=status, method="octant", quantity="brdf", wavelengths=WL,
+                               spectrum=np.array(spectrum, float), vertices=list(vertices),
+                               detail="")
+
+
+class Readings(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.rs = synthetic.make_session()
+
+    def test_dataframe_one_row_per_reading(self):
+        df = self.rs.to_dataframe()
+        self.assertEqual(len(df), len(self.rs))
+        np.testing.assert_array_equal(df.index, self.rs.ids)
+        np.testing.assert_array_equal(df.beta, self.rs.poses[:, 1])
+        np.testing.assert_array_equal(df.phi_o, self.rs.directions[:, 3])
+        self.assertEqual(list(df.columns[:3]), ["kind", "step_index", "label"])
+        self.assertEqual(df.attrs["wavelength_nm"], list(self.rs.wavelengths))
+
+    def test_dataarray_radiance_and_brdf(self):
+        rad = self.rs.to_dataarray()
+        np.testing.assert_array_equal(rad.values, self.rs.spectra)
+        self.assertEqual(rad.attrs["units"], "W·m⁻²·sr⁻¹·nm⁻¹")
+        f = self.rs.to_dataarray("brdf", white_reflectance=0.9)
+        sample = int(self.rs.of_kind("sample").ids[3])
+        np.testing.assert_array_equal(f.sel(reading=sample).values,
+                                      reading_spectrum(self.rs, sample, "brdf", 0.9))
+        self.assertEqual(set(f.kind.values), {"sample"})
+        with self.assertRaises(ValueError):
+            self.rs.to_dataarray("luminance")
+
+
+class Grids(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="brdf_grid_offline_")
+        self.addCleanup(shutil.rmtree, self.dir, True)
+
+    def test_dataset_holds_the_values_axes_and_description(self):
+        values = np.arange(2 * 3 * 4 * 5, dtype=float).reshape(2, 3, 4, 5)
+        values[1, 2, 3] = np.nan
+        fill = {"policy": "chain", "interpolated": 20, "fallback": 2, "model": 1, "empty": 1,
+                "model_fraction": 1 / 24}
+        ds = grid_dataset(values, description(fill=fill, axis_scale=[1, 2, 0.5]))
+        self.assertTrue(np.array_equal(ds.brdf.values, values, equal_nan=True))
+        np.testing.assert_array_equal(ds.theta_i, [22.5, 67.5])
+        np.testing.assert_array_equal(ds.theta_o, [15, 45, 75])
+        np.testing.assert_array_equal(ds.wavelength, WL)
+        self.assertEqual(ds.brdf.attrs["units"], "sr⁻¹")
+        self.assertEqual((ds.method.item(), bool(ds.reciprocity), ds.fill_policy.item()),
+                         ("octant", True, "chain"))
+        np.testing.assert_array_equal(ds.axis_scale, [1, 2, 0.5])
+        np.testing.assert_array_equal(ds.fill_count, [20, 2, 1, 1])
+        self.assertEqual(dict(zip(ds.status.values, ds.status_count.values)),
+                         {"ok": 20, "empty_octant": 4})
+        # no stage-by-stage grids given: the chain's cells are "unrecorded", NaN cells empty
+        self.assertEqual(int((ds.provenance == PROVENANCE_CODE["unrecorded"]).sum()), 23)
+        self.assertEqual(int((ds.provenance == PROVENANCE_CODE["empty"]).sum()), 1)
+        self.assertIn(uncertainty_name("brdf"), ds.attrs["uncertainty"])
+        with self.assertRaises(ValueError):
+            grid_dataset(values[:1], description())
+
+    def test_provenance_from_the_stages(self):
+        chain = np.ones((1, 1, 4, 2))
+        chain[0, 0, 3] = np.nan
+        method = np.full_like(chain, np.nan)
+        method[0, 0, 0] = 1
+        delaunay = np.full_like(chain, np.nan)
+        delaunay[0, 0, :2] = 1
+        codes = cell_provenance(chain, "chain", method, delaunay)
+        self.assertEqual([int(c) for c in codes.ravel()],
+                         [PROVENANCE_CODE[k] for k in ("interpolated", "fallback", "model",
+                                                        "empty")])
+        # Delaunay as the method: no fallback stage
+        codes = cell_provenance(chain, "chain", delaunay, None)
+        self.assertEqual(list(codes.ravel()), [0, 0, 2, 3])
+        self.assertEqual(list(cell_provenance(chain, "none").ravel()), [0, 0, 0, 3])
+
+    def test_open_grid_reads_the_npy_and_its_sidecar(self):
+        values = np.random.default_rng(3).random((2, 3, 4, 5))
+        path = os.path.join(self.dir, "g.npy")
+        np.save(path, values)
+        with open(path + ".json", "w", encoding="utf-8") as f:
+            json.dump(description(), f)
+        ds = open_grid(path)
+        np.testing.assert_array_equal(ds.brdf.values, values)
+        self.assertEqual(ds.attrs["source"], path)
+        with self.assertRaises(OSError) as caught:
+            open_grid(os.path.join(self.dir, "missing.npy"))
+        self.assertIn("brdfctl export", str(caught.exception))
+
+    def test_netcdf_round_trip(self):
+        ds = grid_dataset(np.ones((2, 3, 4, 5)), description())
+        for engine in ("netcdf4", "scipy"):
+            path = write_netcdf(ds, os.path.join(self.dir, f"{engine}.nc"), engine=engine)
+            with xr.open_dataset(path, engine=engine) as back:
+                np.testing.assert_array_equal(back.brdf.values, ds.brdf.values)
+                self.assertEqual(back.attrs["session_name"], "paint")
+                self.assertEqual(bool(back.reciprocity), True)
+
+
+class Interpolations(unittest.TestCase):
+    def test_batch_and_one_answer(self):
+        v = [Vertex(7, np.array([1.0, 2, 3]), 0.25), Vertex(9, np.array([4.0, 5, 6]), 0.75)]
+        batch = InterpolationBatch([answer([30, 40, 50], np.arange(5), vertices=v),
+                                    answer([80, 80, 5], [], status="empty_octant")])
+        ds = batch.to_dataset()
+        self.assertEqual(ds.brdf.dims, ("direction", "wavelength"))
+        self.assertTrue(np.isnan(ds.brdf.values[1]).all())
+        self.assertEqual(list(ds.status.values), ["ok", "empty_octant"])
+        np.testing.assert_array_equal(ds.vertex_reading_id.values, [[7, 9], [0, 0]])
+        self.assertTrue(np.isnan(ds.vertex_weight.values[1]).all())
+        np.testing.assert_array_equal(ds.vertex_coords.values[0, 1], [4, 5, 6])
+        np.testing.assert_array_equal(ds.theta_o.values, [40, 80])
+        one = batch[0].to_dataset()
+        self.assertEqual(one.brdf.dims, ("wavelength",))
+        self.assertEqual(float(one.phi), 50)
+        failed = batch[1].to_dataset()
+        self.assertTrue(np.isnan(failed.brdf.values).all())
+        self.assertEqual(failed.sizes["wavelength"], 5)
+
+
+class Angles(unittest.TestCase):
+    def test_known_directions_and_round_trip(self):
+        np.testing.assert_allclose(incidence_from_half_diff(0, 30, 0), (30, 30, 180), atol=1e-9)
+        np.testing.assert_allclose(incidence_from_half_diff(30, 0, 0), (30, 30, 0), atol=1e-9)
+        rng = np.random.default_rng(1)
+        ti, to, p = rng.uniform(0, 85, 500), rng.uniform(0, 85, 500), rng.uniform(0, 180, 500)
+        bi, bo, bp = incidence_from_half_diff(*half_diff_from_incidence(ti, to, p))
+        same = np.abs(bi - ti) + np.abs(bo - to)
+        swapped = np.abs(bi - to) + np.abs(bo - ti)  # reciprocity: the pair, either way round
+        self.assertLess(float(np.max(np.minimum(same, swapped) + np.abs(bp - p))), 1e-6)
+
+
+class ProgressAndErrors(unittest.TestCase):
+    def test_bar_only_when_asked(self):
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            with Bar(True, total=4, desc="work", unit="step") as bar:
+                bar.update(2)
+                bar.moveto(4)
+            self.assertFalse(bar.shown)  # closed on leaving
+        self.assertIn("4/4", err.getvalue())
+        quiet = io.StringIO()
+        with contextlib.redirect_stderr(quiet):
+            with Bar(False, total=4) as bar:
+                bar.update(4)
+        self.assertEqual(quiet.getvalue(), "")
+        self.assertFalse(Bar(None).shown)  # not a terminal here, not a kernel
+
+    def test_errors_are_the_subclass_of_their_code(self):
+        e = BrdfError(grpc.StatusCode.NOT_FOUND, "session 9 does not exist", "Control.GetSession")
+        self.assertIsInstance(e, brdf_client.NotFound)
+        self.assertIsInstance(e, BrdfError)
+        self.assertEqual((e.code_name, e.message, e.method),
+                         ("NOT_FOUND", "session 9 does not exist", "Control.GetSession"))
+        self.assertIs(type(BrdfError(grpc.StatusCode.INTERNAL, "x")), BrdfError)
+        self.assertIsInstance(BrdfError(grpc.StatusCode.DATA_LOSS, "gap"), brdf_client.DataLoss)
+        self.assertIsInstance(brdf_client.InvalidArgument(grpc.StatusCode.INVALID_ARGUMENT, "x"),
+                              brdf_client.InvalidArgument)
+
+
+if __name__ == "__main__":
+    unittest.main()
