@@ -63,19 +63,73 @@ Status ParseError(std::size_t line, const std::string& what) {
   return InvalidArgument("spectral table, line " + std::to_string(line) + ": " + what);
 }
 
-}  // namespace
+enum class Section { kHeader, kFormat, kData, kDone };
 
-Result<SpectralTable> ParseSpectralTable(std::string_view text) {
-  enum class Section { kHeader, kFormat, kData, kDone };
-  SpectralTable table;
-  Section section = Section::kHeader;
+// What a table's lines hold, read before the fields and sets are made sense of.
+struct TableText {
+  Section section = Section::kHeader;  // where the text ended
   std::vector<Token> format, data;
   std::optional<long> declared_fields, declared_sets, declared_bands;
   std::optional<double> declared_start_nm, declared_end_nm;
-  std::size_t line_no = 0, format_line = 0, data_line = 0;
+  std::size_t format_line = 0, data_line = 0;  // of BEGIN_DATA_FORMAT and BEGIN_DATA
   bool have_kind = false;
+};
+
+// A line of the header: the table's kind (the first line), the start of a section, or a key.
+Status ReadHeaderLine(const std::vector<std::string>& tokens, std::size_t line_no, TableText& t,
+                      SpectralTable& table) {
+  const std::string& key = tokens[0];
+  if (!t.have_kind) {
+    table.kind = key;
+    t.have_kind = true;
+  } else if (key == "BEGIN_DATA_FORMAT") {
+    t.section = Section::kFormat;
+    t.format_line = line_no;
+  } else if (key == "BEGIN_DATA") {
+    if (t.format_line == 0) {
+      return ParseError(line_no,
+                        "BEGIN_DATA before any BEGIN_DATA_FORMAT; the field names "
+                        "must come first");
+    }
+    t.section = Section::kData;
+    t.data_line = line_no;
+  } else if (key == "DISPLAY" && tokens.size() > 1) {
+    table.name = tokens[1];
+  } else if (key == "SPECTRAL_START_NM" || key == "SPECTRAL_END_NM") {
+    const std::optional<double> nm =
+        tokens.size() > 1 ? ParseDouble(tokens[1]) : std::optional<double>();
+    if (!nm) return ParseError(line_no, key + " needs a wavelength in nm");
+    (key == "SPECTRAL_START_NM" ? t.declared_start_nm : t.declared_end_nm) = nm;
+  } else if (key == "NUMBER_OF_FIELDS" || key == "NUMBER_OF_SETS" || key == "SPECTRAL_BANDS") {
+    const std::optional<long> n = tokens.size() > 1 ? ParseCount(tokens[1]) : std::optional<long>();
+    if (!n) return ParseError(line_no, key + " needs a non-negative integer");
+    (key == "NUMBER_OF_FIELDS" ? t.declared_fields
+     : key == "NUMBER_OF_SETS" ? t.declared_sets
+                               : t.declared_bands) = n;
+  }
+  return Status::Ok();
+}
+
+// A line of the format or data section: its tokens into `into`, up to `end_key`, which closes
+// the section (the text goes on in `after`).
+void ReadSectionLine(const std::vector<std::string>& tokens, std::size_t line_no,
+                     std::string_view end_key, Section after, std::vector<Token>& into,
+                     Section& section) {
+  for (const std::string& token : tokens) {
+    if (token == end_key) {
+      section = after;
+      return;
+    }
+    into.push_back({token, line_no});
+  }
+}
+
+// The text line by line (blank lines and # comments skipped) up to END_DATA.
+Result<TableText> ReadTableText(std::string_view text, SpectralTable& table) {
+  TableText t;
+  std::size_t line_no = 0;
   std::size_t pos = 0;
-  while (pos <= text.size() && section != Section::kDone) {
+  while (pos <= text.size() && t.section != Section::kDone) {
     const std::size_t nl = text.find('\n', pos);
     const std::string_view line =
         text.substr(pos, nl == std::string_view::npos ? std::string_view::npos : nl - pos);
@@ -83,86 +137,52 @@ Result<SpectralTable> ParseSpectralTable(std::string_view text) {
     ++line_no;
     const std::vector<std::string> tokens = SplitLine(line);
     if (tokens.empty() || tokens[0].starts_with('#')) continue;
-    switch (section) {
-      case Section::kHeader: {
-        const std::string& key = tokens[0];
-        if (!have_kind) {
-          table.kind = key;
-          have_kind = true;
-        } else if (key == "BEGIN_DATA_FORMAT") {
-          section = Section::kFormat;
-          format_line = line_no;
-        } else if (key == "BEGIN_DATA") {
-          if (format_line == 0) {
-            return ParseError(line_no,
-                              "BEGIN_DATA before any BEGIN_DATA_FORMAT; the field names "
-                              "must come first");
-          }
-          section = Section::kData;
-          data_line = line_no;
-        } else if (key == "DISPLAY" && tokens.size() > 1) {
-          table.name = tokens[1];
-        } else if (key == "SPECTRAL_START_NM" || key == "SPECTRAL_END_NM") {
-          const std::optional<double> nm =
-              tokens.size() > 1 ? ParseDouble(tokens[1]) : std::optional<double>();
-          if (!nm) return ParseError(line_no, key + " needs a wavelength in nm");
-          (key == "SPECTRAL_START_NM" ? declared_start_nm : declared_end_nm) = nm;
-        } else if (key == "NUMBER_OF_FIELDS" || key == "NUMBER_OF_SETS" ||
-                   key == "SPECTRAL_BANDS") {
-          const std::optional<long> n =
-              tokens.size() > 1 ? ParseCount(tokens[1]) : std::optional<long>();
-          if (!n) return ParseError(line_no, key + " needs a non-negative integer");
-          (key == "NUMBER_OF_FIELDS" ? declared_fields
-           : key == "NUMBER_OF_SETS" ? declared_sets
-                                     : declared_bands) = n;
-        }
+    switch (t.section) {
+      case Section::kHeader:
+        BRDF_RETURN_IF_ERROR(ReadHeaderLine(tokens, line_no, t, table));
         break;
-      }
       case Section::kFormat:
-        for (const std::string& t : tokens) {
-          if (t == "END_DATA_FORMAT") {
-            section = Section::kHeader;
-            break;
-          }
-          format.push_back({t, line_no});
-        }
+        ReadSectionLine(tokens, line_no, "END_DATA_FORMAT", Section::kHeader, t.format, t.section);
         break;
       case Section::kData:
-        for (const std::string& t : tokens) {
-          if (t == "END_DATA") {
-            section = Section::kDone;
-            break;
-          }
-          data.push_back({t, line_no});
-        }
+        ReadSectionLine(tokens, line_no, "END_DATA", Section::kDone, t.data, t.section);
         break;
       case Section::kDone:
         break;
     }
   }
-  if (!have_kind) return InvalidArgument("spectral table: the text is empty");
-  if (format_line == 0) {
+  return t;
+}
+
+// Both sections present and closed, and the format as long as NUMBER_OF_FIELDS says.
+Status CheckTableText(const TableText& t) {
+  if (!t.have_kind) return InvalidArgument("spectral table: the text is empty");
+  if (t.format_line == 0) {
     return InvalidArgument(
         "spectral table: no BEGIN_DATA_FORMAT section; is this a colord "
         ".sp/.cmf file?");
   }
-  if (section == Section::kFormat) {
-    return ParseError(format_line, "BEGIN_DATA_FORMAT is never closed by END_DATA_FORMAT");
+  if (t.section == Section::kFormat) {
+    return ParseError(t.format_line, "BEGIN_DATA_FORMAT is never closed by END_DATA_FORMAT");
   }
-  if (data_line == 0) return InvalidArgument("spectral table: no BEGIN_DATA section");
-  if (section == Section::kData) {
-    return ParseError(data_line, "BEGIN_DATA is never closed by END_DATA");
+  if (t.data_line == 0) return InvalidArgument("spectral table: no BEGIN_DATA section");
+  if (t.section == Section::kData) {
+    return ParseError(t.data_line, "BEGIN_DATA is never closed by END_DATA");
   }
-  if (declared_fields && static_cast<std::size_t>(*declared_fields) != format.size()) {
-    return ParseError(format_line, "NUMBER_OF_FIELDS says " + std::to_string(*declared_fields) +
-                                       " but the format names " + std::to_string(format.size()) +
-                                       " fields");
+  if (t.declared_fields && static_cast<std::size_t>(*t.declared_fields) != t.format.size()) {
+    return ParseError(t.format_line, "NUMBER_OF_FIELDS says " + std::to_string(*t.declared_fields) +
+                                         " but the format names " +
+                                         std::to_string(t.format.size()) + " fields");
   }
+  return Status::Ok();
+}
 
-  // Which column holds what.
-  enum class Column { kSpectral, kSampleId, kOther };
+enum class Column { kSpectral, kSampleId, kOther };
+
+// Which column holds what; the SPEC_<nm> fields' wavelengths into the table.
+Result<std::vector<Column>> ReadColumns(const TableText& t, SpectralTable& table) {
   std::vector<Column> columns;
-  for (const Token& f : format) {
+  for (const Token& f : t.format) {
     if (f.text.starts_with("SPEC_")) {
       const std::optional<double> nm = ParseDouble(std::string_view(f.text).substr(5));
       if (!nm) return ParseError(f.line, "field " + f.text + " does not name a wavelength");
@@ -173,32 +193,40 @@ Result<SpectralTable> ParseSpectralTable(std::string_view text) {
     }
   }
   if (table.wavelengths_nm.empty()) {
-    return ParseError(format_line, "the format has no SPEC_<nm> fields, so no spectrum");
+    return ParseError(t.format_line, "the format has no SPEC_<nm> fields, so no spectrum");
   }
-  // The header's range, when complete, is authoritative: colord's illuminant/CIE-A.sp says
-  // 300–830 nm in 531 bands but names its fields SPEC_300000, SPEC_301000, …
-  if (declared_start_nm && declared_end_nm && declared_bands) {
-    const std::size_t bands = static_cast<std::size_t>(*declared_bands);
-    if (bands != table.wavelengths_nm.size()) {
-      return ParseError(format_line,
-                        "SPECTRAL_BANDS says " + std::to_string(bands) + " but the format has " +
-                            std::to_string(table.wavelengths_nm.size()) + " SPEC_ fields");
-    }
-    const double step =
-        bands > 1 ? (*declared_end_nm - *declared_start_nm) / static_cast<double>(bands - 1) : 0;
-    for (std::size_t k = 0; k < bands; ++k) {
-      table.wavelengths_nm[k] = *declared_start_nm + step * static_cast<double>(k);
-    }
+  return columns;
+}
+
+// The header's range, when complete, is authoritative: colord's illuminant/CIE-A.sp says
+// 300–830 nm in 531 bands but names its fields SPEC_300000, SPEC_301000, …
+Status ApplyDeclaredRange(const TableText& t, SpectralTable& table) {
+  if (!(t.declared_start_nm && t.declared_end_nm && t.declared_bands)) return Status::Ok();
+  const std::size_t bands = static_cast<std::size_t>(*t.declared_bands);
+  if (bands != table.wavelengths_nm.size()) {
+    return ParseError(t.format_line,
+                      "SPECTRAL_BANDS says " + std::to_string(bands) + " but the format has " +
+                          std::to_string(table.wavelengths_nm.size()) + " SPEC_ fields");
   }
-  if (data.size() % columns.size() != 0) {
-    return ParseError(data_line, std::to_string(data.size()) +
-                                     " values do not fill whole sets of " +
-                                     std::to_string(columns.size()) + " fields");
+  const double step =
+      bands > 1 ? (*t.declared_end_nm - *t.declared_start_nm) / static_cast<double>(bands - 1) : 0;
+  for (std::size_t k = 0; k < bands; ++k) {
+    table.wavelengths_nm[k] = *t.declared_start_nm + step * static_cast<double>(k);
   }
-  const std::size_t n_sets = data.size() / columns.size();
-  if (declared_sets && static_cast<std::size_t>(*declared_sets) != n_sets) {
-    return ParseError(data_line, "NUMBER_OF_SETS says " + std::to_string(*declared_sets) +
-                                     " but the data holds " + std::to_string(n_sets));
+  return Status::Ok();
+}
+
+// The data, set by set: the spectral values and (when a SAMPLE_ID field is named) the ids.
+Status ReadSets(const TableText& t, const std::vector<Column>& columns, SpectralTable& table) {
+  if (t.data.size() % columns.size() != 0) {
+    return ParseError(t.data_line, std::to_string(t.data.size()) +
+                                       " values do not fill whole sets of " +
+                                       std::to_string(columns.size()) + " fields");
+  }
+  const std::size_t n_sets = t.data.size() / columns.size();
+  if (t.declared_sets && static_cast<std::size_t>(*t.declared_sets) != n_sets) {
+    return ParseError(t.data_line, "NUMBER_OF_SETS says " + std::to_string(*t.declared_sets) +
+                                       " but the data holds " + std::to_string(n_sets));
   }
   const bool has_ids =
       std::find(columns.begin(), columns.end(), Column::kSampleId) != columns.end();
@@ -206,14 +234,15 @@ Result<SpectralTable> ParseSpectralTable(std::string_view text) {
     std::vector<double> values;
     values.reserve(table.wavelengths_nm.size());
     for (std::size_t c = 0; c < columns.size(); ++c) {
-      const Token& t = data[s * columns.size() + c];
+      const Token& token = t.data[s * columns.size() + c];
       if (columns[c] == Column::kSampleId) {
-        table.set_ids.push_back(t.text);
+        table.set_ids.push_back(token.text);
       } else if (columns[c] == Column::kSpectral) {
-        const std::optional<double> v = ParseDouble(t.text);
+        const std::optional<double> v = ParseDouble(token.text);
         if (!v) {
-          return ParseError(t.line, "value '" + t.text + "' of field " + format[c].text +
-                                        " in set " + std::to_string(s + 1) + " is not a number");
+          return ParseError(token.line, "value '" + token.text + "' of field " + t.format[c].text +
+                                            " in set " + std::to_string(s + 1) +
+                                            " is not a number");
         }
         values.push_back(*v);
       }
@@ -221,6 +250,20 @@ Result<SpectralTable> ParseSpectralTable(std::string_view text) {
     table.sets.push_back(std::move(values));
   }
   if (!has_ids) table.set_ids.clear();
+  return Status::Ok();
+}
+
+}  // namespace
+
+Result<SpectralTable> ParseSpectralTable(std::string_view text) {
+  SpectralTable table;
+  const Result<TableText> t = ReadTableText(text, table);
+  if (!t.ok()) return t.status();
+  BRDF_RETURN_IF_ERROR(CheckTableText(*t));
+  const Result<std::vector<Column>> columns = ReadColumns(*t, table);
+  if (!columns.ok()) return columns.status();
+  BRDF_RETURN_IF_ERROR(ApplyDeclaredRange(*t, table));
+  BRDF_RETURN_IF_ERROR(ReadSets(*t, *columns, table));
   return table;
 }
 

@@ -143,6 +143,89 @@ Status ValidateReading(const ReadingRecord& r) {
   return Status::Ok();
 }
 
+// The step is pending and takes a reading of this kind, and the reading's reference and dark
+// readings are this session's.
+Status RequireStepTakes(Database& db, std::int64_t session, int step_index,
+                        const ReadingRecord& reading, const std::string& what) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(StepRow step, StepOf(db, session, step_index));
+  const std::optional<ReadingKind> expected = ReadingKindFor(step.kind);
+  if (!expected.has_value()) {
+    return InvalidArgument(what + ": it is a " + std::string(ToString(step.kind)) +
+                           " step, which takes no reading; use CompleteStep");
+  }
+  if (*expected != reading.kind) {
+    return InvalidArgument(what + ": it is a " + std::string(ToString(step.kind)) +
+                           " step but the reading is a " + std::string(ToString(reading.kind)) +
+                           " reading");
+  }
+  if (step.state != StepState::kPending) {
+    return NotPending(db, session, step_index, step.state).WithContext(what);
+  }
+  BRDF_RETURN_IF_ERROR(RequireLinkedReading(db, session, reading.reference_reading_id,
+                                            ReadingKind::kReference, "reference")
+                           .WithContext(what));
+  return RequireLinkedReading(db, session, reading.dark_reading_id, ReadingKind::kDark, "dark")
+      .WithContext(what);
+}
+
+// The reading's row (its spectrum encoded as `blob`).
+Status InsertReading(Database& db, std::int64_t session, int step_index,
+                     const ReadingRecord& reading, const std::vector<std::uint8_t>& blob,
+                     UnixSeconds recorded_at, const std::string& what) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(
+      Statement st,
+      db.Prepare(
+          "INSERT INTO readings (session_id, step_index, kind, alpha, beta, gamma, delta, "
+          "theta_i, phi_i, theta_o, phi_o, wl_start_nm, wl_step_nm, wl_count, spectrum, "
+          "quality_code, flagged, integration_ms, attempts, note, reference_reading_id, "
+          "dark_reading_id, meter_serial, recorded_at) "
+          "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
+  st.Bind(1, session)
+      .Bind(2, step_index)
+      .Bind(3, ToString(reading.kind))
+      .Bind(4, reading.pose.alpha)
+      .Bind(5, reading.pose.beta)
+      .Bind(6, reading.pose.gamma)
+      .Bind(7, reading.pose.delta)
+      .Bind(8, reading.directions.theta_i)
+      .Bind(9, reading.directions.phi_i)
+      .Bind(10, reading.directions.theta_o)
+      .Bind(11, reading.directions.phi_o)
+      .Bind(12, reading.grid.start_nm)
+      .Bind(13, reading.grid.step_nm)
+      .Bind(14, static_cast<std::int64_t>(reading.grid.count))
+      .Bind(15, blob)
+      .Bind(16, reading.quality_code)
+      .Bind(17, reading.flagged)
+      .Bind(18, reading.integration_ms)
+      .Bind(19, reading.attempts)
+      .Bind(20, reading.note)
+      .Bind(21, reading.reference_reading_id)
+      .Bind(22, reading.dark_reading_id)
+      .Bind(23, reading.meter_serial)
+      .Bind(24, recorded_at);
+  return st.Run().WithContext(what);
+}
+
+// The pending step done at `recorded_at`, and counted in the session's done_steps.
+Status MarkStepDone(Database& db, std::int64_t session, int step_index, UnixSeconds recorded_at,
+                    const std::string& what) {
+  {
+    BRDF_STORAGE_ASSIGN_OR_RETURN(
+        Statement st, db.Prepare("UPDATE steps SET state = 'done', completed_at = ? "
+                                 "WHERE session_id = ? AND step_index = ? AND state = 'pending'"));
+    st.Bind(1, recorded_at).Bind(2, session).Bind(3, step_index);
+    BRDF_RETURN_IF_ERROR(st.Run().WithContext(what + ": marking the step done"));
+    if (db.changes() != 1) {
+      return Internal(what + ": the step stopped being pending inside the transaction");
+    }
+  }
+  BRDF_STORAGE_ASSIGN_OR_RETURN(
+      Statement st, db.Prepare("UPDATE sessions SET done_steps = done_steps + 1 WHERE id = ?"));
+  st.Bind(1, session);
+  return st.Run().WithContext(what + ": counting the step done");
+}
+
 }  // namespace
 
 // --- Opening
@@ -439,79 +522,10 @@ Result<std::int64_t> SessionStore::CompleteStepWithReading(std::int64_t session,
   BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
   BRDF_STORAGE_ASSIGN_OR_RETURN(SessionState state, SessionStateOf(db, session));
   BRDF_RETURN_IF_ERROR(RequireStarted(session, state, what));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(StepRow step, StepOf(db, session, step_index));
-  const std::optional<ReadingKind> expected = ReadingKindFor(step.kind);
-  if (!expected.has_value()) {
-    return InvalidArgument(what + ": it is a " + std::string(ToString(step.kind)) +
-                           " step, which takes no reading; use CompleteStep");
-  }
-  if (*expected != reading.kind) {
-    return InvalidArgument(what + ": it is a " + std::string(ToString(step.kind)) +
-                           " step but the reading is a " + std::string(ToString(reading.kind)) +
-                           " reading");
-  }
-  if (step.state != StepState::kPending) {
-    return NotPending(db, session, step_index, step.state).WithContext(what);
-  }
-  BRDF_RETURN_IF_ERROR(RequireLinkedReading(db, session, reading.reference_reading_id,
-                                            ReadingKind::kReference, "reference")
-                           .WithContext(what));
-  BRDF_RETURN_IF_ERROR(
-      RequireLinkedReading(db, session, reading.dark_reading_id, ReadingKind::kDark, "dark")
-          .WithContext(what));
-
-  {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement st,
-        db.Prepare(
-            "INSERT INTO readings (session_id, step_index, kind, alpha, beta, gamma, delta, "
-            "theta_i, phi_i, theta_o, phi_o, wl_start_nm, wl_step_nm, wl_count, spectrum, "
-            "quality_code, flagged, integration_ms, attempts, note, reference_reading_id, "
-            "dark_reading_id, meter_serial, recorded_at) "
-            "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
-    st.Bind(1, session)
-        .Bind(2, step_index)
-        .Bind(3, ToString(reading.kind))
-        .Bind(4, reading.pose.alpha)
-        .Bind(5, reading.pose.beta)
-        .Bind(6, reading.pose.gamma)
-        .Bind(7, reading.pose.delta)
-        .Bind(8, reading.directions.theta_i)
-        .Bind(9, reading.directions.phi_i)
-        .Bind(10, reading.directions.theta_o)
-        .Bind(11, reading.directions.phi_o)
-        .Bind(12, reading.grid.start_nm)
-        .Bind(13, reading.grid.step_nm)
-        .Bind(14, static_cast<std::int64_t>(reading.grid.count))
-        .Bind(15, blob)
-        .Bind(16, reading.quality_code)
-        .Bind(17, reading.flagged)
-        .Bind(18, reading.integration_ms)
-        .Bind(19, reading.attempts)
-        .Bind(20, reading.note)
-        .Bind(21, reading.reference_reading_id)
-        .Bind(22, reading.dark_reading_id)
-        .Bind(23, reading.meter_serial)
-        .Bind(24, recorded_at);
-    BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
-  }
+  BRDF_RETURN_IF_ERROR(RequireStepTakes(db, session, step_index, reading, what));
+  BRDF_RETURN_IF_ERROR(InsertReading(db, session, step_index, reading, blob, recorded_at, what));
   const std::int64_t id = db.last_insert_rowid();
-  {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement st, db.Prepare("UPDATE steps SET state = 'done', completed_at = ? "
-                                 "WHERE session_id = ? AND step_index = ? AND state = 'pending'"));
-    st.Bind(1, recorded_at).Bind(2, session).Bind(3, step_index);
-    BRDF_RETURN_IF_ERROR(st.Run().WithContext(what + ": marking the step done"));
-    if (db.changes() != 1) {
-      return Internal(what + ": the step stopped being pending inside the transaction");
-    }
-  }
-  {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement st, db.Prepare("UPDATE sessions SET done_steps = done_steps + 1 WHERE id = ?"));
-    st.Bind(1, session);
-    BRDF_RETURN_IF_ERROR(st.Run().WithContext(what + ": counting the step done"));
-  }
+  BRDF_RETURN_IF_ERROR(MarkStepDone(db, session, step_index, recorded_at, what));
   BRDF_RETURN_IF_ERROR(tx.Commit().WithContext(what));
   return id;
 }

@@ -29,6 +29,156 @@ Status FillUuids(Database& db, const std::set<std::int64_t>& ids,
   return Status::Ok();
 }
 
+// Changes noted in the outbox: which sessions, which sessions with all their steps, which steps.
+struct OutboxChanges {
+  std::set<std::int64_t> sessions, all_steps;
+  std::set<std::pair<std::int64_t, int>> steps;
+  int count = 0;  // outbox entries read
+};
+
+// Up to max_changes outbox entries, oldest first; batch.outbox_through becomes the last.
+Status ReadOutbox(Database& db, int max_changes, OutboxChanges& changes, ShipBatch& batch) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
+                                db.Prepare("SELECT seq, session_id, step_index FROM archive_outbox "
+                                           "ORDER BY seq LIMIT ?"));
+  st.Bind(1, max_changes);
+  while (true) {
+    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    if (!row) break;
+    ++changes.count;
+    batch.outbox_through = st.Int64(0);
+    const std::int64_t session = st.Int64(1);
+    changes.sessions.insert(session);
+    if (st.IsNull(2)) continue;
+    if (st.Int64(2) < 0) {
+      changes.all_steps.insert(session);
+    } else {
+      changes.steps.insert({session, st.Int(2)});
+    }
+  }
+  return Status::Ok();
+}
+
+// The changed sessions' rows (those still present) and their uuids.
+Status ReadChangedSessions(Database& db, const std::string& path,
+                           const std::set<std::int64_t>& sessions, ShipBatch& batch) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db.Prepare("SELECT " + std::string(kSessionColumns) +
+                                                         " FROM sessions WHERE id = ?"));
+  for (std::int64_t id : sessions) {
+    st.Bind(1, id);
+    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    if (row) {
+      BRDF_STORAGE_ASSIGN_OR_RETURN(SessionRecord s, ReadSession(st, path));
+      batch.uuids[s.id] = s.uuid;
+      batch.sessions.push_back(std::move(s));
+    }
+    st.Reset();
+  }
+  return Status::Ok();
+}
+
+// The changed steps: every step of the sessions in all_steps, then each other changed step.
+Status ReadChangedSteps(Database& db, const std::string& path, const OutboxChanges& changes,
+                        ShipBatch& batch) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement all,
+                                db.Prepare("SELECT " + std::string(kStepColumns) +
+                                           " FROM steps WHERE session_id = ? ORDER BY step_index"));
+  for (std::int64_t id : changes.all_steps) {
+    all.Bind(1, id);
+    while (true) {
+      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, all.Step());
+      if (!row) break;
+      BRDF_STORAGE_ASSIGN_OR_RETURN(StepRecord s, ReadStep(all, path));
+      batch.steps.push_back(std::move(s));
+    }
+    all.Reset();
+  }
+  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement one,
+                                db.Prepare("SELECT " + std::string(kStepColumns) +
+                                           " FROM steps WHERE session_id = ? AND step_index = ?"));
+  for (const auto& [id, index] : changes.steps) {
+    if (changes.all_steps.count(id) != 0) continue;
+    one.Bind(1, id).Bind(2, index);
+    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, one.Step());
+    if (row) {
+      BRDF_STORAGE_ASSIGN_OR_RETURN(StepRecord s, ReadStep(one, path));
+      batch.steps.push_back(std::move(s));
+    }
+    one.Reset();
+  }
+  return Status::Ok();
+}
+
+// Up to `limit` readings past batch.readings_through, which moves to the last.
+Status ReadNewReadings(Database& db, const std::string& path, int limit, ShipBatch& batch,
+                       std::set<std::int64_t>& named) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
+                                db.Prepare("SELECT " + std::string(kReadingColumns) +
+                                           " FROM readings WHERE id > ? ORDER BY id LIMIT ?"));
+  st.Bind(1, batch.readings_through).Bind(2, limit);
+  while (true) {
+    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    if (!row) break;
+    BRDF_STORAGE_ASSIGN_OR_RETURN(ReadingRecord r, ReadReading(st, path));
+    batch.readings_through = r.id;
+    named.insert(r.session_id);
+    batch.readings.push_back(std::move(r));
+  }
+  return Status::Ok();
+}
+
+// Up to `limit` devices past batch.devices_through, which moves to the last.
+Status ReadNewDevices(Database& db, int limit, ShipBatch& batch, std::set<std::int64_t>& named) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
+                                db.Prepare("SELECT id, session_id, kind, model, serial, first_seen "
+                                           "FROM devices WHERE id > ? ORDER BY id LIMIT ?"));
+  st.Bind(1, batch.devices_through).Bind(2, limit);
+  while (true) {
+    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    if (!row) break;
+    batch.devices.push_back(DeviceRecord{st.Int64(0), st.OptionalInt64(1), st.Text(2), st.Text(3),
+                                         st.Text(4), st.Double(5)});
+    batch.devices_through = batch.devices.back().id;
+    if (batch.devices.back().session_id) named.insert(*batch.devices.back().session_id);
+  }
+  return Status::Ok();
+}
+
+// Up to `limit` audit entries past batch.audit_through, which moves to the last.
+Status ReadNewAudit(Database& db, int limit, ShipBatch& batch, std::set<std::int64_t>& named) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
+                                db.Prepare("SELECT id, at, role, actor, action, session_id, detail "
+                                           "FROM audit WHERE id > ? ORDER BY id LIMIT ?"));
+  st.Bind(1, batch.audit_through).Bind(2, limit);
+  while (true) {
+    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    if (!row) break;
+    batch.audit.push_back(AuditRecord{st.Int64(0), st.Double(1), st.Text(2), st.Text(3), st.Text(4),
+                                      st.OptionalInt64(5), st.Text(6)});
+    batch.audit_through = batch.audit.back().id;
+    if (batch.audit.back().session_id) named.insert(*batch.audit.back().session_id);
+  }
+  return Status::Ok();
+}
+
+// Up to `limit` session events past batch.events_through, which moves to the last.
+Status ReadNewEvents(Database& db, const std::string& path, int limit, ShipBatch& batch,
+                     std::set<std::int64_t>& named) {
+  BRDF_STORAGE_ASSIGN_OR_RETURN(
+      Statement st, db.Prepare("SELECT " + std::string(kEventColumns) +
+                               " FROM session_events WHERE id > ? ORDER BY id LIMIT ?"));
+  st.Bind(1, batch.events_through).Bind(2, limit);
+  while (true) {
+    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    if (!row) break;
+    BRDF_STORAGE_ASSIGN_OR_RETURN(SessionEventRecord e, ReadEvent(st, path));
+    batch.events_through = e.id;
+    named.insert(e.session_id);
+    batch.events.push_back(std::move(e));
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status SessionStore::SetArchiveShipping(bool enabled) {
@@ -57,137 +207,24 @@ Result<ShipBatch> SessionStore::NextShipBatch(int max_readings, int max_changes)
   BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   ShipBatch batch;
 
-  // Changes noted in the outbox: which sessions, which sessions with all their steps, which steps.
-  std::set<std::int64_t> sessions, all_steps;
-  std::set<std::pair<std::int64_t, int>> steps;
-  int changes = 0;
-  {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement st, db->Prepare("SELECT seq, session_id, step_index FROM archive_outbox "
-                                  "ORDER BY seq LIMIT ?"));
-    st.Bind(1, max_changes);
-    while (true) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
-      if (!row) break;
-      ++changes;
-      batch.outbox_through = st.Int64(0);
-      const std::int64_t session = st.Int64(1);
-      sessions.insert(session);
-      if (st.IsNull(2)) continue;
-      if (st.Int64(2) < 0) {
-        all_steps.insert(session);
-      } else {
-        steps.insert({session, st.Int(2)});
-      }
-    }
-  }
-  {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement st,
-        db->Prepare("SELECT " + std::string(kSessionColumns) + " FROM sessions WHERE id = ?"));
-    for (std::int64_t id : sessions) {
-      st.Bind(1, id);
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
-      if (row) {
-        BRDF_STORAGE_ASSIGN_OR_RETURN(SessionRecord s, ReadSession(st, path_));
-        batch.uuids[s.id] = s.uuid;
-        batch.sessions.push_back(std::move(s));
-      }
-      st.Reset();
-    }
-  }
-  {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement all, db->Prepare("SELECT " + std::string(kStepColumns) +
-                                   " FROM steps WHERE session_id = ? ORDER BY step_index"));
-    for (std::int64_t id : all_steps) {
-      all.Bind(1, id);
-      while (true) {
-        BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, all.Step());
-        if (!row) break;
-        BRDF_STORAGE_ASSIGN_OR_RETURN(StepRecord s, ReadStep(all, path_));
-        batch.steps.push_back(std::move(s));
-      }
-      all.Reset();
-    }
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement one, db->Prepare("SELECT " + std::string(kStepColumns) +
-                                   " FROM steps WHERE session_id = ? AND step_index = ?"));
-    for (const auto& [id, index] : steps) {
-      if (all_steps.count(id) != 0) continue;
-      one.Bind(1, id).Bind(2, index);
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, one.Step());
-      if (row) {
-        BRDF_STORAGE_ASSIGN_OR_RETURN(StepRecord s, ReadStep(one, path_));
-        batch.steps.push_back(std::move(s));
-      }
-      one.Reset();
-    }
-  }
+  OutboxChanges changes;
+  BRDF_RETURN_IF_ERROR(ReadOutbox(*db, max_changes, changes, batch));
+  BRDF_RETURN_IF_ERROR(ReadChangedSessions(*db, path_, changes.sessions, batch));
+  BRDF_RETURN_IF_ERROR(ReadChangedSteps(*db, path_, changes, batch));
 
   BRDF_STORAGE_ASSIGN_OR_RETURN(batch.readings_through, Mark(*db, "readings"));
   BRDF_STORAGE_ASSIGN_OR_RETURN(batch.devices_through, Mark(*db, "devices"));
   BRDF_STORAGE_ASSIGN_OR_RETURN(batch.audit_through, Mark(*db, "audit"));
   BRDF_STORAGE_ASSIGN_OR_RETURN(batch.events_through, Mark(*db, "events"));
-  if (changes >= max_changes) return batch;  // rows may name sessions not shipped yet: next time
+  // Rows may name sessions not shipped yet: next time.
+  if (changes.count >= max_changes) return batch;
 
+  // Rows past the marks, and the sessions they name.
   std::set<std::int64_t> named;
-  {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                  db->Prepare("SELECT " + std::string(kReadingColumns) +
-                                              " FROM readings WHERE id > ? ORDER BY id LIMIT ?"));
-    st.Bind(1, batch.readings_through).Bind(2, max_readings);
-    while (true) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
-      if (!row) break;
-      BRDF_STORAGE_ASSIGN_OR_RETURN(ReadingRecord r, ReadReading(st, path_));
-      batch.readings_through = r.id;
-      named.insert(r.session_id);
-      batch.readings.push_back(std::move(r));
-    }
-  }
-  {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement st, db->Prepare("SELECT id, session_id, kind, model, serial, first_seen "
-                                  "FROM devices WHERE id > ? ORDER BY id LIMIT ?"));
-    st.Bind(1, batch.devices_through).Bind(2, max_readings);
-    while (true) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
-      if (!row) break;
-      batch.devices.push_back(DeviceRecord{st.Int64(0), st.OptionalInt64(1), st.Text(2), st.Text(3),
-                                           st.Text(4), st.Double(5)});
-      batch.devices_through = batch.devices.back().id;
-      if (batch.devices.back().session_id) named.insert(*batch.devices.back().session_id);
-    }
-  }
-  {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement st, db->Prepare("SELECT id, at, role, actor, action, session_id, detail "
-                                  "FROM audit WHERE id > ? ORDER BY id LIMIT ?"));
-    st.Bind(1, batch.audit_through).Bind(2, max_readings);
-    while (true) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
-      if (!row) break;
-      batch.audit.push_back(AuditRecord{st.Int64(0), st.Double(1), st.Text(2), st.Text(3),
-                                        st.Text(4), st.OptionalInt64(5), st.Text(6)});
-      batch.audit_through = batch.audit.back().id;
-      if (batch.audit.back().session_id) named.insert(*batch.audit.back().session_id);
-    }
-  }
-  {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement st, db->Prepare("SELECT " + std::string(kEventColumns) +
-                                  " FROM session_events WHERE id > ? ORDER BY id LIMIT ?"));
-    st.Bind(1, batch.events_through).Bind(2, max_readings);
-    while (true) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
-      if (!row) break;
-      BRDF_STORAGE_ASSIGN_OR_RETURN(SessionEventRecord e, ReadEvent(st, path_));
-      batch.events_through = e.id;
-      named.insert(e.session_id);
-      batch.events.push_back(std::move(e));
-    }
-  }
+  BRDF_RETURN_IF_ERROR(ReadNewReadings(*db, path_, max_readings, batch, named));
+  BRDF_RETURN_IF_ERROR(ReadNewDevices(*db, max_readings, batch, named));
+  BRDF_RETURN_IF_ERROR(ReadNewAudit(*db, max_readings, batch, named));
+  BRDF_RETURN_IF_ERROR(ReadNewEvents(*db, path_, max_readings, batch, named));
   BRDF_RETURN_IF_ERROR(FillUuids(*db, named, batch.uuids));
   return batch;
 }

@@ -96,6 +96,61 @@ double InvertMatrix(int n, const double* a, double* inverse) {
   return std::isfinite(rcond) ? rcond : 0.0;
 }
 
+template <int D>
+const double* PointAt(std::span<const double> points, std::int32_t v) {
+  return &points[static_cast<std::size_t>(v) * D];
+}
+
+// Bounding box of the triangulated points.
+template <int D>
+void BoundingBox(std::span<const double> points, const std::vector<std::int32_t>& verts,
+                 std::array<double, 4>& lower, std::array<double, 4>& upper) {
+  for (std::size_t i = 0; i < D; ++i) {
+    lower[i] = std::numeric_limits<double>::infinity();
+    upper[i] = -std::numeric_limits<double>::infinity();
+  }
+  for (std::int32_t v : verts) {
+    for (std::size_t i = 0; i < D; ++i) {
+      lower[i] = std::min(lower[i], PointAt<D>(points, v)[i]);
+      upper[i] = std::max(upper[i], PointAt<D>(points, v)[i]);
+    }
+  }
+}
+
+// The simplices ordered along a Morton curve through their centroids (the triangulation's
+// simplex at each place): a walk's next simplex, and the simplices of nearby queries, are then
+// mostly a few cache lines away, not anywhere in tens of megabytes.
+template <int D>
+std::vector<std::int32_t> MortonOrder(std::span<const double> points,
+                                      const std::vector<std::int32_t>& verts,
+                                      const std::array<double, 4>& lower,
+                                      const std::array<double, 4>& upper) {
+  constexpr std::size_t K = D + 1;
+  const std::size_t simplex_count = verts.size() / K;
+  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(simplex_count);
+  constexpr int kBits = 64 / D;
+  const double levels = static_cast<double>((std::uint64_t{1} << kBits) - 1);
+  for (std::size_t s = 0; s < simplex_count; ++s) {
+    std::uint64_t q[D];
+    for (std::size_t i = 0; i < D; ++i) {
+      double c = 0;
+      for (std::size_t m = 0; m < K; ++m) c += PointAt<D>(points, verts[s * K + m])[i];
+      const double extent = upper[i] - lower[i];
+      const double t = extent > 0 ? (c / K - lower[i]) / extent : 0.0;
+      q[i] = static_cast<std::uint64_t>(std::clamp(t, 0.0, 1.0) * levels);
+    }
+    std::uint64_t key = 0;
+    for (int bit = kBits - 1; bit >= 0; --bit) {
+      for (std::size_t i = 0; i < D; ++i) key = (key << 1) | ((q[i] >> bit) & 1);
+    }
+    keyed[s] = {key, static_cast<std::int32_t>(s)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::int32_t> order(simplex_count);
+  for (std::size_t s = 0; s < simplex_count; ++s) order[s] = keyed[s].second;
+  return order;
+}
+
 }  // namespace
 
 template <>
@@ -174,79 +229,13 @@ Result<SimplexLocator> SimplexLocator::Build(std::span<const double> points, int
 template <int D>
 Result<SimplexLocator> SimplexLocator::BuildFor(std::span<const double> points,
                                                 const QhullTriangulation& triangulation) {
-  constexpr std::size_t K = D + 1;
-  const auto& verts = triangulation.vertices;
-  const auto& nbrs = triangulation.neighbours;
-  const std::size_t simplex_count = verts.size() / K;
-  const auto point = [&](std::int32_t v) { return &points[static_cast<std::size_t>(v) * D]; };
-
+  const std::size_t simplex_count = triangulation.vertices.size() / (D + 1);
   SimplexLocator loc;
   loc.dims_ = D;
   loc.simplex_count_ = simplex_count;
-
-  // Bounding box of the triangulated points.
-  for (int i = 0; i < D; ++i) {
-    loc.lower_[i] = std::numeric_limits<double>::infinity();
-    loc.upper_[i] = -std::numeric_limits<double>::infinity();
-  }
-  for (std::int32_t v : verts) {
-    for (int i = 0; i < D; ++i) {
-      loc.lower_[i] = std::min(loc.lower_[i], point(v)[i]);
-      loc.upper_[i] = std::max(loc.upper_[i], point(v)[i]);
-    }
-  }
-
-  // Order simplices along a Morton curve through their centroids: a walk's next simplex, and
-  // the simplices of nearby queries, are then mostly a few cache lines away, not anywhere in
-  // tens of megabytes.
-  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(simplex_count);
-  constexpr int kBits = 64 / D;
-  const double levels = static_cast<double>((std::uint64_t{1} << kBits) - 1);
-  for (std::size_t s = 0; s < simplex_count; ++s) {
-    std::uint64_t q[D];
-    for (int i = 0; i < D; ++i) {
-      double c = 0;
-      for (std::size_t m = 0; m < K; ++m) c += point(verts[s * K + m])[i];
-      const double extent = loc.upper_[i] - loc.lower_[i];
-      const double t = extent > 0 ? (c / K - loc.lower_[i]) / extent : 0.0;
-      q[i] = static_cast<std::uint64_t>(std::clamp(t, 0.0, 1.0) * levels);
-    }
-    std::uint64_t key = 0;
-    for (int bit = kBits - 1; bit >= 0; --bit) {
-      for (int i = 0; i < D; ++i) key = (key << 1) | ((q[i] >> bit) & 1);
-    }
-    keyed[s] = {key, static_cast<std::int32_t>(s)};
-  }
-  std::sort(keyed.begin(), keyed.end());
-  std::vector<std::int32_t> new_index(simplex_count);
-  for (std::size_t s = 0; s < simplex_count; ++s) {
-    new_index[static_cast<std::size_t>(keyed[s].second)] = static_cast<std::int32_t>(s);
-  }
-
-  // Records in curve order: topology (renumbered) and barycentric transforms.
-  auto& records = loc.records<D>();
-  records.resize(simplex_count);
-  for (std::size_t s = 0; s < simplex_count; ++s) {
-    const auto old = static_cast<std::size_t>(keyed[s].second);
-    Record<D>& r = records[s];
-    for (std::size_t m = 0; m < K; ++m) {
-      r.vertices[m] = verts[old * K + m];
-      const std::int32_t n = nbrs[old * K + m];
-      r.neighbours[m] = n < 0 ? -1 : new_index[static_cast<std::size_t>(n)];
-    }
-    const double* last = point(r.vertices[D]);
-    double edges[D * D];
-    for (int j = 0; j < D; ++j) {
-      const double* vj = point(r.vertices[j]);
-      for (int i = 0; i < D; ++i) edges[i * D + j] = vj[i] - last[i];
-    }
-    const double rcond = InvertMatrix(D, edges, r.transform);
-    for (int i = 0; i < D; ++i) r.transform[D * D + i] = last[i];
-    if (rcond < kFlatRcond) {
-      r.transform[0] = std::numeric_limits<double>::quiet_NaN();
-      ++loc.degenerate_count_;
-    }
-  }
+  BoundingBox<D>(points, triangulation.vertices, loc.lower_, loc.upper_);
+  loc.BuildRecords<D>(points, triangulation,
+                      MortonOrder<D>(points, triangulation.vertices, loc.lower_, loc.upper_));
   if (loc.degenerate_count_ == simplex_count) {
     return InvalidArgument("Delaunay point location: all " + std::to_string(simplex_count) +
                            " simplices are flat; the samples lie on a hyperplane");
@@ -257,6 +246,45 @@ Result<SimplexLocator> SimplexLocator::BuildFor(std::span<const double> points,
       64 + 16 * static_cast<int>(std::ceil(std::pow(static_cast<double>(simplex_count), 1.0 / D)));
   loc.BuildGrid<D>(points.size() / D);
   return loc;
+}
+
+// Records in curve order (`order`: the triangulation's simplex at each place): topology
+// (renumbered) and barycentric transforms; flat simplices counted.
+template <int D>
+void SimplexLocator::BuildRecords(std::span<const double> points,
+                                  const QhullTriangulation& triangulation,
+                                  const std::vector<std::int32_t>& order) {
+  constexpr std::size_t K = D + 1;
+  const auto& verts = triangulation.vertices;
+  const auto& nbrs = triangulation.neighbours;
+  const std::size_t simplex_count = order.size();
+  std::vector<std::int32_t> new_index(simplex_count);
+  for (std::size_t s = 0; s < simplex_count; ++s) {
+    new_index[static_cast<std::size_t>(order[s])] = static_cast<std::int32_t>(s);
+  }
+  auto& recs = records<D>();
+  recs.resize(simplex_count);
+  for (std::size_t s = 0; s < simplex_count; ++s) {
+    const auto old = static_cast<std::size_t>(order[s]);
+    Record<D>& r = recs[s];
+    for (std::size_t m = 0; m < K; ++m) {
+      r.vertices[m] = verts[old * K + m];
+      const std::int32_t n = nbrs[old * K + m];
+      r.neighbours[m] = n < 0 ? -1 : new_index[static_cast<std::size_t>(n)];
+    }
+    const double* last = PointAt<D>(points, r.vertices[D]);
+    double edges[D * D];
+    for (int j = 0; j < D; ++j) {
+      const double* vj = PointAt<D>(points, r.vertices[j]);
+      for (int i = 0; i < D; ++i) edges[i * D + j] = vj[i] - last[i];
+    }
+    const double rcond = InvertMatrix(D, edges, r.transform);
+    for (int i = 0; i < D; ++i) r.transform[D * D + i] = last[i];
+    if (rcond < kFlatRcond) {
+      r.transform[0] = std::numeric_limits<double>::quiet_NaN();
+      ++degenerate_count_;
+    }
+  }
 }
 
 bool SimplexLocator::IsDegenerate(std::int32_t simplex) const {

@@ -83,6 +83,9 @@ class SimplexLocator {
   template <int D>
   static Result<SimplexLocator> BuildFor(std::span<const double> points,
                                          const QhullTriangulation& triangulation);
+  template <int D>
+  void BuildRecords(std::span<const double> points, const QhullTriangulation& triangulation,
+                    const std::vector<std::int32_t>& order);
   bool IsDegenerate(std::int32_t simplex) const;
   std::int32_t GridStart(const double* x) const;
   bool InBounds(const double* x) const;

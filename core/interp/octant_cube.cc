@@ -214,15 +214,13 @@ __attribute__((target("avx512f"))) inline __m512d Det3x8(const __m512d* c0, cons
   return _mm512_add_pd(_mm512_sub_pd(t0, t1), t2);
 }
 
-// Barycentric (barycentric.cc) for the five tetrahedra of kTetrahedra at once, lane t for
-// tetrahedron t (lanes 5–7 repeat tetrahedron 0 and are ignored). Every lane performs exactly
-// the scalar function's operations, in its order, each rounded (no fused multiply-add: the
-// products are pinned); the scalar function's early exits skip work whose outcome they already
-// know, so computing everything and reading the verdict at the end gives the same answer.
-// x[j]: coordinate j of the winners, lane o for orthant o; rank: the winners' ranks by orthant.
-__attribute__((target("avx512f"), always_inline)) inline OctantBlend Blend3Avx512(
-    const __m512d (&x)[3], const std::uint32_t* rank, const double* p) {
-  OctantBlend out;
+// The phases of Blend3Avx512, inlined into it.
+#define BRDF_AVX512_PHASE __attribute__((target("avx512f"), always_inline)) inline
+
+// The five tetrahedra's edges e_k = v_{k+1} − v_0 (columns), their squared lengths, and
+// r = p − v_0, lane t for tetrahedron t. x[j]: coordinate j of the winners, lane o for orthant o.
+BRDF_AVX512_PHASE void TetrahedraEdges512(const __m512d (&x)[3], const double* p,
+                                          __m512d (&e)[3][3], __m512d (&len2)[3], __m512d (&r)[3]) {
   // Vertex k of tetrahedron t: orthant kTetrahedra[t].corners[k].
   const __m512i corner[4] = {
       _mm512_set_epi64(0, 0, 0, 0, 3, 0, 0, 0),  // lanes 7..0
@@ -234,13 +232,8 @@ __attribute__((target("avx512f"), always_inline)) inline OctantBlend Blend3Avx51
   for (int k = 0; k < 4; ++k) {
     for (int j = 0; j < 3; ++j) v[k][j] = _mm512_maskz_permutexvar_pd(0xFF, corner[k], x[j]);
   }
-  const __m512d zero = _mm512_setzero_pd();
-  // Edges e_k = v_{k+1} − v_0 (columns), their squared lengths, r = p − v_0.
-  __m512d e[3][3];
-  __m512d len2[3];
-  __m512d r[3];
   for (int k = 0; k < 3; ++k) {
-    __m512d sum = zero;
+    __m512d sum = _mm512_setzero_pd();
     for (int j = 0; j < 3; ++j) {
       e[k][j] = _mm512_sub_pd(v[k + 1][j], v[0][j]);
       sum = _mm512_add_pd(sum, Mul8(e[k][j], e[k][j]));
@@ -248,8 +241,10 @@ __attribute__((target("avx512f"), always_inline)) inline OctantBlend Blend3Avx51
     len2[k] = sum;
   }
   for (int j = 0; j < 3; ++j) r[j] = _mm512_sub_pd(_mm512_set1_pd(p[j]), v[0][j]);
-  const __m512d det = Det3x8(e[0], e[1], e[2]);
-  // The degenerate test, as Barycentric does it.
+}
+
+// The degenerate test, as Barycentric does it: the tetrahedra (bits 0–4) too flat to use.
+BRDF_AVX512_PHASE unsigned FlatTetrahedra512(__m512d det, const __m512d (&len2)[3]) {
   const __m512d product = Mul8(Mul8(Mul8(_mm512_set1_pd(1.0), len2[0]), len2[1]), len2[2]);
   const __m512d abs_det = _mm512_abs_pd(det);
   const __mmask8 quick_range = _mm512_cmp_pd_mask(product, _mm512_set1_pd(1e-280), _CMP_GT_OQ) &
@@ -273,14 +268,19 @@ __attribute__((target("avx512f"), always_inline)) inline OctantBlend Blend3Avx51
     exact_ok = _mm512_cmp_pd_mask(
         abs_det, Mul8(_mm512_set1_pd(kDegenerateRelativeVolume), hadamard), _CMP_GT_OQ);
   }
-  const auto flat = static_cast<unsigned>(static_cast<__mmask8>(~(quick_ok | exact_ok))) & 0x1Fu;
-  // Cramer's rule: μ_k = det(edges with e_k replaced by r) / det; outside when some weight is
-  // below −tolerance. The numerators for every lane; the divisions (slow for 8 lanes on some
-  // CPUs) only for the lanes Barycentric's shortcut leaves open: a numerator of the other sign
-  // than det, larger than 2·tolerance·|det|, means outside (kept as it is for the rare inputs
-  // where rounding could make it disagree with the division). Most tetrahedra of a cube are
-  // decided by it; about one lane per query is divided, in the scalar code's order.
-  alignas(64) double numerator[3][8];
+  return static_cast<unsigned>(static_cast<__mmask8>(~(quick_ok | exact_ok))) & 0x1Fu;
+}
+
+// Cramer's rule: μ_k = det(edges with e_k replaced by r) / det; outside when some weight is
+// below −tolerance. The numerators for every lane; the divisions (slow for 8 lanes on some
+// CPUs) only for the lanes Barycentric's shortcut leaves open: a numerator of the other sign
+// than det, larger than 2·tolerance·|det|, means outside (kept as it is for the rare inputs
+// where rounding could make it disagree with the division). Most tetrahedra of a cube are
+// decided by it; about one lane per query is divided. Returns the lanes it decides ("cut").
+BRDF_AVX512_PHASE unsigned CramerNumerators512(const __m512d (&e)[3][3], const __m512d (&r)[3],
+                                               __m512d det, double (&numerator)[3][8]) {
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512d abs_det = _mm512_abs_pd(det);
   __mmask8 cut = 0;
   for (int k = 0; k < 3; ++k) {
     const __m512d* c0 = k == 0 ? r : e[0];
@@ -294,10 +294,33 @@ __attribute__((target("avx512f"), always_inline)) inline OctantBlend Blend3Avx51
                               Mul8(_mm512_set1_pd(2.0 * kEnclosingTolerance), abs_det), _CMP_GT_OQ);
     _mm512_store_pd(numerator[k], n);
   }
+  return cut;
+}
+
+#undef BRDF_AVX512_PHASE
+
+// Barycentric (barycentric.cc) for the five tetrahedra of kTetrahedra at once, lane t for
+// tetrahedron t (lanes 5–7 repeat tetrahedron 0 and are ignored). Every lane performs exactly
+// the scalar function's operations, in its order, each rounded (no fused multiply-add: the
+// products are pinned); the scalar function's early exits skip work whose outcome they already
+// know, so computing everything and reading the verdict at the end gives the same answer.
+// x[j]: coordinate j of the winners, lane o for orthant o; rank: the winners' ranks by orthant.
+__attribute__((target("avx512f"), always_inline)) inline OctantBlend Blend3Avx512(
+    const __m512d (&x)[3], const std::uint32_t* rank, const double* p) {
+  OctantBlend out;
+  __m512d e[3][3];
+  __m512d len2[3];
+  __m512d r[3];
+  TetrahedraEdges512(x, p, e, len2, r);
+  const __m512d det = Det3x8(e[0], e[1], e[2]);
+  const unsigned flat = FlatTetrahedra512(det, len2);
+  alignas(64) double numerator[3][8];
+  const unsigned cut = CramerNumerators512(e, r, det, numerator);
   alignas(64) double determinant[8];
   _mm512_store_pd(determinant, det);
+  // The divisions, in the scalar code's order, for the open tetrahedra (about one per query).
   double lambda[4];
-  for (unsigned open = ~(static_cast<unsigned>(cut) | flat) & 0x1Fu; open != 0; open &= open - 1) {
+  for (unsigned open = ~(cut | flat) & 0x1Fu; open != 0; open &= open - 1) {
     const int t = std::countr_zero(open);
     double sum_mu = 0.0;
     bool inside = true;

@@ -164,9 +164,9 @@ class OrthantGrid {
     std::uint32_t count = kNoList;
     std::uint32_t need = 0;
   };
+  // Builds the lists (orthant_grid.cc): the box, the points in buckets, then cell by cell.
   template <int D>
-  void Build(const PointCloud& cloud, const std::vector<std::uint32_t>& position_of,
-             const Search& search, const Options& options);
+  class Builder;
 
   int dims_ = 0;
   std::size_t cells_ = 0;

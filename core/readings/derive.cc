@@ -56,50 +56,55 @@ SampleQuantities ReadingDeriver::Derive(const Reading& r) {
     FailAll(out, valid.message());
     return out;
   }
-  if (!grid_.has_value()) {
-    grid_ = r.spectrum.grid;
-    if (white_spectrum_.has_value()) {
-      Result<Spectrum> on_grid = Resample(*white_spectrum_, *grid_);
-      if (!on_grid.ok()) {
-        on_grid = InvalidArgument(
-            "the white standard's ρw spectrum (" + std::to_string(white_spectrum_->grid.start_nm) +
-            "–" + std::to_string(white_spectrum_->grid.last_nm()) +
-            " nm) does not cover the session's grid: " + on_grid.status().message());
-      }
-      white_on_grid_ = std::move(on_grid);
-    }
-  }
+  if (!grid_.has_value()) AdoptGrid(r.spectrum.grid);
   if (!(r.spectrum.grid == *grid_)) {
     FailAll(out, Name(r) + ": its wavelength grid differs from the session's first sample reading");
     return out;
   }
-
-  const Spectrum* dark = nullptr;
-  if (r.dark_id.has_value()) {
-    auto it = darks_.find(*r.dark_id);
-    const std::string which = Name(r) + ": its dark reading " + std::to_string(*r.dark_id);
-    if (it == darks_.end()) {
-      FailAll(out, which + " is not a dark reading of this session");
-      return out;
-    }
-    if (!(it->second.grid == r.spectrum.grid)) {
-      FailAll(out, which + " is on another wavelength grid");
-      return out;
-    }
-    if (Status valid = ValidateSpectrum(it->second, "dark reading " + std::to_string(*r.dark_id));
-        !valid.ok()) {
-      FailAll(out, Name(r) + ": " + valid.message());
-      return out;
-    }
-    dark = &it->second;
+  const Result<const Spectrum*> dark = DarkOf(r);
+  if (!dark.ok()) {
+    FailAll(out, dark.status().message());
+    return out;
   }
-
   std::vector<double>& radiance = out.values[static_cast<int>(Quantity::kRadiance)];
   radiance = r.spectrum.values;
-  if (dark != nullptr) {
-    for (std::size_t b = 0; b < radiance.size(); ++b) radiance[b] -= dark->values[b];
+  if (*dark != nullptr) {
+    for (std::size_t b = 0; b < radiance.size(); ++b) radiance[b] -= (*dark)->values[b];
   }
+  DeriveReflectanceAndBrdf(r, *dark, out);
+  return out;
+}
 
+void ReadingDeriver::AdoptGrid(const WavelengthGrid& grid) {
+  grid_ = grid;
+  if (!white_spectrum_.has_value()) return;
+  Result<Spectrum> on_grid = Resample(*white_spectrum_, *grid_);
+  if (!on_grid.ok()) {
+    on_grid = InvalidArgument(
+        "the white standard's ρw spectrum (" + std::to_string(white_spectrum_->grid.start_nm) +
+        "–" + std::to_string(white_spectrum_->grid.last_nm()) +
+        " nm) does not cover the session's grid: " + on_grid.status().message());
+  }
+  white_on_grid_ = std::move(on_grid);
+}
+
+Result<const Spectrum*> ReadingDeriver::DarkOf(const Reading& r) const {
+  if (!r.dark_id.has_value()) return static_cast<const Spectrum*>(nullptr);
+  auto it = darks_.find(*r.dark_id);
+  const std::string which = Name(r) + ": its dark reading " + std::to_string(*r.dark_id);
+  if (it == darks_.end()) return InvalidArgument(which + " is not a dark reading of this session");
+  if (!(it->second.grid == r.spectrum.grid)) {
+    return InvalidArgument(which + " is on another wavelength grid");
+  }
+  if (Status valid = ValidateSpectrum(it->second, "dark reading " + std::to_string(*r.dark_id));
+      !valid.ok()) {
+    return InvalidArgument(Name(r) + ": " + valid.message());
+  }
+  return &it->second;
+}
+
+void ReadingDeriver::DeriveReflectanceAndBrdf(const Reading& r, const Spectrum* dark,
+                                              SampleQuantities& out) const {
   const Reference* ref = nullptr;
   if (r.reference_id.has_value()) {
     auto it = references_.find(*r.reference_id);
@@ -113,19 +118,19 @@ SampleQuantities ReadingDeriver::Derive(const Reading& r) {
                                 : Name(r) + ": it names no reference reading";
     Fail(out, Quantity::kReflectance, why);
     Fail(out, Quantity::kBrdf, why);
-    return out;
+    return;
   }
   Result<Spectrum> reflectance = dark != nullptr ? Reflectance(r.spectrum, ref->spectrum, *dark)
                                                  : Reflectance(r.spectrum, ref->spectrum);
   if (!reflectance.ok()) {
     Fail(out, Quantity::kReflectance, Name(r) + ": " + reflectance.status().message());
     Fail(out, Quantity::kBrdf, Name(r) + ": " + reflectance.status().message());
-    return out;
+    return;
   }
   if (white_on_grid_.has_value() && !white_on_grid_->ok()) {
     Fail(out, Quantity::kBrdf, Name(r) + ": " + white_on_grid_->status().message());
     out.values[static_cast<int>(Quantity::kReflectance)] = std::move(reflectance->values);
-    return out;
+    return;
   }
   Result<Spectrum> brdf =
       white_on_grid_.has_value()
@@ -135,10 +140,9 @@ SampleQuantities ReadingDeriver::Derive(const Reading& r) {
   out.values[static_cast<int>(Quantity::kReflectance)] = std::move(reflectance->values);
   if (!brdf.ok()) {
     Fail(out, Quantity::kBrdf, Name(r) + ": " + brdf.status().message());
-    return out;
+    return;
   }
   out.values[static_cast<int>(Quantity::kBrdf)] = std::move(brdf->values);
-  return out;
 }
 
 }  // namespace brdf

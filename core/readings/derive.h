@@ -65,6 +65,13 @@ class ReadingDeriver {
     double theta_i = 0;  // incidence at which the white was read (θi,ref)
   };
   SampleQuantities Derive(const Reading& sample);
+  // The session's grid from the first sample reading, and ρw(λ) on it (or why not).
+  void AdoptGrid(const WavelengthGrid& grid);
+  // The sample's dark reading (nullptr when it names none), or why it cannot be used.
+  Result<const Spectrum*> DarkOf(const Reading& sample) const;
+  // Reflectance and BRDF of a sample whose radiance is in `out`, or why not.
+  void DeriveReflectanceAndBrdf(const Reading& sample, const Spectrum* dark,
+                                SampleQuantities& out) const;
 
   double white_reflectance_;
   std::optional<Spectrum> white_spectrum_;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <optional>
 #include <utility>
 
 #include "drivers/stage/modbus_errors.h"
@@ -104,89 +105,22 @@ class ModbusBus::Link {
 
   // One request with the bounded retry policy of the header.
   Status Execute(Job& job) {
-    int timeouts = 0, busy = 0, garbled = 0, relinks = 0;
-    SteadyClock::time_point busy_since;
-    milliseconds busy_backoff = config_.busy_backoff;
+    Retries retries;
+    retries.busy_backoff = config_.busy_backoff;
     const std::string what = description_ + " " + job.What();
     while (true) {
       if (job.GivenUp() || stopping_) return GaveUp(job);
       if (!connected_) {
-        if (relinks++ > config_.reconnect_attempts) {
+        if (retries.relinks++ > config_.reconnect_attempts) {
           return Disconnected(what + ": the link keeps dropping; check the cabling and the drive");
         }
         BRDF_RETURN_IF_ERROR(Connect(job, false).WithContext(what));
       }
-      modbus_flush(ctx_);  // nothing left over from an earlier exchange may answer this one
-      modbus_set_slave(ctx_, job.unit);
-      SetResponseTimeout(job);
-      errno = 0;
-      int rc = -1;
-      int expected = 0;
-      if (job.kind == Job::Kind::kRead) {
-        job.data.assign(static_cast<std::size_t>(job.count), 0);
-        expected = job.count;
-        rc = modbus_read_registers(ctx_, job.address, job.count, job.data.data());
-      } else if (job.values.size() == 1) {
-        expected = 1;
-        rc = modbus_write_register(ctx_, job.address, job.values[0]);
-      } else {
-        expected = static_cast<int>(job.values.size());
-        rc = modbus_write_registers(ctx_, job.address, expected, job.values.data());
-      }
-      if (rc == expected) return Status::Ok();
-      const int err = rc < 0 ? errno : EMBBADDATA;
-      const std::string problem = what + ": " + ModbusErrorText(err);
-      switch (ClassifyModbusErrno(err)) {
-        case ModbusFailure::kIllegalRequest:
-          return {StatusCode::kConfigurationError,
-                  problem + " (exception " + std::to_string(ModbusExceptionCode(err)) +
-                      "); the drive does not accept this register or value: check the register "
-                      "profile and the unit id",
-                  ModbusExceptionCode(err)};
-        case ModbusFailure::kBusy: {
-          const auto now = SteadyClock::now();
-          if (busy++ == 0) busy_since = now;
-          if (now - busy_since >= config_.busy_window) {
-            const int code = ModbusExceptionCode(err);
-            return DeviceError(
-                code, problem + " (exception " + std::to_string(code) + ", " +
-                          std::to_string(busy) + " answers over " +
-                          std::to_string(config_.busy_window.count()) + " ms, the stage's " +
-                          "busy_window_ms); the drive stays busy or refuses to execute: check "
-                          "the drive's display or alarm log");
-          }
-          if (!Sleep(busy_backoff, job)) return GaveUp(job);
-          busy_backoff = std::min(busy_backoff * 2, config_.busy_backoff_max);
-          continue;
-        }
-        case ModbusFailure::kDeviceException:
-          return DeviceError(ModbusExceptionCode(err),
-                             problem + " (exception " + std::to_string(ModbusExceptionCode(err)) +
-                                 "); check the drive's display or alarm log");
-        case ModbusFailure::kTimeout:
-          DiscardStrayReplies(job);
-          if (++timeouts > config_.timeout_retries) {
-            return Timeout(problem + " (no reply within " +
-                           std::to_string(config_.response_timeout.count()) + " ms, " +
-                           std::to_string(timeouts) +
-                           " attempts); check the unit id, the cabling and the drive's power");
-          }
-          continue;
-        case ModbusFailure::kStaleOrGarbled:
-          DiscardStrayReplies(job);
-          if (++garbled > config_.garbled_retries) {
-            return ProtocolError(problem + " (" + std::to_string(garbled) +
-                                 " replies did not match their request); check for another "
-                                 "master on the bus, the baud rate and the parity");
-          }
-          continue;
-        case ModbusFailure::kLinkDown:
-          Drop();  // the next round reconnects, bounded
-          continue;
-        case ModbusFailure::kOther:
-          Drop();
-          return IoError(problem + "; the local system refused the request");
-      }
+      int err = 0;
+      if (Transfer(job, err)) return Status::Ok();
+      std::optional<Status> verdict =
+          AfterFailure(job, err, what + ": " + ModbusErrorText(err), retries);
+      if (verdict.has_value()) return *std::move(verdict);
     }
   }
 
@@ -199,6 +133,98 @@ class ModbusBus::Link {
   }
 
  private:
+  // What the retry policy has counted so far for one request.
+  struct Retries {
+    int timeouts = 0, busy = 0, garbled = 0, relinks = 0;
+    SteadyClock::time_point busy_since;
+    milliseconds busy_backoff{};
+  };
+
+  // One exchange on the connected link: true when the drive answered the whole request; else
+  // the errno (EMBBADDATA for a short answer) in `err`.
+  bool Transfer(Job& job, int& err) {
+    modbus_flush(ctx_);  // nothing left over from an earlier exchange may answer this one
+    modbus_set_slave(ctx_, job.unit);
+    SetResponseTimeout(job);
+    errno = 0;
+    int rc = -1;
+    int expected = 0;
+    if (job.kind == Job::Kind::kRead) {
+      job.data.assign(static_cast<std::size_t>(job.count), 0);
+      expected = job.count;
+      rc = modbus_read_registers(ctx_, job.address, job.count, job.data.data());
+    } else if (job.values.size() == 1) {
+      expected = 1;
+      rc = modbus_write_register(ctx_, job.address, job.values[0]);
+    } else {
+      expected = static_cast<int>(job.values.size());
+      rc = modbus_write_registers(ctx_, job.address, expected, job.values.data());
+    }
+    if (rc == expected) return true;
+    err = rc < 0 ? errno : EMBBADDATA;
+    return false;
+  }
+
+  // A failed exchange (`problem` names it): the Status to return, or nullopt to try again
+  // (busy within its window, a timeout or garbled reply within its retries, a dropped link).
+  std::optional<Status> AfterFailure(Job& job, int err, const std::string& problem, Retries& r) {
+    switch (ClassifyModbusErrno(err)) {
+      case ModbusFailure::kIllegalRequest:
+        return Status{StatusCode::kConfigurationError,
+                      problem + " (exception " + std::to_string(ModbusExceptionCode(err)) +
+                          "); the drive does not accept this register or value: check the "
+                          "register profile and the unit id",
+                      ModbusExceptionCode(err)};
+      case ModbusFailure::kBusy:
+        return AfterBusy(job, err, problem, r);
+      case ModbusFailure::kDeviceException:
+        return DeviceError(ModbusExceptionCode(err),
+                           problem + " (exception " + std::to_string(ModbusExceptionCode(err)) +
+                               "); check the drive's display or alarm log");
+      case ModbusFailure::kTimeout:
+        DiscardStrayReplies(job);
+        if (++r.timeouts > config_.timeout_retries) {
+          return Timeout(problem + " (no reply within " +
+                         std::to_string(config_.response_timeout.count()) + " ms, " +
+                         std::to_string(r.timeouts) +
+                         " attempts); check the unit id, the cabling and the drive's power");
+        }
+        return std::nullopt;
+      case ModbusFailure::kStaleOrGarbled:
+        DiscardStrayReplies(job);
+        if (++r.garbled > config_.garbled_retries) {
+          return ProtocolError(problem + " (" + std::to_string(r.garbled) +
+                               " replies did not match their request); check for another "
+                               "master on the bus, the baud rate and the parity");
+        }
+        return std::nullopt;
+      case ModbusFailure::kLinkDown:
+        Drop();  // the next round reconnects, bounded
+        return std::nullopt;
+      case ModbusFailure::kOther:
+        Drop();
+        return IoError(problem + "; the local system refused the request");
+    }
+    return std::nullopt;
+  }
+
+  // The drive answered busy: wait (backing off) and try again, until busy_window has passed.
+  std::optional<Status> AfterBusy(Job& job, int err, const std::string& problem, Retries& r) {
+    const auto now = SteadyClock::now();
+    if (r.busy++ == 0) r.busy_since = now;
+    if (now - r.busy_since >= config_.busy_window) {
+      const int code = ModbusExceptionCode(err);
+      return DeviceError(code, problem + " (exception " + std::to_string(code) + ", " +
+                                   std::to_string(r.busy) + " answers over " +
+                                   std::to_string(config_.busy_window.count()) +
+                                   " ms, the stage's busy_window_ms); the drive stays busy or "
+                                   "refuses to execute: check the drive's display or alarm log");
+    }
+    if (!Sleep(r.busy_backoff, job)) return GaveUp(job);
+    r.busy_backoff = std::min(r.busy_backoff * 2, config_.busy_backoff_max);
+    return std::nullopt;
+  }
+
   bool is_rtu() const { return std::holds_alternative<RtuEndpoint>(config_.endpoint); }
 
   Status Create() {

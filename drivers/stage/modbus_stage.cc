@@ -48,6 +48,11 @@ bool GaveUp(const Status& st, const CallContext& ctx) {
          (st.code() == StatusCode::kTimeout && ctx.expired());
 }
 
+// " while moving to 12.5°" / " while homing", for messages about an axis in motion.
+std::string Where(const std::optional<double>& target_deg) {
+  return target_deg ? " while moving to " + Deg(*target_deg) : std::string(" while homing");
+}
+
 }  // namespace
 
 class ModbusStage::MotionGuard {
@@ -294,10 +299,6 @@ Status ModbusStage::WaitForMotion(std::vector<Motion>& motions, const CallContex
   std::vector<const AxisIo*> all;
   for (const Motion& m : motions) all.push_back(m.io);
   const Clock& clock = ctx.clock();
-  auto where = [&](const Motion& m) {
-    return m.target_deg ? " while moving to " + Deg(*m.target_deg) : std::string(" while homing");
-  };
-
   while (true) {
     if (ctx.cancelled()) {
       return Cancelled(std::string("stage: ") + what + " cancelled (" + ctx.cancel().reason() +
@@ -311,66 +312,82 @@ Status ModbusStage::WaitForMotion(std::vector<Motion>& motions, const CallContex
     bool gave_up = false;
     for (Motion& m : motions) {
       if (m.done) continue;
-      auto status = m.io->ReadStatus(ctx);
-      if (!status.ok()) {
-        if (GaveUp(status.status(), ctx)) {
-          gave_up = true;
-          break;
-        }
-        return Status(status.status().code(),
-                      std::string("stage: polling during the ") + what + ": " +
-                          status.status().message() + StopAfterFailure(all, clock),
-                      status.status().device_code());
-      }
-      const Clock::TimePoint now = clock.Now();
-      if (status->flags.alarm) {
-        std::vector<const AxisIo*> others;
-        for (const AxisIo* io : all) {
-          if (io != m.io) others.push_back(io);
-        }
-        return DeviceError(status->alarm_code, m.io->name() + " raised alarm " +
-                                                   AlarmHex(status->alarm_code) + where(m) +
-                                                   StopAfterFailure(others, clock) +
-                                                   "; remove the cause, then call ResetAlarm(" +
-                                                   AxisName(m.io->axis()) + ")");
-      }
-      if (MoveComplete(status->flags)) {
-        if (!m.target_deg) {
-          // Homing: trust IN-POS once the drive had time to raise MOVE.
-          m.done = now - m.started >= config_.start_grace;
-        } else {
-          auto pos = m.io->ReadPositionDeg(ctx);
-          if (!pos.ok()) {
-            if (GaveUp(pos.status(), ctx)) {
-              gave_up = true;
-              break;
-            }
-            return pos.status().WithContext(std::string("stage: ") + what);
-          }
-          if (std::abs(*pos - *m.target_deg) <= config_.position_tolerance_deg) {
-            m.done = true;
-          } else if (now - m.started >= config_.start_grace) {
-            return DeviceError(0, m.io->name() + " stopped at " + Deg(*pos) +
-                                      " short of its target " + Deg(*m.target_deg) +
-                                      " without an alarm (stopped at the "
-                                      "drive or by another master?)" +
-                                      StopAfterFailure(all, clock) + "; move again");
-          }
-        }
-      }
-      if (!m.done && now >= m.timeout_at) {
-        const double allowed = duration<double>(m.timeout_at - m.started).count();
-        return Timeout(m.io->name() + " did not finish" + where(m) + " within " +
-                       std::to_string(allowed) + " s (expected " + std::to_string(m.expected_s) +
-                       " s plus margin)" + StopAfterFailure(all, clock) +
-                       "; check for a stall, an obstruction or a wrong speed setting");
-      }
+      BRDF_RETURN_IF_ERROR(PollMotion(m, all, ctx, what, gave_up));
+      if (gave_up) break;
       all_done = all_done && m.done;
     }
     if (gave_up) continue;  // the checks at the top report it
     if (all_done) return Status::Ok();
     clock.SleepFor(config_.poll_interval, &ctx.cancel());
   }
+}
+
+Status ModbusStage::PollMotion(Motion& m, const std::vector<const AxisIo*>& all,
+                               const CallContext& ctx, const char* what, bool& gave_up) {
+  const Clock& clock = ctx.clock();
+  auto status = m.io->ReadStatus(ctx);
+  if (!status.ok()) {
+    if (GaveUp(status.status(), ctx)) {
+      gave_up = true;
+      return Status::Ok();
+    }
+    return Status(status.status().code(),
+                  std::string("stage: polling during the ") + what + ": " +
+                      status.status().message() + StopAfterFailure(all, clock),
+                  status.status().device_code());
+  }
+  const Clock::TimePoint now = clock.Now();
+  if (status->flags.alarm) {
+    std::vector<const AxisIo*> others;
+    for (const AxisIo* io : all) {
+      if (io != m.io) others.push_back(io);
+    }
+    return DeviceError(status->alarm_code, m.io->name() + " raised alarm " +
+                                               AlarmHex(status->alarm_code) + Where(m.target_deg) +
+                                               StopAfterFailure(others, clock) +
+                                               "; remove the cause, then call ResetAlarm(" +
+                                               AxisName(m.io->axis()) + ")");
+  }
+  if (MoveComplete(status->flags)) {
+    BRDF_RETURN_IF_ERROR(CheckArrival(m, now, all, ctx, what, gave_up));
+    if (gave_up) return Status::Ok();
+  }
+  if (!m.done && now >= m.timeout_at) {
+    const double allowed = duration<double>(m.timeout_at - m.started).count();
+    return Timeout(m.io->name() + " did not finish" + Where(m.target_deg) + " within " +
+                   std::to_string(allowed) + " s (expected " + std::to_string(m.expected_s) +
+                   " s plus margin)" + StopAfterFailure(all, clock) +
+                   "; check for a stall, an obstruction or a wrong speed setting");
+  }
+  return Status::Ok();
+}
+
+Status ModbusStage::CheckArrival(Motion& m, Clock::TimePoint now,
+                                 const std::vector<const AxisIo*>& all, const CallContext& ctx,
+                                 const char* what, bool& gave_up) {
+  if (!m.target_deg) {
+    // Homing: trust IN-POS once the drive had time to raise MOVE.
+    m.done = now - m.started >= config_.start_grace;
+    return Status::Ok();
+  }
+  auto pos = m.io->ReadPositionDeg(ctx);
+  if (!pos.ok()) {
+    if (GaveUp(pos.status(), ctx)) {
+      gave_up = true;
+      return Status::Ok();
+    }
+    return pos.status().WithContext(std::string("stage: ") + what);
+  }
+  if (std::abs(*pos - *m.target_deg) <= config_.position_tolerance_deg) {
+    m.done = true;
+  } else if (now - m.started >= config_.start_grace) {
+    return DeviceError(0, m.io->name() + " stopped at " + Deg(*pos) + " short of its target " +
+                              Deg(*m.target_deg) +
+                              " without an alarm (stopped at the "
+                              "drive or by another master?)" +
+                              StopAfterFailure(all, ctx.clock()) + "; move again");
+  }
+  return Status::Ok();
 }
 
 Result<AxisState> ModbusStage::ReadAxis(Axis axis, const CallContext& ctx) {

@@ -96,6 +96,15 @@ class ModbusStage final : public RotationStage {
   Status PulseCommand(const std::vector<const AxisIo*>& axes, const CommandAction& command,
                       const char* command_name, const CallContext& ctx, BusPriority priority);
   Status WaitForMotion(std::vector<Motion>& motions, const CallContext& ctx, const char* what);
+  // One poll of a motion not yet done: its status, alarm, arrival and time limit. Ok when it is
+  // done or still under way; gave_up when the call was cancelled or ran out of time meanwhile
+  // (WaitForMotion's checks report it). `all`: the axes to stop after a failure.
+  Status PollMotion(Motion& m, const std::vector<const AxisIo*>& all, const CallContext& ctx,
+                    const char* what, bool& gave_up);
+  // The drive says the move is complete: homing counts once the start grace has passed; a move
+  // once the axis is within tolerance of its target (stopped short: an error).
+  Status CheckArrival(Motion& m, Clock::TimePoint now, const std::vector<const AxisIo*>& all,
+                      const CallContext& ctx, const char* what, bool& gave_up);
   // Best-effort stop of `axes` on a fresh, uncancelled context; returns "" or a note for messages.
   std::string StopAfterFailure(const std::vector<const AxisIo*>& axes, const Clock& clock);
   // Rejects a second MoveTo/Home while one is running.

@@ -125,15 +125,9 @@ std::string Percent(double v) {
   return b;
 }
 
-}  // namespace
-
-int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream& err) {
-  auto fail = [&err](const Status& s) {
-    err << "brdf-interp accuracy: " << s.message() << "\n";
-    return ExitCodeFor(s);
-  };
-  const WavelengthGrid wavelengths = WavelengthGrid::Pr650();
-  const std::string& which = request.sample;
+// The samples --sample names.
+Result<std::vector<KnownSample>> SamplesNamed(const std::string& which,
+                                              const WavelengthGrid& wavelengths) {
   std::vector<KnownSample> samples;
   if (which == "paint" || which == "both" || which == "all") {
     samples.push_back(
@@ -145,130 +139,205 @@ int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream&
   }
   if (which == "glossy-ct" || which == "all") samples.push_back(GlossyCookTorrance(wavelengths));
   if (samples.empty()) {
-    return fail(InvalidArgument("--sample '" + which +
-                                "': use paint, glossy, glossy-ct, both (paint and glossy) or all"));
+    return InvalidArgument("--sample '" + which +
+                           "': use paint, glossy, glossy-ct, both (paint and glossy) or all");
   }
+  return samples;
+}
+
+// How the methods are run: in each coordinate system, and in logs or not.
+struct Setup {
+  interp::Trend trend = interp::Trend::kNone;
+  bool log_blend = false;
+  interp::Options incidence, half;
+};
+
+Result<Setup> ReadSetup(const AccuracyRequest& request) {
+  Setup setup;
   Result<interp::Trend> trend = interp::ParseTrend(request.trend);
-  if (!trend.ok()) return fail(trend.status().WithContext("--trend"));
-  if (request.queries == 0) return fail(InvalidArgument("--queries: give at least one query"));
+  if (!trend.ok()) return trend.status().WithContext("--trend");
+  setup.trend = *trend;
+  if (request.queries == 0) return InvalidArgument("--queries: give at least one query");
   if (!(request.noise >= 0 && request.noise < 1)) {
-    return fail(InvalidArgument("--noise: a relative standard deviation in [0, 1), e.g. 0.01"));
+    return InvalidArgument("--noise: a relative standard deviation in [0, 1), e.g. 0.01");
   }
   if (request.blend != "linear" && request.blend != "log") {
-    return fail(InvalidArgument("--blend '" + request.blend + "': use linear or log"));
+    return InvalidArgument("--blend '" + request.blend + "': use linear or log");
   }
-  const bool log_blend = request.blend == "log";
-  interp::Options incidence;
-  incidence.mirror_phi = request.mirror_phi;
-  incidence.reciprocity = request.reciprocity;
-  incidence.trend = *trend;
-  interp::Options half = incidence;
-  half.coordinates = interp::Coordinates::kHalfDifference;
+  setup.log_blend = request.blend == "log";
+  setup.incidence.mirror_phi = request.mirror_phi;
+  setup.incidence.reciprocity = request.reciprocity;
+  setup.incidence.trend = *trend;
+  setup.half = setup.incidence;
+  setup.half.coordinates = interp::Coordinates::kHalfDifference;
   if (!request.scale.empty()) {
     Result<std::vector<double>> s = ParseNumberList(request.scale, "--scale");
-    if (!s.ok()) return fail(s.status());
-    incidence.axis_scale = *s;
+    if (!s.ok()) return s.status();
+    setup.incidence.axis_scale = *s;
   }
   if (!request.half_scale.empty()) {
     Result<std::vector<double>> s = ParseNumberList(request.half_scale, "--half-scale");
-    if (!s.ok()) return fail(s.status());
-    half.axis_scale = *s;
+    if (!s.ok()) return s.status();
+    setup.half.axis_scale = *s;
   }
+  return setup;
+}
 
+void PrintSetup(const AccuracyRequest& request, const Setup& setup, std::size_t grid_points,
+                const WavelengthGrid& wavelengths, std::size_t peak_band, std::ostream& out) {
+  out << "Paper's rig grid: " << grid_points << " points; " << request.queries
+      << " random rig poses (seed " << request.seed << ")"
+      << (request.mirror_phi ? "; mirror φ" : "") << (request.reciprocity ? "; reciprocity" : "")
+      << "; scales (θi, θo, φ) " << (request.scale.empty() ? "1,1,1" : request.scale)
+      << ", (θh·cos φd, θh·sin φd, θd) "
+      << (request.half_scale.empty() ? "1,1,1 (default)" : request.half_scale) << "; "
+      << (setup.log_blend ? "log blend (floor 1e-6 of each band's largest value)" : "linear blend")
+      << (setup.trend == interp::Trend::kBivariate ? "; bivariate trend" : "");
+  if (request.noise > 0) out << "; readings × (1 + " << request.noise << " · N(0, 1))";
+  out << "\n";
+  out << "peak: (" << kPeakQuery[0] << ", " << kPeakQuery[1] << ", " << kPeakQuery[2] << ") at "
+      << wavelengths.at(peak_band) << " nm; RMS over the queries every row answered\n";
+}
+
+// What the methods are judged against: the sample's spectra at the queries, and its value at the
+// peak query's band.
+struct Truth {
+  std::vector<double> spectra;  // queries × bands
+  double peak = 0;
+};
+
+Truth TruthOf(const KnownSample& sample, const std::vector<double>& queries, std::size_t bands,
+              std::size_t peak_band) {
+  const std::size_t n = queries.size() / 3;
+  Truth truth;
+  truth.spectra.resize(n * bands);
+  for (std::size_t q = 0; q < n; ++q) {
+    sample.spectrum({queries[3 * q], queries[3 * q + 1], queries[3 * q + 2]},
+                    std::span<double>(truth.spectra).subspan(q * bands, bands));
+  }
+  std::vector<double> peak_spectrum(bands);
+  sample.spectrum({kPeakQuery[0], kPeakQuery[1], kPeakQuery[2]}, peak_spectrum);
+  truth.peak = peak_spectrum[peak_band];
+  return truth;
+}
+
+// One method in one coordinate system on the sample's readings (`set`, or `log_set` when the
+// blend is in logs): its answers at the queries and its error at the peak.
+Result<Row> RunMethod(const char* method, const interp::Options& options, bool log_blend,
+                      const std::shared_ptr<interp::SampleSet>& set,
+                      const std::shared_ptr<interp::SampleSet>& log_set,
+                      const std::vector<double>& queries, std::size_t bands, std::size_t peak_band,
+                      double peak_truth) {
+  const std::size_t n = queries.size() / 3;
+  Row row{method, options.coordinates, std::vector<interp::InterpStatus>(n),
+          std::vector<double>(n * bands)};
+  const bool in_logs = log_blend && std::string(method) != "nearest";
+  auto made = MakeNamedInterpolator(method, in_logs ? log_set : set, options);
+  if (!made.ok()) return made.status();
+  (*made)->SpectraAt(queries, row.status, row.spectra);
+  for (interp::InterpStatus s : row.status) row.ok += s == interp::InterpStatus::kOk;
+  if (in_logs) {
+    for (double& v : row.spectra) v = std::exp(v);  // NaN rows stay NaN
+  }
+  std::vector<double> peak(bands);
+  if ((*made)->SpectrumAt(kPeakQuery, peak) == interp::InterpStatus::kOk) {
+    if (in_logs) {
+      for (double& v : peak) v = std::exp(v);
+    }
+    row.peak = (peak[peak_band] - peak_truth) / peak_truth;
+  }
+  return row;
+}
+
+// The common set: queries every row answered; and those of them near the peak.
+struct CommonQueries {
+  std::vector<bool> common, near_peak;
+  std::size_t common_count = 0, near_count = 0;
+};
+
+CommonQueries CommonOf(const std::vector<Row>& rows, const std::vector<double>& queries) {
+  const std::size_t n = queries.size() / 3;
+  CommonQueries c{std::vector<bool>(n, true), std::vector<bool>(n, false)};
+  for (std::size_t q = 0; q < n; ++q) {
+    for (const Row& r : rows) c.common[q] = c.common[q] && r.status[q] == interp::InterpStatus::kOk;
+    const double theta_h =
+        interp::ToHalfDifference({queries[3 * q], queries[3 * q + 1], queries[3 * q + 2]}).theta_h;
+    c.near_peak[q] = c.common[q] && theta_h < kNearPeakThetaHalfDeg;
+    c.common_count += c.common[q];
+    c.near_count += c.near_peak[q];
+  }
+  return c;
+}
+
+// The row's RMS error over the queries in `use`, relative to the truth's mean there.
+double RelativeRms(const Row& r, const std::vector<double>& truth, const std::vector<bool>& use,
+                   std::size_t bands) {
+  double sum = 0, mean = 0, count = 0;
+  for (std::size_t q = 0; q < use.size(); ++q) {
+    if (!use[q]) continue;
+    for (std::size_t b = 0; b < bands; ++b) {
+      const double d = r.spectra[q * bands + b] - truth[q * bands + b];
+      sum += d * d;
+      mean += truth[q * bands + b];
+      count += 1;
+    }
+  }
+  return count == 0 ? std::nan("") : std::sqrt(sum / count) / (mean / count);
+}
+
+void PrintTable(const std::string& name, const std::vector<Row>& rows,
+                const std::vector<double>& truth, const CommonQueries& c, std::size_t bands,
+                std::ostream& out) {
+  out << "\n"
+      << name << ": " << c.common_count << " common queries, " << c.near_count
+      << " of them with θh < " << kNearPeakThetaHalfDeg << "°\n";
+  out << "| method | coordinates | ok | RMS | RMS θh<10° | peak |\n|---|---|---|---|---|---|\n";
+  for (const Row& r : rows) {
+    char line[256];
+    std::snprintf(line, sizeof line, "| %s | %s | %zu | %.2f %% | %.2f %% | %s |\n",
+                  r.method.c_str(),
+                  r.coordinates == interp::Coordinates::kIncidence ? "θi, θo, φ" : "θh, θd, φd",
+                  r.ok, 100 * RelativeRms(r, truth, c.common, bands),
+                  100 * RelativeRms(r, truth, c.near_peak, bands),
+                  std::isnan(r.peak) ? "failed" : Percent(r.peak).c_str());
+    out << line;
+  }
+}
+
+}  // namespace
+
+int RunAccuracy(const AccuracyRequest& request, std::ostream& out, std::ostream& err) {
+  auto fail = [&err](const Status& s) {
+    err << "brdf-interp accuracy: " << s.message() << "\n";
+    return ExitCodeFor(s);
+  };
+  const WavelengthGrid wavelengths = WavelengthGrid::Pr650();
+  const Result<std::vector<KnownSample>> samples = SamplesNamed(request.sample, wavelengths);
+  if (!samples.ok()) return fail(samples.status());
+  const Result<Setup> setup = ReadSetup(request);
+  if (!setup.ok()) return fail(setup.status());
   Result<SyntheticPoints> grid = PaperGridPoints();
   if (!grid.ok()) return fail(grid.status());
   const std::size_t bands = wavelengths.count;
   const auto peak_band =
       static_cast<std::size_t>(std::lround((550.0 - wavelengths.start_nm) / wavelengths.step_nm));
   const std::vector<double> queries = RigPoseQueries(request.queries, request.seed);
-  const std::size_t n = request.queries;
+  PrintSetup(request, *setup, grid->size(), wavelengths, peak_band, out);
 
-  out << "Paper's rig grid: " << grid->size() << " points; " << n << " random rig poses (seed "
-      << request.seed << ")" << (request.mirror_phi ? "; mirror φ" : "")
-      << (request.reciprocity ? "; reciprocity" : "") << "; scales (θi, θo, φ) "
-      << (request.scale.empty() ? "1,1,1" : request.scale) << ", (θh·cos φd, θh·sin φd, θd) "
-      << (request.half_scale.empty() ? "1,1,1 (default)" : request.half_scale) << "; "
-      << (log_blend ? "log blend (floor 1e-6 of each band's largest value)" : "linear blend")
-      << (*trend == interp::Trend::kBivariate ? "; bivariate trend" : "");
-  if (request.noise > 0) out << "; readings × (1 + " << request.noise << " · N(0, 1))";
-  out << "\n";
-  out << "peak: (" << kPeakQuery[0] << ", " << kPeakQuery[1] << ", " << kPeakQuery[2] << ") at "
-      << wavelengths.at(peak_band) << " nm; RMS over the queries every row answered\n";
-
-  for (const KnownSample& sample : samples) {
-    const std::string& name = sample.name;
+  for (const KnownSample& sample : *samples) {
     const auto set = KnownSamples(*grid, wavelengths, sample, request.noise, request.seed + 1);
-    const auto log_set = log_blend ? LogSamples(*set) : nullptr;
-    std::vector<double> truth(n * bands);
-    for (std::size_t q = 0; q < n; ++q) {
-      sample.spectrum({queries[3 * q], queries[3 * q + 1], queries[3 * q + 2]},
-                      std::span<double>(truth).subspan(q * bands, bands));
-    }
-    std::vector<double> peak_spectrum(bands);
-    sample.spectrum({kPeakQuery[0], kPeakQuery[1], kPeakQuery[2]}, peak_spectrum);
-    const double peak_truth = peak_spectrum[peak_band];
-
+    const auto log_set = setup->log_blend ? LogSamples(*set) : nullptr;
+    const Truth truth = TruthOf(sample, queries, bands, peak_band);
     std::vector<Row> rows;
     for (const char* method : {"octant", "delaunay", "nearest"}) {
-      for (const interp::Options* o : {&incidence, &half}) {
-        Row row{method, o->coordinates, std::vector<interp::InterpStatus>(n),
-                std::vector<double>(n * bands)};
-        const bool in_logs = log_blend && std::string(method) != "nearest";
-        auto made = MakeNamedInterpolator(method, in_logs ? log_set : set, *o);
-        if (!made.ok()) return fail(made.status());
-        (*made)->SpectraAt(queries, row.status, row.spectra);
-        for (interp::InterpStatus s : row.status) row.ok += s == interp::InterpStatus::kOk;
-        if (in_logs) {
-          for (double& v : row.spectra) v = std::exp(v);  // NaN rows stay NaN
-        }
-        std::vector<double> peak(bands);
-        if ((*made)->SpectrumAt(kPeakQuery, peak) == interp::InterpStatus::kOk) {
-          if (in_logs) {
-            for (double& v : peak) v = std::exp(v);
-          }
-          row.peak = (peak[peak_band] - peak_truth) / peak_truth;
-        }
-        rows.push_back(std::move(row));
+      for (const interp::Options* o : {&setup->incidence, &setup->half}) {
+        Result<Row> row = RunMethod(method, *o, setup->log_blend, set, log_set, queries, bands,
+                                    peak_band, truth.peak);
+        if (!row.ok()) return fail(row.status());
+        rows.push_back(std::move(row).value());
       }
     }
-    // The common set: queries every row answered.
-    std::vector<bool> common(n, true), near_peak(n, false);
-    std::size_t common_count = 0, near_count = 0;
-    for (std::size_t q = 0; q < n; ++q) {
-      for (const Row& r : rows) common[q] = common[q] && r.status[q] == interp::InterpStatus::kOk;
-      const double theta_h =
-          interp::ToHalfDifference({queries[3 * q], queries[3 * q + 1], queries[3 * q + 2]})
-              .theta_h;
-      near_peak[q] = common[q] && theta_h < kNearPeakThetaHalfDeg;
-      common_count += common[q];
-      near_count += near_peak[q];
-    }
-    out << "\n"
-        << name << ": " << common_count << " common queries, " << near_count
-        << " of them with θh < " << kNearPeakThetaHalfDeg << "°\n";
-    out << "| method | coordinates | ok | RMS | RMS θh<10° | peak |\n|---|---|---|---|---|---|\n";
-    for (const Row& r : rows) {
-      auto rms = [&](const std::vector<bool>& use) {
-        double sum = 0, mean = 0, count = 0;
-        for (std::size_t q = 0; q < n; ++q) {
-          if (!use[q]) continue;
-          for (std::size_t b = 0; b < bands; ++b) {
-            const double d = r.spectra[q * bands + b] - truth[q * bands + b];
-            sum += d * d;
-            mean += truth[q * bands + b];
-            count += 1;
-          }
-        }
-        return count == 0 ? std::nan("") : std::sqrt(sum / count) / (mean / count);
-      };
-      char line[256];
-      std::snprintf(line, sizeof line, "| %s | %s | %zu | %.2f %% | %.2f %% | %s |\n",
-                    r.method.c_str(),
-                    r.coordinates == interp::Coordinates::kIncidence ? "θi, θo, φ" : "θh, θd, φd",
-                    r.ok, 100 * rms(common), 100 * rms(near_peak),
-                    std::isnan(r.peak) ? "failed" : Percent(r.peak).c_str());
-      out << line;
-    }
+    PrintTable(sample.name, rows, truth.spectra, CommonOf(rows, queries), bands, out);
   }
   return kExitOk;
 }

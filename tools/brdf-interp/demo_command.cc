@@ -36,6 +36,92 @@ Error Compare(const std::vector<double>& value, const std::vector<double>& truth
   return e;
 }
 
+// The request's query (the default one when it gives none) and interpolation options.
+Status ReadDemoRequest(const DemoRequest& request, std::vector<double>& query,
+                       interp::Options& options) {
+  query.assign(std::begin(kDemoQuery), std::end(kDemoQuery));
+  if (!request.query.empty()) {
+    Result<std::vector<double>> q = ParseNumberList(request.query, "--query");
+    if (!q.ok()) return q.status();
+    if (q->size() != 3) return InvalidArgument("--query needs three angles: θi,θo,φ");
+    query = *q;
+  }
+  options.mirror_phi = request.mirror_phi;
+  options.reciprocity = request.reciprocity;
+  Result<interp::Coordinates> coordinates = interp::ParseCoordinates(request.coordinates);
+  if (!coordinates.ok()) return coordinates.status().WithContext("--coordinates");
+  options.coordinates = *coordinates;
+  Result<interp::Trend> trend = interp::ParseTrend(request.trend);
+  if (!trend.ok()) return trend.status().WithContext("--trend");
+  options.trend = *trend;
+  if (!request.scale.empty()) {
+    Result<std::vector<double>> scale = ParseNumberList(request.scale, "--scale");
+    if (!scale.ok()) return scale.status();
+    options.axis_scale = *scale;
+  }
+  return Status::Ok();
+}
+
+void PrintVertices(const interp::Interpolation& answer, const std::vector<double>& query,
+                   const interp::Options& options, std::ostream& out) {
+  out << "Vertices:\n  letter  row    θi        θo        φ         weight\n";
+  for (std::size_t k = 0; k < answer.vertices.size(); ++k) {
+    const interp::Vertex& v = answer.vertices[k];
+    // For the octant method the letter is the octant the vertex won (relative to the query; in
+    // half/difference angles the octants are of (θh, θd, φd), not of the columns shown).
+    std::string letter = "-";
+    if (answer.method == interp::Method::kOctant &&
+        options.coordinates == interp::Coordinates::kIncidence) {
+      letter =
+          std::string(1, interp::OctantLetter(interp::OrthantOf(v.coords.data(), query.data(), 3)));
+    }
+    char line[160];
+    std::snprintf(line, sizeof line, "  %-6s  %-5zu  %-8.3f  %-8.3f  %-8.3f  %.6f\n",
+                  letter.c_str(), v.index, v.coords[0], v.coords[1], v.coords[2], v.weight);
+    out << line;
+  }
+}
+
+// The interpolated spectrum s: its range and mean, and beside the truth every 40 nm.
+void PrintSpectrum(const std::vector<double>& s, const std::vector<double>& truth,
+                   const WavelengthGrid& wavelengths, std::ostream& out) {
+  std::size_t lo = 0, hi = 0;
+  double mean = 0;
+  for (std::size_t b = 0; b < s.size(); ++b) {
+    if (s[b] < s[lo]) lo = b;
+    if (s[b] > s[hi]) hi = b;
+    mean += s[b];
+  }
+  mean /= static_cast<double>(s.size());
+  out << Format("Spectrum (sr⁻¹): min %.5f at %g nm, max %.5f at %g nm, mean %.5f\n", s[lo],
+                wavelengths.at(lo), s[hi], wavelengths.at(hi), mean);
+  out << "  nm     interpolated  truth\n";
+  for (double nm : {380.0, 420.0, 460.0, 500.0, 540.0, 580.0, 620.0, 660.0, 700.0, 740.0, 780.0}) {
+    const auto b =
+        static_cast<std::size_t>(std::lround((nm - wavelengths.start_nm) / wavelengths.step_nm));
+    if (b >= s.size()) continue;
+    out << Format("  %-5g  %-12.5f  %.5f\n", wavelengths.at(b), s[b], truth[b]);
+  }
+}
+
+// The answer's error against the truth, and for scale the nearest sample's.
+void PrintErrors(const std::vector<double>& s, const std::vector<double>& truth,
+                 const std::shared_ptr<interp::SampleSet>& samples, const interp::Options& options,
+                 const std::vector<double>& query, std::ostream& out) {
+  const Error e = Compare(s, truth);
+  out << Format(
+      "Error against the analytic truth: RMS %.3g sr⁻¹, max |Δ| %.3g sr⁻¹ (RMS %.2f %% of the "
+      "mean)\n",
+      e.rms, e.max_abs, 100 * e.rms / e.mean_truth);
+  auto nearest = MakeNamedInterpolator("nearest", samples, options);
+  if (!nearest.ok()) return;
+  const interp::Interpolation n = (*nearest)->Evaluate(query);
+  if (n.status != interp::InterpStatus::kOk) return;
+  const Error ne = Compare(n.spectrum, truth);
+  out << Format("For scale, the nearest sample (row %g) alone: RMS %.3g sr⁻¹, max |Δ| %.3g sr⁻¹\n",
+                static_cast<double>(n.vertices[0].index), ne.rms, ne.max_abs);
+}
+
 }  // namespace
 
 int RunDemo(const DemoRequest& request, std::ostream& out, std::ostream& err) {
@@ -43,27 +129,9 @@ int RunDemo(const DemoRequest& request, std::ostream& out, std::ostream& err) {
     err << "brdf-interp demo: " << s.message() << "\n";
     return ExitCodeFor(s);
   };
-  std::vector<double> query(std::begin(kDemoQuery), std::end(kDemoQuery));
-  if (!request.query.empty()) {
-    Result<std::vector<double>> q = ParseNumberList(request.query, "--query");
-    if (!q.ok()) return fail(q.status());
-    if (q->size() != 3) return fail(InvalidArgument("--query needs three angles: θi,θo,φ"));
-    query = *q;
-  }
+  std::vector<double> query;
   interp::Options options;
-  options.mirror_phi = request.mirror_phi;
-  options.reciprocity = request.reciprocity;
-  Result<interp::Coordinates> coordinates = interp::ParseCoordinates(request.coordinates);
-  if (!coordinates.ok()) return fail(coordinates.status().WithContext("--coordinates"));
-  options.coordinates = *coordinates;
-  Result<interp::Trend> trend = interp::ParseTrend(request.trend);
-  if (!trend.ok()) return fail(trend.status().WithContext("--trend"));
-  options.trend = *trend;
-  if (!request.scale.empty()) {
-    Result<std::vector<double>> scale = ParseNumberList(request.scale, "--scale");
-    if (!scale.ok()) return fail(scale.status());
-    options.axis_scale = *scale;
-  }
+  if (Status read = ReadDemoRequest(request, query, options); !read.ok()) return fail(read);
 
   Result<SyntheticPoints> grid = PaperGridPoints();
   if (!grid.ok()) return fail(grid.status());
@@ -93,59 +161,11 @@ int RunDemo(const DemoRequest& request, std::ostream& out, std::ostream& err) {
     out << "No spectrum: the method cannot answer this query (see the status).\n";
     return kExitOk;
   }
-
-  out << "Vertices:\n  letter  row    θi        θo        φ         weight\n";
-  for (std::size_t k = 0; k < answer.vertices.size(); ++k) {
-    const interp::Vertex& v = answer.vertices[k];
-    // For the octant method the letter is the octant the vertex won (relative to the query; in
-    // half/difference angles the octants are of (θh, θd, φd), not of the columns shown).
-    std::string letter = "-";
-    if (answer.method == interp::Method::kOctant &&
-        options.coordinates == interp::Coordinates::kIncidence) {
-      letter =
-          std::string(1, interp::OctantLetter(interp::OrthantOf(v.coords.data(), query.data(), 3)));
-    }
-    char line[160];
-    std::snprintf(line, sizeof line, "  %-6s  %-5zu  %-8.3f  %-8.3f  %-8.3f  %.6f\n",
-                  letter.c_str(), v.index, v.coords[0], v.coords[1], v.coords[2], v.weight);
-    out << line;
-  }
-
+  PrintVertices(answer, query, options, out);
   const AnalyticBrdf brdf = SyntheticBrdf(3);
   const std::vector<double> truth = brdf.EvaluateSpectrum(PointDirections(query), wavelengths);
-  const std::vector<double>& s = answer.spectrum;
-  std::size_t lo = 0, hi = 0;
-  double mean = 0;
-  for (std::size_t b = 0; b < s.size(); ++b) {
-    if (s[b] < s[lo]) lo = b;
-    if (s[b] > s[hi]) hi = b;
-    mean += s[b];
-  }
-  mean /= static_cast<double>(s.size());
-  out << Format("Spectrum (sr⁻¹): min %.5f at %g nm, max %.5f at %g nm, mean %.5f\n", s[lo],
-                wavelengths.at(lo), s[hi], wavelengths.at(hi), mean);
-  out << "  nm     interpolated  truth\n";
-  for (double nm : {380.0, 420.0, 460.0, 500.0, 540.0, 580.0, 620.0, 660.0, 700.0, 740.0, 780.0}) {
-    const auto b =
-        static_cast<std::size_t>(std::lround((nm - wavelengths.start_nm) / wavelengths.step_nm));
-    if (b >= s.size()) continue;
-    out << Format("  %-5g  %-12.5f  %.5f\n", wavelengths.at(b), s[b], truth[b]);
-  }
-  const Error e = Compare(s, truth);
-  out << Format(
-      "Error against the analytic truth: RMS %.3g sr⁻¹, max |Δ| %.3g sr⁻¹ (RMS %.2f %% of the "
-      "mean)\n",
-      e.rms, e.max_abs, 100 * e.rms / e.mean_truth);
-  auto nearest = MakeNamedInterpolator("nearest", samples, options);
-  if (nearest.ok()) {
-    const interp::Interpolation n = (*nearest)->Evaluate(query);
-    if (n.status == interp::InterpStatus::kOk) {
-      const Error ne = Compare(n.spectrum, truth);
-      out << Format(
-          "For scale, the nearest sample (row %g) alone: RMS %.3g sr⁻¹, max |Δ| %.3g sr⁻¹\n",
-          static_cast<double>(n.vertices[0].index), ne.rms, ne.max_abs);
-    }
-  }
+  PrintSpectrum(answer.spectrum, truth, wavelengths, out);
+  PrintErrors(answer.spectrum, truth, samples, options, query, out);
   return kExitOk;
 }
 

@@ -49,16 +49,8 @@ void AddMethodOptions(CLI::App& app, std::string& method, std::string& scale, bo
       ->capture_default_str();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{
-      "brdf-interp: interpolate scattered spectral BRDF samples (Sun & Wang's octant "
-      "method, Delaunay, nearest neighbour)"};
-  app.footer(kFooter);
-
-  InterpRequest interp;
-  bool demo_flag = false;
+// The top level: SAMPLES.csv QUERIES.csv and their options (and --demo).
+void AddInterpOptions(CLI::App& app, InterpRequest& interp, bool& demo_flag) {
   app.add_option("samples", interp.samples_path, "samples CSV");
   app.add_option("queries", interp.queries_path, "queries CSV");
   AddMethodOptions(app, interp.method, interp.scale, interp.mirror_phi, interp.reciprocity,
@@ -69,16 +61,19 @@ int main(int argc, char** argv) {
   app.add_flag("--explain", interp.explain, "add vertex rows, weights and detail columns");
   app.add_option("-o,--output", interp.output_path, "output CSV (default: standard output)");
   app.add_flag("--demo", demo_flag, "same as the demo subcommand");
+}
 
-  DemoRequest demo;
+CLI::App* AddDemoCommand(CLI::App& app, DemoRequest& demo) {
   CLI::App* demo_cmd = app.add_subcommand(
       "demo",
       "interpolate the analytic paint sample on the paper's rig grid and explain one answer");
   AddMethodOptions(*demo_cmd, demo.method, demo.scale, demo.mirror_phi, demo.reciprocity,
                    demo.coordinates, demo.trend);
   demo_cmd->add_option("--query", demo.query, "θi,θo,φ in degrees (default 37,52,128)");
+  return demo_cmd;
+}
 
-  AccuracyRequest accuracy;
+CLI::App* AddAccuracyCommand(CLI::App& app, AccuracyRequest& accuracy) {
   CLI::App* accuracy_cmd = app.add_subcommand(
       "accuracy",
       "RMS and specular-peak error of every method, in (θi, θo, φ) and in (θh, θd, φd), against "
@@ -114,9 +109,10 @@ int main(int argc, char** argv) {
                    "largest value) blend of the vertices' spectra; nearest is unaffected")
       ->check(CLI::IsMember({"linear", "log"}))
       ->capture_default_str();
+  return accuracy_cmd;
+}
 
-  SynthRequest synth;
-  std::vector<std::string> grid_args;
+CLI::App* AddSynthCommand(CLI::App& app, SynthRequest& synth, std::vector<std::string>& grid_args) {
   CLI::App* synth_cmd = app.add_subcommand("synth", "write a synthetic samples (or queries) CSV");
   synth_cmd->add_option("--grid", grid_args, "paper | random N")->required()->expected(1, 2);
   synth_cmd->add_option("--seed", synth.seed, "random seed")->capture_default_str();
@@ -126,6 +122,51 @@ int main(int argc, char** argv) {
   synth_cmd->add_flag("--coordinates-only", synth.coordinates_only,
                       "write the coordinate columns only (a queries file)");
   synth_cmd->add_option("-o,--output", synth.output_path, "output CSV (default: standard output)");
+  return synth_cmd;
+}
+
+// synth with --grid's words: paper, or random and a count.
+int RunSynthCommand(SynthRequest& synth, const std::vector<std::string>& grid_args) {
+  synth.grid = grid_args.at(0);
+  if (grid_args.size() == 2) {
+    try {
+      synth.count = static_cast<std::size_t>(std::stoull(grid_args[1]));
+    } catch (const std::exception&) {
+      std::cerr << "brdf-interp synth: --grid random N: '" << grid_args[1] << "' is not a count\n";
+      return kExitUsage;
+    }
+  }
+  return RunSynth(synth, std::cerr);
+}
+
+// --demo: the demo with the top level's method options.
+int RunDemoFlag(const InterpRequest& interp, DemoRequest& demo) {
+  demo.method = interp.method;
+  demo.scale = interp.scale;
+  demo.mirror_phi = interp.mirror_phi;
+  demo.reciprocity = interp.reciprocity;
+  demo.coordinates = interp.coordinates;
+  demo.trend = interp.trend;
+  return RunDemo(demo, std::cout, std::cerr);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "brdf-interp: interpolate scattered spectral BRDF samples (Sun & Wang's octant "
+      "method, Delaunay, nearest neighbour)"};
+  app.footer(kFooter);
+  InterpRequest interp;
+  bool demo_flag = false;
+  AddInterpOptions(app, interp, demo_flag);
+  DemoRequest demo;
+  CLI::App* demo_cmd = AddDemoCommand(app, demo);
+  AccuracyRequest accuracy;
+  CLI::App* accuracy_cmd = AddAccuracyCommand(app, accuracy);
+  SynthRequest synth;
+  std::vector<std::string> grid_args;
+  CLI::App* synth_cmd = AddSynthCommand(app, synth, grid_args);
 
   try {
     app.parse(argc, argv);
@@ -133,31 +174,10 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? kExitOk : kExitUsage;
   }
-
-  if (synth_cmd->parsed()) {
-    synth.grid = grid_args.at(0);
-    if (grid_args.size() == 2) {
-      try {
-        synth.count = static_cast<std::size_t>(std::stoull(grid_args[1]));
-      } catch (const std::exception&) {
-        std::cerr << "brdf-interp synth: --grid random N: '" << grid_args[1]
-                  << "' is not a count\n";
-        return kExitUsage;
-      }
-    }
-    return RunSynth(synth, std::cerr);
-  }
+  if (synth_cmd->parsed()) return RunSynthCommand(synth, grid_args);
   if (demo_cmd->parsed()) return RunDemo(demo, std::cout, std::cerr);
   if (accuracy_cmd->parsed()) return RunAccuracy(accuracy, std::cout, std::cerr);
-  if (demo_flag) {
-    demo.method = interp.method;
-    demo.scale = interp.scale;
-    demo.mirror_phi = interp.mirror_phi;
-    demo.reciprocity = interp.reciprocity;
-    demo.coordinates = interp.coordinates;
-    demo.trend = interp.trend;
-    return RunDemo(demo, std::cout, std::cerr);
-  }
+  if (demo_flag) return RunDemoFlag(interp, demo);
   if (interp.samples_path.empty() || interp.queries_path.empty()) {
     std::cerr << "brdf-interp: give SAMPLES.csv and QUERIES.csv, or use `brdf-interp demo` or "
                  "`brdf-interp synth`; see --help\n";

@@ -193,41 +193,14 @@ void Pr650Endpoint::Run() {
 }
 
 void Pr650Endpoint::Handle(const std::string& command) {
-  const SerialFaults faults = control_.serial();
   unsigned epoch = 0;
-  {
-    std::lock_guard lock(mu_);
-    commands_.push_back(command);
-    if (faults.silent) return;
-    if (!remote_) {
-      const double since_power_on = options_.time_scale.ToSim(
-          std::chrono::duration_cast<std::chrono::nanoseconds>(SteadyClock::now() - power_on_));
-      if (standalone_ || (options_.wake_window_s > 0 && since_power_on > options_.wake_window_s)) {
-        standalone_ = true;  // first command too late: stand-alone until power-cycled
-        return;
-      }
-      remote_ = true;
-    }
-    epoch = power_epoch_;
-  }
-
+  if (!Admit(command, epoch)) return;
   if (command.size() == 2 && command[0] == 'B' && command[1] >= '0' && command[1] <= '3') {
     Reply({"000"});
     return;
   }
   if (command[0] == 'S') {
-    const Pr650SetupResult result = ApplyPr650Setup(std::string_view(command).substr(1));
-    {
-      std::lock_guard lock(mu_);
-      last_setup_reply_ = result.reply_code;
-      if (result.reply_code == 0) {
-        setup_ = result.setup;
-        sync_ = result.sync;
-      }
-    }
-    char text[8];
-    std::snprintf(text, sizeof text, "%02d", result.reply_code);
-    Reply({text});
+    HandleSetup(command);
     return;
   }
   if (command == "F") {
@@ -239,35 +212,76 @@ void Pr650Endpoint::Handle(const std::string& command) {
   const std::optional<int> code = ResponseCode(command);
   if (!code.has_value()) return;  // unknown: the simulated meter does not answer
   if (command[0] == 'M' && (*code == 0 || IsServedReport(*code))) {
-    // M0 measures and holds; Mn is M0 followed by report n, in one reply.
-    const std::optional<int> quality_code = Measure(epoch);
-    if (!quality_code.has_value()) return;
-    if (*code != 0) {
-      ReplyReport(*code);
-      return;
-    }
-    const int status = options_.m0_reply_is_quality ? std::clamp(*quality_code, 0, 999) : 0;
-    char text[8];
-    std::snprintf(text, sizeof text, "%03d", status);
-    Reply({text});
+    HandleMeasure(*code, epoch);
     return;
   }
   if (command[0] != 'D') return;  // M7 … M98: not served
-  if (IsServedReport(*code)) {
-    ReplyReport(*code);
+  HandleReport(*code);
+}
+
+bool Pr650Endpoint::Admit(const std::string& command, unsigned& epoch) {
+  const SerialFaults faults = control_.serial();
+  std::lock_guard lock(mu_);
+  commands_.push_back(command);
+  if (faults.silent) return false;
+  if (!remote_) {
+    const double since_power_on = options_.time_scale.ToSim(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(SteadyClock::now() - power_on_));
+    if (standalone_ || (options_.wake_window_s > 0 && since_power_on > options_.wake_window_s)) {
+      standalone_ = true;  // first command too late: stand-alone until power-cycled
+      return false;
+    }
+    remote_ = true;
+  }
+  epoch = power_epoch_;
+  return true;
+}
+
+void Pr650Endpoint::HandleSetup(const std::string& command) {
+  const Pr650SetupResult result = ApplyPr650Setup(std::string_view(command).substr(1));
+  {
+    std::lock_guard lock(mu_);
+    last_setup_reply_ = result.reply_code;
+    if (result.reply_code == 0) {
+      setup_ = result.setup;
+      sync_ = result.sync;
+    }
+  }
+  char text[8];
+  std::snprintf(text, sizeof text, "%02d", result.reply_code);
+  Reply({text});
+}
+
+void Pr650Endpoint::HandleMeasure(int code, unsigned epoch) {
+  // M0 measures and holds; Mn is M0 followed by report n, in one reply.
+  const std::optional<int> quality_code = Measure(epoch);
+  if (!quality_code.has_value()) return;
+  if (code != 0) {
+    ReplyReport(code);
     return;
   }
-  if (*code == 110) {
+  const int status = options_.m0_reply_is_quality ? std::clamp(*quality_code, 0, 999) : 0;
+  char text[8];
+  std::snprintf(text, sizeof text, "%03d", status);
+  Reply({text});
+}
+
+void Pr650Endpoint::HandleReport(int code) {
+  if (IsServedReport(code)) {
+    ReplyReport(code);
+    return;
+  }
+  if (code == 110) {
     std::string serial = options_.serial_number.substr(0, 8);
     serial.resize(8, ' ');
     Reply({serial});
     return;
   }
-  if (*code == 120) {
+  if (code == 120) {
     Reply({Pr650LayoutLine()});
     return;
   }
-  if (*code == 201) {
+  if (code == 201) {
     // The reply to the last S command again ("pp"); 00 before any.
     int reply = 0;
     {

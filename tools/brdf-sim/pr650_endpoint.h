@@ -141,6 +141,15 @@ class Pr650Endpoint {
 
   void Run();
   void Handle(const std::string& command);
+  // Notes the command; false when the meter does not answer it (silent fault, or stand-alone:
+  // the first command came after the wake window). `epoch`: the power cycle it is answered in.
+  bool Admit(const std::string& command, unsigned& epoch);
+  // S: applies the setup and replies with its code.
+  void HandleSetup(const std::string& command);
+  // M0 measures and holds; Mn (n a served report) is M0 followed by report n, in one reply.
+  void HandleMeasure(int code, unsigned epoch);
+  // Dn: a served report, the serial number (110), the layout (120) or the last S reply (201).
+  void HandleReport(int code);
   // Takes a measurement (its simulated duration in real time) into last_ and returns its quality
   // code; nullopt if stopped or switched off meanwhile (no reply then).
   std::optional<int> Measure(unsigned epoch);
