@@ -3,7 +3,7 @@
 // prove that no kill, at any moment, leaves a step without its reading or a reading twice.
 #include <string>
 
-#include "storage/assign_or_return.h"
+#include "core/status.h"
 #include "storage/session_store.h"
 
 namespace brdf::storage {
@@ -23,11 +23,11 @@ std::string ListOf(std::string_view noun, const std::vector<std::int64_t>& ids) 
 
 // The first column of every row of `sql` with ?1 bound to `session`.
 Result<std::vector<std::int64_t>> Ids(Database& db, std::string_view sql, std::int64_t session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db.Prepare(sql));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare(sql));
   st.Bind(1, session);
   std::vector<std::int64_t> ids;
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
     ids.push_back(st.Int64(0));
   }
@@ -44,20 +44,20 @@ std::string IntegrityReport::Summary() const {
 }
 
 Result<IntegrityReport> SessionStore::CheckSession(std::int64_t session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease lease, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease lease, readers_->Acquire());
   Database& db = *lease;
   // One snapshot for every query: a writer committing meanwhile cannot make counts disagree.
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(db));
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(db));
 
   IntegrityReport report;
   report.session_id = session;
   std::string state;
   {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
+    BRDF_ASSIGN_OR_RETURN(
         Statement st,
         db.Prepare("SELECT total_steps, done_steps, state FROM sessions WHERE id = ?"));
     st.Bind(1, session);
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) return NotFound("no session " + std::to_string(session) + " in the database");
     report.total_steps = st.Int(0);
     report.done_steps_recorded = st.Int(1);
@@ -66,13 +66,13 @@ Result<IntegrityReport> SessionStore::CheckSession(std::int64_t session) {
   std::int64_t min_index = 0;
   std::int64_t max_index = -1;
   {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
+    BRDF_ASSIGN_OR_RETURN(
         Statement st,
         db.Prepare("SELECT count(*), ifnull(min(step_index), 0), ifnull(max(step_index), -1), "
                    "total(state = 'done'), total(state = 'skipped'), total(state = 'pending') "
                    "FROM steps WHERE session_id = ?"));
     st.Bind(1, session);
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (row) {
       report.steps_present = st.Int(0);
       min_index = st.Int64(1);
@@ -82,7 +82,7 @@ Result<IntegrityReport> SessionStore::CheckSession(std::int64_t session) {
       report.steps_pending = static_cast<int>(st.Double(5));
     }
   }
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       std::int64_t readings,
       db.QueryInt64("SELECT count(*) FROM readings WHERE session_id = " + std::to_string(session)));
   report.readings = static_cast<int>(readings);
@@ -147,15 +147,15 @@ Result<IntegrityReport> SessionStore::CheckSession(std::int64_t session) {
        "readings", "have a spectrum whose size does not match their wavelength grid"},
   };
   for (const Query& q : queries) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(std::vector<std::int64_t> ids, Ids(db, q.sql, session));
+    BRDF_ASSIGN_OR_RETURN(std::vector<std::int64_t> ids, Ids(db, q.sql, session));
     if (!ids.empty()) problems.push_back(ListOf(q.noun, ids) + " " + std::string(q.problem));
   }
 
   // The file as a whole: b-trees, indexes and every foreign key.
   {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db.Prepare("PRAGMA integrity_check"));
+    BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("PRAGMA integrity_check"));
     while (true) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+      BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
       if (!row) break;
       if (!report.integrity_check.empty()) report.integrity_check += "; ";
       report.integrity_check += st.Text(0);
@@ -165,11 +165,11 @@ Result<IntegrityReport> SessionStore::CheckSession(std::int64_t session) {
     }
   }
   {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db.Prepare("PRAGMA foreign_key_check"));
+    BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("PRAGMA foreign_key_check"));
     int broken = 0;
     std::string first;
     while (true) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+      BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
       if (!row) break;
       if (broken++ == 0) {
         first = st.Text(0) + " row " + std::to_string(st.Int64(1)) + " refers to a missing " +
