@@ -124,3 +124,16 @@ class [[nodiscard]] Result {
     ::brdf::Status brdf_status_ = (expr);        \
     if (!brdf_status_.ok()) return brdf_status_; \
   } while (false)
+
+// Unwraps `expr` (a Result<T>) into `lhs` (a declaration such as `auto rows` or an lvalue), or
+// returns its Status from the enclosing function:
+//   BRDF_ASSIGN_OR_RETURN(const Session session, store.GetSession(id));
+// Expands to statements, not an expression: not the sole body of an unbraced if or loop.
+#define BRDF_ASSIGN_OR_RETURN(lhs, expr) \
+  BRDF_ASSIGN_OR_RETURN_IMPL_(BRDF_STATUS_CONCAT_(brdf_result_, __LINE__), lhs, expr)
+#define BRDF_STATUS_CONCAT_INNER_(a, b) a##b
+#define BRDF_STATUS_CONCAT_(a, b) BRDF_STATUS_CONCAT_INNER_(a, b)
+#define BRDF_ASSIGN_OR_RETURN_IMPL_(tmp, lhs, expr) \
+  auto tmp = (expr);                                \
+  if (!tmp.ok()) return tmp.status();               \
+  lhs = std::move(tmp).value()

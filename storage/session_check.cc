@@ -3,7 +3,7 @@
 // prove that no kill, at any moment, leaves a step without its reading or a reading twice.
 #include <string>
 
-#include "storage/assign_or_return.h"
+#include "core/status.h"
 #include "storage/session_store.h"
 
 namespace brdf::storage {
@@ -23,11 +23,11 @@ std::string ListOf(std::string_view noun, const std::vector<std::int64_t>& ids) 
 
 // The first column of every row of `sql` with ?1 bound to `session`.
 Result<std::vector<std::int64_t>> Ids(Database& db, std::string_view sql, std::int64_t session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db.Prepare(sql));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare(sql));
   st.Bind(1, session);
   std::vector<std::int64_t> ids;
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
     ids.push_back(st.Int64(0));
   }
@@ -36,10 +36,10 @@ Result<std::vector<std::int64_t>> Ids(Database& db, std::string_view sql, std::i
 
 // The session's row: its plan's step count and done_steps into the report; returns its state.
 Result<std::string> ReadSessionRow(Database& db, std::int64_t session, IntegrityReport& report) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       Statement st, db.Prepare("SELECT total_steps, done_steps, state FROM sessions WHERE id = ?"));
   st.Bind(1, session);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
   if (!row) return NotFound("no session " + std::to_string(session) + " in the database");
   report.total_steps = st.Int(0);
   report.done_steps_recorded = st.Int(1);
@@ -53,13 +53,13 @@ struct StepIndexRange {
 
 // The stored steps by state into the report; returns the range of their indexes.
 Result<StepIndexRange> CountSteps(Database& db, std::int64_t session, IntegrityReport& report) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       Statement st,
       db.Prepare("SELECT count(*), ifnull(min(step_index), 0), ifnull(max(step_index), -1), "
                  "total(state = 'done'), total(state = 'skipped'), total(state = 'pending') "
                  "FROM steps WHERE session_id = ?"));
   st.Bind(1, session);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
   StepIndexRange range;
   if (row) {
     report.steps_present = st.Int(0);
@@ -139,9 +139,9 @@ constexpr RowCheck kRowChecks[] = {
 
 // PRAGMA integrity_check's answer into the report (a problem unless "ok").
 Status CheckIntegrity(Database& db, IntegrityReport& report) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db.Prepare("PRAGMA integrity_check"));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("PRAGMA integrity_check"));
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
     if (!report.integrity_check.empty()) report.integrity_check += "; ";
     report.integrity_check += st.Text(0);
@@ -154,11 +154,11 @@ Status CheckIntegrity(Database& db, IntegrityReport& report) {
 
 // PRAGMA foreign_key_check: how many references are broken, and the first.
 Status CheckForeignKeys(Database& db, std::vector<std::string>& problems) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db.Prepare("PRAGMA foreign_key_check"));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("PRAGMA foreign_key_check"));
   int broken = 0;
   std::string first;
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
     if (broken++ == 0) {
       first = st.Text(0) + " row " + std::to_string(st.Int64(1)) + " refers to a missing " +
@@ -182,23 +182,23 @@ std::string IntegrityReport::Summary() const {
 }
 
 Result<IntegrityReport> SessionStore::CheckSession(std::int64_t session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease lease, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease lease, readers_->Acquire());
   Database& db = *lease;
   // One snapshot for every query: a writer committing meanwhile cannot make counts disagree.
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(db));
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(db));
 
   IntegrityReport report;
   report.session_id = session;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(const std::string state, ReadSessionRow(db, session, report));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(const StepIndexRange range, CountSteps(db, session, report));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(const std::string state, ReadSessionRow(db, session, report));
+  BRDF_ASSIGN_OR_RETURN(const StepIndexRange range, CountSteps(db, session, report));
+  BRDF_ASSIGN_OR_RETURN(
       std::int64_t readings,
       db.QueryInt64("SELECT count(*) FROM readings WHERE session_id = " + std::to_string(session)));
   report.readings = static_cast<int>(readings);
 
   CheckCounts(state, range, report);
   for (const RowCheck& check : kRowChecks) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(std::vector<std::int64_t> ids, Ids(db, check.sql, session));
+    BRDF_ASSIGN_OR_RETURN(std::vector<std::int64_t> ids, Ids(db, check.sql, session));
     if (!ids.empty()) {
       report.problems.push_back(ListOf(check.noun, ids) + " " + std::string(check.problem));
     }

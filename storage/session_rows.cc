@@ -1,6 +1,6 @@
 #include "storage/session_rows.h"
 
-#include "storage/assign_or_return.h"
+#include "core/status.h"
 #include "storage/spectrum_blob.h"
 
 namespace brdf::storage {
@@ -42,8 +42,8 @@ Result<SessionRecord> ReadSession(const Statement& st, const std::string& path) 
   s.name = st.Text(1);
   s.plan_kind = st.Text(2);
   s.plan_json = st.Text(3);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(s.state,
-                                FromColumn(ParseSessionState(st.Text(4)), path, SessionName(s.id)));
+  BRDF_ASSIGN_OR_RETURN(s.state,
+                        FromColumn(ParseSessionState(st.Text(4)), path, SessionName(s.id)));
   s.state_reason = st.Text(5);
   s.created_at = st.Double(6);
   s.started_at = st.OptionalDouble(7);
@@ -64,7 +64,7 @@ Result<SessionEventRecord> ReadEvent(const Statement& st, const std::string& pat
   e.id = st.Int64(0);
   e.session_id = st.Int64(1);
   e.at = st.Double(2);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       e.state, FromColumn(ParseSessionState(st.Text(3)), path,
                           "event " + std::to_string(e.id) + " of " + SessionName(e.session_id)));
   e.reason = st.Text(4);
@@ -76,7 +76,7 @@ Result<StepRecord> ReadStep(const Statement& st, const std::string& path) {
   s.session_id = st.Int64(0);
   s.step_index = st.Int(1);
   const std::string where = StepName(s.session_id, s.step_index);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(s.kind, FromColumn(ParseStepKind(st.Text(2)), path, where));
+  BRDF_ASSIGN_OR_RETURN(s.kind, FromColumn(ParseStepKind(st.Text(2)), path, where));
   s.pose = Pose{st.Double(3), st.Double(4), st.Double(5), st.Double(6)};
   s.prompt = st.OptionalText(7);
   s.prompt_kind = st.OptionalText(8);
@@ -85,7 +85,7 @@ Result<StepRecord> ReadStep(const Statement& st, const std::string& path) {
     s.target = Directions{st.Double(10), st.Double(11), st.Double(12), st.Double(13)};
   }
   s.label = st.Text(14);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(s.state, FromColumn(ParseStepState(st.Text(15)), path, where));
+  BRDF_ASSIGN_OR_RETURN(s.state, FromColumn(ParseStepState(st.Text(15)), path, where));
   s.note = st.OptionalText(16);
   s.completed_at = st.OptionalDouble(17);
   return s;
@@ -97,14 +97,13 @@ Result<ReadingRecord> ReadReading(const Statement& st, const std::string& path) 
   r.session_id = st.Int64(1);
   r.step_index = st.Int(2);
   const std::string where = "reading " + std::to_string(r.id);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(r.kind, FromColumn(ParseReadingKind(st.Text(3)), path, where));
+  BRDF_ASSIGN_OR_RETURN(r.kind, FromColumn(ParseReadingKind(st.Text(3)), path, where));
   r.pose = Pose{st.Double(4), st.Double(5), st.Double(6), st.Double(7)};
   r.directions = Directions{st.Double(8), st.Double(9), st.Double(10), st.Double(11)};
   const std::int64_t count = st.Int64(14);
   r.grid = WavelengthGrid{st.Double(12), st.Double(13), static_cast<std::size_t>(count)};
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
-      r.spectrum,
-      FromColumn(DecodeSpectrum(st.BlobView(15), r.grid.count), path, where + "'s spectrum"));
+  BRDF_ASSIGN_OR_RETURN(r.spectrum, FromColumn(DecodeSpectrum(st.BlobView(15), r.grid.count), path,
+                                               where + "'s spectrum"));
   r.quality_code = st.Int(16);
   r.flagged = st.Int(17) != 0;
   r.integration_ms = st.Int(18);
@@ -120,7 +119,7 @@ Result<ReadingRecord> ReadReading(const Statement& st, const std::string& path) 
 Result<ReadingPointRecord> ReadReadingPoint(const Statement& st, const std::string& path) {
   ReadingPointRecord r;
   r.id = st.Int64(0);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       r.kind, FromColumn(ParseReadingKind(st.Text(1)), path, "reading " + std::to_string(r.id)));
   r.pose = Pose{st.Double(2), st.Double(3), st.Double(4), st.Double(5)};
   r.directions = Directions{st.Double(6), st.Double(7), st.Double(8), st.Double(9)};

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <utility>
 
-#include "storage/assign_or_return.h"
+#include "core/status.h"
 #include "storage/schema.h"
 #include "storage/session_rows.h"
 #include "storage/spectrum_blob.h"
@@ -29,10 +29,9 @@ std::string StepName(std::int64_t session, int step) {
 
 // The session's state inside a transaction; kNotFound naming it when it does not exist.
 Result<SessionState> SessionStateOf(Database& db, std::int64_t session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db.Prepare("SELECT state FROM sessions WHERE id = ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("SELECT state FROM sessions WHERE id = ?"));
   st.Bind(1, session);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
   if (!row) return NotFound("no " + SessionName(session) + " in the database");
   return FromColumn(ParseSessionState(st.Text(0)), db.path(), SessionName(session));
 }
@@ -63,22 +62,22 @@ struct StepRow {
 
 // A step's kind and state inside a transaction; kNotFound naming it when it does not exist.
 Result<StepRow> StepOf(Database& db, std::int64_t session, int step_index) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       Statement st,
       db.Prepare("SELECT kind, state FROM steps WHERE session_id = ? AND step_index = ?"));
   st.Bind(1, session).Bind(2, step_index);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
   const std::string where = StepName(session, step_index);
   if (!row) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
+    BRDF_ASSIGN_OR_RETURN(
         std::int64_t total,
         db.QueryInt64("SELECT total_steps FROM sessions WHERE id = " + S(session)));
     return NotFound("no " + where + " (its plan has " + S(total) + " steps, numbered 0 to " +
                     S(total - 1) + ")");
   }
   StepRow r{};
-  BRDF_STORAGE_ASSIGN_OR_RETURN(r.kind, FromColumn(ParseStepKind(st.Text(0)), db.path(), where));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(r.state, FromColumn(ParseStepState(st.Text(1)), db.path(), where));
+  BRDF_ASSIGN_OR_RETURN(r.kind, FromColumn(ParseStepKind(st.Text(0)), db.path(), where));
+  BRDF_ASSIGN_OR_RETURN(r.state, FromColumn(ParseStepState(st.Text(1)), db.path(), where));
   return r;
 }
 
@@ -99,10 +98,10 @@ Status NotPending(Database& db, std::int64_t session, int step_index, StepState 
 Status RequireLinkedReading(Database& db, std::int64_t session, std::optional<std::int64_t> id,
                             ReadingKind kind, std::string_view role) {
   if (!id.has_value()) return Status::Ok();
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db.Prepare("SELECT session_id, kind FROM readings WHERE id = ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db.Prepare("SELECT session_id, kind FROM readings WHERE id = ?"));
   st.Bind(1, *id);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
   const std::string what = std::string(role) + " reading " + S(*id);
   if (!row) return InvalidArgument(what + " does not exist");
   if (st.Int64(0) != session) {
@@ -147,7 +146,7 @@ Status ValidateReading(const ReadingRecord& r) {
 // readings are this session's.
 Status RequireStepTakes(Database& db, std::int64_t session, int step_index,
                         const ReadingRecord& reading, const std::string& what) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(StepRow step, StepOf(db, session, step_index));
+  BRDF_ASSIGN_OR_RETURN(StepRow step, StepOf(db, session, step_index));
   const std::optional<ReadingKind> expected = ReadingKindFor(step.kind);
   if (!expected.has_value()) {
     return InvalidArgument(what + ": it is a " + std::string(ToString(step.kind)) +
@@ -172,7 +171,7 @@ Status RequireStepTakes(Database& db, std::int64_t session, int step_index,
 Status InsertReading(Database& db, std::int64_t session, int step_index,
                      const ReadingRecord& reading, const std::vector<std::uint8_t>& blob,
                      UnixSeconds recorded_at, const std::string& what) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       Statement st,
       db.Prepare(
           "INSERT INTO readings (session_id, step_index, kind, alpha, beta, gamma, delta, "
@@ -211,7 +210,7 @@ Status InsertReading(Database& db, std::int64_t session, int step_index,
 Status MarkStepDone(Database& db, std::int64_t session, int step_index, UnixSeconds recorded_at,
                     const std::string& what) {
   {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
+    BRDF_ASSIGN_OR_RETURN(
         Statement st, db.Prepare("UPDATE steps SET state = 'done', completed_at = ? "
                                  "WHERE session_id = ? AND step_index = ? AND state = 'pending'"));
     st.Bind(1, recorded_at).Bind(2, session).Bind(3, step_index);
@@ -220,8 +219,8 @@ Status MarkStepDone(Database& db, std::int64_t session, int step_index, UnixSeco
       return Internal(what + ": the step stopped being pending inside the transaction");
     }
   }
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
-      Statement st, db.Prepare("UPDATE sessions SET done_steps = done_steps + 1 WHERE id = ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db.Prepare("UPDATE sessions SET done_steps = done_steps + 1 WHERE id = ?"));
   st.Bind(1, session);
   return st.Run().WithContext(what + ": counting the step done");
 }
@@ -243,10 +242,10 @@ SessionStore::~SessionStore() = default;
 Result<std::unique_ptr<SessionStore>> SessionStore::Open(const std::string& path, Options options) {
   OpenOptions open;
   open.busy_timeout = options.busy_timeout;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(std::unique_ptr<Database> db, Database::Open(path, open));
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<Database> db, Database::Open(path, open));
   BRDF_RETURN_IF_ERROR(Migrate(*db));
   if (options.max_database_bytes > 0) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(std::int64_t page, db->QueryInt64("PRAGMA page_size"));
+    BRDF_ASSIGN_OR_RETURN(std::int64_t page, db->QueryInt64("PRAGMA page_size"));
     const std::int64_t pages = std::max<std::int64_t>(1, options.max_database_bytes / page);
     BRDF_RETURN_IF_ERROR(db->Exec("PRAGMA max_page_count = " + S(pages)));
   }
@@ -279,9 +278,9 @@ Result<std::int64_t> SessionStore::CreateSession(const NewSession& session,
 
   MutexLock lock(write_mu_);
   Database& db = *writer_;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
   {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
+    BRDF_ASSIGN_OR_RETURN(
         Statement st,
         db.Prepare("INSERT INTO sessions (name, plan_kind, plan_json, state, created_at, "
                    "created_by_role, total_steps, white_reflectance, meter_serial, config_json, "
@@ -300,7 +299,7 @@ Result<std::int64_t> SessionStore::CreateSession(const NewSession& session,
     BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
   }
   const std::int64_t id = db.last_insert_rowid();
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       Statement st,
       db.Prepare("INSERT INTO steps (session_id, step_index, kind, alpha, beta, gamma, delta, "
                  "prompt, prompt_kind, expected_action, target_theta_i, target_phi_i, "
@@ -337,8 +336,8 @@ Status SessionStore::SetSessionState(std::int64_t session, SessionState state, s
 
   MutexLock lock(write_mu_);
   Database& db = *writer_;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(SessionState current, SessionStateOf(db, session));
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
+  BRDF_ASSIGN_OR_RETURN(SessionState current, SessionStateOf(db, session));
   if (IsTerminal(current)) {
     if (current == state) return Status::Ok();  // a retried call: already there
     return FailedPrecondition(what + ": it is already " + std::string(ToString(current)) +
@@ -349,18 +348,17 @@ Status SessionStore::SetSessionState(std::int64_t session, SessionState state, s
                               "; a session that has started cannot be queued again");
   }
   if (state == SessionState::kCompleted) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                  db.Prepare("SELECT count(*), min(step_index) FROM steps "
-                                             "WHERE session_id = ? AND state = 'pending'"));
+    BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("SELECT count(*), min(step_index) FROM steps "
+                                                   "WHERE session_id = ? AND state = 'pending'"));
     st.Bind(1, session);
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (row && st.Int64(0) > 0) {
       return FailedPrecondition(what + ": " + S(st.Int64(0)) +
                                 " steps are still pending (the first is step " + S(st.Int64(1)) +
                                 "); finish or skip them first");
     }
   }
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       Statement st,
       db.Prepare("UPDATE sessions SET state = ?1, state_reason = ?2, state_changed_at = ?3, "
                  "started_at = CASE WHEN ?1 = 'running' AND started_at IS NULL THEN ?3 "
@@ -379,8 +377,8 @@ Status SessionStore::SetSessionMeterSerial(std::int64_t session, const std::stri
   const std::string what = "recording the meter serial of " + SessionName(session);
   MutexLock lock(write_mu_);
   Database& db = *writer_;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db.Prepare("UPDATE sessions SET meter_serial = ? WHERE id = ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db.Prepare("UPDATE sessions SET meter_serial = ? WHERE id = ?"));
   st.Bind(1, meter_serial).Bind(2, session);
   BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
   if (db.changes() == 0) return NotFound("no " + SessionName(session) + " in the database");
@@ -390,41 +388,40 @@ Status SessionStore::SetSessionMeterSerial(std::int64_t session, const std::stri
 Status SessionStore::AdoptUnnamedSessions(const std::string& rig) {
   MutexLock lock(write_mu_);
   Database& db = *writer_;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db.Prepare("UPDATE sessions SET rig = ? WHERE rig = ''"));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("UPDATE sessions SET rig = ? WHERE rig = ''"));
   st.Bind(1, rig);
   return st.Run().WithContext("naming the rig of sessions recorded before rig names");
 }
 
 Result<SessionRecord> SessionStore::GetSessionByUuid(const std::string& uuid) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(kSessionColumns) +
-                                                          " FROM sessions WHERE uuid = ?"));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(kSessionColumns) +
+                                                  " FROM sessions WHERE uuid = ?"));
   st.Bind(1, uuid);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
   if (!row) return NotFound("no session with uuid " + uuid + " in " + path_);
   return ReadSession(st, path_);
 }
 
 Result<SessionRecord> SessionStore::GetSession(std::int64_t session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(kSessionColumns) +
-                                                          " FROM sessions WHERE id = ?"));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(kSessionColumns) +
+                                                  " FROM sessions WHERE id = ?"));
   st.Bind(1, session);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
   if (!row) return NotFound("no " + SessionName(session) + " in the database");
   return ReadSession(st, path_);
 }
 
 Result<std::vector<SessionRecord>> SessionStore::ListSessions() {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(kSessionColumns) +
-                                                          " FROM sessions ORDER BY id"));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(kSessionColumns) +
+                                                  " FROM sessions ORDER BY id"));
   std::vector<SessionRecord> out;
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
-    BRDF_STORAGE_ASSIGN_OR_RETURN(SessionRecord s, ReadSession(st, path_));
+    BRDF_ASSIGN_OR_RETURN(SessionRecord s, ReadSession(st, path_));
     out.push_back(std::move(s));
   }
   return out;
@@ -434,24 +431,23 @@ Result<std::vector<std::int64_t>> SessionStore::RecoverInterruptedSessions() {
   const std::string what = "pausing sessions interrupted by a restart";
   MutexLock lock(write_mu_);
   Database& db = *writer_;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
   constexpr std::string_view kInterrupted = "('running', 'pausing', 'awaiting_operator')";
   std::vector<std::int64_t> ids;
   {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                  db.Prepare("SELECT id FROM sessions WHERE state IN " +
-                                             std::string(kInterrupted) + " ORDER BY id"));
+    BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("SELECT id FROM sessions WHERE state IN " +
+                                                   std::string(kInterrupted) + " ORDER BY id"));
     while (true) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+      BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
       if (!row) break;
       ids.push_back(st.Int64(0));
     }
   }
   if (ids.empty()) return ids;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
-      Statement st, db.Prepare("UPDATE sessions SET state = 'paused', state_reason = ?, "
-                               "state_changed_at = ? WHERE state IN " +
-                               std::string(kInterrupted)));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db.Prepare("UPDATE sessions SET state = 'paused', state_reason = ?, "
+                                   "state_changed_at = ? WHERE state IN " +
+                                   std::string(kInterrupted)));
   st.Bind(1, kRecoveredReason).Bind(2, Now());
   BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
   BRDF_RETURN_IF_ERROR(tx.Commit().WithContext(what));
@@ -462,50 +458,49 @@ Result<std::vector<std::int64_t>> SessionStore::RecoverInterruptedSessions() {
 // ----------------------------------------------------------------------------------------
 
 Result<std::vector<StepRecord>> SessionStore::GetSteps(std::int64_t session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   BRDF_RETURN_IF_ERROR(RequireSession(*db, session));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
-      Statement st, db->Prepare("SELECT " + std::string(kStepColumns) +
-                                " FROM steps WHERE session_id = ? ORDER BY step_index"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db->Prepare("SELECT " + std::string(kStepColumns) +
+                                    " FROM steps WHERE session_id = ? ORDER BY step_index"));
   st.Bind(1, session);
   std::vector<StepRecord> out;
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
-    BRDF_STORAGE_ASSIGN_OR_RETURN(StepRecord s, ReadStep(st, path_));
+    BRDF_ASSIGN_OR_RETURN(StepRecord s, ReadStep(st, path_));
     out.push_back(std::move(s));
   }
   return out;
 }
 
 Result<std::vector<SessionEventRecord>> SessionStore::ListSessionEvents(std::int64_t session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   BRDF_RETURN_IF_ERROR(RequireSession(*db, session));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
-      Statement st, db->Prepare("SELECT " + std::string(kEventColumns) +
-                                " FROM session_events WHERE session_id = ? ORDER BY id"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db->Prepare("SELECT " + std::string(kEventColumns) +
+                                    " FROM session_events WHERE session_id = ? ORDER BY id"));
   st.Bind(1, session);
   std::vector<SessionEventRecord> out;
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
-    BRDF_STORAGE_ASSIGN_OR_RETURN(SessionEventRecord e, ReadEvent(st, path_));
+    BRDF_ASSIGN_OR_RETURN(SessionEventRecord e, ReadEvent(st, path_));
     out.push_back(std::move(e));
   }
   return out;
 }
 
 Result<std::optional<int>> SessionStore::FirstUnfinishedStep(std::int64_t session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   BRDF_RETURN_IF_ERROR(RequireSession(*db, session));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db->Prepare("SELECT min(step_index) FROM steps "
-                                            "WHERE session_id = ? AND state = 'pending'"));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT min(step_index) FROM steps "
+                                                  "WHERE session_id = ? AND state = 'pending'"));
   st.Bind(1, session);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
   if (!row || st.IsNull(0)) return std::optional<int>();
   return std::optional<int>(st.Int(0));
 }
@@ -519,8 +514,8 @@ Result<std::int64_t> SessionStore::CompleteStepWithReading(std::int64_t session,
 
   MutexLock lock(write_mu_);
   Database& db = *writer_;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(SessionState state, SessionStateOf(db, session));
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
+  BRDF_ASSIGN_OR_RETURN(SessionState state, SessionStateOf(db, session));
   BRDF_RETURN_IF_ERROR(RequireStarted(session, state, what));
   BRDF_RETURN_IF_ERROR(RequireStepTakes(db, session, step_index, reading, what));
   BRDF_RETURN_IF_ERROR(InsertReading(db, session, step_index, reading, blob, recorded_at, what));
@@ -546,15 +541,15 @@ Status SessionStore::MarkStepFinished(std::int64_t session, int step_index, Step
 
   MutexLock lock(write_mu_);
   Database& db = *writer_;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(SessionState session_state, SessionStateOf(db, session));
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
+  BRDF_ASSIGN_OR_RETURN(SessionState session_state, SessionStateOf(db, session));
   if (state == StepState::kDone) {
     BRDF_RETURN_IF_ERROR(RequireStarted(session, session_state, what));
   } else if (IsTerminal(session_state)) {
     return FailedPrecondition(what + ": " + SessionName(session) + " is " +
                               std::string(ToString(session_state)));
   }
-  BRDF_STORAGE_ASSIGN_OR_RETURN(StepRow step, StepOf(db, session, step_index));
+  BRDF_ASSIGN_OR_RETURN(StepRow step, StepOf(db, session, step_index));
   if (!measuring_allowed && ReadingKindFor(step.kind).has_value()) {
     return InvalidArgument(what + ": it is a " + std::string(ToString(step.kind)) +
                            " step; it completes with its reading (CompleteStepWithReading) or is "
@@ -564,14 +559,14 @@ Status SessionStore::MarkStepFinished(std::int64_t session, int step_index, Step
     return NotPending(db, session, step_index, step.state).WithContext(what);
   }
   {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
+    BRDF_ASSIGN_OR_RETURN(
         Statement st, db.Prepare("UPDATE steps SET state = ?, note = ?, completed_at = ? "
                                  "WHERE session_id = ? AND step_index = ? AND state = 'pending'"));
     st.Bind(1, ToString(state)).Bind(2, note).Bind(3, now).Bind(4, session).Bind(5, step_index);
     BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
   }
   {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
+    BRDF_ASSIGN_OR_RETURN(
         Statement st, db.Prepare("UPDATE sessions SET done_steps = done_steps + 1 WHERE id = ?"));
     st.Bind(1, session);
     BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
@@ -596,19 +591,18 @@ Result<std::vector<Record>> ReadingPage(ReaderPool& readers, const std::string& 
     return InvalidArgument("reading the readings of " + SessionName(session) + ": limit " +
                            std::to_string(limit) + " must be positive");
   }
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers.Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers.Acquire());
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   BRDF_RETURN_IF_ERROR(RequireSession(*db, session));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db->Prepare("SELECT " + std::string(columns) +
-                                            " FROM readings WHERE session_id = ? AND id > ? "
-                                            "ORDER BY id LIMIT ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(columns) +
+                                                  " FROM readings WHERE session_id = ? AND id > ? "
+                                                  "ORDER BY id LIMIT ?"));
   st.Bind(1, session).Bind(2, after_id).Bind(3, limit);
   std::vector<Record> out;
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
-    BRDF_STORAGE_ASSIGN_OR_RETURN(Record r, read(st, path));
+    BRDF_ASSIGN_OR_RETURN(Record r, read(st, path));
     out.push_back(std::move(r));
   }
   return out;
@@ -630,11 +624,11 @@ Result<std::vector<ReadingPointRecord>> SessionStore::GetReadingPoints(std::int6
 }
 
 Result<ReadingRecord> SessionStore::GetReading(std::int64_t reading_id) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(kReadingColumns) +
-                                                          " FROM readings WHERE id = ?"));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(kReadingColumns) +
+                                                  " FROM readings WHERE id = ?"));
   st.Bind(1, reading_id);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
   if (!row) return NotFound("no reading " + S(reading_id) + " in the database");
   return ReadReading(st, path_);
 }
@@ -643,8 +637,8 @@ Status SessionStore::ForEachReading(std::int64_t session,
                                     const std::function<Status(const ReadingRecord&)>& visit) {
   std::int64_t after = 0;
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(std::vector<ReadingRecord> page,
-                                  GetReadings(session, after, kReadingPage));
+    BRDF_ASSIGN_OR_RETURN(std::vector<ReadingRecord> page,
+                          GetReadings(session, after, kReadingPage));
     for (const ReadingRecord& r : page) BRDF_RETURN_IF_ERROR(visit(r));
     if (page.size() < static_cast<std::size_t>(kReadingPage)) return Status::Ok();
     after = page.back().id;
@@ -652,10 +646,10 @@ Status SessionStore::ForEachReading(std::int64_t session,
 }
 
 Result<int> SessionStore::CountReadings(std::int64_t session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   BRDF_RETURN_IF_ERROR(RequireSession(*db, session));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       std::int64_t n,
       db->QueryInt64("SELECT count(*) FROM readings WHERE session_id = " + S(session)));
   return static_cast<int>(n);
@@ -672,7 +666,7 @@ Status SessionStore::RecordDevice(const DeviceRecord& device) {
   }
   const UnixSeconds first_seen = device.first_seen != 0 ? device.first_seen : Now();
   MutexLock lock(write_mu_);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(
       Statement st,
       writer_->Prepare("INSERT INTO devices (session_id, kind, model, serial, first_seen) "
                        "VALUES (?, ?, ?, ?, ?) ON CONFLICT DO NOTHING"));
@@ -685,14 +679,14 @@ Status SessionStore::RecordDevice(const DeviceRecord& device) {
 }
 
 Result<std::vector<DeviceRecord>> SessionStore::GetDevices(std::optional<std::int64_t> session) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(
       Statement st, db->Prepare("SELECT id, session_id, kind, model, serial, first_seen "
                                 "FROM devices WHERE ?1 IS NULL OR session_id = ?1 ORDER BY id"));
   st.Bind(1, session);
   std::vector<DeviceRecord> out;
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
     out.push_back(DeviceRecord{st.Int64(0), st.OptionalInt64(1), st.Text(2), st.Text(3), st.Text(4),
                                st.Double(5)});
@@ -707,9 +701,9 @@ Status SessionStore::AppendAudit(const AuditRecord& entry) {
   }
   const UnixSeconds at = entry.at != 0 ? entry.at : Now();
   MutexLock lock(write_mu_);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
-      Statement st, writer_->Prepare("INSERT INTO audit (at, role, actor, action, session_id, "
-                                     "detail) VALUES (?, ?, ?, ?, ?, ?)"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        writer_->Prepare("INSERT INTO audit (at, role, actor, action, session_id, "
+                                         "detail) VALUES (?, ?, ?, ?, ?, ?)"));
   st.Bind(1, at)
       .Bind(2, entry.role)
       .Bind(3, entry.actor)
@@ -725,8 +719,8 @@ Result<std::vector<AuditRecord>> SessionStore::GetAudit(std::optional<std::int64
     return InvalidArgument("reading the audit: limit " + std::to_string(limit) +
                            " must be positive");
   }
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(
       Statement st,
       db->Prepare(session.has_value()
                       ? "SELECT id, at, role, actor, action, session_id, detail FROM audit "
@@ -737,7 +731,7 @@ Result<std::vector<AuditRecord>> SessionStore::GetAudit(std::optional<std::int64
   st.Bind(2, limit);
   std::vector<AuditRecord> out;
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
     out.push_back(AuditRecord{st.Int64(0), st.Double(1), st.Text(2), st.Text(3), st.Text(4),
                               st.OptionalInt64(5), st.Text(6)});

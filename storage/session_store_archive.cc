@@ -4,7 +4,7 @@
 #include <string>
 #include <utility>
 
-#include "storage/assign_or_return.h"
+#include "core/status.h"
 #include "storage/session_rows.h"
 #include "storage/session_store.h"
 
@@ -18,11 +18,11 @@ Result<std::int64_t> Mark(Database& db, std::string_view name) {
 // The uuid of each session in `ids` not yet in `uuids`.
 Status FillUuids(Database& db, const std::set<std::int64_t>& ids,
                  std::map<std::int64_t, std::string>& uuids) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db.Prepare("SELECT uuid FROM sessions WHERE id = ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("SELECT uuid FROM sessions WHERE id = ?"));
   for (std::int64_t id : ids) {
     if (uuids.count(id) != 0) continue;
     st.Bind(1, id);
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (row) uuids[id] = st.Text(0);
     st.Reset();
   }
@@ -38,12 +38,12 @@ struct OutboxChanges {
 
 // Up to max_changes outbox entries, oldest first; batch.outbox_through becomes the last.
 Status ReadOutbox(Database& db, int max_changes, OutboxChanges& changes, ShipBatch& batch) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db.Prepare("SELECT seq, session_id, step_index FROM archive_outbox "
-                                           "ORDER BY seq LIMIT ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db.Prepare("SELECT seq, session_id, step_index FROM archive_outbox "
+                                   "ORDER BY seq LIMIT ?"));
   st.Bind(1, max_changes);
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
     ++changes.count;
     batch.outbox_through = st.Int64(0);
@@ -62,13 +62,13 @@ Status ReadOutbox(Database& db, int max_changes, OutboxChanges& changes, ShipBat
 // The changed sessions' rows (those still present) and their uuids.
 Status ReadChangedSessions(Database& db, const std::string& path,
                            const std::set<std::int64_t>& sessions, ShipBatch& batch) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st, db.Prepare("SELECT " + std::string(kSessionColumns) +
-                                                         " FROM sessions WHERE id = ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("SELECT " + std::string(kSessionColumns) +
+                                                 " FROM sessions WHERE id = ?"));
   for (std::int64_t id : sessions) {
     st.Bind(1, id);
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (row) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(SessionRecord s, ReadSession(st, path));
+      BRDF_ASSIGN_OR_RETURN(SessionRecord s, ReadSession(st, path));
       batch.uuids[s.id] = s.uuid;
       batch.sessions.push_back(std::move(s));
     }
@@ -80,28 +80,28 @@ Status ReadChangedSessions(Database& db, const std::string& path,
 // The changed steps: every step of the sessions in all_steps, then each other changed step.
 Status ReadChangedSteps(Database& db, const std::string& path, const OutboxChanges& changes,
                         ShipBatch& batch) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement all,
-                                db.Prepare("SELECT " + std::string(kStepColumns) +
-                                           " FROM steps WHERE session_id = ? ORDER BY step_index"));
+  BRDF_ASSIGN_OR_RETURN(Statement all,
+                        db.Prepare("SELECT " + std::string(kStepColumns) +
+                                   " FROM steps WHERE session_id = ? ORDER BY step_index"));
   for (std::int64_t id : changes.all_steps) {
     all.Bind(1, id);
     while (true) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, all.Step());
+      BRDF_ASSIGN_OR_RETURN(bool row, all.Step());
       if (!row) break;
-      BRDF_STORAGE_ASSIGN_OR_RETURN(StepRecord s, ReadStep(all, path));
+      BRDF_ASSIGN_OR_RETURN(StepRecord s, ReadStep(all, path));
       batch.steps.push_back(std::move(s));
     }
     all.Reset();
   }
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement one,
-                                db.Prepare("SELECT " + std::string(kStepColumns) +
-                                           " FROM steps WHERE session_id = ? AND step_index = ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement one,
+                        db.Prepare("SELECT " + std::string(kStepColumns) +
+                                   " FROM steps WHERE session_id = ? AND step_index = ?"));
   for (const auto& [id, index] : changes.steps) {
     if (changes.all_steps.count(id) != 0) continue;
     one.Bind(1, id).Bind(2, index);
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, one.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, one.Step());
     if (row) {
-      BRDF_STORAGE_ASSIGN_OR_RETURN(StepRecord s, ReadStep(one, path));
+      BRDF_ASSIGN_OR_RETURN(StepRecord s, ReadStep(one, path));
       batch.steps.push_back(std::move(s));
     }
     one.Reset();
@@ -112,14 +112,14 @@ Status ReadChangedSteps(Database& db, const std::string& path, const OutboxChang
 // Up to `limit` readings past batch.readings_through, which moves to the last.
 Status ReadNewReadings(Database& db, const std::string& path, int limit, ShipBatch& batch,
                        std::set<std::int64_t>& named) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db.Prepare("SELECT " + std::string(kReadingColumns) +
-                                           " FROM readings WHERE id > ? ORDER BY id LIMIT ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db.Prepare("SELECT " + std::string(kReadingColumns) +
+                                   " FROM readings WHERE id > ? ORDER BY id LIMIT ?"));
   st.Bind(1, batch.readings_through).Bind(2, limit);
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
-    BRDF_STORAGE_ASSIGN_OR_RETURN(ReadingRecord r, ReadReading(st, path));
+    BRDF_ASSIGN_OR_RETURN(ReadingRecord r, ReadReading(st, path));
     batch.readings_through = r.id;
     named.insert(r.session_id);
     batch.readings.push_back(std::move(r));
@@ -129,12 +129,12 @@ Status ReadNewReadings(Database& db, const std::string& path, int limit, ShipBat
 
 // Up to `limit` devices past batch.devices_through, which moves to the last.
 Status ReadNewDevices(Database& db, int limit, ShipBatch& batch, std::set<std::int64_t>& named) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db.Prepare("SELECT id, session_id, kind, model, serial, first_seen "
-                                           "FROM devices WHERE id > ? ORDER BY id LIMIT ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db.Prepare("SELECT id, session_id, kind, model, serial, first_seen "
+                                   "FROM devices WHERE id > ? ORDER BY id LIMIT ?"));
   st.Bind(1, batch.devices_through).Bind(2, limit);
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
     batch.devices.push_back(DeviceRecord{st.Int64(0), st.OptionalInt64(1), st.Text(2), st.Text(3),
                                          st.Text(4), st.Double(5)});
@@ -146,12 +146,12 @@ Status ReadNewDevices(Database& db, int limit, ShipBatch& batch, std::set<std::i
 
 // Up to `limit` audit entries past batch.audit_through, which moves to the last.
 Status ReadNewAudit(Database& db, int limit, ShipBatch& batch, std::set<std::int64_t>& named) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Statement st,
-                                db.Prepare("SELECT id, at, role, actor, action, session_id, detail "
-                                           "FROM audit WHERE id > ? ORDER BY id LIMIT ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db.Prepare("SELECT id, at, role, actor, action, session_id, detail "
+                                   "FROM audit WHERE id > ? ORDER BY id LIMIT ?"));
   st.Bind(1, batch.audit_through).Bind(2, limit);
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
     batch.audit.push_back(AuditRecord{st.Int64(0), st.Double(1), st.Text(2), st.Text(3), st.Text(4),
                                       st.OptionalInt64(5), st.Text(6)});
@@ -164,14 +164,14 @@ Status ReadNewAudit(Database& db, int limit, ShipBatch& batch, std::set<std::int
 // Up to `limit` session events past batch.events_through, which moves to the last.
 Status ReadNewEvents(Database& db, const std::string& path, int limit, ShipBatch& batch,
                      std::set<std::int64_t>& named) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
-      Statement st, db.Prepare("SELECT " + std::string(kEventColumns) +
-                               " FROM session_events WHERE id > ? ORDER BY id LIMIT ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db.Prepare("SELECT " + std::string(kEventColumns) +
+                                   " FROM session_events WHERE id > ? ORDER BY id LIMIT ?"));
   st.Bind(1, batch.events_through).Bind(2, limit);
   while (true) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
-    BRDF_STORAGE_ASSIGN_OR_RETURN(SessionEventRecord e, ReadEvent(st, path));
+    BRDF_ASSIGN_OR_RETURN(SessionEventRecord e, ReadEvent(st, path));
     batch.events_through = e.id;
     named.insert(e.session_id);
     batch.events.push_back(std::move(e));
@@ -186,8 +186,8 @@ Status SessionStore::SetArchiveShipping(bool enabled) {
       enabled ? "turning on shipping to the archive" : "turning off shipping to the archive";
   MutexLock lock(write_mu_);
   Database& db = *writer_;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(std::int64_t was, Mark(db, "enabled"));
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
+  BRDF_ASSIGN_OR_RETURN(std::int64_t was, Mark(db, "enabled"));
   if ((was == 1) == enabled) return Status::Ok();
   if (enabled) {
     BRDF_RETURN_IF_ERROR(db.Exec("INSERT INTO archive_outbox (session_id, step_index) "
@@ -203,8 +203,8 @@ Status SessionStore::SetArchiveShipping(bool enabled) {
 }
 
 Result<ShipBatch> SessionStore::NextShipBatch(int max_readings, int max_changes) {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   ShipBatch batch;
 
   OutboxChanges changes;
@@ -212,10 +212,10 @@ Result<ShipBatch> SessionStore::NextShipBatch(int max_readings, int max_changes)
   BRDF_RETURN_IF_ERROR(ReadChangedSessions(*db, path_, changes.sessions, batch));
   BRDF_RETURN_IF_ERROR(ReadChangedSteps(*db, path_, changes, batch));
 
-  BRDF_STORAGE_ASSIGN_OR_RETURN(batch.readings_through, Mark(*db, "readings"));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(batch.devices_through, Mark(*db, "devices"));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(batch.audit_through, Mark(*db, "audit"));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(batch.events_through, Mark(*db, "events"));
+  BRDF_ASSIGN_OR_RETURN(batch.readings_through, Mark(*db, "readings"));
+  BRDF_ASSIGN_OR_RETURN(batch.devices_through, Mark(*db, "devices"));
+  BRDF_ASSIGN_OR_RETURN(batch.audit_through, Mark(*db, "audit"));
+  BRDF_ASSIGN_OR_RETURN(batch.events_through, Mark(*db, "events"));
   // Rows may name sessions not shipped yet: next time.
   if (changes.count >= max_changes) return batch;
 
@@ -233,8 +233,8 @@ Status SessionStore::MarkShipped(const ShipBatch& batch) {
   const std::string what = "recording what the archive has";
   MutexLock lock(write_mu_);
   Database& db = *writer_;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
+  BRDF_ASSIGN_OR_RETURN(
       Statement st, db.Prepare("UPDATE archive_marks SET value = max(value, ?) WHERE name = ?"));
   for (const auto& [name, value] :
        {std::pair<const char*, std::int64_t>{"readings", batch.readings_through},
@@ -246,8 +246,7 @@ Status SessionStore::MarkShipped(const ShipBatch& batch) {
     st.Reset();
   }
   if (batch.outbox_through > 0) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(Statement del,
-                                  db.Prepare("DELETE FROM archive_outbox WHERE seq <= ?"));
+    BRDF_ASSIGN_OR_RETURN(Statement del, db.Prepare("DELETE FROM archive_outbox WHERE seq <= ?"));
     del.Bind(1, batch.outbox_through);
     BRDF_RETURN_IF_ERROR(del.Run().WithContext(what));
   }
@@ -255,24 +254,23 @@ Status SessionStore::MarkShipped(const ShipBatch& batch) {
 }
 
 Result<ShipLag> SessionStore::ShippingLag() {
-  BRDF_STORAGE_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_STORAGE_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   ShipLag lag;
-  BRDF_STORAGE_ASSIGN_OR_RETURN(lag.shipped_readings, Mark(*db, "readings"));
+  BRDF_ASSIGN_OR_RETURN(lag.shipped_readings, Mark(*db, "readings"));
   const std::string above = " FROM readings WHERE id > " + std::to_string(lag.shipped_readings);
-  BRDF_STORAGE_ASSIGN_OR_RETURN(lag.readings, db->QueryInt64("SELECT count(*)" + above));
+  BRDF_ASSIGN_OR_RETURN(lag.readings, db->QueryInt64("SELECT count(*)" + above));
   if (lag.readings > 0) {
-    BRDF_STORAGE_ASSIGN_OR_RETURN(
-        Statement st, db->Prepare("SELECT recorded_at" + above + " ORDER BY id LIMIT 1"));
-    BRDF_STORAGE_ASSIGN_OR_RETURN(bool row, st.Step());
+    BRDF_ASSIGN_OR_RETURN(Statement st,
+                          db->Prepare("SELECT recorded_at" + above + " ORDER BY id LIMIT 1"));
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (row) lag.oldest_unshipped = st.Double(0);
   }
-  BRDF_STORAGE_ASSIGN_OR_RETURN(lag.pending_changes,
-                                db->QueryInt64("SELECT count(*) FROM archive_outbox"));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(std::int64_t events_mark, Mark(*db, "events"));
-  BRDF_STORAGE_ASSIGN_OR_RETURN(lag.events,
-                                db->QueryInt64("SELECT count(*) FROM session_events WHERE id > " +
-                                               std::to_string(events_mark)));
+  BRDF_ASSIGN_OR_RETURN(lag.pending_changes, db->QueryInt64("SELECT count(*) FROM archive_outbox"));
+  BRDF_ASSIGN_OR_RETURN(std::int64_t events_mark, Mark(*db, "events"));
+  BRDF_ASSIGN_OR_RETURN(lag.events,
+                        db->QueryInt64("SELECT count(*) FROM session_events WHERE id > " +
+                                       std::to_string(events_mark)));
   return lag;
 }
 

@@ -1,9 +1,12 @@
 // brdfd's configuration: one TOML file (e.g. /etc/brdfd/brdfd.toml). Every key is optional and
 // has the default written next to it below; a file with a wrong type, a value out of range or a
 // key brdfd does not know (a typo must not silently fall back to a default) is refused with
-// kConfigurationError, naming every bad key with its line and the reason:
-//   "config /etc/brdfd/brdfd.toml: line 31, column 1: unknown key stage.axes.alpa (known: alpha,
-//    beta, gamma, delta)".
+// kConfigurationError, naming every bad key with its line and the reason, one per line, then what
+// to do (core/toml/table_reader.h, as every TOML file of brdfd):
+//   config /etc/brdfd/brdfd.toml: line 31, column 1: unknown key stage.axes.alpa (known here:
+//     alpha, beta, delta, gamma)
+//   config /etc/brdfd/brdfd.toml: fix the file; brdfd.example.toml (deploy/, installed in
+//     share/doc/brdfd/) shows every key with its default
 //
 //   [server]
 //   listen = "127.0.0.1:50051"          # host:port (port 0: any free port) or "unix:/path"

@@ -7,9 +7,11 @@
 // binary at build time (builtin_profiles.h) and installed to share/brdfd/stage-profiles/ for a lab
 // to copy; `[stage] profile_file` points brdfd at the lab's own.
 //
-// Every error is kConfigurationError naming the file, the line and the key, and what to do:
-//   "stage profile file /etc/brdfd/x.toml: line 40: key 'status_bits.moving': must be an
-//    integer (a bit mask such as 0x2000), got a string; fix the key in the file ..."
+// Every error is kConfigurationError naming the file, and for each bad key its line and what is
+// wrong (every one of them, a line each), then what to do (core/toml/table_reader.h):
+//   stage profile file /etc/brdfd/x.toml: line 40, column 10: status_bits.moving: must be an
+//     integer, not a string
+//   stage profile file /etc/brdfd/x.toml: fix the file (the shipped profiles in …)
 // A parsed profile has passed ValidateProfile.
 #pragma once
 

@@ -27,6 +27,28 @@ TEST(StatusTest, ResultHoldsValueOrStatus) {
   EXPECT_EQ(bad.status().code(), StatusCode::kTimeout);
 }
 
+// Halves an even number; an odd one is refused.
+Result<int> Half(int n) {
+  if (n % 2 != 0) return InvalidArgument(std::to_string(n) + " is odd");
+  return n / 2;
+}
+
+// Halves twice through BRDF_ASSIGN_OR_RETURN, once into a new name and once into an existing one.
+Result<int> Quarter(int n) {
+  BRDF_ASSIGN_OR_RETURN(const int half, Half(n));
+  int quarter = -1;
+  BRDF_ASSIGN_OR_RETURN(quarter, Half(half));
+  return quarter;
+}
+
+TEST(StatusTest, AssignOrReturnUnwrapsOrReturnsTheStatus) {
+  ASSERT_TRUE(Quarter(12).ok());
+  EXPECT_EQ(*Quarter(12), 3);
+  EXPECT_EQ(Quarter(7).status().message(), "7 is odd");  // the first call fails
+  EXPECT_EQ(Quarter(6).status().message(), "3 is odd");  // the second one does
+  EXPECT_EQ(Quarter(6).status().code(), StatusCode::kInvalidArgument);
+}
+
 TEST(CallContextTest, CancelWakesWaiter) {
   CancelToken token;
   std::thread t([token]() mutable {

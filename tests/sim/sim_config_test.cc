@@ -171,7 +171,7 @@ TEST(SimConfigTest, FileErrorsNameTheKey) {
   Status type = LoadConfigString("time_scale = \"fast\"\n", "x.toml", c);
   EXPECT_NE(type.message().find("time_scale"), std::string::npos) << type.message();
   Status syntax = LoadConfigString("time_scale = = 3\n", "x.toml", c);
-  EXPECT_NE(syntax.message().find("x.toml:1"), std::string::npos) << syntax.message();
+  EXPECT_NE(syntax.message().find("x.toml: line 1"), std::string::npos) << syntax.message();
   Status mounted = LoadConfigString("mounted = \"grey\"\n", "x.toml", c);
   EXPECT_NE(mounted.message().find("grey"), std::string::npos) << mounted.message();
   // A failed load leaves the configuration as it was.

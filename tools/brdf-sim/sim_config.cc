@@ -4,267 +4,160 @@
 
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
-#include <initializer_list>
 #include <map>
 #include <sstream>
 #include <string_view>
 
+#include "core/toml/table_reader.h"
+
 namespace brdf::sim {
 namespace {
 
-// ---- TOML reading: every key is checked, every type error names the key and the file. ----
+// ---- TOML reading (core/toml/table_reader.h): every key is checked, every problem names the
+// file, the line and the key. ----
 
-class TomlReader {
- public:
-  explicit TomlReader(std::string source) : source_(std::move(source)) {}
+using toml_keys::Empty;
+using toml_keys::TableReader;
 
-  // Errors on keys of `table` outside `known`.
-  Status CheckKeys(const toml::table& table, std::string_view where,
-                   std::initializer_list<std::string_view> known) const {
-    for (const auto& [key, node] : table) {
-      bool found = false;
-      for (std::string_view k : known) found = found || key.str() == k;
-      if (!found) {
-        std::string allowed;
-        for (std::string_view k : known) allowed += (allowed.empty() ? "" : ", ") + std::string(k);
-        return InvalidArgument(source_ + ": unknown key '" + Path(where, key.str()) +
-                               "'; expected one of: " + allowed +
-                               " (see tools/brdf-sim/README.md)");
-      }
-    }
-    return Status::Ok();
-  }
-
-  Status Read(const toml::table& t, std::string_view where, std::string_view key,
-              double& out) const {
-    const toml::node* n = t.get(key);
-    if (n == nullptr) return Status::Ok();
-    if (auto v = n->value<double>()) {  // integers convert too
-      out = *v;
-      return Status::Ok();
-    }
-    return TypeError(where, key, "a number");
-  }
-  Status Read(const toml::table& t, std::string_view where, std::string_view key, int& out) const {
-    const toml::node* n = t.get(key);
-    if (n == nullptr) return Status::Ok();
-    if (const auto* v = n->as_integer()) {
-      const std::int64_t x = v->get();
-      if (x < INT32_MIN || x > INT32_MAX) return TypeError(where, key, "an integer in int range");
-      out = static_cast<int>(x);
-      return Status::Ok();
-    }
-    return TypeError(where, key, "an integer");
-  }
-  Status Read(const toml::table& t, std::string_view where, std::string_view key,
-              std::uint64_t& out) const {
-    const toml::node* n = t.get(key);
-    if (n == nullptr) return Status::Ok();
-    if (const auto* v = n->as_integer(); v != nullptr && v->get() >= 0) {
-      out = static_cast<std::uint64_t>(v->get());
-      return Status::Ok();
-    }
-    return TypeError(where, key, "a non-negative integer");
-  }
-  Status Read(const toml::table& t, std::string_view where, std::string_view key, bool& out) const {
-    const toml::node* n = t.get(key);
-    if (n == nullptr) return Status::Ok();
-    if (const auto* v = n->as_boolean()) {
-      out = v->get();
-      return Status::Ok();
-    }
-    return TypeError(where, key, "true or false");
-  }
-  Status Read(const toml::table& t, std::string_view where, std::string_view key,
-              std::string& out) const {
-    const toml::node* n = t.get(key);
-    if (n == nullptr) return Status::Ok();
-    if (const auto* v = n->as_string()) {
-      out = v->get();
-      return Status::Ok();
-    }
-    return TypeError(where, key, "a string");
-  }
-
-  // The sub-table `key` of `t`, or nullptr when absent; an error when `key` is not a table.
-  Result<const toml::table*> Table(const toml::table& t, std::string_view where,
-                                   std::string_view key) const {
-    const toml::node* n = t.get(key);
-    if (n == nullptr) return static_cast<const toml::table*>(nullptr);
-    if (const auto* tab = n->as_table()) return tab;
-    return TypeError(where, key, "a table ([" + Path(where, key) + "])");
-  }
-
-  const std::string& source() const { return source_; }
-
- private:
-  static std::string Path(std::string_view where, std::string_view key) {
-    return where.empty() ? std::string(key) : std::string(where) + "." + std::string(key);
-  }
-  Status TypeError(std::string_view where, std::string_view key, const std::string& what) const {
-    return InvalidArgument(source_ + ": '" + Path(where, key) + "' must be " + what);
-  }
-
-  std::string source_;
-};
+// One key into a field of the file's types; a string may be empty, a number any finite one,
+// and ValidateConfig checks the ranges afterwards as for the flags.
+void Get(TableReader& t, std::string_view key, double& out) {
+  t.Double(key, out);
+}
+void Get(TableReader& t, std::string_view key, int& out) {
+  t.Int(key, out, INT32_MIN, INT32_MAX);
+}
+void Get(TableReader& t, std::string_view key, std::uint64_t& out) {
+  t.Int(key, out, 0, INT64_MAX);
+}
+void Get(TableReader& t, std::string_view key, bool& out) {
+  t.Bool(key, out);
+}
+void Get(TableReader& t, std::string_view key, std::string& out) {
+  t.String(key, out, Empty::kAllowed);
+}
 
 // A fault code given without its count means "the next one".
 void DefaultCount(int code, int& count) {
   if (code != 0 && count == 0) count = 1;
 }
 
-Status ReadFaults(const TomlReader& r, const toml::table& faults, SimConfig& c) {
-  BRDF_RETURN_IF_ERROR(r.CheckKeys(faults, "faults", {"serial", "modbus"}));
-  auto serial = r.Table(faults, "faults", "serial");
-  if (!serial.ok()) return serial.status();
-  if (const toml::table* s = *serial) {
-    const char* w = "faults.serial";
-    SerialFaults& f = c.serial_faults;
-    BRDF_RETURN_IF_ERROR(r.CheckKeys(*s, w,
-                                     {"silent", "garbage_next", "truncate_next", "quality_code",
-                                      "quality_count", "vanish_seconds"}));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, w, "silent", f.silent));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, w, "garbage_next", f.garbage_next));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, w, "truncate_next", f.truncate_next));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, w, "quality_code", f.quality_code));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, w, "quality_count", f.quality_count));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, w, "vanish_seconds", f.vanish_seconds));
-    if (s->get("quality_count") == nullptr) DefaultCount(f.quality_code, f.quality_count);
+void ReadSerialFaults(TableReader& t, SerialFaults& f) {
+  Get(t, "silent", f.silent);
+  Get(t, "garbage_next", f.garbage_next);
+  Get(t, "truncate_next", f.truncate_next);
+  Get(t, "quality_code", f.quality_code);
+  Get(t, "quality_count", f.quality_count);
+  Get(t, "vanish_seconds", f.vanish_seconds);
+  if (t.table() != nullptr && t.table()->get("quality_count") == nullptr) {
+    DefaultCount(f.quality_code, f.quality_count);
   }
-  auto modbus = r.Table(faults, "faults", "modbus");
-  if (!modbus.ok()) return modbus.status();
-  if (const toml::table* m = *modbus) {
-    const char* w = "faults.modbus";
-    ModbusFaults& f = c.modbus_faults;
-    BRDF_RETURN_IF_ERROR(r.CheckKeys(*m, w,
-                                     {"exception_code", "exception_count", "late_reply_ms",
-                                      "late_count", "drop_connection", "alarm_mid_move", "stall"}));
-    BRDF_RETURN_IF_ERROR(r.Read(*m, w, "exception_code", f.exception_code));
-    BRDF_RETURN_IF_ERROR(r.Read(*m, w, "exception_count", f.exception_count));
-    BRDF_RETURN_IF_ERROR(r.Read(*m, w, "late_reply_ms", f.late_reply_ms));
-    BRDF_RETURN_IF_ERROR(r.Read(*m, w, "late_count", f.late_count));
-    BRDF_RETURN_IF_ERROR(r.Read(*m, w, "drop_connection", f.drop_connection));
-    BRDF_RETURN_IF_ERROR(r.Read(*m, w, "alarm_mid_move", f.alarm_mid_move));
-    BRDF_RETURN_IF_ERROR(r.Read(*m, w, "stall", f.stall));
-    if (m->get("exception_count") == nullptr) DefaultCount(f.exception_code, f.exception_count);
-    if (m->get("late_count") == nullptr) DefaultCount(f.late_reply_ms, f.late_count);
-  }
-  return Status::Ok();
+  t.Finish();
 }
 
-Status ReadOptics(const TomlReader& r, const toml::table& o, OpticsConfig& c) {
-  BRDF_RETURN_IF_ERROR(r.CheckKeys(
-      o, "optics", {"white_reflectance", "ambient_radiance", "noise_scale", "lamp", "detector"}));
-  BRDF_RETURN_IF_ERROR(r.Read(o, "optics", "white_reflectance", c.white_reflectance));
-  BRDF_RETURN_IF_ERROR(r.Read(o, "optics", "ambient_radiance", c.ambient_radiance));
-  BRDF_RETURN_IF_ERROR(r.Read(o, "optics", "noise_scale", c.noise_scale));
-  auto lamp = r.Table(o, "optics", "lamp");
-  if (!lamp.ok()) return lamp.status();
-  if (const toml::table* l = *lamp) {
-    const char* w = "optics.lamp";
-    BRDF_RETURN_IF_ERROR(r.CheckKeys(*l, w, {"color_temperature_k", "irradiance_at_560nm"}));
-    BRDF_RETURN_IF_ERROR(r.Read(*l, w, "color_temperature_k", c.lamp.color_temperature_k));
-    BRDF_RETURN_IF_ERROR(r.Read(*l, w, "irradiance_at_560nm", c.lamp.irradiance_at_560nm));
+void ReadModbusFaults(TableReader& t, ModbusFaults& f) {
+  Get(t, "exception_code", f.exception_code);
+  Get(t, "exception_count", f.exception_count);
+  Get(t, "late_reply_ms", f.late_reply_ms);
+  Get(t, "late_count", f.late_count);
+  Get(t, "drop_connection", f.drop_connection);
+  Get(t, "alarm_mid_move", f.alarm_mid_move);
+  Get(t, "stall", f.stall);
+  if (t.table() != nullptr) {
+    if (t.table()->get("exception_count") == nullptr) {
+      DefaultCount(f.exception_code, f.exception_count);
+    }
+    if (t.table()->get("late_count") == nullptr) DefaultCount(f.late_reply_ms, f.late_count);
   }
-  auto detector = r.Table(o, "optics", "detector");
-  if (!detector.ok()) return detector.status();
-  if (const toml::table* d = *detector) {
-    const char* w = "optics.detector";
-    DetectorConfig& dc = c.detector;
-    BRDF_RETURN_IF_ERROR(r.CheckKeys(
-        *d, w,
-        {"full_scale", "adaptive_fill", "low_light_fill", "weak_fill", "full_well_counts",
-         "read_noise_counts", "min_integration_ms", "max_integration_ms", "overhead_s"}));
-    BRDF_RETURN_IF_ERROR(r.Read(*d, w, "full_scale", dc.full_scale));
-    BRDF_RETURN_IF_ERROR(r.Read(*d, w, "adaptive_fill", dc.adaptive_fill));
-    BRDF_RETURN_IF_ERROR(r.Read(*d, w, "low_light_fill", dc.low_light_fill));
-    BRDF_RETURN_IF_ERROR(r.Read(*d, w, "weak_fill", dc.weak_fill));
-    BRDF_RETURN_IF_ERROR(r.Read(*d, w, "full_well_counts", dc.full_well_counts));
-    BRDF_RETURN_IF_ERROR(r.Read(*d, w, "read_noise_counts", dc.read_noise_counts));
-    BRDF_RETURN_IF_ERROR(r.Read(*d, w, "min_integration_ms", dc.min_integration_ms));
-    BRDF_RETURN_IF_ERROR(r.Read(*d, w, "max_integration_ms", dc.max_integration_ms));
-    BRDF_RETURN_IF_ERROR(r.Read(*d, w, "overhead_s", dc.overhead_s));
-  }
-  return Status::Ok();
+  t.Finish();
 }
 
-Status ReadTable(const TomlReader& r, const toml::table& root, SimConfig& c) {
-  BRDF_RETURN_IF_ERROR(r.CheckKeys(root, "",
-                                   {"time_scale", "seed", "anisotropic", "glossy", "mounted",
-                                    "log_level", "modbus", "pr650", "stage", "faults", "optics"}));
-  BRDF_RETURN_IF_ERROR(r.Read(root, "", "time_scale", c.time_scale));
-  BRDF_RETURN_IF_ERROR(r.Read(root, "", "seed", c.optics.seed));
-  BRDF_RETURN_IF_ERROR(r.Read(root, "", "anisotropic", c.optics.anisotropic));
-  BRDF_RETURN_IF_ERROR(r.Read(root, "", "glossy", c.optics.glossy));
-  BRDF_RETURN_IF_ERROR(r.Read(root, "", "log_level", c.log_level));
+void ReadFaults(TableReader& root, SimConfig& c) {
+  TableReader faults = root.Sub("faults");
+  TableReader serial = faults.Sub("serial");
+  ReadSerialFaults(serial, c.serial_faults);
+  TableReader modbus = faults.Sub("modbus");
+  ReadModbusFaults(modbus, c.modbus_faults);
+  faults.Finish();
+}
+
+void ReadDetector(TableReader& d, DetectorConfig& dc) {
+  Get(d, "full_scale", dc.full_scale);
+  Get(d, "adaptive_fill", dc.adaptive_fill);
+  Get(d, "low_light_fill", dc.low_light_fill);
+  Get(d, "weak_fill", dc.weak_fill);
+  Get(d, "full_well_counts", dc.full_well_counts);
+  Get(d, "read_noise_counts", dc.read_noise_counts);
+  Get(d, "min_integration_ms", dc.min_integration_ms);
+  Get(d, "max_integration_ms", dc.max_integration_ms);
+  Get(d, "overhead_s", dc.overhead_s);
+  d.Finish();
+}
+
+void ReadOptics(TableReader& root, OpticsConfig& c) {
+  TableReader o = root.Sub("optics");
+  Get(o, "white_reflectance", c.white_reflectance);
+  Get(o, "ambient_radiance", c.ambient_radiance);
+  Get(o, "noise_scale", c.noise_scale);
+  TableReader lamp = o.Sub("lamp");
+  Get(lamp, "color_temperature_k", c.lamp.color_temperature_k);
+  Get(lamp, "irradiance_at_560nm", c.lamp.irradiance_at_560nm);
+  lamp.Finish();
+  TableReader detector = o.Sub("detector");
+  ReadDetector(detector, c.detector);
+  o.Finish();
+}
+
+void ReadLinks(TableReader& root, SimConfig& c) {
+  TableReader m = root.Sub("modbus");
+  Get(m, "host", c.modbus_host);
+  Get(m, "port", c.modbus_port);
+  Get(m, "rtu", c.rtu);
+  m.Finish();
+  TableReader p = root.Sub("pr650");
+  Get(p, "d5_header_bare_cr", c.d5_header_bare_cr);
+  Get(p, "m0_reply_is_quality", c.m0_reply_is_quality);
+  Get(p, "link", c.pr650_link);
+  Get(p, "pacing", c.pacing);
+  Get(p, "fifo_bytes", c.fifo_bytes);
+  Get(p, "wake_window_s", c.wake_window_s);
+  p.Finish();
+}
+
+void ReadStage(TableReader& root, SimConfig& c) {
+  TableReader s = root.Sub("stage");
+  Get(s, "ramp_unit", c.stage_ramp_unit);
+  Get(s, "function_codes", c.stage_function_codes);
+  Get(s, "word_order", c.stage_word_order);
+  Get(s, "detector_arm", c.detector_arm);
+  Get(s, "manual_delta_deg", c.manual_delta_deg);
+  for (std::size_t i = 0; i < kAxisNames.size(); ++i) {
+    TableReader a = s.Sub(kAxisNames[i]);
+    Get(a, "home_speed_deg_s", c.axes[i].home_speed_deg_s);
+    Get(a, "min_deg", c.axes[i].min_deg);
+    Get(a, "max_deg", c.axes[i].max_deg);
+    a.Finish();
+  }
+  s.Finish();
+}
+
+void ReadTable(TableReader& root, SimConfig& c) {
+  Get(root, "time_scale", c.time_scale);
+  Get(root, "seed", c.optics.seed);
+  Get(root, "anisotropic", c.optics.anisotropic);
+  Get(root, "glossy", c.optics.glossy);
+  Get(root, "log_level", c.log_level);
   std::string mounted;
-  BRDF_RETURN_IF_ERROR(r.Read(root, "", "mounted", mounted));
-  if (!mounted.empty()) {
-    auto t = ParseMountedTarget(mounted);
-    if (!t) {
-      return InvalidArgument(r.source() + ": 'mounted' is \"" + mounted +
-                             "\"; expected \"sample\", \"white\" or \"dark\"");
-    }
-    c.mounted = *t;
+  if (root.OneOf("mounted", mounted, {"sample", "white", "dark"})) {
+    c.mounted = *ParseMountedTarget(mounted);
   }
-
-  auto modbus = r.Table(root, "", "modbus");
-  if (!modbus.ok()) return modbus.status();
-  if (const toml::table* m = *modbus) {
-    BRDF_RETURN_IF_ERROR(r.CheckKeys(*m, "modbus", {"host", "port", "rtu"}));
-    BRDF_RETURN_IF_ERROR(r.Read(*m, "modbus", "host", c.modbus_host));
-    BRDF_RETURN_IF_ERROR(r.Read(*m, "modbus", "port", c.modbus_port));
-    BRDF_RETURN_IF_ERROR(r.Read(*m, "modbus", "rtu", c.rtu));
-  }
-
-  auto pr650 = r.Table(root, "", "pr650");
-  if (!pr650.ok()) return pr650.status();
-  if (const toml::table* p = *pr650) {
-    BRDF_RETURN_IF_ERROR(r.CheckKeys(*p, "pr650",
-                                     {"pacing", "fifo_bytes", "wake_window_s", "link",
-                                      "d5_header_bare_cr", "m0_reply_is_quality"}));
-    BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "d5_header_bare_cr", c.d5_header_bare_cr));
-    BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "m0_reply_is_quality", c.m0_reply_is_quality));
-    BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "link", c.pr650_link));
-    BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "pacing", c.pacing));
-    BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "fifo_bytes", c.fifo_bytes));
-    BRDF_RETURN_IF_ERROR(r.Read(*p, "pr650", "wake_window_s", c.wake_window_s));
-  }
-
-  auto stage = r.Table(root, "", "stage");
-  if (!stage.ok()) return stage.status();
-  if (const toml::table* s = *stage) {
-    BRDF_RETURN_IF_ERROR(
-        r.CheckKeys(*s, "stage",
-                    {"detector_arm", "manual_delta_deg", "function_codes", "word_order",
-                     "ramp_unit", "alpha", "beta", "gamma", "delta"}));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, "stage", "ramp_unit", c.stage_ramp_unit));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, "stage", "function_codes", c.stage_function_codes));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, "stage", "word_order", c.stage_word_order));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, "stage", "detector_arm", c.detector_arm));
-    BRDF_RETURN_IF_ERROR(r.Read(*s, "stage", "manual_delta_deg", c.manual_delta_deg));
-    for (std::size_t i = 0; i < kAxisNames.size(); ++i) {
-      auto axis = r.Table(*s, "stage", kAxisNames[i]);
-      if (!axis.ok()) return axis.status();
-      const toml::table* a = *axis;
-      if (a == nullptr) continue;
-      const std::string w = std::string("stage.") + kAxisNames[i];
-      BRDF_RETURN_IF_ERROR(r.CheckKeys(*a, w, {"home_speed_deg_s", "min_deg", "max_deg"}));
-      BRDF_RETURN_IF_ERROR(r.Read(*a, w, "home_speed_deg_s", c.axes[i].home_speed_deg_s));
-      BRDF_RETURN_IF_ERROR(r.Read(*a, w, "min_deg", c.axes[i].min_deg));
-      BRDF_RETURN_IF_ERROR(r.Read(*a, w, "max_deg", c.axes[i].max_deg));
-    }
-  }
-
-  auto faults = r.Table(root, "", "faults");
-  if (!faults.ok()) return faults.status();
-  if (const toml::table* f = *faults) BRDF_RETURN_IF_ERROR(ReadFaults(r, *f, c));
-
-  auto optics = r.Table(root, "", "optics");
-  if (!optics.ok()) return optics.status();
-  if (const toml::table* o = *optics) BRDF_RETURN_IF_ERROR(ReadOptics(r, *o, c.optics));
-  return Status::Ok();
+  ReadLinks(root, c);
+  ReadStage(root, c);
+  ReadFaults(root, c);
+  ReadOptics(root, c.optics);
+  root.Finish();
 }
 
 bool Finite(double x) {
@@ -309,17 +202,14 @@ std::optional<std::string> FindConfigPath(int argc, const char* const* argv) {
 
 Status LoadConfigString(const std::string& toml_text, const std::string& source_name,
                         SimConfig& config) {
-  toml::table root;
-  try {
-    root = toml::parse(toml_text, source_name);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream msg;
-    msg << source_name << ":" << e.source().begin.line << ":" << e.source().begin.column
-        << ": not valid TOML: " << e.description() << "; fix the file or drop --config";
-    return InvalidArgument(msg.str());
-  }
+  toml_keys::Problems problems(
+      "brdf-sim config " + source_name, StatusCode::kInvalidArgument,
+      "fix the file or drop --config (tools/brdf-sim/README.md lists every key)");
+  BRDF_ASSIGN_OR_RETURN(const toml::table root, problems.Parse(toml_text, source_name));
   SimConfig updated = config;
-  BRDF_RETURN_IF_ERROR(ReadTable(TomlReader(source_name), root, updated));
+  TableReader reader(problems, &root);
+  ReadTable(reader, updated);
+  BRDF_RETURN_IF_ERROR(problems.status());
   config = updated;
   return Status::Ok();
 }

@@ -1,6 +1,8 @@
 #include "tools/brdfctl/appearance_command.h"
 
+#include <CLI/CLI.hpp>
 #include <fstream>
+#include <memory>
 
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/json_output.h"
@@ -98,6 +100,31 @@ int RunAppearance(CommandContext& ctx, const AppearanceOptions& o) {
     }
   }
   return kExitOk;
+}
+
+namespace {
+
+Runner AddAppearanceOptions(CLI::App& cmd) {
+  auto options = std::make_shared<AppearanceOptions>();
+  AddSessionId(cmd, options->session_id);
+  cmd.add_option("--illuminant", options->illuminant, "D65 or A (default both)")
+      ->check(CLI::IsMember({"D65", "A"}));
+  cmd.add_option("--method", options->method, "octant (the paper's), delaunay, nearest")
+      ->check(CLI::IsMember({"octant", "delaunay", "nearest"}))
+      ->capture_default_str();
+  cmd.add_option("--size", options->size,
+                 "the sphere's pixels per side, at most 512 (default 128)");
+  cmd.add_option("-o,--output", options->output,
+                 "write the sphere as a PPM (both illuminants: NAME-D65.ppm, NAME-A.ppm)");
+  return OnDaemon([options](CommandContext& ctx) { return RunAppearance(ctx, *options); });
+}
+
+}  // namespace
+
+void RegisterAppearanceCommand(CommandRegistry& registry) {
+  registry.Add({"appearance",
+                "the sample's colour (45°:0°) and a lit sphere in sRGB under D65 and illuminant A",
+                "", AddAppearanceOptions});
 }
 
 }  // namespace brdf::ctl

@@ -8,6 +8,7 @@
 
 #include <string>
 
+#include "tools/brdfctl/command.h"
 #include "tools/brdfctl/command_context.h"
 
 namespace brdf::ctl {
@@ -21,5 +22,8 @@ struct AppearanceOptions {
 };
 
 int RunAppearance(CommandContext& ctx, const AppearanceOptions& options);
+
+// `appearance`, with its flags (command.h).
+void RegisterAppearanceCommand(CommandRegistry& registry);
 
 }  // namespace brdf::ctl

@@ -1,5 +1,8 @@
 #include "tools/brdfctl/control_commands.h"
 
+#include <CLI/CLI.hpp>
+#include <memory>
+
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/json_output.h"
 #include "tools/brdfctl/plan_file.h"
@@ -294,6 +297,146 @@ int RunRig(CommandContext& ctx) {
           << (reply.active_session_id().empty() ? "none" : reply.active_session_id()) << "\n";
   PrintArchiveStatus(ctx.out, reply.archive());
   return kExitOk;
+}
+
+// ---- The subcommands: their arguments and flags, and the Run function each calls. ----
+namespace {
+
+Runner AddValidateOptions(CLI::App& cmd) {
+  struct Args {
+    std::string plan_path;
+    double time_scale = 1.0;
+  };
+  auto args = std::make_shared<Args>();
+  cmd.add_option("plan", args->plan_path, "plan JSON file (- for standard input)")->required();
+  cmd.add_option("--time-scale", args->time_scale,
+                 "estimate for a simulated rig this many times faster (brdf-sim "
+                 "--time-scale; the quick start's is 8)")
+      ->check(CLI::Range(0.001, 1e6));
+  return OnDaemon(
+      [args](CommandContext& ctx) { return RunValidate(ctx, args->plan_path, args->time_scale); });
+}
+
+Runner AddSubmitOptions(CLI::App& cmd) {
+  struct Args {
+    std::string plan_path;
+    bool start_now = false;
+    bool quiet = false;
+  };
+  auto args = std::make_shared<Args>();
+  cmd.add_option("plan", args->plan_path, "plan JSON file (- for standard input)")->required();
+  cmd.add_flag("--start", args->start_now, "start it at once (else it stays queued)");
+  cmd.add_flag("-q,--quiet", args->quiet, "print only the new session's id");
+  return OnDaemon([args](CommandContext& ctx) {
+    return RunSubmit(ctx, args->plan_path, args->start_now, args->quiet);
+  });
+}
+
+// A subcommand whose only argument is the session id.
+std::function<Runner(CLI::App&)> SessionIdOnly(int (*run)(CommandContext&, const std::string&)) {
+  return [run](CLI::App& cmd) {
+    auto session_id = std::make_shared<std::string>();
+    AddSessionId(cmd, *session_id);
+    return OnDaemon([run, session_id](CommandContext& ctx) { return run(ctx, *session_id); });
+  };
+}
+
+Runner AddPauseOptions(CLI::App& cmd) {
+  struct Args {
+    std::string session_id;
+    bool immediate = false;
+  };
+  auto args = std::make_shared<Args>();
+  AddSessionId(cmd, args->session_id);
+  cmd.add_flag("--immediate", args->immediate, "cancel the step in progress now");
+  return OnDaemon(
+      [args](CommandContext& ctx) { return RunPause(ctx, args->session_id, args->immediate); });
+}
+
+Runner AddAbortOptions(CLI::App& cmd) {
+  struct Args {
+    std::string session_id;
+    std::string reason;
+  };
+  auto args = std::make_shared<Args>();
+  AddSessionId(cmd, args->session_id);
+  cmd.add_option("--reason", args->reason, "why (stored with the session)");
+  return OnDaemon(
+      [args](CommandContext& ctx) { return RunAbort(ctx, args->session_id, args->reason); });
+}
+
+Runner AddAnswerOptions(CLI::App& cmd) {
+  struct Args {
+    std::string session_id;
+    int step_index = -1;
+    std::string note;
+  };
+  auto args = std::make_shared<Args>();
+  AddSessionId(cmd, args->session_id);
+  cmd.add_option("step", args->step_index, "the prompt's step index (brdfctl get ID shows it)")
+      ->required();
+  cmd.add_option("--note", args->note, "remark stored with the session's log");
+  return OnDaemon([args](CommandContext& ctx) {
+    return RunAnswer(ctx, args->session_id, args->step_index, args->note);
+  });
+}
+
+Runner AddListOptions(CLI::App& cmd) {
+  struct Args {
+    std::vector<std::string> states;
+    unsigned limit = 0;
+    ListFilters filters;
+  };
+  auto args = std::make_shared<Args>();
+  cmd.add_option("--state", args->states,
+                 "only these states: queued, running, pausing, paused, awaiting_operator, "
+                 "completed, aborted, failed (repeat or comma-separate)")
+      ->delimiter(',');
+  cmd.add_option("--limit", args->limit, "at most this many (0: all)");
+  cmd.add_option("--rig", args->filters.rig, "only sessions recorded by this rig ([rig] name)");
+  cmd.add_option("--sample", args->filters.sample,
+                 "only sessions of this sample: its id, or its name (ignoring case)");
+  cmd.add_option("--material", args->filters.material,
+                 "only sessions of samples of this material (ignoring case)");
+  cmd.add_option("--tag", args->filters.tag, "only sessions of samples carrying this tag");
+  return OnDaemon([args](CommandContext& ctx) {
+    return RunList(ctx, args->states, args->limit, args->filters);
+  });
+}
+
+Runner AddRigOptions(CLI::App&) {
+  return OnDaemon([](CommandContext& ctx) { return RunRig(ctx); });
+}
+
+}  // namespace
+
+void RegisterPlanCommands(CommandRegistry& registry) {
+  registry.Add({"validate",
+                "check a plan file against the rig: every problem with its field path, or the "
+                "step count and duration",
+                "", AddValidateOptions});
+  registry.Add({"submit", "submit a plan file as a new session", "", AddSubmitOptions});
+}
+
+void RegisterOperatorCommands(CommandRegistry& registry) {
+  registry.Add({"start", "start a queued session", "", SessionIdOnly(RunStart)});
+  registry.Add({"pause",
+                "pause a session after the current step (--immediate: cancel the step now; resume "
+                "redoes it)",
+                "", AddPauseOptions});
+  registry.Add({"resume", "resume a paused session", "", SessionIdOnly(RunResume)});
+  registry.Add({"abort", "stop a session for good (its readings are kept)", "", AddAbortOptions});
+  registry.Add({"answer", "confirm the operator prompt at STEP once its manual action is done", "",
+                AddAnswerOptions});
+}
+
+void RegisterViewCommands(CommandRegistry& registry) {
+  registry.Add(
+      {"get", "one session: state, progress, prompt, fault, plan", "", SessionIdOnly(RunGet)});
+  registry.Add({"events", "a session's history of states, oldest first: time, state, reason", "",
+                SessionIdOnly(RunEvents)});
+  registry.Add({"list", "sessions, newest first", "", AddListOptions});
+  registry.Add({"rig", "the rig: devices, axes, live pose, meter serial", "", AddRigOptions});
 }
 
 }  // namespace brdf::ctl

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "tools/brdfctl/command.h"
 #include "tools/brdfctl/command_context.h"
 
 namespace brdf::ctl {
@@ -43,5 +44,11 @@ int RunList(CommandContext& ctx, const std::vector<std::string>& states, unsigne
 
 // GetRigStatus: devices, axes, live pose, meter serial, the session holding the rig.
 int RunRig(CommandContext& ctx);
+
+// The subcommands, with their flags (command.h): validate and submit; start, pause, resume, abort
+// and answer; get, events, list and rig.
+void RegisterPlanCommands(CommandRegistry& registry);
+void RegisterOperatorCommands(CommandRegistry& registry);
+void RegisterViewCommands(CommandRegistry& registry);
 
 }  // namespace brdf::ctl

@@ -1,5 +1,8 @@
 #include "tools/brdfctl/export_command.h"
 
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -7,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/json_output.h"
@@ -32,13 +36,11 @@ std::string Megabytes(std::uint64_t bytes) {
   return text;
 }
 
-// The request for the options, or an exit status and message for a bad option.
-int BuildRequest(const ExportOptions& o, std::ostream& err, v1::ExportRequest* request) {
-  request->set_session_id(o.session_id);
-  const bool grid = o.what == "grid";
+// The request's format from `what` (and, for a grid, --format or the output's extension).
+int SetFormat(const ExportOptions& o, std::ostream& err, v1::ExportRequest* request) {
   if (o.what == "csv") {
     request->set_format(v1::EXPORT_FORMAT_READINGS_CSV);
-  } else if (grid) {
+  } else if (o.what == "grid") {
     std::string format = o.format;
     if (format.empty()) format = EndsWith(o.output, ".csv") ? "csv" : "npy";
     if (format == "npy") {
@@ -55,7 +57,12 @@ int BuildRequest(const ExportOptions& o, std::ostream& err, v1::ExportRequest* r
   } else {
     return Invalid(err, "'" + o.what + "': export csv, grid, merl or rgl");
   }
+  return kExitOk;
+}
 
+// The quantity, the RGL flags and the fill policy, each refused where the format has no use
+// for it.
+int SetQuantityAndFill(const ExportOptions& o, std::ostream& err, v1::ExportRequest* request) {
   if (o.quantity == "brdf") {
     request->set_quantity(v1::QUANTITY_BRDF);
   } else if (o.quantity == "reflectance") {
@@ -86,7 +93,11 @@ int BuildRequest(const ExportOptions& o, std::ostream& err, v1::ExportRequest* r
   if (o.what == "csv" && o.fill != "chain") {
     return Invalid(err, "--fill is for grid, merl and rgl exports");
   }
+  return kExitOk;
+}
 
+// The interpolation: method, coordinates, trend, axis scale, mirrored and swapped readings.
+int SetInterpolation(const ExportOptions& o, std::ostream& err, v1::ExportRequest* request) {
   if (o.method == "octant") {
     request->set_method(v1::INTERPOLATION_METHOD_OCTANT);
   } else if (o.method == "delaunay") {
@@ -116,10 +127,19 @@ int BuildRequest(const ExportOptions& o, std::ostream& err, v1::ExportRequest* r
   for (double s : o.axis_scale) options->add_axis_scale(s);
   options->set_mirror_phi(o.mirror_phi);
   // A MERL or RGL cell stands for a pair of directions and its swap alike (as brdf-export).
-  options->set_reciprocity(o.what == "merl" || rgl ? !o.no_reciprocity : o.reciprocity);
+  const bool swapped_by_default = o.what == "merl" || o.what == "rgl";
+  options->set_reciprocity(swapped_by_default ? !o.no_reciprocity : o.reciprocity);
+  return kExitOk;
+}
 
+// The request for the options, or an exit status and message for a bad option.
+int BuildRequest(const ExportOptions& o, std::ostream& err, v1::ExportRequest* request) {
+  request->set_session_id(o.session_id);
+  if (int rc = SetFormat(o, err, request); rc != kExitOk) return rc;
+  if (int rc = SetQuantityAndFill(o, err, request); rc != kExitOk) return rc;
+  if (int rc = SetInterpolation(o, err, request); rc != kExitOk) return rc;
   if (!o.steps.empty()) {
-    if (!grid) return Invalid(err, "--steps is for grid exports");
+    if (o.what != "grid") return Invalid(err, "--steps is for grid exports");
     if (o.steps.size() != 1 && o.steps.size() != 3) {
       return Invalid(err, "--steps: give dθi,dθo,dφ in degrees (three values) or one for all");
     }
@@ -196,6 +216,118 @@ void PrintReport(std::ostream& err, const v1::ExportReport& r, const std::string
   }
 }
 
+// Where the bytes go until the report names the file: FILE.partial, renamed when kept and
+// removed when discarded, or standard output.
+class ExportDestination {
+ public:
+  ExportDestination(std::ostream& standard_output, std::string partial, bool to_stdout)
+      : standard_output_(standard_output), partial_(std::move(partial)), to_stdout_(to_stdout) {}
+
+  bool Open() {
+    if (to_stdout_) return true;
+    file_.open(partial_, std::ios::binary | std::ios::trunc);
+    return static_cast<bool>(file_);
+  }
+  std::ostream& out() { return to_stdout_ ? standard_output_ : file_; }
+  // For messages: "standard output" or the .partial file.
+  std::string name() const { return to_stdout_ ? "standard output" : partial_; }
+  const std::string& partial() const { return partial_; }
+
+  void Discard() {
+    if (to_stdout_) return;
+    file_.close();
+    std::remove(partial_.c_str());
+  }
+  // Closes the file and renames it to `path`; false (the .partial file left) when either fails.
+  bool Keep(const std::string& path) {
+    file_.close();
+    return file_ && std::rename(partial_.c_str(), path.c_str()) == 0;
+  }
+
+ private:
+  std::ostream& standard_output_;
+  std::string partial_;
+  bool to_stdout_;
+  std::ofstream file_;
+};
+
+struct Received {
+  std::uint64_t bytes = 0;
+  std::optional<v1::ExportReport> report;
+};
+
+// Writes a data chunk at the offset expected; false (the message printed) when the offset or
+// the write is wrong.
+bool WriteChunk(CommandContext& ctx, const v1::ExportData& data, ExportDestination& destination,
+                std::uint64_t received) {
+  if (data.offset() != received) {
+    ctx.err << "brdfctl export: the daemon sent bytes at offset " << data.offset() << " after "
+            << received << " bytes; try again\n";
+    return false;
+  }
+  destination.out().write(data.content().data(),
+                          static_cast<std::streamsize>(data.content().size()));
+  if (!destination.out()) {
+    ctx.err << "brdfctl export: writing " << destination.name() << " failed (disk full?)\n";
+    return false;
+  }
+  return true;
+}
+
+// Reads the Export stream into `destination`, drawing the progress line. kExitOk once the report
+// has come and its byte count matches; else the exit status, the problem printed.
+int ReceiveExport(CommandContext& ctx, const ExportOptions& o, const v1::ExportRequest& request,
+                  ExportDestination& destination, Received* received) {
+  ExportProgressLine line(ctx.err, o.what, o.progress, o.progress_tty);
+  std::unique_ptr<grpc::ClientContext> call = ctx.client.StreamContext();
+  std::unique_ptr<grpc::ClientReader<v1::ExportChunk>> reader =
+      ctx.client.data().Export(call.get(), request);
+  v1::ExportChunk chunk;
+  std::string stage = "waiting";
+  double fraction = 0;
+  while (reader->Read(&chunk)) {
+    if (chunk.has_progress()) {
+      stage = chunk.progress().stage();
+      fraction = chunk.progress().fraction();
+      line.Update(stage, fraction, received->bytes);
+    } else if (chunk.has_data()) {
+      if (!WriteChunk(ctx, chunk.data(), destination, received->bytes)) {
+        call->TryCancel();
+        line.Finish();
+        return kExitFailure;
+      }
+      received->bytes += chunk.data().content().size();
+      line.Update(stage, fraction, received->bytes);
+    } else if (chunk.has_report()) {
+      received->report = chunk.report();
+    }
+  }
+  line.Finish();
+  const grpc::Status status = reader->Finish();
+  if (!status.ok()) {
+    return ReportRpcError(ctx.err, status, "Export", ctx.client.options().address);
+  }
+  if (!received->report || received->report->bytes() != received->bytes) {
+    ctx.err << "brdfctl export: the stream ended "
+            << (received->report ? "with a byte count" : "without a report")
+            << " that does not match the " << received->bytes << " bytes received; try again\n";
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+// The grid's description next to it (PATH.json), when the daemon sent one.
+bool WriteDescription(std::ostream& err, const v1::ExportReport& report, const std::string& path) {
+  if (report.description_json().empty()) return true;
+  std::ofstream json(path + ".json", std::ios::trunc);
+  json << report.description_json();
+  if (!json) {
+    err << "brdfctl export: cannot write " << path << ".json\n";
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 int RunExport(CommandContext& ctx, const ExportOptions& o) {
@@ -207,101 +339,123 @@ int RunExport(CommandContext& ctx, const ExportOptions& o) {
                     request.format() == v1::EXPORT_FORMAT_RGL_BSDF)) {
     return Invalid(ctx.err, "a binary export needs a file: give -o FILE");
   }
-
   // Until the report names the file, bytes go to a .partial file (or standard output).
-  const std::string partial =
-      (o.output.empty() ? "brdfctl-export-" + o.session_id : o.output) + ".partial";
-  std::ofstream file;
-  if (!to_stdout) {
-    file.open(partial, std::ios::binary | std::ios::trunc);
-    if (!file) return Invalid(ctx.err, "cannot create " + partial + ": check the directory");
+  ExportDestination destination(
+      ctx.out, (o.output.empty() ? "brdfctl-export-" + o.session_id : o.output) + ".partial",
+      to_stdout);
+  if (!destination.Open()) {
+    return Invalid(ctx.err, "cannot create " + destination.partial() + ": check the directory");
   }
-  std::ostream& out = to_stdout ? ctx.out : file;
-  auto fail = [&](int rc) {
-    if (!to_stdout) {
-      file.close();
-      std::remove(partial.c_str());
-    }
+  Received received;
+  if (int rc = ReceiveExport(ctx, o, request, destination, &received); rc != kExitOk) {
+    destination.Discard();
     return rc;
-  };
-
-  ExportProgressLine line(ctx.err, o.what, o.progress, o.progress_tty);
-  std::unique_ptr<grpc::ClientContext> call = ctx.client.StreamContext();
-  std::unique_ptr<grpc::ClientReader<v1::ExportChunk>> reader =
-      ctx.client.data().Export(call.get(), request);
-  v1::ExportChunk chunk;
-  std::uint64_t received = 0;
-  std::optional<v1::ExportReport> report;
-  std::string stage = "waiting";
-  double fraction = 0;
-  while (reader->Read(&chunk)) {
-    if (chunk.has_progress()) {
-      stage = chunk.progress().stage();
-      fraction = chunk.progress().fraction();
-      line.Update(stage, fraction, received);
-    } else if (chunk.has_data()) {
-      if (chunk.data().offset() != received) {
-        call->TryCancel();
-        line.Finish();
-        ctx.err << "brdfctl export: the daemon sent bytes at offset " << chunk.data().offset()
-                << " after " << received << " bytes; try again\n";
-        return fail(kExitFailure);
-      }
-      out.write(chunk.data().content().data(),
-                static_cast<std::streamsize>(chunk.data().content().size()));
-      if (!out) {
-        call->TryCancel();
-        line.Finish();
-        ctx.err << "brdfctl export: writing " << (to_stdout ? "standard output" : partial)
-                << " failed (disk full?)\n";
-        return fail(kExitFailure);
-      }
-      received += chunk.data().content().size();
-      line.Update(stage, fraction, received);
-    } else if (chunk.has_report()) {
-      report = chunk.report();
-    }
   }
-  line.Finish();
-  const grpc::Status status = reader->Finish();
-  if (!status.ok()) {
-    fail(0);
-    return ReportRpcError(ctx.err, status, "Export", ctx.client.options().address);
-  }
-  if (!report || report->bytes() != received) {
-    ctx.err << "brdfctl export: the stream ended "
-            << (report ? "with a byte count" : "without a report") << " that does not match the "
-            << received << " bytes received; try again\n";
-    return fail(kExitFailure);
-  }
+  const v1::ExportReport& report = *received.report;
   const std::string path = to_stdout          ? "standard output"
-                           : o.output.empty() ? report->file_name()
+                           : o.output.empty() ? report.file_name()
                                               : o.output;
   if (!to_stdout) {
-    file.close();
-    if (!file || std::rename(partial.c_str(), path.c_str()) != 0) {
-      ctx.err << "brdfctl export: cannot move " << partial << " to " << path << "\n";
-      return fail(kExitFailure);
+    if (!destination.Keep(path)) {
+      ctx.err << "brdfctl export: cannot move " << destination.partial() << " to " << path << "\n";
+      destination.Discard();
+      return kExitFailure;
     }
-    if (!report->description_json().empty()) {
-      std::ofstream json(path + ".json", std::ios::trunc);
-      json << report->description_json();
-      if (!json) {
-        ctx.err << "brdfctl export: cannot write " << path << ".json\n";
-        return kExitFailure;
-      }
-    }
+    if (!WriteDescription(ctx.err, report, path)) return kExitFailure;
   } else {
     ctx.out.flush();
   }
-  for (const std::string& w : report->warnings())
+  for (const std::string& w : report.warnings())
     ctx.err << "brdfctl export: warning: " << w << "\n";
   if (ctx.json) {
-    PrintJsonLine(to_stdout ? ctx.err : ctx.out, *report);
+    PrintJsonLine(to_stdout ? ctx.err : ctx.out, report);
   } else {
-    PrintReport(ctx.err, *report, path);
+    PrintReport(ctx.err, report, path);
   }
   return kExitOk;
+}
+
+namespace {
+
+void AddFileFlags(CLI::App& cmd, ExportOptions& o) {
+  cmd.add_option("what", o.what, "csv, grid, merl or rgl")
+      ->required()
+      ->check(CLI::IsMember({"csv", "grid", "merl", "rgl"}));
+  cmd.add_option("-o,--output", o.output,
+                 "the file (default: the daemon's name for it, e.g. "
+                 "session-1-grid-brdf.npy); - for standard output (csv)");
+  cmd.add_option("--quantity", o.quantity, "csv, grid: radiance, reflectance or brdf")
+      ->capture_default_str();
+  cmd.add_option("--format", o.format,
+                 "grid: npy or csv (default: from the file's extension, else npy)");
+  cmd.add_option("--steps", o.steps,
+                 "grid: dθi,dθo,dφ in degrees, or one for all (default 1: 90 × 90 × 180 cells)")
+      ->delimiter(',');
+  cmd.add_flag("--nodes", o.nodes,
+               "grid: nodes 0, step, …, 90 (180) instead of the cells' centres");
+}
+
+void AddInterpolationFlags(CLI::App& cmd, ExportOptions& o) {
+  cmd.add_option("--method", o.method, "octant (the paper's), delaunay, nearest")
+      ->capture_default_str();
+  cmd.add_option("--scale", o.axis_scale, "per-axis distance multipliers a,b,c")->delimiter(',');
+  cmd.add_flag("--mirror-phi", o.mirror_phi, "also use readings mirrored to −φ");
+  cmd.add_option("--coordinates", o.coordinates,
+                 "grid, merl, rgl: interpolate in incidence (θi, θo, φ) or half-diff "
+                 "(Rusinkiewicz's half/difference angles) coordinates")
+      ->check(CLI::IsMember({"incidence", "half-diff"}))
+      ->capture_default_str();
+  cmd.add_option("--trend", o.trend,
+                 "grid, merl, rgl: none, or bivariate (blend the readings' residuals from a "
+                 "fitted smooth f(θh, θd) and add it back)")
+      ->check(CLI::IsMember({"none", "bivariate"}))
+      ->capture_default_str();
+  cmd.add_flag("--reciprocity", o.reciprocity,
+               "grid: also use readings with θi and θo swapped (merl, rgl: always, see below)");
+  cmd.add_flag("--no-reciprocity", o.no_reciprocity,
+               "merl, rgl: do not add the θi↔θo swapped readings");
+  cmd.add_option("--fill", o.fill,
+                 "grid, merl, rgl: cells the method cannot fill: chain (Delaunay, then the "
+                 "fitted Cook-Torrance model) or none (NaN / −1)")
+      ->check(CLI::IsMember({"chain", "none"}))
+      ->capture_default_str();
+}
+
+void AddRglAndReadingFlags(CLI::App& cmd, ExportOptions& o, bool& no_progress) {
+  cmd.add_flag("--rgb", o.rgb, "rgl: linear sRGB under D65 (field rgb) instead of spectra");
+  cmd.add_option("--theta-i", o.theta_i_count, "rgl: θi slices (default 24)");
+  cmd.add_option("--resolution", o.resolution,
+                 "rgl: nodes per side of the warped square (default 48)");
+  cmd.add_flag("--exclude-flagged", o.exclude_flagged,
+               "leave out readings the quality policy flagged");
+  cmd.add_flag("--no-progress", no_progress, "no progress line");
+}
+
+Runner AddExportOptions(CLI::App& cmd) {
+  struct Args {
+    ExportOptions options;
+    bool no_progress = false;
+  };
+  auto args = std::make_shared<Args>();
+  AddSessionId(cmd, args->options.session_id);
+  AddFileFlags(cmd, args->options);
+  AddInterpolationFlags(cmd, args->options);
+  AddRglAndReadingFlags(cmd, args->options, args->no_progress);
+  return OnDaemon([args](CommandContext& ctx) {
+    ExportOptions options = args->options;
+    options.progress = !args->no_progress;
+    options.progress_tty = isatty(STDERR_FILENO) != 0;
+    return RunExport(ctx, options);
+  });
+}
+
+}  // namespace
+
+void RegisterExportCommand(CommandRegistry& registry) {
+  registry.Add({"export",
+                "a session as a file: readings CSV, a regular grid (.npy or CSV), a MERL .binary, "
+                "an RGL .bsdf",
+                "", AddExportOptions});
 }
 
 }  // namespace brdf::ctl

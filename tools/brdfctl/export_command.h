@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "tools/brdfctl/command.h"
 #include "tools/brdfctl/command_context.h"
 
 namespace brdf::ctl {
@@ -49,5 +50,9 @@ struct ExportOptions {
 };
 
 int RunExport(CommandContext& ctx, const ExportOptions& options);
+
+// `export`, with its flags (command.h); the progress line is redrawn when standard error is a
+// terminal.
+void RegisterExportCommand(CommandRegistry& registry);
 
 }  // namespace brdf::ctl

@@ -1,7 +1,9 @@
 #include "tools/brdfctl/interpolate_command.h"
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/json_output.h"
@@ -72,11 +74,11 @@ bool ParseQuantity(const std::string& name, v1::Quantity* quantity) {
   return true;
 }
 
-}  // namespace
-
-int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
-  v1::InterpolateRequest request;
-  request.set_session_id(o.session_id);
+// The request for the options; kExitInvalid (and a message) for a bad method, quantity,
+// direction, coordinates or trend.
+int BuildRequest(CommandContext& ctx, const InterpolateOptions& o,
+                 v1::InterpolateRequest* request) {
+  request->set_session_id(o.session_id);
   v1::InterpolationMethod method{};
   v1::Quantity quantity{};
   if (!ParseMethod(o.method, &method)) {
@@ -87,15 +89,15 @@ int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
     ctx.err << "brdfctl: --quantity " << o.quantity << ": use radiance, reflectance or brdf\n";
     return kExitInvalid;
   }
-  request.set_method(method);
-  request.set_quantity(quantity);
+  request->set_method(method);
+  request->set_quantity(quantity);
   if (o.phi) {
-    v1::IsoDirection* d = request.mutable_direction()->mutable_iso();
+    v1::IsoDirection* d = request->mutable_direction()->mutable_iso();
     d->set_theta_i(o.theta_i);
     d->set_theta_o(o.theta_o);
     d->set_phi(*o.phi);
   } else if (o.phi_i && o.phi_o) {
-    v1::Directions* d = request.mutable_direction()->mutable_four();
+    v1::Directions* d = request->mutable_direction()->mutable_four();
     d->set_theta_i(o.theta_i);
     d->set_phi_i(*o.phi_i);
     d->set_theta_o(o.theta_o);
@@ -104,7 +106,7 @@ int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
     ctx.err << "brdfctl: give --phi (isotropic: θi, θo, φ) or both --phi-i and --phi-o\n";
     return kExitInvalid;
   }
-  v1::InterpolationOptions* options = request.mutable_options();
+  v1::InterpolationOptions* options = request->mutable_options();
   v1::InterpolationCoordinates coordinates{};
   if (!ParseCoordinatesName(o.coordinates, &coordinates)) {
     ctx.err << "brdfctl: --coordinates " << o.coordinates << ": use incidence or half-diff\n";
@@ -120,100 +122,132 @@ int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
   options->set_mirror_phi(o.mirror_phi);
   options->set_reciprocity(o.reciprocity);
   for (double s : o.axis_scale) options->add_axis_scale(s);
+  return kExitOk;
+}
 
+// For --explain: each vertex's own spectrum (one InterpolateBatch call, nearest method, at the
+// vertices' positions); none and a note when that call fails.
+struct VertexSpectra {
+  std::vector<v1::InterpolationResult> results;
+  std::string note;
+};
+
+VertexSpectra FetchVertexSpectra(CommandContext& ctx, const v1::InterpolateRequest& request,
+                                 const v1::InterpolationResult& result) {
+  VertexSpectra spectra;
+  v1::InterpolateBatchRequest batch;
+  batch.set_session_id(request.session_id());
+  batch.set_method(v1::INTERPOLATION_METHOD_NEAREST);
+  batch.set_quantity(request.quantity());
+  *batch.mutable_options() = request.options();
+  for (const v1::InterpolationVertex& v : result.vertices()) {
+    *batch.add_directions() = VertexQuery(v);
+  }
+  auto context = ctx.client.UnaryContext();
+  auto reader = ctx.client.interpolation().InterpolateBatch(context.get(), batch);
+  v1::InterpolateBatchChunk chunk;
+  while (reader->Read(&chunk)) {
+    for (const v1::InterpolationResult& r : chunk.results()) spectra.results.push_back(r);
+  }
+  const grpc::Status status = reader->Finish();
+  if (!status.ok()) {
+    spectra.note =
+        "(vertex spectra unavailable: " + std::string(GrpcCodeName(status.error_code())) + ": " +
+        status.error_message() + ")";
+    spectra.results.clear();
+  }
+  return spectra;
+}
+
+// The blended readings: ids, positions, weights and their sum.
+void PrintVertices(std::ostream& out, const v1::InterpolationResult& result,
+                   const std::string& note) {
+  out << "\nvertices (blended readings):\n";
+  const bool four = result.vertices(0).coords_size() == 4;
+  out << "  #   " << Cell("reading", 9)
+      << (four ? Cell("θi", 9) + Cell("φi", 9) + Cell("θo", 9) + Cell("φo", 9)
+               : Cell("θi", 9) + Cell("θo", 9) + Cell("φ", 9))
+      << "weight\n";
+  double sum = 0;
+  for (int i = 0; i < result.vertices_size(); ++i) {
+    const v1::InterpolationVertex& v = result.vertices(i);
+    sum += v.weight();
+    out << "  " << Cell("v" + std::to_string(i + 1), 4) << Cell(std::to_string(v.reading_id()), 9)
+        << CoordsText(v) << Num(v.weight(), 6) << "\n";
+  }
+  out << "  weights sum to " << Num(sum, 8) << "\n";
+  if (!note.empty()) out << "  " << note << "\n";
+}
+
+// The table of wavelength and value (every Nth band), with a column per vertex spectrum.
+void PrintSpectra(std::ostream& out, const v1::InterpolationResult& result,
+                  const std::vector<v1::InterpolationResult>& vertex_results, int every) {
+  const v1::WavelengthGrid& g = result.grid();
+  out << "\n" << Cell("λ (nm)", 9) << Cell("interpolated", 14);
+  for (std::size_t i = 0; i < vertex_results.size(); ++i) {
+    out << Cell("v" + std::to_string(i + 1), 14);
+  }
+  out << "\n";
+  for (int b = 0; b<result.spectrum_size(); b += every> 0 ? every : 1) {
+    out << Cell(Num(g.start_nm() + b * g.step_nm()), 9) << Cell(Num(result.spectrum(b), 6), 14);
+    for (const v1::InterpolationResult& r : vertex_results) {
+      out << Cell(b < r.spectrum_size() ? Num(r.spectrum(b), 6) : "-", 14);
+    }
+    out << "\n";
+  }
+  for (std::size_t i = 0; i < vertex_results.size(); ++i) {
+    const v1::InterpolationResult& r = vertex_results[i];
+    const std::int64_t got = r.vertices_size() > 0 ? r.vertices(0).reading_id() : 0;
+    if (got != result.vertices(static_cast<int>(i)).reading_id()) {
+      out << "  note: v" << (i + 1) << "'s column is reading " << got
+          << ", taken at the same direction as reading "
+          << result.vertices(static_cast<int>(i)).reading_id() << "\n";
+    }
+  }
+}
+
+void PrintReadable(std::ostream& out, const InterpolateOptions& o,
+                   const v1::InterpolateRequest& request, const v1::InterpolationResult& result,
+                   const VertexSpectra& vertex_spectra) {
+  out << "session " << o.session_id << ": " << QuantityName(result.quantity()) << " ("
+      << QuantityUnit(result.quantity()) << ") at " << QueryText(result.query()) << ", "
+      << MethodName(result.method())
+      << (request.options().coordinates() == v1::INTERPOLATION_COORDINATES_HALF_DIFFERENCE
+              ? " in half/difference coordinates"
+              : "")
+      << (request.options().trend() == v1::INTERPOLATION_TREND_BIVARIATE
+              ? " over the bivariate trend"
+              : "")
+      << ": " << InterpolationStatusName(result.status()) << "\n";
+  if (!result.detail().empty()) out << "  " << result.detail() << "\n";
+  if (o.explain && result.vertices_size() > 0) PrintVertices(out, result, vertex_spectra.note);
+  if (result.status() == v1::INTERPOLATION_STATUS_OK) {
+    PrintSpectra(out, result, vertex_spectra.results, o.every);
+  }
+}
+
+}  // namespace
+
+int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
+  v1::InterpolateRequest request;
+  if (int rc = BuildRequest(ctx, o, &request); rc != kExitOk) return rc;
   v1::InterpolateResponse reply;
-  grpc::Status status =
+  const grpc::Status status =
       ctx.client.interpolation().Interpolate(ctx.client.UnaryContext().get(), request, &reply);
   if (!status.ok()) {
     return ReportRpcError(ctx.err, status, "Interpolate", ctx.client.options().address);
   }
   const v1::InterpolationResult& result = reply.result();
   const bool ok = result.status() == v1::INTERPOLATION_STATUS_OK;
-
-  // The vertices' own spectra, for --explain.
-  std::vector<v1::InterpolationResult> vertex_results;
-  std::string vertex_note;
+  VertexSpectra vertex_spectra;
   if (o.explain && ok && result.vertices_size() > 0) {
-    v1::InterpolateBatchRequest batch;
-    batch.set_session_id(o.session_id);
-    batch.set_method(v1::INTERPOLATION_METHOD_NEAREST);
-    batch.set_quantity(quantity);
-    *batch.mutable_options() = request.options();
-    for (const v1::InterpolationVertex& v : result.vertices()) {
-      *batch.add_directions() = VertexQuery(v);
-    }
-    auto context = ctx.client.UnaryContext();
-    auto reader = ctx.client.interpolation().InterpolateBatch(context.get(), batch);
-    v1::InterpolateBatchChunk chunk;
-    while (reader->Read(&chunk)) {
-      for (const v1::InterpolationResult& r : chunk.results()) vertex_results.push_back(r);
-    }
-    status = reader->Finish();
-    if (!status.ok()) {
-      vertex_note =
-          "(vertex spectra unavailable: " + std::string(GrpcCodeName(status.error_code())) + ": " +
-          status.error_message() + ")";
-      vertex_results.clear();
-    }
+    vertex_spectra = FetchVertexSpectra(ctx, request, result);
   }
-
   if (ctx.json) {
     PrintJsonLine(ctx.out, reply);
-    for (const v1::InterpolationResult& r : vertex_results) PrintJsonLine(ctx.out, r);
+    for (const v1::InterpolationResult& r : vertex_spectra.results) PrintJsonLine(ctx.out, r);
   } else {
-    std::ostream& out = ctx.out;
-    out << "session " << o.session_id << ": " << QuantityName(result.quantity()) << " ("
-        << QuantityUnit(result.quantity()) << ") at " << QueryText(result.query()) << ", "
-        << MethodName(result.method())
-        << (coordinates == v1::INTERPOLATION_COORDINATES_HALF_DIFFERENCE
-                ? " in half/difference coordinates"
-                : "")
-        << (trend == v1::INTERPOLATION_TREND_BIVARIATE ? " over the bivariate trend" : "") << ": "
-        << InterpolationStatusName(result.status()) << "\n";
-    if (!result.detail().empty()) out << "  " << result.detail() << "\n";
-    if (o.explain && result.vertices_size() > 0) {
-      out << "\nvertices (blended readings):\n";
-      const bool four = result.vertices(0).coords_size() == 4;
-      out << "  #   " << Cell("reading", 9)
-          << (four ? Cell("θi", 9) + Cell("φi", 9) + Cell("θo", 9) + Cell("φo", 9)
-                   : Cell("θi", 9) + Cell("θo", 9) + Cell("φ", 9))
-          << "weight\n";
-      double sum = 0;
-      for (int i = 0; i < result.vertices_size(); ++i) {
-        const v1::InterpolationVertex& v = result.vertices(i);
-        sum += v.weight();
-        out << "  " << Cell("v" + std::to_string(i + 1), 4)
-            << Cell(std::to_string(v.reading_id()), 9) << CoordsText(v) << Num(v.weight(), 6)
-            << "\n";
-      }
-      out << "  weights sum to " << Num(sum, 8) << "\n";
-      if (!vertex_note.empty()) out << "  " << vertex_note << "\n";
-    }
-    if (ok) {
-      const v1::WavelengthGrid& g = result.grid();
-      out << "\n" << Cell("λ (nm)", 9) << Cell("interpolated", 14);
-      for (std::size_t i = 0; i < vertex_results.size(); ++i) {
-        out << Cell("v" + std::to_string(i + 1), 14);
-      }
-      out << "\n";
-      const int every = o.every > 0 ? o.every : 1;
-      for (int b = 0; b < result.spectrum_size(); b += every) {
-        out << Cell(Num(g.start_nm() + b * g.step_nm()), 9) << Cell(Num(result.spectrum(b), 6), 14);
-        for (const v1::InterpolationResult& r : vertex_results) {
-          out << Cell(b < r.spectrum_size() ? Num(r.spectrum(b), 6) : "-", 14);
-        }
-        out << "\n";
-      }
-      for (std::size_t i = 0; i < vertex_results.size(); ++i) {
-        const v1::InterpolationResult& r = vertex_results[i];
-        const std::int64_t got = r.vertices_size() > 0 ? r.vertices(0).reading_id() : 0;
-        if (got != result.vertices(static_cast<int>(i)).reading_id()) {
-          out << "  note: v" << (i + 1) << "'s column is reading " << got
-              << ", taken at the same direction as reading "
-              << result.vertices(static_cast<int>(i)).reading_id() << "\n";
-        }
-      }
-    }
+    PrintReadable(ctx.out, o, request, result, vertex_spectra);
   }
   if (!ok) {
     ctx.err << "brdfctl: no spectrum at " << QueryText(result.query()) << ": "
@@ -223,6 +257,79 @@ int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
     return kExitNoResult;
   }
   return kExitOk;
+}
+
+namespace {
+
+// The options and the three φ flags, whose presence CLI11 reports after parsing.
+struct InterpolateArgs {
+  InterpolateOptions options;
+  double phi = 0, phi_i = 0, phi_o = 0;
+  CLI::Option* phi_flag = nullptr;
+  CLI::Option* phi_i_flag = nullptr;
+  CLI::Option* phi_o_flag = nullptr;
+};
+
+void AddDirectionFlags(CLI::App& cmd, InterpolateArgs& a) {
+  cmd.add_option("--theta-i", a.options.theta_i, "incidence polar angle θi, degrees")->required();
+  cmd.add_option("--theta-o", a.options.theta_o, "outgoing polar angle θo, degrees")->required();
+  a.phi_flag = cmd.add_option(
+      "--phi", a.phi, "relative azimuth φ = |φo − φi|, degrees, 180 = specular side (isotropic)");
+  a.phi_i_flag = cmd.add_option("--phi-i", a.phi_i, "incidence azimuth φi, degrees (anisotropic)");
+  a.phi_o_flag = cmd.add_option("--phi-o", a.phi_o, "outgoing azimuth φo, degrees (anisotropic)");
+  a.phi_flag->excludes(a.phi_i_flag)->excludes(a.phi_o_flag);
+  a.phi_i_flag->needs(a.phi_o_flag);
+  a.phi_o_flag->needs(a.phi_i_flag);
+}
+
+void AddMethodFlags(CLI::App& cmd, InterpolateOptions& o) {
+  cmd.add_option("--method", o.method, "octant (the paper's), delaunay, nearest")
+      ->check(CLI::IsMember({"octant", "delaunay", "nearest"}))
+      ->capture_default_str();
+  cmd.add_option("--quantity", o.quantity,
+                 "radiance (W·m⁻²·sr⁻¹·nm⁻¹), reflectance (R = I/I0) or brdf (sr⁻¹)")
+      ->check(CLI::IsMember({"radiance", "reflectance", "brdf"}))
+      ->capture_default_str();
+  cmd.add_flag("--explain", o.explain,
+               "also the blended readings, their weights and their own spectra");
+  cmd.add_option("--every", o.every, "print every Nth wavelength")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd.add_flag("--mirror-phi", o.mirror_phi, "also use readings mirrored to −φ");
+  cmd.add_flag("--reciprocity", o.reciprocity, "also use readings with θi and θo swapped");
+  cmd.add_option("--scale", o.axis_scale, "per-axis distance multipliers a,b,c[,d]")
+      ->delimiter(',');
+  cmd.add_option("--coordinates", o.coordinates,
+                 "incidence (θi, θo, φ) or half-diff (Rusinkiewicz's half/difference angles; "
+                 "isotropic sessions)")
+      ->check(CLI::IsMember({"incidence", "half-diff"}))
+      ->capture_default_str();
+  cmd.add_option("--trend", o.trend,
+                 "none, or bivariate: blend the readings' residuals from a fitted smooth "
+                 "f(θh, θd) and add it back (isotropic sessions)")
+      ->check(CLI::IsMember({"none", "bivariate"}))
+      ->capture_default_str();
+}
+
+Runner AddInterpolateOptions(CLI::App& cmd) {
+  auto args = std::make_shared<InterpolateArgs>();
+  AddSessionId(cmd, args->options.session_id);
+  AddDirectionFlags(cmd, *args);
+  AddMethodFlags(cmd, args->options);
+  return OnDaemon([args](CommandContext& ctx) {
+    InterpolateOptions options = args->options;
+    if (args->phi_flag->count() > 0) options.phi = args->phi;
+    if (args->phi_i_flag->count() > 0) options.phi_i = args->phi_i;
+    if (args->phi_o_flag->count() > 0) options.phi_o = args->phi_o;
+    return RunInterpolate(ctx, options);
+  });
+}
+
+}  // namespace
+
+void RegisterInterpolateCommand(CommandRegistry& registry) {
+  registry.Add({"interpolate", "the spectrum at a direction between the samples of a session", "",
+                AddInterpolateOptions});
 }
 
 }  // namespace brdf::ctl

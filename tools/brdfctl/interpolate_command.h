@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "tools/brdfctl/command.h"
 #include "tools/brdfctl/command_context.h"
 
 namespace brdf::ctl {
@@ -35,5 +36,8 @@ struct InterpolateOptions {
 };
 
 int RunInterpolate(CommandContext& ctx, const InterpolateOptions& options);
+
+// `interpolate`, with its flags (command.h).
+void RegisterInterpolateCommand(CommandRegistry& registry);
 
 }  // namespace brdf::ctl

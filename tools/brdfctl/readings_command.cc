@@ -1,6 +1,8 @@
 #include "tools/brdfctl/readings_command.h"
 
+#include <CLI/CLI.hpp>
 #include <cctype>
+#include <memory>
 
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/json_output.h"
@@ -79,6 +81,27 @@ int RunReadings(CommandContext& ctx, const ReadingsOptions& options) {
   }
   if (!ctx.json) ctx.out << count << (count == 1 ? " reading" : " readings") << "\n";
   return kExitOk;
+}
+
+namespace {
+
+Runner AddReadingsOptions(CLI::App& cmd) {
+  auto options = std::make_shared<ReadingsOptions>();
+  AddSessionId(cmd, options->session_id);
+  cmd.add_flag("--follow", options->follow,
+               "keep going: print new readings as they are taken, until the session ends");
+  cmd.add_option("--kind", options->kinds,
+                 "only sample, reference or dark (repeat or comma-separate)")
+      ->delimiter(',');
+  cmd.add_option("--after-id", options->after_id, "only readings with a larger id");
+  cmd.add_flag("--spectra", options->spectra, "also print each spectrum");
+  return OnDaemon([options](CommandContext& ctx) { return RunReadings(ctx, *options); });
+}
+
+}  // namespace
+
+void RegisterReadingsCommand(CommandRegistry& registry) {
+  registry.Add({"readings", "a session's readings, in the order taken", "", AddReadingsOptions});
 }
 
 }  // namespace brdf::ctl

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "tools/brdfctl/command.h"
 #include "tools/brdfctl/command_context.h"
 
 namespace brdf::ctl {
@@ -20,5 +21,8 @@ struct ReadingsOptions {
 };
 
 int RunReadings(CommandContext& ctx, const ReadingsOptions& options);
+
+// `readings`, with its flags (command.h).
+void RegisterReadingsCommand(CommandRegistry& registry);
 
 }  // namespace brdf::ctl

@@ -2,8 +2,11 @@
 
 #include <modbus.h>
 
+#include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstdlib>
+#include <iostream>
+#include <memory>
 
 #include "tools/brdf-sim/stage_control_map.h"
 #include "tools/brdfctl/exit_codes.h"
@@ -82,6 +85,35 @@ int RunSimMount(std::ostream& out, std::ostream& err, const std::string& target,
   if (!status.ok()) return ReportLocalError(err, status);
   out << "sim-mount: " << resolved << " mounted on brdf-sim at " << modbus << "\n";
   return kExitOk;
+}
+
+namespace {
+
+Runner AddSimMountOptions(CLI::App& cmd) {
+  struct Args {
+    std::string target;
+    std::string modbus;
+    int unit = 100;
+  };
+  auto args = std::make_shared<Args>();
+  cmd.add_option("target", args->target, "sample, white, dark or from-prompt")->required();
+  cmd.add_option("--modbus", args->modbus, "brdf-sim's Modbus TCP host:port")
+      ->envname("BRDF_SIM_MODBUS")
+      ->required();
+  cmd.add_option("--unit", args->unit, "brdf-sim's control unit id")->capture_default_str();
+  // No daemon: sim-mount writes to brdf-sim directly.
+  return [args](const GlobalOptions&) {
+    return RunSimMount(std::cout, std::cerr, args->target, args->modbus, args->unit);
+  };
+}
+
+}  // namespace
+
+void RegisterSimMountCommand(CommandRegistry& registry) {
+  registry.Add({"sim-mount",
+                "SIMULATOR ONLY: mount sample, white or dark on brdf-sim (from-prompt: what "
+                "$BRDF_PROMPT_KIND asks)",
+                "Simulator only (brdf-sim)", AddSimMountOptions});
 }
 
 }  // namespace brdf::ctl

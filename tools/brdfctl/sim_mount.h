@@ -14,6 +14,7 @@
 #include <string>
 
 #include "core/status.h"
+#include "tools/brdfctl/command.h"
 
 namespace brdf::ctl {
 
@@ -29,5 +30,9 @@ Status SimMount(const std::string& modbus, int unit, int value);
 // The subcommand: resolves `target` (from-prompt through $BRDF_PROMPT_KIND), writes, reports.
 int RunSimMount(std::ostream& out, std::ostream& err, const std::string& target,
                 const std::string& modbus, int unit);
+
+// `sim-mount`, with its flags (command.h), under the heading "Simulator only (brdf-sim)". It runs
+// without brdfd: the shared flags (--address, --token-file, …) are ignored.
+void RegisterSimMountCommand(CommandRegistry& registry);
 
 }  // namespace brdf::ctl

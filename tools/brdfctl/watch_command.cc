@@ -1,12 +1,16 @@
 #include "tools/brdfctl/watch_command.h"
 
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <condition_variable>
+#include <cstdlib>
 #include <deque>
 #include <iostream>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -358,6 +362,53 @@ class Watcher {
 
 int RunWatch(CommandContext& ctx, const WatchOptions& options) {
   return Watcher(ctx, options).Run();
+}
+
+namespace {
+
+int TerminalWidth() {
+  winsize ws{};
+  if (ioctl(STDOUT_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0) return ws.ws_col;
+  if (const char* columns = std::getenv("COLUMNS")) {
+    const int n = std::atoi(columns);
+    if (n > 0) return n;
+  }
+  return 80;
+}
+
+Runner AddWatchOptions(CLI::App& cmd) {
+  struct Args {
+    WatchOptions options;
+    bool force_ask = false;
+    bool no_progress = false;
+  };
+  auto args = std::make_shared<Args>();
+  AddSessionId(cmd, args->options.session_id);
+  cmd.add_flag("--auto-confirm", args->options.auto_confirm, "confirm every prompt without asking");
+  cmd.add_option("--on-prompt", args->options.on_prompt,
+                 "shell command run before confirming a prompt; sees BRDF_PROMPT_KIND, "
+                 "BRDF_PROMPT_STEP, BRDF_PROMPT_TEXT, BRDF_SESSION_ID, BRDF_PROMPT_DELTA …");
+  cmd.add_flag("--ask", args->force_ask,
+               "ask y/N for each prompt on standard input even when it is not a terminal");
+  cmd.add_flag("--no-progress", args->no_progress, "plain lines even on a terminal");
+  cmd.add_flag("--exit-on-pause", args->options.exit_on_pause,
+               "stop watching (exit 4) when the session pauses, e.g. after a device fault");
+  return OnDaemon([args](CommandContext& ctx) {
+    WatchOptions options = args->options;
+    const bool tty_out = isatty(STDOUT_FILENO) != 0;
+    options.progress_bar = tty_out && !ctx.json && !args->no_progress;
+    options.ask =
+        (args->force_ask || (tty_out && isatty(STDIN_FILENO) != 0)) && !options.auto_confirm;
+    options.width = TerminalWidth();
+    return RunWatch(ctx, options);
+  });
+}
+
+}  // namespace
+
+void RegisterWatchCommand(CommandRegistry& registry) {
+  registry.Add({"watch", "follow a session live until it ends, confirming operator prompts", "",
+                AddWatchOptions});
 }
 
 }  // namespace brdf::ctl

@@ -16,6 +16,7 @@
 
 #include <string>
 
+#include "tools/brdfctl/command.h"
 #include "tools/brdfctl/command_context.h"
 
 namespace brdf::ctl {
@@ -31,5 +32,8 @@ struct WatchOptions {
 };
 
 int RunWatch(CommandContext& ctx, const WatchOptions& options);
+
+// `watch`, with its flags (command.h); on a terminal it draws the progress line and asks y/N.
+void RegisterWatchCommand(CommandRegistry& registry);
 
 }  // namespace brdf::ctl
