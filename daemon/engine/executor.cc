@@ -81,27 +81,59 @@ CallContext Executor::DeviceContext() const {
 void Executor::Run() {
   Context c;
   const std::string where = "session " + std::to_string(session_);
+  if (!Load(c, where)) return;
+  spdlog::info("{}: running from step {} ({} of {} steps left)", where,
+               c.steps.size() - static_cast<std::size_t>(c.pending), c.pending, c.steps.size());
+  RunSteps(c);
+  if (cancel_.cancelled()) {
+    // Pause immediate, abort or shutdown: the canceller has set the state. Make sure nothing
+    // keeps turning.
+    (void)rig_.StopStage();
+    spdlog::info("{}: run cancelled ({})", where, cancel_.reason());
+    return;
+  }
+  if (c.pending == 0) {
+    Result<SessionState> done =
+        host_.ApplyEvent(session_, SessionEvent::kFinish, "every step done");
+    if (done.ok()) spdlog::info("{}: completed", where);
+  }
+}
+
+bool Executor::Load(Context& c, const std::string& where) {
   Result<storage::SessionRecord> session = store_->GetSession(session_);
   if (!session.ok()) {
     Stop(c, -1, session.status(), "reading " + where + " from the database", false);
-    return;
+    return false;
   }
   c.session = std::move(*session);
   Result<std::vector<storage::StepRecord>> steps = store_->GetSteps(session_);
   if (!steps.ok()) {
     Stop(c, -1, steps.status(), "reading the steps of " + where, false);
-    return;
+    return false;
   }
   c.steps = std::move(*steps);
-
   Result<std::shared_ptr<const SessionPlan>> plan = host_.Plan(session_);
   if (!plan.ok()) {
     Stop(c, -1, plan.status(), "reading the plan of " + where, false);
-    return;
+    return false;
   }
   c.settings = (*plan)->settings;
   c.sample_fixed = c.session.plan_kind == "sample_fixed";
+  TallySteps(c);
+  // The latest reference and dark of the session so far: later samples are divided by them.
+  Status scan = store_->ForEachReading(session_, [&c](const storage::ReadingRecord& r) {
+    if (r.kind == storage::ReadingKind::kReference) c.last_reference = r.id;
+    if (r.kind == storage::ReadingKind::kDark) c.last_dark = r.id;
+    return Status::Ok();
+  });
+  if (!scan.ok()) {
+    Stop(c, -1, scan, "reading the readings of " + where, false);
+    return false;
+  }
+  return true;
+}
 
+void Executor::TallySteps(Context& c) {
   const std::vector<plan::StepTime> times =
       plan::EstimateSteps(ToPlanSteps(c.steps), rig_.description(), c.settings.measurement);
   c.estimate_s.resize(c.steps.size(), 0);
@@ -121,20 +153,9 @@ void Executor::Run() {
       if (s.kind == storage::StepKind::kSample) ++c.done_samples;
     }
   }
+}
 
-  // The latest reference and dark of the session so far: later samples are divided by them.
-  Status scan = store_->ForEachReading(session_, [&c](const storage::ReadingRecord& r) {
-    if (r.kind == storage::ReadingKind::kReference) c.last_reference = r.id;
-    if (r.kind == storage::ReadingKind::kDark) c.last_dark = r.id;
-    return Status::Ok();
-  });
-  if (!scan.ok()) {
-    Stop(c, -1, scan, "reading the readings of " + where, false);
-    return;
-  }
-
-  spdlog::info("{}: running from step {} ({} of {} steps left)", where,
-               c.steps.size() - static_cast<std::size_t>(c.pending), c.pending, c.steps.size());
+void Executor::RunSteps(Context& c) {
   int i = 0;
   const int n = static_cast<int>(c.steps.size());
   while (i < n) {
@@ -164,19 +185,6 @@ void Executor::Run() {
     }
     if (outcome == Outcome::kStop) break;
     i += advanced;
-  }
-
-  if (cancel_.cancelled()) {
-    // Pause immediate, abort or shutdown: the canceller has set the state. Make sure nothing
-    // keeps turning.
-    (void)rig_.StopStage();
-    spdlog::info("{}: run cancelled ({})", where, cancel_.reason());
-    return;
-  }
-  if (c.pending == 0) {
-    Result<SessionState> done =
-        host_.ApplyEvent(session_, SessionEvent::kFinish, "every step done");
-    if (done.ok()) spdlog::info("{}: completed", where);
   }
 }
 

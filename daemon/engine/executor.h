@@ -119,6 +119,13 @@ class Executor {
   struct Context;  // per-run state (steps, settings, the latest reference/dark, …)
   enum class Outcome { kContinue, kStop };
 
+  // The run's phases: the session, its steps and plan, the latest reference and dark read into
+  // `c` (false, after stopping the run with the error, when the store fails); each step's
+  // estimate and the progress so far; the pending steps run in order until one stops the run.
+  bool Load(Context& c, const std::string& where);
+  void TallySteps(Context& c);
+  void RunSteps(Context& c);
+
   Outcome RunMove(Context& c, int index, std::uint32_t first_attempt);
   Outcome RunPrompt(Context& c, int index);
   // A reading step (engine_reading_step.h's handlers, then CommitReading and, when a move was

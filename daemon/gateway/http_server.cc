@@ -134,6 +134,62 @@ grpc::Status ParseTimeout(const httplib::Request& req, std::chrono::seconds* dea
   return grpc::Status::OK;
 }
 
+// The stream's gRPC call, on a thread of its own: answers queue on `call` (at most
+// kMaxQueuedMessages ahead of the browser), then the final status.
+void StartReader(const std::shared_ptr<JsonRpc>& rpc, StreamCall* call, const WebMethod& method,
+                 const httplib::Request& req, OmitFields omit) {
+  call->reader = std::thread([rpc, call, &method, body = req.body, omit = std::move(omit),
+                              auth = req.get_header_value("Authorization")] {
+    grpc::Status st =
+        rpc->Stream(method, body, auth, omit, &call->context, [call](std::string json) {
+          MutexLock lock(call->mu);
+          call->cv.Wait(call->mu, [call]() REQUIRES(call->mu) {
+            return call->abandoned || call->queue.size() < kMaxQueuedMessages;
+          });
+          if (call->abandoned) return false;
+          call->queue.push_back(std::move(json));
+          call->cv.NotifyAll();
+          return true;
+        });
+    MutexLock lock(call->mu);
+    call->done = true;
+    call->status = std::move(st);
+    call->cv.NotifyAll();
+  });
+}
+
+// The call's refusal when it was refused up front (no token, wrong role, bad request: it ended
+// without an answer within kFirstMessageWait); OK otherwise.
+grpc::Status RefusedUpFront(StreamCall& call) {
+  MutexLock lock(call.mu);
+  call.cv.WaitFor(call.mu, kFirstMessageWait,
+                  [&]() REQUIRES(call.mu) { return !call.queue.empty() || call.done; });
+  if (call.queue.empty() && call.done && !call.status.ok()) return call.status;
+  return grpc::Status::OK;
+}
+
+// The next server-sent event of `call` (an answer, the end with its status, or a keep-alive
+// that also finds out whether the browser is still there); false when the call was abandoned.
+bool NextEvent(StreamCall& call, std::string* event, bool* end) {
+  MutexLock lock(call.mu);
+  call.cv.WaitFor(call.mu, WebGateway::kKeepAlive, [&]() REQUIRES(call.mu) {
+    return !call.queue.empty() || call.done || call.abandoned;
+  });
+  if (!call.queue.empty()) {
+    *event = "data: " + call.queue.front() + "\n\n";
+    call.queue.pop_front();
+    call.cv.NotifyAll();
+  } else if (call.done) {
+    *event = "event: end\ndata: " + StatusJson(call.status) + "\n\n";
+    *end = true;
+  } else if (call.abandoned) {
+    return false;
+  } else {
+    *event = ": keep-alive\n\n";
+  }
+  return true;
+}
+
 void ServeStream(const std::shared_ptr<JsonRpc>& rpc, const std::shared_ptr<WebStreams>& streams,
                  const WebMethod& method, const httplib::Request& req, httplib::Response& res) {
   if (req.has_param("timeout_s")) {
@@ -155,42 +211,16 @@ void ServeStream(const std::shared_ptr<JsonRpc>& rpc, const std::shared_ptr<WebS
                                      "); close other console tabs and retry"));
     return;
   }
-  StreamCall* raw = call.get();
-  call->reader = std::thread([rpc, raw, &method, body = req.body, omit = std::move(omit),
-                              auth = req.get_header_value("Authorization")] {
-    grpc::Status st = rpc->Stream(method, body, auth, omit, &raw->context, [raw](std::string json) {
-      MutexLock lock(raw->mu);
-      raw->cv.Wait(raw->mu, [raw]() REQUIRES(raw->mu) {
-        return raw->abandoned || raw->queue.size() < kMaxQueuedMessages;
-      });
-      if (raw->abandoned) return false;
-      raw->queue.push_back(std::move(json));
-      raw->cv.NotifyAll();
-      return true;
-    });
-    MutexLock lock(raw->mu);
-    raw->done = true;
-    raw->status = std::move(st);
-    raw->cv.NotifyAll();
-  });
+  StartReader(rpc, call.get(), method, req, std::move(omit));
   auto finish = [streams, call] {
     call->Abandon();
     if (call->reader.joinable()) call->reader.join();
     streams->Remove(call.get());
   };
-
-  // A call refused up front (no token, wrong role, bad request) is answered as an error.
-  {
-    MutexLock lock(call->mu);
-    call->cv.WaitFor(call->mu, kFirstMessageWait,
-                     [&]() REQUIRES(call->mu) { return !call->queue.empty() || call->done; });
-    if (call->queue.empty() && call->done && !call->status.ok()) {
-      const grpc::Status st = call->status;
-      lock.Unlock();
-      finish();
-      ReplyError(res, st);
-      return;
-    }
+  if (grpc::Status refused = RefusedUpFront(*call); !refused.ok()) {
+    finish();
+    ReplyError(res, refused);
+    return;
   }
   res.set_header("X-Accel-Buffering", "no");
   res.set_chunked_content_provider(
@@ -198,24 +228,7 @@ void ServeStream(const std::shared_ptr<JsonRpc>& rpc, const std::shared_ptr<WebS
       [call](std::size_t, httplib::DataSink& sink) {
         std::string event;
         bool end = false;
-        {
-          MutexLock lock(call->mu);
-          call->cv.WaitFor(call->mu, WebGateway::kKeepAlive, [&]() REQUIRES(call->mu) {
-            return !call->queue.empty() || call->done || call->abandoned;
-          });
-          if (!call->queue.empty()) {
-            event = "data: " + call->queue.front() + "\n\n";
-            call->queue.pop_front();
-            call->cv.NotifyAll();
-          } else if (call->done) {
-            event = "event: end\ndata: " + StatusJson(call->status) + "\n\n";
-            end = true;
-          } else if (call->abandoned) {
-            return false;
-          } else {
-            event = ": keep-alive\n\n";  // also finds out whether the browser is still there
-          }
-        }
+        if (!NextEvent(*call, &event, &end)) return false;
         if (!sink.write(event.data(), event.size())) return false;
         if (end) sink.done();
         return true;
@@ -273,46 +286,37 @@ std::string DefaultWebRoot(const WebConfig& web) {
 #endif
 }
 
-Result<std::unique_ptr<WebGateway>> WebGateway::Start(
-    const WebConfig& config, const std::optional<TlsConfig>& tls, const std::string& root,
-    std::shared_ptr<grpc::Channel> channel, const Authenticator& auth, const std::string& server) {
-  std::string host;
-  int port = 0;
-  if (!ParseListen(config.listen, &host, &port)) {
-    return ConfigurationError("config web.listen: \"" + config.listen +
-                              "\" is not host:port; give e.g. \"127.0.0.1:8080\"");
-  }
-  std::unique_ptr<WebGateway> gateway(new WebGateway());
-  if (tls.has_value()) {
-    for (const std::string* path : {&tls->cert, &tls->key}) {
-      if (!std::ifstream(*path)) {
-        return ConfigurationError("config server.tls: cannot read \"" + *path +
-                                  "\" for the web gateway; check the path and its mode");
-      }
-    }
-    auto https = std::make_unique<httplib::SSLServer>(
-        tls->cert.c_str(), tls->key.c_str(),
-        tls->client_ca.empty() ? nullptr : tls->client_ca.c_str());
-    if (!https->is_valid()) {
-      return ConfigurationError(
-          "config server.tls: the web gateway cannot use the certificate and key (not a "
-          "matching PEM pair?)");
-    }
-    gateway->http_ = std::move(https);
-  } else {
-    gateway->http_ = std::make_unique<httplib::Server>();
-  }
-  httplib::Server& http = *gateway->http_;
-  auto rpc = std::make_shared<JsonRpc>(std::move(channel), auth);
-  gateway->streams_ = std::make_shared<WebStreams>();
-  auto streams = gateway->streams_;
+namespace {
 
-  http.new_task_queue = [] { return new httplib::ThreadPool(kThreads); };
+// The HTTPS server with [server.tls]'s certificate and key (client certificates required when
+// client_ca is set), or a plain HTTP server.
+Result<std::unique_ptr<httplib::Server>> MakeHttpServer(const std::optional<TlsConfig>& tls) {
+  if (!tls.has_value()) return std::make_unique<httplib::Server>();
+  for (const std::string* path : {&tls->cert, &tls->key}) {
+    if (!std::ifstream(*path)) {
+      return ConfigurationError("config server.tls: cannot read \"" + *path +
+                                "\" for the web gateway; check the path and its mode");
+    }
+  }
+  auto https = std::make_unique<httplib::SSLServer>(
+      tls->cert.c_str(), tls->key.c_str(),
+      tls->client_ca.empty() ? nullptr : tls->client_ca.c_str());
+  if (!https->is_valid()) {
+    return ConfigurationError(
+        "config server.tls: the web gateway cannot use the certificate and key (not a "
+        "matching PEM pair?)");
+  }
+  return std::unique_ptr<httplib::Server>(std::move(https));
+}
+
+// Threads, sockets, limits, time-outs and the security headers of every answer.
+void ConfigureTransport(httplib::Server& http, bool tls) {
+  http.new_task_queue = [] { return new httplib::ThreadPool(WebGateway::kThreads); };
   http.set_socket_options(SocketOptions);
   // A stream writes one small event at a time, which Nagle's algorithm would hold back for the
   // browser's delayed ACK (~40 ms an event: 2.4 s for 87 readings).
   http.set_tcp_nodelay(true);
-  http.set_payload_max_length(kMaxBodyBytes);
+  http.set_payload_max_length(WebGateway::kMaxBodyBytes);
   http.set_read_timeout(10, 0);
   http.set_write_timeout(10, 0);
   http.set_keep_alive_timeout(2);
@@ -326,9 +330,13 @@ Result<std::unique_ptr<WebGateway>> WebGateway::Start(
       {"Cross-Origin-Resource-Policy", "same-origin"},
       {"Cache-Control", "no-store"},
   };
-  if (tls.has_value()) headers.emplace("Strict-Transport-Security", "max-age=31536000");
+  if (tls) headers.emplace("Strict-Transport-Security", "max-age=31536000");
   http.set_default_headers(headers);
+}
 
+// POST /api/brdf.v1.<Service>/<Method>, GET /api/about, and a refusal for any other /api/ GET.
+void RouteApi(httplib::Server& http, const std::shared_ptr<JsonRpc>& rpc,
+              const std::shared_ptr<WebStreams>& streams, const std::string& server) {
   http.Post(R"(/api/(brdf\.v1\.[A-Za-z]+/[A-Za-z]+))",
             [rpc, streams](const httplib::Request& req, httplib::Response& res) {
               ServeApi(rpc, streams, req, res);
@@ -344,7 +352,10 @@ Result<std::unique_ptr<WebGateway>> WebGateway::Start(
                                  "JSON body"));
     res.status = 405;
   });
+}
 
+// The built front end under `root`, or at / a page saying how to build it. True when built.
+bool RouteFrontEnd(httplib::Server& http, const std::string& root) {
   const bool have_root = !root.empty() && std::filesystem::exists(root + "/index.html");
   if (have_root) http.set_mount_point("/", root);
   http.set_file_extension_and_mimetype_mapping("js", kJavaScript);
@@ -355,12 +366,18 @@ Result<std::unique_ptr<WebGateway>> WebGateway::Start(
                         "set [web] root. The JSON API works without it.\n",
                     "text/plain; charset=utf-8");
   });
+  return have_root;
+}
+
+// Bodies for errors httplib answers itself (413 as the API's JSON), internal errors, the log.
+void HandleErrors(httplib::Server& http) {
   http.set_error_handler([](const httplib::Request&, httplib::Response& res) {
     if (!res.body.empty()) return;
     if (res.status == 413) {
-      ReplyError(res, grpc::Status(grpc::RESOURCE_EXHAUSTED, "request body over " +
-                                                                 std::to_string(kMaxBodyBytes) +
-                                                                 " bytes; send a smaller request"));
+      ReplyError(res,
+                 grpc::Status(grpc::RESOURCE_EXHAUSTED,
+                              "request body over " + std::to_string(WebGateway::kMaxBodyBytes) +
+                                  " bytes; send a smaller request"));
       res.status = 413;
       return;
     }
@@ -374,13 +391,39 @@ Result<std::unique_ptr<WebGateway>> WebGateway::Start(
   http.set_logger([](const httplib::Request& req, const httplib::Response& res) {
     spdlog::debug("web {} {} {} from {}", req.method, req.path, res.status, req.remote_addr);
   });
+}
 
+// Binds host:port (0: any free port); the port bound, or 0 when nothing could be bound.
+int Bind(httplib::Server& http, const std::string& host, int port) {
   if (port == 0) {
     port = http.bind_to_any_port(host);
-    if (port < 0) port = 0;
-  } else if (!http.bind_to_port(host, port)) {
-    port = 0;
+    return port < 0 ? 0 : port;
   }
+  return http.bind_to_port(host, port) ? port : 0;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<WebGateway>> WebGateway::Start(
+    const WebConfig& config, const std::optional<TlsConfig>& tls, const std::string& root,
+    std::shared_ptr<grpc::Channel> channel, const Authenticator& auth, const std::string& server) {
+  std::string host;
+  int port = 0;
+  if (!ParseListen(config.listen, &host, &port)) {
+    return ConfigurationError("config web.listen: \"" + config.listen +
+                              "\" is not host:port; give e.g. \"127.0.0.1:8080\"");
+  }
+  Result<std::unique_ptr<httplib::Server>> made = MakeHttpServer(tls);
+  if (!made.ok()) return made.status();
+  std::unique_ptr<WebGateway> gateway(new WebGateway());
+  gateway->http_ = std::move(*made);
+  gateway->streams_ = std::make_shared<WebStreams>();
+  httplib::Server& http = *gateway->http_;
+  ConfigureTransport(http, tls.has_value());
+  RouteApi(http, std::make_shared<JsonRpc>(std::move(channel), auth), gateway->streams_, server);
+  const bool have_root = RouteFrontEnd(http, root);
+  HandleErrors(http);
+  port = Bind(http, host, port);
   if (port == 0) {
     return IoError("cannot listen on " + config.listen +
                    " for the web console (address in use, not allowed, or no such interface); "

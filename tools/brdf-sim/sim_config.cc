@@ -350,7 +350,10 @@ SimRampUnit StageRampUnit(const SimConfig& c) {
   return it == RampUnits().end() ? SimRampUnit::kKhzPerSecond : it->second;
 }
 
-Status ValidateConfig(const SimConfig& c) {
+namespace {
+
+// The run: time scale, the Modbus endpoint, the sample, the operator's detector, the PR-650 link.
+Status ValidateRun(const SimConfig& c) {
   if (!Finite(c.time_scale) || c.time_scale <= 0) {
     return InvalidArgument("time scale " + std::to_string(c.time_scale) +
                            " is not positive; use --time-scale > 0 (1 = real time)");
@@ -375,6 +378,11 @@ Status ValidateConfig(const SimConfig& c) {
   if (!Finite(c.wake_window_s) || c.wake_window_s < 0) {
     return InvalidArgument("wake window must be >= 0 s; fix --wake-window");
   }
+  return Status::Ok();
+}
+
+// Each axis's homing speed and travel limits.
+Status ValidateAxes(const SimConfig& c) {
   for (std::size_t i = 0; i < c.axes.size(); ++i) {
     const AxisSettings& a = c.axes[i];
     const std::string n = kAxisNames[i];
@@ -387,6 +395,11 @@ Status ValidateConfig(const SimConfig& c) {
                              "-min/--" + n + "-max");
     }
   }
+  return Status::Ok();
+}
+
+// The faults to inject on the serial line and the Modbus link.
+Status ValidateFaults(const SimConfig& c) {
   const SerialFaults& s = c.serial_faults;
   if (s.garbage_next < 0 || s.truncate_next < 0 || s.quality_count < 0 ||
       !Finite(s.vanish_seconds) || s.vanish_seconds < 0) {
@@ -402,6 +415,11 @@ Status ValidateConfig(const SimConfig& c) {
   if (m.exception_code < 0 || m.exception_code > 255) {
     return InvalidArgument("Modbus fault exception code must be 0–255 (usually 2, 4 or 6)");
   }
+  return Status::Ok();
+}
+
+// The stage controller's register conventions: function codes, word order, ramp unit.
+Status ValidateStageRegisters(const SimConfig& c) {
   std::string error;
   if (!ParseFunctionCodes(c.stage_function_codes, &error)) {
     return InvalidArgument("stage function codes '" + c.stage_function_codes + "': " + error +
@@ -417,6 +435,11 @@ Status ValidateConfig(const SimConfig& c) {
                            "' is unknown; use khz_per_s, s or ms_per_khz ([stage] ramp_unit, "
                            "--stage-ramp-unit)");
   }
+  return Status::Ok();
+}
+
+// The optics: noise, stray light, the white standard, the lamp, the detector.
+Status ValidateOptics(const SimConfig& c) {
   const OpticsConfig& o = c.optics;
   if (!Finite(o.noise_scale) || o.noise_scale < 0) {
     return InvalidArgument("noise scale must be >= 0 (0 = noiseless)");
@@ -440,12 +463,27 @@ Status ValidateConfig(const SimConfig& c) {
         "read_noise_counts >= 0, 0 <= weak_fill <= low_light_fill, overhead_s >= 0, "
         "1 <= min_integration_ms <= max_integration_ms");
   }
+  return Status::Ok();
+}
+
+Status ValidateLogLevel(const SimConfig& c) {
   static const char* const kLevels[] = {"trace", "debug", "info", "warn", "error", "off"};
   bool level_ok = false;
   for (const char* l : kLevels) level_ok = level_ok || c.log_level == l;
   if (!level_ok) {
     return InvalidArgument("log level '" + c.log_level +
                            "' is unknown; use trace, debug, info, warn, error or off");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ValidateConfig(const SimConfig& c) {
+  for (Status (*check)(const SimConfig&) :
+       {ValidateRun, ValidateAxes, ValidateFaults, ValidateStageRegisters, ValidateOptics,
+        ValidateLogLevel}) {
+    if (Status st = check(c); !st.ok()) return st;
   }
   return Status::Ok();
 }
