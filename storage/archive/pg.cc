@@ -1,6 +1,7 @@
 #include "storage/archive/pg.h"
 
 #include <libpq-fe.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -145,6 +146,16 @@ void PgParams::Seal() {
   }
 }
 
+namespace {
+
+// The server's notices (NOTICE, WARNING: "relation … already exists, skipping") go to the
+// program's log at debug level, one line each, instead of libpq's default: its stderr.
+void LogNotice(void* /*arg*/, const char* message) {
+  spdlog::debug("archive: PostgreSQL says: {}", OneLine(message));
+}
+
+}  // namespace
+
 // --- PgConnection -----------------------------------------------------------------------------
 
 Result<std::unique_ptr<PgConnection>> PgConnection::Open(const std::string& conninfo) {
@@ -161,6 +172,7 @@ Result<std::unique_ptr<PgConnection>> PgConnection::Open(const std::string& conn
                       message.find("role \"") != std::string::npos;
     return auth ? FromSqlState("28000", message) : FromSqlState(nullptr, message);
   }
+  PQsetNoticeProcessor(conn, LogNotice, nullptr);
   return std::unique_ptr<PgConnection>(new PgConnection(conn));
 }
 

@@ -175,42 +175,51 @@ Result<int> ArchiveVersion(PgConnection& conn) {
   return static_cast<int>(v->Int64(0, 0));
 }
 
+namespace {
+
+Status NewerThanThisBuild(int version, int latest) {
+  return FailedPrecondition("the archive has schema version " + std::to_string(version) +
+                            ", newer than the latest this build knows (" + std::to_string(latest) +
+                            "): it was written by a newer brdfd; upgrade this rig or archive "
+                            "server");
+}
+
+// One migration in its transaction, under the lock that serialises migrations: applied unless
+// another rig or server applied it since `before` was read.
+Status ApplyMigration(PgConnection& conn, const ArchiveMigration& m, int latest) {
+  const std::string what = "migrating the archive to schema version " + std::to_string(m.version) +
+                           " (" + std::string(m.description) + ")";
+  Result<PgTransaction> tx = PgTransaction::Begin(conn);
+  if (!tx.ok()) return tx.status().WithContext(what);
+  BRDF_RETURN_IF_ERROR(conn.Exec(kMigrationLock).WithContext(what));
+  BRDF_RETURN_IF_ERROR(
+      conn.Exec("CREATE TABLE IF NOT EXISTS archive_schema (version integer PRIMARY KEY, "
+                "description text NOT NULL, applied_at timestamptz NOT NULL DEFAULT now())")
+          .WithContext(what));
+  Result<int> now = ArchiveVersion(conn);
+  if (!now.ok()) return now.status().WithContext(what);
+  if (*now > latest) return NewerThanThisBuild(*now, latest);
+  if (*now >= m.version) return Status::Ok();  // the destructor rolls the empty transaction back
+  BRDF_RETURN_IF_ERROR(conn.Exec(m.sql).WithContext(what));
+  Result<PgResult> row =
+      conn.Query("INSERT INTO archive_schema (version, description) VALUES ($1, $2)",
+                 PgParams().Add(m.version).Add(m.description));
+  if (!row.ok()) return row.status().WithContext(what);
+  return tx->Commit().WithContext(what);
+}
+
+}  // namespace
+
 Status MigrateArchive(PgConnection& conn, std::span<const ArchiveMigration> migrations) {
   const int latest = static_cast<int>(migrations.size());
+  // Read first, without a lock: an archive already at this build's version (every reconnect of
+  // every rig) needs no transaction, and a failure here is a failed check, not a migration.
+  Result<int> before = ArchiveVersion(conn);
+  if (!before.ok()) return before.status().WithContext("checking the archive's schema version");
+  if (*before > latest) return NewerThanThisBuild(*before, latest);
   for (const ArchiveMigration& m : migrations) {
-    const std::string what = "migrating the archive to schema version " +
-                             std::to_string(m.version) + " (" + std::string(m.description) + ")";
-    Result<PgTransaction> tx = PgTransaction::Begin(conn);
-    if (!tx.ok()) return tx.status().WithContext(what);
-    BRDF_RETURN_IF_ERROR(conn.Exec(kMigrationLock).WithContext(what));
-    BRDF_RETURN_IF_ERROR(
-        conn.Exec("CREATE TABLE IF NOT EXISTS archive_schema (version integer PRIMARY KEY, "
-                  "description text NOT NULL, applied_at timestamptz NOT NULL DEFAULT now())")
-            .WithContext(what));
-    Result<int> now = ArchiveVersion(conn);
-    if (!now.ok()) return now.status().WithContext(what);
-    if (*now > latest) {
-      return FailedPrecondition(
-          "the archive has schema version " + std::to_string(*now) +
-          ", newer than the latest this build knows (" + std::to_string(latest) +
-          "): it was written by a newer brdfd; upgrade this rig or archive server");
-    }
-    if (*now >= m.version) continue;  // the destructor rolls the empty transaction back
-    BRDF_RETURN_IF_ERROR(conn.Exec(m.sql).WithContext(what));
-    Result<PgResult> row =
-        conn.Query("INSERT INTO archive_schema (version, description) VALUES ($1, $2)",
-                   PgParams().Add(m.version).Add(m.description));
-    if (!row.ok()) return row.status().WithContext(what);
-    BRDF_RETURN_IF_ERROR(tx->Commit().WithContext(what));
-  }
-  if (migrations.empty()) return Status::Ok();
-  // A newer archive with every migration of ours already applied.
-  Result<int> now = ArchiveVersion(conn);
-  if (!now.ok()) return now.status();
-  if (*now > latest) {
-    return FailedPrecondition("the archive has schema version " + std::to_string(*now) +
-                              ", newer than the latest this build knows (" +
-                              std::to_string(latest) + "); upgrade this rig or archive server");
+    if (*before >= m.version) continue;
+    BRDF_RETURN_IF_ERROR(ApplyMigration(conn, m, latest));
   }
   return Status::Ok();
 }

@@ -4,7 +4,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <spdlog/sinks/ringbuffer_sink.h>
+#include <spdlog/spdlog.h>
+
 #include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
 #include <thread>
 
 #include "storage/archive/pg.h"
@@ -68,6 +74,45 @@ TEST_F(ArchiveSchemaTest, NewerArchiveIsRefused) {
   Status s = MigrateArchive(*conn);
   EXPECT_EQ(s.code(), StatusCode::kFailedPrecondition);
   EXPECT_THAT(s.message(), HasSubstr("schema version 99"));
+}
+
+TEST_F(ArchiveSchemaTest, ServerNoticesGoToTheLogAtDebugLevelNotToStderr) {
+  auto conn = Connect();
+  ASSERT_NE(conn, nullptr);
+  ASSERT_TRUE(MigrateArchive(*conn).ok());
+  auto ring = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(64);
+  auto logger = std::make_shared<spdlog::logger>("notices", ring);
+  logger->set_level(spdlog::level::debug);
+  std::shared_ptr<spdlog::logger> before = spdlog::default_logger();
+  spdlog::set_default_logger(logger);
+  ::testing::internal::CaptureStderr();
+  // Every reconnect of a rig migrates: an archive at this build's version is only read.
+  ASSERT_TRUE(MigrateArchive(*conn).ok());
+  std::vector<std::string> logged = ring->last_formatted();
+  // A statement that makes the server say something: it reaches the log, not stderr.
+  ASSERT_TRUE(conn->Exec("CREATE TABLE IF NOT EXISTS archive_schema (version integer)").ok());
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  spdlog::set_default_logger(before);
+  EXPECT_TRUE(logged.empty()) << logged.front();
+  std::vector<std::string> after = ring->last_formatted();
+  ASSERT_EQ(after.size(), 1u);
+  EXPECT_THAT(after[0], HasSubstr("PostgreSQL says: NOTICE:"));
+  EXPECT_THAT(after[0], HasSubstr("already exists, skipping"));
+  EXPECT_THAT(after[0], HasSubstr("[debug]"));
+  EXPECT_EQ(err, "");
+}
+
+TEST_F(ArchiveSchemaTest, AConnectionCutDuringTheCheckSaysTheCheckFailedNotAMigration) {
+  auto conn = Connect();
+  ASSERT_NE(conn, nullptr);
+  ASSERT_TRUE(MigrateArchive(*conn).ok());
+  ASSERT_TRUE(pg_->Psql("SELECT count(pg_terminate_backend(pid)) FROM pg_stat_activity WHERE "
+                        "application_name = 'brdfd'")
+                  .ok());
+  Status s = MigrateArchive(*conn);
+  ASSERT_FALSE(s.ok());
+  EXPECT_THAT(s.message(), HasSubstr("checking the archive's schema version"));
+  EXPECT_THAT(s.message(), Not(HasSubstr("migrating")));
 }
 
 TEST_F(ArchiveSchemaTest, WrongPasswordAndUnreachableServerSayWhatHappened) {

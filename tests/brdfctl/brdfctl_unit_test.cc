@@ -59,6 +59,18 @@ TEST(TextFormat, ShortNamesAndDurations) {
   EXPECT_EQ(Duration(-1), "?");
 }
 
+TEST(TextFormat, PosesPrintToTheStagesResolutionNotTheFloatingPointNoise) {
+  v1::Pose pose;
+  pose.set_alpha(2.0255e-15);  // a sample-fixed pose, computed
+  pose.set_beta(-29.99999999);
+  pose.set_gamma(12.5);
+  pose.set_delta(-0.0001);
+  EXPECT_EQ(PoseText(pose), "α 0° β -30° γ 12.5° δ 0°");
+  EXPECT_EQ(StageAngle(123.4567), "123.457");
+  EXPECT_EQ(StageAngle(-30.0014), "-30.001");
+  EXPECT_EQ(StageAngle(45), "45");
+}
+
 TEST(ProgressLine, ShowsCountsPercentEtaPoseAndQuality) {
   ProgressView v;
   v.state = "running";

@@ -44,7 +44,7 @@ TEST_F(RigStageProfile, ALabsOwnFileIsUsedAndABadOneIsRefusedNamingFileKeyAndLin
   EXPECT_EQ(refused.status().code(), StatusCode::kConfigurationError);
   EXPECT_THAT(refused.status().message(),
               AllOf(HasSubstr("config stage.profile_file"), HasSubstr(path_), HasSubstr("line "),
-                    HasSubstr("position.words"), HasSubstr("fix the key in the file")));
+                    HasSubstr("position.words"), HasSubstr("fix the file")));
 
   config.stage.profile_file = path_ + ".missing";
   auto missing = Rig::FromConfig(config, Rig::Options());

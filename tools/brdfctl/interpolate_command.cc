@@ -226,6 +226,31 @@ void PrintReadable(std::ostream& out, const InterpolateOptions& o,
   }
 }
 
+// What to try when the method found no spectrum: the symmetry flags not given that fill the
+// point (asked of the daemon with the same request), else another method or direction.
+std::string NoResultHint(CommandContext& ctx, const v1::InterpolateRequest& request) {
+  const v1::InterpolationOptions& given = request.options();
+  struct Try {
+    bool mirror_phi, reciprocity;
+    const char* flags;
+  };
+  for (const Try& t : {Try{true, false, "--mirror-phi"}, Try{false, true, "--reciprocity"},
+                       Try{true, true, "--mirror-phi --reciprocity"}}) {
+    if ((t.mirror_phi && given.mirror_phi()) || (t.reciprocity && given.reciprocity())) continue;
+    v1::InterpolateRequest again = request;
+    again.mutable_options()->set_mirror_phi(given.mirror_phi() || t.mirror_phi);
+    again.mutable_options()->set_reciprocity(given.reciprocity() || t.reciprocity);
+    v1::InterpolateResponse reply;
+    const grpc::Status st =
+        ctx.client.interpolation().Interpolate(ctx.client.UnaryContext().get(), again, &reply);
+    if (st.ok() && reply.result().status() == v1::INTERPOLATION_STATUS_OK) {
+      return std::string("; ") + t.flags +
+             " fills it (the readings' symmetric copies close the gap), or try --method nearest";
+    }
+  }
+  return "; try --method nearest, or a direction inside the measured range";
+}
+
 }  // namespace
 
 int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
@@ -253,7 +278,7 @@ int RunInterpolate(CommandContext& ctx, const InterpolateOptions& o) {
     ctx.err << "brdfctl: no spectrum at " << QueryText(result.query()) << ": "
             << InterpolationStatusName(result.status())
             << (result.detail().empty() ? "" : " (" + result.detail() + ")")
-            << "; try --method nearest, or a direction inside the measured range\n";
+            << NoResultHint(ctx, request) << "\n";
     return kExitNoResult;
   }
   return kExitOk;

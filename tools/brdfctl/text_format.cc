@@ -103,9 +103,20 @@ std::string Duration(double seconds) {
   return buf;
 }
 
+std::string StageAngle(double degrees) {
+  if (!std::isfinite(degrees)) return Num(degrees, 5);
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.3f", std::round(degrees * 1000.0) / 1000.0);
+  std::string out = buf;
+  while (out.back() == '0') out.pop_back();
+  if (out.back() == '.') out.pop_back();
+  if (out == "-0") out = "0";
+  return out;
+}
+
 std::string PoseText(const v1::Pose& pose) {
-  return "α " + Num(pose.alpha(), 5) + "° β " + Num(pose.beta(), 5) + "° γ " +
-         Num(pose.gamma(), 5) + "° δ " + Num(pose.delta(), 5) + "°";
+  return "α " + StageAngle(pose.alpha()) + "° β " + StageAngle(pose.beta()) + "° γ " +
+         StageAngle(pose.gamma()) + "° δ " + StageAngle(pose.delta()) + "°";
 }
 
 std::string DirectionsText(const v1::Directions& d) {

@@ -41,6 +41,9 @@ std::string Num(double value, int digits = 6);
 // Seconds as "42 s", "3:07", "1:02:03" (negative or non-finite: "?").
 std::string Duration(double seconds);
 
+// A stage angle to 0.001° (finer than a rotation stage's step; a pose computed for the
+// sample-fixed method prints 0, not 2.0255e-15): "45", "12.5", "-30.001".
+std::string StageAngle(double degrees);
 // "α 20° β −30° γ 0° δ 22.5°".
 std::string PoseText(const v1::Pose& pose);
 // "θi 35° φi 0° θo 20° φo 150°".
