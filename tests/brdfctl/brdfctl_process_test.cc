@@ -367,6 +367,22 @@ void BrdfctlProcessTest::CheckInterpolateOutside() {
                                "180", "--method", "delaunay"});
   EXPECT_EQ(r.exit_code, 4) << Describe(r);
   EXPECT_NE(r.err.find("outside_hull"), std::string::npos) << Describe(r);
+  // A measured retro-plane direction the octant method cannot enclose: the readings mirrored to
+  // −φ fill it, and the hint says so (the daemon answers with --mirror-phi).
+  const CommandResult retro =
+      Ctl({"interpolate", w.id, "--theta-i", "30", "--theta-o", "30", "--phi", "180"});
+  EXPECT_EQ(retro.exit_code, 4) << Describe(retro);
+  EXPECT_NE(retro.err.find("empty_octant"), std::string::npos) << Describe(retro);
+  EXPECT_NE(retro.err.find("--mirror-phi fills it"), std::string::npos) << Describe(retro);
+  const CommandResult filled = Ctl({"interpolate", w.id, "--theta-i", "30", "--theta-o", "30",
+                                    "--phi", "180", "--mirror-phi"});
+  EXPECT_EQ(filled.exit_code, 0) << Describe(filled);
+  // Where no symmetry helps, the hint says what else to try.
+  const CommandResult corner =
+      Ctl({"interpolate", w.id, "--theta-i", "20", "--theta-o", "70", "--phi", "180"});
+  EXPECT_EQ(corner.exit_code, 4) << Describe(corner);
+  EXPECT_NE(corner.err.find("try --method nearest"), std::string::npos) << Describe(corner);
+  EXPECT_EQ(corner.err.find("fills it"), std::string::npos) << Describe(corner);
 }
 
 // The quick start's demo plan (examples/plans/demo.json) through brdfctl, end to end. One test,
