@@ -355,9 +355,15 @@ class LiveSession(unittest.TestCase):
                             lambda: list(wrong.readings(self.session.session_id)))
         with BrdfClient(self.rig.address, "") as none:  # "": no token at all (not $BRDF_TOKEN)
             self.assertCode(grpc.StatusCode.UNAUTHENTICATED, none.rig_status)
+            self.assertCode(grpc.StatusCode.UNAUTHENTICATED, none.who_am_i)
 
     def test_analyst_reads_but_may_not_operate(self):
+        me = self.client.who_am_i()
+        self.assertEqual((me.role, me.server), ("operator", "brdfd"))
         with BrdfClient(self.rig.address, self.rig.analyst_token) as analyst:
+            who = analyst.who_am_i()
+            self.assertEqual((who.role, who.server), ("analyst", "brdfd"))
+            self.assertNotEqual(who.name, me.name)
             self.assertEqual(analyst.get_session(self.session.session_id).session_id,
                              self.session.session_id)
             self.assertTrue(analyst.interpolate(self.session.session_id, 30, 30, 90).status)

@@ -288,6 +288,12 @@ class BrdfClient:
             if not token:
                 return sessions
 
+    def who_am_i(self) -> Message:
+        """brdf_pb2.Caller: this client's token as the server knows it: `name` (the token's
+        configured name, never the token), `role` ("operator" or "analyst") and `server`
+        ("brdfd" or "brdf-archive"). UNAUTHENTICATED for a token the server does not know."""
+        return self._unary(self._control.WhoAmI, brdf_pb2.WhoAmIRequest(), "Control.WhoAmI")
+
     def rig_status(self) -> Message:
         """brdf_pb2.RigStatus: devices' connection states, live pose, meter serial, active session."""
         return self._unary(self._control.GetRigStatus, brdf_pb2.GetRigStatusRequest(),
