@@ -155,8 +155,8 @@ struct MeterConfig {
   int measurement_timeout_ms = 30000;
   int wake_attempts = 5;
   bool measure_with_spectrum = true;
-  int rts_settle_ms = 1000;  // wake-up: wait after RTS is raised again (manual: > 0.5 s)
-  int char_gap_ms = 50;      // PR-655/670: pause after each character of a command
+  int rts_settle_ms = 1000;        // wake-up: wait after RTS is raised again (manual: > 0.5 s)
+  int char_gap_ms = 50;            // PR-655/670: pause after each character of a command
   std::string nd_filter = "auto";  // CS-2000/3000: the internal ND filter ("off", "on", "auto")
   // For plan-time estimates only (core/plan/timing.h): the meter's own time per reading beyond
   // integration and transfer, and the integration it is expected to choose when the plan says

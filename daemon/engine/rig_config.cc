@@ -18,9 +18,12 @@
 namespace brdf::daemon {
 namespace {
 
-drivers::Pr650Options MeterOptions(const MeterConfig& m) {
+// What every meter's options take from [meter] alike: the line, the pacing, the timeouts, the
+// quality policy's overrides and the log (`tag`: "pr650: …").
+template <typename Options>
+Options LineOptions(const MeterConfig& m, const char* tag) {
   using std::chrono::milliseconds;
-  drivers::Pr650Options o;
+  Options o;
   o.port = m.port;
   o.baud = m.baud;
   o.hardware_flow_control = m.hardware_flow_control;
@@ -28,49 +31,34 @@ drivers::Pr650Options MeterOptions(const MeterConfig& m) {
   o.quiet_gap = milliseconds(m.quiet_gap_ms);
   o.reply_timeout = milliseconds(m.reply_timeout_ms);
   o.measurement_timeout = milliseconds(m.measurement_timeout_ms);
+  for (const auto& [code, rule] : m.quality_overrides) o.quality_policy.Set(code, rule);
+  o.log = [tag](std::string_view line) { spdlog::debug("{}: {}", tag, line); };
+  return o;
+}
+
+drivers::Pr650Options MeterOptions(const MeterConfig& m) {
+  auto o = LineOptions<drivers::Pr650Options>(m, "pr650");
   o.wake_attempts = m.wake_attempts;
   o.measure_with_spectrum = m.measure_with_spectrum;
-  o.wake_settle = milliseconds(m.rts_settle_ms);
-  for (const auto& [code, rule] : m.quality_overrides) o.quality_policy.Set(code, rule);
-  o.log = [](std::string_view line) { spdlog::debug("pr650: {}", line); };
+  o.wake_settle = std::chrono::milliseconds(m.rts_settle_ms);
   return o;
 }
 
 drivers::Pr670Options Pr670MeterOptions(const MeterConfig& m) {
-  using std::chrono::milliseconds;
-  drivers::Pr670Options o;
-  o.port = m.port;
-  o.baud = m.baud;
-  o.hardware_flow_control = m.hardware_flow_control;
+  auto o = LineOptions<drivers::Pr670Options>(m, "pr670");
   o.model = MeterModelName(m.model);
-  o.char_gap = milliseconds(m.char_gap_ms);
-  o.command_pacing = milliseconds(m.pacing_ms);
-  o.quiet_gap = milliseconds(m.quiet_gap_ms);
-  o.reply_timeout = milliseconds(m.reply_timeout_ms);
-  o.measurement_timeout = milliseconds(m.measurement_timeout_ms);
+  o.char_gap = std::chrono::milliseconds(m.char_gap_ms);
   o.remote_attempts = m.wake_attempts;
-  for (const auto& [code, rule] : m.quality_overrides) o.quality_policy.Set(code, rule);
-  o.log = [](std::string_view line) { spdlog::debug("pr670: {}", line); };
   return o;
 }
 
 drivers::Cs2000Options Cs2000MeterOptions(const MeterConfig& m) {
-  using std::chrono::milliseconds;
-  drivers::Cs2000Options o;
-  o.port = m.port;
-  o.baud = m.baud;
-  o.hardware_flow_control = m.hardware_flow_control;
+  auto o = LineOptions<drivers::Cs2000Options>(m, "cs2000");
   o.model = MeterModelName(m.model);
   o.nd_filter = m.nd_filter == "off"  ? drivers::cs2000::NdFilter::kOff
                 : m.nd_filter == "on" ? drivers::cs2000::NdFilter::kOn
                                       : drivers::cs2000::NdFilter::kAuto;
-  o.command_pacing = milliseconds(m.pacing_ms);
-  o.quiet_gap = milliseconds(m.quiet_gap_ms);
-  o.reply_timeout = milliseconds(m.reply_timeout_ms);
-  o.measurement_timeout = milliseconds(m.measurement_timeout_ms);
   o.remote_attempts = m.wake_attempts;
-  for (const auto& [code, rule] : m.quality_overrides) o.quality_policy.Set(code, rule);
-  o.log = [](std::string_view line) { spdlog::debug("cs2000: {}", line); };
   return o;
 }
 

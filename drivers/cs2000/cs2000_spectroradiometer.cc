@@ -47,8 +47,9 @@ void Cs2000Spectroradiometer::Log(const std::string& message) const {
 Status Cs2000Spectroradiometer::RequireConnected() const {
   if (connected_) return Status::Ok();
   if (lost_connection_) {
-    return Disconnected(Where() + " lost its connection earlier: connect again once the port is "
-                                  "back");
+    return Disconnected(Where() +
+                        " lost its connection earlier: connect again once the port is "
+                        "back");
   }
   return FailedPrecondition(Where() + " is not connected: call Connect first");
 }
@@ -81,10 +82,11 @@ Status Cs2000Spectroradiometer::Connect(const CallContext& ctx) {
         status.ToString());
   }
   if (status.code() == StatusCode::kTimeout && !ctx.expired()) {
-    status = Timeout(Where() + " did not answer RMTS,1 in " +
-                     std::to_string(options_.remote_attempts) + " attempt(s): check that it is "
-                     "switched on, that its cable is in (RS-232C: the baud rate set on the meter "
-                     "matches [meter] baud) and that no other program has the port");
+    status =
+        Timeout(Where() + " did not answer RMTS,1 in " + std::to_string(options_.remote_attempts) +
+                " attempt(s): check that it is "
+                "switched on, that its cable is in (RS-232C: the baud rate set on the meter "
+                "matches [meter] baud) and that no other program has the port");
   }
   if (!status.ok()) {
     channel_.Close();
@@ -180,8 +182,7 @@ Result<cs2000::Reply> Cs2000Spectroradiometer::MeasureOnce(const CallContext& ct
                          "\"); expected the measuring time, then the completion");
   }
   if (completion.empty()) {
-    const auto timeout =
-        std::chrono::milliseconds(seconds * 1000LL) + options_.measurement_timeout;
+    const auto timeout = std::chrono::milliseconds(seconds * 1000LL) + options_.measurement_timeout;
     Result<std::string> done =
         channel_.ReadMore(kCommand, {.lines = 1, .first_byte_timeout = timeout}, ctx);
     if (!done.ok()) {
@@ -189,7 +190,8 @@ Result<cs2000::Reply> Cs2000Spectroradiometer::MeasureOnce(const CallContext& ct
       if (st.code() == StatusCode::kTimeout && !ctx.expired()) {
         st = Timeout(Where() + " announced a measuring time of " + std::to_string(seconds) +
                      " s but did not report the measurement done within " +
-                     std::to_string(timeout.count()) + " ms ([meter] measurement_timeout_ms is "
+                     std::to_string(timeout.count()) +
+                     " ms ([meter] measurement_timeout_ms is "
                      "the margin); if it left remote mode or was switched off, it is connected "
                      "again");
       }
@@ -201,8 +203,7 @@ Result<cs2000::Reply> Cs2000Spectroradiometer::MeasureOnce(const CallContext& ct
 }
 
 Status Cs2000Spectroradiometer::PrepareRemeasure(const pr650::QualityDecision& decision, int code,
-                                                 pr650::QualityLoop& loop,
-                                                 const CallContext& ctx) {
+                                                 pr650::QualityLoop& loop, const CallContext& ctx) {
   if (decision.kind == pr650::QualityDecision::Kind::kFail) {
     return loop.Failure(code, code == 10 ? "less light, or a shorter manual integration time"
                                          : "see the error codes in the meter's manual");
@@ -252,8 +253,8 @@ Result<SpectrumReport> Cs2000Spectroradiometer::TransferSpectrum(const CallConte
   report.radiance.reserve(report.grid.count);
   for (int block = 1; block <= cs2000::kBlocks; ++block) {
     const std::string command = cs2000::SpectralBlockCommand(block);
-    Result<std::string> reply = channel_.Exchange(
-        command, {.lines = 1, .first_byte_timeout = options_.reply_timeout}, ctx);
+    Result<std::string> reply =
+        channel_.Exchange(command, {.lines = 1, .first_byte_timeout = options_.reply_timeout}, ctx);
     if (!reply.ok()) return Lost(reply.status());
     BRDF_ASSIGN_OR_RETURN(const std::vector<double> values,
                           cs2000::ParseSpectralBlock(*reply, block));

@@ -27,14 +27,14 @@ namespace brdf::drivers::pr650 {
 struct ChannelOptions {
   using Millis = std::chrono::milliseconds;
 
-  SerialSettings serial;           // port, baud, flow control and the meter's name for messages
-  std::string line_end = "\r";     // appended to every command ("\r" PR-670, "\n" CS-2000)
-  Millis char_gap{0};              // > 0: written a character at a time, this far apart
-  Millis command_pacing{100};      // pause after an exchange before the next command
-  Millis quiet_gap{50};            // silence that ends a complete reply
-  Millis stall_timeout{1000};      // silence that ends an incomplete reply (truncated)
+  SerialSettings serial;        // port, baud, flow control and the meter's name for messages
+  std::string line_end = "\r";  // appended to every command ("\r" PR-670, "\n" CS-2000)
+  Millis char_gap{0};           // > 0: written a character at a time, this far apart
+  Millis command_pacing{100};   // pause after an exchange before the next command
+  Millis quiet_gap{50};         // silence that ends a complete reply
+  Millis stall_timeout{1000};   // silence that ends an incomplete reply (truncated)
   std::size_t max_reply_bytes = 16 * 1024;
-  LogSink log;                     // diagnostics; required
+  LogSink log;  // diagnostics; required
 };
 
 // What one reply looks like: its line count (or the count its first line tells), how long the

@@ -18,8 +18,8 @@ QualityDecision QualityLoop::Judge(int meter_code, const std::string& meaning, i
     // The meter's own words first; the policy's (in the PR-650's numbering) after.
     std::string note = "code " + std::to_string(meter_code) + " (" + meaning + ")";
     if (policy_code != meter_code || decision.note.empty()) {
-      note += ", handled as " + (decision.note.empty() ? DescribeQualityCode(policy_code)
-                                                       : decision.note);
+      note += ", handled as " +
+              (decision.note.empty() ? DescribeQualityCode(policy_code) : decision.note);
     } else {
       note += ": " + decision.note;
     }
@@ -47,9 +47,8 @@ MeasurementOutcome QualityLoop::Outcome(int meter_code, const QualityDecision& d
 }
 
 Status QualityLoop::Failure(int meter_code, const std::string& hint) const {
-  return DeviceError(meter_code, where_ + ": measurement failed after " +
-                                     std::to_string(attempt_) + " attempt(s): " + notes() + "; " +
-                                     hint);
+  return DeviceError(meter_code, where_ + ": measurement failed after " + std::to_string(attempt_) +
+                                     " attempt(s): " + notes() + "; " + hint);
 }
 
 std::string QualityLoop::notes() const {

@@ -25,7 +25,8 @@ std::vector<std::string_view> SplitFields(std::string_view line) {
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = line.find(',', start);
-    fields.push_back(line.substr(start, comma == std::string_view::npos ? line.npos : comma - start));
+    fields.push_back(
+        line.substr(start, comma == std::string_view::npos ? line.npos : comma - start));
     if (comma == std::string_view::npos) return fields;
     start = comma + 1;
   }
@@ -75,7 +76,8 @@ Result<std::vector<std::string>> Lines(std::string_view reply, std::string_view 
 
 Result<std::string> ExposureCommand(int exposure_ms) {
   if (exposure_ms != 0 && (exposure_ms < kMinExposureMs || exposure_ms > kMaxExposureMs)) {
-    return InvalidArgument("PR-670 exposure " + std::to_string(exposure_ms) + " ms is out of range: use 0 (adaptive) or " +
+    return InvalidArgument("PR-670 exposure " + std::to_string(exposure_ms) +
+                           " ms is out of range: use 0 (adaptive) or " +
                            std::to_string(kMinExposureMs) + "–" + std::to_string(kMaxExposureMs) +
                            " ms");
   }
@@ -181,7 +183,8 @@ Result<SpectrumReply> ParseSpectrumReply(std::string_view reply,
   if (out.header.result_code != 0) return CodeNotZero(out.header.result_code, command);
   if (lines.size() < 3) {
     return ProtocolError("PR-670 reply to " + std::string(command) + " has " +
-                         std::to_string(lines.size()) + " line(s): a report needs its header and "
+                         std::to_string(lines.size()) +
+                         " line(s): a report needs its header and "
                          "at least two bands");
   }
   std::vector<double> nm;
@@ -204,7 +207,8 @@ Result<SpectrumReply> ParseSpectrumReply(std::string_view reply,
     return ProtocolError("PR-670 reply to " + std::string(command) + " has " +
                          std::to_string(nm.size()) + " bands from " + std::to_string(nm[0]) +
                          " nm every " + std::to_string(step) + " nm, but the meter reported " +
-                         std::to_string(expected->count) + " bands (D120): the reply is "
+                         std::to_string(expected->count) +
+                         " bands (D120): the reply is "
                          "incomplete or garbled; measure again");
   }
   return out;

@@ -21,8 +21,8 @@ namespace brdf::drivers::pr670 {
 
 // ---- Commands (host → meter; the driver appends CR, except to PHOTO and Q) --------------------
 
-inline constexpr std::string_view kRemoteModeCommand = "PHOTO";  // enter remote mode (no CR)
-inline constexpr std::string_view kQuitCommand = "Q";            // leave remote mode (no CR)
+inline constexpr std::string_view kRemoteModeCommand = "PHOTO";    // enter remote mode (no CR)
+inline constexpr std::string_view kQuitCommand = "Q";              // leave remote mode (no CR)
 inline constexpr std::string_view kMeasureSpectrumCommand = "M5";  // measure, send report 5
 inline constexpr std::string_view kSpectrumCommand = "D5";         // report 5 of the last one
 inline constexpr std::string_view kSerialNumberCommand = "D110";
@@ -78,10 +78,10 @@ Result<WavelengthGrid> ParseLayoutReply(std::string_view reply);
 // The first line of report 5: "qqqqq,UUUU,peak,integrated,photon".
 struct SpectrumHeader {
   int result_code = 0;
-  int units_code = 0;           // 0 luminance (radiance), 1 illuminance (irradiance), ...
-  double peak_nm = 0;           // peak wavelength
-  double integrated = 0;        // integrated radiometric value
-  double integrated_photon = 0; // integrated photon radiometric value
+  int units_code = 0;            // 0 luminance (radiance), 1 illuminance (irradiance), ...
+  double peak_nm = 0;            // peak wavelength
+  double integrated = 0;         // integrated radiometric value
+  double integrated_photon = 0;  // integrated photon radiometric value
 };
 Result<SpectrumHeader> ParseSpectrumHeader(std::string_view line, std::string_view command);
 

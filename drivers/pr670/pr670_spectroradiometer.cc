@@ -52,8 +52,9 @@ void Pr670Spectroradiometer::Log(const std::string& message) const {
 Status Pr670Spectroradiometer::RequireConnected() const {
   if (connected_) return Status::Ok();
   if (lost_connection_) {
-    return Disconnected(Where() + " lost its connection earlier: connect again once the port is "
-                                  "back");
+    return Disconnected(Where() +
+                        " lost its connection earlier: connect again once the port is "
+                        "back");
   }
   return FailedPrecondition(Where() + " is not connected: call Connect first");
 }
@@ -75,12 +76,13 @@ Status Pr670Spectroradiometer::EnterRemoteMode(const CallContext& ctx) {
   for (int attempt = 1; attempt <= options_.remote_attempts; ++attempt) {
     // Q first: a meter left in remote mode answers the next PHOTO only after leaving it.
     BRDF_RETURN_IF_ERROR(channel_.Send(pr670::kQuitCommand, ctx));
-    BRDF_RETURN_IF_ERROR(pr650::WaitChecked(options_.quit_settle, ctx, "letting the meter leave "
-                                                                       "remote mode"));
+    BRDF_RETURN_IF_ERROR(pr650::WaitChecked(options_.quit_settle, ctx,
+                                            "letting the meter leave "
+                                            "remote mode"));
     BRDF_RETURN_IF_ERROR(channel_.Send(pr670::kRemoteModeCommand, ctx));
-    Result<std::string> answer = channel_.ReadMore(
-        pr670::kRemoteModeCommand, {.lines = 1, .first_byte_timeout = options_.remote_timeout},
-        ctx);
+    Result<std::string> answer =
+        channel_.ReadMore(pr670::kRemoteModeCommand,
+                          {.lines = 1, .first_byte_timeout = options_.remote_timeout}, ctx);
     if (answer.ok()) {
       Log(Where() + " is in remote mode: \"" + pr650::Printable(*answer) + "\"");
       return Status::Ok();
@@ -88,8 +90,7 @@ Status Pr670Spectroradiometer::EnterRemoteMode(const CallContext& ctx) {
     last = answer.status();
     if (last.code() != StatusCode::kTimeout || ctx.expired()) return last;
     Log("remote-mode attempt " + std::to_string(attempt) + " of " +
-        std::to_string(options_.remote_attempts) + " on " + options_.port + ": " +
-        last.ToString());
+        std::to_string(options_.remote_attempts) + " on " + options_.port + ": " + last.ToString());
   }
   return Timeout(Where() + " did not answer PHOTO in " + std::to_string(options_.remote_attempts) +
                  " attempt(s) of " + std::to_string(options_.remote_timeout.count()) +
@@ -134,8 +135,8 @@ Result<std::string> Pr670Spectroradiometer::Ask(std::string_view command,
                                                 std::chrono::milliseconds timeout,
                                                 const CallContext& ctx) {
   BRDF_RETURN_IF_ERROR(RequireConnected());
-  Result<std::string> reply = channel_.Exchange(command, {.lines = 1, .first_byte_timeout = timeout},
-                                                ctx);
+  Result<std::string> reply =
+      channel_.Exchange(command, {.lines = 1, .first_byte_timeout = timeout}, ctx);
   if (!reply.ok()) return Lost(reply.status());
   return reply;
 }
@@ -225,8 +226,7 @@ Result<std::string> Pr670Spectroradiometer::MeasureOnce(
 }
 
 Status Pr670Spectroradiometer::PrepareRemeasure(const pr650::QualityDecision& decision, int code,
-                                                pr650::QualityLoop& loop,
-                                                const CallContext& ctx) {
+                                                pr650::QualityLoop& loop, const CallContext& ctx) {
   if (decision.kind == pr650::QualityDecision::Kind::kFail) {
     return loop.Failure(code, code == -8 ? "more light, or a longer fixed exposure"
                                          : "see the result codes in the meter's manual");

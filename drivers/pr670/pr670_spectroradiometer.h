@@ -1,4 +1,5 @@
-// The PR-655 and PR-670 SpectraScan behind the Spectroradiometer interface (docs/pr670-protocol.md).
+// The PR-655 and PR-670 SpectraScan behind the Spectroradiometer interface
+// (docs/pr670-protocol.md).
 //
 // Connect opens the port (exclusively), sends Q (no line end; a meter still in remote mode from an
 // earlier program leaves it, so the next PHOTO is answered), waits quit_settle, types PHOTO a
@@ -91,11 +92,11 @@ class Pr670Spectroradiometer final : public Spectroradiometer {
   bool connected_ = false;
   bool lost_connection_ = false;
 
-  std::optional<Setup> configured_;  // what Configure asked for
+  std::optional<Setup> configured_;   // what Configure asked for
   std::optional<Setup> meter_setup_;  // what the meter was last set to
   bool dark_ = false;
   std::string model_;
-  WavelengthGrid grid_{380, 2, 201};  // the PR-670's, until D120 tells
+  WavelengthGrid grid_{380, 2, 201};    // the PR-670's, until D120 tells
   std::optional<SpectrumReport> held_;  // the last accepted measurement's spectrum
 };
 

@@ -1,8 +1,8 @@
 // The PR-670 protocol's pure side: commands, result codes, and every reply the driver parses.
+#include "drivers/pr670/pr670_protocol.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-
-#include "drivers/pr670/pr670_protocol.h"
 
 namespace brdf::drivers::pr670 {
 namespace {
@@ -22,8 +22,8 @@ TEST(Pr670Commands, SetupCommandsCarryTheirValuesAndRefuseOutOfRange) {
 
 TEST(Pr670ResultCodes, KnownCodesMapOntoThePolicyAndUnknownOnesFail) {
   EXPECT_EQ(PolicyCodeFor(0), 0);
-  EXPECT_EQ(PolicyCodeFor(-8), 10);   // too dark → weak light
-  EXPECT_EQ(PolicyCodeFor(-1), 7);    // sync failure → unable to sync
+  EXPECT_EQ(PolicyCodeFor(-8), 10);  // too dark → weak light
+  EXPECT_EQ(PolicyCodeFor(-1), 7);   // sync failure → unable to sync
   EXPECT_EQ(PolicyCodeFor(-10), 7);
   EXPECT_EQ(PolicyCodeFor(-3), kUnknownPolicyCode);
   EXPECT_EQ(DescribeResultCode(-8), "-8 (too dark)");
