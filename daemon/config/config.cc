@@ -188,6 +188,10 @@ void ReadQualityRules(TableReader& meter, Problems& problems, MeterConfig& m) {
 void ReadMeter(TableReader& root, Problems& problems, Config& c) {
   TableReader t = root.Sub("meter");
   MeterConfig& m = c.meter;
+  std::string model;
+  if (t.OneOf("model", model, {"pr650", "pr655", "pr670", "cs2000", "cs2000a", "cs3000"})) {
+    m.model = *ParseMeterModel(model);
+  }
   t.String("port", m.port);
   int baud = m.baud;
   if (t.Int("baud", baud, 1, 1000000)) {
@@ -197,7 +201,8 @@ void ReadMeter(TableReader& root, Problems& problems, Config& c) {
     if (standard) {
       m.baud = baud;
     } else {
-      t.Issue("baud", std::to_string(baud) + " is not a standard rate (the PR-650 uses 9600)");
+      t.Issue("baud", std::to_string(baud) +
+                          " is not a standard rate (1200 … 115200; the PR-650 uses 9600)");
     }
   }
   t.Bool("hardware_flow_control", m.hardware_flow_control);
@@ -208,6 +213,8 @@ void ReadMeter(TableReader& root, Problems& problems, Config& c) {
   t.Int("wake_attempts", m.wake_attempts, 1, 20);
   t.Bool("measure_with_spectrum", m.measure_with_spectrum);
   t.Int("rts_settle_ms", m.rts_settle_ms, 0, 10000);
+  t.Int("char_gap_ms", m.char_gap_ms, 0, 1000);
+  t.OneOf("nd_filter", m.nd_filter, {"off", "on", "auto"});
   t.Int("overhead_ms", m.overhead_ms, 0, 60000);
   // The PR-650's integration range (S command: 10 … 6000 ms).
   t.Int("adaptive_reference_ms", m.adaptive_reference_ms, 10, 6000);
@@ -374,6 +381,51 @@ void ReadOthers(TableReader& root, Config& c) {
 
 }  // namespace
 
+namespace {
+
+struct MeterModelNames {
+  MeterModel model;
+  const char* key;
+  const char* name;
+  MeterFamily family;
+};
+constexpr MeterModelNames kMeterModels[] = {
+    {MeterModel::kPr650, "pr650", "PR-650", MeterFamily::kPr650},
+    {MeterModel::kPr655, "pr655", "PR-655", MeterFamily::kPr670},
+    {MeterModel::kPr670, "pr670", "PR-670", MeterFamily::kPr670},
+    {MeterModel::kCs2000, "cs2000", "CS-2000", MeterFamily::kCs2000},
+    {MeterModel::kCs2000A, "cs2000a", "CS-2000A", MeterFamily::kCs2000},
+    {MeterModel::kCs3000, "cs3000", "CS-3000", MeterFamily::kCs2000},
+};
+
+const MeterModelNames& NamesOf(MeterModel model) {
+  for (const MeterModelNames& m : kMeterModels) {
+    if (m.model == model) return m;
+  }
+  return kMeterModels[0];
+}
+
+}  // namespace
+
+const char* MeterModelKey(MeterModel model) {
+  return NamesOf(model).key;
+}
+
+const char* MeterModelName(MeterModel model) {
+  return NamesOf(model).name;
+}
+
+std::optional<MeterModel> ParseMeterModel(std::string_view key) {
+  for (const MeterModelNames& m : kMeterModels) {
+    if (key == m.key) return m.model;
+  }
+  return std::nullopt;
+}
+
+MeterFamily FamilyOf(MeterModel model) {
+  return NamesOf(model).family;
+}
+
 const char* RoleName(Role role) {
   return role == Role::kOperator ? "operator" : "analyst";
 }
@@ -446,8 +498,13 @@ plan::RigDescription ToRigDescription(const Config& config) {
   auto convention = [](const AxisSettings& a) { return AxisConvention{a.sign, a.zero_offset_deg}; };
   rig.convention = {convention(s.alpha), convention(s.beta), convention(s.gamma),
                     convention(s.delta)};
-  // The D5 report is ~1,730 bytes; 10 bits per byte on the wire (8N1).
-  rig.meter_transfer_s = 1730.0 * 10.0 / config.meter.baud;
+  // The spectrum on the wire, 10 bits per byte (8N1): the PR-650's D5 report is ~1,730 bytes, a
+  // PR-670's report 5 ~3,000 (201 bands), a CS-2000's four MEDR blocks ~4,500 (401 values).
+  const MeterFamily family = FamilyOf(config.meter.model);
+  const double report_bytes = family == MeterFamily::kPr650   ? 1730.0
+                              : family == MeterFamily::kPr670 ? 3000.0
+                                                              : 4500.0;
+  rig.meter_transfer_s = report_bytes * 10.0 / config.meter.baud;
   // The meter's own time per reading and the integration it is expected to choose when adaptive
   // ([meter] overhead_ms, adaptive_*_ms); the daemon's own waits per exchange (M5; or M0 and
   // D5): the pacing before the command and the quiet gap that ends the reply. The move after a

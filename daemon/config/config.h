@@ -20,7 +20,9 @@
 //   [storage]
 //   database = "/var/lib/brdfd/brdfd.db"
 //
-//   [meter]                             # the PR-650 (pr650.md)
+//   [meter]                             # the spectroradiometer (pr650.md, pr670-protocol.md,
+//   model = "pr650"                     #   cs2000-protocol.md): pr650, pr655, pr670, cs2000,
+//                                       #   cs2000a or cs3000
 //   port = "/dev/ttyUSB0"
 //   baud = 9600
 //   hardware_flow_control = false
@@ -31,6 +33,8 @@
 //   wake_attempts = 5                   # remote-mode wake-up tries before asking for a power cycle
 //   measure_with_spectrum = true        # M5 (one exchange per reading); false: M0 then D5
 //   rts_settle_ms = 1000                # wait after RTS drop/raise before the first command
+//   char_gap_ms = 50                    # PR-655/670: commands typed a character at a time
+//   nd_filter = "auto"                  # CS-2000/3000: internal ND filter, "off", "on", "auto"
 //   overhead_ms = 300                   # the meter's own time per reading (for estimates)
 //   adaptive_reference_ms = 2000        # integration the meter is expected to choose when the
 //   adaptive_dark_ms = 6000             #   plan says adaptive, by kind of reading (for
@@ -130,7 +134,18 @@ struct StorageConfig {
   std::string database = "/var/lib/brdfd/brdfd.db";
 };
 
+// The meters brdfd drives, by [meter] model.
+enum class MeterModel { kPr650, kPr655, kPr670, kCs2000, kCs2000A, kCs3000 };
+// "pr650" … "cs3000" (the configuration's names) and "PR-650" … "CS-3000" (the meters' own).
+const char* MeterModelKey(MeterModel model);
+const char* MeterModelName(MeterModel model);
+std::optional<MeterModel> ParseMeterModel(std::string_view key);
+// The driver family: the PR-650's own, the PR-655/670's letter commands, the CS-2000's.
+enum class MeterFamily { kPr650, kPr670, kCs2000 };
+MeterFamily FamilyOf(MeterModel model);
+
 struct MeterConfig {
+  MeterModel model = MeterModel::kPr650;
   std::string port = "/dev/ttyUSB0";
   int baud = 9600;
   bool hardware_flow_control = false;
@@ -140,7 +155,9 @@ struct MeterConfig {
   int measurement_timeout_ms = 30000;
   int wake_attempts = 5;
   bool measure_with_spectrum = true;
-  int rts_settle_ms = 1000;  // wake-up: wait after RTS is raised again (manual: > 0.5 s)
+  int rts_settle_ms = 1000;        // wake-up: wait after RTS is raised again (manual: > 0.5 s)
+  int char_gap_ms = 50;            // PR-655/670: pause after each character of a command
+  std::string nd_filter = "auto";  // CS-2000/3000: the internal ND filter ("off", "on", "auto")
   // For plan-time estimates only (core/plan/timing.h): the meter's own time per reading beyond
   // integration and transfer, and the integration it is expected to choose when the plan says
   // adaptive, by kind of reading (the white reference is bright, a dark reading runs to 6 s).

@@ -1,4 +1,5 @@
-// Rig::FromConfig: the daemon's configuration ([meter], [stage]) turned into the two drivers.
+// Rig::FromConfig: the daemon's configuration ([meter], [stage]) turned into the two drivers: the
+// meter's by [meter] model (PR-650; PR-655/670; CS-2000/2000A/3000).
 // Stage readings are what the drivers deal in; the zero offsets and signs of [stage.axes.*] map
 // them to geometry.md's model angles in core/plan (RigDescription::convention), not here.
 #include <spdlog/spdlog.h>
@@ -8,16 +9,21 @@
 
 #include "daemon/config/config.h"
 #include "daemon/engine/rig.h"
+#include "drivers/cs2000/cs2000_spectroradiometer.h"
 #include "drivers/pr650/pr650_spectroradiometer.h"
+#include "drivers/pr670/pr670_spectroradiometer.h"
 #include "drivers/stage/modbus_stage.h"
 #include "drivers/stage/profile_file.h"
 
 namespace brdf::daemon {
 namespace {
 
-drivers::Pr650Options MeterOptions(const MeterConfig& m) {
+// What every meter's options take from [meter] alike: the line, the pacing, the timeouts, the
+// quality policy's overrides and the log (`tag`: "pr650: …").
+template <typename Options>
+Options LineOptions(const MeterConfig& m, const char* tag) {
   using std::chrono::milliseconds;
-  drivers::Pr650Options o;
+  Options o;
   o.port = m.port;
   o.baud = m.baud;
   o.hardware_flow_control = m.hardware_flow_control;
@@ -25,12 +31,63 @@ drivers::Pr650Options MeterOptions(const MeterConfig& m) {
   o.quiet_gap = milliseconds(m.quiet_gap_ms);
   o.reply_timeout = milliseconds(m.reply_timeout_ms);
   o.measurement_timeout = milliseconds(m.measurement_timeout_ms);
+  for (const auto& [code, rule] : m.quality_overrides) o.quality_policy.Set(code, rule);
+  o.log = [tag](std::string_view line) { spdlog::debug("{}: {}", tag, line); };
+  return o;
+}
+
+drivers::Pr650Options MeterOptions(const MeterConfig& m) {
+  auto o = LineOptions<drivers::Pr650Options>(m, "pr650");
   o.wake_attempts = m.wake_attempts;
   o.measure_with_spectrum = m.measure_with_spectrum;
-  o.wake_settle = milliseconds(m.rts_settle_ms);
-  for (const auto& [code, rule] : m.quality_overrides) o.quality_policy.Set(code, rule);
-  o.log = [](std::string_view line) { spdlog::debug("pr650: {}", line); };
+  o.wake_settle = std::chrono::milliseconds(m.rts_settle_ms);
   return o;
+}
+
+drivers::Pr670Options Pr670MeterOptions(const MeterConfig& m) {
+  auto o = LineOptions<drivers::Pr670Options>(m, "pr670");
+  o.model = MeterModelName(m.model);
+  o.char_gap = std::chrono::milliseconds(m.char_gap_ms);
+  o.remote_attempts = m.wake_attempts;
+  return o;
+}
+
+drivers::Cs2000Options Cs2000MeterOptions(const MeterConfig& m) {
+  auto o = LineOptions<drivers::Cs2000Options>(m, "cs2000");
+  o.model = MeterModelName(m.model);
+  o.nd_filter = m.nd_filter == "off"  ? drivers::cs2000::NdFilter::kOff
+                : m.nd_filter == "on" ? drivers::cs2000::NdFilter::kOn
+                                      : drivers::cs2000::NdFilter::kAuto;
+  o.remote_attempts = m.wake_attempts;
+  return o;
+}
+
+// The driver of [meter] model, its options checked.
+Result<std::unique_ptr<drivers::Spectroradiometer>> MakeMeter(const MeterConfig& m) {
+  std::unique_ptr<drivers::Spectroradiometer> meter;
+  Status checked;
+  switch (FamilyOf(m.model)) {
+    case MeterFamily::kPr650: {
+      drivers::Pr650Options o = MeterOptions(m);
+      checked = drivers::ValidatePr650Options(o);
+      meter = std::make_unique<drivers::Pr650Spectroradiometer>(std::move(o));
+      break;
+    }
+    case MeterFamily::kPr670: {
+      drivers::Pr670Options o = Pr670MeterOptions(m);
+      checked = drivers::ValidatePr670Options(o);
+      meter = std::make_unique<drivers::Pr670Spectroradiometer>(std::move(o));
+      break;
+    }
+    case MeterFamily::kCs2000: {
+      drivers::Cs2000Options o = Cs2000MeterOptions(m);
+      checked = drivers::ValidateCs2000Options(o);
+      meter = std::make_unique<drivers::Cs2000Spectroradiometer>(std::move(o));
+      break;
+    }
+  }
+  if (!checked.ok()) return checked.WithContext("config [meter]");
+  return meter;
 }
 
 drivers::stage::AxisConfig Axis(const AxisSettings& a, bool present) {
@@ -87,10 +144,8 @@ Result<drivers::stage::ModbusStageConfig> StageOptions(const StageConfig& s) {
 }  // namespace
 
 Result<std::unique_ptr<Rig>> Rig::FromConfig(const Config& config, Options options) {
-  drivers::Pr650Options meter_options = MeterOptions(config.meter);
-  if (Status st = drivers::ValidatePr650Options(meter_options); !st.ok()) {
-    return st.WithContext("config [meter]");
-  }
+  Result<std::unique_ptr<drivers::Spectroradiometer>> meter = MakeMeter(config.meter);
+  if (!meter.ok()) return meter.status();
   Result<drivers::stage::ModbusStageConfig> stage_options = StageOptions(config.stage);
   if (!stage_options.ok()) return stage_options.status();
   auto stage = drivers::stage::ModbusStage::Create(*stage_options);
@@ -101,8 +156,8 @@ Result<std::unique_ptr<Rig>> Rig::FromConfig(const Config& config, Options optio
       config.stage.transport == "rtu" ? config.stage.device
                                       : config.stage.host + ":" + std::to_string(config.stage.port);
   return std::make_unique<Rig>(
-      std::make_unique<drivers::Pr650Spectroradiometer>(std::move(meter_options)),
-      DeviceInfo{"PR-650", config.meter.port}, std::move(*stage),
+      std::move(meter).value(), DeviceInfo{MeterModelName(config.meter.model), config.meter.port},
+      std::move(*stage),
       DeviceInfo{"Modbus stage (" + StageProfileLabel(config.stage) + ")", stage_address},
       ToRigDescription(config), options);
 }

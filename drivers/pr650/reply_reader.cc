@@ -29,7 +29,8 @@ Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
   const auto first_deadline = clock.Now() + request.first_byte_timeout;
   std::string reply;
   auto last_byte = clock.Now();
-  bool first_line_seen = !request.first_line;
+  bool first_line_seen = !request.first_line && !request.lines_after_first;
+  std::size_t lines = request.lines;
 
   auto append = [&](const std::string& bytes) -> Status {
     reply += bytes;
@@ -37,14 +38,18 @@ Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
     if (!first_line_seen && CountCompleteLines(reply) > 0) {
       first_line_seen = true;
       const std::size_t begin = reply.find_first_not_of("\r\n");
-      request.first_line(
-          std::string_view(reply).substr(begin, reply.find_first_of("\r\n", begin) - begin));
+      const std::string_view line =
+          std::string_view(reply).substr(begin, reply.find_first_of("\r\n", begin) - begin);
+      if (request.first_line) request.first_line(line);
+      if (request.lines_after_first) {
+        if (const std::size_t n = request.lines_after_first(line); n > 0) lines = n;
+      }
     }
     if (reply.size() > framing.max_reply_bytes) {
-      return ProtocolError("PR-650 reply to " + command + " on " + link.port() + " exceeds " +
+      return ProtocolError(framing.device + " reply to " + command + " on " + link.port() + " exceeds " +
                            std::to_string(framing.max_reply_bytes) +
                            " bytes without ending: line noise or a wrong baud rate; check the "
-                           "cable and that the meter is set to 9600 baud");
+                           "cable and that the meter is set to the configured baud rate");
     }
     return Status::Ok();
   };
@@ -52,12 +57,12 @@ Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
   while (true) {
     auto until = first_deadline;
     if (!reply.empty()) {
-      const bool complete = Complete(reply, request.lines);
+      const bool complete = Complete(reply, lines);
       const auto gap = complete ? framing.quiet_gap : framing.stall_timeout;
       if (clock.Now() - last_byte >= gap) {
         if (complete) return reply;
-        return ProtocolError("PR-650 reply to " + command + " on " + link.port() +
-                             " stopped after " + Progress(reply, request.lines) +
+        return ProtocolError(framing.device + " reply to " + command + " on " + link.port() +
+                             " stopped after " + Progress(reply, lines) +
                              " and nothing more came for " +
                              std::to_string(Millis(framing.stall_timeout)) +
                              " ms: the reply is truncated; check the cable and retry");
@@ -81,16 +86,16 @@ Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
     if (!late.ok()) return late.status();
     if (!late->empty()) BRDF_RETURN_IF_ERROR(append(*late));
     if (deadline_passed) {
-      if (Complete(reply, request.lines)) return reply;
+      if (Complete(reply, lines)) return reply;
       if (reply.empty()) {
-        return Timeout("PR-650 on " + link.port() + " did not answer " + command +
+        return Timeout(framing.device + " on " + link.port() + " did not answer " + command +
                        " before the call's deadline");
       }
-      return Timeout("call deadline passed while reading the PR-650's reply to " + command +
-                     " on " + link.port() + " (" + Progress(reply, request.lines) + ")");
+      return Timeout("call deadline passed while reading the " + framing.device + "'s reply to " + command +
+                     " on " + link.port() + " (" + Progress(reply, lines) + ")");
     }
     if (reply.empty()) {
-      return Timeout("PR-650 on " + link.port() + " did not answer " + command + " within " +
+      return Timeout(framing.device + " on " + link.port() + " did not answer " + command + " within " +
                      std::to_string(Millis(request.first_byte_timeout)) + " ms");
     }
   }

@@ -24,8 +24,11 @@ struct FramingOptions {
   std::chrono::steady_clock::duration quiet_gap = std::chrono::milliseconds(50);
   // Silence after the last byte that ends an incomplete reply: the reply is truncated.
   std::chrono::steady_clock::duration stall_timeout = std::chrono::seconds(1);
-  // Longer replies are garbage (a D5 report is about 1.7 kB).
+  // Longer replies are garbage (a D5 report is about 1.7 kB; a PR-670's about 3.5 kB, a
+  // CS-2000's spectral block about 1.1 kB).
   std::size_t max_reply_bytes = 16 * 1024;
+  // The meter on the line, for messages ("PR-650 reply to D5 on /dev/ttyUSB0 stopped ...").
+  std::string device = "PR-650";
 };
 
 struct ReplyRequest {
@@ -36,6 +39,10 @@ struct ReplyRequest {
   // rest may still be on the wire: a report's status line can be acted on before its data has
   // arrived (M5: the stage may leave once the measurement is known good).
   std::function<void(std::string_view first_line)> first_line = nullptr;
+  // Called once with the reply's first line (after first_line): the number of lines the whole
+  // reply has, when the first line tells (a PR-670 answers M5 with its error code alone instead
+  // of the 202-line report). 0 keeps `lines`.
+  std::function<std::size_t(std::string_view first_line)> lines_after_first = nullptr;
 };
 
 // Reads one reply. Errors:

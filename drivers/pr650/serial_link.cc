@@ -41,16 +41,18 @@ bool IsPseudoTerminal(const std::string& port) {
 
 Result<std::unique_ptr<SerialLink>> MakeSerialLink(const SerialSettings& settings, LogSink log) {
   if (settings.port.empty()) {
-    return ConfigurationError(
-        "PR-650 serial port name is empty: set it in the configuration "
-        "(e.g. /dev/ttyUSB0)");
+    return ConfigurationError(settings.device +
+                              " serial port name is empty: set it in the configuration "
+                              "(e.g. /dev/ttyUSB0)");
   }
   if (settings.port.find('\0') != std::string::npos) {
-    return ConfigurationError("PR-650 serial port name contains a NUL byte: fix the configuration");
+    return ConfigurationError(settings.device +
+                              " serial port name contains a NUL byte: fix the configuration");
   }
   if (!IsSupportedBaud(settings.baud)) {
-    return ConfigurationError("PR-650 baud rate " + std::to_string(settings.baud) +
-                              " is not supported (the meter talks 9600 baud)");
+    return ConfigurationError(settings.device + " baud rate " + std::to_string(settings.baud) +
+                              " is not supported: use a standard rate 1200–115200 that the "
+                              "meter is set to");
   }
   if (IsPseudoTerminal(settings.port)) {
     return std::unique_ptr<SerialLink>(std::make_unique<TermiosLink>(settings, std::move(log)));

@@ -32,6 +32,7 @@ struct SerialSettings {
   std::string port;                    // "/dev/ttyUSB0", or a pty path / link to one
   int baud = 9600;                     // 8 data bits, no parity, 1 stop bit
   bool hardware_flow_control = false;  // RTS/CTS; off by default, as the meter ships
+  std::string device = "PR-650";       // the meter on the line, for messages ("PR-670")
 };
 
 class SerialLink {

@@ -4,6 +4,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <chrono>
 #include <fstream>
 #include <string>
@@ -438,6 +440,49 @@ TEST(ConfigTest, WebConsoleIsOffUnlessListenIsSet) {
   EXPECT_THAT(Refusal("[web]\nlisten = \"8080\"\n"), HasSubstr("web.listen"));
   EXPECT_THAT(Refusal("[web]\nlisten = \"127.0.0.1:70000\"\n"), HasSubstr("web.listen"));
   EXPECT_THAT(Refusal("[web]\nlisen = \"127.0.0.1:8080\"\n"), HasSubstr("unknown key web.lisen"));
+}
+
+}  // namespace
+}  // namespace brdf::daemon
+
+namespace brdf::daemon {
+namespace {
+
+// [meter] model picks the driver (issue 41); the PR-650 stays the default, and its transfer time
+// follows the meter's report size.
+TEST(ConfigMeterModel, ModelPicksTheFamilyAndUnknownModelsAreRefused) {
+  const Result<Config> defaults = ParseConfig("", "empty.toml");
+  ASSERT_TRUE(defaults.ok());
+  EXPECT_EQ(defaults->meter.model, MeterModel::kPr650);
+  EXPECT_EQ(defaults->meter.char_gap_ms, 50);
+  EXPECT_EQ(defaults->meter.nd_filter, "auto");
+  for (const auto& [key, family, name] :
+       {std::tuple{"pr650", MeterFamily::kPr650, "PR-650"},
+        std::tuple{"pr655", MeterFamily::kPr670, "PR-655"},
+        std::tuple{"pr670", MeterFamily::kPr670, "PR-670"},
+        std::tuple{"cs2000", MeterFamily::kCs2000, "CS-2000"},
+        std::tuple{"cs2000a", MeterFamily::kCs2000, "CS-2000A"},
+        std::tuple{"cs3000", MeterFamily::kCs2000, "CS-3000"}}) {
+    const Result<Config> r = ParseConfig(std::string("[meter]\nmodel = \"") + key +
+                                             "\"\nchar_gap_ms = 5\nnd_filter = \"off\"\n",
+                                         "meter.toml");
+    ASSERT_TRUE(r.ok()) << key << ": " << r.status().ToString();
+    EXPECT_EQ(FamilyOf(r->meter.model), family) << key;
+    EXPECT_STREQ(MeterModelName(r->meter.model), name);
+    EXPECT_STREQ(MeterModelKey(r->meter.model), key);
+    EXPECT_EQ(r->meter.char_gap_ms, 5);
+    EXPECT_EQ(r->meter.nd_filter, "off");
+  }
+  const Result<Config> bad = ParseConfig("[meter]\nmodel = \"pr-670\"\n", "bad.toml");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_THAT(bad.status().message(), ::testing::HasSubstr("meter.model"));
+  EXPECT_THAT(bad.status().message(), ::testing::HasSubstr("pr670"));
+  const Result<Config> nd = ParseConfig("[meter]\nnd_filter = \"half\"\n", "bad.toml");
+  EXPECT_FALSE(nd.ok());
+
+  const Result<Config> pr650 = ParseConfig("", "a.toml");
+  const Result<Config> cs = ParseConfig("[meter]\nmodel = \"cs2000\"\n", "b.toml");
+  EXPECT_GT(ToRigDescription(*cs).meter_transfer_s, ToRigDescription(*pr650).meter_transfer_s);
 }
 
 }  // namespace

@@ -108,6 +108,8 @@ struct FaultCase {
   std::function<bool(DaemonRig&)> consumed;
   // Extra checks on the readings (e.g. a flagged one), or nullptr.
   std::function<void(const std::vector<v1::Reading>&)> check_readings;
+  // The meter brdf-sim simulates and brdfd drives ([meter] model); nullptr: the PR-650.
+  const char* meter = nullptr;
 };
 
 // gtest prints a failing row by its name.
@@ -252,6 +254,12 @@ bool SerialConsumed(DaemonRig& rig) {
   return f.ok() && f->garbage_next == 0 && f->truncate_next == 0 && f->quality_count == 0 &&
          f->vanish_seconds == 0 && f->no_data_next == 0;
 }
+// The serial faults ran down and the meter's way out of remote mode was taken.
+bool SerialAndRemoteConsumed(DaemonRig& rig) {
+  Result<sim::SerialFaults> f = rig.sim_control().SerialFaults();
+  return SerialConsumed(rig) && f.ok() && !f->leave_remote;
+}
+
 bool ModbusConsumed(DaemonRig& rig) {
   Result<sim::ModbusFaults> f = rig.sim_control().ModbusFaults();
   return f.ok() && f->exception_count == 0 && f->late_count == 0 && !f->drop_connection &&
@@ -437,6 +445,59 @@ const FaultCase kMatrix[] = {
      nullptr},
 };
 
+// The meters after the PR-650 (issue 41): brdf-sim's PR-670 and CS-2000 with their own codes
+// (the PR-670's result codes, the CS-2000's ERxx), a meter that leaves remote mode (the driver is
+// answered again once the rig has connected it, which re-enters remote mode) and an unplugged
+// USB cable (the port vanishes during the spectrum; brief: reconnected away; long: paused until
+// it is back). docs/pr670-protocol.md and docs/cs2000-protocol.md list the codes' handling.
+const FaultCase kMeterMatrix[] = {
+    {"Pr670TooDarkAdapted", "PR-670 result code -8 (too dark) on a light reading: exposure doubled",
+     Expect::kRecovers, 0, Serial([](auto& f) {
+       f.quality_code = -8;
+       f.quality_count = 1;
+     }),
+     nullptr, "", -1, SerialConsumed, nullptr, "pr670"},
+    {"Pr670SyncFailureRetried", "PR-670 result code -10 (sync failure): SS0, measured again",
+     Expect::kRecovers, 2, Serial([](auto& f) {
+       f.quality_code = -10;
+       f.quality_count = 1;
+     }),
+     nullptr, "", -1, SerialConsumed, nullptr, "pr670"},
+    {"Pr670UnknownCodeFails", "PR-670 result code -3 (not in the sources) on every try",
+     Expect::kPauses, 2, Serial([](auto& f) {
+       f.quality_code = -3;
+       f.quality_count = 1000;
+     }),
+     ClearSerial, "code -3", -1, nullptr, nullptr, "pr670"},
+    {"Pr670LeavesRemoteMode", "the PR-670 leaves remote mode (its operator pressed a key)",
+     Expect::kRecovers, 2, Serial([](auto& f) { f.leave_remote = true; }), nullptr, "", -1,
+     SerialAndRemoteConsumed, nullptr, "pr670"},
+    {"Pr670UnpluggedBriefly", "the PR-670's USB port vanishes during report 5, back at once",
+     Expect::kRecovers, 2, Serial([](auto& f) { f.vanish_seconds = 5; }), nullptr, "", -1,
+     SerialConsumed, nullptr, "pr670"},
+    {"Pr670Unplugged", "the PR-670's USB cable is pulled during report 5 and stays out",
+     Expect::kPauses, 2, Serial([](auto& f) { f.vanish_seconds = 300; }), MeterBack, "vanished", -1,
+     nullptr, nullptr, "pr670"},
+    {"Cs2000OverRangeAdapted", "CS-2000 ER10 (over measurement range): integration halved",
+     Expect::kRecovers, 0, Serial([](auto& f) {
+       f.quality_code = 10;
+       f.quality_count = 1;
+     }),
+     nullptr, "", -1, SerialConsumed, nullptr, "cs2000"},
+    {"Cs2000AnswersErrorCodes", "CS-2000 ER83 (measurement angle abnormality) on every try",
+     Expect::kPauses, 2, Serial([](auto& f) {
+       f.quality_code = 83;
+       f.quality_count = 1000;
+     }),
+     ClearSerial, "ER83", 83, nullptr, nullptr, "cs2000"},
+    {"Cs2000LeavesRemoteMode", "the CS-2000 leaves remote mode", Expect::kRecovers, 2,
+     Serial([](auto& f) { f.leave_remote = true; }), nullptr, "", -1, SerialAndRemoteConsumed,
+     nullptr, "cs2000"},
+    {"Cs2000Unplugged", "the CS-2000's port vanishes during a spectral block and stays away",
+     Expect::kPauses, 2, Serial([](auto& f) { f.vanish_seconds = 300; }), MeterBack, "vanished", -1,
+     nullptr, nullptr, "cs2000"},
+};
+
 // The stage on Modbus RTU (brdf-sim's RTU pty): the fault plan with Modbus faults that the bus
 // retries away and ones that pause the session until cleared.
 const FaultCase kRtuMatrix[] = {
@@ -473,10 +534,19 @@ std::string Lower(std::string s) {
 class FaultMatrixTest : public ::testing::TestWithParam<FaultCase> {
  protected:
   void SetUp() override {
-    Status sim = rtu_ ? rig_.StartSim({"--rtu"}) : rig_.StartSim();
+    const char* meter = GetParam().meter;
+    std::vector<std::string> args;
+    if (rtu_) args.push_back("--rtu");
+    if (meter != nullptr) args.insert(args.end(), {"--meter", meter});
+    Status sim = rig_.StartSim(args);
     ASSERT_TRUE(sim.ok()) << sim.ToString();
-    const std::string toml = rtu_ ? RtuFaultConfigToml(rig_.sim(), rig_.database())
-                                  : FaultConfigToml(rig_.sim(), rig_.database());
+    std::string toml = rtu_ ? RtuFaultConfigToml(rig_.sim(), rig_.database())
+                            : FaultConfigToml(rig_.sim(), rig_.database());
+    if (meter != nullptr) {
+      const std::string table = "[meter]\n";
+      toml.insert(toml.find(table) + table.size(),
+                  "model = \"" + std::string(meter) + "\"\nchar_gap_ms = 1\n");
+    }
     if (rtu_) {
       ASSERT_NE(toml.find("transport = \"rtu\""), std::string::npos) << toml;
     }
@@ -636,6 +706,7 @@ std::string RowName(const ::testing::TestParamInfo<FaultCase>& row) {
 
 INSTANTIATE_TEST_SUITE_P(Matrix, FaultMatrixTest, ::testing::ValuesIn(kMatrix), RowName);
 INSTANTIATE_TEST_SUITE_P(Rtu, FaultMatrixRtuTest, ::testing::ValuesIn(kRtuMatrix), RowName);
+INSTANTIATE_TEST_SUITE_P(Meters, FaultMatrixTest, ::testing::ValuesIn(kMeterMatrix), RowName);
 
 }  // namespace
 }  // namespace brdf::testing

@@ -255,3 +255,45 @@ TEST(SimConfigTest, FindConfigPathAcceptsBothSpellings) {
 
 }  // namespace
 }  // namespace brdf::sim
+
+namespace brdf::sim {
+namespace {
+
+// --meter and [meter] model pick the meter on the pty (issue 41); a fault's code is the meter's
+// own, so a PR-670's negative result codes are valid for it and for it only.
+TEST(SimConfigMeter, FlagAndFileChooseTheMeterAndItsCodes) {
+  SimConfig flags;
+  ASSERT_TRUE(ParseLikeMain({"--meter", "pr670", "--serial-quality-code", "-8",
+                             "--serial-leave-remote", "--meter-serial", "6700042"},
+                            flags)
+                  .ok());
+  EXPECT_EQ(flags.meter, "pr670");
+  EXPECT_EQ(flags.meter_serial, "6700042");
+  EXPECT_EQ(flags.serial_faults.quality_code, -8);
+  EXPECT_EQ(flags.serial_faults.quality_count, 1);
+  EXPECT_TRUE(flags.serial_faults.leave_remote);
+  EXPECT_EQ(MeterFamilyOf("pr655"), "pr670");
+  EXPECT_EQ(MeterFamilyOf("cs3000"), "cs2000");
+  EXPECT_EQ(MeterModelOf("cs2000a"), "CS-2000A");
+
+  SimConfig pr650;
+  EXPECT_FALSE(ParseLikeMain({"--serial-quality-code", "-8"}, pr650).ok());
+  SimConfig unknown;
+  EXPECT_FALSE(ParseLikeMain({"--meter", "pr999"}, unknown).ok());
+
+  SimConfig file;
+  ASSERT_TRUE(LoadConfigString("[meter]\nmodel = \"cs2000\"\nserial_number = \"2000777\"\n"
+                               "[faults.serial]\nleave_remote = true\n",
+                               "meter.toml", file)
+                  .ok());
+  EXPECT_EQ(file.meter, "cs2000");
+  EXPECT_EQ(file.meter_serial, "2000777");
+  EXPECT_TRUE(file.serial_faults.leave_remote);
+  SimConfig bad;
+  Status refused = LoadConfigString("[meter]\nmodel = \"cs-2000\"\n", "bad.toml", bad);
+  EXPECT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("meter.model"), std::string::npos) << refused.message();
+}
+
+}  // namespace
+}  // namespace brdf::sim

@@ -108,15 +108,16 @@ Status ModbusControl::SetSerialFaults(const sim::SerialFaults& f) {
       Flag(f.silent),
       Word(f.garbage_next),
       Word(f.truncate_next),
-      Word(f.quality_code),
+      static_cast<std::uint16_t>(static_cast<std::int16_t>(f.quality_code)),
       Word(f.quality_count),
       static_cast<std::uint16_t>(vanish_ms >> 16),
       static_cast<std::uint16_t>(vanish_ms & 0xFFFFu),
       Word(f.no_data_next),
       Word(f.units_code),
+      Flag(f.leave_remote),
   };
   static_assert(map::kSerialVanishMs - map::kSerialSilent == 5, "serial fault block layout");
-  static_assert(map::kSerialUnitsCode - map::kSerialSilent == 8, "serial fault block layout");
+  static_assert(map::kSerialLeaveRemote - map::kSerialSilent == 9, "serial fault block layout");
   return WriteRegisters(map::kSerialSilent, regs);
 }
 
@@ -131,18 +132,19 @@ Status ModbusControl::SetModbusFaults(const sim::ModbusFaults& f) {
 }
 
 Result<sim::SerialFaults> ModbusControl::SerialFaults() {
-  auto r = ReadRegisters(map::kSerialSilent, 9);
+  auto r = ReadRegisters(map::kSerialSilent, 10);
   if (!r.ok()) return r.status();
   const auto& v = *r;
   sim::SerialFaults f;
   f.silent = v[0] != 0;
   f.garbage_next = v[1];
   f.truncate_next = v[2];
-  f.quality_code = v[3];
+  f.quality_code = static_cast<std::int16_t>(v[3]);
   f.quality_count = v[4];
   f.vanish_seconds = ((static_cast<std::uint32_t>(v[5]) << 16) | v[6]) / 1000.0;
   f.no_data_next = v[7];
   f.units_code = v[8];
+  f.leave_remote = v[9] != 0;
   return f;
 }
 

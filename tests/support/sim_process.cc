@@ -1,6 +1,8 @@
 #include "tests/support/sim_process.h"
 
 #include <cstdlib>
+#include <set>
+#include <string>
 
 namespace brdf::testing {
 namespace {
@@ -57,8 +59,11 @@ Status SimProcess::ParseLine(const std::string& line) {
   const std::size_t space = line.find(' ');
   const std::string key = line.substr(0, space);
   const std::string value = space == std::string::npos ? "" : line.substr(space + 1);
-  if (key == "pr650" && !value.empty()) {
+  static const std::set<std::string> kMeters = {"pr650",  "pr655",   "pr670",
+                                                "cs2000", "cs2000a", "cs3000"};
+  if (kMeters.count(key) > 0 && !value.empty()) {
     pr650_path_ = value;
+    meter_ = key;
   } else if (key == "modbus-tcp") {
     const std::size_t colon = value.rfind(':');
     if (colon == std::string::npos || colon == 0) {
@@ -80,7 +85,8 @@ Status SimProcess::ParseLine(const std::string& line) {
     }
   } else if (line == "ready") {
     if (pr650_path_.empty() || modbus_port_ == 0 || control_unit_ == 0) {
-      return ProtocolError("'ready' came before the pr650, modbus-tcp and control-unit lines");
+      return ProtocolError(
+          "'ready' came before the meter (pr650 …), modbus-tcp and control-unit lines");
     }
   } else {
     return ProtocolError("unexpected start-up line '" + line +

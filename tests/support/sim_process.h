@@ -33,7 +33,10 @@ class SimProcess {
   SimProcess(const SimProcess&) = delete;
   SimProcess& operator=(const SimProcess&) = delete;
 
+  // The meter's port, whichever meter it is (--meter; the line is named after it).
   const std::string& pr650_path() const { return pr650_path_; }
+  const std::string& meter_path() const { return pr650_path_; }
+  const std::string& meter() const { return meter_; }  // "pr650", "pr670", "cs2000", ...
   const std::string& modbus_host() const { return modbus_host_; }
   int modbus_port() const { return modbus_port_; }
   const std::string& rtu_path() const { return rtu_path_; }  // empty without --rtu
@@ -53,6 +56,7 @@ class SimProcess {
 
   std::unique_ptr<ChildProcess> child_;
   std::string pr650_path_;
+  std::string meter_ = "pr650";
   std::string modbus_host_;
   int modbus_port_ = 0;
   std::string rtu_path_;

@@ -1,9 +1,10 @@
-// brdf-sim: a whole simulated rig in one process. A PR-650 on a pty and the rotation stage on
-// Modbus TCP (and RTU on a pty with --rtu), joined by the optical model, so the daemon and the
-// tests can run plans without hardware. `brdf-sim truth` prints the virtual sample's true BRDF.
+// brdf-sim: a whole simulated rig in one process. A meter on a pty (--meter: the PR-650, a
+// PR-655/670 or a CS-2000/2000A/3000) and the rotation stage on Modbus TCP (and RTU on a pty with
+// --rtu), joined by the optical model, so the daemon and the tests can run plans without
+// hardware. `brdf-sim truth` prints the virtual sample's true BRDF.
 //
 // stdout carries only the start-up contract (tools/brdf-sim/README.md), one line each, flushed:
-//   pr650 <port path>
+//   <meter> <port path>          (pr650, pr655, pr670, cs2000, cs2000a or cs3000: --meter)
 //   modbus-tcp <host>:<port>
 //   modbus-rtu <pty path>        (with --rtu only)
 //   control-unit <unit id>
@@ -19,8 +20,10 @@
 #include <string>
 
 #include "daemon/config/startup.h"
+#include "tools/brdf-sim/cs2000_endpoint.h"
 #include "tools/brdf-sim/optics.h"
 #include "tools/brdf-sim/pr650_endpoint.h"
+#include "tools/brdf-sim/pr670_endpoint.h"
 #include "tools/brdf-sim/rig_manual_detector.h"
 #include "tools/brdf-sim/rig_truth.h"
 #include "tools/brdf-sim/sim_config.h"
@@ -64,6 +67,42 @@ Pr650EndpointOptions MeterOptionsFrom(const SimConfig& c) {
   return o;
 }
 
+LineEndpointOptions LineOptionsFrom(const SimConfig& c, const std::string& default_serial) {
+  LineEndpointOptions o;
+  o.time_scale = TimeScale{c.time_scale};
+  o.link_path = c.pr650_link;
+  o.serial_number = c.meter_serial.empty() ? default_serial : c.meter_serial;
+  return o;
+}
+
+// The meter --meter names, over the optics.
+std::unique_ptr<MeterPort> MakeMeter(const SimConfig& c, MeterBackend& optics,
+                                     SimControl& control) {
+  const std::string family = MeterFamilyOf(c.meter);
+  if (family == "pr670") {
+    Pr670EndpointOptions o{LineOptionsFrom(c, "67012345"), MeterModelOf(c.meter)};
+    o.line.eol = "\r\n";
+    return std::make_unique<Pr670Endpoint>(optics, control, std::move(o));
+  }
+  if (family == "cs2000") {
+    Cs2000EndpointOptions o{LineOptionsFrom(c, "20001234"), MeterModelOf(c.meter)};
+    o.line.eol = "\n";
+    return std::make_unique<Cs2000Endpoint>(optics, control, std::move(o));
+  }
+  Pr650EndpointOptions o = MeterOptionsFrom(c);
+  if (!c.meter_serial.empty()) o.serial_number = c.meter_serial;
+  return std::make_unique<Pr650Endpoint>(optics, control, std::move(o));
+}
+
+// The optics on the meter's grid.
+OpticsConfig OpticsFor(const SimConfig& c) {
+  OpticsConfig o = c.optics;
+  const std::string family = MeterFamilyOf(c.meter);
+  if (family == "pr670") o.grid = Pr670Grid(MeterModelOf(c.meter));
+  if (family == "cs2000") o.grid = WavelengthGrid{380, 1, 401};
+  return o;
+}
+
 // One start-up line on stdout, flushed at once: a test may be waiting for it.
 void Announce(const std::string& line) {
   std::fputs((line + "\n").c_str(), stdout);
@@ -78,10 +117,10 @@ int Run(const SimConfig& config, const sigset_t& stop_signals) {
 
   // The control unit's power-cycle register reaches the meter through this pointer, set once the
   // meter exists and before either endpoint starts serving.
-  Pr650Endpoint* meter_ptr = nullptr;
+  MeterPort* meter_ptr = nullptr;
   StageSimulator stage(StageConfigFrom(config), control, [&meter_ptr] {
     if (meter_ptr != nullptr) {
-      spdlog::info("control unit: power-cycling the PR-650");
+      spdlog::info("control unit: power-cycling the meter");
       meter_ptr->PowerCycle();
     }
   });
@@ -89,12 +128,13 @@ int Run(const SimConfig& config, const sigset_t& stop_signals) {
   ManualDetectorPose manual_detector(stage, config.manual_delta_deg);
   const StagePoseSource& live_pose =
       config.detector_arm ? static_cast<const StagePoseSource&>(stage) : manual_detector;
-  RigOptics optics(live_pose, control, config.optics);
-  Pr650Endpoint meter(optics, control, MeterOptionsFrom(config));
+  RigOptics optics(live_pose, control, OpticsFor(config));
+  const std::unique_ptr<MeterPort> meter_port = MakeMeter(config, optics, control);
+  MeterPort& meter = *meter_port;
   meter_ptr = &meter;
 
   if (Status s = meter.Start(); !s.ok()) {
-    spdlog::error("cannot start the simulated PR-650: {}", s.ToString());
+    spdlog::error("cannot start the simulated {}: {}", MeterModelOf(config.meter), s.ToString());
     return kStartError;
   }
   std::string error;
@@ -107,14 +147,15 @@ int Run(const SimConfig& config, const sigset_t& stop_signals) {
     return kStartError;
   }
   spdlog::info(
-      "PR-650 on {} (pty {}), Modbus TCP on {}:{}{}{}, time scale {}, seed {}, {} sample, "
+      "{} on {} (pty {}), Modbus TCP on {}:{}{}{}, time scale {}, seed {}, {} sample, "
       "{} mounted",
-      meter.path(), meter.slave_path(), config.modbus_host, stage.tcp_port(),
-      config.rtu ? ", Modbus RTU on " : "", config.rtu ? stage.rtu_path() : "", config.time_scale,
-      config.optics.seed, SampleName(config.optics.anisotropic, config.optics.glossy),
+      MeterModelOf(config.meter), meter.path(), meter.slave_path(), config.modbus_host,
+      stage.tcp_port(), config.rtu ? ", Modbus RTU on " : "", config.rtu ? stage.rtu_path() : "",
+      config.time_scale, config.optics.seed,
+      SampleName(config.optics.anisotropic, config.optics.glossy),
       MountedTargetName(config.mounted));
 
-  Announce("pr650 " + meter.path());
+  Announce(config.meter + " " + meter.path());
   Announce("modbus-tcp " + config.modbus_host + ":" + std::to_string(stage.tcp_port()));
   if (config.rtu) Announce("modbus-rtu " + stage.rtu_path());
   Announce("control-unit " + std::to_string(stage.control_unit_id()));
@@ -150,7 +191,8 @@ int main(int argc, char** argv) {
   SimConfig config;
   TruthQuery truth;
   CLI::App app(
-      "brdf-sim: a simulated spectral BRDF rig (PR-650 on a pty, rotation stage on Modbus)");
+      "brdf-sim: a simulated spectral BRDF rig (a spectroradiometer on a pty, rotation stage on "
+      "Modbus)");
   AddRunFlags(app, config);
   CLI::App* truth_cmd = app.add_subcommand(
       "truth", "Print the virtual sample's true BRDF (sr^-1), 380-780 nm / 4 nm");

@@ -42,6 +42,9 @@ struct OpticsConfig {
   std::uint64_t seed = 1;
   // Standard deviations scale by this (0 = noiseless, for tests that want exact values).
   double noise_scale = 1.0;
+  // The meter's wavelength grid: the PR-650's 101 bands; a PR-670's 201 (2 nm), a CS-2000's 401
+  // (1 nm). Every band sees the same physics; only the sampling differs.
+  WavelengthGrid grid = WavelengthGrid::Pr650();
 };
 
 // The virtual sample's BRDF model, and its name ("paint-like", "brushed (anisotropic)", "glossy").
@@ -63,7 +66,7 @@ class RigOptics final : public MeterBackend {
   // down here, so the PR-650 endpoint does not apply it again). Thread-safe.
   SimMeasurement Measure(const MeterSetup& setup) override;
 
-  // The noiseless radiance the meter would see for `target` at `pose`, on the PR-650 grid.
+  // The noiseless radiance the meter would see for `target` at `pose`, on the meter's grid.
   std::vector<double> ExpectedRadiance(MountedTarget target, const Pose& pose) const;
 
   // The virtual sample's BRDF (sr⁻¹) for directions in the sample frame.
@@ -72,7 +75,7 @@ class RigOptics final : public MeterBackend {
   const OpticsConfig& config() const { return config_; }
   const Lamp& lamp() const { return lamp_; }
   const Detector& detector() const { return detector_; }
-  static WavelengthGrid Grid() { return WavelengthGrid::Pr650(); }
+  const WavelengthGrid& Grid() const { return config_.grid; }
 
  private:
   const StagePoseSource& stage_;

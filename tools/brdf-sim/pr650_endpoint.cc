@@ -10,26 +10,13 @@
 #include <cstdio>
 
 #include "tools/brdf-sim/pr650_sim_protocol.h"
+#include "tools/brdf-sim/serial_wire.h"
 
 namespace brdf::sim {
 
 namespace {
 
 constexpr auto kSlice = std::chrono::milliseconds(20);
-// A reply nobody reads (the pty's buffer is full) is given up after this long.
-constexpr auto kWriteStall = std::chrono::seconds(2);
-
-std::string Upper(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return s;
-}
-
-std::string Trim(const std::string& s) {
-  const auto first = s.find_first_not_of(" \t");
-  if (first == std::string::npos) return {};
-  const auto last = s.find_last_not_of(" \t");
-  return s.substr(first, last - first + 1);
-}
 
 // The reports brdf-sim answers: D1 (Y, x, y), D2 (X, Y, Z), D3 (Y, u', v'), D4 (Y, colour
 // temperature, its deviation), D5 (spectrum), D6 (Y, x, y, u', v').
@@ -51,15 +38,6 @@ std::optional<int> ResponseCode(const std::string& command) {
   return code;
 }
 
-// Junk of the same shape as the reply it replaces (same line count and lengths), so a driver
-// gets a complete-looking reply that does not parse: what a wrong baud rate or line noise gives.
-std::string Garble(const std::string& line, unsigned seed) {
-  static const char kJunk[] = "\x7f#~?@%&\xff\xfe\x1b!*";
-  std::string out(line.size(), '#');
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = kJunk[(seed + i * 7) % (sizeof kJunk - 1)];
-  return out;
-}
-
 }  // namespace
 
 Pr650Endpoint::Pr650Endpoint(MeterBackend& backend, SimControl& control,
@@ -74,14 +52,7 @@ Status Pr650Endpoint::Start() {
   Stop();
   {
     std::lock_guard lock(mu_);
-    BRDF_RETURN_IF_ERROR(pty_.Open());
-    Status status = link_.Create(options_.link_path);
-    if (status.ok()) status = link_.PointAt(pty_.slave_path());
-    if (!status.ok()) {
-      pty_.Close();
-      link_.Remove();
-      return status;
-    }
+    BRDF_RETURN_IF_ERROR(port_.Open(options_.link_path));
     power_on_ = SteadyClock::now();
     remote_ = false;
     standalone_ = false;
@@ -96,18 +67,17 @@ void Pr650Endpoint::Stop() {
   stop_ = true;
   if (thread_.joinable()) thread_.join();
   std::lock_guard lock(mu_);
-  pty_.Close();
-  link_.Remove();
+  port_.Close();
 }
 
 std::string Pr650Endpoint::path() const {
   std::lock_guard lock(mu_);
-  return link_.path();
+  return port_.path();
 }
 
 std::string Pr650Endpoint::slave_path() const {
   std::lock_guard lock(mu_);
-  return pty_.slave_path();
+  return port_.slave_path();
 }
 
 void Pr650Endpoint::PowerCycle() {
@@ -122,7 +92,7 @@ void Pr650Endpoint::PowerCycle() {
   last_ = Measurement{};
   input_.clear();
   // Whatever was sent to the meter while it was off is lost.
-  if (pty_.is_open()) ::tcflush(pty_.master_fd(), TCIFLUSH);
+  if (port_.is_open()) ::tcflush(port_.master_fd(), TCIFLUSH);
 }
 
 bool Pr650Endpoint::remote_mode() const {
@@ -141,13 +111,7 @@ std::vector<MeterSetup> Pr650Endpoint::measured_setups() const {
 }
 
 bool Pr650Endpoint::SleepReal(std::chrono::nanoseconds d) {
-  const auto end = SteadyClock::now() + d;
-  while (!stop_) {
-    const auto now = SteadyClock::now();
-    if (now >= end) return true;
-    std::this_thread::sleep_for(std::min<SteadyClock::duration>(end - now, kSlice));
-  }
-  return false;
+  return SleepUnlessStopped(d, stop_);
 }
 
 void Pr650Endpoint::Run() {
@@ -155,7 +119,7 @@ void Pr650Endpoint::Run() {
     int fd = -1;
     {
       std::lock_guard lock(mu_);
-      fd = pty_.master_fd();
+      fd = port_.master_fd();
     }
     if (fd < 0) {
       SleepReal(kSlice);
@@ -177,9 +141,9 @@ void Pr650Endpoint::Run() {
       for (ssize_t i = 0; i < n; ++i) {
         const char c = buffer[i];
         if (c == '\r' || c == '\n') {
-          std::string command = Trim(input_);
+          std::string command = TrimBlanks(input_);
           input_.clear();
-          if (!command.empty()) complete.push_back(Upper(command));
+          if (!command.empty()) complete.push_back(UpperAscii(command));
         } else if (input_.size() < 256) {
           input_.push_back(c);
         }
@@ -364,7 +328,7 @@ void Pr650Endpoint::Reply(std::vector<std::string> lines, double vanish_seconds)
                                                                         : "\r\n";
   std::string bytes;
   for (std::size_t i = 0; i < lines.size(); ++i) {
-    const std::string line = garble ? Garble(lines[i], static_cast<unsigned>(i)) : lines[i];
+    const std::string line = garble ? GarbleLine(lines[i], static_cast<unsigned>(i)) : lines[i];
     bytes += line;
     const bool bare_cr = q.d5_header_bare_cr && i == 0 && lines.size() > 2;
     bytes += bare_cr ? "\r" : eol;
@@ -382,74 +346,27 @@ void Pr650Endpoint::Reply(std::vector<std::string> lines, double vanish_seconds)
 }
 
 bool Pr650Endpoint::WriteOut(const std::string& bytes) {
-  const Pr650WireQuirks& q = options_.quirks;
   int fd = -1;
   {
     std::lock_guard lock(mu_);
-    fd = pty_.master_fd();
+    fd = port_.master_fd();
   }
-  if (fd < 0) return false;
-  // Serial pacing: one byte is 10 bits (start, 8 data, stop) on the wire.
-  const double byte_sim_s = 10.0 / std::max(options_.baud, 1);
-  const std::size_t piece =
-      q.piece_bytes > 0 ? static_cast<std::size_t>(q.piece_bytes) : bytes.size();
-  const auto start = SteadyClock::now();
-  auto paused = SteadyClock::duration::zero();  // piece gaps do not count as transmission time
-  std::size_t sent = 0;
-  auto last_progress = start;
-  while (sent < bytes.size()) {
-    if (stop_) return false;
-    // Never write across the end of the current piece.
-    std::size_t chunk = std::min(bytes.size(), (sent / piece + 1) * piece) - sent;
-    if (options_.pace_replies) {
-      // Byte k (counting from 0) is due k byte-times after the start. The next burst leaves
-      // once its last byte is due; then everything due goes (more than a burst if late).
-      const auto elapsed =
-          std::chrono::duration_cast<std::chrono::nanoseconds>(SteadyClock::now() - start - paused);
-      const double elapsed_sim = options_.time_scale.ToSim(elapsed);
-      const auto due = static_cast<std::size_t>(elapsed_sim / byte_sim_s) + 1;
-      const std::size_t burst_end =
-          sent + std::min(chunk, static_cast<std::size_t>(std::max(options_.fifo_bytes, 1)));
-      if (due < burst_end) {
-        const double wait_sim = static_cast<double>(burst_end - 1) * byte_sim_s - elapsed_sim;
-        SleepReal(std::clamp<std::chrono::nanoseconds>(options_.time_scale.ToReal(wait_sim),
-                                                       std::chrono::microseconds(50), kSlice));
-        continue;
-      }
-      chunk = std::min(chunk, due - sent);
-    }
-    const ssize_t n = ::write(fd, bytes.data() + sent, chunk);
-    if (n > 0) {
-      sent += static_cast<std::size_t>(n);
-      last_progress = SteadyClock::now();
-      if (sent % piece == 0 && sent < bytes.size() && q.piece_gap.count() > 0) {
-        const auto before = SteadyClock::now();
-        if (!SleepReal(q.piece_gap)) return false;
-        paused += SteadyClock::now() - before;
-      }
-      continue;
-    }
-    if (n < 0 && errno != EAGAIN && errno != EINTR) return false;
-    if (SteadyClock::now() - last_progress > kWriteStall) return false;  // nobody is reading
-    pollfd p{fd, POLLOUT, 0};
-    ::poll(&p, 1, static_cast<int>(kSlice.count()));
-  }
-  return true;
+  const Pr650WireQuirks& q = options_.quirks;
+  const WirePace pace{options_.time_scale, options_.pace_replies, options_.baud,
+                      options_.fifo_bytes, q.piece_bytes,         q.piece_gap};
+  return WriteWire(fd, bytes, pace, stop_);
 }
 
 void Pr650Endpoint::Vanish(double seconds) {
   {
     std::lock_guard lock(mu_);
-    pty_.Close();
-    link_.Unlink();
+    port_.Unplug();
     input_.clear();
   }
   if (!SleepReal(options_.time_scale.ToReal(seconds))) return;
   std::lock_guard lock(mu_);
   // The meter itself stayed on: it is still in remote mode and still holds its measurement.
-  if (pty_.Open().ok()) {
-    if (!link_.PointAt(pty_.slave_path()).ok()) pty_.Close();
-  }
+  port_.Replug();
 }
 
 }  // namespace brdf::sim

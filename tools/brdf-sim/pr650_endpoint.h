@@ -53,6 +53,7 @@
 #include <vector>
 
 #include "core/status.h"
+#include "tools/brdf-sim/meter_endpoint.h"
 #include "tools/brdf-sim/pr650_pty.h"
 #include "tools/brdf-sim/sim_shared.h"
 
@@ -102,26 +103,26 @@ struct Pr650EndpointOptions {
 // The reply to a report asked for before any measurement.
 inline constexpr const char* kNoMeasurementReply = "-1";
 
-class Pr650Endpoint {
+class Pr650Endpoint final : public MeterPort {
  public:
   Pr650Endpoint(MeterBackend& backend, SimControl& control, Pr650EndpointOptions options = {});
-  ~Pr650Endpoint();
+  ~Pr650Endpoint() override;
   Pr650Endpoint(const Pr650Endpoint&) = delete;
   Pr650Endpoint& operator=(const Pr650Endpoint&) = delete;
 
   // Creates the pty and the link, powers the meter on and starts the thread.
-  Status Start();
+  Status Start() override;
   // Stops the thread and removes the pty and the link. Idempotent.
-  void Stop();
+  void Stop() override;
 
   // The path drivers open: the stable link. brdf-sim prints it as "pr650 <path>".
-  std::string path() const;
+  std::string path() const override;
   // The current pty slave (/dev/pts/N); changes when the port vanishes and comes back.
-  std::string slave_path() const;
+  std::string slave_path() const override;
 
   // Switches the meter off and on: it leaves remote mode, forgets its setup and last measurement,
   // and the wake-up window starts again.
-  void PowerCycle();
+  void PowerCycle() override;
 
   bool remote_mode() const;
   // Every command received so far, upper-cased, without its line end (also those not answered).
@@ -173,8 +174,7 @@ class Pr650Endpoint {
   std::atomic<bool> stop_{false};
 
   mutable std::mutex mu_;  // guards everything below
-  Pr650Pty pty_;
-  Pr650PtyLink link_;
+  PtyPort port_;
   std::string input_;  // bytes of a command not yet ended
   SteadyClock::time_point power_on_;
   unsigned power_epoch_ = 0;  // bumped by PowerCycle; a measurement spanning one is dropped

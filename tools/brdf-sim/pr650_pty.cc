@@ -101,4 +101,26 @@ void Pr650PtyLink::Remove() {
   path_.clear();
 }
 
+Status PtyPort::Open(const std::string& link_path) {
+  BRDF_RETURN_IF_ERROR(pty_.Open());
+  Status status = link_.Create(link_path);
+  if (status.ok()) status = link_.PointAt(pty_.slave_path());
+  if (!status.ok()) Close();
+  return status;
+}
+
+void PtyPort::Close() {
+  pty_.Close();
+  link_.Remove();
+}
+
+void PtyPort::Unplug() {
+  pty_.Close();
+  link_.Unlink();
+}
+
+void PtyPort::Replug() {
+  if (pty_.Open().ok() && !link_.PointAt(pty_.slave_path()).ok()) pty_.Close();
+}
+
 }  // namespace brdf::sim

@@ -65,4 +65,27 @@ class Pr650PtyLink {
   std::string private_dir_;
 };
 
+// A meter's port as the endpoints handle it: the pty behind its stable link, which can be
+// unplugged (the pty closed, the link removed: a driver holding it sees a hang-up) and plugged in
+// again (a new pty, the link pointing at it). Not thread-safe: the endpoint's mutex guards it.
+class PtyPort {
+ public:
+  // Creates the pty and the link at `link_path` (empty: a private temp directory).
+  Status Open(const std::string& link_path);
+  // Closes the pty and removes the link.
+  void Close();
+  void Unplug();
+  // Best effort: a new pty and the link at it; the port stays away if either fails.
+  void Replug();
+
+  bool is_open() const { return pty_.is_open(); }
+  int master_fd() const { return pty_.master_fd(); }
+  const std::string& path() const { return link_.path(); }
+  const std::string& slave_path() const { return pty_.slave_path(); }
+
+ private:
+  Pr650Pty pty_;
+  Pr650PtyLink link_;
+};
+
 }  // namespace brdf::sim

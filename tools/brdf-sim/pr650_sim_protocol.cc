@@ -77,15 +77,19 @@ std::string Coordinate(double value) {
 }  // namespace
 
 Pr650Tristimulus Pr650TristimulusOf(const std::vector<double>& radiance) {
+  return TristimulusOf(radiance, WavelengthGrid::Pr650());
+}
+
+Pr650Tristimulus TristimulusOf(const std::vector<double>& radiance, const WavelengthGrid& grid) {
   constexpr double kLumensPerWatt = 683.0;
   Pr650Tristimulus t;
-  for (std::size_t i = 0; i < radiance.size() && i < static_cast<std::size_t>(kPr650Bands); ++i) {
-    const double nm = kPr650FirstNm + kPr650StepNm * static_cast<double>(i);
+  for (std::size_t i = 0; i < radiance.size() && i < grid.count; ++i) {
+    const double nm = grid.at(i);
     const double x_bar = 1.056 * Lobe(nm, 599.8, 37.9, 31.0) + 0.362 * Lobe(nm, 442.0, 16.0, 26.7) -
                          0.065 * Lobe(nm, 501.1, 20.4, 26.2);
     const double y_bar = 0.821 * Lobe(nm, 568.8, 46.9, 40.5) + 0.286 * Lobe(nm, 530.9, 16.3, 31.1);
     const double z_bar = 1.217 * Lobe(nm, 437.0, 11.8, 36.0) + 0.681 * Lobe(nm, 459.0, 26.0, 13.8);
-    const double w = kLumensPerWatt * radiance[i] * kPr650StepNm;
+    const double w = kLumensPerWatt * radiance[i] * grid.step_nm;
     t.X += w * x_bar;
     t.Y += w * y_bar;
     t.Z += w * z_bar;

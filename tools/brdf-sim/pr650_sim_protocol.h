@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/wavelength_grid.h"
 #include "tools/brdf-sim/sim_shared.h"
 
 namespace brdf::sim {
@@ -34,6 +35,8 @@ struct Pr650Tristimulus {
   double X = 0, Y = 0, Z = 0;
 };
 Pr650Tristimulus Pr650TristimulusOf(const std::vector<double>& radiance);
+// The same on any grid (the PR-670's 2 nm, the CS-2000's 1 nm).
+Pr650Tristimulus TristimulusOf(const std::vector<double>& radiance, const WavelengthGrid& grid);
 
 // The colorimetric reports, one line each, as the open PR-650 programs parse them:
 //   1  "qq,U,Y.YYYEsee,.xxxx,.yyyy"      luminance and CIE 1931 x, y

@@ -51,6 +51,7 @@ void ReadSerialFaults(TableReader& t, SerialFaults& f) {
   Get(t, "quality_code", f.quality_code);
   Get(t, "quality_count", f.quality_count);
   Get(t, "vanish_seconds", f.vanish_seconds);
+  Get(t, "leave_remote", f.leave_remote);
   if (t.table() != nullptr && t.table()->get("quality_count") == nullptr) {
     DefaultCount(f.quality_code, f.quality_count);
   }
@@ -126,6 +127,13 @@ void ReadLinks(TableReader& root, SimConfig& c) {
   p.Finish();
 }
 
+void ReadMeter(TableReader& root, SimConfig& c) {
+  TableReader m = root.Sub("meter");
+  m.OneOf("model", c.meter, {"pr650", "pr655", "pr670", "cs2000", "cs2000a", "cs3000"});
+  Get(m, "serial_number", c.meter_serial);
+  m.Finish();
+}
+
 void ReadStage(TableReader& root, SimConfig& c) {
   TableReader s = root.Sub("stage");
   Get(s, "ramp_unit", c.stage_ramp_unit);
@@ -154,6 +162,7 @@ void ReadTable(TableReader& root, SimConfig& c) {
     c.mounted = *ParseMountedTarget(mounted);
   }
   ReadLinks(root, c);
+  ReadMeter(root, c);
   ReadStage(root, c);
   ReadFaults(root, c);
   ReadOptics(root, c.optics);
@@ -165,6 +174,21 @@ bool Finite(double x) {
 }
 
 }  // namespace
+
+std::string MeterModelOf(const std::string& key) {
+  if (key == "pr655") return "PR-655";
+  if (key == "pr670") return "PR-670";
+  if (key == "cs2000") return "CS-2000";
+  if (key == "cs2000a") return "CS-2000A";
+  if (key == "cs3000") return "CS-3000";
+  return "PR-650";
+}
+
+std::string MeterFamilyOf(const std::string& key) {
+  if (key == "pr655" || key == "pr670") return "pr670";
+  if (key.rfind("cs", 0) == 0) return "cs2000";
+  return "pr650";
+}
 
 const char* MountedTargetName(MountedTarget target) {
   switch (target) {
@@ -230,6 +254,10 @@ void AddRunFlags(CLI::App& app, SimConfig& c) {
   app.add_option("--config", c.config_path, "TOML file with settings; flags override it");
 
   app.add_option("--time-scale", c.time_scale, "Simulated time runs this many times faster");
+  app.add_option("--meter", c.meter,
+                 "The meter on the pty: pr650, pr670 (pr655), cs2000 (cs2000a, cs3000)")
+      ->check(CLI::IsMember({"pr650", "pr655", "pr670", "cs2000", "cs2000a", "cs3000"}));
+  app.add_option("--meter-serial", c.meter_serial, "The serial number the meter reports");
   app.add_option("--seed", c.optics.seed, "Noise seed (same seed, same readings)");
   app.add_option("--modbus-host", c.modbus_host, "Address the Modbus TCP server listens on");
   app.add_option("--modbus-port", c.modbus_port, "Modbus TCP port (0 = pick a free one)");
@@ -285,7 +313,9 @@ void AddRunFlags(CLI::App& app, SimConfig& c) {
   app.add_option("--serial-quality-count", s.quality_count,
                  "... for the next N measurements (default 1 when a code is given)");
   app.add_option("--serial-vanish-seconds", s.vanish_seconds,
-                 "Fault: the pty vanishes during the next D5, back after S seconds");
+                 "Fault: the pty vanishes during the next spectrum transfer, back after S seconds");
+  app.add_flag("--serial-leave-remote", s.leave_remote,
+               "Fault: the meter leaves remote mode at the next command (PR-670, CS-2000)");
   ModbusFaults& m = c.modbus_faults;
   app.add_option("--modbus-exception-code", m.exception_code,
                  "Fault: reply with this exception (2, 4 busy, 6) ...");
@@ -405,8 +435,15 @@ Status ValidateFaults(const SimConfig& c) {
       !Finite(s.vanish_seconds) || s.vanish_seconds < 0) {
     return InvalidArgument("serial fault counts and durations must be >= 0");
   }
-  if (s.quality_code < 0 || s.quality_code > 99) {
-    return InvalidArgument("serial fault quality code must be 0–99 (a PR-650 code such as 18)");
+  // The meter's own code: a PR-650 quality code (18), a CS-2000 ERxx number (10 → ER10), both
+  // two digits; a PR-670 result code (−8, up to five characters).
+  const bool pr670 = MeterFamilyOf(c.meter) == "pr670";
+  if (pr670 ? (s.quality_code < -9999 || s.quality_code > 99999)
+            : (s.quality_code < 0 || s.quality_code > 99)) {
+    return InvalidArgument(pr670 ? "serial fault quality code must be a PR-670 result code "
+                                   "(−9999 … 99999, e.g. −8)"
+                                 : "serial fault quality code must be 0–99 (a PR-650 code such "
+                                   "as 18, a CS-2000 ERxx number such as 10)");
   }
   const ModbusFaults& m = c.modbus_faults;
   if (m.exception_count < 0 || m.late_count < 0 || m.late_reply_ms < 0) {

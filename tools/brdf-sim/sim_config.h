@@ -36,6 +36,11 @@ struct SimConfig {
   std::string config_path;  // the --config file read, if any (for the log)
   double time_scale = 1.0;  // simulated time runs this many times faster than real time
 
+  // The meter on the pty: "pr650" (default), "pr670" or "pr655" (PR-670 protocol), "cs2000",
+  // "cs2000a" or "cs3000" (CS-2000 protocol). [meter] model in the file, --meter on the line.
+  std::string meter = "pr650";
+  std::string meter_serial;  // what the meter reports as its serial number (empty: the model's)
+
   std::string modbus_host = "127.0.0.1";
   int modbus_port = 0;          // 0 = an ephemeral port, printed at start-up
   bool rtu = false;             // also serve Modbus RTU on a pty
@@ -83,6 +88,14 @@ struct TruthQuery {
   bool glossy = false;
   bool json = false;
 };
+
+// The meter keys --meter and [meter] model take.
+inline constexpr std::array<const char*, 6> kMeterKeys = {"pr650",  "pr655",   "pr670",
+                                                          "cs2000", "cs2000a", "cs3000"};
+// The meter's own name for a key ("pr670" → "PR-670"), its wavelength grid, and its protocol
+// family ("pr650", "pr670" or "cs2000").
+std::string MeterModelOf(const std::string& key);
+std::string MeterFamilyOf(const std::string& key);
 
 // Names of mounted targets as flags and the control unit spell them: sample, white, dark.
 const char* MountedTargetName(MountedTarget target);

@@ -27,7 +27,8 @@ struct TimeScale {
 
 enum class MountedTarget : int { kSample = 0, kWhite = 1, kDark = 2 };
 
-// The meter's setup as the PR-650 endpoint understands it (from the S command).
+// The meter's setup as the meter endpoints understand it (the PR-650's S command, the PR-670's
+// SE and SN, the CS-2000's SPMS).
 struct MeterSetup {
   int integration_ms = 0;  // 0 = adaptive
   int averages = 1;
@@ -61,11 +62,17 @@ struct SerialFaults {
   int truncate_next = 0;  // the next N replies stop half-way
   // The injected quality code is a fault of the meter: the PR-650 endpoint applies it over the
   // backend's own code and counts quality_count down (one place only; the optics never do).
+  // The meter's own code: the PR-650's quality code (0–99), the PR-670's result code (−8, −1,
+  // −10, ...), the CS-2000's ERxx number (10 → ER10).
   int quality_code = 0;       // force this quality code ...
   int quality_count = 0;      // ... for the next N measurements
   double vanish_seconds = 0;  // >0: the port vanishes during the next D5 transfer, back after this
   int no_data_next = 0;       // the next N measurements give no data: their reports answer "-1"
   int units_code = 0;         // the reports' units code: 0 radiance, 1 irradiance, 2 uncalibrated
+  // The meter leaves remote mode at the next command (its operator pressed a key, or it fell back
+  // to local mode) and ignores it; it answers again once a driver re-enters remote mode (PHOTO,
+  // RMTS,1). Consumed when it fires. The PR-650 has no such way back (only a power cycle).
+  bool leave_remote = false;
 };
 
 struct ModbusFaults {

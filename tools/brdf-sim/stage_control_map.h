@@ -13,12 +13,15 @@
 //     10  serial.silent             0/1: the meter answers nothing
 //     11  serial.garbage_next       N: the next N meter replies are garbage bytes
 //     12  serial.truncate_next      N: the next N meter replies stop half-way
-//     13  serial.quality_code       force this quality code ...
+//     13  serial.quality_code       force this quality code (signed 16-bit: the PR-670's −8 is
+//                                   0xFFF8) ...
 //     14  serial.quality_count      ... for the next N measurements
 //  15-16  serial.vanish_ms          32-bit, high word first: >0 = the port vanishes during the next
 //                                   D5 transfer and comes back after this many (simulated) ms
 //     17  serial.no_data_next       N: the next N measurements give no data (reports answer "-1")
 //     18  serial.units_code         0 radiance, 1 irradiance, 2 uncalibrated: the reports' units
+//     19  serial.leave_remote       1: the meter leaves remote mode at the next command (PR-670,
+//                                   CS-2000: a driver that enters it again is answered again)
 //     20  modbus.exception_code     exception (2 illegal address, 6 busy, ...) to reply with ...
 //     21  modbus.exception_count    ... to the next N axis requests (the request is not applied)
 //     22  modbus.late_reply_ms      delay the next N axis replies by this many real ms ...
@@ -35,7 +38,7 @@
 //                                   unanswered); then the same port listens again. Reads N until
 //                                   the outage starts, then 0
 //
-// Registers 2–9 and 19 read 0 and refuse writes (exception 02), as do addresses past 28.
+// Registers 2–9 read 0 and refuse writes (exception 02), as do addresses past 28.
 // A value out of range (mounted 3, a flag of 2, exception code 12) is refused with exception 03
 // and nothing of that write is applied. Faults apply to the axis unit ids only, never to the
 // control unit itself, so setting a fault cannot consume it.
@@ -60,6 +63,7 @@ inline constexpr std::uint16_t kSerialQualityCount = 14;
 inline constexpr std::uint16_t kSerialVanishMs = 15;  // 2 registers, high word first
 inline constexpr std::uint16_t kSerialNoDataNext = 17;
 inline constexpr std::uint16_t kSerialUnitsCode = 18;
+inline constexpr std::uint16_t kSerialLeaveRemote = 19;
 inline constexpr std::uint16_t kModbusExceptionCode = 20;
 inline constexpr std::uint16_t kModbusExceptionCount = 21;
 inline constexpr std::uint16_t kModbusLateReplyMs = 22;

@@ -14,13 +14,13 @@ namespace cm = control_map;
 
 bool Defined(std::uint16_t a) {
   return a == cm::kMountedTarget || a == cm::kPowerCycleMeter ||
-         (a >= cm::kSerialSilent && a <= cm::kSerialUnitsCode) ||
+         (a >= cm::kSerialSilent && a <= cm::kSerialLeaveRemote) ||
          (a >= cm::kModbusExceptionCode && a <= cm::kModbusOutageMs);
 }
 
 bool IsFlag(std::uint16_t a) {
-  return a == cm::kSerialSilent || a == cm::kModbusDropConnection || a == cm::kModbusAlarmMidMove ||
-         a == cm::kModbusStall || a == cm::kModbusSwapWordOrder;
+  return a == cm::kSerialSilent || a == cm::kSerialLeaveRemote || a == cm::kModbusDropConnection ||
+         a == cm::kModbusAlarmMidMove || a == cm::kModbusStall || a == cm::kModbusSwapWordOrder;
 }
 
 std::uint16_t Clamp16(long v) {
@@ -36,7 +36,9 @@ std::vector<std::uint16_t> Snapshot(const SimControl& control) {
   r[cm::kSerialSilent] = s.silent ? 1 : 0;
   r[cm::kSerialGarbageNext] = Clamp16(s.garbage_next);
   r[cm::kSerialTruncateNext] = Clamp16(s.truncate_next);
-  r[cm::kSerialQualityCode] = Clamp16(s.quality_code);
+  // Signed: two's complement in the register.
+  r[cm::kSerialQualityCode] = static_cast<std::uint16_t>(
+      static_cast<std::int16_t>(std::clamp(s.quality_code, -32768, 32767)));
   r[cm::kSerialQualityCount] = Clamp16(s.quality_count);
   const auto vanish_ms = static_cast<std::uint32_t>(
       std::clamp(std::llround(s.vanish_seconds * 1000.0), 0LL, 0xFFFFFFFFLL));
@@ -44,6 +46,7 @@ std::vector<std::uint16_t> Snapshot(const SimControl& control) {
   r[cm::kSerialVanishMs + 1] = static_cast<std::uint16_t>(vanish_ms & 0xFFFF);
   r[cm::kSerialNoDataNext] = Clamp16(s.no_data_next);
   r[cm::kSerialUnitsCode] = Clamp16(s.units_code);
+  r[cm::kSerialLeaveRemote] = s.leave_remote ? 1 : 0;
   r[cm::kModbusExceptionCode] = Clamp16(m.exception_code);
   r[cm::kModbusExceptionCount] = Clamp16(m.exception_count);
   r[cm::kModbusLateReplyMs] = Clamp16(m.late_reply_ms);
@@ -90,12 +93,14 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
   if (written(cm::kMountedTarget)) {
     control_.set_mounted(static_cast<MountedTarget>(image[cm::kMountedTarget]));
   }
-  if (address <= cm::kSerialUnitsCode && address + values.size() > cm::kSerialSilent) {
+  if (address <= cm::kSerialLeaveRemote && address + values.size() > cm::kSerialSilent) {
     control_.UpdateSerial([&](SerialFaults& s) {
       if (written(cm::kSerialSilent)) s.silent = image[cm::kSerialSilent] != 0;
       if (written(cm::kSerialGarbageNext)) s.garbage_next = image[cm::kSerialGarbageNext];
       if (written(cm::kSerialTruncateNext)) s.truncate_next = image[cm::kSerialTruncateNext];
-      if (written(cm::kSerialQualityCode)) s.quality_code = image[cm::kSerialQualityCode];
+      if (written(cm::kSerialQualityCode)) {
+        s.quality_code = static_cast<std::int16_t>(image[cm::kSerialQualityCode]);
+      }
       if (written(cm::kSerialQualityCount)) s.quality_count = image[cm::kSerialQualityCount];
       if (written(cm::kSerialVanishMs) || written(cm::kSerialVanishMs + 1)) {
         const std::uint32_t ms = (static_cast<std::uint32_t>(image[cm::kSerialVanishMs]) << 16) |
@@ -104,6 +109,7 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
       }
       if (written(cm::kSerialNoDataNext)) s.no_data_next = image[cm::kSerialNoDataNext];
       if (written(cm::kSerialUnitsCode)) s.units_code = image[cm::kSerialUnitsCode];
+      if (written(cm::kSerialLeaveRemote)) s.leave_remote = image[cm::kSerialLeaveRemote] != 0;
     });
   }
   if (address <= cm::kModbusOutageMs && address + values.size() > cm::kModbusExceptionCode) {
