@@ -21,6 +21,7 @@
 #include "core/export/spectrum_source.h"
 #include "core/fit/fit.h"
 #include "daemon/api/interpolation.h"
+#include "daemon/wire/values.h"
 #include "data/cie_tables.h"
 
 namespace brdf::daemon {

@@ -87,22 +87,9 @@ grpc::Status ParseMethodField(int method, interp::Method* out);
 grpc::Status ParseCoordinatesField(int coordinates, interp::Coordinates* out);
 // InterpolationOptions.trend: unset is NONE; an unknown value names options.trend.
 grpc::Status ParseTrendField(int trend, interp::Trend* out);
-v1::Quantity ToProtoQuantity(Quantity quantity);
 
 // Checks a finite angle within [lo, hi]; the message names `field` and the range.
 Status CheckAngle(double value, double lo, double hi, const std::string& field);
-
-// The API's messages for storage's records.
-v1::WavelengthGrid ToProtoGrid(const WavelengthGrid& grid);
-v1::ReadingKind ToProtoReadingKind(storage::ReadingKind kind);
-
-// What a Reading message needs beyond the record: the step's label, and the plan's averaging
-// (the meter's averaging count is a plan setting, the same for every reading of a session).
-struct ReadingExtras {
-  std::map<int, std::string> step_labels;
-  std::uint32_t averages = 1;
-};
-v1::Reading ToProtoReading(const storage::ReadingRecord& record, const ReadingExtras& extras);
 
 // Control.WhoAmI, for brdfd and brdf-archive alike: the caller the call was admitted as
 // (Authenticator::CallerOf), and `server`, the program's name.

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "core/plan/plan_proto.h"
-#include "daemon/engine/steps.h"
+#include "daemon/wire/enums.h"
+#include "daemon/wire/plan.h"
 
 namespace brdf::daemon {
 
@@ -77,7 +77,7 @@ grpc::Status ControlService::ValidatePlan(grpc::ServerContext* /*context*/,
   if (!std::isfinite(time_scale) || time_scale < 0) {
     return InvalidField("time_scale", "must be a positive number (0 or unset: 1, a real rig)");
   }
-  *response = plan::ToValidatePlanResponse(
+  *response = ToValidatePlanResponse(
       manager_.ValidatePlan(request->plan(), time_scale > 0 ? time_scale : 1));
   return grpc::Status::OK;
 }
@@ -102,21 +102,13 @@ grpc::Status ControlService::PauseSession(grpc::ServerContext* context,
   if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
   SessionId id = 0;
   if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
-  PauseMode mode = PauseMode::kDeferred;
-  switch (request->mode()) {
-    case v1::PAUSE_MODE_UNSPECIFIED:
-    case v1::PAUSE_MODE_DEFERRED:
-      mode = PauseMode::kDeferred;
-      break;
-    case v1::PAUSE_MODE_IMMEDIATE:
-      mode = PauseMode::kImmediate;
-      break;
-    default:
-      return InvalidField("mode", "unknown pause mode " + std::to_string(request->mode()) +
-                                      "; use PAUSE_MODE_DEFERRED or PAUSE_MODE_IMMEDIATE");
+  const std::optional<PauseMode> mode = FromProtoPauseMode(request->mode());
+  if (!mode.has_value()) {
+    return InvalidField("mode", "unknown pause mode " + std::to_string(request->mode()) +
+                                    "; use PAUSE_MODE_DEFERRED or PAUSE_MODE_IMMEDIATE");
   }
   Result<v1::Session> before = manager_.GetSession(id);
-  Result<v1::Session> session = manager_.Pause(id, mode, caller.ToActor());
+  Result<v1::Session> session = manager_.Pause(id, *mode, caller.ToActor());
   if (!session.ok()) return ToGrpcStatus(session.status());
   response->set_already_paused(before.ok() && before->state() == v1::SESSION_STATE_PAUSED &&
                                session->state() == v1::SESSION_STATE_PAUSED);

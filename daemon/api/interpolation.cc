@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "core/geometry.h"
+#include "daemon/wire/enums.h"
+#include "daemon/wire/values.h"
 
 namespace brdf::daemon {
 
@@ -94,32 +96,6 @@ grpc::Status ToCoords(const v1::DirectionQuery& q, const IndexSnapshot& index,
   return grpc::Status::OK;
 }
 
-v1::InterpolationStatus ToProtoStatus(interp::InterpStatus s) {
-  switch (s) {
-    case interp::InterpStatus::kOk:
-      return v1::INTERPOLATION_STATUS_OK;
-    case interp::InterpStatus::kEmptyOctant:
-      return v1::INTERPOLATION_STATUS_EMPTY_OCTANT;
-    case interp::InterpStatus::kNoEnclosingSimplex:
-      return v1::INTERPOLATION_STATUS_NO_ENCLOSING_SIMPLEX;
-    case interp::InterpStatus::kOutsideHull:
-      return v1::INTERPOLATION_STATUS_OUTSIDE_HULL;
-  }
-  return v1::INTERPOLATION_STATUS_UNSPECIFIED;
-}
-
-v1::InterpolationMethod ToProtoMethod(interp::Method m) {
-  switch (m) {
-    case interp::Method::kOctant:
-      return v1::INTERPOLATION_METHOD_OCTANT;
-    case interp::Method::kDelaunay:
-      return v1::INTERPOLATION_METHOD_DELAUNAY;
-    case interp::Method::kNearest:
-      return v1::INTERPOLATION_METHOD_NEAREST;
-  }
-  return v1::INTERPOLATION_METHOD_UNSPECIFIED;
-}
-
 // Whether each vertex carries its sample's spectrum (InterpolateRequest.include_vertex_spectra).
 enum class VertexSpectra { kOmit, kInclude };
 
@@ -128,7 +104,7 @@ void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const 
               const IndexSnapshot& index, VertexSpectra vertex_spectra,
               v1::InterpolationResult* out) {
   *out->mutable_query() = query;
-  out->set_status(ToProtoStatus(r.status));
+  out->set_status(ToProtoInterpStatus(r.status));
   out->set_method(ToProtoMethod(r.method));
   out->set_quantity(ToProtoQuantity(settings.quantity));
   *out->mutable_grid() = ToProtoGrid(index.grid);

@@ -14,6 +14,7 @@
 #include "daemon/api/common.h"
 #include "daemon/rpc/auth.h"
 #include "daemon/rpc/stream_registry.h"
+#include "daemon/wire/reading.h"
 #include "storage/session_reader.h"
 
 namespace brdf::daemon {

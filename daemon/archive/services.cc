@@ -10,8 +10,8 @@
 
 #include "daemon/api/export_session.h"
 #include "daemon/api/stream_readings.h"
-#include "daemon/engine/steps.h"
 #include "daemon/sessions/session_plan.h"
+#include "daemon/wire/session.h"
 
 namespace brdf::daemon {
 namespace {
@@ -46,41 +46,13 @@ bool ParsePageToken(const std::string& token, std::pair<double, std::int64_t>* o
 
 v1::Session ArchivedSession(const storage::SessionRecord& rec,
                             const std::vector<storage::StepRecord>* steps, bool with_plan) {
-  v1::Session s;
-  s.set_session_id(std::to_string(rec.id));
-  s.set_name(rec.name);
-  s.set_state(ToProtoState(rec.state));
+  SessionFacts facts(rec);
   // A plan that does not parse is shown as none, as on the rig.
-  if (Result<SessionPlan> plan = ParseSessionPlan(rec); plan.ok()) {
-    if (with_plan) *s.mutable_plan() = plan->plan;
-    if (plan->plan.has_sample()) *s.mutable_sample() = plan->plan.sample();
-  }
-  s.set_uuid(rec.uuid);
-  s.set_rig(rec.rig);
-  v1::Progress* progress = s.mutable_progress();
-  progress->set_done_steps(static_cast<std::uint32_t>(rec.done_steps));
-  progress->set_total_steps(static_cast<std::uint32_t>(rec.total_steps));
-  int first_pending = -1;
-  if (steps != nullptr) {
-    const storage::StepTally tally = storage::TallySteps(*steps);
-    first_pending = tally.first_pending;
-    progress->set_done_samples(tally.done_samples);
-    progress->set_total_samples(tally.samples);
-  }
-  const bool never_started = rec.state == SessionState::kQueued && !rec.started_at.has_value();
-  s.set_current_step(never_started || IsTerminal(rec.state) ? -1 : first_pending);
-  s.set_last_quality_code(-1);
-  *s.mutable_created_at() = ToTimestamp(rec.created_at);
-  if (rec.started_at.has_value()) *s.mutable_started_at() = ToTimestamp(*rec.started_at);
-  if (rec.finished_at.has_value()) *s.mutable_finished_at() = ToTimestamp(*rec.finished_at);
-  if (rec.state == SessionState::kAborted || rec.state == SessionState::kFailed) {
-    s.set_end_reason(rec.state_reason);
-  }
-  if (rec.state == SessionState::kQueued || rec.state == SessionState::kPaused ||
-      rec.state == SessionState::kPausing || IsTerminal(rec.state)) {
-    s.set_state_reason(rec.state_reason);
-  }
-  return s;
+  Result<SessionPlan> plan = ParseSessionPlan(rec);
+  facts.plan = plan.ok() ? &*plan : nullptr;
+  facts.with_plan = with_plan;
+  facts.steps = steps;
+  return ToProtoSession(facts);
 }
 
 // --- Control ------------------------------------------------------------------------------------
