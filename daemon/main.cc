@@ -37,6 +37,8 @@
 #include "daemon/engine/shipper.h"
 #include "daemon/gateway/http_server.h"
 #include "daemon/index/cache.h"
+#include "daemon/rig/catalogue.h"
+#include "daemon/rig/port.h"
 #include "daemon/rpc/auth.h"
 #include "drivers/exclusive_open.h"
 #include "storage/session_store.h"
@@ -200,7 +202,10 @@ int main(int argc, char** argv) {
     spdlog::info("{} bearer token(s) configured", auth.token_count());
   }
 
-  Result<std::unique_ptr<Server>> server = Server::Start(config.server, manager, cache, auth);
+  RigCatalogue catalogue(manager);
+  ManagerRigPort rig_port(manager);
+  Result<std::unique_ptr<Server>> server =
+      Server::Start(config.server, manager, catalogue, rig_port, cache, auth);
   if (!server.ok()) {
     spdlog::critical("{}", server.status().ToString());
     manager.RemoveReadingListener(cache_listener);

@@ -1,15 +1,11 @@
 #include "daemon/api/common.h"
 
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <optional>
 #include <sstream>
 
 #include "daemon/sessions/session_id.h"
 #include "daemon/wire/enums.h"
-#include "daemon/wire/session.h"
-#include "daemon/wire/values.h"
 
 namespace brdf::daemon {
 
@@ -116,32 +112,6 @@ grpc::Status ParseSessionIdField(const std::string& text, const std::string& fie
   return grpc::Status::OK;
 }
 
-grpc::Status ServeWhoAmI(const Authenticator& auth, const grpc::ServerContextBase& context,
-                         const char* server, v1::Caller* response) {
-  Caller caller;
-  if (grpc::Status st = auth.CallerOf(context, &caller); !st.ok()) return st;
-  response->set_name(caller.name);
-  response->set_role(RoleName(caller.role));
-  response->set_server(server);
-  return grpc::Status::OK;
-}
-
-grpc::Status ServeListSessionEvents(storage::SessionReader& reader,
-                                    const v1::ListSessionEventsRequest& request,
-                                    v1::ListSessionEventsResponse* response) {
-  std::int64_t id = 0;
-  if (grpc::Status st = ParseSessionIdField(request.session_id(), "session_id", &id); !st.ok()) {
-    return st;
-  }
-  Result<std::vector<storage::SessionEventRecord>> events = reader.ListSessionEvents(id);
-  if (!events.ok()) return ToGrpcStatus(events.status());
-  response->mutable_events()->Reserve(static_cast<int>(events->size()));
-  for (const storage::SessionEventRecord& e : *events) {
-    *response->add_events() = ToProtoStateEvent(e);
-  }
-  return grpc::Status::OK;
-}
-
 namespace {
 std::string Num(double v) {
   std::ostringstream out;
@@ -174,27 +144,6 @@ bool StopSignal::WaitFor(std::chrono::steady_clock::duration d) const {
   return cv_.WaitFor(mu_, d, [this] { return stopped_.load(); });
 }
 
-namespace {
-
-std::string Lower(std::string text) {
-  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return text;
-}
-
-grpc::Status TimestampField(const v1::ListSessionsRequest& request, bool after,
-                            std::optional<double>* out) {
-  if (after ? !request.has_created_after() : !request.has_created_before()) return grpc::Status::OK;
-  const google::protobuf::Timestamp& t = after ? request.created_after() : request.created_before();
-  if (t.nanos() < 0 || t.nanos() > 999999999) {
-    return InvalidField(after ? "created_after" : "created_before",
-                        "nanos " + std::to_string(t.nanos()) + " is outside 0 … 999,999,999");
-  }
-  *out = ToUnixSeconds(t);
-  return grpc::Status::OK;
-}
-
-}  // namespace
-
 grpc::Status ParseReadingKinds(const v1::StreamReadingsRequest& request,
                                std::set<storage::ReadingKind>* kinds) {
   for (int i = 0; i < request.kinds_size(); ++i) {
@@ -206,43 +155,6 @@ grpc::Status ParseReadingKinds(const v1::StreamReadingsRequest& request,
     }
     kinds->insert(*kind);
   }
-  return grpc::Status::OK;
-}
-
-bool CatalogueFilter::Matches(const v1::Session& session) const {
-  if (!rig.empty() && session.rig() != rig) return false;
-  const v1::Sample& s = session.sample();
-  if (!sample.empty() && s.id() != sample && Lower(s.name()) != Lower(sample)) return false;
-  if (!material.empty() && Lower(s.material()) != Lower(material)) return false;
-  if (!tag.empty() && std::find(s.tags().begin(), s.tags().end(), tag) == s.tags().end()) {
-    return false;
-  }
-  const double created = ToUnixSeconds(session.created_at());
-  if (created_after.has_value() && created < *created_after) return false;
-  if (created_before.has_value() && !(created < *created_before)) return false;
-  return true;
-}
-
-grpc::Status ParseCatalogueFilter(const v1::ListSessionsRequest& request, CatalogueFilter* out) {
-  CatalogueFilter f;
-  for (int i = 0; i < request.states_size(); ++i) {
-    const int state = request.states(i);
-    if (!v1::SessionState_IsValid(state) || state == v1::SESSION_STATE_UNSPECIFIED) {
-      return InvalidField("states[" + std::to_string(i) + "]",
-                          "unknown session state " + std::to_string(state));
-    }
-    f.states.push_back(FromProtoState(static_cast<v1::SessionState>(state)));
-  }
-  f.rig = request.rig();
-  f.sample = request.sample();
-  f.material = request.material();
-  f.tag = request.tag();
-  if (grpc::Status st = TimestampField(request, true, &f.created_after); !st.ok()) return st;
-  if (grpc::Status st = TimestampField(request, false, &f.created_before); !st.ok()) return st;
-  if (f.created_after && f.created_before && !(*f.created_after < *f.created_before)) {
-    return InvalidField("created_before", "must be later than created_after");
-  }
-  *out = std::move(f);
   return grpc::Status::OK;
 }
 

@@ -95,6 +95,7 @@ class Server {
   // address is served in plaintext or the TLS key is readable by others, and logs the limits
   // (service_common.h) it enforces. `manager`, `cache` and `auth` must outlive it.
   static Result<std::unique_ptr<Server>> Start(const ServerConfig& config, SessionManager& manager,
+                                               SessionCatalogue& catalogue, RigPort& rig,
                                                IndexCache& cache, const Authenticator& auth);
   // Shutdown(1 s) if not called before.
   ~Server();
@@ -116,8 +117,8 @@ class Server {
   void Shutdown(std::chrono::milliseconds grace);
 
  private:
-  Server(const ServerConfig& config, SessionManager& manager, IndexCache& cache,
-         const Authenticator& auth);
+  Server(const ServerConfig& config, SessionManager& manager, SessionCatalogue& catalogue,
+         RigPort& rig, IndexCache& cache, const Authenticator& auth);
 
   StopSignal stopping_;
   StreamRegistry streams_;  // before the services, which hold slots in it

@@ -23,7 +23,8 @@ ArchiveServer::ArchiveServer(const ServerConfig& config,
       streams_(config, auth.enabled()),
       control_loop_(1),
       health_(stopping_, streams_),
-      control_(archive, auth),
+      catalogue_(archive),
+      control_(catalogue_, nullptr, auth, stopping_, streams_, "brdf-archive"),
       data_(archive, auth, stopping_, streams_),
       interpolation_(cache_, auth, stopping_, streams_),
       interpolate_loop_(interpolation_,
@@ -50,6 +51,7 @@ Result<std::unique_ptr<ArchiveServer>> ArchiveServer::Start(
   std::unique_ptr<ArchiveServer> server(
       new ArchiveServer(config, std::move(archive), auth, options));
   server->health_.ServeOn(server->control_loop_);
+  server->control_.ServeOn(server->control_loop_);
   int selected_port = 0;
   Result<std::string> address = BuildAndStartServer(
       config, *credentials, tls, auth,

@@ -3,8 +3,8 @@
 // (MakeServerCredentials), the same limits and stream caps (stream_registry.h), the standard
 // health service and server reflection.
 //
-//   Control        archive_services.h: GetSession, ListSessions, ListSessionEvents; the rig's verbs
-//                  refused
+//   Control        brdfd's own (api/control.h) over the archive's catalogue (catalogue.h):
+//                  GetSession, ListSessions, ListSessionEvents; no rig, so its verbs are refused
 //   Data           archive_services.h: StreamReadings, StreamReadingPoints, Export
 //   Interpolation  brdfd's own InterpolationService and InterpolateLoop over an IndexCache whose
 //                  store is the archive (storage/archive/reader.h): the same code, over the same
@@ -29,10 +29,12 @@
 #include <thread>
 
 #include "core/status.h"
+#include "daemon/api/control.h"
 #include "daemon/api/health.h"
 #include "daemon/api/interpolate_loop.h"
 #include "daemon/api/interpolation.h"
 #include "daemon/api/reflection.h"
+#include "daemon/archive/catalogue.h"
 #include "daemon/archive/services.h"
 #include "daemon/config/config.h"
 #include "daemon/index/cache.h"
@@ -85,7 +87,8 @@ class ArchiveServer {
   StreamRegistry streams_;
   ControlLoop control_loop_;  // the health service's Check
   HealthService health_;
-  ArchiveControlService control_;
+  ArchiveCatalogue catalogue_;
+  ControlService control_;
   ArchiveDataService data_;
   InterpolationService interpolation_;
   InterpolateLoop interpolate_loop_;
