@@ -205,7 +205,7 @@ int main(int argc, char** argv) {
   RigCatalogue catalogue(manager);
   ManagerRigPort rig_port(manager);
   Result<std::unique_ptr<Server>> server =
-      Server::Start(config.server, manager, catalogue, rig_port, cache, auth);
+      Server::Start(config.server, catalogue, rig_port, cache, auth);
   if (!server.ok()) {
     spdlog::critical("{}", server.status().ToString());
     manager.RemoveReadingListener(cache_listener);

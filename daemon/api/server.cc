@@ -208,13 +208,13 @@ int InterpolateLoopThreads(unsigned cores) {
   return static_cast<int>(std::clamp(cores / 2, 1U, 8U));
 }
 
-Server::Server(const ServerConfig& config, SessionManager& manager, SessionCatalogue& catalogue,
-               RigPort& rig, IndexCache& cache, const Authenticator& auth)
+Server::Server(const ServerConfig& config, SessionCatalogue& catalogue, RigPort& rig,
+               IndexCache& cache, const Authenticator& auth)
     : streams_(config, auth.enabled()),
       control_loop_(kControlThreads),
       health_(stopping_, streams_),
       control_(catalogue, &rig, auth, stopping_, streams_, "brdfd"),
-      data_(manager, auth, stopping_, streams_),
+      data_(catalogue, auth, stopping_, streams_, "brdfd"),
       interpolation_(cache, auth, stopping_, streams_),
       interpolate_loop_(interpolation_,
                         config.interpolate_threads > 0
@@ -228,7 +228,7 @@ Server::~Server() {
   Shutdown(std::chrono::seconds(1));
 }
 
-Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, SessionManager& manager,
+Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config,
                                               SessionCatalogue& catalogue, RigPort& rig,
                                               IndexCache& cache, const Authenticator& auth) {
   bool tls = false;
@@ -242,7 +242,7 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
 
   if (Status st = CheckCpusAvailable(config.interpolate_cpus); !st.ok()) return st;
-  std::unique_ptr<Server> server(new Server(config, manager, catalogue, rig, cache, auth));
+  std::unique_ptr<Server> server(new Server(config, catalogue, rig, cache, auth));
   server->health_.ServeOn(server->control_loop_);
   server->control_.ServeOn(server->control_loop_);
   int selected_port = 0;

@@ -31,7 +31,6 @@
 #include "daemon/api/interpolation.h"
 #include "daemon/api/reflection.h"
 #include "daemon/config/config.h"
-#include "daemon/engine/session_manager.h"
 #include "daemon/index/cache.h"
 #include "daemon/rpc/auth.h"
 #include "daemon/rpc/control_loop.h"
@@ -94,7 +93,7 @@ class Server {
   // interface) or gRPC refuses the certificate/key pair. Logs a warning when a non-loopback
   // address is served in plaintext or the TLS key is readable by others, and logs the limits
   // (service_common.h) it enforces. `manager`, `cache` and `auth` must outlive it.
-  static Result<std::unique_ptr<Server>> Start(const ServerConfig& config, SessionManager& manager,
+  static Result<std::unique_ptr<Server>> Start(const ServerConfig& config,
                                                SessionCatalogue& catalogue, RigPort& rig,
                                                IndexCache& cache, const Authenticator& auth);
   // Shutdown(1 s) if not called before.
@@ -117,8 +116,8 @@ class Server {
   void Shutdown(std::chrono::milliseconds grace);
 
  private:
-  Server(const ServerConfig& config, SessionManager& manager, SessionCatalogue& catalogue,
-         RigPort& rig, IndexCache& cache, const Authenticator& auth);
+  Server(const ServerConfig& config, SessionCatalogue& catalogue, RigPort& rig, IndexCache& cache,
+         const Authenticator& auth);
 
   StopSignal stopping_;
   StreamRegistry streams_;  // before the services, which hold slots in it

@@ -25,7 +25,7 @@ ArchiveServer::ArchiveServer(const ServerConfig& config,
       health_(stopping_, streams_),
       catalogue_(archive),
       control_(catalogue_, nullptr, auth, stopping_, streams_, "brdf-archive"),
-      data_(archive, auth, stopping_, streams_),
+      data_(catalogue_, auth, stopping_, streams_, "brdf-archive"),
       interpolation_(cache_, auth, stopping_, streams_),
       interpolate_loop_(interpolation_,
                         config.interpolate_threads > 0

@@ -5,7 +5,8 @@
 //
 //   Control        brdfd's own (api/control.h) over the archive's catalogue (catalogue.h):
 //                  GetSession, ListSessions, ListSessionEvents; no rig, so its verbs are refused
-//   Data           archive_services.h: StreamReadings, StreamReadingPoints, Export
+//   Data           brdfd's own (api/data.h) over the archive's catalogue: StreamReadings,
+//                  StreamReadingPoints (following a session polls the archive), Export
 //   Interpolation  brdfd's own InterpolationService and InterpolateLoop over an IndexCache whose
 //                  store is the archive (storage/archive/reader.h): the same code, over the same
 //                  records, answers as on the rig, bit for bit
@@ -30,12 +31,12 @@
 
 #include "core/status.h"
 #include "daemon/api/control.h"
+#include "daemon/api/data.h"
 #include "daemon/api/health.h"
 #include "daemon/api/interpolate_loop.h"
 #include "daemon/api/interpolation.h"
 #include "daemon/api/reflection.h"
 #include "daemon/archive/catalogue.h"
-#include "daemon/archive/services.h"
 #include "daemon/config/config.h"
 #include "daemon/index/cache.h"
 #include "daemon/rpc/auth.h"
@@ -89,7 +90,7 @@ class ArchiveServer {
   HealthService health_;
   ArchiveCatalogue catalogue_;
   ControlService control_;
-  ArchiveDataService data_;
+  DataService data_;
   InterpolationService interpolation_;
   InterpolateLoop interpolate_loop_;
   ReflectionV1Service reflection_v1_;
