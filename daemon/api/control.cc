@@ -75,7 +75,7 @@ grpc::Status CheckNote(const std::string& text, const std::string& field) {
 template <typename Response>
 grpc::Status Answer(Result<v1::Session> session, Response* response) {
   if (!session.ok()) return ToGrpcStatus(session.status());
-  *response->mutable_session() = *std::move(session);
+  *response->mutable_session() = std::move(*session);
   return grpc::Status::OK;
 }
 
@@ -139,7 +139,7 @@ grpc::Status ControlService::PauseSession(grpc::ServerContext* context,
   if (!session.ok()) return ToGrpcStatus(session.status());
   response->set_already_paused(before.ok() && before->state() == v1::SESSION_STATE_PAUSED &&
                                session->state() == v1::SESSION_STATE_PAUSED);
-  *response->mutable_session() = *std::move(session);
+  *response->mutable_session() = std::move(*session);
   return grpc::Status::OK;
 }
 

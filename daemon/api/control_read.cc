@@ -60,7 +60,7 @@ grpc::Status ControlService::GetSession(grpc::ServerContext* /*context*/,
   }
   Result<v1::Session> session = catalogue_.GetSession(id);
   if (!session.ok()) return ToGrpcStatus(session.status());
-  *response = *std::move(session);
+  *response = std::move(*session);
   return grpc::Status::OK;
 }
 

@@ -61,7 +61,7 @@ v1::RigStatus ManagerRigPort::GetRigStatus() const {
 Result<std::unique_ptr<SessionWatch>> ManagerRigPort::Watch(SessionId session) {
   Result<std::shared_ptr<EventSubscription>> subscribed = manager_.Subscribe(session);
   if (!subscribed.ok()) return subscribed.status();
-  return std::unique_ptr<SessionWatch>(std::make_unique<EventWatch>(*std::move(subscribed)));
+  return std::unique_ptr<SessionWatch>(std::make_unique<EventWatch>(std::move(*subscribed)));
 }
 
 }  // namespace brdf::daemon
