@@ -2,7 +2,7 @@
 // session's index (index_cache.h). Every request is checked before any work: angles finite and
 // in range (θ in [0, 90], φ in [−180, 360]), the direction's form set, enums known, options
 // positive, batches of 1 … kMaxBatchDirections directions with chunks of at most kMaxChunkSize
-// (service_common.h: 100,000 directions; chunks of 256 results by default, at most 1,024).
+// (common.h: 100,000 directions; chunks of 256 results by default, at most 1,024).
 // Errors name the field and, in a batch, the index: INVALID_ARGUMENT "directions[17].iso.phi:
 // must be a finite angle …" (NaN, ±inf, out of range, no direction set, an empty batch, an
 // unknown enum, a chunk_size over the limit); NOT_FOUND for an unknown session; RESOURCE_EXHAUSTED
