@@ -12,7 +12,8 @@
 // inside PostgreSQL (generate_series), and the ListSessions-style catalogue query (filter by
 // material and tag, newest first, a page of 100) timed --queries times: p50 and p99, against the
 // same query without a filter as the baseline (SQL over libpq). Then the same through a
-// brdf-archive server (daemon/archive/server.h, in this process, over gRPC on a loopback port):
+// brdf-archive server (daemon/api/server.h over daemon/archive/back_end.h, in this process, over
+// gRPC on a loopback port):
 // ListSessions with the filter against ListSessions without one, and the first Interpolate on a
 // cold session (its 1,000 readings read from PostgreSQL, the index built) against the next
 // Interpolate on the same session (warm), each over --cold sessions. Last, InterpolateBatch
@@ -30,7 +31,8 @@
 #include <vector>
 
 #include "brdf/v1/brdf.grpc.pb.h"
-#include "daemon/archive/server.h"
+#include "daemon/api/server.h"
+#include "daemon/archive/back_end.h"
 #include "daemon/engine/shipper.h"
 #include "daemon/rpc/auth.h"
 #include "storage/archive/pg.h"
@@ -245,8 +247,9 @@ int main(int argc, char** argv) {
   brdf::daemon::ServerConfig server_config;
   server_config.listen = "127.0.0.1:0";
   brdf::daemon::Authenticator auth({});
-  Result<std::unique_ptr<brdf::daemon::ArchiveServer>> server = brdf::daemon::ArchiveServer::Start(
-      server_config, *reader, auth, brdf::daemon::ArchiveServer::Options());
+  brdf::daemon::ArchiveBackEnd back_end(*reader);
+  Result<std::unique_ptr<brdf::daemon::Server>> server =
+      brdf::daemon::Server::Start(server_config, back_end.Served(), auth);
   if (!server.ok()) return Fail("starting brdf-archive", server.status());
   auto channel = grpc::CreateChannel((*server)->address(), grpc::InsecureChannelCredentials());
   auto control = brdf::v1::Control::NewStub(channel);
@@ -322,9 +325,9 @@ int main(int argc, char** argv) {
   Result<std::shared_ptr<storage::ArchiveReader>> reader_b =
       storage::ArchiveReader::Open((*pg)->conninfo());
   if (!reader_b.ok()) return Fail("opening the archive for the second replica", reader_b.status());
-  Result<std::unique_ptr<brdf::daemon::ArchiveServer>> server_b =
-      brdf::daemon::ArchiveServer::Start(server_config, *reader_b, auth,
-                                         brdf::daemon::ArchiveServer::Options());
+  brdf::daemon::ArchiveBackEnd back_end_b(*reader_b);
+  Result<std::unique_ptr<brdf::daemon::Server>> server_b =
+      brdf::daemon::Server::Start(server_config, back_end_b.Served(), auth);
   if (!server_b.ok()) return Fail("starting the second brdf-archive", server_b.status());
   brdf::v1::InterpolateBatchRequest batch_request;
   batch_request.set_session_id(sessions_page.sessions(0).session_id());

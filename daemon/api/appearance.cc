@@ -21,6 +21,7 @@
 #include "core/export/spectrum_source.h"
 #include "core/fit/fit.h"
 #include "daemon/api/interpolation.h"
+#include "daemon/wire/values.h"
 #include "data/cie_tables.h"
 
 namespace brdf::daemon {
@@ -155,6 +156,114 @@ std::string DeterministicBytes(const google::protobuf::Message& message) {
   return bytes;
 }
 
+// The exports' fill chain (core/export/fill_chain.h) over the cache's indexes, as the sphere's
+// BRDF: the index asked for, then (another method's) the Delaunay fallback, then the model fitted
+// to the samples. The last two are made only when a direction first needs them.
+class AppearanceChain {
+ public:
+  AppearanceChain(IndexCache& cache, grpc::ServerContext& context, const AppearanceSettings& s,
+                  const std::shared_ptr<const IndexSnapshot>& index)
+      : fallback_([this, &cache, &s]() -> Result<exports::SpectrumSource> {
+          Result<std::shared_ptr<const IndexSnapshot>> d =
+              cache.Get(s.session, Quantity::kBrdf, interp::Method::kDelaunay, s.options);
+          if (!d.ok()) return d.status().WithContext("the fill chain's Delaunay fallback");
+          delaunay_ = std::move(*d);
+          return exports::InterpolatorSource(*delaunay_->interpolator);
+        }),
+        model_([this, &context, &index]() -> Result<exports::SpectrumSource> {
+          Result<fit::CookTorranceFit> fitted =
+              exports::FitSampleModel(*index->samples, index->grid, FitContext(context));
+          if (!fitted.ok()) return fitted.status().WithContext("the fill chain's model");
+          model_fit_ = std::move(*fitted);
+          return exports::ModelSource(*model_fit_);
+        }),
+        chain_(exports::FillPolicy::kChain, Stages(s, *index)),
+        source_(chain_.Source()) {}
+  AppearanceChain(const AppearanceChain&) = delete;
+  AppearanceChain& operator=(const AppearanceChain&) = delete;
+
+  BrdfLookup Lookup() const {
+    return [this](const IsoDirection& at, std::span<double> out) {
+      return source_(at, out) == interp::InterpStatus::kOk;
+    };
+  }
+  exports::FillTally Tally() const { return chain_.Tally(); }
+  // No stage failed for a reason of this call (see LazyStage::Lasting).
+  bool Lasting() const { return fallback_.Lasting() && model_.Lasting(); }
+  // Why a stage could not be made: the first, and all of them ("; ").
+  const std::string& FirstError() const {
+    return fallback_.error().empty() ? model_.error() : fallback_.error();
+  }
+  std::string Errors() const {
+    std::string all = fallback_.error();
+    if (!model_.error().empty()) all += (all.empty() ? "" : "; ") + model_.error();
+    return all;
+  }
+
+ private:
+  std::vector<exports::FillChain::Stage> Stages(const AppearanceSettings& s,
+                                                const IndexSnapshot& index) {
+    std::vector<exports::FillChain::Stage> stages;
+    stages.push_back(
+        {exports::Provenance::kInterpolated, exports::InterpolatorSource(*index.interpolator)});
+    if (s.method != interp::Method::kDelaunay) {
+      stages.push_back({exports::Provenance::kFallback, fallback_.Source()});
+    }
+    stages.push_back({exports::Provenance::kModel, model_.Source()});
+    return stages;
+  }
+
+  std::shared_ptr<const IndexSnapshot> delaunay_;
+  std::optional<fit::CookTorranceFit> model_fit_;
+  LazyStage fallback_;
+  LazyStage model_;
+  const exports::FillChain chain_;
+  const exports::SpectrumSource source_;
+};
+
+// One illuminant's image (and, the first time, the grid and reflectance) into `response`.
+// *lasting as for Render.
+grpc::Status RenderImage(v1::Illuminant which, const AppearanceChain& chain,
+                         const IndexSnapshot& index, const data::CieTables& cie,
+                         const SphereOptions& sphere_options, v1::AppearanceResponse* response,
+                         bool* lasting) {
+  const bool d65 = which == v1::ILLUMINANT_D65;
+  const Spectrum illuminant = d65 ? cie.d65 : CieIlluminantA(index.grid);
+  const BrdfLookup brdf = chain.Lookup();
+  Result<SampleColour> colour = ComputeSampleColour(brdf, index.grid, illuminant, cie.cmf);
+  *lasting = chain.Lasting();
+  if (!colour.ok()) {
+    const std::string& why = chain.FirstError();
+    return ToGrpcStatus(why.empty() ? colour.status() : colour.status().WithContext(why));
+  }
+  const exports::FillTally before = chain.Tally();
+  Result<LitSphere> sphere = RenderLitSphere(brdf, index.grid, illuminant, cie.cmf, sphere_options);
+  *lasting = chain.Lasting();
+  if (!sphere.ok()) return ToGrpcStatus(sphere.status());
+  const exports::FillTally after = chain.Tally();
+
+  v1::AppearanceImage* image = response->add_images();
+  image->set_illuminant(which);
+  image->set_name(d65 ? "D65" : "A");
+  SetColour(*colour, image->mutable_colour());
+  image->set_sphere_size(static_cast<std::uint32_t>(sphere->size));
+  image->set_sphere_rgba(sphere->rgba.data(), sphere->rgba.size());
+  image->set_disc_pixels(static_cast<std::uint32_t>(sphere->disc_pixels));
+  image->set_unlit_pixels(static_cast<std::uint32_t>(sphere->unlit_pixels));
+  image->set_interpolated_pixels(
+      static_cast<std::uint32_t>(after.interpolated - before.interpolated));
+  image->set_fallback_pixels(static_cast<std::uint32_t>(after.fallback - before.fallback));
+  image->set_model_pixels(static_cast<std::uint32_t>(after.model - before.model));
+  image->set_empty_pixels(static_cast<std::uint32_t>(after.empty - before.empty));
+  image->set_peak_y(sphere->peak_y);
+  if (response->reflectance_size() == 0) {
+    *response->mutable_grid() = ToProtoGrid(index.grid);
+    response->mutable_reflectance()->Add(colour->reflectance.values.begin(),
+                                         colour->reflectance.values.end());
+  }
+  return grpc::Status::OK;
+}
+
 // The answer from `index` (the request checked into `s`). *lasting: false when the outcome
 // depends on this call (a stage of the fill chain that failed for its deadline or the store), so
 // that it may be neither cached nor handed to another caller.
@@ -162,36 +271,7 @@ grpc::Status Render(IndexCache& cache, const StopSignal& stopping, grpc::ServerC
                     const AppearanceSettings& s, const data::CieTables& cie,
                     const std::shared_ptr<const IndexSnapshot>& index,
                     v1::AppearanceResponse* response, bool* lasting) {
-  // The exports' fill chain (core/export/fill_chain.h) over the cache's indexes.
-  std::shared_ptr<const IndexSnapshot> delaunay;
-  LazyStage fallback([&]() -> Result<exports::SpectrumSource> {
-    Result<std::shared_ptr<const IndexSnapshot>> d =
-        cache.Get(s.session, Quantity::kBrdf, interp::Method::kDelaunay, s.options);
-    if (!d.ok()) return d.status().WithContext("the fill chain's Delaunay fallback");
-    delaunay = *std::move(d);
-    return exports::InterpolatorSource(*delaunay->interpolator);
-  });
-  std::optional<fit::CookTorranceFit> model_fit;
-  LazyStage model([&]() -> Result<exports::SpectrumSource> {
-    Result<fit::CookTorranceFit> fitted =
-        exports::FitSampleModel(*index->samples, index->grid, FitContext(context));
-    if (!fitted.ok()) return fitted.status().WithContext("the fill chain's model");
-    model_fit = *std::move(fitted);
-    return exports::ModelSource(*model_fit);
-  });
-  std::vector<exports::FillChain::Stage> stages;
-  stages.push_back(
-      {exports::Provenance::kInterpolated, exports::InterpolatorSource(*index->interpolator)});
-  if (s.method != interp::Method::kDelaunay) {
-    stages.push_back({exports::Provenance::kFallback, fallback.Source()});
-  }
-  stages.push_back({exports::Provenance::kModel, model.Source()});
-  const exports::FillChain chain(exports::FillPolicy::kChain, std::move(stages));
-  const exports::SpectrumSource source = chain.Source();
-  const BrdfLookup brdf = [&source](const IsoDirection& at, std::span<double> out) {
-    return source(at, out) == interp::InterpStatus::kOk;
-  };
-
+  const AppearanceChain chain(cache, context, s, index);
   for (const v1::Illuminant which : s.illuminants) {
     if (stopping.stopped()) {
       return grpc::Status(grpc::StatusCode::UNAVAILABLE,
@@ -201,48 +281,18 @@ grpc::Status Render(IndexCache& cache, const StopSignal& stopping, grpc::ServerC
     if (context.IsCancelled()) {
       return grpc::Status(grpc::StatusCode::CANCELLED, "RenderAppearance: cancelled");
     }
-    const bool d65 = which == v1::ILLUMINANT_D65;
-    const Spectrum illuminant = d65 ? cie.d65 : CieIlluminantA(index->grid);
-    Result<SampleColour> colour = ComputeSampleColour(brdf, index->grid, illuminant, cie.cmf);
-    *lasting = fallback.Lasting() && model.Lasting();
-    if (!colour.ok()) {
-      std::string why = fallback.error().empty() ? model.error() : fallback.error();
-      return ToGrpcStatus(why.empty() ? colour.status() : colour.status().WithContext(why));
-    }
-    const exports::FillTally before = chain.Tally();
-    Result<LitSphere> sphere = RenderLitSphere(brdf, index->grid, illuminant, cie.cmf, s.sphere);
-    *lasting = fallback.Lasting() && model.Lasting();
-    if (!sphere.ok()) return ToGrpcStatus(sphere.status());
-    const exports::FillTally after = chain.Tally();
-
-    v1::AppearanceImage* image = response->add_images();
-    image->set_illuminant(which);
-    image->set_name(d65 ? "D65" : "A");
-    SetColour(*colour, image->mutable_colour());
-    image->set_sphere_size(static_cast<std::uint32_t>(sphere->size));
-    image->set_sphere_rgba(sphere->rgba.data(), sphere->rgba.size());
-    image->set_disc_pixels(static_cast<std::uint32_t>(sphere->disc_pixels));
-    image->set_unlit_pixels(static_cast<std::uint32_t>(sphere->unlit_pixels));
-    image->set_interpolated_pixels(
-        static_cast<std::uint32_t>(after.interpolated - before.interpolated));
-    image->set_fallback_pixels(static_cast<std::uint32_t>(after.fallback - before.fallback));
-    image->set_model_pixels(static_cast<std::uint32_t>(after.model - before.model));
-    image->set_empty_pixels(static_cast<std::uint32_t>(after.empty - before.empty));
-    image->set_peak_y(sphere->peak_y);
-    if (response->reflectance_size() == 0) {
-      *response->mutable_grid() = ToProtoGrid(index->grid);
-      response->mutable_reflectance()->Add(colour->reflectance.values.begin(),
-                                           colour->reflectance.values.end());
+    if (grpc::Status st = RenderImage(which, chain, *index, cie, s.sphere, response, lasting);
+        !st.ok()) {
+      return st;
     }
   }
-
   std::string detail;
   if (index->skipped > 0) {
     detail = std::to_string(index->skipped) +
              " sample reading(s) of the session left out (first: " + index->skipped_detail + ")";
   }
-  for (const std::string* error : {&fallback.error(), &model.error()}) {
-    if (!error->empty()) detail += (detail.empty() ? "" : "; ") + *error;
+  if (const std::string errors = chain.Errors(); !errors.empty()) {
+    detail += (detail.empty() ? "" : "; ") + errors;
   }
   response->set_detail(std::move(detail));
   return grpc::Status::OK;
@@ -288,7 +338,7 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
   Result<std::shared_ptr<const IndexSnapshot>> got =
       cache_.Get(s.session, Quantity::kBrdf, s.method, s.options);
   if (!got.ok()) return ToGrpcStatus(got.status());
-  const std::shared_ptr<const IndexSnapshot> index = *std::move(got);
+  const std::shared_ptr<const IndexSnapshot> index = std::move(*got);
   if (index->anisotropic) {
     return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
                         "RenderAppearance: session " + request->session_id() +
@@ -300,8 +350,29 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
   const AppearanceKey key{index.get(), s.session, index->through_reading_id,
                           DeterministicBytes(*request)};
   std::shared_ptr<AppearanceFlight> flight;
-  while (flight == nullptr) {
-    MutexLock lock(appearance_mu_);
+  if (std::optional<grpc::Status> answered = AwaitAppearance(*context, key, response, &flight)) {
+    return *answered;
+  }
+  auto rendered = std::make_shared<v1::AppearanceResponse>();
+  bool lasting = false;
+  grpc::Status st(grpc::StatusCode::CANCELLED, "RenderAppearance: cancelled");
+  if (Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir); !cie.ok()) {
+    st = ToGrpcStatus(cie.status());
+    lasting = true;  // the installation's: the same for every call
+  } else if (slot->Work() && !context->IsCancelled()) {
+    ++appearance_renders_;
+    st = Render(cache_, stopping_, *context, s, *cie, index, rendered.get(), &lasting);
+  }
+  LandAppearance(flight, index, rendered, st, lasting);
+  if (st.ok()) *response = *rendered;
+  return st;
+}
+
+std::optional<grpc::Status> InterpolationService::AwaitAppearance(
+    grpc::ServerContext& context, const AppearanceKey& key, v1::AppearanceResponse* response,
+    std::shared_ptr<AppearanceFlight>* flight) {
+  MutexLock lock(appearance_mu_);
+  for (;;) {
     if (std::shared_ptr<const v1::AppearanceResponse> hit = CachedAppearance(key)) {
       lock.Unlock();
       ++appearance_reuses_;
@@ -311,15 +382,15 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
     auto it = std::find_if(appearance_flights_.begin(), appearance_flights_.end(),
                            [&key](const auto& f) { return f->key == key; });
     if (it == appearance_flights_.end()) {
-      flight = std::make_shared<AppearanceFlight>();
-      flight->key = key;
-      appearance_flights_.push_back(flight);
-      break;
+      *flight = std::make_shared<AppearanceFlight>();
+      (*flight)->key = key;
+      appearance_flights_.push_back(*flight);
+      return std::nullopt;
     }
     const std::shared_ptr<const AppearanceFlight> other = *it;
     while (!other->done) {
       // The synchronous API has no wake-up for a cancelled call: look now and then.
-      if (context->IsCancelled()) {
+      if (context.IsCancelled()) {
         return grpc::Status(grpc::StatusCode::CANCELLED, "RenderAppearance: cancelled");
       }
       if (stopping_.stopped()) {
@@ -339,17 +410,12 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
     // The other call was cancelled, or its answer held only for it: look again (a third call
     // may render it by now), else render here.
   }
+}
 
-  auto rendered = std::make_shared<v1::AppearanceResponse>();
-  bool lasting = false;
-  grpc::Status st(grpc::StatusCode::CANCELLED, "RenderAppearance: cancelled");
-  if (Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir); !cie.ok()) {
-    st = ToGrpcStatus(cie.status());
-    lasting = true;  // the installation's: the same for every call
-  } else if (slot->Work() && !context->IsCancelled()) {
-    ++appearance_renders_;
-    st = Render(cache_, stopping_, *context, s, *cie, index, rendered.get(), &lasting);
-  }
+void InterpolationService::LandAppearance(const std::shared_ptr<AppearanceFlight>& flight,
+                                          const std::shared_ptr<const IndexSnapshot>& index,
+                                          const std::shared_ptr<v1::AppearanceResponse>& rendered,
+                                          const grpc::Status& st, bool lasting) {
   {
     MutexLock lock(appearance_mu_);
     flight->done = true;
@@ -358,13 +424,11 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
     if (st.ok()) flight->response = rendered;
     appearance_flights_.remove(flight);
     if (st.ok() && flight->shared) {
-      appearance_cache_.push_front(AppearanceEntry{key, index, rendered});
+      appearance_cache_.push_front(AppearanceEntry{flight->key, index, rendered});
       if (appearance_cache_.size() > kAppearanceCacheEntries) appearance_cache_.pop_back();
     }
   }
   appearance_done_.NotifyAll();
-  if (st.ok()) *response = *rendered;
-  return st;
 }
 
 }  // namespace brdf::daemon

@@ -1,7 +1,7 @@
 // What the three gRPC services share: the limits every request is checked against, the mapping
-// of brdfd's Status codes onto gRPC codes (session_manager.h's table), argument checks that name
-// the offending field, storage records as the API's messages, and the daemon-wide "stopping"
-// signal that ends long-lived streams at shutdown.
+// of brdfd's Status codes onto gRPC codes (engine/session_manager.h's table), argument checks that
+// name the offending field (the values themselves are read by wire/enums.h), and the server-wide
+// "stopping" signal that ends long-lived streams at shutdown.
 #pragma once
 
 #include <grpcpp/support/status.h>
@@ -9,12 +9,8 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
-#include <map>
-#include <optional>
 #include <set>
 #include <string>
-#include <string_view>
-#include <vector>
 
 #include "brdf/v1/brdf.pb.h"
 #include "core/client_text.h"
@@ -22,10 +18,8 @@
 #include "core/mutex.h"
 #include "core/readings/quantity.h"
 #include "core/status.h"
-#include "core/wavelength_grid.h"
 #include "daemon/rpc/auth.h"
 #include "storage/records.h"
-#include "storage/session_reader.h"
 
 namespace brdf::daemon {
 
@@ -87,56 +81,14 @@ grpc::Status ParseMethodField(int method, interp::Method* out);
 grpc::Status ParseCoordinatesField(int coordinates, interp::Coordinates* out);
 // InterpolationOptions.trend: unset is NONE; an unknown value names options.trend.
 grpc::Status ParseTrendField(int trend, interp::Trend* out);
-v1::Quantity ToProtoQuantity(Quantity quantity);
 
 // Checks a finite angle within [lo, hi]; the message names `field` and the range.
 Status CheckAngle(double value, double lo, double hi, const std::string& field);
-
-// The API's messages for storage's records.
-v1::WavelengthGrid ToProtoGrid(const WavelengthGrid& grid);
-v1::ReadingKind ToProtoReadingKind(storage::ReadingKind kind);
-
-// What a Reading message needs beyond the record: the step's label, and the plan's averaging
-// (the meter's averaging count is a plan setting, the same for every reading of a session).
-struct ReadingExtras {
-  std::map<int, std::string> step_labels;
-  std::uint32_t averages = 1;
-};
-v1::Reading ToProtoReading(const storage::ReadingRecord& record, const ReadingExtras& extras);
-
-// Control.WhoAmI, for brdfd and brdf-archive alike: the caller the call was admitted as
-// (Authenticator::CallerOf), and `server`, the program's name.
-grpc::Status ServeWhoAmI(const Authenticator& auth, const grpc::ServerContextBase& context,
-                         const char* server, v1::Caller* response);
-
-// Control.ListSessionEvents, for brdfd (its store) and brdf-archive (the archive) alike, after
-// the caller's role was checked: the session id parsed (INVALID_ARGUMENT naming session_id), the
-// session's history read from `reader` (NOT_FOUND naming the session), oldest first.
-grpc::Status ServeListSessionEvents(storage::SessionReader& reader,
-                                    const v1::ListSessionEventsRequest& request,
-                                    v1::ListSessionEventsResponse* response);
 
 // StreamReadingsRequest.kinds as a set (empty: every kind); INVALID_ARGUMENT naming "kinds[i]"
 // for a kind the API does not have.
 grpc::Status ParseReadingKinds(const v1::StreamReadingsRequest& request,
                                std::set<storage::ReadingKind>* kinds);
-
-// ListSessions' catalogue filters (ListSessionsRequest fields 4-9), checked: brdfd applies them
-// to its sessions with Matches, brdf-archive in its SQL (storage/archive/reader.h), with the same
-// meaning. Timestamps as Unix seconds.
-struct CatalogueFilter {
-  std::vector<SessionState> states;  // ListSessionsRequest.states (Matches leaves them out)
-  std::string rig;
-  std::string sample;    // the sample's id, or its name ignoring case
-  std::string material;  // ignoring case
-  std::string tag;
-  std::optional<double> created_after;   // created_at ≥
-  std::optional<double> created_before;  // created_at <
-  bool Matches(const v1::Session& session) const;
-};
-// INVALID_ARGUMENT naming the field for an unknown state, a timestamp out of range (nanos outside
-// 0…999,999,999) or created_before not after created_after.
-grpc::Status ParseCatalogueFilter(const v1::ListSessionsRequest& request, CatalogueFilter* out);
 
 // Set once at shutdown; streams end when they see it. Waiters wake at once.
 class StopSignal {

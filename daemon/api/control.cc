@@ -2,21 +2,26 @@
 
 #include <spdlog/spdlog.h>
 
-#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
-#include <vector>
+#include <utility>
 
-#include "core/plan/plan_proto.h"
-#include "daemon/engine/steps.h"
+#include "daemon/wire/enums.h"
+#include "daemon/wire/plan.h"
 
 namespace brdf::daemon {
 
-ControlService::ControlService(SessionManager& manager, const Authenticator& auth,
-                               const StopSignal& stopping, StreamRegistry& streams)
-    : manager_(manager), auth_(auth), stopping_(stopping), streams_(streams) {}
+ControlService::ControlService(SessionCatalogue& catalogue, RigPort* rig, const Authenticator& auth,
+                               const StopSignal& stopping, StreamRegistry& streams,
+                               std::string program)
+    : catalogue_(catalogue),
+      rig_(rig),
+      auth_(auth),
+      stopping_(stopping),
+      streams_(streams),
+      program_(std::move(program)) {}
 
 void ControlService::ServeOn(ControlLoop& loop) {
   // Each method's async request (RequestX) and its handler (X), by name.
@@ -35,6 +40,22 @@ void ControlService::ServeOn(ControlLoop& loop) {
 #undef BRDF_CONTROL_METHOD
 }
 
+grpc::Status ControlService::NoRig(const char* method, const std::string& session_id) {
+  std::string rig;
+  SessionId id = 0;
+  if (!session_id.empty() && ParseSessionIdField(session_id, "session_id", &id).ok()) {
+    if (Result<v1::Session> s = catalogue_.GetSession(id); s.ok()) {
+      rig = "rig \"" + s->rig() + "\"'s brdfd";
+    }
+  }
+  return grpc::Status(
+      grpc::StatusCode::FAILED_PRECONDITION,
+      std::string(method) +
+          ": this is brdf-archive, the lab archive's read-only server; it "
+          "answers sessions, readings and interpolation, never a rig's verbs. Ask " +
+          (rig.empty() ? std::string("the rig's brdfd") : rig) + " instead");
+}
+
 namespace {
 
 // The session id of a request, or INVALID_ARGUMENT naming the field.
@@ -50,26 +71,33 @@ grpc::Status CheckNote(const std::string& text, const std::string& field) {
   return grpc::Status::OK;
 }
 
-}  // namespace
-
-grpc::Status ControlService::SubmitPlan(grpc::ServerContext* context,
-                                        const v1::SubmitPlanRequest* request,
-                                        v1::SubmitPlanResponse* response) {
-  Caller caller;
-  if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
-  if (!request->has_plan()) {
-    return InvalidField("plan", "missing; give the plan to run (see ValidatePlan)");
-  }
-  Result<v1::Session> session =
-      manager_.SubmitPlan(request->plan(), caller.ToActor(), request->start_now());
+// The session a verb returned, into its response, or the verb's error.
+template <typename Response>
+grpc::Status Answer(Result<v1::Session> session, Response* response) {
   if (!session.ok()) return ToGrpcStatus(session.status());
   *response->mutable_session() = std::move(*session);
   return grpc::Status::OK;
 }
 
+}  // namespace
+
+grpc::Status ControlService::SubmitPlan(grpc::ServerContext* context,
+                                        const v1::SubmitPlanRequest* request,
+                                        v1::SubmitPlanResponse* response) {
+  if (rig_ == nullptr) return NoRig("SubmitPlan", "");
+  Caller caller;
+  if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
+  if (!request->has_plan()) {
+    return InvalidField("plan", "missing; give the plan to run (see ValidatePlan)");
+  }
+  return Answer(rig_->SubmitPlan(request->plan(), caller.ToActor(), request->start_now()),
+                response);
+}
+
 grpc::Status ControlService::ValidatePlan(grpc::ServerContext* /*context*/,
                                           const v1::ValidatePlanRequest* request,
                                           v1::ValidatePlanResponse* response) {
+  if (rig_ == nullptr) return NoRig("ValidatePlan", "");
   if (!request->has_plan()) {
     return InvalidField("plan", "missing; give the plan to check");
   }
@@ -77,46 +105,37 @@ grpc::Status ControlService::ValidatePlan(grpc::ServerContext* /*context*/,
   if (!std::isfinite(time_scale) || time_scale < 0) {
     return InvalidField("time_scale", "must be a positive number (0 or unset: 1, a real rig)");
   }
-  *response = plan::ToValidatePlanResponse(
-      manager_.ValidatePlan(request->plan(), time_scale > 0 ? time_scale : 1));
+  *response =
+      ToValidatePlanResponse(rig_->ValidatePlan(request->plan(), time_scale > 0 ? time_scale : 1));
   return grpc::Status::OK;
 }
 
 grpc::Status ControlService::StartSession(grpc::ServerContext* context,
                                           const v1::StartSessionRequest* request,
                                           v1::StartSessionResponse* response) {
+  if (rig_ == nullptr) return NoRig("StartSession", request->session_id());
   Caller caller;
   if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
   SessionId id = 0;
   if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
-  Result<v1::Session> session = manager_.Start(id, caller.ToActor());
-  if (!session.ok()) return ToGrpcStatus(session.status());
-  *response->mutable_session() = std::move(*session);
-  return grpc::Status::OK;
+  return Answer(rig_->Start(id, caller.ToActor()), response);
 }
 
 grpc::Status ControlService::PauseSession(grpc::ServerContext* context,
                                           const v1::PauseSessionRequest* request,
                                           v1::PauseSessionResponse* response) {
+  if (rig_ == nullptr) return NoRig("PauseSession", request->session_id());
   Caller caller;
   if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
   SessionId id = 0;
   if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
-  PauseMode mode = PauseMode::kDeferred;
-  switch (request->mode()) {
-    case v1::PAUSE_MODE_UNSPECIFIED:
-    case v1::PAUSE_MODE_DEFERRED:
-      mode = PauseMode::kDeferred;
-      break;
-    case v1::PAUSE_MODE_IMMEDIATE:
-      mode = PauseMode::kImmediate;
-      break;
-    default:
-      return InvalidField("mode", "unknown pause mode " + std::to_string(request->mode()) +
-                                      "; use PAUSE_MODE_DEFERRED or PAUSE_MODE_IMMEDIATE");
+  const std::optional<PauseMode> mode = FromProtoPauseMode(request->mode());
+  if (!mode.has_value()) {
+    return InvalidField("mode", "unknown pause mode " + std::to_string(request->mode()) +
+                                    "; use PAUSE_MODE_DEFERRED or PAUSE_MODE_IMMEDIATE");
   }
-  Result<v1::Session> before = manager_.GetSession(id);
-  Result<v1::Session> session = manager_.Pause(id, mode, caller.ToActor());
+  Result<v1::Session> before = catalogue_.GetSession(id);
+  Result<v1::Session> session = rig_->Pause(id, *mode, caller.ToActor());
   if (!session.ok()) return ToGrpcStatus(session.status());
   response->set_already_paused(before.ok() && before->state() == v1::SESSION_STATE_PAUSED &&
                                session->state() == v1::SESSION_STATE_PAUSED);
@@ -127,19 +146,18 @@ grpc::Status ControlService::PauseSession(grpc::ServerContext* context,
 grpc::Status ControlService::ResumeSession(grpc::ServerContext* context,
                                            const v1::ResumeSessionRequest* request,
                                            v1::ResumeSessionResponse* response) {
+  if (rig_ == nullptr) return NoRig("ResumeSession", request->session_id());
   Caller caller;
   if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
   SessionId id = 0;
   if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
-  Result<v1::Session> session = manager_.Resume(id, caller.ToActor());
-  if (!session.ok()) return ToGrpcStatus(session.status());
-  *response->mutable_session() = std::move(*session);
-  return grpc::Status::OK;
+  return Answer(rig_->Resume(id, caller.ToActor()), response);
 }
 
 grpc::Status ControlService::AbortSession(grpc::ServerContext* context,
                                           const v1::AbortSessionRequest* request,
                                           v1::AbortSessionResponse* response) {
+  if (rig_ == nullptr) return NoRig("AbortSession", request->session_id());
   Caller caller;
   if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
   SessionId id = 0;
@@ -147,15 +165,13 @@ grpc::Status ControlService::AbortSession(grpc::ServerContext* context,
   if (grpc::Status st = CheckNote(request->reason(), "reason"); !st.ok()) return st;
   const std::string reason =
       request->reason().empty() ? "aborted by " + caller.name : request->reason();
-  Result<v1::Session> session = manager_.Abort(id, reason, caller.ToActor());
-  if (!session.ok()) return ToGrpcStatus(session.status());
-  *response->mutable_session() = std::move(*session);
-  return grpc::Status::OK;
+  return Answer(rig_->Abort(id, reason, caller.ToActor()), response);
 }
 
 grpc::Status ControlService::AnswerPrompt(grpc::ServerContext* context,
                                           const v1::AnswerPromptRequest* request,
                                           v1::AnswerPromptResponse* response) {
+  if (rig_ == nullptr) return NoRig("AnswerPrompt", request->session_id());
   Caller caller;
   if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
   SessionId id = 0;
@@ -165,85 +181,22 @@ grpc::Status ControlService::AnswerPrompt(grpc::ServerContext* context,
                                           "); give the pending prompt's Prompt.step_index");
   }
   if (grpc::Status st = CheckNote(request->note(), "note"); !st.ok()) return st;
-  Result<v1::Session> session =
-      manager_.AnswerPrompt(id, request->step_index(), request->note(), caller.ToActor());
-  if (!session.ok()) return ToGrpcStatus(session.status());
-  *response->mutable_session() = std::move(*session);
-  return grpc::Status::OK;
-}
-
-grpc::Status ControlService::GetSession(grpc::ServerContext* /*context*/,
-                                        const v1::GetSessionRequest* request,
-                                        v1::Session* response) {
-  SessionId id = 0;
-  if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
-  Result<v1::Session> session = manager_.GetSession(id);
-  if (!session.ok()) return ToGrpcStatus(session.status());
-  *response = std::move(*session);
-  return grpc::Status::OK;
-}
-
-grpc::Status ControlService::ListSessionEvents(grpc::ServerContext* /*context*/,
-                                               const v1::ListSessionEventsRequest* request,
-                                               v1::ListSessionEventsResponse* response) {
-  return ServeListSessionEvents(*manager_.store(), *request, response);
-}
-
-grpc::Status ControlService::ListSessions(grpc::ServerContext* /*context*/,
-                                          const v1::ListSessionsRequest* request,
-                                          v1::ListSessionsResponse* response) {
-  CatalogueFilter filter;
-  if (grpc::Status st = ParseCatalogueFilter(*request, &filter); !st.ok()) return st;
-  // The page token is the id of the last session of the previous page: sessions are listed
-  // newest (highest id) first, so the next page holds the ids below it. Stable under inserts.
-  std::optional<SessionId> before;
-  if (!request->page_token().empty()) {
-    SessionId token = 0;
-    if (!ParseSessionIdField(request->page_token(), "page_token", &token).ok()) {
-      const std::string shown =
-          request->page_token().size() <= kMaxSessionIdBytes
-              ? "\"" + PrintablePrefix(request->page_token(), kMaxSessionIdBytes) + "\""
-              : "the " + std::to_string(request->page_token().size()) + "-byte token given";
-      return InvalidField("page_token",
-                          shown +
-                              " is not a token this daemon gave out; pass next_page_token as it "
-                              "was returned, or leave it empty for the first page");
-    }
-    before = token;
-  }
-  const std::uint32_t page_size =
-      request->page_size() == 0 ? kDefaultPageSize : std::min(request->page_size(), kMaxPageSize);
-
-  Result<std::vector<v1::Session>> sessions = manager_.ListSessions(filter.states);
-  if (!sessions.ok()) return ToGrpcStatus(sessions.status());
-  std::optional<SessionId> last;
-  bool more = false;
-  for (v1::Session& s : *sessions) {
-    Result<SessionId> id = ParseSessionId(s.session_id());
-    if (!id.ok()) continue;
-    if (before.has_value() && *id >= *before) continue;
-    if (!filter.Matches(s)) continue;
-    if (static_cast<std::uint32_t>(response->sessions_size()) == page_size) {
-      more = true;
-      break;
-    }
-    last = *id;
-    *response->add_sessions() = std::move(s);
-  }
-  if (more && last.has_value()) response->set_next_page_token(std::to_string(*last));
-  return grpc::Status::OK;
+  return Answer(rig_->AnswerPrompt(id, request->step_index(), request->note(), caller.ToActor()),
+                response);
 }
 
 grpc::Status ControlService::GetRigStatus(grpc::ServerContext* /*context*/,
                                           const v1::GetRigStatusRequest* /*request*/,
                                           v1::RigStatus* response) {
-  *response = manager_.GetRigStatus();
+  if (rig_ == nullptr) return NoRig("GetRigStatus", "");
+  *response = rig_->GetRigStatus();
   return grpc::Status::OK;
 }
 
 grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
                                           const v1::WatchSessionRequest* request,
                                           grpc::ServerWriter<v1::SessionEvent>* writer) {
+  if (rig_ == nullptr) return NoRig("WatchSession", request->session_id());
   Caller caller;
   if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
   std::unique_ptr<StreamRegistry::Slot> slot;
@@ -252,40 +205,35 @@ grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
   }
   SessionId id = 0;
   if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
-  Result<std::shared_ptr<EventSubscription>> subscribed = manager_.Subscribe(id);
-  if (!subscribed.ok()) return ToGrpcStatus(subscribed.status());
-  const std::shared_ptr<EventSubscription> sub = *subscribed;
+  Result<std::unique_ptr<SessionWatch>> watching = rig_->Watch(id);
+  if (!watching.ok()) return ToGrpcStatus(watching.status());
+  SessionWatch& watch = **watching;
   spdlog::debug("WatchSession: {} watches session {}", caller.name, id);
 
   for (;;) {
     if (context->IsCancelled()) {
-      sub->Close();
+      watch.Close();
       return grpc::Status(grpc::StatusCode::CANCELLED, "WatchSession: cancelled by the client");
     }
     // At shutdown, send what is queued (the pause the shutdown made, typically), then end.
     const bool stopping = stopping_.stopped();
     std::optional<v1::SessionEvent> event =
-        sub->Next(stopping ? std::chrono::milliseconds(0) : kStreamPollInterval);
+        watch.Next(stopping ? std::chrono::milliseconds(0) : kStreamPollInterval);
     if (event.has_value()) {
       if (!slot->Write(writer, *event)) {
-        sub->Close();
+        watch.Close();
         return grpc::Status(grpc::StatusCode::CANCELLED, "WatchSession: the client went away");
       }
       continue;
     }
-    if (sub->ended()) return grpc::Status::OK;
+    if (watch.ended()) return grpc::Status::OK;
     if (stopping) {
-      sub->Close();
+      watch.Close();
       return grpc::Status(grpc::StatusCode::UNAVAILABLE,
                           "WatchSession: the daemon is shutting down; watch again once it is "
                           "back (the session is kept)");
     }
   }
-}
-
-grpc::Status ControlService::WhoAmI(grpc::ServerContext* context,
-                                    const v1::WhoAmIRequest* /*request*/, v1::Caller* response) {
-  return ServeWhoAmI(auth_, *context, "brdfd", response);
 }
 
 }  // namespace brdf::daemon

@@ -1,11 +1,18 @@
-// The Control service (brdf.proto): plans, sessions, operator verbs, the rig, WatchSession.
-// Thin: every RPC authorizes the caller (auth.h), checks its arguments (naming the field), calls
-// the SessionManager and maps its Status onto a gRPC code (service_common.h).
+// The Control service (brdf.proto), once for brdfd and brdf-archive: the sessions read from a
+// SessionCatalogue (GetSession, ListSessions with the catalogue filters and paging,
+// ListSessionEvents), WhoAmI, and the rig's verbs, GetRigStatus and WatchSession through the
+// server's RigPort. A server without a rig (brdf-archive) answers those FAILED_PRECONDITION,
+// naming the session's rig as the place to ask. Thin: the token gate admitted the call; each RPC
+// checks its arguments (naming the field), calls the catalogue or the rig, and maps its Status
+// onto a gRPC code (common.h).
 #pragma once
+
+#include <string>
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/api/common.h"
-#include "daemon/engine/session_manager.h"
+#include "daemon/api/rig_port.h"
+#include "daemon/api/session_catalogue.h"
 #include "daemon/rpc/auth.h"
 #include "daemon/rpc/control_loop.h"
 #include "daemon/rpc/stream_registry.h"
@@ -21,14 +28,16 @@ using ControlServiceBase =
 
 class ControlService final : public ControlServiceBase {
  public:
-  // All three must outlive the service. `stopping` ends WatchSession streams at shutdown.
-  ControlService(SessionManager& manager, const Authenticator& auth, const StopSignal& stopping,
-                 StreamRegistry& streams);
+  // `rig` may be null (a server without a rig). All must outlive the service. `stopping` ends
+  // WatchSession streams at shutdown; `program` ("brdfd", "brdf-archive") is WhoAmI's server.
+  ControlService(SessionCatalogue& catalogue, RigPort* rig, const Authenticator& auth,
+                 const StopSignal& stopping, StreamRegistry& streams, std::string program);
 
   // Adds the control plane's methods (the operator's verbs and GetRigStatus) to `loop`, which
   // then answers them with the methods below. Before the server is built.
   void ServeOn(ControlLoop& loop);
 
+  // The rig's (control.cc).
   grpc::Status SubmitPlan(grpc::ServerContext* context, const v1::SubmitPlanRequest* request,
                           v1::SubmitPlanResponse* response) override;
   grpc::Status ValidatePlan(grpc::ServerContext* context, const v1::ValidatePlanRequest* request,
@@ -43,6 +52,14 @@ class ControlService final : public ControlServiceBase {
                             v1::AbortSessionResponse* response) override;
   grpc::Status AnswerPrompt(grpc::ServerContext* context, const v1::AnswerPromptRequest* request,
                             v1::AnswerPromptResponse* response) override;
+  grpc::Status GetRigStatus(grpc::ServerContext* context, const v1::GetRigStatusRequest* request,
+                            v1::RigStatus* response) override;
+  // A snapshot, then every event until the session ends, the client cancels, or the server stops
+  // (then UNAVAILABLE, after the events already queued were sent).
+  grpc::Status WatchSession(grpc::ServerContext* context, const v1::WatchSessionRequest* request,
+                            grpc::ServerWriter<v1::SessionEvent>* writer) override;
+
+  // The catalogue's (control_read.cc).
   grpc::Status GetSession(grpc::ServerContext* context, const v1::GetSessionRequest* request,
                           v1::Session* response) override;
   grpc::Status ListSessions(grpc::ServerContext* context, const v1::ListSessionsRequest* request,
@@ -50,21 +67,21 @@ class ControlService final : public ControlServiceBase {
   grpc::Status ListSessionEvents(grpc::ServerContext* context,
                                  const v1::ListSessionEventsRequest* request,
                                  v1::ListSessionEventsResponse* response) override;
-  grpc::Status GetRigStatus(grpc::ServerContext* context, const v1::GetRigStatusRequest* request,
-                            v1::RigStatus* response) override;
-  // A snapshot, then every event until the session ends, the client cancels, or the daemon stops
-  // (then UNAVAILABLE, after the events already queued were sent).
-  grpc::Status WatchSession(grpc::ServerContext* context, const v1::WatchSessionRequest* request,
-                            grpc::ServerWriter<v1::SessionEvent>* writer) override;
-  // The caller's token's name and role, and "brdfd".
+  // The caller's token's name and role, and the program's name.
   grpc::Status WhoAmI(grpc::ServerContext* context, const v1::WhoAmIRequest* request,
                       v1::Caller* response) override;
 
  private:
-  SessionManager& manager_;
+  // FAILED_PRECONDITION for a rig's verb on a server without a rig (the token gate checked the
+  // caller's role as on a rig), naming the rig of `session_id` when the catalogue knows it.
+  grpc::Status NoRig(const char* method, const std::string& session_id);
+
+  SessionCatalogue& catalogue_;
+  RigPort* rig_;
   const Authenticator& auth_;
   const StopSignal& stopping_;
   StreamRegistry& streams_;
+  std::string program_;
 };
 
 }  // namespace brdf::daemon

@@ -37,7 +37,6 @@
 #include "core/export/session_interpolant.h"
 #include "core/export/spectral_rgb.h"
 #include "core/export/spectrum_source.h"
-#include "daemon/api/data.h"
 #include "daemon/api/export_session.h"
 #include "data/cie_tables.h"
 #include "storage/session_readings.h"
@@ -515,11 +514,6 @@ Status ExportRgl(const exports::Session& session, const ExportSettings& s, const
 }
 
 }  // namespace
-
-grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportRequest* request,
-                                 grpc::ServerWriter<v1::ExportChunk>* writer) {
-  return ExportSession(*context, *request, *writer, auth_, streams_, stopping_, *manager_.store());
-}
 
 grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest& request,
                            grpc::ServerWriter<v1::ExportChunk>& writer, const Authenticator& auth,

@@ -1,9 +1,8 @@
-// Data.Export's work, shared by brdfd's Data service (service_data.h, over the rig's store) and
-// brdf-archive's (archive_services.h, over the archive): the caller authorized (kRead), a stream
-// slot taken, the request checked, the session loaded through `reader`, the requested export
-// computed by core/export, and its bytes streamed as progress, the file in chunks, then the
-// report. The same session gives the same file from either server. Defined in
-// service_export.cc.
+// Data.Export's work (data.h), over any SessionCatalogue's reader (the rig's store, the archive):
+// the caller authorized (kRead), a stream slot taken, the request checked, the session loaded
+// through `reader`, the requested export computed by core/export, and its bytes streamed as
+// progress, the file in chunks, then the report. The same session gives the same file from either
+// server. Defined in export.cc.
 #pragma once
 
 #include "brdf/v1/brdf.grpc.pb.h"

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "core/geometry.h"
+#include "daemon/wire/enums.h"
+#include "daemon/wire/values.h"
 
 namespace brdf::daemon {
 
@@ -94,32 +96,6 @@ grpc::Status ToCoords(const v1::DirectionQuery& q, const IndexSnapshot& index,
   return grpc::Status::OK;
 }
 
-v1::InterpolationStatus ToProtoStatus(interp::InterpStatus s) {
-  switch (s) {
-    case interp::InterpStatus::kOk:
-      return v1::INTERPOLATION_STATUS_OK;
-    case interp::InterpStatus::kEmptyOctant:
-      return v1::INTERPOLATION_STATUS_EMPTY_OCTANT;
-    case interp::InterpStatus::kNoEnclosingSimplex:
-      return v1::INTERPOLATION_STATUS_NO_ENCLOSING_SIMPLEX;
-    case interp::InterpStatus::kOutsideHull:
-      return v1::INTERPOLATION_STATUS_OUTSIDE_HULL;
-  }
-  return v1::INTERPOLATION_STATUS_UNSPECIFIED;
-}
-
-v1::InterpolationMethod ToProtoMethod(interp::Method m) {
-  switch (m) {
-    case interp::Method::kOctant:
-      return v1::INTERPOLATION_METHOD_OCTANT;
-    case interp::Method::kDelaunay:
-      return v1::INTERPOLATION_METHOD_DELAUNAY;
-    case interp::Method::kNearest:
-      return v1::INTERPOLATION_METHOD_NEAREST;
-  }
-  return v1::INTERPOLATION_METHOD_UNSPECIFIED;
-}
-
 // Whether each vertex carries its sample's spectrum (InterpolateRequest.include_vertex_spectra).
 enum class VertexSpectra { kOmit, kInclude };
 
@@ -128,7 +104,7 @@ void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const 
               const IndexSnapshot& index, VertexSpectra vertex_spectra,
               v1::InterpolationResult* out) {
   *out->mutable_query() = query;
-  out->set_status(ToProtoStatus(r.status));
+  out->set_status(ToProtoInterpStatus(r.status));
   out->set_method(ToProtoMethod(r.method));
   out->set_quantity(ToProtoQuantity(settings.quantity));
   *out->mutable_grid() = ToProtoGrid(index.grid);
@@ -234,25 +210,19 @@ std::optional<grpc::Status> InterpolationService::Respond(const v1::InterpolateR
   return grpc::Status::OK;
 }
 
-grpc::Status InterpolationService::InterpolateBatch(
-    grpc::ServerContext* context, const v1::InterpolateBatchRequest* request,
-    grpc::ServerWriter<v1::InterpolateBatchChunk>* writer) {
-  Caller caller;
-  if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
-  std::unique_ptr<StreamRegistry::Slot> slot;
+namespace {
+
+// An InterpolateBatch request checked before any index is asked: the session, the settings, the
+// directions' count and ranges, and the results per chunk.
+grpc::Status CheckBatch(const v1::InterpolateBatchRequest& request, SessionId* id,
+                        Settings* settings, int* chunk) {
+  if (grpc::Status st = SessionOf(request.session_id(), id); !st.ok()) return st;
   if (grpc::Status st =
-          streams_.Open(*context, &caller, "InterpolateBatch", &slot, /*computes=*/true);
-      !st.ok())
-    return st;
-  SessionId id = 0;
-  if (grpc::Status st = SessionOf(request->session_id(), &id); !st.ok()) return st;
-  Settings settings;
-  if (grpc::Status st =
-          ParseSettings(request->method(), request->quantity(), request->options(), &settings);
+          ParseSettings(request.method(), request.quantity(), request.options(), settings);
       !st.ok()) {
     return st;
   }
-  const int n = request->directions_size();
+  const int n = request.directions_size();
   if (n == 0)
     return InvalidField("directions",
                         "empty; give 1 to " + std::to_string(kMaxBatchDirections) + " directions");
@@ -264,41 +234,69 @@ grpc::Status InterpolationService::InterpolateBatch(
                             std::to_string(kMaxBatchDirections) +
                             " per InterpolateBatch (split the request into several batches)");
   }
-  if (request->chunk_size() > kMaxChunkSize) {
-    return InvalidField("chunk_size", std::to_string(request->chunk_size()) +
+  if (request.chunk_size() > kMaxChunkSize) {
+    return InvalidField("chunk_size", std::to_string(request.chunk_size()) +
                                           " results per chunk; at most " +
                                           std::to_string(kMaxChunkSize) +
                                           " (0: " + std::to_string(kDefaultChunkSize) + ")");
   }
-  const int chunk =
-      static_cast<int>(request->chunk_size() == 0 ? kDefaultChunkSize : request->chunk_size());
+  *chunk = static_cast<int>(request.chunk_size() == 0 ? kDefaultChunkSize : request.chunk_size());
   for (int i = 0; i < n; ++i) {
     if (grpc::Status st =
-            CheckDirection(request->directions(i), "directions[" + std::to_string(i) + "]");
+            CheckDirection(request.directions(i), "directions[" + std::to_string(i) + "]");
         !st.ok()) {
       return st;
     }
   }
+  return grpc::Status::OK;
+}
+
+// The batch's directions in the index's coordinates, row-major (the index's dims per row).
+grpc::Status BatchCoords(const v1::InterpolateBatchRequest& request, const IndexSnapshot& index,
+                         std::vector<double>* coords) {
+  const int n = request.directions_size();
+  const auto d = static_cast<std::size_t>(index.dims);
+  coords->assign(static_cast<std::size_t>(n) * d, 0);
+  for (int i = 0; i < n; ++i) {
+    std::array<double, 4> at{};
+    if (grpc::Status st =
+            ToCoords(request.directions(i), index, "directions[" + std::to_string(i) + "]", &at);
+        !st.ok()) {
+      return st;
+    }
+    std::copy_n(at.begin(), d, coords->begin() + static_cast<std::ptrdiff_t>(i * d));
+  }
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
+grpc::Status InterpolationService::InterpolateBatch(
+    grpc::ServerContext* context, const v1::InterpolateBatchRequest* request,
+    grpc::ServerWriter<v1::InterpolateBatchChunk>* writer) {
+  Caller caller;
+  if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
+  std::unique_ptr<StreamRegistry::Slot> slot;
+  if (grpc::Status st =
+          streams_.Open(*context, &caller, "InterpolateBatch", &slot, /*computes=*/true);
+      !st.ok())
+    return st;
+  SessionId id = 0;
+  Settings settings;
+  int chunk = 0;
+  if (grpc::Status st = CheckBatch(*request, &id, &settings, &chunk); !st.ok()) return st;
 
   // One snapshot for the whole batch: every result sees the same readings.
   Result<std::shared_ptr<const IndexSnapshot>> got =
       cache_.Get(id, settings.quantity, settings.method, settings.options);
   if (!got.ok()) return ToGrpcStatus(got.status());
   const IndexSnapshot& index = **got;
-  const auto d = static_cast<std::size_t>(index.dims);
-  std::vector<double> coords(static_cast<std::size_t>(n) * d);  // row-major, the index's dims
-  for (int i = 0; i < n; ++i) {
-    std::array<double, 4> at{};
-    if (grpc::Status st =
-            ToCoords(request->directions(i), index, "directions[" + std::to_string(i) + "]", &at);
-        !st.ok()) {
-      return st;
-    }
-    std::copy_n(at.begin(), d, coords.begin() + static_cast<std::ptrdiff_t>(i * d));
-  }
+  std::vector<double> coords;
+  if (grpc::Status st = BatchCoords(*request, index, &coords); !st.ok()) return st;
 
   // The whole batch in one EvaluateEach (the octant method sorts it by cell), its answers
   // streamed chunk by chunk as they come, in order.
+  const int n = request->directions_size();
   grpc::Status outcome = grpc::Status::OK;
   v1::InterpolateBatchChunk out;
   auto start_chunk = [&](int first) {

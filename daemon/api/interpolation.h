@@ -2,7 +2,7 @@
 // session's index (index_cache.h). Every request is checked before any work: angles finite and
 // in range (θ in [0, 90], φ in [−180, 360]), the direction's form set, enums known, options
 // positive, batches of 1 … kMaxBatchDirections directions with chunks of at most kMaxChunkSize
-// (service_common.h: 100,000 directions; chunks of 256 results by default, at most 1,024).
+// (common.h: 100,000 directions; chunks of 256 results by default, at most 1,024).
 // Errors name the field and, in a batch, the index: INVALID_ARGUMENT "directions[17].iso.phi:
 // must be a finite angle …" (NaN, ±inf, out of range, no direction set, an empty batch, an
 // unknown enum, a chunk_size over the limit); NOT_FOUND for an unknown session; RESOURCE_EXHAUSTED
@@ -129,6 +129,19 @@ class InterpolationService final
   // gone.
   std::shared_ptr<const v1::AppearanceResponse> CachedAppearance(const AppearanceKey& key)
       REQUIRES(appearance_mu_);
+  // RenderAppearance's answer when the cache holds it or an identical call renders it (waiting
+  // for that call), or the call's end (cancelled, stopping); nullopt with `*flight` registered
+  // when this call must render.
+  std::optional<grpc::Status> AwaitAppearance(grpc::ServerContext& context,
+                                              const AppearanceKey& key,
+                                              v1::AppearanceResponse* response,
+                                              std::shared_ptr<AppearanceFlight>* flight);
+  // A render's outcome handed to the calls waiting on `flight`, and cached when it holds for any
+  // call (`lasting`, not cancelled).
+  void LandAppearance(const std::shared_ptr<AppearanceFlight>& flight,
+                      const std::shared_ptr<const IndexSnapshot>& index,
+                      const std::shared_ptr<v1::AppearanceResponse>& rendered,
+                      const grpc::Status& st, bool lasting);
 
   // Both of the above; with `may_load` false, returns nullopt where it would load.
   std::optional<grpc::Status> Respond(const v1::InterpolateRequest& request,

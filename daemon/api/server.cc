@@ -27,6 +27,15 @@ constexpr int kControlThreads = 2;
 constexpr const char* kBrdfServices[] = {"brdf.v1.Control", "brdf.v1.Data",
                                          "brdf.v1.Interpolation"};
 
+// Every service the server registers (reflection's list_services).
+std::vector<std::string> ServedServices() {
+  std::vector<std::string> names(std::begin(kBrdfServices), std::end(kBrdfServices));
+  names.push_back("grpc.health.v1.Health");
+  names.push_back("grpc.reflection.v1.ServerReflection");
+  names.push_back("grpc.reflection.v1alpha.ServerReflection");
+  return names;
+}
+
 // Reads a PEM file and checks that it holds a block of the expected kind ("CERTIFICATE",
 // "PRIVATE KEY": also matches "EC PRIVATE KEY", "RSA PRIVATE KEY"). gRPC itself only says that
 // the port could not be opened when a file is not PEM, so the check here names the file.
@@ -90,25 +99,10 @@ Status CheckCpusAvailable(const std::vector<int>& cpus) {
   return Status::Ok();
 }
 
-}  // namespace
-
-bool IsLoopbackAddress(const std::string& listen) {
-  if (listen.rfind("unix:", 0) == 0) return true;
-  const std::string host = HostOf(listen);
-  if (host == "localhost") return true;
-  // Literal addresses only: a host NAME such as "127.example.org" may resolve anywhere.
-  in_addr v4{};
-  if (::inet_pton(AF_INET, host.c_str(), &v4) == 1) {
-    return (ntohl(v4.s_addr) >> 24) == 127;
-  }
-  in6_addr v6{};
-  if (::inet_pton(AF_INET6, host.c_str(), &v6) == 1) {
-    if (IN6_IS_ADDR_LOOPBACK(&v6)) return true;
-    return IN6_IS_ADDR_V4MAPPED(&v6) && v6.s6_addr[12] == 127;  // ::ffff:127.x.y.z
-  }
-  return false;
-}
-
+// The server's credentials from [server] and [server.tls]: TLS (client certificates required
+// when client_ca is set; `tls` true) or plaintext that still takes the token gate (a warning is
+// logged when a non-loopback address is served in plaintext). kConfigurationError naming the key
+// when a TLS file cannot be read or holds no PEM block of its kind.
 Result<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(const ServerConfig& config,
                                                                        bool* tls) {
   std::shared_ptr<grpc::ServerCredentials> credentials;
@@ -144,32 +138,8 @@ Result<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(const Ser
   return credentials;
 }
 
-std::vector<std::string> BrdfServiceNames() {
-  return {std::begin(kBrdfServices), std::end(kBrdfServices)};
-}
-
-std::vector<std::string> ServedServices() {
-  std::vector<std::string> names = BrdfServiceNames();
-  names.push_back("grpc.health.v1.Health");
-  names.push_back("grpc.reflection.v1.ServerReflection");
-  names.push_back("grpc.reflection.v1alpha.ServerReflection");
-  return names;
-}
-
-void PrepareServerBuilder(grpc::ServerBuilder& builder, const ServerConfig& config,
-                          const std::shared_ptr<grpc::ServerCredentials>& credentials,
-                          const Authenticator& auth, int* selected_port) {
-  credentials->SetAuthMetadataProcessor(std::make_shared<TokenGate>(auth));
-  builder.AddListeningPort(config.listen, credentials, selected_port);
-  // One daemon per address: without SO_REUSEPORT a second brdfd's bind fails instead of sharing
-  // the port (and answering some of the first one's calls).
-  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
-  builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
-  grpc::ResourceQuota quota("brdfd");
-  quota.SetMaxThreads(ServerThreadCap(config));
-  builder.SetResourceQuota(quota);
-}
-
+// After BuildAndStart (`built`: it returned a server): the address served, with the port bound
+// ("127.0.0.1:43123", "unix:/run/brdfd.sock"); kIoError naming the address when nothing was bound.
 Result<std::string> BoundAddress(const ServerConfig& config, bool built, int selected_port,
                                  bool tls) {
   const bool unix_socket = config.listen.rfind("unix:", 0) == 0;
@@ -184,38 +154,36 @@ Result<std::string> BoundAddress(const ServerConfig& config, bool built, int sel
   return config.listen.substr(0, config.listen.rfind(':') + 1) + std::to_string(selected_port);
 }
 
-Result<std::string> BuildAndStartServer(const ServerConfig& config,
-                                        const std::shared_ptr<grpc::ServerCredentials>& credentials,
-                                        bool tls, const Authenticator& auth,
-                                        std::initializer_list<grpc::Service*> services,
-                                        InterpolateLoop& interpolate_loop,
-                                        ControlLoop& control_loop,
-                                        std::unique_ptr<grpc::Server>* server, int* selected_port) {
-  grpc::ServerBuilder builder;
-  PrepareServerBuilder(builder, config, credentials, auth, selected_port);
-  for (grpc::Service* service : services) builder.RegisterService(service);
-  interpolate_loop.AddQueues(builder);
-  control_loop.AddQueue(builder);
-  *server = builder.BuildAndStart();
-  Result<std::string> address = BoundAddress(config, *server != nullptr, *selected_port, tls);
-  if (!address.ok()) return address.status();
-  interpolate_loop.Start();
-  control_loop.Start();
-  return address;
+}  // namespace
+
+bool IsLoopbackAddress(const std::string& listen) {
+  if (listen.rfind("unix:", 0) == 0) return true;
+  const std::string host = HostOf(listen);
+  if (host == "localhost") return true;
+  // Literal addresses only: a host NAME such as "127.example.org" may resolve anywhere.
+  in_addr v4{};
+  if (::inet_pton(AF_INET, host.c_str(), &v4) == 1) {
+    return (ntohl(v4.s_addr) >> 24) == 127;
+  }
+  in6_addr v6{};
+  if (::inet_pton(AF_INET6, host.c_str(), &v6) == 1) {
+    if (IN6_IS_ADDR_LOOPBACK(&v6)) return true;
+    return IN6_IS_ADDR_V4MAPPED(&v6) && v6.s6_addr[12] == 127;  // ::ffff:127.x.y.z
+  }
+  return false;
 }
 
 int InterpolateLoopThreads(unsigned cores) {
   return static_cast<int>(std::clamp(cores / 2, 1U, 8U));
 }
 
-Server::Server(const ServerConfig& config, SessionManager& manager, IndexCache& cache,
-               const Authenticator& auth)
+Server::Server(const ServerConfig& config, const BackEnd& back_end, const Authenticator& auth)
     : streams_(config, auth.enabled()),
       control_loop_(kControlThreads),
       health_(stopping_, streams_),
-      control_(manager, auth, stopping_, streams_),
-      data_(manager, auth, stopping_, streams_),
-      interpolation_(cache, auth, stopping_, streams_),
+      control_(*back_end.catalogue, back_end.rig, auth, stopping_, streams_, back_end.program),
+      data_(*back_end.catalogue, auth, stopping_, streams_, back_end.program),
+      interpolation_(*back_end.cache, auth, stopping_, streams_),
       interpolate_loop_(interpolation_,
                         config.interpolate_threads > 0
                             ? config.interpolate_threads
@@ -228,12 +196,12 @@ Server::~Server() {
   Shutdown(std::chrono::seconds(1));
 }
 
-Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, SessionManager& manager,
-                                              IndexCache& cache, const Authenticator& auth) {
+Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, const BackEnd& back_end,
+                                              const Authenticator& auth) {
   bool tls = false;
-  Result<std::shared_ptr<grpc::ServerCredentials>> made = MakeServerCredentials(config, &tls);
-  if (!made.ok()) return made.status();
-  std::shared_ptr<grpc::ServerCredentials> credentials = *made;
+  Result<std::shared_ptr<grpc::ServerCredentials>> credentials =
+      MakeServerCredentials(config, &tls);
+  if (!credentials.ok()) return credentials.status();
 
   // Debian builds Abseil without NDEBUG, which leaves absl::Mutex's lock-order (deadlock) graph
   // on: every lock gRPC takes records the lock in a global graph, about a tenth of the CPU of a
@@ -241,19 +209,48 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
   absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
 
   if (Status st = CheckCpusAvailable(config.interpolate_cpus); !st.ok()) return st;
-  std::unique_ptr<Server> server(new Server(config, manager, cache, auth));
+  std::unique_ptr<Server> server(new Server(config, back_end, auth));
   server->health_.ServeOn(server->control_loop_);
   server->control_.ServeOn(server->control_loop_);
+  if (Status st = server->Listen(config, *credentials, tls, auth); !st.ok()) return st;
+  server->LogLimits(config);
+  server->health_.SetServingStatus("", true);
+  for (const char* name : kBrdfServices) server->health_.SetServingStatus(name, true);
+  return server;
+}
+
+Status Server::Listen(const ServerConfig& config,
+                      const std::shared_ptr<grpc::ServerCredentials>& credentials, bool tls,
+                      const Authenticator& auth) {
+  grpc::ServerBuilder builder;
+  credentials->SetAuthMetadataProcessor(std::make_shared<TokenGate>(auth));
   int selected_port = 0;
-  Result<std::string> address = BuildAndStartServer(
-      config, credentials, tls, auth,
-      {&server->health_, &server->control_, &server->data_, &server->interpolation_,
-       &server->reflection_v1_, &server->reflection_v1alpha_},
-      server->interpolate_loop_, server->control_loop_, &server->server_, &selected_port);
+  builder.AddListeningPort(config.listen, credentials, &selected_port);
+  // One server per address: without SO_REUSEPORT a second one's bind fails instead of sharing
+  // the port (and answering some of the first one's calls).
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder.SetMaxReceiveMessageSize(kMaxReceiveMessageBytes);
+  grpc::ResourceQuota quota("brdfd");
+  quota.SetMaxThreads(ServerThreadCap(config));
+  builder.SetResourceQuota(quota);
+  for (grpc::Service* service : std::initializer_list<grpc::Service*>{
+           &health_, &control_, &data_, &interpolation_, &reflection_v1_, &reflection_v1alpha_}) {
+    builder.RegisterService(service);
+  }
+  interpolate_loop_.AddQueues(builder);
+  control_loop_.AddQueue(builder);
+  server_ = builder.BuildAndStart();
+  Result<std::string> address = BoundAddress(config, server_ != nullptr, selected_port, tls);
   if (!address.ok()) return address.status();
-  server->tls_ = tls;
-  server->port_ = selected_port;
-  server->address_ = *address;
+  interpolate_loop_.Start();
+  control_loop_.Start();
+  tls_ = tls;
+  port_ = selected_port;
+  address_ = *address;
+  return Status::Ok();
+}
+
+void Server::LogLimits(const ServerConfig& config) const {
   spdlog::info(
       "limits: requests up to {} bytes (larger: RESOURCE_EXHAUSTED), InterpolateBatch up to {} "
       "directions in chunks of up to {} results, notes up to {} bytes, pages up to {} sessions, "
@@ -263,12 +260,9 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, Sessio
       kMaxReceiveMessageBytes, kMaxBatchDirections, kMaxChunkSize, kMaxNoteBytes, kMaxPageSize,
       config.max_streams_per_token, config.max_streams_analyst, config.max_streams_operator,
       config.max_streams_unauthenticated, config.stream_stall_timeout_s, ServerThreadCap(config),
-      server->control_loop_.threads(), server->interpolate_loop_.threads(),
-      tls ? (config.tls->client_ca.empty() ? "; TLS" : "; TLS, client certificates required")
-          : "; plaintext");
-  server->health_.SetServingStatus("", true);
-  for (const std::string& name : BrdfServiceNames()) server->health_.SetServingStatus(name, true);
-  return server;
+      control_loop_.threads(), interpolate_loop_.threads(),
+      tls_ ? (config.tls->client_ca.empty() ? "; TLS" : "; TLS, client certificates required")
+           : "; plaintext");
 }
 
 std::shared_ptr<grpc::Channel> Server::InProcessChannel() {

@@ -1,26 +1,23 @@
-// The gRPC server: the Control, Data and Interpolation services, the standard health service
-// (grpc.health.v1.Health: "" and each brdf.v1 service SERVING while up) and server reflection
-// (grpc.reflection.v1 and v1alpha, reflection_service.h),
-// on the configured address, in plaintext or TLS ([server.tls]; client_ca → clients must present
-// a certificate). Every call passes the token gate first (token_gate.h: the bearer token is
-// checked from the metadata, before the request is read). Three sets of threads answer:
+// The gRPC server of brdfd and brdf-archive alike: the Control, Data and Interpolation services
+// over a program's back end (a SessionCatalogue, an IndexCache and, on a rig, a RigPort), the
+// standard health service (grpc.health.v1.Health: "" and each brdf.v1 service SERVING while up)
+// and server reflection (grpc.reflection.v1 and v1alpha, reflection.h), on the configured
+// address, in plaintext or TLS ([server.tls]; client_ca → clients must present a certificate).
+// Every call passes the token gate first (token_gate.h: the bearer token is checked from the
+// metadata, before the request is read). Three sets of threads answer:
 //  - the control plane (the operator's verbs, GetRigStatus, health Check): ControlLoop's threads
 //    on gRPC's completion-queue API (control_loop.h), whatever the streams hold;
-//  - Interpolate, the call analysis clients make by the thousand: brdfd's own loop threads on the
-//    completion-queue API (interpolate_loop.h), one per two cores;
+//  - Interpolate, the call analysis clients make by the thousand: the server's own loop threads on
+//    the completion-queue API (interpolate_loop.h), one per two cores;
 //  - everything else, the streams among them: gRPC's synchronous pool, one thread per call in
 //    flight, capped at ServerThreadCap (stream_registry.h), above the caps on open streams.
 #pragma once
 
-#include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server.h>
-#include <grpcpp/server_builder.h>
 
 #include <chrono>
-#include <initializer_list>
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "core/status.h"
 #include "daemon/api/common.h"
@@ -30,8 +27,9 @@
 #include "daemon/api/interpolate_loop.h"
 #include "daemon/api/interpolation.h"
 #include "daemon/api/reflection.h"
+#include "daemon/api/rig_port.h"
+#include "daemon/api/session_catalogue.h"
 #include "daemon/config/config.h"
-#include "daemon/engine/session_manager.h"
 #include "daemon/index/cache.h"
 #include "daemon/rpc/auth.h"
 #include "daemon/rpc/control_loop.h"
@@ -48,54 +46,25 @@ int InterpolateLoopThreads(unsigned cores);
 // "localhost", unix sockets. Host names (other than localhost) and 0.0.0.0 / [::] are not.
 bool IsLoopbackAddress(const std::string& listen);
 
-// The brdf.v1 services by their full names (the health service's per-service status), and with
-// them every service the server registers (reflection's list_services). brdf-archive serves the
-// same.
-std::vector<std::string> BrdfServiceNames();
-std::vector<std::string> ServedServices();
-
-// The server's credentials from [server] and [server.tls]: TLS (client certificates required
-// when client_ca is set; `tls` true) or plaintext that still takes the token gate (a warning is
-// logged when a non-loopback address is served in plaintext). kConfigurationError naming the key
-// when a TLS file cannot be read or holds no PEM block of its kind. brdfd and brdf-archive both.
-Result<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(const ServerConfig& config,
-                                                                       bool* tls);
-
-// What brdfd and brdf-archive set up alike on their builder: the listening port with
-// `credentials` behind the token gate (token_gate.h), no SO_REUSEPORT (one server per address),
-// the request size limit and the thread cap (ServerThreadCap). `*selected_port` is the port bound,
-// once the server is built.
-void PrepareServerBuilder(grpc::ServerBuilder& builder, const ServerConfig& config,
-                          const std::shared_ptr<grpc::ServerCredentials>& credentials,
-                          const Authenticator& auth, int* selected_port);
-// After BuildAndStart (`built`: it returned a server): the address served, with the port bound
-// ("127.0.0.1:43123", "unix:/run/brdfd.sock"); kIoError naming the address when nothing was bound.
-Result<std::string> BoundAddress(const ServerConfig& config, bool built, int selected_port,
-                                 bool tls);
-
-// Everything else brdfd and brdf-archive do alike to serve: prepares a builder
-// (PrepareServerBuilder), registers `services`, adds the completion queues of their Interpolate
-// and control-plane loops, builds and starts the server into `*server` (null when gRPC could not
-// build it), then, once the address is bound, starts both loops. Returns the address served
-// (BoundAddress) and sets `*selected_port`. The loops' handlers (ServeOn) must be set first.
-Result<std::string> BuildAndStartServer(const ServerConfig& config,
-                                        const std::shared_ptr<grpc::ServerCredentials>& credentials,
-                                        bool tls, const Authenticator& auth,
-                                        std::initializer_list<grpc::Service*> services,
-                                        InterpolateLoop& interpolate_loop,
-                                        ControlLoop& control_loop,
-                                        std::unique_ptr<grpc::Server>* server, int* selected_port);
+// What a program serves.
+struct BackEnd {
+  std::string program;                    // "brdfd", "brdf-archive": WhoAmI's server, messages
+  SessionCatalogue* catalogue = nullptr;  // the sessions (required)
+  IndexCache* cache = nullptr;            // Interpolation's indexes over them (required)
+  RigPort* rig = nullptr;                 // the rig; null: none (its verbs are refused)
+};
 
 class Server {
  public:
-  // Builds the services and starts serving on config.listen (port 0: any free port; see
-  // address()). Errors: kConfigurationError when a TLS file cannot be read or holds no PEM block
-  // of its kind, kIoError when the address cannot be bound (in use, not allowed, no such
-  // interface) or gRPC refuses the certificate/key pair. Logs a warning when a non-loopback
-  // address is served in plaintext or the TLS key is readable by others, and logs the limits
-  // (service_common.h) it enforces. `manager`, `cache` and `auth` must outlive it.
-  static Result<std::unique_ptr<Server>> Start(const ServerConfig& config, SessionManager& manager,
-                                               IndexCache& cache, const Authenticator& auth);
+  // Builds the services over `back_end` and starts serving on config.listen (port 0: any free
+  // port; see address()). Errors: kConfigurationError when a TLS file cannot be read or holds no
+  // PEM block of its kind, or interpolate_cpus names a CPU the process may not use; kIoError
+  // when the address cannot be bound (in use, not allowed, no such interface) or gRPC refuses the
+  // certificate/key pair. Logs a warning when a non-loopback address is served in plaintext or
+  // the TLS key is readable by others, and logs the limits (common.h) it enforces. The back end's
+  // parts and `auth` must outlive the server.
+  static Result<std::unique_ptr<Server>> Start(const ServerConfig& config, const BackEnd& back_end,
+                                               const Authenticator& auth);
   // Shutdown(1 s) if not called before.
   ~Server();
   Server(const Server&) = delete;
@@ -108,7 +77,7 @@ class Server {
 
   // A channel to these services inside the process (no socket, no TLS): calls on it pass the
   // same authentication, roles, validation and limits as calls from the network. The web
-  // gateway (web_gateway.h) forwards the browser's calls through it.
+  // gateway (gateway/http_server.h) forwards the browser's calls through it.
   std::shared_ptr<grpc::Channel> InProcessChannel();
 
   // Health → NOT_SERVING, long-lived streams end (after sending what is queued), then calls in
@@ -116,8 +85,12 @@ class Server {
   void Shutdown(std::chrono::milliseconds grace);
 
  private:
-  Server(const ServerConfig& config, SessionManager& manager, IndexCache& cache,
-         const Authenticator& auth);
+  Server(const ServerConfig& config, const BackEnd& back_end, const Authenticator& auth);
+  // Registers the services, builds and starts the gRPC server, then the loops.
+  Status Listen(const ServerConfig& config,
+                const std::shared_ptr<grpc::ServerCredentials>& credentials, bool tls,
+                const Authenticator& auth);
+  void LogLimits(const ServerConfig& config) const;
 
   StopSignal stopping_;
   StreamRegistry streams_;  // before the services, which hold slots in it

@@ -1,11 +1,8 @@
 #include "daemon/api/stream_readings.h"
 
-#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
-
-#include "core/geometry.h"
 
 namespace brdf::daemon {
 namespace {
@@ -98,26 +95,6 @@ grpc::Status ForEachReadingPage(
   }
 }
 
-// ReadingPoints' angles are for plotting and picking: rounded to a micro-degree, far below any
-// stage's resolution. A computed direction's 17 digits (59.999999999999993) become a few (60), so
-// the JSON the web gateway prints for 50,000 readings is about half as long and printed faster.
-// StreamReadings keeps the exact values.
-double MicroDegrees(double degrees) {
-  return std::round(degrees * 1e6) / 1e6;
-}
-
-void AddPoint(const storage::ReadingPointRecord& r, v1::ReadingPoints* points) {
-  points->add_ids(r.id);
-  points->add_alpha(MicroDegrees(r.pose.alpha));
-  points->add_beta(MicroDegrees(r.pose.beta));
-  points->add_delta(MicroDegrees(r.pose.delta));
-  const IsoDirection iso = ToIsotropic(r.directions);
-  points->add_theta_i(MicroDegrees(iso.theta_i));
-  points->add_theta_o(MicroDegrees(iso.theta_o));
-  points->add_phi(MicroDegrees(iso.phi));
-  points->add_flagged(r.flagged);
-}
-
 }  // namespace
 
 grpc::Status StreamSessionReadings(grpc::ServerContext& context,
@@ -150,7 +127,7 @@ grpc::Status StreamSessionReadingPoints(grpc::ServerContext& context,
       },
       [&](const std::vector<const storage::ReadingPointRecord*>& page, bool more_stored) {
         for (const storage::ReadingPointRecord* r : page) {
-          AddPoint(*r, &points);
+          AddReadingPoint(*r, &points);
           if (points.ids_size() == kPointsPerMessage) {
             if (!call.slot->Write(writer, points)) return false;
             points.Clear();

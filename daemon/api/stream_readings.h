@@ -1,8 +1,8 @@
-// StreamReadings' (and StreamReadingPoints') work, shared by brdfd's Data service (service_data.h,
-// over the rig's store) and brdf-archive's (archive_services.h, over the archive): the request
-// checked, then the session's readings written in id order a page at a time (memory bounded by one
-// page), and with `follow` the readings that arrive later, until the session ends, the client
-// cancels or the server stops.
+// StreamReadings' (and StreamReadingPoints') work for the Data service (data.h, over any
+// SessionCatalogue's reader: the rig's store, the archive): the request checked, then the
+// session's readings written in id order a page at a time (memory bounded by one page), and with
+// `follow` the readings that arrive later, until the session ends, the client cancels or the
+// server stops.
 #pragma once
 
 #include <functional>
@@ -14,6 +14,7 @@
 #include "daemon/api/common.h"
 #include "daemon/rpc/auth.h"
 #include "daemon/rpc/stream_registry.h"
+#include "daemon/wire/reading.h"
 #include "storage/session_reader.h"
 
 namespace brdf::daemon {
@@ -43,15 +44,15 @@ struct ReadingSource {
   // With follow, after a short page of a session not ended: waits a while for more; true when
   // the server is stopping (the stream then ends with UNAVAILABLE).
   std::function<bool()> wait;
-  std::string server = "the daemon";  // in the stopping message
+  std::string server = "the server";  // in the stopping message ("brdfd is shutting down; …")
   // The session's step labels and averaging (ReadingExtrasOf), for the readings that carry them:
   // StreamReadings asks once, before its first page; StreamReadingPoints never (a session of
   // 50,000 steps is 50,000 labels read for nothing).
   std::function<ReadingExtras()> extras;
 };
 
-// What a readings stream does once its request is checked and its source set up (the rig's and
-// the archive's Data services share their set-up between StreamReadings and StreamReadingPoints).
+// What a readings stream does once its request is checked and its source set up (the Data
+// service shares its set-up between StreamReadings and StreamReadingPoints).
 using ReadingStreamBody =
     std::function<grpc::Status(StreamReadingsCall& call, const ReadingSource& source)>;
 

@@ -1,21 +1,12 @@
 #include "daemon/engine/event_bus.h"
 
-#include <google/protobuf/util/time_util.h>
-
 #include <algorithm>
 #include <chrono>
 #include <utility>
 
+#include "daemon/wire/values.h"
+
 namespace brdf::daemon {
-namespace {
-
-google::protobuf::Timestamp NowTimestamp() {
-  const auto now = std::chrono::system_clock::now().time_since_epoch();
-  return google::protobuf::util::TimeUtil::NanosecondsToTimestamp(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(now).count());
-}
-
-}  // namespace
 
 EventSubscription::EventSubscription(std::size_t capacity)
     : capacity_(std::max<std::size_t>(capacity, 2)) {}

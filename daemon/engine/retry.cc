@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
-#include "daemon/engine/steps.h"
+#include "daemon/wire/values.h"
 
 namespace brdf::daemon {
 

@@ -1,12 +1,13 @@
 #include "daemon/engine/rig.h"
 
-#include <google/protobuf/util/time_util.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
 #include <shared_mutex>
 #include <utility>
+
+#include "daemon/wire/values.h"
 
 namespace brdf::daemon {
 namespace {
@@ -16,11 +17,6 @@ using std::chrono::steady_clock;
 
 // How long a caller waits for a device another thread holds before looking at its context again.
 constexpr milliseconds kLockSlice{20};
-
-google::protobuf::Timestamp ToTimestamp(std::chrono::system_clock::time_point t) {
-  return google::protobuf::util::TimeUtil::NanosecondsToTimestamp(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
-}
 
 v1::ConnectionState ToProto(DeviceConnection c) {
   switch (c) {
@@ -95,10 +91,7 @@ v1::RigStatus ToProto(const RigStatus& status) {
   if (!status.description.has_detector_arm && status.manual_delta_deg.has_value()) {
     pose.delta = *status.manual_delta_deg;
   }
-  out.mutable_live_pose()->set_alpha(pose.alpha);
-  out.mutable_live_pose()->set_beta(pose.beta);
-  out.mutable_live_pose()->set_gamma(pose.gamma);
-  out.mutable_live_pose()->set_delta(pose.delta);
+  *out.mutable_live_pose() = ToProtoPose(pose);
   out.set_live_pose_valid(status.live_pose.has_value());
   const plan::RigDescription& rig = status.description;
   struct AxisRow {

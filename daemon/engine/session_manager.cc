@@ -11,13 +11,14 @@
 
 #include "core/mutex.h"
 #include "core/plan/plan_json.h"
-#include "core/plan/plan_proto.h"
 #include "core/plan/plan_settings.h"
 #include "core/plan/plan_summary.h"
 #include "core/plan/sample.h"
 #include "core/plan/timing.h"
 #include "daemon/engine/executor.h"
-#include "daemon/engine/steps.h"
+#include "daemon/wire/enums.h"
+#include "daemon/wire/plan.h"
+#include "daemon/wire/session.h"
 
 namespace brdf::daemon {
 namespace {
@@ -241,55 +242,34 @@ struct SessionManager::Impl final : public ExecutorHost {
     const Live& l = live[id];
     const SessionState state = l.state.value_or(rec->state);
 
-    v1::Session s;
-    s.set_session_id(std::to_string(id));
-    s.set_name(rec->name);
-    s.set_state(ToProtoState(state));
-    // A plan that no longer parses is shown as none (PlanLocked logged it once).
+    // A plan that no longer parses is shown as none (PlanLocked logged it once); its summary and
+    // ETA are the default settings'.
     static const SessionPlan kNoPlan = MakeSessionPlan(v1::Plan());
     Result<std::shared_ptr<const SessionPlan>> kept = PlanLocked(id, &*rec);
-    const SessionPlan& plan = kept.ok() ? **kept : kNoPlan;
-    const plan::PlanSettings& settings = plan.settings;
-    if (with_plan) *s.mutable_plan() = plan.plan;
-    s.set_uuid(rec->uuid);
-    s.set_rig(rec->rig);
-    if (plan.plan.has_sample()) *s.mutable_sample() = plan.plan.sample();
-
+    const plan::PlanSettings& settings = kept.ok() ? (*kept)->settings : kNoPlan.settings;
     const std::vector<plan::Step> plan_steps = ToPlanSteps(*steps);
-    *s.mutable_summary() = plan::ToProto(
-        plan::SummarizeSteps(plan_steps, owner.options_.rig_description, settings.measurement));
+    const plan::PlanSummary summary =
+        plan::SummarizeSteps(plan_steps, owner.options_.rig_description, settings.measurement);
     const std::vector<plan::StepTime> times =
         plan::EstimateSteps(plan_steps, owner.options_.rig_description, settings.measurement);
     double eta = 0;
     for (std::size_t i = 0; i < steps->size() && i < times.size(); ++i) {
       if ((*steps)[i].state == storage::StepState::kPending) eta += times[i].estimate_s;
     }
-    const storage::StepTally tally = storage::TallySteps(*steps);
-    const int first_pending = tally.first_pending;
-    v1::Progress* progress = s.mutable_progress();
-    progress->set_done_steps(static_cast<std::uint32_t>(rec->done_steps));
-    progress->set_total_steps(static_cast<std::uint32_t>(rec->total_steps));
-    progress->set_done_samples(tally.done_samples);
-    progress->set_total_samples(tally.samples);
+
+    SessionFacts facts(*rec);
+    facts.live_state = l.state;
+    facts.live_reason = l.reason;
+    facts.plan = kept.ok() ? kept->get() : nullptr;
+    facts.with_plan = with_plan;
+    facts.steps = &*steps;
+    facts.summary = &summary;
     // A queued session has no running ETA: it has not started (or waits for another session).
-    s.set_eta_s(IsTerminal(state) || state == SessionState::kQueued ? 0 : eta);
-    const bool never_started = state == SessionState::kQueued && !rec->started_at.has_value();
-    s.set_current_step(never_started || IsTerminal(state) ? -1 : first_pending);
-    if (state == SessionState::kAwaitingOperator && l.prompt.has_value()) {
-      *s.mutable_pending_prompt() = *l.prompt;
-    }
-    if (l.last_fault.has_value()) *s.mutable_last_fault() = *l.last_fault;
-    s.set_last_quality_code(l.last_quality);
-    *s.mutable_created_at() = ToTimestamp(rec->created_at);
-    if (rec->started_at.has_value()) *s.mutable_started_at() = ToTimestamp(*rec->started_at);
-    if (rec->finished_at.has_value()) *s.mutable_finished_at() = ToTimestamp(*rec->finished_at);
-    if (state == SessionState::kAborted || state == SessionState::kFailed) {
-      s.set_end_reason(rec->state_reason);
-    }
-    if (state == SessionState::kQueued || state == SessionState::kPaused ||
-        state == SessionState::kPausing || IsTerminal(state)) {
-      s.set_state_reason(l.state.has_value() && !l.reason.empty() ? l.reason : rec->state_reason);
-    }
+    facts.eta_s = IsTerminal(state) || state == SessionState::kQueued ? 0 : eta;
+    facts.pending_prompt = l.prompt.has_value() ? &*l.prompt : nullptr;
+    facts.last_fault = l.last_fault.has_value() ? &*l.last_fault : nullptr;
+    facts.last_quality_code = l.last_quality;
+    v1::Session s = ToProtoSession(facts);
     if (IsTerminal(state) && !with_plan) terminal_cache[id] = s;
     return s;
   }

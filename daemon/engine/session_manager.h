@@ -55,6 +55,7 @@
 #include "core/status.h"
 #include "daemon/engine/event_bus.h"
 #include "daemon/engine/rig.h"
+#include "daemon/sessions/pause_mode.h"
 #include "daemon/sessions/session_id.h"
 #include "daemon/sessions/session_plan.h"
 #include "storage/records.h"
@@ -63,11 +64,6 @@
 namespace brdf::daemon {
 
 class Executor;
-
-enum class PauseMode {
-  kDeferred,   // finish the step in progress, then pause (the session is pausing until then)
-  kImmediate,  // cancel the step in progress now; resume redoes it
-};
 
 // Called after a reading is committed: (session, the stored reading with its id). The record is
 // the one the executor committed, complete for deriving from it (kind, pose, directions, grid,
@@ -121,7 +117,7 @@ class SessionManager {
   // --- Plans ----------------------------------------------------------------------------------
 
   // Checks and summarises a plan against this rig; stores nothing. The gRPC layer turns it into
-  // a ValidatePlanResponse with plan::ToValidatePlanResponse. The summary's times are for a rig
+  // a ValidatePlanResponse (wire/plan.h: ToValidatePlanResponse). The summary's times are for a rig
   // whose devices run `time_scale` (> 0) times faster (plan::AnalyzePlan).
   plan::PlanAnalysis ValidatePlan(const v1::Plan& plan, double time_scale = 1) const;
 

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "daemon/engine/steps.h"
+#include "daemon/wire/values.h"
 #include "storage/archive/pg.h"
 #include "storage/archive/schema.h"
 #include "storage/archive/writer.h"

@@ -1,0 +1,111 @@
+#include "daemon/rig/catalogue.h"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "daemon/api/common.h"
+
+namespace brdf::daemon {
+
+RigCatalogue::RigCatalogue(SessionManager& manager) : manager_(manager) {
+  listener_ = manager_.AddReadingListener([this](SessionId, const storage::ReadingRecord&) {
+    {
+      MutexLock lock(mu_);
+      ++generation_;
+    }
+    cv_.NotifyAll();
+  });
+}
+
+RigCatalogue::~RigCatalogue() {
+  manager_.RemoveReadingListener(listener_);
+}
+
+Result<v1::Session> RigCatalogue::GetSession(SessionId session) {
+  return manager_.GetSession(session);
+}
+
+namespace {
+
+// The session id a page token carries, or kInvalidArgument naming page_token.
+Result<std::optional<SessionId>> PageTokenId(const std::string& token) {
+  if (token.empty()) return std::optional<SessionId>();
+  SessionId id = 0;
+  if (ParseSessionIdField(token, "page_token", &id).ok()) return std::optional<SessionId>(id);
+  const std::string shown = token.size() <= kMaxSessionIdBytes
+                                ? "\"" + PrintablePrefix(token, kMaxSessionIdBytes) + "\""
+                                : "the " + std::to_string(token.size()) + "-byte token given";
+  return InvalidArgument("page_token: " + shown +
+                         " is not a token this daemon gave out; pass next_page_token as it was "
+                         "returned, or leave it empty for the first page");
+}
+
+}  // namespace
+
+Result<SessionPage> RigCatalogue::ListSessions(const CatalogueFilter& filter,
+                                               const std::string& page_token,
+                                               std::uint32_t page_size) {
+  // Sessions are listed newest (highest id) first, so the next page holds the ids below the
+  // token's. Stable under inserts.
+  Result<std::optional<SessionId>> before = PageTokenId(page_token);
+  if (!before.ok()) return before.status();
+  Result<std::vector<v1::Session>> sessions = manager_.ListSessions(filter.states);
+  if (!sessions.ok()) return sessions.status();
+  SessionPage page;
+  std::optional<SessionId> last;
+  for (v1::Session& s : *sessions) {
+    Result<SessionId> id = ParseSessionId(s.session_id());
+    if (!id.ok()) continue;
+    if (before->has_value() && *id >= **before) continue;
+    if (!filter.Matches(s)) continue;
+    if (page.sessions.size() == page_size) {
+      if (last.has_value()) page.next_page_token = std::to_string(*last);
+      break;
+    }
+    last = *id;
+    page.sessions.push_back(std::move(s));
+  }
+  return page;
+}
+
+storage::SessionReader& RigCatalogue::reader() {
+  return *manager_.store();
+}
+
+std::uint64_t RigCatalogue::Generation() const {
+  MutexLock lock(mu_);
+  return generation_;
+}
+
+void RigCatalogue::WaitForReading(std::uint64_t seen, std::chrono::steady_clock::duration d,
+                                  const StopSignal& stopping) const {
+  MutexLock lock(mu_);
+  cv_.WaitFor(mu_, d, [&]() REQUIRES(mu_) { return generation_ != seen || stopping.stopped(); });
+}
+
+SessionFollow RigCatalogue::Follow(SessionId session) {
+  auto seen = std::make_shared<std::uint64_t>(0);
+  SessionFollow follow;
+  follow.ended = [this, session, seen]() -> Result<bool> {
+    Result<storage::SessionRecord> now = manager_.store()->GetSession(session);
+    if (!now.ok()) return now.status();
+    *seen = Generation();
+    return IsTerminal(now->state);
+  };
+  follow.wait = [this, seen](const StopSignal& stopping) {
+    if (stopping.stopped()) return true;
+    WaitForReading(*seen, kStreamPollInterval, stopping);
+    return false;
+  };
+  return follow;
+}
+
+std::uint32_t RigCatalogue::Averages(SessionId session) {
+  Result<std::shared_ptr<const SessionPlan>> plan = manager_.Plan(session);
+  return plan.ok() ? (*plan)->plan.measurement().averages() : 0;
+}
+
+}  // namespace brdf::daemon
