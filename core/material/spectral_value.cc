@@ -57,32 +57,19 @@ double SpectralValue::At(double nm) const {
   return y0 + t * (y1 - y0);
 }
 
-double SpectralValue::Min() const {
+std::pair<double, double> SpectralValue::Range() const {
   switch (kind_) {
     case Kind::kConstant:
-      return value_;
+      return {value_, value_};
     case Kind::kBump:
-      return value_ + std::min(amplitude_, 0.0);
+      return {value_ + std::min(amplitude_, 0.0), value_ + std::max(amplitude_, 0.0)};
     case Kind::kTable:
       break;
   }
-  double m = points_.front().second;
-  for (const auto& p : points_) m = std::min(m, p.second);
-  return m;
-}
-
-double SpectralValue::Max() const {
-  switch (kind_) {
-    case Kind::kConstant:
-      return value_;
-    case Kind::kBump:
-      return value_ + std::max(amplitude_, 0.0);
-    case Kind::kTable:
-      break;
-  }
-  double m = points_.front().second;
-  for (const auto& p : points_) m = std::max(m, p.second);
-  return m;
+  const auto [lo, hi] =
+      std::minmax_element(points_.begin(), points_.end(),
+                          [](const auto& a, const auto& b) { return a.second < b.second; });
+  return {lo->second, hi->second};
 }
 
 }  // namespace brdf::material

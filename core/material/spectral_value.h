@@ -28,12 +28,13 @@ class SpectralValue {
   double At(double nm) const;
   // The least and the greatest value over all wavelengths (a table's extreme points; a bump's
   // base and base + amplitude).
-  double Min() const;
-  double Max() const;
+  double Min() const { return Range().first; }
+  double Max() const { return Range().second; }
   bool constant() const { return kind_ == Kind::kConstant; }
 
  private:
   enum class Kind { kConstant, kTable, kBump };
+  std::pair<double, double> Range() const;
 
   Kind kind_ = Kind::kConstant;
   double value_ = 0;  // the constant, or the bump's base
