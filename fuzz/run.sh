@@ -6,7 +6,7 @@
 #
 #   seconds-per-target  default 60 (--smoke: 8)
 #   target              pr650_reply pr650_framing stage_codec stage_rtu plan_json config interp_csv
-#                       stage_profile
+#                       stage_profile material
 #                       (default: all)
 #   --smoke             the CI pass: fresh scratch corpora, 8 s per target
 #   --no-build          run what build-fuzz/ already holds
@@ -22,7 +22,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${BUILD_DIR:-$root/build-fuzz}"
 jobs="${JOBS:-2}"
 all_targets=(pr650_reply pr650_framing stage_codec stage_rtu plan_json config interp_csv
-  stage_profile)
+  stage_profile material)
 
 smoke=0
 do_build=1

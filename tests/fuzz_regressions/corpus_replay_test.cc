@@ -24,6 +24,7 @@ int FuzzPlanJson(const std::uint8_t* data, std::size_t size);
 int FuzzConfig(const std::uint8_t* data, std::size_t size);
 int FuzzInterpCsv(const std::uint8_t* data, std::size_t size);
 int FuzzStageProfile(const std::uint8_t* data, std::size_t size);
+int FuzzMaterial(const std::uint8_t* data, std::size_t size);
 
 namespace {
 
@@ -77,6 +78,9 @@ TEST(FuzzCorpusReplay, StageProfile) {
 }
 TEST(FuzzCorpusReplay, InterpCsv) {
   EXPECT_GE(Replay("interp_csv", FuzzInterpCsv), 3u);
+}
+TEST(FuzzCorpusReplay, Material) {
+  EXPECT_GE(Replay("material", FuzzMaterial), 12u);
 }
 
 }  // namespace

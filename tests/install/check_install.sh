@@ -68,6 +68,10 @@ for profile in az leadshine moons; do
   grep -q "^name = \"$profile\"" "$prefix/share/brdfd/stage-profiles/$profile.toml" 2>/dev/null ||
     fail "share/brdfd/stage-profiles/$profile.toml is missing"
 done
+for material in paint glossy brushed gold; do
+  [[ -f "$prefix/share/brdfd/materials/$material.toml" ]] ||
+    fail "share/brdfd/materials/$material.toml is missing"
+done
 if [[ -x /usr/bin/python3 ]] && command -v grpc_python_plugin >/dev/null; then
   # The installed client generates its stubs from the installed .proto files and imports.
   out="$(cd / && BRDF_PY_STUBS="$prefix/stubs" /usr/bin/python3 -c "

@@ -295,5 +295,90 @@ TEST(SimConfigMeter, FlagAndFileChooseTheMeterAndItsCodes) {
   EXPECT_NE(refused.message().find("meter.model"), std::string::npos) << refused.message();
 }
 
+TEST(SimConfigTest, MaterialFromAFlagOrRelativeToTheConfigFile) {
+  SimConfig flag;
+  ASSERT_TRUE(ParseLikeMain({"--material", "/x/gold.toml"}, flag).ok());
+  EXPECT_EQ(flag.optics.material_path, "/x/gold.toml");
+
+  testing::TempDir dir;
+  const std::string path = dir.file("sim.toml").string();
+  std::ofstream(path) << "material = \"materials/gold.toml\"\n";
+  SimConfig file;
+  ASSERT_TRUE(ParseLikeMain({"--config", path}, file).ok());
+  EXPECT_EQ(file.optics.material_path, (dir.path() / "materials/gold.toml").string());
+  // A flag still wins, taken as given.
+  SimConfig both;
+  ASSERT_TRUE(ParseLikeMain({"--config", path, "--material", "here.toml"}, both).ok());
+  EXPECT_EQ(both.optics.material_path, "here.toml");
+}
+
+TEST(SimConfigTest, AMaterialAndABuiltInSampleAreTwoSamples) {
+  SimConfig c;
+  const Status s = ParseLikeMain({"--material", "gold.toml", "--glossy"}, c);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("--material and --anisotropic/--glossy"), std::string::npos)
+      << s.message();
+}
+
+TEST(SimConfigTest, ErrorSourcesFromTheFileAndFlags) {
+  SimConfig c;
+  ASSERT_TRUE(LoadConfigString(R"(
+[optics.errors]
+gain_noise = 0.001
+lamp_drift_per_hour = -0.002
+lamp_wander_per_sqrt_hour = 0.003
+white_error = 0.01
+pose_jitter_deg = 0.05
+wavelength_shift_nm = 0.5
+wavelength_shift_sigma_nm = 1.0
+stray_light = 0.0004
+[optics.detector]
+read_noise_counts = 35
+)",
+                               "t.toml", c)
+                  .ok());
+  const ErrorSources& e = c.optics.errors;
+  EXPECT_EQ(e.gain_noise, 0.001);
+  EXPECT_EQ(e.lamp_drift_per_hour, -0.002);
+  EXPECT_EQ(e.lamp_wander_per_sqrt_hour, 0.003);
+  EXPECT_EQ(e.white_error, 0.01);
+  EXPECT_EQ(e.pose_jitter_deg, 0.05);
+  EXPECT_EQ(e.wavelength_shift_nm, 0.5);
+  EXPECT_EQ(e.wavelength_shift_sigma_nm, 1.0);
+  EXPECT_EQ(e.stray_light, 0.0004);
+  EXPECT_EQ(c.optics.detector.read_noise_counts, 35);
+
+  SimConfig f;
+  ASSERT_TRUE(ParseLikeMain({"--gain-noise", "0.002", "--lamp-drift", "0.01", "--lamp-wander",
+                             "0.02", "--white-error", "0.005", "--pose-jitter", "0.1",
+                             "--wavelength-shift", "-1", "--wavelength-shift-sigma", "0.7",
+                             "--stray-light", "0.001", "--read-noise", "40"},
+                            f)
+                  .ok());
+  EXPECT_EQ(f.optics.errors.gain_noise, 0.002);
+  EXPECT_EQ(f.optics.errors.lamp_drift_per_hour, 0.01);
+  EXPECT_EQ(f.optics.errors.lamp_wander_per_sqrt_hour, 0.02);
+  EXPECT_EQ(f.optics.errors.white_error, 0.005);
+  EXPECT_EQ(f.optics.errors.pose_jitter_deg, 0.1);
+  EXPECT_EQ(f.optics.errors.wavelength_shift_nm, -1);
+  EXPECT_EQ(f.optics.errors.wavelength_shift_sigma_nm, 0.7);
+  EXPECT_EQ(f.optics.errors.stray_light, 0.001);
+  EXPECT_EQ(f.optics.detector.read_noise_counts, 40);
+}
+
+TEST(SimConfigTest, ErrorSourcesOutOfRangeAreNamed) {
+  SimConfig c;
+  const Status file =
+      LoadConfigString("[optics.errors]\nwhite_error = 0.5\nstray = 0.1\n", "t.toml", c);
+  EXPECT_NE(file.message().find("line 2, column 15: optics.errors.white_error: 0.5 is outside"),
+            std::string::npos)
+      << file.message();
+  EXPECT_NE(file.message().find("unknown key optics.errors.stray"), std::string::npos)
+      << file.message();
+  const Status flag = ParseLikeMain({"--pose-jitter", "-1"}, c);
+  EXPECT_EQ(flag.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(flag.message().find("--pose-jitter"), std::string::npos) << flag.message();
+}
+
 }  // namespace
 }  // namespace brdf::sim

@@ -27,6 +27,7 @@
 #include "tools/brdf-sim/rig_manual_detector.h"
 #include "tools/brdf-sim/rig_truth.h"
 #include "tools/brdf-sim/sim_config.h"
+#include "tools/brdf-sim/sim_material.h"
 #include "tools/brdf-sim/sim_shared.h"
 #include "tools/brdf-sim/stage_simulator.h"
 
@@ -151,8 +152,7 @@ int Run(const SimConfig& config, const sigset_t& stop_signals) {
       "{} mounted",
       MeterModelOf(config.meter), meter.path(), meter.slave_path(), config.modbus_host,
       stage.tcp_port(), config.rtu ? ", Modbus RTU on " : "", config.rtu ? stage.rtu_path() : "",
-      config.time_scale, config.optics.seed,
-      SampleName(config.optics.anisotropic, config.optics.glossy),
+      config.time_scale, config.optics.seed, optics.sample().name(),
       MountedTargetName(config.mounted));
 
   Announce(config.meter + " " + meter.path());
@@ -213,16 +213,19 @@ int main(int argc, char** argv) {
   }
 
   if (*truth_cmd) {
-    if (brdf::Status s = ValidateTruthQuery(truth); !s.ok()) {
-      std::fprintf(stderr, "brdf-sim: %s\n", s.ToString().c_str());
+    brdf::Result<brdf::material::Material> sample = TruthSample(truth, config.optics);
+    if (!sample.ok()) {
+      std::fprintf(stderr, "brdf-sim: %s\n", sample.status().ToString().c_str());
       return kUsageError;
     }
-    std::fputs(FormatTruth(truth).c_str(), stdout);
+    std::fputs(FormatTruth(truth, *sample).c_str(), stdout);
     return 0;
   }
 
   FinishFlags(app, config);
-  if (brdf::Status s = ValidateConfig(config); !s.ok()) {
+  brdf::Status valid = ValidateConfig(config);
+  if (valid.ok()) valid = LoadMountedMaterial(config.optics);
+  if (brdf::Status s = valid; !s.ok()) {
     std::fprintf(stderr, "brdf-sim: %s\n", s.ToString().c_str());
     return kUsageError;
   }

@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "core/geometry.h"
+#include "core/material/builtin_samples.h"
 
 namespace brdf::sim {
 namespace {
@@ -22,9 +23,9 @@ double CosAbove(double theta_deg) {
 
 }  // namespace
 
-AnalyticBrdf SampleBrdf(bool anisotropic, bool glossy) {
-  if (anisotropic) return AnalyticBrdf::Brushed();
-  return glossy ? AnalyticBrdf::Glossy() : AnalyticBrdf::PaintLike();
+material::Material SampleMaterial(bool anisotropic, bool glossy) {
+  if (anisotropic) return material::BrushedMaterial();
+  return glossy ? material::GlossyMaterial() : material::PaintMaterial();
 }
 
 const char* SampleName(bool anisotropic, bool glossy) {
@@ -32,9 +33,20 @@ const char* SampleName(bool anisotropic, bool glossy) {
   return glossy ? "glossy" : "paint-like";
 }
 
-std::vector<double> TrueBrdf(const Directions& directions, bool anisotropic, bool glossy) {
-  return SampleBrdf(anisotropic, glossy).EvaluateSpectrum(directions, WavelengthGrid::Pr650());
+material::Material MountedSample(const OpticsConfig& config) {
+  return config.material ? *config.material : SampleMaterial(config.anisotropic, config.glossy);
 }
+
+std::vector<double> TrueBrdf(const Directions& directions, bool anisotropic, bool glossy) {
+  return SampleMaterial(anisotropic, glossy).EvaluateSpectrum(directions, WavelengthGrid::Pr650());
+}
+
+namespace {
+WavelengthGrid Shifted(WavelengthGrid grid, double shift_nm) {
+  grid.start_nm += shift_nm;
+  return grid;
+}
+}  // namespace
 
 RigOptics::RigOptics(const StagePoseSource& stage, SimControl& control, OpticsConfig config)
     : stage_(stage),
@@ -42,8 +54,10 @@ RigOptics::RigOptics(const StagePoseSource& stage, SimControl& control, OpticsCo
       config_(config),
       lamp_(config.lamp),
       detector_(config.detector),
-      sample_(SampleBrdf(config.anisotropic, config.glossy)),
-      lamp_spectrum_(lamp_.Spectrum(Grid())),
+      sample_(MountedSample(config)),
+      errors_(config.errors, config.seed),
+      measured_grid_(Shifted(Grid(), errors_.wavelength_shift_nm())),
+      lamp_spectrum_(lamp_.Spectrum(measured_grid_)),
       rng_(config.seed) {}
 
 std::vector<double> RigOptics::TrueBrdf(const Directions& directions) const {
@@ -51,29 +65,41 @@ std::vector<double> RigOptics::TrueBrdf(const Directions& directions) const {
 }
 
 std::vector<double> RigOptics::ExpectedRadiance(MountedTarget target, const Pose& pose) const {
-  const WavelengthGrid grid = Grid();
+  const WavelengthGrid& grid = measured_grid_;
   std::vector<double> out(grid.count, config_.ambient_radiance);
   if (target == MountedTarget::kDark) return out;
 
+  // Without drift the factor is exactly 1 and leaves every product as it was.
+  const double lamp = errors_.LampFactor();
+  if (const double stray = errors_.sources().stray_light; stray > 0) {
+    for (std::size_t k = 0; k < grid.count; ++k) {
+      out[k] += stray * lamp_spectrum_[k] / std::numbers::pi * lamp;
+    }
+  }
   const Directions d = PoseToDirections(pose);
   const double cos_i = CosAbove(d.theta_i);
-  // The detector behind the surface sees only the holder's back: ambient light.
+  // The detector behind the surface sees only the holder's back: ambient (and stray) light.
   if (cos_i <= 0.0 || CosAbove(d.theta_o) <= 0.0) return out;
 
   if (target == MountedTarget::kWhite) {
-    const double lambertian = config_.white_reflectance / std::numbers::pi;
-    for (std::size_t k = 0; k < grid.count; ++k) out[k] += lamp_spectrum_[k] * lambertian * cos_i;
+    const double lambertian = config_.white_reflectance * errors_.white_factor() / std::numbers::pi;
+    for (std::size_t k = 0; k < grid.count; ++k) {
+      out[k] += lamp_spectrum_[k] * lambertian * cos_i * lamp;
+    }
     return out;
   }
   const std::vector<double> f = sample_.EvaluateSpectrum(d, grid);
-  for (std::size_t k = 0; k < grid.count; ++k) out[k] += lamp_spectrum_[k] * f[k] * cos_i;
+  for (std::size_t k = 0; k < grid.count; ++k) out[k] += lamp_spectrum_[k] * f[k] * cos_i * lamp;
   return out;
 }
 
 SimMeasurement RigOptics::Measure(const MeterSetup& setup) {
   const MountedTarget target = control_.mounted();
-  const Pose pose = stage_.LivePose();
-  const std::vector<double> expected = ExpectedRadiance(target, pose);
+  const Pose pose = errors_.TruePose(stage_.LivePose());
+  std::vector<double> expected = ExpectedRadiance(target, pose);
+  if (const double gain = errors_.NextGain(); gain != 1.0) {
+    for (double& e : expected) e = std::max(0.0, e * gain);
+  }
 
   const double peak = *std::max_element(expected.begin(), expected.end());
   const Exposure exposure = detector_.ChooseExposure(peak, setup);
@@ -95,6 +121,7 @@ SimMeasurement RigOptics::Measure(const MeterSetup& setup) {
       m.radiance[k] = std::clamp(expected[k] + sigma * unit(rng_), 0.0, saturation);
     }
   }
+  errors_.AdvanceLamp(m.duration_s);
   const double step = Grid().step_nm;
   for (double r : m.radiance) m.integrated += r * step;
   // What the meter chose, for timing the rig (bench/daemon/estimate.sh reads these lines).

@@ -5,12 +5,14 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string_view>
 
 #include "core/toml/table_reader.h"
+#include "tools/brdf-sim/rig_errors_settings.h"
 
 namespace brdf::sim {
 namespace {
@@ -108,6 +110,8 @@ void ReadOptics(TableReader& root, OpticsConfig& c) {
   lamp.Finish();
   TableReader detector = o.Sub("detector");
   ReadDetector(detector, c.detector);
+  TableReader errors = o.Sub("errors");
+  ReadErrorSources(errors, c.errors);
   o.Finish();
 }
 
@@ -156,6 +160,7 @@ void ReadTable(TableReader& root, SimConfig& c) {
   Get(root, "seed", c.optics.seed);
   Get(root, "anisotropic", c.optics.anisotropic);
   Get(root, "glossy", c.optics.glossy);
+  Get(root, "material", c.optics.material_path);
   Get(root, "log_level", c.log_level);
   std::string mounted;
   if (root.OneOf("mounted", mounted, {"sample", "white", "dark"})) {
@@ -246,7 +251,15 @@ Status LoadConfigFile(const std::string& path, SimConfig& config) {
   }
   std::ostringstream text;
   text << in.rdbuf();
-  return LoadConfigString(text.str(), path, config);
+  const std::string material_before = config.optics.material_path;
+  BRDF_RETURN_IF_ERROR(LoadConfigString(text.str(), path, config));
+  // A material the file names is found relative to the file.
+  std::string& material = config.optics.material_path;
+  if (material != material_before && !material.empty() &&
+      std::filesystem::path(material).is_relative()) {
+    material = (std::filesystem::path(path).parent_path() / material).string();
+  }
+  return Status::Ok();
 }
 
 void AddRunFlags(CLI::App& app, SimConfig& c) {
@@ -294,7 +307,12 @@ void AddRunFlags(CLI::App& app, SimConfig& c) {
                                                         {"dark", MountedTarget::kDark}};
   app.add_option("--mounted", c.mounted, "What is on the holder at start: sample, white or dark")
       ->transform(CLI::CheckedTransformer(targets, CLI::ignore_case));
+  app.add_option("--material", c.optics.material_path,
+                 "Mount the sample in this material file (docs/materials.md; deploy/materials/)");
   app.add_option("--noise-scale", c.optics.noise_scale, "Scale the meter's noise (0 = none)");
+  app.add_option("--read-noise", c.optics.detector.read_noise_counts,
+                 "The detector's read noise, counts (shot noise: full_well_counts at full scale)");
+  AddErrorFlags(app, c.optics.errors);
   app.add_option("--log-level", c.log_level, "trace, debug, info, warn, error or off");
 
   for (std::size_t i = 0; i < kAxisNames.size(); ++i) {
@@ -353,6 +371,7 @@ void AddTruthFlags(CLI::App& truth, TruthQuery& q) {
   phi->excludes(phi_i)->excludes(phi_o);
   truth.add_flag("--anisotropic", q.anisotropic, "The brushed (anisotropic) sample");
   truth.add_flag("--glossy", q.glossy, "The glossy isotropic sample");
+  truth.add_option("--material", q.material_path, "The sample in this material file");
   truth.add_flag("--json", q.json, "Print JSON instead of two columns");
 }
 
@@ -396,6 +415,11 @@ Status ValidateRun(const SimConfig& c) {
   if (c.optics.anisotropic && c.optics.glossy) {
     return InvalidArgument(
         "--anisotropic and --glossy name two samples; mount one (the glossy sample is isotropic)");
+  }
+  if (!c.optics.material_path.empty() && (c.optics.anisotropic || c.optics.glossy)) {
+    return InvalidArgument(
+        "--material and --anisotropic/--glossy name two samples; mount one (deploy/materials/ "
+        "has brushed.toml and glossy.toml)");
   }
   if (!Finite(c.manual_delta_deg) || c.manual_delta_deg < 0 || c.manual_delta_deg > 180) {
     return InvalidArgument("manual detector angle must be 0–180 deg; fix --manual-delta");
@@ -500,7 +524,7 @@ Status ValidateOptics(const SimConfig& c) {
         "read_noise_counts >= 0, 0 <= weak_fill <= low_light_fill, overhead_s >= 0, "
         "1 <= min_integration_ms <= max_integration_ms");
   }
-  return Status::Ok();
+  return ValidateErrorSources(o.errors);
 }
 
 Status ValidateLogLevel(const SimConfig& c) {

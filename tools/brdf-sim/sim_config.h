@@ -74,8 +74,9 @@ struct SimConfig {
   SerialFaults serial_faults;
   ModbusFaults modbus_faults;
 
-  // Lamp, detector, white standard, ambient level, noise; also --seed (optics.seed) and
-  // --anisotropic (optics.anisotropic), which only the optics use.
+  // Lamp, detector, white standard, ambient level, noise, the rig's known errors; also --seed
+  // (optics.seed), --anisotropic, --glossy and --material (the sample), which only the optics
+  // use.
   OpticsConfig optics;
 
   std::string log_level = "info";  // trace, debug, info, warn, error, off
@@ -86,6 +87,7 @@ struct TruthQuery {
   Directions directions;
   bool anisotropic = false;
   bool glossy = false;
+  std::string material_path;  // --material: the sample in a material file
   bool json = false;
 };
 
@@ -106,7 +108,8 @@ std::optional<MountedTarget> ParseMountedTarget(const std::string& name);
 std::optional<std::string> FindConfigPath(int argc, const char* const* argv);
 
 // Reads a TOML file over `config`. Unknown keys are errors (a typo must not go unnoticed). The
-// message names the file, the key and what is expected.
+// message names the file, the key and what is expected. A relative `material` path in the file
+// is taken relative to the file's directory.
 Status LoadConfigFile(const std::string& path, SimConfig& config);
 Status LoadConfigString(const std::string& toml_text, const std::string& source_name,
                         SimConfig& config);
