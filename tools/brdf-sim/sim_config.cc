@@ -262,23 +262,14 @@ Status LoadConfigFile(const std::string& path, SimConfig& config) {
   return Status::Ok();
 }
 
-void AddRunFlags(CLI::App& app, SimConfig& c) {
-  // Read beforehand (FindConfigPath); registered so that it is accepted and documented.
-  app.add_option("--config", c.config_path, "TOML file with settings; flags override it");
+namespace {
 
-  app.add_option("--time-scale", c.time_scale, "Simulated time runs this many times faster");
+// The meter on the pty and its link: model, serial, PR-650 pacing and wire variants.
+void AddMeterFlags(CLI::App& app, SimConfig& c) {
   app.add_option("--meter", c.meter,
                  "The meter on the pty: pr650, pr670 (pr655), cs2000 (cs2000a, cs3000)")
       ->check(CLI::IsMember({"pr650", "pr655", "pr670", "cs2000", "cs2000a", "cs3000"}));
   app.add_option("--meter-serial", c.meter_serial, "The serial number the meter reports");
-  app.add_option("--seed", c.optics.seed, "Noise seed (same seed, same readings)");
-  app.add_option("--modbus-host", c.modbus_host, "Address the Modbus TCP server listens on");
-  app.add_option("--modbus-port", c.modbus_port, "Modbus TCP port (0 = pick a free one)");
-  app.add_flag("--rtu", c.rtu, "Also serve Modbus RTU on a pseudo-terminal");
-  app.add_flag("!--no-detector-arm", c.detector_arm,
-               "No motorized detector arm (no unit 4): the operator places the detector");
-  app.add_option("--manual-delta", c.manual_delta_deg,
-                 "Without the arm: the detector angle δ the operator set, deg");
   app.add_flag("--pacing,!--no-pacing", c.pacing, "Pace PR-650 replies at 9600 baud");
   app.add_option("--fifo-bytes", c.fifo_bytes,
                  "With pacing: reply bytes reach the port in bursts of this many (a UART's "
@@ -292,12 +283,27 @@ void AddRunFlags(CLI::App& app, SimConfig& c) {
                "End the D5 header line \"qq,U\" with a bare CR (a quoted manual's variant)");
   app.add_flag("--pr650-m0-quality", c.m0_reply_is_quality,
                "M0 answers the quality code (\"018\") instead of the meter's \"000\"");
+}
+
+// The stage's drives: register conventions, then each axis's homing speed and travel limits.
+void AddStageFlags(CLI::App& app, SimConfig& c) {
   app.add_option("--stage-function-codes", c.stage_function_codes,
                  "Function codes the drives answer: az (3,6,8,16), leadshine, moons, or a list");
   app.add_option("--stage-word-order", c.stage_word_order,
                  "32-bit values in two registers: upper_first (AZ default) or lower_first");
   app.add_option("--stage-ramp-unit", c.stage_ramp_unit,
                  "Unit of the drives' ramp rates: khz_per_s (AZ default), s or ms_per_khz");
+  for (std::size_t i = 0; i < kAxisNames.size(); ++i) {
+    const std::string n = kAxisNames[i];
+    app.add_option("--" + n + "-home-speed", c.axes[i].home_speed_deg_s,
+                   "Homing speed of " + n + ", deg/s (moves run at the speed the driver writes)");
+    app.add_option("--" + n + "-min", c.axes[i].min_deg, "Lower travel limit of " + n + ", deg");
+    app.add_option("--" + n + "-max", c.axes[i].max_deg, "Upper travel limit of " + n + ", deg");
+  }
+}
+
+// What is mounted and how the meter sees it: the sample or a material file, noise and errors.
+void AddSampleFlags(CLI::App& app, SimConfig& c) {
   app.add_flag("--anisotropic", c.optics.anisotropic, "Mount the brushed (anisotropic) sample");
   app.add_flag("--glossy", c.optics.glossy,
                "Mount the glossy isotropic sample (AnalyticBrdf::Glossy: the paint's base under a "
@@ -313,16 +319,10 @@ void AddRunFlags(CLI::App& app, SimConfig& c) {
   app.add_option("--read-noise", c.optics.detector.read_noise_counts,
                  "The detector's read noise, counts (shot noise: full_well_counts at full scale)");
   AddErrorFlags(app, c.optics.errors);
-  app.add_option("--log-level", c.log_level, "trace, debug, info, warn, error or off");
+}
 
-  for (std::size_t i = 0; i < kAxisNames.size(); ++i) {
-    const std::string n = kAxisNames[i];
-    app.add_option("--" + n + "-home-speed", c.axes[i].home_speed_deg_s,
-                   "Homing speed of " + n + ", deg/s (moves run at the speed the driver writes)");
-    app.add_option("--" + n + "-min", c.axes[i].min_deg, "Lower travel limit of " + n + ", deg");
-    app.add_option("--" + n + "-max", c.axes[i].max_deg, "Upper travel limit of " + n + ", deg");
-  }
-
+// Faults to inject on the serial line and the Modbus link.
+void AddFaultFlags(CLI::App& app, SimConfig& c) {
   SerialFaults& s = c.serial_faults;
   app.add_flag("--serial-silent", s.silent, "Fault: the PR-650 answers nothing");
   app.add_option("--serial-garbage-next", s.garbage_next, "Fault: next N replies are garbage");
@@ -347,6 +347,27 @@ void AddRunFlags(CLI::App& app, SimConfig& c) {
   app.add_flag("--modbus-alarm-mid-move", m.alarm_mid_move,
                "Fault: the next move raises an alarm half-way");
   app.add_flag("--modbus-stall", m.stall, "Fault: the next move never clears MOVE");
+}
+
+}  // namespace
+
+void AddRunFlags(CLI::App& app, SimConfig& c) {
+  // Read beforehand (FindConfigPath); registered so that it is accepted and documented.
+  app.add_option("--config", c.config_path, "TOML file with settings; flags override it");
+  app.add_option("--time-scale", c.time_scale, "Simulated time runs this many times faster");
+  app.add_option("--seed", c.optics.seed, "Noise seed (same seed, same readings)");
+  app.add_option("--modbus-host", c.modbus_host, "Address the Modbus TCP server listens on");
+  app.add_option("--modbus-port", c.modbus_port, "Modbus TCP port (0 = pick a free one)");
+  app.add_flag("--rtu", c.rtu, "Also serve Modbus RTU on a pseudo-terminal");
+  app.add_flag("!--no-detector-arm", c.detector_arm,
+               "No motorized detector arm (no unit 4): the operator places the detector");
+  app.add_option("--manual-delta", c.manual_delta_deg,
+                 "Without the arm: the detector angle δ the operator set, deg");
+  app.add_option("--log-level", c.log_level, "trace, debug, info, warn, error or off");
+  AddMeterFlags(app, c);
+  AddStageFlags(app, c);
+  AddSampleFlags(app, c);
+  AddFaultFlags(app, c);
 }
 
 void FinishFlags(CLI::App& app, SimConfig& c) {
