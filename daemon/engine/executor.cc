@@ -8,7 +8,9 @@
 #include "core/plan/timing.h"
 #include "daemon/engine/reading_step.h"
 #include "daemon/engine/retry.h"
-#include "daemon/engine/steps.h"
+#include "daemon/wire/enums.h"
+#include "daemon/wire/plan.h"
+#include "daemon/wire/values.h"
 
 namespace brdf::daemon {
 namespace {
