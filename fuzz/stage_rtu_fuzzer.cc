@@ -1,8 +1,9 @@
 // Fuzz target: the simulator's side of the stage bus, which the driver's tests and the fault
-// campaign trust: the RTU frame splitter and CRC (tools/brdf-sim/stage_rtu_frame.h), the PDU
-// layer (stage_pdu.h) and the simulated drives and control unit behind it (stage_sim_axis.h,
-// stage_control_unit.h), on simulated time. Then the driver's codec reads the drive's status and
-// position back over the same PDU layer and must agree with the drive.
+// campaign trust: the RTU frame splitter and CRC (tools/brdf-sim/stage/rtu_frame.h), the PDU
+// layer (tools/brdf-sim/stage/pdu.h) and the simulated drives and control unit behind it
+// (tools/brdf-sim/stage/sim_axis.h, tools/brdf-sim/stage/control_unit.h), on simulated time. Then
+// the driver's codec reads the drive's status and position back over the same PDU layer and must
+// agree with the drive.
 //
 // Input: chunks of [control] [length] [bytes...]; control's low 5 bits are the pause before the
 // chunk in 10 ms units, bit 5 asks the splitter to expire stale bytes first, bit 6 appends a
@@ -25,10 +26,10 @@
 #include "drivers/stage/modbus_codec.h"
 #include "drivers/stage/register_profile.h"
 #include "fuzz/fuzz_check.h"
-#include "tools/brdf-sim/stage_control_unit.h"
-#include "tools/brdf-sim/stage_pdu.h"
-#include "tools/brdf-sim/stage_rtu_frame.h"
-#include "tools/brdf-sim/stage_sim_axis.h"
+#include "tools/brdf-sim/stage/control_unit.h"
+#include "tools/brdf-sim/stage/pdu.h"
+#include "tools/brdf-sim/stage/rtu_frame.h"
+#include "tools/brdf-sim/stage/sim_axis.h"
 
 namespace brdf::fuzz {
 namespace {

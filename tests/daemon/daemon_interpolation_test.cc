@@ -24,7 +24,7 @@
 #include "tests/daemon/interpolation_rig_test.h"
 #include "tests/support/daemon_test_rig.h"
 #include "tests/support/plan_fixtures.h"
-#include "tools/brdf-sim/optics.h"
+#include "tools/brdf-sim/optics/optics.h"
 
 namespace brdf::testing {
 namespace {

@@ -4,7 +4,7 @@
 // drivers, and every reading's BRDF, recomputed from the raw spectra it stored, matches what
 // `brdf-sim truth --material gold.toml` prints at the reading's directions within that noise:
 //   |f − truth| ≤ 5 σf + q   in every band,
-// where σf propagates the detector's noise model (tools/brdf-sim/rig_detector.h) and the meter's
+// where σf propagates the detector's noise model (tools/brdf-sim/optics/detector.h) and the meter's
 // 4-digit printout through f = (I − D) / (I0 − D) · ρw / π · cos θi,ref / cos θi, and q bounds
 // the stage's quantisation (half a count, 0.018°, on each axis) through the truth's own slope.
 // The errors normalised by σf must also spread as the noise does (RMS near 1): the readings are
@@ -26,8 +26,8 @@
 #include "tests/support/daemon_test_rig.h"
 #include "tests/support/plan_fixtures.h"
 #include "tests/support/rig_teardown.h"
-#include "tools/brdf-sim/rig_detector.h"
-#include "tools/brdf-sim/sim_material.h"
+#include "tools/brdf-sim/optics/detector.h"
+#include "tools/brdf-sim/optics/material.h"
 
 namespace brdf::testing {
 namespace {

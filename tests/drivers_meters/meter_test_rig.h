@@ -14,8 +14,8 @@
 #include "core/wavelength_grid.h"
 #include "drivers/cs2000/cs2000_options.h"
 #include "drivers/pr670/pr670_options.h"
-#include "tools/brdf-sim/cs2000_endpoint.h"
-#include "tools/brdf-sim/pr670_endpoint.h"
+#include "tools/brdf-sim/meter/cs2000_endpoint.h"
+#include "tools/brdf-sim/meter/pr670_endpoint.h"
 #include "tools/brdf-sim/sim_shared.h"
 
 namespace brdf::testing {

@@ -1,6 +1,6 @@
 // The simulator's PR-650 endpoint on its own, through a plain POSIX client on the pty: the exact
 // bytes of each reply, setup checking, remote-mode entry, faults.
-#include "tools/brdf-sim/pr650_endpoint.h"
+#include "tools/brdf-sim/meter/pr650_endpoint.h"
 
 #include <fcntl.h>
 #include <gmock/gmock.h>
@@ -18,7 +18,7 @@
 #include "core/wavelength_grid.h"
 #include "drivers/pr650/pr650_protocol.h"
 #include "tests/drivers_pr650/pr650_test_rig.h"
-#include "tools/brdf-sim/pr650_sim_protocol.h"
+#include "tools/brdf-sim/meter/pr650_protocol.h"
 
 namespace brdf::testing {
 namespace {

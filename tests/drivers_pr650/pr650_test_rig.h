@@ -15,7 +15,7 @@
 
 #include "drivers/pr650/pr650_options.h"
 #include "drivers/pr650/pr650_spectroradiometer.h"
-#include "tools/brdf-sim/pr650_endpoint.h"
+#include "tools/brdf-sim/meter/pr650_endpoint.h"
 #include "tools/brdf-sim/sim_shared.h"
 
 namespace brdf::testing {

@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "tests/drivers_stage/stage_test_rig.h"
-#include "tools/brdf-sim/stage_control_map.h"
+#include "tools/brdf-sim/stage/control_map.h"
 
 namespace brdf::testing {
 namespace {

@@ -7,9 +7,9 @@
 #include <thread>
 #include <vector>
 
-#include "tools/brdf-sim/stage_control_map.h"
-#include "tools/brdf-sim/stage_rtu_frame.h"
-#include "tools/brdf-sim/stage_simulator.h"
+#include "tools/brdf-sim/stage/control_map.h"
+#include "tools/brdf-sim/stage/rtu_frame.h"
+#include "tools/brdf-sim/stage/simulator.h"
 
 namespace brdf::sim {
 namespace {

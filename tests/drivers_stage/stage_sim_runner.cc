@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "tools/brdf-sim/stage_simulator.h"
+#include "tools/brdf-sim/stage/simulator.h"
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;

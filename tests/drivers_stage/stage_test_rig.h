@@ -12,7 +12,7 @@
 
 #include "drivers/stage/modbus_stage.h"
 #include "tests/drivers_stage/scaled_clock.h"
-#include "tools/brdf-sim/stage_simulator.h"
+#include "tools/brdf-sim/stage/simulator.h"
 
 namespace brdf::testing {
 

@@ -5,7 +5,7 @@ window, any free Modbus port), writes a brdfd configuration for it (any free gRP
 database in a temporary directory, an operator and an analyst token, a motorized detector arm as
 the simulator has one) and starts brdfd, then waits for "brdfd listening on <address>". The
 operator's manual actions are done on the simulator through its Modbus control unit (unit 100,
-register 0: 0 sample, 1 white, 2 dark; tools/brdf-sim/stage_control_map.h) with the plain-socket
+register 0: 0 sample, 1 white, 2 dark; tools/brdf-sim/stage/control_map.h) with the plain-socket
 Modbus client of tools/check/modbus_probe.py.
 """
 

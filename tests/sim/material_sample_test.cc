@@ -13,9 +13,9 @@
 #include "core/geometry.h"
 #include "tests/support/sim_process.h"
 #include "tests/support/test_env.h"
-#include "tools/brdf-sim/optics.h"
-#include "tools/brdf-sim/rig_truth.h"
-#include "tools/brdf-sim/sim_material.h"
+#include "tools/brdf-sim/optics/material.h"
+#include "tools/brdf-sim/optics/optics.h"
+#include "tools/brdf-sim/optics/truth.h"
 
 namespace brdf::sim {
 namespace {

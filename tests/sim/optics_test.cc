@@ -1,7 +1,7 @@
 // The optical model behind the simulated PR-650: what the meter reads for the sample, the white
 // standard and the dark shutter at a pose, and how the detector's light level shows in the
 // integration time and the quality code.
-#include "tools/brdf-sim/optics.h"
+#include "tools/brdf-sim/optics/optics.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "tools/brdf-sim/rig_manual_detector.h"
+#include "tools/brdf-sim/optics/manual_detector.h"
 
 namespace brdf::sim {
 namespace {

@@ -1,8 +1,6 @@
-// The rig's known errors (tools/brdf-sim/rig_errors.h) as the simulated meter shows them: off by
+// The rig's known errors (tools/brdf-sim/optics/errors.h) as the simulated meter shows them: off by
 // default (no reading moves), each one's effect on sample, white and dark readings against its
 // stated model, each reproducible from the seed, and each drawn from its own stream.
-#include "tools/brdf-sim/rig_errors.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,7 +8,8 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "tools/brdf-sim/optics.h"
+#include "tools/brdf-sim/optics/errors.h"
+#include "tools/brdf-sim/optics/optics.h"
 
 namespace brdf::sim {
 namespace {

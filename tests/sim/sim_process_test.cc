@@ -24,7 +24,7 @@
 #include "core/geometry.h"
 #include "tests/support/modbus_control.h"
 #include "tests/support/test_env.h"
-#include "tools/brdf-sim/optics.h"
+#include "tools/brdf-sim/optics/optics.h"
 
 namespace brdf::sim {
 namespace {

@@ -7,7 +7,7 @@
 #include <thread>
 #include <vector>
 
-#include "tools/brdf-sim/stage_simulator.h"
+#include "tools/brdf-sim/stage/simulator.h"
 
 namespace brdf::sim {
 namespace {

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "tools/brdf-sim/stage_rtu_frame.h"
-#include "tools/brdf-sim/stage_simulator.h"
+#include "tools/brdf-sim/stage/rtu_frame.h"
+#include "tools/brdf-sim/stage/simulator.h"
 
 namespace brdf::sim {
 namespace {

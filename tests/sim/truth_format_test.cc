@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "core/analytic_brdf.h"
-#include "tools/brdf-sim/optics.h"
-#include "tools/brdf-sim/rig_truth.h"
+#include "tools/brdf-sim/optics/optics.h"
+#include "tools/brdf-sim/optics/truth.h"
 
 namespace brdf::sim {
 namespace {

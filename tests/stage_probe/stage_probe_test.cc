@@ -13,7 +13,7 @@
 #include <string>
 
 #include "drivers/stage/profile_file.h"
-#include "tools/brdf-sim/stage_simulator.h"
+#include "tools/brdf-sim/stage/simulator.h"
 
 namespace brdf::tools::stage_probe {
 namespace {

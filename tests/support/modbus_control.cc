@@ -5,14 +5,14 @@
 #include <cerrno>
 #include <cmath>
 
-#include "tools/brdf-sim/stage_control_map.h"
+#include "tools/brdf-sim/stage/control_map.h"
 
 namespace brdf::testing {
 namespace {
 
 namespace map = sim::control_map;
 
-// The simulated drives' feedback position register (tools/brdf-sim/stage_sim_axis.h).
+// The simulated drives' feedback position register (tools/brdf-sim/stage/sim_axis.h).
 constexpr std::uint16_t kFeedbackPosition = 0x00CC;
 
 std::uint16_t Word(int value) {

@@ -1,6 +1,6 @@
 // Acts as the operator on a running brdf-sim: writes the control unit's holding registers (what is
 // mounted in front of the meter, the meter's power, injected faults) over Modbus TCP, using the
-// register map in tools/brdf-sim/stage_control_map.h. Also reads an axis' feedback position, so a
+// register map in tools/brdf-sim/stage/control_map.h. Also reads an axis' feedback position, so a
 // test can see where the simulated stage is without a stage driver.
 //
 // One instance, one connection, one thread at a time (a libmodbus context is not thread-safe).

@@ -20,16 +20,16 @@
 #include <string>
 
 #include "daemon/config/startup.h"
-#include "tools/brdf-sim/cs2000_endpoint.h"
-#include "tools/brdf-sim/optics.h"
-#include "tools/brdf-sim/pr650_endpoint.h"
-#include "tools/brdf-sim/pr670_endpoint.h"
-#include "tools/brdf-sim/rig_manual_detector.h"
-#include "tools/brdf-sim/rig_truth.h"
+#include "tools/brdf-sim/meter/cs2000_endpoint.h"
+#include "tools/brdf-sim/meter/pr650_endpoint.h"
+#include "tools/brdf-sim/meter/pr670_endpoint.h"
+#include "tools/brdf-sim/optics/manual_detector.h"
+#include "tools/brdf-sim/optics/material.h"
+#include "tools/brdf-sim/optics/optics.h"
+#include "tools/brdf-sim/optics/truth.h"
 #include "tools/brdf-sim/sim_config.h"
-#include "tools/brdf-sim/sim_material.h"
 #include "tools/brdf-sim/sim_shared.h"
-#include "tools/brdf-sim/stage_simulator.h"
+#include "tools/brdf-sim/stage/simulator.h"
 
 namespace brdf::sim {
 namespace {

@@ -12,7 +12,7 @@
 #include <string_view>
 
 #include "core/toml/table_reader.h"
-#include "tools/brdf-sim/rig_errors_settings.h"
+#include "tools/brdf-sim/optics/errors_settings.h"
 
 namespace brdf::sim {
 namespace {

@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "core/status.h"
-#include "tools/brdf-sim/optics.h"
+#include "tools/brdf-sim/optics/optics.h"
 #include "tools/brdf-sim/sim_shared.h"
-#include "tools/brdf-sim/stage_pdu.h"
-#include "tools/brdf-sim/stage_sim_axis.h"
+#include "tools/brdf-sim/stage/pdu.h"
+#include "tools/brdf-sim/stage/sim_axis.h"
 
 namespace CLI {
 class App;

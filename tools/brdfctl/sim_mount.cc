@@ -8,7 +8,7 @@
 #include <iostream>
 #include <memory>
 
-#include "tools/brdf-sim/stage_control_map.h"
+#include "tools/brdf-sim/stage/control_map.h"
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/rpc_error.h"
 

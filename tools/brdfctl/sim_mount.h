@@ -1,7 +1,7 @@
 // SIMULATOR ONLY. `brdfctl sim-mount sample|white|dark|from-prompt --modbus HOST:PORT` does by
 // remote what the operator does by hand on a real rig: it puts the sample, the white standard or
 // the closed shutter in front of brdf-sim's meter, by writing register 0 of brdf-sim's control unit
-// (tools/brdf-sim/stage_control_map.h) over Modbus TCP. A real rig has no such register; on one,
+// (tools/brdf-sim/stage/control_map.h) over Modbus TCP. A real rig has no such register; on one,
 // this command fails to connect or writes nothing that matters — do not point it at real drives.
 // `from-prompt` reads BRDF_PROMPT_KIND (set by `watch --on-prompt`, prompt_hook.h) and mounts what
 // the prompt asks for: mount_white → white, mount_sample → sample, close_shutter → dark; other
