@@ -2,7 +2,7 @@
 
 #include <unordered_map>
 
-#include "core/export/grid_text.h"
+#include "core/export/grid/text.h"
 #include "core/export/number_text.h"
 
 namespace brdf::exports {

@@ -3,7 +3,7 @@
 // The transform. An isotropic point (θi, θo, φ) stands for the directions ωi = (θi, 0) and
 // ωo = (θo, φ) (core/geometry.h: CanonicalDirections). The half vector h = (ωi + ωo)/|ωi + ωo| is
 // at (θh, φh); the difference vector d = Ry(−θh) · Rz(−φh) · ωi (ωi seen from a frame whose pole
-// is h) is at (θd, φd). MERL's tables use the same vectors (core/export/merl_layout.h). Degrees.
+// is h) is at (θd, φd). MERL's tables use the same vectors (core/export/merl/layout.h). Degrees.
 //   θh in [0, 90]: 0 is the mirror configuration (ωo is ωi reflected about the normal); a
 //     specular lobe varies along θh and slowly along θd, φd.
 //   θd in [0, 90]: the angle between ωi and h (0: retro-reflection, ωi = ωo).

@@ -16,9 +16,9 @@
 #include <utility>
 #include <vector>
 
-#include "core/export/fill_chain.h"
-#include "core/export/session_interpolant.h"
-#include "core/export/spectrum_source.h"
+#include "core/export/fill/chain.h"
+#include "core/export/fill/session_interpolant.h"
+#include "core/export/fill/spectrum_source.h"
 #include "core/fit/fit.h"
 #include "daemon/api/interpolation.h"
 #include "daemon/wire/values.h"
@@ -156,7 +156,7 @@ std::string DeterministicBytes(const google::protobuf::Message& message) {
   return bytes;
 }
 
-// The exports' fill chain (core/export/fill_chain.h) over the cache's indexes, as the sphere's
+// The exports' fill chain (core/export/fill/chain.h) over the cache's indexes, as the sphere's
 // BRDF: the index asked for, then (another method's) the Delaunay fallback, then the model fitted
 // to the samples. The last two are made only when a direction first needs them.
 class AppearanceChain {

@@ -7,11 +7,11 @@
 // the export (its CancelToken) at the next progress report or chunk.
 //
 // The exports are the same code as brdf-export's (storage/session_readings.h: the session;
-// data/cie_tables.h: the CIE tables; core/export: the formats; core/export/session_interpolant.h:
-// the interpolant behind the fill chain, and the RGL material), so a file from the daemon and one
-// from the tool are the same bytes for the same session and options. Grids, MERL and RGL fill
-// through the chain unless the request's fill is NONE, and the report counts each cell's
-// provenance (ExportReport.fill).
+// data/cie_tables.h: the CIE tables; core/export: the formats;
+// core/export/fill/session_interpolant.h: the interpolant behind the fill chain, and the RGL
+// material), so a file from the daemon and one from the tool are the same bytes for the same
+// session and options. Grids, MERL and RGL fill through the chain unless the request's fill is
+// NONE, and the report counts each cell's provenance (ExportReport.fill).
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
@@ -25,18 +25,18 @@
 #include <vector>
 
 #include "core/call_context.h"
-#include "core/export/fill_chain.h"
-#include "core/export/grid_text.h"
-#include "core/export/merl_export.h"
-#include "core/export/npy_writer.h"
+#include "core/export/fill/chain.h"
+#include "core/export/fill/session_interpolant.h"
+#include "core/export/fill/spectrum_source.h"
+#include "core/export/grid/npy_writer.h"
+#include "core/export/grid/regular_grid.h"
+#include "core/export/grid/text.h"
+#include "core/export/merl/writer.h"
 #include "core/export/readings_csv.h"
-#include "core/export/regular_grid.h"
-#include "core/export/rgl_export.h"
+#include "core/export/rgl/writer.h"
 #include "core/export/run_control.h"
 #include "core/export/session_data.h"
-#include "core/export/session_interpolant.h"
 #include "core/export/spectral_rgb.h"
-#include "core/export/spectrum_source.h"
 #include "daemon/api/export_session.h"
 #include "data/cie_tables.h"
 #include "storage/session_readings.h"
@@ -354,7 +354,7 @@ void AddSkipped(const std::vector<exports::SkippedReading>& skipped, v1::ExportR
 }
 
 // The session's interpolant over the derived quantity behind the fill chain (as brdf-export
-// builds it: session_interpolant.h).
+// builds it: core/export/fill/session_interpolant.h).
 Result<exports::SessionInterpolant> BuildInterpolator(const exports::Session& session,
                                                       exports::Quantity quantity,
                                                       const ExportSettings& s,

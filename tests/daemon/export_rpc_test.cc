@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "core/export/merl_layout.h"
-#include "core/export/merl_reader.h"
-#include "core/export/rgl_reader.h"
+#include "core/export/merl/layout.h"
+#include "core/export/merl/reader.h"
+#include "core/export/rgl/reader.h"
 #include "tests/support/daemon_test_rig.h"
 #include "tests/support/plan_fixtures.h"
 #include "tests/support/process_launcher.h"

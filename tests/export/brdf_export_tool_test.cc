@@ -11,8 +11,8 @@
 #include <map>
 #include <sstream>
 
-#include "core/export/merl_reader.h"
-#include "core/export/rgl_reader.h"
+#include "core/export/merl/reader.h"
+#include "core/export/rgl/reader.h"
 #include "core/export/synthetic_session.h"
 #include "export_test_util.h"
 #include "storage/session_store.h"

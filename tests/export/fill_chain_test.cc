@@ -1,8 +1,6 @@
-// The fill chain (fill_chain.h): each direction takes the first stage's ok answer, the counts say
-// which stage answered, batches agree with one-by-one answers, and on the synthetic paper-grid
-// session a MERL table and a grid have no empty cell above the horizon.
-#include "core/export/fill_chain.h"
-
+// The fill chain (core/export/fill/chain.h): each direction takes the first stage's ok answer, the
+// counts say which stage answered, batches agree with one-by-one answers, and on the synthetic
+// paper-grid session a MERL table and a grid have no empty cell above the horizon.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -10,9 +8,10 @@
 #include <memory>
 #include <vector>
 
-#include "core/export/grid_text.h"
-#include "core/export/merl_export.h"
-#include "core/export/regular_grid.h"
+#include "core/export/fill/chain.h"
+#include "core/export/grid/regular_grid.h"
+#include "core/export/grid/text.h"
+#include "core/export/merl/writer.h"
 #include "core/export/synthetic_session.h"
 #include "core/interp/interpolator.h"
 #include "export_test_util.h"

@@ -9,8 +9,8 @@
 #include <random>
 #include <sstream>
 
-#include "core/export/merl_export.h"
-#include "core/export/merl_reader.h"
+#include "core/export/merl/reader.h"
+#include "core/export/merl/writer.h"
 #include "core/export/synthetic_session.h"
 #include "core/geometry.h"
 #include "core/interp/octant.h"

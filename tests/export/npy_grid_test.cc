@@ -8,9 +8,9 @@
 #include <regex>
 #include <sstream>
 
-#include "core/export/grid_text.h"
-#include "core/export/npy_writer.h"
-#include "core/export/regular_grid.h"
+#include "core/export/grid/npy_writer.h"
+#include "core/export/grid/regular_grid.h"
+#include "core/export/grid/text.h"
 #include "core/export/synthetic_session.h"
 #include "core/interp/octant.h"
 #include "export_test_util.h"

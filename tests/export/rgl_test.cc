@@ -11,9 +11,9 @@
 #include <random>
 #include <sstream>
 
-#include "core/export/rgl_export.h"
-#include "core/export/rgl_reader.h"
-#include "core/export/rgl_warp.h"
+#include "core/export/rgl/reader.h"
+#include "core/export/rgl/warp.h"
+#include "core/export/rgl/writer.h"
 #include "core/export/synthetic_session.h"
 #include "core/geometry.h"
 #include "export_test_util.h"

@@ -9,7 +9,7 @@
 #include <random>
 
 #include "core/analytic_brdf.h"
-#include "core/export/merl_layout.h"
+#include "core/export/merl/layout.h"
 #include "core/interp/delaunay.h"
 #include "core/interp/octant.h"
 #include "tests/interp/interp_test_data.h"

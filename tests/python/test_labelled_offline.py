@@ -36,7 +36,7 @@ WL = 380.0 + 4.0 * np.arange(5)
 
 
 def description(shape=(2, 3, 4, 5), fill=None, **extra):
-    """A grid description as GridDescriptionJson writes it (core/export/grid_text.cc)."""
+    """A grid description as GridDescriptionJson writes it (core/export/grid/text.cc)."""
     d = {"format": "brdfd regular grid (.npy, float64, C order)",
          "axes": ["theta_i", "theta_o", "phi", "band"], "shape": list(shape),
          "theta_i_deg": {"start": 22.5, "step": 45, "count": shape[0]},

@@ -36,7 +36,7 @@ struct InterpChoice {
   std::string coordinates = "incidence";
   std::string trend = "none";  // none or bivariate (core/interp/trend.h)
   // none: the method alone (holes stay NaN / −1); chain: then Delaunay, then the fitted
-  // Cook-Torrance model (core/export/fill_chain.h).
+  // Cook-Torrance model (core/export/fill/chain.h).
   std::string fill = "chain";
 };
 
@@ -76,7 +76,7 @@ int RunCsv(const CommonOptions& common, const CsvOptions& options, std::ostream&
 int RunGrid(const CommonOptions& common, const GridOptions& options, std::ostream& err);
 int RunMerl(const CommonOptions& common, const MerlOptions& options, std::ostream& out,
             std::ostream& err);
-// The RGL material (.bsdf, core/export/rgl_export.h): the microfacet distribution from the
+// The RGL material (.bsdf, core/export/rgl/writer.h): the microfacet distribution from the
 // session's retro-reflection readings, else from a fitted Cook-Torrance (GGX) model.
 int RunRgl(const CommonOptions& common, const RglCommandOptions& options, std::ostream& err);
 int RunFit(const CommonOptions& common, const FitCommandOptions& options, std::ostream& err);

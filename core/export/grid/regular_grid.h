@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "core/call_context.h"
+#include "core/export/fill/spectrum_source.h"
 #include "core/export/run_control.h"
-#include "core/export/spectrum_source.h"
 #include "core/interp/interpolator.h"
 #include "core/status.h"
 #include "core/wavelength_grid.h"

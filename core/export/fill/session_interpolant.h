@@ -1,9 +1,9 @@
 // A session's interpolant as every export that fills a table builds it (brdf-export and the
 // daemon's Data.Export alike, so that the same session and options give the same bytes): the
-// chosen interpolation method on the derived samples, behind the fill chain (fill_chain.h) —
+// chosen interpolation method on the derived samples, behind the fill chain (fill/chain.h) —
 // alone with FillPolicy kNone; with kChain followed by Delaunay on the same samples and options
 // (unless the method is Delaunay) and by the Cook-Torrance (GGX) model fitted to the samples.
-// Also the RGL export of such an interpolant (rgl_export.h), with its microfacet distribution
+// Also the RGL export of such an interpolant (rgl/writer.h), with its microfacet distribution
 // from the session's retro-reflection readings or, without them, from the fitted model. Pure:
 // no I/O.
 #pragma once
@@ -15,9 +15,9 @@
 #include <string>
 
 #include "core/call_context.h"
-#include "core/export/fill_chain.h"
-#include "core/export/grid_text.h"
-#include "core/export/rgl_export.h"
+#include "core/export/fill/chain.h"
+#include "core/export/grid/text.h"
+#include "core/export/rgl/writer.h"
 #include "core/export/run_control.h"
 #include "core/export/session_data.h"
 #include "core/export/spectral_rgb.h"

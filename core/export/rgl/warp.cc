@@ -1,4 +1,4 @@
-#include "core/export/rgl_warp.h"
+#include "core/export/rgl/warp.h"
 
 #include <algorithm>
 #include <cmath>

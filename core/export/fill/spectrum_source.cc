@@ -1,4 +1,4 @@
-#include "core/export/spectrum_source.h"
+#include "core/export/fill/spectrum_source.h"
 
 #include <algorithm>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "core/export/regular_grid.h"
+#include "core/export/grid/regular_grid.h"
 
 #include <algorithm>
 #include <cmath>

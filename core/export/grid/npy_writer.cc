@@ -1,4 +1,4 @@
-#include "core/export/npy_writer.h"
+#include "core/export/grid/npy_writer.h"
 
 #include <bit>
 #include <cstdint>

@@ -10,7 +10,7 @@
 #include <span>
 #include <string>
 
-#include "core/export/regular_grid.h"
+#include "core/export/grid/regular_grid.h"
 #include "core/status.h"
 
 namespace brdf::exports {

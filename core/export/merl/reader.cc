@@ -1,4 +1,4 @@
-#include "core/export/merl_reader.h"
+#include "core/export/merl/reader.h"
 
 #include <bit>
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "core/export/fill_chain.h"
+#include "core/export/fill/chain.h"
 
 #include <algorithm>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "core/export/rgl_reader.h"
+#include "core/export/rgl/reader.h"
 
 #include <algorithm>
 #include <bit>

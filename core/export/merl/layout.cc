@@ -1,4 +1,4 @@
-#include "core/export/merl_layout.h"
+#include "core/export/merl/layout.h"
 
 #include <cmath>
 #include <numbers>

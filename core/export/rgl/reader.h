@@ -1,4 +1,4 @@
-// A reader of RGL material files (rgl_export.h, docs/rgl-format.md) that evaluates the BRDF the
+// A reader of RGL material files (rgl/writer.h, docs/rgl-format.md) that evaluates the BRDF the
 // way Mitsuba 3's `measured` BSDF and pbrt-v4's MeasuredBxDF do: the half vector is mapped to
 // the unit square, inverted through the visible-normal warp, the stored values are interpolated
 // there (bilinearly, and linearly in θi and wavelength), multiplied by D / (4σ) and — because
@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/export/rgl_warp.h"
+#include "core/export/rgl/warp.h"
 #include "core/pose.h"
 #include "core/status.h"
 

@@ -1,4 +1,4 @@
-#include "core/export/rgl_export.h"
+#include "core/export/rgl/writer.h"
 
 #include <algorithm>
 #include <bit>
@@ -9,7 +9,7 @@
 #include <span>
 #include <utility>
 
-#include "core/export/rgl_warp.h"
+#include "core/export/rgl/warp.h"
 
 namespace brdf::exports {
 namespace {

@@ -26,10 +26,10 @@
 #include <vector>
 
 #include "core/call_context.h"
+#include "core/export/fill/spectrum_source.h"
 #include "core/export/run_control.h"
 #include "core/export/session_data.h"
 #include "core/export/spectral_rgb.h"
-#include "core/export/spectrum_source.h"
 #include "core/status.h"
 
 namespace brdf::exports {

@@ -1,4 +1,4 @@
-#include "core/export/session_interpolant.h"
+#include "core/export/fill/session_interpolant.h"
 
 #include <algorithm>
 #include <span>

@@ -1,4 +1,4 @@
-#include "core/export/merl_export.h"
+#include "core/export/merl/writer.h"
 
 #include <bit>
 #include <cstdint>
@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/export/npy_writer.h"
+#include "core/export/grid/npy_writer.h"
 #include "core/geometry.h"
 
 namespace brdf::exports {

@@ -1,4 +1,4 @@
-// The piecewise-bilinear 2D distribution that readers of the RGL material format (rgl_export.h)
+// The piecewise-bilinear 2D distribution that readers of the RGL material format (rgl/writer.h)
 // build from its tables: values on a regular nx × ny grid over the unit square, interpolated
 // bilinearly, optionally conditioned on up to three parameters (φi, θi, wavelength) at which the
 // 2D slices are tabulated and between which values are blended linearly. With a CDF it maps the

@@ -6,7 +6,7 @@
 #include <string_view>
 
 #include "core/colorimetry.h"
-#include "core/export/merl_layout.h"
+#include "core/export/merl/layout.h"
 #include "core/pose.h"
 #include "core/status.h"
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/export/regular_grid.h"
+#include "core/export/grid/regular_grid.h"
 #include "core/export/session_data.h"
 
 namespace brdf::exports {

@@ -1,4 +1,4 @@
-#include "core/export/grid_text.h"
+#include "core/export/grid/text.h"
 
 #include <utility>
 

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "core/export/spectrum_source.h"
+#include "core/export/fill/spectrum_source.h"
 #include "core/fit/fit.h"
 #include "core/status.h"
 #include "core/wavelength_grid.h"

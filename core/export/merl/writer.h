@@ -1,4 +1,4 @@
-// A session exported as a MERL ".binary" (merl_layout.h): every cell of the 90 × 90 × 180
+// A session exported as a MERL ".binary" (merl/layout.h): every cell of the 90 × 90 × 180
 // half/difference table asks a SpectrumSource (the session's interpolator of the BRDF, sr⁻¹) for
 // the spectrum at the cell's directions, turns it into linear sRGB under D65 (spectral_rgb.h) and
 // stores it divided by MERL's channel scales. Parallel, with progress and cancellation
@@ -17,10 +17,10 @@
 #include <string>
 
 #include "core/call_context.h"
-#include "core/export/merl_layout.h"
+#include "core/export/fill/spectrum_source.h"
+#include "core/export/merl/layout.h"
 #include "core/export/run_control.h"
 #include "core/export/spectral_rgb.h"
-#include "core/export/spectrum_source.h"
 #include "core/status.h"
 
 namespace brdf::exports {
