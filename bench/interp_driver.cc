@@ -35,11 +35,11 @@
 
 #include "core/interp/batch.h"
 #include "core/interp/csv_table.h"
-#include "core/interp/delaunay.h"
+#include "core/interp/delaunay/delaunay.h"
 #include "core/interp/interpolator.h"
 #include "core/interp/nearest.h"
-#include "core/interp/octant.h"
-#include "core/interp/octant_reference.h"
+#include "core/interp/octant/octant.h"
+#include "core/interp/octant/reference.h"
 
 namespace brdf::interp {
 namespace {

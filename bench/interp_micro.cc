@@ -17,11 +17,11 @@
 #include <vector>
 
 #include "core/interp/barycentric.h"
-#include "core/interp/kd_tree.h"
-#include "core/interp/octant.h"
-#include "core/interp/octant_cube.h"
-#include "core/interp/orthant_grid.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/octant/cube.h"
+#include "core/interp/octant/octant.h"
+#include "core/interp/search/kd_tree.h"
+#include "core/interp/search/orthant_grid.h"
+#include "core/interp/search/point_cloud.h"
 #include "core/wavelength_grid.h"
 #include "tools/brdf-interp/synthetic_samples.h"
 
@@ -109,8 +109,8 @@ void BM_KdTreeBuild(benchmark::State& state, std::string set, KdTree::Kernel ker
   state.counters["points"] = static_cast<double>(data.cloud.size());
 }
 
-// The grid shortcut of the octant search (orthant_grid.h): build time (tree and grid), size, and
-// how many of the benchmark's queries it answers (the rest walk the tree).
+// The grid shortcut of the octant search (core/interp/search/orthant_grid.h): build time (tree and
+// grid), size, and how many of the benchmark's queries it answers (the rest walk the tree).
 void BM_GridBuild(benchmark::State& state, std::string set) {
   const DataSet& data = Data(set);
   // What a user of the shortcut pays: the tree and its grid.

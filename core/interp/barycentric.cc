@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "core/interp/point_cloud.h"
+#include "core/interp/search/point_cloud.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>

@@ -60,7 +60,7 @@ struct BatchOptions {
   BatchPool* pool = nullptr;
   // Queries per chunk: the unit of work sharing, progress and cancellation, and one SpectraAt
   // call: large enough for the octant method to sort a chunk by cell (a quarter of a query per
-  // cell: about 2,000 queries on the rig grid, 6,000 on 50,000 points; octant.h).
+  // cell: about 2,000 queries on the rig grid, 6,000 on 50,000 points; octant/octant.h).
   std::size_t chunk = 16384;
   // Checked before each chunk: once cancelled or past its deadline, no new chunk starts and the
   // batch returns kCancelled or kTimeout (the outputs then hold only some answers).

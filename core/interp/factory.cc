@@ -1,10 +1,10 @@
 // MakeInterpolator: the one entry point that picks a method. Kept in its own file so that code
 // which only needs the octant or nearest methods (their own factories) does not pull in Qhull.
-#include "core/interp/delaunay.h"
+#include "core/interp/delaunay/delaunay.h"
 #include "core/interp/half_difference.h"
 #include "core/interp/interpolator.h"
 #include "core/interp/nearest.h"
-#include "core/interp/octant.h"
+#include "core/interp/octant/octant.h"
 #include "core/interp/trend.h"
 
 namespace brdf::interp {

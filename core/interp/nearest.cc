@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <array>
 
-#include "core/interp/kd_tree.h"
-#include "core/interp/octant_cube.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/octant/cube.h"
+#include "core/interp/search/kd_tree.h"
+#include "core/interp/search/point_cloud.h"
 
 namespace brdf::interp {
 namespace {

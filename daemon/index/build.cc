@@ -6,7 +6,7 @@
 #include <tuple>
 #include <utility>
 
-#include "core/interp/octant.h"
+#include "core/interp/octant/octant.h"
 #include "daemon/index/cache.h"
 
 namespace brdf::daemon {

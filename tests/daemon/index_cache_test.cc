@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "core/interp/octant.h"
+#include "core/interp/octant/octant.h"
 #include "daemon/index/cache.h"
 #include "storage/session_store.h"
 #include "tests/support/test_env.h"

@@ -13,7 +13,7 @@
 #include "core/export/merl/writer.h"
 #include "core/export/synthetic_session.h"
 #include "core/geometry.h"
-#include "core/interp/octant.h"
+#include "core/interp/octant/octant.h"
 #include "export_test_util.h"
 
 namespace brdf::exports {

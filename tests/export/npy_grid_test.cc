@@ -12,7 +12,7 @@
 #include "core/export/grid/regular_grid.h"
 #include "core/export/grid/text.h"
 #include "core/export/synthetic_session.h"
-#include "core/interp/octant.h"
+#include "core/interp/octant/octant.h"
 #include "export_test_util.h"
 
 namespace brdf::exports {

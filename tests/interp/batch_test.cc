@@ -11,7 +11,7 @@
 #include <mutex>
 #include <set>
 
-#include "core/interp/octant.h"
+#include "core/interp/octant/octant.h"
 #include "interp_test_data.h"
 
 namespace brdf::interp {

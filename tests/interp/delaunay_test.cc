@@ -1,5 +1,5 @@
 // Delaunay interpolation: the triangulation, the point location walk and the blend.
-#include "core/interp/delaunay.h"
+#include "core/interp/delaunay/delaunay.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -13,8 +13,8 @@
 #include <thread>
 #include <vector>
 
-#include "core/interp/delaunay_locate.h"
-#include "core/interp/delaunay_qhull.h"
+#include "core/interp/delaunay/locate.h"
+#include "core/interp/delaunay/qhull.h"
 #include "core/interp/interpolator.h"
 
 namespace brdf::interp {

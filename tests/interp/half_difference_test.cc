@@ -10,8 +10,8 @@
 
 #include "core/analytic_brdf.h"
 #include "core/export/merl/layout.h"
-#include "core/interp/delaunay.h"
-#include "core/interp/octant.h"
+#include "core/interp/delaunay/delaunay.h"
+#include "core/interp/octant/octant.h"
 #include "tests/interp/interp_test_data.h"
 
 namespace brdf::interp {

@@ -7,8 +7,8 @@
 
 #include "core/interp/barycentric.h"
 #include "core/interp/interpolator.h"
-#include "core/interp/octant_cube.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/octant/cube.h"
+#include "core/interp/search/point_cloud.h"
 
 namespace brdf::interp {
 namespace {

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "core/interp/octant.h"
+#include "core/interp/octant/octant.h"
 #include "tests/interp/interp_test_data.h"
 
 namespace brdf::interp {

@@ -13,11 +13,11 @@
 #include <random>
 #include <span>
 
-#include "core/interp/kd_tree.h"
 #include "core/interp/nearest.h"
-#include "core/interp/octant.h"
-#include "core/interp/octant_cube.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/octant/cube.h"
+#include "core/interp/octant/octant.h"
+#include "core/interp/search/kd_tree.h"
+#include "core/interp/search/point_cloud.h"
 #include "interp_test_data.h"
 
 namespace brdf::interp {

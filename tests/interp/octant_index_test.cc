@@ -9,8 +9,8 @@
 #include <limits>
 
 #include "core/interp/nearest.h"
-#include "core/interp/octant.h"
-#include "core/interp/octant_reference.h"
+#include "core/interp/octant/octant.h"
+#include "core/interp/octant/reference.h"
 #include "interp_test_data.h"
 
 namespace brdf::interp {

@@ -1,7 +1,7 @@
-// Properties of the paper's octant method (core/interp/octant.h), checked on the paper's rig grid,
-// random sets, lattices and hand-built configurations. No snapshots: every expectation follows
-// from the method's definition in docs/interpolation.md.
-#include "core/interp/octant.h"
+// Properties of the paper's octant method (core/interp/octant/octant.h), checked on the paper's rig
+// grid, random sets, lattices and hand-built configurations. No snapshots: every expectation
+// follows from the method's definition in docs/interpolation.md.
+#include "core/interp/octant/octant.h"
 
 #include <gtest/gtest.h>
 
@@ -144,7 +144,8 @@ TEST(OctantTest, IsExactAtInteriorLatticePoints) {
 
 TEST(OctantTest, AtASampleThatIsAVertexTheWeightIsOne) {
   // At a sample point that sample wins the (+,+,+) octant. Whenever it is a vertex of the answer,
-  // the answer is that sample exactly (another tetrahedron may enclose it first: see octant.h).
+  // the answer is that sample exactly (another tetrahedron may enclose it first: see
+  // core/interp/octant/octant.h).
   const auto points = RandomPoints(2000, {0, 0, 0}, {90, 90, 180}, 31);
   const auto samples = MakeSamples(points, AnalyticSpectrum(3));
   const auto octant = Octant(samples);

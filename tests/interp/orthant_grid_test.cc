@@ -1,10 +1,10 @@
-// The k-d tree's grid shortcut (orthant_grid.h, KdTree::Search::kGridThenTree) against an O(N)
-// scan written here: the winners of every orthant, ties to the lower rank, must be the scan's on
-// data full of ties, duplicates and points on the cell lines, for queries on the cell lines,
-// inside and outside the grid, in 3D and 4D, with symmetry copies, for every kernel; and the grid
-// must actually answer queries (a shortcut that always fell back would pass the exactness checks
-// and be useless).
-#include "core/interp/orthant_grid.h"
+// The k-d tree's grid shortcut (core/interp/search/orthant_grid.h, KdTree::Search::kGridThenTree)
+// against an O(N) scan written here: the winners of every orthant, ties to the lower rank, must be
+// the scan's on data full of ties, duplicates and points on the cell lines, for queries on the cell
+// lines, inside and outside the grid, in 3D and 4D, with symmetry copies, for every kernel; and the
+// grid must actually answer queries (a shortcut that always fell back would pass the exactness
+// checks and be useless).
+#include "core/interp/search/orthant_grid.h"
 
 #include <gtest/gtest.h>
 
@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "core/interp/kd_tree.h"
-#include "core/interp/octant_cube.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/octant/cube.h"
+#include "core/interp/search/kd_tree.h"
+#include "core/interp/search/point_cloud.h"
 #include "interp_test_data.h"
 
 namespace brdf::interp {
@@ -86,8 +86,9 @@ struct Case {
   std::vector<Point> points;
   std::vector<double> lo, hi;  // the query box (a little wider than the data)
   Options options;
-  // The share of the queries the grid must answer itself. 4D clouds get no grid (orthant_grid.cc
-  // says why): the tree answers everything, and must still be exact.
+  // The share of the queries the grid must answer itself. 4D clouds get no grid
+  // (core/interp/search/orthant_grid.cc says why): the tree answers everything, and must still be
+  // exact.
   double min_share = 0.1;
 };
 

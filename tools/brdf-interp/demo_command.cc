@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "core/analytic_brdf.h"
-#include "core/interp/octant_cube.h"
+#include "core/interp/octant/cube.h"
 #include "tools/brdf-interp/synthetic_samples.h"
 #include "tools/brdf-interp/tool_common.h"
 

@@ -3,7 +3,7 @@
 #include <charconv>
 #include <cmath>
 
-#include "core/interp/octant_reference.h"
+#include "core/interp/octant/reference.h"
 
 namespace brdf::interp_tool {
 

@@ -25,7 +25,7 @@ class SpectrumSource {
   // n = statuses.size() directions, row-major (θi, θo, φ) in `directions`; statuses[i] and row i
   // of `spectra` (n × bands values) as One would give them, except that a row whose status is not
   // kOk holds NaN. Interpolator::SpectraAt's contract: what lets a 3D octant interpolator sort a
-  // large batch by cell (octant.h) instead of answering query by query.
+  // large batch by cell (core/interp/octant/octant.h) instead of answering query by query.
   using Many =
       std::function<void(std::span<const double> directions,
                          std::span<interp::InterpStatus> statuses, std::span<double> spectra)>;

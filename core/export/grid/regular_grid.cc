@@ -12,8 +12,9 @@ namespace {
 constexpr double kTheta = 90.0;
 constexpr double kPhi = 180.0;
 // Cells answered as one SpectrumSource::Spectra batch: enough for the octant method to sort them
-// by cell (a quarter of a query per cell, about 6,000 on 50,000 readings; octant.h), yet at least
-// 64 batches per grid for the progress line and a prompt cancel (1° × 1° × 2°: 11,390 cells).
+// by cell (a quarter of a query per cell, about 6,000 on 50,000 readings;
+// core/interp/octant/octant.h), yet at least 64 batches per grid for the progress line and a prompt
+// cancel (1° × 1° × 2°: 11,390 cells).
 std::size_t BatchCells(std::size_t cells) {
   return std::clamp<std::size_t>(cells / 64, 1024, 16384);
 }

@@ -18,9 +18,9 @@ constexpr std::uint8_t kBelowHorizon = 0x40;
 constexpr std::uint8_t kClamped = 0x80;
 constexpr std::uint8_t kStatusMask = 0x3f;
 // Cells per chunk, whose cells above the horizon (about half) go as one SpectrumSource::Spectra
-// batch: enough for the octant method to sort them by cell (octant.h: a quarter of a query per
-// cell, about 12,500 for 50,000 readings with their reciprocity images, MERL's default), few
-// enough for a progress report every 1/22 of the table and a prompt cancel.
+// batch: enough for the octant method to sort them by cell (core/interp/octant/octant.h: a quarter
+// of a query per cell, about 12,500 for 50,000 readings with their reciprocity images, MERL's
+// default), few enough for a progress report every 1/22 of the table and a prompt cancel.
 constexpr std::size_t kBatchCells = 65536;
 
 }  // namespace

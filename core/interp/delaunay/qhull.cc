@@ -1,4 +1,4 @@
-#include "core/interp/delaunay_qhull.h"
+#include "core/interp/delaunay/qhull.h"
 
 #include <cstdio>
 #include <cstdlib>

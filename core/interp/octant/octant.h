@@ -3,12 +3,13 @@
 // the 2^dims orthants cut by the axis planes through P; the first simplex of the cube of winners
 // (3D: ABCF, ACDH, AEFH, CFGH, ACFH; 4D: the 24 Kuhn simplices) that encloses P; the vertex
 // spectra blended with P's barycentric weights. Everything happens in the scaled space of
-// Options.axis_scale, over the samples plus their symmetry copies (point_cloud.h).
+// Options.axis_scale, over the samples plus their symmetry copies (search/point_cloud.h).
 //
 // Two implementations give bit-identical answers (same vertices, weights, statuses, spectra):
 //   OctantInterpolator (MakeOctantInterpolator): the nearest point per orthant from a k-d tree
-//                                    (kd_tree.h); what MakeInterpolator(Method::kOctant) returns.
-//   MakeOctantReferenceInterpolator: the paper's O(N) scan (octant_reference.h), for tests and
+//                                    (search/kd_tree.h); what MakeInterpolator(Method::kOctant)
+//                                    returns.
+//   MakeOctantReferenceInterpolator: the paper's O(N) scan (octant/reference.h), for tests and
 //                                    `brdf-interp --method octant-reference`.
 //
 // Not a property of the method: exactness at the data points. When P is a sample, that sample
@@ -57,10 +58,10 @@ struct OctantResult {
 class OctantInterpolator final : public Interpolator {
  public:
   // How the nearest point per orthant is searched. kGridThenTree adds the tree's grid shortcut
-  // (orthant_grid.h: 3D clouds of at most 16,384 points; the others get the tree alone): about
-  // twice the search speed on the rig grid, for a build of tens of milliseconds instead of about
-  // one. Same answers either way. Extend's folds build kTree: they happen while a session records,
-  // on the query path, and the set keeps changing.
+  // (search/orthant_grid.h: 3D clouds of at most 16,384 points; the others get the tree alone):
+  // about twice the search speed on the rig grid, for a build of tens of milliseconds instead of
+  // about one. Same answers either way. Extend's folds build kTree: they happen while a session
+  // records, on the query path, and the set keeps changing.
   enum class Search { kTree, kGridThenTree };
 
   // Errors (kInvalidArgument): null or empty samples, not 3D/4D, bad options (ValidateOptions).
@@ -104,12 +105,12 @@ class OctantInterpolator final : public Interpolator {
   // that its queries meet in cells (a quarter of a query per cell or more: about 2,000 queries on
   // the rig grid, 6,000 on 50,000 points) is sorted by cell first: the queries of a grid cell
   // share one scan of its list, and without a grid, consecutive queries search the same part of
-  // the tree (octant.cc, SpectraByCell).
+  // the tree (octant/octant.cc, SpectraByCell).
   void SpectraAt(std::span<const double> queries, std::span<InterpStatus> statuses,
                  std::span<double> spectra) const override;
   // Evaluate's answers, bit for bit, in query order; a 3D batch of 65,536 queries or a remainder
   // large enough to sort (as for SpectraAt) is sorted and searched by cell first, its answers
-  // then assembled in query order (octant.cc). What brdfd's InterpolateBatch calls.
+  // then assembled in query order (octant/octant.cc). What brdfd's InterpolateBatch calls.
   void EvaluateEach(std::span<const double> queries, const TakeAnswer& take) const override;
   // Queries answered so far by the cell-sorted passes of SpectraAt and EvaluateEach, over this
   // interpolator's life (relaxed counter): how tests tell that a product path takes them.

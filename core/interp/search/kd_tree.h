@@ -7,7 +7,7 @@
 // distance of a point in the box, then shrunk by a relative 1e-12, so pruning never drops a point
 // the brute-force scan would pick. Every kernel computes a point's distance with SquaredDistance's
 // operations in SquaredDistance's order (no fused multiply-add), and ties go to the lower rank:
-// results, ties included, are identical to the O(N) scan of octant_reference.h.
+// results, ties included, are identical to the O(N) scan of octant/reference.h.
 //
 // Speed: the points live in tree order as one array per axis, so a leaf is scanned several points
 // per instruction. A leaf kernel (chosen once, from what the CPU supports) computes distances and
@@ -23,7 +23,7 @@
 // The walk (hard-to-predict visits) still costs about as much as the leaf scans (perf on a sorted
 // batch over 50,000 random points, 2026-12-02: walk 14 %, leaves 13 % of all samples).
 //
-// Shortcut (Search::kGridThenTree, opt-in): an OrthantGrid (orthant_grid.h) lists, for each
+// Shortcut (Search::kGridThenTree, opt-in): an OrthantGrid (search/orthant_grid.h) lists, for each
 // cell of a uniform grid, every point that can win an orthant for some query in the cell; a query
 // whose cell has a list scans it and skips the tree. The list kernels (AVX-512, AVX2: 8 or 4
 // entries at a time, coordinates gathered from the per-axis arrays by tree position, bests in
@@ -38,9 +38,9 @@
 #include <span>
 #include <vector>
 
-#include "core/interp/octant_cube.h"
-#include "core/interp/orthant_grid.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/octant/cube.h"
+#include "core/interp/search/orthant_grid.h"
+#include "core/interp/search/point_cloud.h"
 
 namespace brdf::interp {
 
@@ -54,8 +54,8 @@ class KdTree {
   // rig grid the grid makes the search 2–3× faster (AVX2: about 0.45 against 1.2 µs), but tree +
   // grid take about 100× the tree's build time (about 0.14 s; bench/README.md has the figures),
   // so it is opt-in here;
-  // OctantInterpolator::Create opts in, its Extend's folds do not (octant.h). Only 3D clouds of
-  // at most OrthantGrid::Options::max_points points get a grid.
+  // OctantInterpolator::Create opts in, its Extend's folds do not (octant/octant.h). Only 3D clouds
+  // of at most OrthantGrid::Options::max_points points get a grid.
   enum class Search { kTree, kGridThenTree };
 
   // Indexes the cloud's scaled points (3D or 4D, at least one). Keeps a pointer to `cloud`, which
@@ -87,15 +87,15 @@ class KdTree {
   // of one cell can share one scan of its list. ListedCell is p's cell (OrthantGrid::kNoCell when p
   // is outside the grid or its cell has no list: search those with NearestPerOrthant).
   // NearestPerOrthantInCell answers `count` (1 … kCellLanes) queries of one such cell at once,
-  // each as the cube of winners the vector blends read (octant_cube.h, WinnerCube3):
+  // each as the cube of winners the vector blends read (octant/cube.h, WinnerCube3):
   // with AVX-512, one query per vector lane, the list's entries broadcast to all lanes, no
-  // branch per entry (the kernel in kd_tree_cells.cc); elsewhere, and for a lone query, one list
-  // scan per query. The winners are NearestPerOrthant's, bit for bit, ties included.
+  // branch per entry (the kernel in search/kd_tree_cells.cc); elsewhere, and for a lone query, one
+  // list scan per query. The winners are NearestPerOrthant's, bit for bit, ties included.
   static constexpr int kCellLanes = 8;
   std::uint32_t ListedCell(const double* p) const;
   // Without a grid, batches still sort their queries by the cell of the coarse seed grid (about
-  // two points per cell, kd_tree.cc): consecutive queries then walk the same part of the tree and
-  // read the same points. SeedCell(p) < seed_cell_count(); p must be finite.
+  // two points per cell, search/kd_tree.cc): consecutive queries then walk the same part of the
+  // tree and read the same points. SeedCell(p) < seed_cell_count(); p must be finite.
   std::uint32_t SeedCell(const double* p) const;
   std::size_t seed_cell_count() const { return seeds_.size() >> dims_; }
   void NearestPerOrthantInCell(std::uint32_t cell, const double* const* queries, int count,
@@ -107,7 +107,7 @@ class KdTree {
   // The grid shortcut (empty with Search::kTree).
   const OrthantGrid& grid() const { return grid_; }
 
-  // The search state of one NearestPerOrthant call (public for the kernels in kd_tree.cc).
+  // The search state of one NearestPerOrthant call (public for the kernels in search/kd_tree.cc).
   struct OrthantBest;
   // Points a leaf kernel scans: one array per axis and their ranks.
   struct Entries {

@@ -20,7 +20,7 @@
 #include <span>
 #include <vector>
 
-#include "core/interp/delaunay_qhull.h"
+#include "core/interp/delaunay/qhull.h"
 #include "core/status.h"
 
 namespace brdf::interp {

@@ -1,4 +1,4 @@
-#include "core/interp/octant.h"
+#include "core/interp/octant/octant.h"
 
 #include <algorithm>
 #include <array>
@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "core/interp/barycentric.h"
-#include "core/interp/kd_tree.h"
-#include "core/interp/octant_cube.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/octant/cube.h"
+#include "core/interp/search/kd_tree.h"
+#include "core/interp/search/point_cloud.h"
 
 namespace brdf::interp {
 

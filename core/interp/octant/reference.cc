@@ -1,10 +1,10 @@
-#include "core/interp/octant_reference.h"
+#include "core/interp/octant/reference.h"
 
 #include <array>
 #include <limits>
 
-#include "core/interp/octant_cube.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/octant/cube.h"
+#include "core/interp/search/point_cloud.h"
 
 namespace brdf::interp {
 namespace {

@@ -1,12 +1,12 @@
-// The kernel behind KdTree::NearestPerOrthantInCell (kd_tree.h): one scan of a grid cell's list
-// for up to kCellLanes queries of that cell, one query per vector lane. Internal to the k-d
-// tree; kd_tree_cells.cc says how it works and why it gives the exact winners. Pure: no I/O.
+// The kernel behind KdTree::NearestPerOrthantInCell (search/kd_tree.h): one scan of a grid cell's
+// list for up to kCellLanes queries of that cell, one query per vector lane. Internal to the k-d
+// tree; search/kd_tree_cells.cc says how it works and why it gives the exact winners. Pure: no I/O.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
-#include "core/interp/octant_cube.h"
+#include "core/interp/octant/cube.h"
 
 namespace brdf::interp {
 

@@ -1,6 +1,7 @@
-// The multi-query list kernel of KdTree::NearestPerOrthantInCell (kd_tree.h, kd_tree_cells.h).
+// The multi-query list kernel of KdTree::NearestPerOrthantInCell (search/kd_tree.h,
+// search/kd_tree_cells.h).
 //
-// Why: one query's list scan (kd_tree.cc, ListAvx512) holds 8 list entries in its lanes and
+// Why: one query's list scan (search/kd_tree.cc, ListAvx512) holds 8 list entries in its lanes and
 // sends every entry that beats its orthant's best through the exact rule one by one; on the rig
 // grid that is ~15 entries per query, each an unpredictable branch, and most of the query's
 // time. Here the lanes hold up to 8 queries of the same cell instead: each list entry is
@@ -19,12 +20,12 @@
 // scanned beyond it are points of the cloud, so they cannot change a minimum that already holds
 // the winner. Same winners as NearestPerOrthant, bit for bit (tests/interp/).
 // Pure: no I/O.
-#include "core/interp/kd_tree_cells.h"
+#include "core/interp/search/kd_tree_cells.h"
 
 #include <cstdint>
 #include <limits>
 
-#include "core/interp/octant_cube.h"
+#include "core/interp/octant/cube.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>

@@ -1,5 +1,5 @@
 // The octant method exactly as the paper runs it: every query scans all N points (O(N)) for the
-// nearest one in each orthant. The definition the fast, indexed implementation (octant.h) is
+// nearest one in each orthant. The definition the fast, indexed implementation (octant/octant.h) is
 // tested against, bit for bit; also `brdf-interp --method octant-reference`. Pure: no I/O.
 #pragma once
 

@@ -1,4 +1,4 @@
-#include "core/interp/delaunay.h"
+#include "core/interp/delaunay/delaunay.h"
 
 #include <algorithm>
 #include <array>
@@ -9,9 +9,9 @@
 #include <utility>
 
 #include "core/interp/barycentric.h"
-#include "core/interp/delaunay_locate.h"
-#include "core/interp/delaunay_qhull.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/delaunay/locate.h"
+#include "core/interp/delaunay/qhull.h"
+#include "core/interp/search/point_cloud.h"
 
 namespace brdf::interp {
 namespace {

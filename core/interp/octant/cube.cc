@@ -1,4 +1,4 @@
-#include "core/interp/octant_cube.h"
+#include "core/interp/octant/cube.h"
 
 #include <algorithm>
 #include <array>

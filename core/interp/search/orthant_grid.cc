@@ -1,10 +1,10 @@
-#include "core/interp/orthant_grid.h"
+#include "core/interp/search/orthant_grid.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/interp/octant_cube.h"
+#include "core/interp/octant/cube.h"
 
 namespace brdf::interp {
 namespace {

@@ -1,4 +1,4 @@
-// The k-d tree's opt-in shortcut for the octant method's search (kd_tree.h, Search::
+// The k-d tree's opt-in shortcut for the octant method's search (search/kd_tree.h, Search::
 // kGridThenTree): a uniform grid of cells over the scaled points' bounding box that lists, for
 // each cell, every point that can be the nearest in some orthant around SOME query inside the
 // cell. A query finds its cell and scans one short list (tree positions, whose coordinates the
@@ -32,8 +32,8 @@
 #include <span>
 #include <vector>
 
-#include "core/interp/octant_cube.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/octant/cube.h"
+#include "core/interp/search/point_cloud.h"
 
 namespace brdf::interp {
 
@@ -164,7 +164,7 @@ class OrthantGrid {
     std::uint32_t count = kNoList;
     std::uint32_t need = 0;
   };
-  // Builds the lists (orthant_grid.cc): the box, the points in buckets, then cell by cell.
+  // Builds the lists (search/orthant_grid.cc): the box, the points in buckets, then cell by cell.
   template <int D>
   class Builder;
 

@@ -12,7 +12,7 @@
 #include <string>
 
 #include "core/interp/interpolator.h"
-#include "core/interp/point_cloud.h"
+#include "core/interp/search/point_cloud.h"
 
 namespace brdf::interp {
 

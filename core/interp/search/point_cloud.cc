@@ -1,4 +1,4 @@
-#include "core/interp/point_cloud.h"
+#include "core/interp/search/point_cloud.h"
 
 #include <cmath>
 #include <string>

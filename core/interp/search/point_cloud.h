@@ -72,9 +72,9 @@ inline double RoundedSquare(double d) {
 }
 
 // Squared Euclidean distance in the cloud's scaled space, ((0 + d0²) + d1²) + d2² (+ d3²): summed
-// in axis order. Every search uses this one definition (the vector kernels of kd_tree.cc compute
-// the same operations lane by lane), so "nearest" and "tie" mean the same thing bit for bit in
-// all of them.
+// in axis order. Every search uses this one definition (the vector kernels of search/kd_tree.cc
+// compute the same operations lane by lane), so "nearest" and "tie" mean the same thing bit for bit
+// in all of them.
 template <int D>
 inline double SquaredDistance(const double* a, const double* b) {
   double sum = 0.0;

@@ -1,4 +1,4 @@
-#include "core/interp/delaunay_locate.h"
+#include "core/interp/delaunay/locate.h"
 
 #include <algorithm>
 #include <cmath>

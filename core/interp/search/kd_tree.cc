@@ -1,4 +1,4 @@
-#include "core/interp/kd_tree.h"
+#include "core/interp/search/kd_tree.h"
 
 #include <algorithm>
 #include <bit>
@@ -6,7 +6,7 @@
 #include <limits>
 #include <numeric>
 
-#include "core/interp/kd_tree_cells.h"
+#include "core/interp/search/kd_tree_cells.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define BRDF_KD_X86 1
@@ -521,8 +521,8 @@ struct LeafKernels {
     }
     return improved;
   }
-  // A grid list (orthant_grid.h): tree positions, 8 per block, nearest blocks first. Stops at the
-  // first block whose bound exceeds the best of every orthant in `need`. 8 points at a time,
+  // A grid list (search/orthant_grid.h): tree positions, 8 per block, nearest blocks first. Stops
+  // at the first block whose bound exceeds the best of every orthant in `need`. 8 points at a time,
   // their coordinates gathered from the tree's per-axis arrays (small: they stay in cache).
   __attribute__((target("avx512f"))) static void ListAvx512(const KdTree& tree,
                                                             const std::uint32_t* entry,
