@@ -10,14 +10,14 @@
 
 #include "daemon/config/config.h"
 #include "tests/support/test_env.h"
-#include "tools/brdfctl/eta_calibrator.h"
+#include "tools/brdfctl/commands/sim_mount.h"
 #include "tools/brdfctl/exit_codes.h"
+#include "tools/brdfctl/output/text_format.h"
 #include "tools/brdfctl/plan_file.h"
-#include "tools/brdfctl/progress_line.h"
-#include "tools/brdfctl/prompt_hook.h"
 #include "tools/brdfctl/rpc_error.h"
-#include "tools/brdfctl/sim_mount.h"
-#include "tools/brdfctl/text_format.h"
+#include "tools/brdfctl/watch/eta_calibrator.h"
+#include "tools/brdfctl/watch/progress_line.h"
+#include "tools/brdfctl/watch/prompt_hook.h"
 
 namespace brdf::ctl {
 namespace {

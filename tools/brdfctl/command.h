@@ -1,4 +1,4 @@
-// brdfctl's subcommands as data: each family of subcommands (control_commands.h, watch_command.h,
+// brdfctl's subcommands as data: each family of subcommands (commands/control.h, commands/watch.h,
 // …) registers its own into a CommandRegistry — name, help, its CLI11 arguments and flags, and
 // what runs it — and main.cc only parses the shared flags, finds the subcommand given and runs it.
 // The registry keeps the order of registration, which is the order `brdfctl --help` lists them

@@ -1,13 +1,13 @@
 // brdfctl's subcommands, each family registered by its own file, in the order `brdfctl --help`
 // lists them.
-#include "tools/brdfctl/appearance_command.h"
 #include "tools/brdfctl/command.h"
-#include "tools/brdfctl/control_commands.h"
-#include "tools/brdfctl/export_command.h"
-#include "tools/brdfctl/interpolate_command.h"
-#include "tools/brdfctl/readings_command.h"
-#include "tools/brdfctl/sim_mount.h"
-#include "tools/brdfctl/watch_command.h"
+#include "tools/brdfctl/commands/appearance.h"
+#include "tools/brdfctl/commands/control.h"
+#include "tools/brdfctl/commands/export.h"
+#include "tools/brdfctl/commands/interpolate.h"
+#include "tools/brdfctl/commands/readings.h"
+#include "tools/brdfctl/commands/sim_mount.h"
+#include "tools/brdfctl/commands/watch.h"
 
 namespace brdf::ctl {
 

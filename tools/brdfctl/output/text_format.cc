@@ -1,4 +1,4 @@
-#include "tools/brdfctl/text_format.h"
+#include "tools/brdfctl/output/text_format.h"
 
 #include <cctype>
 #include <cmath>

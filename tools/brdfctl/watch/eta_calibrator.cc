@@ -1,4 +1,4 @@
-#include "tools/brdfctl/eta_calibrator.h"
+#include "tools/brdfctl/watch/eta_calibrator.h"
 
 #include <algorithm>
 

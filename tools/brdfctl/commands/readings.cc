@@ -1,13 +1,13 @@
-#include "tools/brdfctl/readings_command.h"
+#include "tools/brdfctl/commands/readings.h"
 
 #include <CLI/CLI.hpp>
 #include <cctype>
 #include <memory>
 
 #include "tools/brdfctl/exit_codes.h"
-#include "tools/brdfctl/json_output.h"
+#include "tools/brdfctl/output/json.h"
+#include "tools/brdfctl/output/text_format.h"
 #include "tools/brdfctl/rpc_error.h"
-#include "tools/brdfctl/text_format.h"
 
 namespace brdf::ctl {
 namespace {

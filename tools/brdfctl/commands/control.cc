@@ -1,14 +1,14 @@
-#include "tools/brdfctl/control_commands.h"
+#include "tools/brdfctl/commands/control.h"
 
 #include <CLI/CLI.hpp>
 #include <memory>
 
 #include "tools/brdfctl/exit_codes.h"
-#include "tools/brdfctl/json_output.h"
+#include "tools/brdfctl/output/json.h"
+#include "tools/brdfctl/output/session_text.h"
+#include "tools/brdfctl/output/text_format.h"
 #include "tools/brdfctl/plan_file.h"
 #include "tools/brdfctl/rpc_error.h"
-#include "tools/brdfctl/session_text.h"
-#include "tools/brdfctl/text_format.h"
 
 namespace brdf::ctl {
 namespace {

@@ -1,4 +1,4 @@
-#include "tools/brdfctl/export_command.h"
+#include "tools/brdfctl/commands/export.h"
 
 #include <unistd.h>
 
@@ -13,9 +13,9 @@
 #include <utility>
 
 #include "tools/brdfctl/exit_codes.h"
-#include "tools/brdfctl/json_output.h"
+#include "tools/brdfctl/output/json.h"
+#include "tools/brdfctl/output/text_format.h"
 #include "tools/brdfctl/rpc_error.h"
-#include "tools/brdfctl/text_format.h"
 
 namespace brdf::ctl {
 namespace {

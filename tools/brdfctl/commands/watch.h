@@ -1,6 +1,7 @@
 // `brdfctl watch <id>`: follows a session (WatchSession) until it ends.
-//   - On a terminal: a live progress line (progress_line.h) — done/total, ETA, the pose of the
-//     latest reading, its quality code — with state changes, prompts and faults printed above it.
+//   - On a terminal: a live progress line (watch/progress_line.h) — done/total, ETA, the pose
+//     of the latest reading, its quality code — with state changes, prompts and faults printed
+//     above it.
 //   - Otherwise: one plain line per event. With --json: each SessionEvent as one JSON line.
 // At an operator prompt it offers to confirm: "[y/N]" on a terminal (or with --ask), while it
 // keeps showing what the session does; a question whose session leaves awaiting_operator (a pause,
@@ -8,8 +9,9 @@
 // --auto-confirm answers every prompt; without either it waits for someone to answer
 // (`brdfctl answer`). Every state change is shown with its reason (pausing, paused and why,
 // faults, resumed, queued behind another session).
-// --on-prompt CMD runs before each confirmation (prompt_hook.h).
-// The ETA is the daemon's, rescaled to the pace the rig shows while watched (eta_calibrator.h).
+// --on-prompt CMD runs before each confirmation (watch/prompt_hook.h).
+// The ETA is the daemon's, rescaled to the pace the rig shows while watched
+// (watch/eta_calibrator.h).
 // Exit: 0 when the session completed, 4 when it ended aborted or failed (or paused, with
 // --exit-on-pause), else exit_codes.h.
 #pragma once

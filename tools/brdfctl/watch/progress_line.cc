@@ -1,8 +1,8 @@
-#include "tools/brdfctl/progress_line.h"
+#include "tools/brdfctl/watch/progress_line.h"
 
 #include <algorithm>
 
-#include "tools/brdfctl/text_format.h"
+#include "tools/brdfctl/output/text_format.h"
 
 namespace brdf::ctl {
 

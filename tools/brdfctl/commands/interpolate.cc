@@ -1,4 +1,4 @@
-#include "tools/brdfctl/interpolate_command.h"
+#include "tools/brdfctl/commands/interpolate.h"
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -6,9 +6,9 @@
 #include <memory>
 
 #include "tools/brdfctl/exit_codes.h"
-#include "tools/brdfctl/json_output.h"
+#include "tools/brdfctl/output/json.h"
+#include "tools/brdfctl/output/text_format.h"
 #include "tools/brdfctl/rpc_error.h"
-#include "tools/brdfctl/text_format.h"
 
 namespace brdf::ctl {
 namespace {

@@ -1,4 +1,4 @@
-#include "tools/brdfctl/json_output.h"
+#include "tools/brdfctl/output/json.h"
 
 #include <google/protobuf/util/json_util.h>
 

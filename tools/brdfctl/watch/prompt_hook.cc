@@ -1,4 +1,4 @@
-#include "tools/brdfctl/prompt_hook.h"
+#include "tools/brdfctl/watch/prompt_hook.h"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -6,7 +6,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "tools/brdfctl/text_format.h"
+#include "tools/brdfctl/output/text_format.h"
 
 extern char** environ;
 

@@ -1,4 +1,4 @@
-#include "tools/brdfctl/watch_command.h"
+#include "tools/brdfctl/commands/watch.h"
 
 #include <poll.h>
 #include <sys/ioctl.h>
@@ -17,14 +17,14 @@
 #include <sstream>
 #include <thread>
 
-#include "tools/brdfctl/eta_calibrator.h"
 #include "tools/brdfctl/exit_codes.h"
-#include "tools/brdfctl/json_output.h"
-#include "tools/brdfctl/progress_line.h"
-#include "tools/brdfctl/prompt_hook.h"
+#include "tools/brdfctl/output/json.h"
+#include "tools/brdfctl/output/session_text.h"
+#include "tools/brdfctl/output/text_format.h"
 #include "tools/brdfctl/rpc_error.h"
-#include "tools/brdfctl/session_text.h"
-#include "tools/brdfctl/text_format.h"
+#include "tools/brdfctl/watch/eta_calibrator.h"
+#include "tools/brdfctl/watch/progress_line.h"
+#include "tools/brdfctl/watch/prompt_hook.h"
 
 namespace brdf::ctl {
 namespace {

@@ -3,8 +3,8 @@
 // the closed shutter in front of brdf-sim's meter, by writing register 0 of brdf-sim's control unit
 // (tools/brdf-sim/stage/control_map.h) over Modbus TCP. A real rig has no such register; on one,
 // this command fails to connect or writes nothing that matters — do not point it at real drives.
-// `from-prompt` reads BRDF_PROMPT_KIND (set by `watch --on-prompt`, prompt_hook.h) and mounts what
-// the prompt asks for: mount_white → white, mount_sample → sample, close_shutter → dark; other
+// `from-prompt` reads BRDF_PROMPT_KIND (set by `watch --on-prompt`, watch/prompt_hook.h) and mounts
+// what the prompt asks for: mount_white → white, mount_sample → sample, close_shutter → dark; other
 // prompts (relocations, the γ dial) need nothing on the simulator, whose lamp and detector follow
 // the stage.
 #pragma once

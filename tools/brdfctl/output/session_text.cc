@@ -1,10 +1,10 @@
-#include "tools/brdfctl/session_text.h"
+#include "tools/brdfctl/output/session_text.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/plan/rig_description.h"
-#include "tools/brdfctl/text_format.h"
+#include "tools/brdfctl/output/text_format.h"
 
 namespace brdf::ctl {
 

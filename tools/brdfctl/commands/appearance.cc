@@ -1,13 +1,13 @@
-#include "tools/brdfctl/appearance_command.h"
+#include "tools/brdfctl/commands/appearance.h"
 
 #include <CLI/CLI.hpp>
 #include <fstream>
 #include <memory>
 
 #include "tools/brdfctl/exit_codes.h"
-#include "tools/brdfctl/json_output.h"
+#include "tools/brdfctl/output/json.h"
+#include "tools/brdfctl/output/text_format.h"
 #include "tools/brdfctl/rpc_error.h"
-#include "tools/brdfctl/text_format.h"
 
 namespace brdf::ctl {
 namespace {

@@ -1,4 +1,4 @@
-#include "tools/brdfctl/sim_mount.h"
+#include "tools/brdfctl/commands/sim_mount.h"
 
 #include <modbus.h>
 
