@@ -1,6 +1,6 @@
 // bench_archive_lag: how far the lab archive trails the rig while a session records.
 //
-// A real PostgreSQL (tests/support/pg_server.h, Debian's server in a temporary directory) and a
+// A real PostgreSQL (tests/support/pg/server.h, Debian's server in a temporary directory) and a
 // real SQLite file; readings are committed through SessionStore::CompleteStepWithReading at a
 // steady pace while the daemon's ArchiveShipper runs. Lag of a reading = when the archive's
 // transaction holding it began (readings.archived_at, PostgreSQL's now()) − when the rig committed
@@ -39,7 +39,7 @@
 #include "storage/archive/reader.h"
 #include "storage/archive/schema.h"
 #include "storage/session_store.h"
-#include "tests/support/pg_server.h"
+#include "tests/support/pg/server.h"
 
 namespace {
 

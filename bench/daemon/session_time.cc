@@ -42,8 +42,8 @@
 #include "drivers/pr650/pr650_spectroradiometer.h"
 #include "drivers/stage/modbus_stage.h"
 #include "storage/session_store.h"
-#include "tests/support/modbus_control.h"
-#include "tests/support/sim_process.h"
+#include "tests/support/sim/modbus_control.h"
+#include "tests/support/sim/process.h"
 
 namespace brdf::bench {
 namespace {

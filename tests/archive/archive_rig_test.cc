@@ -11,8 +11,8 @@
 #include "storage/session_store.h"
 #include "tests/archive/archive_compare.h"
 #include "tests/archive/archive_status.h"
-#include "tests/support/daemon_test_rig.h"
-#include "tests/support/pg_server_fixture.h"
+#include "tests/support/daemon/test_rig.h"
+#include "tests/support/pg/server_fixture.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {

@@ -15,7 +15,7 @@
 
 #include "storage/archive/pg.h"
 #include "storage/archive/schema.h"
-#include "tests/support/pg_server_fixture.h"
+#include "tests/support/pg/server_fixture.h"
 
 namespace brdf::storage {
 namespace {

@@ -19,8 +19,8 @@
 #include "daemon/config/config.h"
 #include "tests/archive/archive_status.h"
 #include "tests/brdfctl/ctl_runner.h"
-#include "tests/support/daemon_test_rig.h"
-#include "tests/support/pg_server_fixture.h"
+#include "tests/support/daemon/test_rig.h"
+#include "tests/support/pg/server_fixture.h"
 #include "tests/support/plan_fixtures.h"
 #include "tests/support/process_launcher.h"
 

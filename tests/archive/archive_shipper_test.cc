@@ -1,5 +1,5 @@
 // The shipper in process, on real parts: a real SQLite file (SessionStore), a real PostgreSQL
-// (tests/support/pg_server.h) that is stopped, killed and restarted while sessions record, and
+// (tests/support/pg/server.h) that is stopped, killed and restarted while sessions record, and
 // the daemon's ArchiveShipper thread. After every fault the archive is compared with the rig's
 // database reading by reading (ids, steps, every spectrum byte, timestamps): each reading is in
 // the archive exactly once, and recording never waited for the archive.
@@ -19,7 +19,7 @@
 #include "storage/spectrum_blob.h"
 #include "tests/archive/archive_compare.h"
 #include "tests/storage/storage_test_util.h"
-#include "tests/support/pg_server_fixture.h"
+#include "tests/support/pg/server_fixture.h"
 
 namespace brdf::storage {
 namespace {

@@ -7,7 +7,7 @@
 #include <functional>
 #include <thread>
 
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 
 namespace brdf::testing {
 

@@ -4,7 +4,7 @@
 #include <sstream>
 #include <thread>
 
-#include "tests/support/sim_rig.h"
+#include "tests/support/sim/rig.h"
 
 namespace brdf::testing {
 

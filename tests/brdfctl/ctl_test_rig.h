@@ -1,5 +1,5 @@
 // What the brdfctl tests stand on: brdf-sim and brdfd as real processes (brdfd through
-// tests/support/daemon_process.h), a generated configuration with an operator and an analyst
+// tests/support/daemon/process.h), a generated configuration with an operator and an analyst
 // token, and the environment a user of brdfctl would set (BRDF_ADDRESS, BRDF_TOKEN).
 #pragma once
 
@@ -8,9 +8,9 @@
 
 #include "core/status.h"
 #include "tests/brdfctl/ctl_runner.h"
-#include "tests/support/daemon_process.h"
-#include "tests/support/modbus_control.h"
-#include "tests/support/sim_process.h"
+#include "tests/support/daemon/process.h"
+#include "tests/support/sim/modbus_control.h"
+#include "tests/support/sim/process.h"
 #include "tests/support/test_env.h"
 
 namespace brdf::testing {

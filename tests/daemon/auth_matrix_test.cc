@@ -15,10 +15,10 @@
 
 #include "daemon/api/server.h"
 #include "daemon/config/config.h"
-#include "tests/support/daemon_test_rig.h"
-#include "tests/support/daemon_test_util.h"
+#include "tests/support/daemon/raw_call.h"
+#include "tests/support/daemon/test_rig.h"
+#include "tests/support/daemon/test_util.h"
 #include "tests/support/plan_fixtures.h"
-#include "tests/support/raw_call.h"
 
 namespace brdf::testing {
 namespace {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "grpc/health/v1/health.grpc.pb.h"
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {

@@ -17,10 +17,10 @@
 #include <thread>
 
 #include "core/plan/plan_json.h"
-#include "tests/support/daemon_test_rig.h"
-#include "tests/support/daemon_test_util.h"
+#include "tests/support/daemon/rig_teardown.h"
+#include "tests/support/daemon/test_rig.h"
+#include "tests/support/daemon/test_util.h"
 #include "tests/support/plan_fixtures.h"
-#include "tests/support/rig_teardown.h"
 
 namespace brdf::testing {
 namespace {

@@ -22,7 +22,7 @@
 #include "core/geometry.h"
 #include "tests/daemon/derived_readings.h"
 #include "tests/daemon/interpolation_rig_test.h"
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
 #include "tools/brdf-sim/optics/optics.h"
 

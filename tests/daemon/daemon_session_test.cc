@@ -16,7 +16,7 @@
 
 #include "storage/session_store.h"
 #include "tests/daemon/session_rig_test.h"
-#include "tests/support/daemon_test_util.h"
+#include "tests/support/daemon/test_util.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {

@@ -14,7 +14,7 @@
 #include "core/interp/interpolator.h"
 #include "tests/daemon/derived_readings.h"
 #include "tests/daemon/interpolation_rig_test.h"
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {

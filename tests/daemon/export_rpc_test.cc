@@ -23,7 +23,7 @@
 #include "core/export/merl/layout.h"
 #include "core/export/merl/reader.h"
 #include "core/export/rgl/reader.h"
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
 #include "tests/support/process_launcher.h"
 

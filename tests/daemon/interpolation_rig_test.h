@@ -17,8 +17,8 @@
 
 #include "core/interp/interpolator.h"
 #include "core/pose.h"
-#include "tests/support/daemon_test_rig.h"
-#include "tests/support/rig_teardown.h"
+#include "tests/support/daemon/rig_teardown.h"
+#include "tests/support/daemon/test_rig.h"
 
 namespace brdf::testing {
 

@@ -13,9 +13,9 @@
 
 #include "core/plan/plan_json.h"
 #include "daemon/api/common.h"
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/raw_call.h"
+#include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
-#include "tests/support/raw_call.h"
 
 namespace brdf::testing {
 namespace {

@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {

@@ -23,9 +23,9 @@
 
 #include "core/geometry.h"
 #include "tests/daemon/derived_readings.h"
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/rig_teardown.h"
+#include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
-#include "tests/support/rig_teardown.h"
 #include "tools/brdf-sim/optics/detector.h"
 #include "tools/brdf-sim/optics/material.h"
 

@@ -13,7 +13,7 @@
 
 #include "core/call_context.h"
 #include "drivers/pr650/serial_link.h"
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 #include "tests/support/process_launcher.h"
 
 namespace brdf::testing {

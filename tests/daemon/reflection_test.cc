@@ -15,7 +15,7 @@
 
 #include "grpc/reflection/v1/reflection.grpc.pb.h"
 #include "grpc/reflection/v1alpha/reflection.grpc.pb.h"
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 
 namespace brdf::testing {
 namespace {

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "tests/support/daemon_test_rig.h"
-#include "tests/support/rig_teardown.h"
+#include "tests/support/daemon/rig_teardown.h"
+#include "tests/support/daemon/test_rig.h"
 
 namespace brdf::testing {
 

@@ -13,7 +13,7 @@
 
 #include "daemon/api/common.h"
 #include "grpc/health/v1/health.grpc.pb.h"
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {

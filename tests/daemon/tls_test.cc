@@ -10,7 +10,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 #include "tests/support/process_launcher.h"
 
 namespace brdf::testing {

@@ -1,5 +1,5 @@
 // The PR-650 driver against the real brdf-sim process (its PR-650 on a pty, its optics behind it),
-// started through tests/support/sim_process.h: the same path the daemon takes in a lab without the
+// started through tests/support/sim/process.h: the same path the daemon takes in a lab without the
 // meter.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 
 #include "drivers/pr650/pr650_spectroradiometer.h"
 #include "tests/drivers_pr650/pr650_test_rig.h"
-#include "tests/support/sim_process.h"
+#include "tests/support/sim/process.h"
 
 namespace brdf::testing {
 namespace {

@@ -1,5 +1,5 @@
 // What the engine tests stand on: the in-process fake meter and stage behind the driver
-// interfaces (tests/support/fake_rig.h), a real SQLite file in a temporary directory, and an
+// interfaces (tests/support/fakes/rig.h), a real SQLite file in a temporary directory, and an
 // "operator" that answers the session's prompts the way a person would: it mounts the white
 // standard, the sample or closes the shutter on the fake bench, then answers the prompt. The
 // real drivers and their wire protocols are exercised against brdf-sim elsewhere (tests/sim,
@@ -22,7 +22,7 @@
 #include "daemon/engine/rig.h"
 #include "daemon/engine/session_manager.h"
 #include "storage/session_store.h"
-#include "tests/support/fake_rig.h"
+#include "tests/support/fakes/rig.h"
 #include "tests/support/test_env.h"
 
 namespace brdf::testing {

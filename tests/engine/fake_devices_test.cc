@@ -1,12 +1,12 @@
-// The in-process fakes the engine tests stand on (tests/support/fake_devices.h) do what their
+// The in-process fakes the engine tests stand on (tests/support/fakes/devices.h) do what their
 // contract says: injected failures, delays, a dropped link, cancellation, a pose-dependent
 // spectrum.
-#include "tests/support/fake_devices.h"
-
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <thread>
+
+#include "tests/support/fakes/devices.h"
 
 namespace brdf::testing {
 namespace {

@@ -1,13 +1,13 @@
 // How soon rig status shows a stage that answers again (issue 21): the supervisor's stage back-off
 // is capped by Rig::Options::stage_backoff_max ([stage] reconnect_max_ms), and asking for rig
 // status or resuming (Rig::RetryStageNow) tries a disconnected stage at once. On the fake stage of
-// tests/support/fake_rig.h, whose Connect fails while it is unreachable.
+// tests/support/fakes/rig.h, whose Connect fails while it is unreachable.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <thread>
 
-#include "tests/support/fake_rig.h"
+#include "tests/support/fakes/rig.h"
 
 namespace brdf::testing {
 namespace {

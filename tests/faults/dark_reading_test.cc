@@ -9,8 +9,8 @@
 #include <chrono>
 
 #include "drivers/pr650/quality_codes.h"
-#include "tests/support/daemon_test_rig.h"
-#include "tests/support/daemon_test_util.h"
+#include "tests/support/daemon/test_rig.h"
+#include "tests/support/daemon/test_util.h"
 
 namespace brdf::testing {
 namespace {

@@ -10,7 +10,7 @@
 //
 // Every row also checks what never changes: the daemon does not exit, no reading recorded before
 // the fault is lost or repeated, and at the end the database holds every planned step once with
-// exactly one reading per measuring step (tests/support/daemon_test_util.h, storage's own check).
+// exactly one reading per measuring step (tests/support/daemon/test_util.h, storage's own check).
 // kRtuMatrix runs the same checks with the stage on Modbus RTU (brdf-sim's RTU pty). The rows are
 // listed with their promises in docs/stage-modbus.md ("The fault matrix's stage rows").
 #include <arpa/inet.h>
@@ -36,10 +36,10 @@
 #include <thread>
 #include <vector>
 
-#include "tests/support/daemon_test_rig.h"
-#include "tests/support/daemon_test_util.h"
+#include "tests/support/daemon/rig_teardown.h"
+#include "tests/support/daemon/test_rig.h"
+#include "tests/support/daemon/test_util.h"
 #include "tests/support/plan_fixtures.h"
-#include "tests/support/rig_teardown.h"
 
 namespace brdf::testing {
 namespace {

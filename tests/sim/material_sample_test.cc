@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "tests/support/sim_process.h"
+#include "tests/support/sim/process.h"
 #include "tests/support/test_env.h"
 #include "tools/brdf-sim/optics/material.h"
 #include "tools/brdf-sim/optics/optics.h"

@@ -1,8 +1,6 @@
 // brdf-sim as a process: the start-up lines other tests rely on, the endpoints they name, the
 // control unit, a measurement through the simulated PR-650's pty, clean exit on SIGTERM, and the
 // `truth` subcommand.
-#include "tests/support/sim_process.h"
-
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -22,7 +20,8 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "tests/support/modbus_control.h"
+#include "tests/support/sim/modbus_control.h"
+#include "tests/support/sim/process.h"
 #include "tests/support/test_env.h"
 #include "tools/brdf-sim/optics/optics.h"
 

@@ -3,7 +3,7 @@
 // test's own stderr or appended to a log file, optionally a changed environment and standard
 // input from /dev/null. The child dies with the test process (PR_SET_PDEATHSIG). Program-specific
 // start-up contracts (brdf-sim's endpoint lines, brdfd's "listening" line) live in their own
-// wrappers (sim_process.h, tests/support/daemon_process.h, tests/brdfctl/ctl_runner.h).
+// wrappers (sim/process.h, tests/support/daemon/process.h, tests/brdfctl/ctl_runner.h).
 #pragma once
 
 #include <sys/types.h>

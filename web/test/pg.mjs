@@ -1,5 +1,5 @@
 // A throwaway PostgreSQL server for the web tests (Debian's postgresql-15 binaries, as the C++
-// archive tests' tests/support/pg_server.h): its own data directory under /tmp, a unix socket
+// archive tests' tests/support/pg/server.h): its own data directory under /tmp, a unix socket
 // there and a free TCP port on 127.0.0.1, trust authentication for the one role `brdf`. As root
 // it runs as `nobody` (PostgreSQL refuses root). BRDF_PG_BIN overrides where the binaries are.
 import { spawn, execFileSync } from 'node:child_process';

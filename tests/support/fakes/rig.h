@@ -1,4 +1,4 @@
-// A daemon::Rig on the in-process fake devices (tests/support/fake_devices.h), for tests of the
+// A daemon::Rig on the in-process fake devices (tests/support/fakes/devices.h), for tests of the
 // executor and the session manager that need instruments but not their wire protocols: no
 // brdf-sim process, no serial line, no Modbus. The test keeps the bench (what is mounted, the
 // pose) and each device's fault switch; the rig owns the fakes.
@@ -8,7 +8,7 @@
 
 #include "core/plan/rig_description.h"
 #include "daemon/engine/rig.h"
-#include "tests/support/fake_devices.h"
+#include "tests/support/fakes/devices.h"
 
 namespace brdf::testing {
 

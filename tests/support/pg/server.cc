@@ -1,4 +1,4 @@
-#include "tests/support/pg_server.h"
+#include "tests/support/pg/server.h"
 
 #include <fcntl.h>
 #include <pwd.h>

@@ -1,4 +1,4 @@
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 
 #include <fstream>
 #include <optional>

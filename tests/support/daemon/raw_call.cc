@@ -1,4 +1,4 @@
-#include "tests/support/raw_call.h"
+#include "tests/support/daemon/raw_call.h"
 
 #include <google/protobuf/dynamic_message.h>
 #include <grpcpp/generic/generic_stub.h>
@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "brdf/v1/brdf.pb.h"
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 
 namespace brdf::testing {
 

@@ -1,4 +1,4 @@
-// A test fixture holding a fresh PostgreSQL server (pg_server.h) in pg_, started for each test;
+// A test fixture holding a fresh PostgreSQL server (pg/server.h) in pg_, started for each test;
 // the test is skipped, saying why, when PostgreSQL is not installed. Header-only: the test
 // executables link GoogleTest, brdf_test_support does not.
 #pragma once
@@ -9,7 +9,7 @@
 #include <string>
 #include <utility>
 
-#include "tests/support/pg_server.h"
+#include "tests/support/pg/server.h"
 
 namespace brdf::testing {
 

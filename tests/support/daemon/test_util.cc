@@ -1,4 +1,4 @@
-#include "tests/support/daemon_test_util.h"
+#include "tests/support/daemon/test_util.h"
 
 #include <sqlite3.h>
 

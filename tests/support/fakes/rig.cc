@@ -1,4 +1,4 @@
-#include "tests/support/fake_rig.h"
+#include "tests/support/fakes/rig.h"
 
 namespace brdf::testing {
 

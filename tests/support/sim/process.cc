@@ -1,4 +1,4 @@
-#include "tests/support/sim_process.h"
+#include "tests/support/sim/process.h"
 
 #include <cstdlib>
 #include <set>

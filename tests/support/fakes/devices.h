@@ -5,7 +5,7 @@
 // distance / speed (scaled), and the meter's spectrum is derived from the stage's pose and from
 // what is mounted in front of it, so readings differ from pose to pose and interpolate smoothly.
 // Tests that exercise the real drivers and their wire protocols use brdf-sim instead
-// (tests/support/sim_rig.h).
+// (tests/support/sim/rig.h).
 //
 // Fault injection, set at any time from the test's thread: fail the next N calls with a given
 // Status, delay every call, drop the link (and refuse to reconnect while unreachable). Waits

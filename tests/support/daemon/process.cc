@@ -1,4 +1,4 @@
-#include "tests/support/daemon_process.h"
+#include "tests/support/daemon/process.h"
 
 #include <fstream>
 #include <optional>

@@ -1,4 +1,4 @@
-#include "tests/support/sim_rig.h"
+#include "tests/support/sim/rig.h"
 
 namespace brdf::testing {
 

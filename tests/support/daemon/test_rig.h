@@ -22,10 +22,10 @@
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "core/status.h"
-#include "tests/support/daemon_process.h"
-#include "tests/support/modbus_control.h"
-#include "tests/support/sim_process.h"
-#include "tests/support/sim_rig.h"
+#include "tests/support/daemon/process.h"
+#include "tests/support/sim/modbus_control.h"
+#include "tests/support/sim/process.h"
+#include "tests/support/sim/rig.h"
 #include "tests/support/test_env.h"
 
 namespace brdf::testing {
@@ -48,7 +48,7 @@ class DaemonRig {
   DaemonRig();
   ~DaemonRig();
 
-  // Starts brdf-sim (tests/support/sim_rig.h, seed 11, then `extra`) and connects to its
+  // Starts brdf-sim (tests/support/sim/rig.h, seed 11, then `extra`) and connects to its
   // control unit.
   Status StartSim(const std::vector<std::string>& extra = {});
   // Writes the configuration (DaemonConfigToml unless `toml` is given) and starts brdfd on it;

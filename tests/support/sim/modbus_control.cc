@@ -1,4 +1,4 @@
-#include "tests/support/modbus_control.h"
+#include "tests/support/sim/modbus_control.h"
 
 #include <modbus.h>
 

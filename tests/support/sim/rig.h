@@ -1,9 +1,9 @@
 // The simulator rig the process tests stand on: brdf-sim started for a fast, deterministic run
 // (simulated time kSimTimeScale× faster, no 9600-baud pacing, no wake window, Modbus on a free
 // port) and the test's hand on its control unit (what is mounted, the meter's power, faults).
-// brdfd then drives it through the real drivers (tests/support/daemon_test_rig.h,
+// brdfd then drives it through the real drivers (tests/support/daemon/test_rig.h,
 // tests/brdfctl/ctl_test_rig.h). Tests that need instruments but not their wire protocols use
-// the in-process fakes instead (tests/support/fake_rig.h).
+// the in-process fakes instead (tests/support/fakes/rig.h).
 #pragma once
 
 #include <memory>
@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "core/status.h"
-#include "tests/support/modbus_control.h"
-#include "tests/support/sim_process.h"
+#include "tests/support/sim/modbus_control.h"
+#include "tests/support/sim/process.h"
 
 namespace brdf::testing {
 

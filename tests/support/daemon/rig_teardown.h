@@ -10,7 +10,7 @@
 #include <iostream>
 #include <string>
 
-#include "tests/support/daemon_test_rig.h"
+#include "tests/support/daemon/test_rig.h"
 
 namespace brdf::testing {
 

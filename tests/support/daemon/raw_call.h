@@ -38,7 +38,7 @@ RawReply CallRaw(const std::shared_ptr<grpc::Channel>& channel, const std::strin
                  int max_messages = 1000);
 
 // A brdfd configuration without devices (no such serial port, nothing on `dead_port`), listening
-// on 127.0.0.1:0, with the operator and analyst tokens of daemon_test_rig.h.
+// on 127.0.0.1:0, with the operator and analyst tokens of daemon/test_rig.h.
 std::string AbsentDevicesToml(const std::string& database, int dead_port,
                               const std::string& log_level = "info");
 

@@ -1,4 +1,4 @@
-#include "tests/support/fake_devices.h"
+#include "tests/support/fakes/devices.h"
 
 #include <algorithm>
 #include <cmath>
