@@ -1,7 +1,7 @@
 // Sessions end to end on the engine: SessionManager → Executor → Rig → the in-process fake meter
 // and stage (tests/support/fakes/rig.h), with a real SQLite file. The test plays the operator
 // (tests/engine/engine_test_rig.h). The same sessions on the real drivers and brdf-sim run in
-// tests/daemon/daemon_session_test.cc.
+// tests/daemon/sessions/daemon_session_test.cc.
 #include "daemon/engine/session_manager.h"
 
 #include <gtest/gtest.h>

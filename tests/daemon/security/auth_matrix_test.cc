@@ -99,8 +99,8 @@ TEST(AuthMatrixClassificationTest, EveryRpcOfTheProtoIsClassified) {
     seen.insert(m->full_name());
     EXPECT_EQ(Classification().count(m->full_name()), 1u)
         << m->full_name()
-        << " is a new RPC: classify it in auth_matrix_test.cc (control or read) and, if it "
-           "changes anything, in rpc/auth.cc's MethodAccess";
+        << " is a new RPC: classify it in tests/daemon/security/auth_matrix_test.cc (control or "
+           "read) and, if it changes anything, in rpc/auth.cc's MethodAccess";
   }
   for (const auto& [name, needs] : Classification()) {
     EXPECT_EQ(seen.count(name), 1u) << name << " is no longer in brdf.proto";

@@ -15,7 +15,7 @@
 #include <thread>
 
 #include "storage/session_store.h"
-#include "tests/daemon/session_rig_test.h"
+#include "tests/daemon/sessions/rig_test.h"
 #include "tests/support/daemon/test_util.h"
 #include "tests/support/plan_fixtures.h"
 

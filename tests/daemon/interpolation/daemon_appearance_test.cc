@@ -16,7 +16,7 @@
 
 #include "core/colorimetry.h"
 #include "data/cie_tables.h"
-#include "tests/daemon/interpolation_rig_test.h"
+#include "tests/daemon/interpolation/rig_test.h"
 #include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
 

@@ -1,4 +1,4 @@
-#include "tests/daemon/derived_readings.h"
+#include "tests/daemon/interpolation/derived_readings.h"
 
 #include <algorithm>
 #include <cmath>

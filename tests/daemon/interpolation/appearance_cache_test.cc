@@ -32,7 +32,7 @@
 #include "daemon/index/cache.h"
 #include "daemon/rpc/auth.h"
 #include "storage/session_store.h"
-#include "tests/daemon/interpolation_service_test.h"
+#include "tests/daemon/interpolation/service_test.h"
 
 namespace brdf::daemon {
 namespace {

@@ -20,8 +20,8 @@
 
 #include "core/analytic_brdf.h"
 #include "core/geometry.h"
-#include "tests/daemon/derived_readings.h"
-#include "tests/daemon/interpolation_rig_test.h"
+#include "tests/daemon/interpolation/derived_readings.h"
+#include "tests/daemon/interpolation/rig_test.h"
 #include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
 #include "tools/brdf-sim/optics/optics.h"

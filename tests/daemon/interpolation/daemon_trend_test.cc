@@ -12,8 +12,8 @@
 #include <cmath>
 
 #include "core/interp/interpolator.h"
-#include "tests/daemon/derived_readings.h"
-#include "tests/daemon/interpolation_rig_test.h"
+#include "tests/daemon/interpolation/derived_readings.h"
+#include "tests/daemon/interpolation/rig_test.h"
 #include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"
 

@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "tests/daemon/derived_readings.h"
+#include "tests/daemon/interpolation/derived_readings.h"
 #include "tests/support/daemon/rig_teardown.h"
 #include "tests/support/daemon/test_rig.h"
 #include "tests/support/plan_fixtures.h"

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "google/protobuf/util/time_util.h"
-#include "tests/daemon/session_rig_test.h"
+#include "tests/daemon/sessions/rig_test.h"
 #include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
