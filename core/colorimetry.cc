@@ -257,13 +257,11 @@ Status ReadSets(const TableText& t, const std::vector<Column>& columns, Spectral
 
 Result<SpectralTable> ParseSpectralTable(std::string_view text) {
   SpectralTable table;
-  const Result<TableText> t = ReadTableText(text, table);
-  if (!t.ok()) return t.status();
-  BRDF_RETURN_IF_ERROR(CheckTableText(*t));
-  const Result<std::vector<Column>> columns = ReadColumns(*t, table);
-  if (!columns.ok()) return columns.status();
-  BRDF_RETURN_IF_ERROR(ApplyDeclaredRange(*t, table));
-  BRDF_RETURN_IF_ERROR(ReadSets(*t, *columns, table));
+  BRDF_ASSIGN_OR_RETURN(const TableText t, ReadTableText(text, table));
+  BRDF_RETURN_IF_ERROR(CheckTableText(t));
+  BRDF_ASSIGN_OR_RETURN(const std::vector<Column> columns, ReadColumns(t, table));
+  BRDF_RETURN_IF_ERROR(ApplyDeclaredRange(t, table));
+  BRDF_RETURN_IF_ERROR(ReadSets(t, columns, table));
   return table;
 }
 
@@ -301,13 +299,10 @@ Result<ColorMatchingFunctions> ColorMatchingFunctionsFromTable(const SpectralTab
                            std::to_string(table.sets.size()) +
                            " sets; a CMF table has three (x̄, ȳ, z̄)");
   }
-  Result<Spectrum> x = table.SetAsSpectrum(0);
-  if (!x.ok()) return x.status();
-  Result<Spectrum> y = table.SetAsSpectrum(1);
-  if (!y.ok()) return y.status();
-  Result<Spectrum> z = table.SetAsSpectrum(2);
-  if (!z.ok()) return z.status();
-  return ColorMatchingFunctions{std::move(x).value(), std::move(y).value(), std::move(z).value()};
+  BRDF_ASSIGN_OR_RETURN(Spectrum x, table.SetAsSpectrum(0));
+  BRDF_ASSIGN_OR_RETURN(Spectrum y, table.SetAsSpectrum(1));
+  BRDF_ASSIGN_OR_RETURN(Spectrum z, table.SetAsSpectrum(2));
+  return ColorMatchingFunctions{std::move(x), std::move(y), std::move(z)};
 }
 
 Result<Xyz> ReflectanceToXyz(const Spectrum& reflectance, const Spectrum& illuminant,

@@ -74,9 +74,9 @@ int ParseFlags(int argc, char** argv, Flags* flags) {
 // One owner: refuses, before anything is touched, a database, address or meter port that another
 // process holds (engine/one_owner.h). The database lock, in `*lock`, is held until exit.
 Status ClaimOwnership(const Config& config, std::unique_ptr<DatabaseLock>* lock) {
-  Result<std::unique_ptr<DatabaseLock>> acquired = DatabaseLock::Acquire(config.storage.database);
-  if (!acquired.ok()) return acquired.status();
-  *lock = std::move(*acquired);
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<DatabaseLock> acquired,
+                        DatabaseLock::Acquire(config.storage.database));
+  *lock = std::move(acquired);
   for (const Status& owned : {CheckListenAddressFree(config.server.listen),
                               drivers::CheckDeviceFree(config.meter.port)}) {
     if (!owned.ok()) return owned;

@@ -4,12 +4,10 @@ namespace brdf::drivers {
 
 Result<MeasuredSpectrum> Spectroradiometer::MeasureSpectrum(const CallContext& ctx,
                                                             const MeasuredCallback& measured) {
-  Result<MeasurementOutcome> outcome = Measure(ctx);
-  if (!outcome.ok()) return outcome.status();
-  if (measured) measured(*outcome);
-  Result<SpectrumReport> report = TransferSpectrum(ctx);
-  if (!report.ok()) return report.status();
-  return MeasuredSpectrum{std::move(*outcome), std::move(*report)};
+  BRDF_ASSIGN_OR_RETURN(MeasurementOutcome outcome, Measure(ctx));
+  if (measured) measured(outcome);
+  BRDF_ASSIGN_OR_RETURN(SpectrumReport report, TransferSpectrum(ctx));
+  return MeasuredSpectrum{std::move(outcome), std::move(report)};
 }
 
 }  // namespace brdf::drivers

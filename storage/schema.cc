@@ -213,9 +213,8 @@ int LatestSchemaVersion() {
 }
 
 Result<int> SchemaVersion(Database& db) {
-  Result<std::int64_t> v = db.QueryInt64("PRAGMA user_version");
-  if (!v.ok()) return v.status();
-  return static_cast<int>(*v);
+  BRDF_ASSIGN_OR_RETURN(std::int64_t v, db.QueryInt64("PRAGMA user_version"));
+  return static_cast<int>(v);
 }
 
 Status Migrate(Database& db, std::span<const Migration> migrations) {
@@ -230,14 +229,13 @@ Status Migrate(Database& db, std::span<const Migration> migrations) {
 
   // Looks at the file; refuses (touching nothing) what this build must not modify.
   auto check = [&](int version) -> Status {
-    Result<std::int64_t> app = db.QueryInt64("PRAGMA application_id");
-    if (!app.ok()) return app.status();
-    Result<std::int64_t> objects = db.QueryInt64("SELECT count(*) FROM sqlite_schema");
-    if (!objects.ok()) return objects.status();
-    if (*app != kApplicationId && (*app != 0 || version != 0 || *objects != 0)) {
+    BRDF_ASSIGN_OR_RETURN(std::int64_t app, db.QueryInt64("PRAGMA application_id"));
+    BRDF_ASSIGN_OR_RETURN(std::int64_t objects,
+                          db.QueryInt64("SELECT count(*) FROM sqlite_schema"));
+    if (app != kApplicationId && (app != 0 || version != 0 || objects != 0)) {
       return FailedPrecondition(
-          db.path() + " is not a brdfd database (application_id " + Hex(*app) +
-          ", schema version " + std::to_string(version) + ", " + std::to_string(*objects) +
+          db.path() + " is not a brdfd database (application_id " + Hex(app) + ", schema version " +
+          std::to_string(version) + ", " + std::to_string(objects) +
           " schema objects): point brdfd at a new or brdfd-made database file");
     }
     if (version > latest) {
@@ -250,13 +248,12 @@ Status Migrate(Database& db, std::span<const Migration> migrations) {
     return Status::Ok();
   };
 
-  Result<int> version = SchemaVersion(db);
-  if (!version.ok()) return version.status();
-  BRDF_RETURN_IF_ERROR(check(*version));
-  if (*version == latest) return Status::Ok();
+  BRDF_ASSIGN_OR_RETURN(int version, SchemaVersion(db));
+  BRDF_RETURN_IF_ERROR(check(version));
+  if (version == latest) return Status::Ok();
 
   for (const Migration& m : migrations) {
-    if (m.version <= *version) continue;
+    if (m.version <= version) continue;
     const std::string what = "migrating " + db.path() + " to schema version " +
                              std::to_string(m.version) + " (" + std::string(m.description) + ")";
     Result<Transaction> tx = Transaction::Begin(db);
@@ -271,7 +268,7 @@ Status Migrate(Database& db, std::span<const Migration> migrations) {
                                  "; PRAGMA application_id = " + std::to_string(kApplicationId))
                              .WithContext(what));
     BRDF_RETURN_IF_ERROR(tx->Commit().WithContext(what));
-    *version = m.version;
+    version = m.version;
   }
   return Status::Ok();
 }

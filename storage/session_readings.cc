@@ -51,15 +51,13 @@ constexpr int kReadingsPerPage = 4096;
 }  // namespace
 
 Result<SessionReadings> LoadSessionReadings(SessionReader& reader, std::int64_t session_id) {
-  Result<SessionReadings> session = LoadSessionRecord(reader, session_id);
-  if (!session.ok()) return session;
+  BRDF_ASSIGN_OR_RETURN(SessionReadings session, LoadSessionRecord(reader, session_id));
   for (std::int64_t after = 0;;) {
-    Result<std::vector<ReadingRecord>> page =
-        reader.GetReadings(session_id, after, kReadingsPerPage);
-    if (!page.ok()) return page.status();
-    for (const ReadingRecord& r : *page) session->readings.push_back(ToReading(r));
-    if (page->size() < static_cast<std::size_t>(kReadingsPerPage)) break;
-    after = page->back().id;
+    BRDF_ASSIGN_OR_RETURN(std::vector<ReadingRecord> page,
+                          reader.GetReadings(session_id, after, kReadingsPerPage));
+    for (const ReadingRecord& r : page) session.readings.push_back(ToReading(r));
+    if (page.size() < static_cast<std::size_t>(kReadingsPerPage)) break;
+    after = page.back().id;
   }
   return session;
 }

@@ -242,9 +242,8 @@ Result<bool> Statement::Step() {
 }
 
 Status Statement::Run() {
-  Result<bool> row = Step();
-  if (!row.ok()) return row.status();
-  if (*row) {
+  BRDF_ASSIGN_OR_RETURN(bool row, Step());
+  if (row) {
     return Internal("\"" + DescribeSql(sql_) + "\" on " + db_->path() +
                     " returned rows where none were expected (a bug in brdfd's storage)");
   }
@@ -325,11 +324,10 @@ Status Database::Configure(const OpenOptions& options) {
     return SqliteStatus(SQLITE_READONLY, path_, "opening the database for writing",
                         "the operating system allows reading only");
   }
-  Result<std::string> mode = QueryText("PRAGMA journal_mode=WAL");
-  if (!mode.ok()) return mode.status();
+  BRDF_ASSIGN_OR_RETURN(std::string mode, QueryText("PRAGMA journal_mode=WAL"));
   // An in-memory database reports "memory"; a read-only connection cannot change the mode.
-  if (*mode != "wal" && *mode != "memory" && !options.read_only) {
-    return IoError("switching " + path_ + " to WAL journal mode failed (SQLite kept \"" + *mode +
+  if (mode != "wal" && mode != "memory" && !options.read_only) {
+    return IoError("switching " + path_ + " to WAL journal mode failed (SQLite kept \"" + mode +
                    "\"): the filesystem may lack shared-memory support (a network share?); keep "
                    "the database on a local disk");
   }
@@ -387,21 +385,17 @@ Status Database::Exec(std::string_view sql) {
 }
 
 Result<std::int64_t> Database::QueryInt64(std::string_view sql) {
-  Result<Statement> st = Prepare(sql);
-  if (!st.ok()) return st.status();
-  Result<bool> row = st->Step();
-  if (!row.ok()) return row.status();
-  if (!*row) return Internal("\"" + DescribeSql(sql) + "\" on " + path_ + " returned no row");
-  return st->Int64(0);
+  BRDF_ASSIGN_OR_RETURN(Statement st, Prepare(sql));
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
+  if (!row) return Internal("\"" + DescribeSql(sql) + "\" on " + path_ + " returned no row");
+  return st.Int64(0);
 }
 
 Result<std::string> Database::QueryText(std::string_view sql) {
-  Result<Statement> st = Prepare(sql);
-  if (!st.ok()) return st.status();
-  Result<bool> row = st->Step();
-  if (!row.ok()) return row.status();
-  if (!*row) return Internal("\"" + DescribeSql(sql) + "\" on " + path_ + " returned no row");
-  return st->Text(0);
+  BRDF_ASSIGN_OR_RETURN(Statement st, Prepare(sql));
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
+  if (!row) return Internal("\"" + DescribeSql(sql) + "\" on " + path_ + " returned no row");
+  return st.Text(0);
 }
 
 std::int64_t Database::last_insert_rowid() const {

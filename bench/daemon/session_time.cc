@@ -127,9 +127,8 @@ Result<std::shared_ptr<daemon::Rig>> MakeRig(const testing::SimProcess& sim,
   stage.poll_interval = 2ms;
   stage.pulse_hold = 2ms;
   stage.start_grace = 50ms;
-  Result<std::unique_ptr<drivers::stage::ModbusStage>> created =
-      drivers::stage::ModbusStage::Create(stage);
-  if (!created.ok()) return created.status();
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<drivers::stage::ModbusStage> created,
+                        drivers::stage::ModbusStage::Create(stage));
   daemon::Rig::Options options;
   options.backoff_initial = 50ms;
   options.backoff_max = 500ms;
@@ -137,7 +136,7 @@ Result<std::shared_ptr<daemon::Rig>> MakeRig(const testing::SimProcess& sim,
   options.pose_poll_interval = 1000ms;  // the supervisor's live pose: not on the session's path
   return std::make_shared<daemon::Rig>(
       std::make_unique<drivers::Pr650Spectroradiometer>(meter),
-      daemon::Rig::DeviceInfo{"PR-650", sim.pr650_path()}, std::move(*created),
+      daemon::Rig::DeviceInfo{"PR-650", sim.pr650_path()}, std::move(created),
       daemon::Rig::DeviceInfo{"Modbus stage", sim.modbus_host()}, rig, options);
 }
 
@@ -155,13 +154,12 @@ struct Run {
 // it ended (COMPLETED or another terminal state).
 Status Operate(daemon::SessionManager& manager, testing::ModbusControl& control,
                daemon::SessionId id, std::chrono::steady_clock::time_point* ended) {
-  Result<std::shared_ptr<daemon::EventSubscription>> sub = manager.Subscribe(id);
-  if (!sub.ok()) return sub.status();
+  BRDF_ASSIGN_OR_RETURN(std::shared_ptr<daemon::EventSubscription> sub, manager.Subscribe(id));
   const auto give_up = std::chrono::steady_clock::now() + 20min;
   while (std::chrono::steady_clock::now() < give_up) {
-    std::optional<v1::SessionEvent> event = (*sub)->Next(200ms);
+    std::optional<v1::SessionEvent> event = sub->Next(200ms);
     if (!event.has_value()) {
-      if ((*sub)->ended()) break;
+      if (sub->ended()) break;
       continue;
     }
     std::optional<v1::Prompt> prompt;
@@ -197,9 +195,8 @@ Status Operate(daemon::SessionManager& manager, testing::ModbusControl& control,
         break;
     }
     BRDF_RETURN_IF_ERROR(acted);
-    Result<v1::Session> answered =
-        manager.AnswerPrompt(id, prompt->step_index(), "bench", kBenchOperator);
-    if (!answered.ok()) return answered.status();
+    BRDF_RETURN_IF_ERROR(
+        manager.AnswerPrompt(id, prompt->step_index(), "bench", kBenchOperator).status());
   }
   return Timeout("session " + std::to_string(id) + " did not complete within 20 minutes");
 }

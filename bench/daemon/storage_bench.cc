@@ -58,9 +58,8 @@ Result<std::int64_t> NewSessionWith(storage::SessionStore& store, int samples) {
   add(storage::StepKind::kReference);
   add(storage::StepKind::kDark);
   for (int i = 0; i < samples; ++i) add(storage::StepKind::kSample);
-  Result<std::int64_t> id = store.CreateSession(s, steps);
-  if (!id.ok()) return id;
-  BRDF_RETURN_IF_ERROR(store.SetSessionState(*id, SessionState::kRunning, "bench"));
+  BRDF_ASSIGN_OR_RETURN(std::int64_t id, store.CreateSession(s, steps));
+  BRDF_RETURN_IF_ERROR(store.SetSessionState(id, SessionState::kRunning, "bench"));
   return id;
 }
 
@@ -73,9 +72,8 @@ Result<std::int64_t> NewSessionWith(storage::SessionStore& store, int samples) {
 class RigPoses {
  public:
   static Result<RigPoses> Make() {
-    Result<std::vector<Pose>> grid = ExpandSampleRotationGrid(GridSpec{});
-    if (!grid.ok()) return grid.status();
-    return RigPoses(*std::move(grid));
+    BRDF_ASSIGN_OR_RETURN(std::vector<Pose> grid, ExpandSampleRotationGrid(GridSpec{}));
+    return RigPoses(std::move(grid));
   }
   // The pose of the i-th sample reading, with its directions.
   std::pair<Pose, Directions> Next(std::size_t i) {
@@ -106,8 +104,7 @@ class RigPoses {
 template <typename Tick>
 Result<int> Fill(storage::SessionStore& store, std::int64_t session, int samples, Tick tick) {
   const WavelengthGrid grid = WavelengthGrid::Pr650();
-  Result<RigPoses> poses = RigPoses::Make();
-  if (!poses.ok()) return poses.status();
+  BRDF_ASSIGN_OR_RETURN(RigPoses poses, RigPoses::Make());
   // The white reference's spectrum I0 (lamp and detector 10° off the normal), the dark D; a
   // sample's radiance is D + (I0 − D)·f·π/ρw·cos θi/cos θi,ref for the paint's BRDF f, i.e. what
   // the daemon's derivation (core/readings/derive.h) turns back into f.
@@ -142,20 +139,20 @@ Result<int> Fill(storage::SessionStore& store, std::int64_t session, int samples
     r.integration_ms = 100;
     return r;
   };
-  Result<std::int64_t> reference = store.CompleteStepWithReading(
-      session, 0, reading(storage::ReadingKind::kReference, {}, reference_at));
-  if (!reference.ok()) return reference.status();
-  Result<std::int64_t> dark =
-      store.CompleteStepWithReading(session, 1, reading(storage::ReadingKind::kDark, {}, {}));
-  if (!dark.ok()) return dark.status();
+  BRDF_ASSIGN_OR_RETURN(
+      std::int64_t reference,
+      store.CompleteStepWithReading(session, 0,
+                                    reading(storage::ReadingKind::kReference, {}, reference_at)));
+  BRDF_ASSIGN_OR_RETURN(
+      std::int64_t dark,
+      store.CompleteStepWithReading(session, 1, reading(storage::ReadingKind::kDark, {}, {})));
   int written = 0;
   for (int i = 0; i < samples; ++i) {
-    const auto [pose, directions] = poses->Next(static_cast<std::size_t>(i));
+    const auto [pose, directions] = poses.Next(static_cast<std::size_t>(i));
     storage::ReadingRecord r = reading(storage::ReadingKind::kSample, pose, directions);
-    r.reference_reading_id = *reference;
-    r.dark_reading_id = *dark;
-    Result<std::int64_t> id = store.CompleteStepWithReading(session, 2 + i, r);
-    if (!id.ok()) return id.status();
+    r.reference_reading_id = reference;
+    r.dark_reading_id = dark;
+    BRDF_RETURN_IF_ERROR(store.CompleteStepWithReading(session, 2 + i, r).status());
     ++written;
     if (!tick()) break;
   }

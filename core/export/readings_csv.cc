@@ -123,15 +123,14 @@ Result<ReadingsCsvReport> WriteReadingsCsv(const Session& session, Quantity quan
     return report;
   }
 
-  Result<DerivedSamples> derived = DeriveSamples(session, quantity, options);
-  if (!derived.ok()) return derived.status();
+  BRDF_ASSIGN_OR_RETURN(DerivedSamples derived, DeriveSamples(session, quantity, options));
   std::unordered_map<std::int64_t, const Reading*> by_id;
   for (const Reading& r : session.readings) by_id.emplace(r.id, &r);
-  report.rows = derived->samples.size();
-  report.skipped = derived->skipped;
-  text = Header(session, quantity, derived->grid, report.rows, derived->skipped);
+  report.rows = derived.samples.size();
+  report.skipped = derived.skipped;
+  text = Header(session, quantity, derived.grid, report.rows, derived.skipped);
   BRDF_RETURN_IF_ERROR(Flush(out, text));
-  for (const DerivedSample& s : derived->samples) {
+  for (const DerivedSample& s : derived.samples) {
     AppendRow(*by_id.at(s.reading_id), s.values, text);
     if (text.size() > (1u << 20)) BRDF_RETURN_IF_ERROR(Flush(out, text));
   }

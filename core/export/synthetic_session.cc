@@ -14,8 +14,7 @@ double SyntheticLampRadiance(double wavelength_nm) {
 }
 
 Result<Session> SyntheticSession(const AnalyticBrdf& brdf, const SyntheticSessionOptions& options) {
-  Result<std::vector<Pose>> poses = ExpandSampleRotationGrid(options.poses);
-  if (!poses.ok()) return poses.status();
+  BRDF_ASSIGN_OR_RETURN(std::vector<Pose> poses, ExpandSampleRotationGrid(options.poses));
   const WavelengthGrid& grid = options.grid;
   if (!grid.valid()) return InvalidArgument("synthetic session: the wavelength grid is invalid");
 
@@ -47,7 +46,7 @@ Result<Session> SyntheticSession(const AnalyticBrdf& brdf, const SyntheticSessio
     session.readings.push_back(dark);
   }
 
-  for (const Pose& pose : *poses) {
+  for (const Pose& pose : poses) {
     Reading r;
     r.id = next_id++;
     r.kind = ReadingKind::kSample;

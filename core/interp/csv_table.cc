@@ -218,9 +218,7 @@ Result<CsvTable> ParseNumericCsv(std::string_view text, std::string_view source)
 }
 
 Result<SampleTable> ParseSamplesCsv(std::string_view text, std::string_view source) {
-  Result<CsvTable> parsed = ParseNumericCsv(text, source);
-  if (!parsed.ok()) return parsed.status();
-  const CsvTable& table = *parsed;
+  BRDF_ASSIGN_OR_RETURN(const CsvTable table, ParseNumericCsv(text, source));
   const std::size_t header_line = table.header_line;
   const int dims = DimsFromHeader(table);
   const std::string usage = "a samples file starts with the columns " +
@@ -270,9 +268,7 @@ Result<SampleTable> ParseSamplesCsv(std::string_view text, std::string_view sour
 }
 
 Result<QueryTable> ParseQueriesCsv(std::string_view text, std::string_view source) {
-  Result<CsvTable> parsed = ParseNumericCsv(text, source);
-  if (!parsed.ok()) return parsed.status();
-  CsvTable& table = *parsed;
+  BRDF_ASSIGN_OR_RETURN(CsvTable table, ParseNumericCsv(text, source));
   const int dims = DimsFromHeader(table);
   const std::string usage = "a queries file has exactly the columns " +
                             Joined(CoordinateColumns(3)) + " (or " + Joined(CoordinateColumns(4)) +

@@ -196,9 +196,9 @@ Result<std::unique_ptr<Interpolator>> MakeHalfDifferenceInterpolator(
   if (inner.axis_scale.empty()) {
     inner.axis_scale.assign(kHalfDifferenceScale.begin(), kHalfDifferenceScale.end());
   }
-  Result<std::unique_ptr<Interpolator>> made = MakeInterpolator(method, std::move(set), inner);
-  if (!made.ok()) return made.status();
-  return std::unique_ptr<Interpolator>(new HalfDifferenceInterpolator(std::move(*made), n));
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<Interpolator> made,
+                        MakeInterpolator(method, std::move(set), inner));
+  return std::unique_ptr<Interpolator>(new HalfDifferenceInterpolator(std::move(made), n));
 }
 
 }  // namespace brdf::interp

@@ -272,11 +272,10 @@ Result<std::unique_ptr<Interpolator>> MakeTrendInterpolator(
   if (!trend.ok()) return trend.status().WithContext("options.trend bivariate");
   Options inner_options = options;
   inner_options.trend = Trend::kNone;
-  Result<std::unique_ptr<Interpolator>> inner =
-      MakeInterpolator(method, TrendResiduals(*samples, *trend), inner_options);
-  if (!inner.ok()) return inner.status();
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<Interpolator> inner,
+                        MakeInterpolator(method, TrendResiduals(*samples, *trend), inner_options));
   return std::unique_ptr<Interpolator>(
-      std::make_unique<TrendInterpolator>(std::move(*inner), std::move(*trend)));
+      std::make_unique<TrendInterpolator>(std::move(inner), std::move(*trend)));
 }
 
 }  // namespace brdf::interp

@@ -373,9 +373,7 @@ class FieldChecker {
 
 Result<Pose> SolveTargetPose(const v1::DirectionTarget& target) {
   const Directions want = TargetDirections(target);
-  Result<Pose> solved = InverseKinematics(ToIsotropic(want));
-  if (!solved.ok()) return solved.status();
-  Pose pose = *solved;
+  BRDF_ASSIGN_OR_RETURN(Pose pose, InverseKinematics(ToIsotropic(want)));
   const bool four = target.has_phi_i() || target.has_phi_o();
   if (!four) return pose;
   auto wrap = [](double a) {

@@ -359,10 +359,9 @@ Result<exports::SessionInterpolant> BuildInterpolator(const exports::Session& se
                                                       exports::Quantity quantity,
                                                       const ExportSettings& s,
                                                       const CallContext& ctx) {
-  Result<exports::DerivedSamples> derived =
-      exports::DeriveSamples(session, quantity, {s.exclude_flagged});
-  if (!derived.ok()) return derived.status();
-  return exports::BuildSessionInterpolant(std::move(*derived), s.method, s.options, s.fill, ctx);
+  BRDF_ASSIGN_OR_RETURN(exports::DerivedSamples derived,
+                        exports::DeriveSamples(session, quantity, {s.exclude_flagged}));
+  return exports::BuildSessionInterpolant(std::move(derived), s.method, s.options, s.fill, ctx);
 }
 
 // The cell counts of a MERL or RGL table (unfilled: by the interpolation's why).
@@ -396,31 +395,30 @@ void AddFill(const exports::FillTally& tally, v1::ExportReport* report) {
 Status ExportReadingsCsv(const exports::Session& session, const ExportSettings& s,
                          ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
   stream.Progress("writing readings", 0.1);
-  Result<exports::ReadingsCsvReport> csv =
-      exports::WriteReadingsCsv(session, s.quantity, out, {s.exclude_flagged});
-  if (!csv.ok()) return csv.status();
-  report->set_rows(csv->rows);
-  AddSkipped(csv->skipped, report);
-  report->set_summary(std::to_string(csv->rows) + " rows (" + exports::QuantityName(s.quantity) +
-                      "), " + std::to_string(csv->skipped.size()) + " sample readings left out");
+  BRDF_ASSIGN_OR_RETURN(exports::ReadingsCsvReport csv,
+                        exports::WriteReadingsCsv(session, s.quantity, out, {s.exclude_flagged}));
+  report->set_rows(csv.rows);
+  AddSkipped(csv.skipped, report);
+  report->set_summary(std::to_string(csv.rows) + " rows (" + exports::QuantityName(s.quantity) +
+                      "), " + std::to_string(csv.skipped.size()) + " sample readings left out");
   return Status();
 }
 
 Status ExportGrid(const exports::Session& session, const ExportSettings& s, const CallContext& ctx,
                   ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
-  Result<exports::RegularGrid> grid = exports::MakeRegularGrid(
-      s.steps[0], s.steps[1], s.steps[2],
-      s.nodes ? exports::GridPlacement::kNodes : exports::GridPlacement::kCellCentres);
-  if (!grid.ok()) return grid.status();
-  Result<exports::SessionInterpolant> in = BuildInterpolator(session, s.quantity, s, ctx);
-  if (!in.ok()) return in.status();
-  const WavelengthGrid bands = in->derived.grid;
+  BRDF_ASSIGN_OR_RETURN(exports::RegularGrid grid,
+                        exports::MakeRegularGrid(s.steps[0], s.steps[1], s.steps[2],
+                                                 s.nodes ? exports::GridPlacement::kNodes
+                                                         : exports::GridPlacement::kCellCentres));
+  BRDF_ASSIGN_OR_RETURN(exports::SessionInterpolant in,
+                        BuildInterpolator(session, s.quantity, s, ctx));
+  const WavelengthGrid bands = in.derived.grid;
   const exports::GridExportInfo info{session.id,
                                      session.name,
                                      s.quantity,
                                      interp::MethodName(s.method),
-                                     in->derived.samples.size(),
-                                     in->derived.skipped.size()};
+                                     in.derived.samples.size(),
+                                     in.derived.skipped.size()};
   exports::NpyGridWriter npy(out);
   exports::CsvGridWriter csv(out, info);
   const bool as_npy = s.format == v1::EXPORT_FORMAT_GRID_NPY;
@@ -428,88 +426,80 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
   exports::RunControl control;
   control.threads = 0;  // every hardware thread: the executor waits on devices, not the CPU
   control.progress = [&stream](double f) { stream.Progress("resampling", 0.05 + 0.95 * f); };
-  Result<exports::GridReport> r =
-      exports::ResampleOnGrid(in->chain->Source(), *grid, bands, control, ctx, sink);
-  if (!r.ok()) return r.status();
-  report->set_summary(r->Summary());
-  report->set_cells(r->cells);
-  report->set_filled_cells(r->filled);
-  report->set_unfilled_cells(r->nan_cells);
-  for (const auto& [status, count] : r->by_status) {
+  BRDF_ASSIGN_OR_RETURN(exports::GridReport r, exports::ResampleOnGrid(in.chain->Source(), grid,
+                                                                       bands, control, ctx, sink));
+  report->set_summary(r.Summary());
+  report->set_cells(r.cells);
+  report->set_filled_cells(r.filled);
+  report->set_unfilled_cells(r.nan_cells);
+  for (const auto& [status, count] : r.by_status) {
     if (status != interp::InterpStatus::kOk) {
       (*report->mutable_unfilled_by_status())[interp::InterpStatusName(status)] = count;
     }
   }
-  AddSkipped(in->derived.skipped, report);
-  AddFill(in->chain->Tally(), report);
+  AddSkipped(in.derived.skipped, report);
+  AddFill(in.chain->Tally(), report);
   if (as_npy) {
-    for (std::size_t n : {grid->theta_i.count, grid->theta_o.count, grid->phi.count}) {
+    for (std::size_t n : {grid.theta_i.count, grid.theta_o.count, grid.phi.count}) {
       report->add_shape(n);
     }
     report->add_shape(bands.count);
-    report->set_description_json(exports::GridDescriptionJson(*grid, bands, info, *r, in->Info()));
+    report->set_description_json(exports::GridDescriptionJson(grid, bands, info, r, in.Info()));
   }
   return Status();
 }
 
 Status ExportMerl(const exports::Session& session, const ExportSettings& s, const CallContext& ctx,
                   ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
-  Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir);
-  if (!cie.ok()) return cie.status();
-  Result<exports::SessionInterpolant> in =
-      BuildInterpolator(session, exports::Quantity::kBrdf, s, ctx);
-  if (!in.ok()) return in.status();
-  const WavelengthGrid bands = in->derived.grid;
-  Result<exports::SpectralRgbWeights> rgb =
-      exports::SpectralRgbWeights::Make(bands, cie->d65, cie->cmf);
-  if (!rgb.ok()) return rgb.status();
+  BRDF_ASSIGN_OR_RETURN(data::CieTables cie, data::LoadCieTables(data::kDefaultColordDir));
+  BRDF_ASSIGN_OR_RETURN(exports::SessionInterpolant in,
+                        BuildInterpolator(session, exports::Quantity::kBrdf, s, ctx));
+  const WavelengthGrid bands = in.derived.grid;
+  BRDF_ASSIGN_OR_RETURN(exports::SpectralRgbWeights rgb,
+                        exports::SpectralRgbWeights::Make(bands, cie.d65, cie.cmf));
   exports::RunControl control;
   control.threads = 0;
   control.progress = [&stream](double f) {
     stream.Progress("building the MERL table", 0.05 + 0.85 * f);
   };
-  Result<exports::MerlExport> table =
-      exports::BuildMerlTable(in->chain->Source(), bands, *rgb, control, ctx);
-  if (!table.ok()) return table.status();
+  BRDF_ASSIGN_OR_RETURN(exports::MerlExport table,
+                        exports::BuildMerlTable(in.chain->Source(), bands, rgb, control, ctx));
   stream.Progress("sending", 0.9);
-  if (Status st = exports::WriteMerl(table->table, out); !st.ok()) return st;
-  const exports::MerlReport& m = table->report;
+  if (Status st = exports::WriteMerl(table.table, out); !st.ok()) return st;
+  const exports::MerlReport& m = table.report;
   report->set_summary(m.Summary());
   AddTableCounts(m.cells, m.filled, m.unfilled, m.below_horizon, m.clamped, report);
-  AddSkipped(in->derived.skipped, report);
-  AddFill(in->chain->Tally(), report);
+  AddSkipped(in.derived.skipped, report);
+  AddFill(in.chain->Tally(), report);
   return Status();
 }
 
 Status ExportRgl(const exports::Session& session, const ExportSettings& s, const CallContext& ctx,
                  ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
   exports::SessionRglOptions options = s.rgl;
-  Result<exports::SessionInterpolant> in =
-      BuildInterpolator(session, exports::Quantity::kBrdf, s, ctx);
-  if (!in.ok()) return in.status();
+  BRDF_ASSIGN_OR_RETURN(exports::SessionInterpolant in,
+                        BuildInterpolator(session, exports::Quantity::kBrdf, s, ctx));
   if (s.rgb) {
-    Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir);
-    if (!cie.ok()) return cie.status();
-    Result<exports::SpectralRgbWeights> rgb =
-        exports::SpectralRgbWeights::Make(in->derived.grid, cie->d65, cie->cmf);
-    if (!rgb.ok()) return rgb.status();
-    options.rgb = *rgb;
+    BRDF_ASSIGN_OR_RETURN(data::CieTables cie, data::LoadCieTables(data::kDefaultColordDir));
+    BRDF_ASSIGN_OR_RETURN(exports::SpectralRgbWeights rgb,
+                          exports::SpectralRgbWeights::Make(in.derived.grid, cie.d65, cie.cmf));
+    options.rgb = rgb;
   }
   exports::RunControl control;
   control.threads = 0;
   control.progress = [&stream](double f) {
     stream.Progress("building the RGL tables", 0.05 + 0.85 * f);
   };
-  Result<exports::RglExport> table = exports::BuildSessionRgl(session, *in, options, control, ctx);
-  if (!table.ok()) return table.status();
+  BRDF_ASSIGN_OR_RETURN(exports::RglExport table,
+                        exports::BuildSessionRgl(session, in, options, control, ctx));
   stream.Progress("sending", 0.9);
-  if (Status st = exports::WriteRgl(table->fields, out); !st.ok()) return st;
-  const exports::RglReport& g = table->report;
+  if (Status st = exports::WriteRgl(table.fields, out); !st.ok()) return st;
+  const exports::RglReport& g = table.report;
   report->set_summary(g.Summary());
   AddTableCounts(g.cells, g.interpolated + g.fallback, g.unfilled, g.below_horizon, g.clamped,
                  report);
-  AddSkipped(in->derived.skipped, report);
-  AddFill(in->chain->Tally(), report);
+  AddSkipped(in.derived.skipped, report);
+  AddFill(in.chain->Tally(), report);
   return Status();
 }
 

@@ -108,18 +108,17 @@ Result<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(const Ser
   std::shared_ptr<grpc::ServerCredentials> credentials;
   *tls = false;
   if (config.tls.has_value()) {
-    Result<std::string> cert = ReadPem(config.tls->cert, "server.tls.cert", "CERTIFICATE");
-    if (!cert.ok()) return cert.status();
-    Result<std::string> key = ReadPem(config.tls->key, "server.tls.key", "PRIVATE KEY");
-    if (!key.ok()) return key.status();
+    BRDF_ASSIGN_OR_RETURN(std::string cert,
+                          ReadPem(config.tls->cert, "server.tls.cert", "CERTIFICATE"));
+    BRDF_ASSIGN_OR_RETURN(std::string key,
+                          ReadPem(config.tls->key, "server.tls.key", "PRIVATE KEY"));
     WarnIfReadableByOthers(config.tls->key);
     grpc::SslServerCredentialsOptions ssl(GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE);
-    ssl.pem_key_cert_pairs.push_back({*key, *cert});
+    ssl.pem_key_cert_pairs.push_back({key, cert});
     if (!config.tls->client_ca.empty()) {
-      Result<std::string> ca =
-          ReadPem(config.tls->client_ca, "server.tls.client_ca", "CERTIFICATE");
-      if (!ca.ok()) return ca.status();
-      ssl.pem_root_certs = *ca;
+      BRDF_ASSIGN_OR_RETURN(std::string ca,
+                            ReadPem(config.tls->client_ca, "server.tls.client_ca", "CERTIFICATE"));
+      ssl.pem_root_certs = ca;
       ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
     }
     credentials = grpc::SslServerCredentials(ssl);
@@ -199,9 +198,8 @@ Server::~Server() {
 Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, const BackEnd& back_end,
                                               const Authenticator& auth) {
   bool tls = false;
-  Result<std::shared_ptr<grpc::ServerCredentials>> credentials =
-      MakeServerCredentials(config, &tls);
-  if (!credentials.ok()) return credentials.status();
+  BRDF_ASSIGN_OR_RETURN(std::shared_ptr<grpc::ServerCredentials> credentials,
+                        MakeServerCredentials(config, &tls));
 
   // Debian builds Abseil without NDEBUG, which leaves absl::Mutex's lock-order (deadlock) graph
   // on: every lock gRPC takes records the lock in a global graph, about a tenth of the CPU of a
@@ -212,7 +210,7 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, const 
   std::unique_ptr<Server> server(new Server(config, back_end, auth));
   server->health_.ServeOn(server->control_loop_);
   server->control_.ServeOn(server->control_loop_);
-  if (Status st = server->Listen(config, *credentials, tls, auth); !st.ok()) return st;
+  if (Status st = server->Listen(config, credentials, tls, auth); !st.ok()) return st;
   server->LogLimits(config);
   server->health_.SetServingStatus("", true);
   for (const char* name : kBrdfServices) server->health_.SetServingStatus(name, true);
@@ -240,13 +238,13 @@ Status Server::Listen(const ServerConfig& config,
   interpolate_loop_.AddQueues(builder);
   control_loop_.AddQueue(builder);
   server_ = builder.BuildAndStart();
-  Result<std::string> address = BoundAddress(config, server_ != nullptr, selected_port, tls);
-  if (!address.ok()) return address.status();
+  BRDF_ASSIGN_OR_RETURN(std::string address,
+                        BoundAddress(config, server_ != nullptr, selected_port, tls));
   interpolate_loop_.Start();
   control_loop_.Start();
   tls_ = tls;
   port_ = selected_port;
-  address_ = *address;
+  address_ = address;
   return Status::Ok();
 }
 

@@ -56,11 +56,9 @@ v1::Session ArchivedSession(const storage::SessionRecord& record,
 }  // namespace
 
 Result<v1::Session> ArchiveCatalogue::GetSession(SessionId session) {
-  Result<storage::SessionRecord> record = archive_->GetSession(session);
-  if (!record.ok()) return record.status();
-  Result<std::vector<storage::StepRecord>> steps = archive_->GetSteps(session);
-  if (!steps.ok()) return steps.status();
-  return ArchivedSession(*record, &*steps, /*with_plan=*/true);
+  BRDF_ASSIGN_OR_RETURN(storage::SessionRecord record, archive_->GetSession(session));
+  BRDF_ASSIGN_OR_RETURN(std::vector<storage::StepRecord> steps, archive_->GetSteps(session));
+  return ArchivedSession(record, &steps, /*with_plan=*/true);
 }
 
 Result<SessionPage> ArchiveCatalogue::ListSessions(const CatalogueFilter& filter,
@@ -84,15 +82,14 @@ Result<SessionPage> ArchiveCatalogue::ListSessions(const CatalogueFilter& filter
     query.after = after;
   }
   query.limit = static_cast<int>(page_size) + 1;  // one more: is there a next page?
-  Result<std::vector<storage::SessionRecord>> records = archive_->ListSessions(query);
-  if (!records.ok()) return records.status();
-  const bool more = records->size() > page_size;
-  if (more) records->resize(page_size);
+  BRDF_ASSIGN_OR_RETURN(std::vector<storage::SessionRecord> records, archive_->ListSessions(query));
+  const bool more = records.size() > page_size;
+  if (more) records.resize(page_size);
   SessionPage page;
-  for (const storage::SessionRecord& r : *records) {
+  for (const storage::SessionRecord& r : records) {
     page.sessions.push_back(ArchivedSession(r, nullptr, /*with_plan=*/false));
   }
-  if (more && !records->empty()) page.next_page_token = PageToken(records->back());
+  if (more && !records.empty()) page.next_page_token = PageToken(records.back());
   return page;
 }
 

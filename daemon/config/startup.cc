@@ -22,9 +22,8 @@ void StartLogging(const std::string& program) {
 }
 
 Result<Config> LoadConfigAndLogLevel(const std::string& path, const std::string& log_level) {
-  Result<Config> loaded = LoadConfig(path);
-  if (!loaded.ok()) return loaded.status();
-  spdlog::set_level(spdlog::level::from_str(log_level.empty() ? loaded->log.level : log_level));
+  BRDF_ASSIGN_OR_RETURN(Config loaded, LoadConfig(path));
+  spdlog::set_level(spdlog::level::from_str(log_level.empty() ? loaded.log.level : log_level));
   return loaded;
 }
 

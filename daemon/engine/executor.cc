@@ -250,10 +250,9 @@ Executor::Outcome Executor::RunMove(Context& c, int index, std::uint32_t first_a
     const CallContext ctx = DeviceContext();
     if (attempt > 1) ResetStageAlarms(rig_, session_, ctx);
     c.stage.target.reset();
-    Result<Pose> reached = MoveStageTo(rig_, step.pose, ctx);
-    if (!reached.ok()) return reached.status();
+    BRDF_ASSIGN_OR_RETURN(Pose reached, MoveStageTo(rig_, step.pose, ctx));
     c.stage.target = step.pose;
-    c.stage.feedback = *reached;
+    c.stage.feedback = reached;
     return Status::Ok();
   });
   if (!st.ok()) return Stop(c, index, st, "moving the stage at " + StepName(step), true);
@@ -312,16 +311,15 @@ ReadingRequest Executor::PlanReading(const Context& c, int index) {
 
 Status Executor::CommitReading(Context& c, int index, storage::ReadingRecord& reading) {
   // The reading and the step's done mark in one transaction (the move, if pipelined, runs on).
-  Result<std::int64_t> id = store_->CompleteStepWithReading(session_, index, reading);
-  if (!id.ok()) return id.status();
-  reading.id = *id;
+  BRDF_ASSIGN_OR_RETURN(std::int64_t id, store_->CompleteStepWithReading(session_, index, reading));
+  reading.id = id;
   reading.session_id = session_;
   reading.step_index = index;
-  if (reading.kind == storage::ReadingKind::kReference) c.last_reference = *id;
-  if (reading.kind == storage::ReadingKind::kDark) c.last_dark = *id;
+  if (reading.kind == storage::ReadingKind::kReference) c.last_reference = id;
+  if (reading.kind == storage::ReadingKind::kDark) c.last_dark = id;
   c.MarkDone(index);
   v1::StepCompletion done = Completion(c, index);
-  done.set_reading_id(*id);
+  done.set_reading_id(id);
   done.set_quality_code(reading.quality_code);
   done.set_flagged(reading.flagged);
   host_.StepCompleted(session_, done, &reading);

@@ -144,11 +144,10 @@ Result<drivers::stage::ModbusStageConfig> StageOptions(const StageConfig& s) {
 }  // namespace
 
 Result<std::unique_ptr<Rig>> Rig::FromConfig(const Config& config, Options options) {
-  Result<std::unique_ptr<drivers::Spectroradiometer>> meter = MakeMeter(config.meter);
-  if (!meter.ok()) return meter.status();
-  Result<drivers::stage::ModbusStageConfig> stage_options = StageOptions(config.stage);
-  if (!stage_options.ok()) return stage_options.status();
-  auto stage = drivers::stage::ModbusStage::Create(*stage_options);
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<drivers::Spectroradiometer> meter, MakeMeter(config.meter));
+  BRDF_ASSIGN_OR_RETURN(drivers::stage::ModbusStageConfig stage_options,
+                        StageOptions(config.stage));
+  auto stage = drivers::stage::ModbusStage::Create(stage_options);
   if (!stage.ok()) return stage.status().WithContext("config [stage]");
 
   options.stage_backoff_max = std::chrono::milliseconds(config.stage.reconnect_max_ms);
@@ -156,7 +155,7 @@ Result<std::unique_ptr<Rig>> Rig::FromConfig(const Config& config, Options optio
       config.stage.transport == "rtu" ? config.stage.device
                                       : config.stage.host + ":" + std::to_string(config.stage.port);
   return std::make_unique<Rig>(
-      std::move(meter).value(), DeviceInfo{MeterModelName(config.meter.model), config.meter.port},
+      std::move(meter), DeviceInfo{MeterModelName(config.meter.model), config.meter.port},
       std::move(*stage),
       DeviceInfo{"Modbus stage (" + StageProfileLabel(config.stage) + ")", stage_address},
       ToRigDescription(config), options);

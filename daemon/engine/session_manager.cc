@@ -136,9 +136,8 @@ struct SessionManager::Impl final : public ExecutorHost {
   // then the watchers.
   Result<SessionState> TransitionLocked(SessionId id, SessionEvent event, std::string reason)
       REQUIRES(mu) {
-    Result<SessionState> from = StateLocked(id);
-    if (!from.ok()) return from.status();
-    Result<SessionState> to = NextState(*from, event, RigFreeFor(id));
+    BRDF_ASSIGN_OR_RETURN(SessionState from, StateLocked(id));
+    Result<SessionState> to = NextState(from, event, RigFreeFor(id));
     if (!to.ok()) return Status(to.status().code(), SessionName(id) + ": " + to.status().message());
     Live& l = live[id];
     if (*to == SessionState::kPaused && reason.empty()) {
@@ -156,7 +155,7 @@ struct SessionManager::Impl final : public ExecutorHost {
                             : " holds it") +
                "); it starts by itself when the rig is free";
     }
-    if (*to == SessionState::kQueued && *from == SessionState::kQueued &&
+    if (*to == SessionState::kQueued && from == SessionState::kQueued &&
         std::find(queue.begin(), queue.end(), id) == queue.end()) {
       // Started while the rig is busy: the session joins the queue (state unchanged).
       BRDF_RETURN_IF_ERROR(store.SetSessionState(id, *to, reason));
@@ -165,7 +164,7 @@ struct SessionManager::Impl final : public ExecutorHost {
       spdlog::info("{}: queued ({})", SessionName(id), reason);
       return *to;
     }
-    if (*to == *from) return *to;  // idempotent (pause while paused, start while queued)
+    if (*to == from) return *to;  // idempotent (pause while paused, start while queued)
 
     if (Status stored = store.SetSessionState(id, *to, reason); !stored.ok()) {
       // The database refuses writes (disk full, read-only file). A pause must still happen: the
@@ -192,11 +191,11 @@ struct SessionManager::Impl final : public ExecutorHost {
     if (IsTerminal(*to)) l.prompt.reset();
 
     v1::SessionEvent change;
-    change.mutable_state_changed()->set_from(ToProtoState(*from));
+    change.mutable_state_changed()->set_from(ToProtoState(from));
     change.mutable_state_changed()->set_to(ToProtoState(*to));
     change.mutable_state_changed()->set_reason(reason);
     bus.Publish(id, std::move(change), IsTerminal(*to));
-    spdlog::info("{}: {} -> {} ({}){}", SessionName(id), SessionStateName(*from),
+    spdlog::info("{}: {} -> {} ({}){}", SessionName(id), SessionStateName(from),
                  SessionStateName(*to), SessionEventName(event),
                  reason.empty() ? "" : ": " + reason);
     scheduler_cv.NotifyAll();
@@ -212,11 +211,10 @@ struct SessionManager::Impl final : public ExecutorHost {
       REQUIRES(mu) {
     auto kept = plans.find(id);
     if (kept != plans.end()) return kept->second;
-    Result<storage::SessionRecord> read = Internal("unset");
+    storage::SessionRecord read;
     if (record == nullptr) {
-      read = store.GetSession(id);
-      if (!read.ok()) return read.status();
-      record = &*read;
+      BRDF_ASSIGN_OR_RETURN(read, store.GetSession(id));
+      record = &read;
     }
     Result<SessionPlan> parsed = ParseSessionPlan(*record);
     if (!parsed.ok()) spdlog::error("{}", parsed.status().message());
@@ -235,34 +233,32 @@ struct SessionManager::Impl final : public ExecutorHost {
       auto cached = terminal_cache.find(id);
       if (cached != terminal_cache.end()) return cached->second;
     }
-    Result<storage::SessionRecord> rec = store.GetSession(id);
-    if (!rec.ok()) return rec.status();
-    Result<std::vector<storage::StepRecord>> steps = store.GetSteps(id);
-    if (!steps.ok()) return steps.status();
+    BRDF_ASSIGN_OR_RETURN(storage::SessionRecord rec, store.GetSession(id));
+    BRDF_ASSIGN_OR_RETURN(std::vector<storage::StepRecord> steps, store.GetSteps(id));
     const Live& l = live[id];
-    const SessionState state = l.state.value_or(rec->state);
+    const SessionState state = l.state.value_or(rec.state);
 
     // A plan that no longer parses is shown as none (PlanLocked logged it once); its summary and
     // ETA are the default settings'.
     static const SessionPlan kNoPlan = MakeSessionPlan(v1::Plan());
-    Result<std::shared_ptr<const SessionPlan>> kept = PlanLocked(id, &*rec);
+    Result<std::shared_ptr<const SessionPlan>> kept = PlanLocked(id, &rec);
     const plan::PlanSettings& settings = kept.ok() ? (*kept)->settings : kNoPlan.settings;
-    const std::vector<plan::Step> plan_steps = ToPlanSteps(*steps);
+    const std::vector<plan::Step> plan_steps = ToPlanSteps(steps);
     const plan::PlanSummary summary =
         plan::SummarizeSteps(plan_steps, owner.options_.rig_description, settings.measurement);
     const std::vector<plan::StepTime> times =
         plan::EstimateSteps(plan_steps, owner.options_.rig_description, settings.measurement);
     double eta = 0;
-    for (std::size_t i = 0; i < steps->size() && i < times.size(); ++i) {
-      if ((*steps)[i].state == storage::StepState::kPending) eta += times[i].estimate_s;
+    for (std::size_t i = 0; i < steps.size() && i < times.size(); ++i) {
+      if (steps[i].state == storage::StepState::kPending) eta += times[i].estimate_s;
     }
 
-    SessionFacts facts(*rec);
+    SessionFacts facts(rec);
     facts.live_state = l.state;
     facts.live_reason = l.reason;
     facts.plan = kept.ok() ? kept->get() : nullptr;
     facts.with_plan = with_plan;
-    facts.steps = &*steps;
+    facts.steps = &steps;
     facts.summary = &summary;
     // A queued session has no running ETA: it has not started (or waits for another session).
     facts.eta_s = IsTerminal(state) || state == SessionState::kQueued ? 0 : eta;
@@ -418,14 +414,13 @@ SessionManager::~SessionManager() {
 }
 
 Result<std::vector<SessionId>> SessionManager::Recover() {
-  Result<std::vector<std::int64_t>> ids = store_->RecoverInterruptedSessions();
-  if (!ids.ok()) return ids.status();
+  BRDF_ASSIGN_OR_RETURN(std::vector<std::int64_t> ids, store_->RecoverInterruptedSessions());
   {
     MutexLock lock(impl_->mu);
-    for (SessionId id : *ids) impl_->live[id].state = SessionState::kPaused;
-    if (!ids->empty() && !impl_->holder.has_value()) impl_->holder = ids->front();
+    for (SessionId id : ids) impl_->live[id].state = SessionState::kPaused;
+    if (!ids.empty() && !impl_->holder.has_value()) impl_->holder = ids.front();
   }
-  for (SessionId id : *ids) {
+  for (SessionId id : ids) {
     spdlog::warn(
         "{}: was running when the daemon stopped; now paused at its first unfinished "
         "step (resume it to go on)",
@@ -433,7 +428,7 @@ Result<std::vector<SessionId>> SessionManager::Recover() {
     impl_->Audit(Actor{"daemon", "brdfd"}, "session.recover", id,
                  std::string(storage::kRecoveredReason));
   }
-  return std::vector<SessionId>(ids->begin(), ids->end());
+  return std::vector<SessionId>(ids.begin(), ids.end());
 }
 
 void SessionManager::Shutdown(std::chrono::milliseconds timeout) {
@@ -491,13 +486,12 @@ Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor
     return InvalidArgument("the plan has " + std::to_string(analysis.problems.size()) +
                            " problem(s); fix them and submit again:\n" + listing);
   }
-  Result<std::string> json = plan::PlanToJson(plan);
-  if (!json.ok()) return json.status();
+  BRDF_ASSIGN_OR_RETURN(std::string json, plan::PlanToJson(plan));
 
   storage::NewSession session;
   session.name = plan.name().empty() ? std::string("unnamed plan") : plan.name();
   session.plan_kind = PlanKindWord(plan);
-  session.plan_json = std::move(*json);
+  session.plan_json = std::move(json);
   session.created_by_role = actor.role;
   session.white_reflectance = plan::WhiteReflectanceOf(plan).value_or(options_.white_reflectance);
   session.rig = options_.rig_name;
@@ -529,10 +523,10 @@ Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor
 Result<v1::Session> SessionManager::Start(SessionId session, const Actor& actor) {
   return impl_->Verb(session, actor, "session.start", "started by " + Who(actor),
                      [&]() REQUIRES(impl_->mu) -> Status {
-                       Result<SessionState> to = impl_->TransitionLocked(
-                           session, SessionEvent::kStart, "started by " + Who(actor));
-                       if (!to.ok()) return to.status();
-                       if (*to == SessionState::kRunning) impl_->EnsureRunLocked(session);
+                       BRDF_ASSIGN_OR_RETURN(SessionState to,
+                                             impl_->TransitionLocked(session, SessionEvent::kStart,
+                                                                     "started by " + Who(actor)));
+                       if (to == SessionState::kRunning) impl_->EnsureRunLocked(session);
                        return Status::Ok();
                      });
 }
@@ -544,14 +538,15 @@ Result<v1::Session> SessionManager::Pause(SessionId session, PauseMode mode, con
   return impl_->Verb(session, actor, "session.pause", reason, [&]() REQUIRES(impl_->mu) -> Status {
     Impl& m = *impl_;
     m.mu.AssertHeld();  // the same mutex, under another name
-    Result<SessionState> from = m.StateLocked(session);
-    if (!from.ok()) return from.status();
+    BRDF_RETURN_IF_ERROR(m.StateLocked(session).status());
     if (!immediate) m.live[session].pause_reason = reason;
-    Result<SessionState> to = m.TransitionLocked(
-        session, immediate ? SessionEvent::kPauseImmediate : SessionEvent::kPauseDeferred, reason);
-    if (!to.ok()) return to.status();
+    BRDF_ASSIGN_OR_RETURN(
+        SessionState to,
+        m.TransitionLocked(session,
+                           immediate ? SessionEvent::kPauseImmediate : SessionEvent::kPauseDeferred,
+                           reason));
     // Paused now (immediate, or while awaiting the operator): stop the run where it is.
-    if (*to == SessionState::kPaused && m.current && m.current->session() == session) {
+    if (to == SessionState::kPaused && m.current && m.current->session() == session) {
       m.current->Cancel(reason);
     }
     return Status::Ok();
@@ -562,13 +557,12 @@ Result<v1::Session> SessionManager::Resume(SessionId session, const Actor& actor
   rig_->RetryStageNow();  // a stage that is back need not wait out its reconnect back-off
   return impl_->Verb(session, actor, "session.resume", "resumed by " + Who(actor),
                      [&]() REQUIRES(impl_->mu) -> Status {
-                       Result<SessionState> from = impl_->StateLocked(session);
-                       if (!from.ok()) return from.status();
-                       Result<SessionState> to = impl_->TransitionLocked(
-                           session, SessionEvent::kResume, "resumed by " + Who(actor));
-                       if (!to.ok()) return to.status();
+                       BRDF_ASSIGN_OR_RETURN(SessionState from, impl_->StateLocked(session));
+                       BRDF_ASSIGN_OR_RETURN(SessionState to,
+                                             impl_->TransitionLocked(session, SessionEvent::kResume,
+                                                                     "resumed by " + Who(actor)));
                        // From pausing, the run is still in its step and simply goes on.
-                       if (*to == SessionState::kRunning && *from != SessionState::kPausing) {
+                       if (to == SessionState::kRunning && from != SessionState::kPausing) {
                          impl_->EnsureRunLocked(session);
                        }
                        return Status::Ok();
@@ -582,8 +576,7 @@ Result<v1::Session> SessionManager::Abort(SessionId session, const std::string& 
   return impl_->Verb(session, actor, "session.abort", why, [&]() REQUIRES(impl_->mu) -> Status {
     Impl& m = *impl_;
     m.mu.AssertHeld();  // the same mutex, under another name
-    Result<SessionState> to = m.TransitionLocked(session, SessionEvent::kAbort, why);
-    if (!to.ok()) return to.status();
+    BRDF_RETURN_IF_ERROR(m.TransitionLocked(session, SessionEvent::kAbort, why).status());
     if (m.current && m.current->session() == session) m.current->Cancel(why);
     if (m.launch == session) m.launch.reset();
     return Status::Ok();
@@ -598,12 +591,11 @@ Result<v1::Session> SessionManager::AnswerPrompt(SessionId session, int step_ind
       session, actor, "session.answer_prompt", detail, [&]() REQUIRES(impl_->mu) -> Status {
         Impl& m = *impl_;
         m.mu.AssertHeld();  // the same mutex, under another name
-        Result<SessionState> state = m.StateLocked(session);
-        if (!state.ok()) return state.status();
+        BRDF_ASSIGN_OR_RETURN(SessionState state, m.StateLocked(session));
         const std::optional<v1::Prompt>& open = m.live[session].prompt;
-        if (*state != SessionState::kAwaitingOperator || !open.has_value()) {
+        if (state != SessionState::kAwaitingOperator || !open.has_value()) {
           return FailedPrecondition(SessionName(session) + " has no open prompt (it is " +
-                                    SessionStateName(*state) + "); nothing to answer");
+                                    SessionStateName(state) + "); nothing to answer");
         }
         if (open->step_index() != step_index) {
           return FailedPrecondition(SessionName(session) + ": the open prompt is step " +
@@ -615,8 +607,7 @@ Result<v1::Session> SessionManager::AnswerPrompt(SessionId session, int step_ind
             m.store.CompleteStep(session, step_index)
                 .WithContext("recording the answer to step " + std::to_string(step_index)));
         const v1::Prompt answered = *open;
-        Result<SessionState> to = m.TransitionLocked(session, SessionEvent::kAnswer, detail);
-        if (!to.ok()) return to.status();
+        BRDF_RETURN_IF_ERROR(m.TransitionLocked(session, SessionEvent::kAnswer, detail).status());
         if (answered.kind() == v1::PROMPT_KIND_RELOCATE_DETECTOR ||
             answered.kind() == v1::PROMPT_KIND_RELOCATE_LAMP_AND_DETECTOR) {
           m.rig.SetManualDelta(answered.pose().delta());
@@ -637,18 +628,16 @@ Result<v1::Session> SessionManager::GetSession(SessionId session) const {
 
 Result<std::vector<v1::Session>> SessionManager::ListSessions(
     const std::vector<SessionState>& states) const {
-  Result<std::vector<storage::SessionRecord>> records = store_->ListSessions();
-  if (!records.ok()) return records.status();
+  BRDF_ASSIGN_OR_RETURN(std::vector<storage::SessionRecord> records, store_->ListSessions());
   std::vector<v1::Session> out;
   MutexLock lock(impl_->mu);
-  for (auto it = records->rbegin(); it != records->rend(); ++it) {
+  for (auto it = records.rbegin(); it != records.rend(); ++it) {
     const SessionState state = impl_->live[it->id].state.value_or(it->state);
     if (!states.empty() && std::find(states.begin(), states.end(), state) == states.end()) {
       continue;
     }
-    Result<v1::Session> s = impl_->BuildLocked(it->id, /*with_plan=*/false);
-    if (!s.ok()) return s.status();
-    out.push_back(std::move(*s));
+    BRDF_ASSIGN_OR_RETURN(v1::Session s, impl_->BuildLocked(it->id, /*with_plan=*/false));
+    out.push_back(std::move(s));
   }
   return out;
 }
@@ -674,18 +663,16 @@ v1::RigStatus SessionManager::GetRigStatus() const {
 Result<std::shared_ptr<EventSubscription>> SessionManager::Subscribe(SessionId session) {
   Impl& m = *impl_;
   MutexLock lock(m.mu);  // no event can fall between the snapshot and the queue
-  Result<SessionState> state = m.StateLocked(session);
-  if (!state.ok()) return state.status();
-  Result<v1::Session> snapshot = m.BuildLocked(session, /*with_plan=*/true);
-  if (!snapshot.ok()) return snapshot.status();
+  BRDF_ASSIGN_OR_RETURN(SessionState state, m.StateLocked(session));
+  BRDF_ASSIGN_OR_RETURN(v1::Session snapshot, m.BuildLocked(session, /*with_plan=*/true));
   const std::optional<v1::Prompt> prompt =
-      *state == SessionState::kAwaitingOperator ? m.live[session].prompt : std::nullopt;
+      state == SessionState::kAwaitingOperator ? m.live[session].prompt : std::nullopt;
   return m.bus.Subscribe(
       session,
       [&] {
-        return EventBus::Opening{*snapshot, prompt};
+        return EventBus::Opening{snapshot, prompt};
       },
-      IsTerminal(*state));
+      IsTerminal(state));
 }
 
 int SessionManager::AddReadingListener(ReadingListener listener) {

@@ -413,10 +413,9 @@ Result<std::unique_ptr<WebGateway>> WebGateway::Start(
     return ConfigurationError("config web.listen: \"" + config.listen +
                               "\" is not host:port; give e.g. \"127.0.0.1:8080\"");
   }
-  Result<std::unique_ptr<httplib::Server>> made = MakeHttpServer(tls);
-  if (!made.ok()) return made.status();
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<httplib::Server> made, MakeHttpServer(tls));
   std::unique_ptr<WebGateway> gateway(new WebGateway());
-  gateway->http_ = std::move(*made);
+  gateway->http_ = std::move(made);
   gateway->streams_ = std::make_shared<WebStreams>();
   httplib::Server& http = *gateway->http_;
   ConfigureTransport(http, tls.has_value());

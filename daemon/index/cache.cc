@@ -182,9 +182,9 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
   const IndexSamples::State& published = samples.published();
   BRDF_RETURN_IF_ERROR(CheckHasSamples(published.sets[qi].get(), quantity, published.skipped[qi],
                                        published.skipped_detail[qi], session));
-  Result<MadeIndex> made = MakeIndex(published.sets[qi], method, options, stale.get(), session);
+  BRDF_ASSIGN_OR_RETURN(MadeIndex made,
+                        MakeIndex(published.sets[qi], method, options, stale.get(), session));
   stale.reset();
-  if (!made.ok()) return made.status();
 
   auto snapshot = std::make_shared<IndexSnapshot>();
   snapshot->session = session;
@@ -199,13 +199,13 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
   snapshot->skipped_detail = published.skipped_detail[qi];
   snapshot->samples = published.sets[qi];
   snapshot->interpolator =
-      std::shared_ptr<const interp::Interpolator>(std::move(made->interpolator));
+      std::shared_ptr<const interp::Interpolator>(std::move(made.interpolator));
   Keep(*entry, key, snapshot);
   build.unlock();
 
   {
     std::unique_lock lock(mu_);
-    ++(made->extended ? stats_.extends : stats_.builds);
+    ++(made.extended ? stats_.extends : stats_.builds);
     Evict(session);
   }
   return std::shared_ptr<const IndexSnapshot>(std::move(snapshot));
@@ -233,34 +233,30 @@ void IndexCache::Forget(SessionId session, const std::shared_ptr<Entry>& entry) 
 }
 
 Status IndexCache::Load(Entry& entry, SessionId session, std::uint64_t* read) {
-  Result<storage::SessionRecord> record = store_->GetSession(session);
-  if (!record.ok()) return record.status();
+  BRDF_ASSIGN_OR_RETURN(storage::SessionRecord record, store_->GetSession(session));
   bool anisotropic = false;
   std::optional<Spectrum> white_spectrum;
   if (plans_) {
-    Result<std::shared_ptr<const SessionPlan>> plan = plans_(session);
-    if (!plan.ok()) return plan.status();
-    anisotropic = (*plan)->plan.anisotropic();
-    white_spectrum = plan::WhiteReflectanceSpectrumOf((*plan)->plan);
-  } else {
-    Result<SessionPlan> plan = ParseSessionPlan(*record);
-    if (!plan.ok()) return plan.status();
+    BRDF_ASSIGN_OR_RETURN(std::shared_ptr<const SessionPlan> plan, plans_(session));
     anisotropic = plan->plan.anisotropic();
     white_spectrum = plan::WhiteReflectanceSpectrumOf(plan->plan);
+  } else {
+    BRDF_ASSIGN_OR_RETURN(SessionPlan plan, ParseSessionPlan(record));
+    anisotropic = plan.plan.anisotropic();
+    white_spectrum = plan::WhiteReflectanceSpectrumOf(plan.plan);
   }
-  IndexSamples samples(anisotropic, record->white_reflectance.value_or(kWhiteStandardReflectance),
+  IndexSamples samples(anisotropic, record.white_reflectance.value_or(kWhiteStandardReflectance),
                        std::move(white_spectrum));
   std::int64_t through = 0;
   for (;;) {
-    Result<std::vector<storage::ReadingRecord>> page =
-        store_->GetReadings(session, through, options_.page_size);
-    if (!page.ok()) return page.status();
-    *read += page->size();
-    for (const storage::ReadingRecord& r : *page) {
+    BRDF_ASSIGN_OR_RETURN(std::vector<storage::ReadingRecord> page,
+                          store_->GetReadings(session, through, options_.page_size));
+    *read += page.size();
+    for (const storage::ReadingRecord& r : page) {
       through = std::max(through, r.id);
       samples.Fold(r);
     }
-    if (static_cast<int>(page->size()) < options_.page_size) break;
+    if (static_cast<int>(page.size()) < options_.page_size) break;
   }
   std::unique_lock state(entry.state_mu);
   entry.samples.emplace(std::move(samples));

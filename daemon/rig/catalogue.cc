@@ -50,16 +50,14 @@ Result<SessionPage> RigCatalogue::ListSessions(const CatalogueFilter& filter,
                                                std::uint32_t page_size) {
   // Sessions are listed newest (highest id) first, so the next page holds the ids below the
   // token's. Stable under inserts.
-  Result<std::optional<SessionId>> before = PageTokenId(page_token);
-  if (!before.ok()) return before.status();
-  Result<std::vector<v1::Session>> sessions = manager_.ListSessions(filter.states);
-  if (!sessions.ok()) return sessions.status();
+  BRDF_ASSIGN_OR_RETURN(std::optional<SessionId> before, PageTokenId(page_token));
+  BRDF_ASSIGN_OR_RETURN(std::vector<v1::Session> sessions, manager_.ListSessions(filter.states));
   SessionPage page;
   std::optional<SessionId> last;
-  for (v1::Session& s : *sessions) {
+  for (v1::Session& s : sessions) {
     Result<SessionId> id = ParseSessionId(s.session_id());
     if (!id.ok()) continue;
-    if (before->has_value() && *id >= **before) continue;
+    if (before.has_value() && *id >= *before) continue;
     if (!filter.Matches(s)) continue;
     if (page.sessions.size() == page_size) {
       if (last.has_value()) page.next_page_token = std::to_string(*last);
@@ -90,10 +88,9 @@ SessionFollow RigCatalogue::Follow(SessionId session) {
   auto seen = std::make_shared<std::uint64_t>(0);
   SessionFollow follow;
   follow.ended = [this, session, seen]() -> Result<bool> {
-    Result<storage::SessionRecord> now = manager_.store()->GetSession(session);
-    if (!now.ok()) return now.status();
+    BRDF_ASSIGN_OR_RETURN(storage::SessionRecord now, manager_.store()->GetSession(session));
     *seen = Generation();
-    return IsTerminal(now->state);
+    return IsTerminal(now.state);
   };
   follow.wait = [this, seen](const StopSignal& stopping) {
     if (stopping.stopped()) return true;

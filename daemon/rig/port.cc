@@ -59,9 +59,8 @@ v1::RigStatus ManagerRigPort::GetRigStatus() const {
 }
 
 Result<std::unique_ptr<SessionWatch>> ManagerRigPort::Watch(SessionId session) {
-  Result<std::shared_ptr<EventSubscription>> subscribed = manager_.Subscribe(session);
-  if (!subscribed.ok()) return subscribed.status();
-  return std::unique_ptr<SessionWatch>(std::make_unique<EventWatch>(std::move(*subscribed)));
+  BRDF_ASSIGN_OR_RETURN(std::shared_ptr<EventSubscription> subscribed, manager_.Subscribe(session));
+  return std::unique_ptr<SessionWatch>(std::make_unique<EventWatch>(std::move(subscribed)));
 }
 
 }  // namespace brdf::daemon

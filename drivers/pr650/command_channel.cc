@@ -21,9 +21,8 @@ CommandChannel::~CommandChannel() {
 
 Status CommandChannel::Open() {
   Close();
-  Result<std::unique_ptr<SerialLink>> made = link_factory_(options_.serial, options_.log);
-  if (!made.ok()) return made.status();
-  std::unique_ptr<SerialLink> link = std::move(made).value();
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<SerialLink> link,
+                        link_factory_(options_.serial, options_.log));
   BRDF_RETURN_IF_ERROR(link->Open(port_seen_));
   port_seen_ = true;
   lost_ = false;

@@ -235,9 +235,8 @@ bool IsNoMeasurementReply(std::string_view reply) {
 }
 
 Result<int> ParseStatusReply(std::string_view reply, std::string_view command) {
-  auto lines = ExpectLines(reply, command, 1, "one status line \"000\"");
-  if (!lines.ok()) return lines.status();
-  const std::string& line = lines.value().front();
+  BRDF_ASSIGN_OR_RETURN(auto lines, ExpectLines(reply, command, 1, "one status line \"000\""));
+  const std::string& line = lines.front();
   if (Trim(line) == "-1") return kNoMeasurementStatus;
   const std::optional<int> code = ParseCode(line);
   if (!code) return LineError(command, 1, line, "a 3-digit status such as \"000\"");
@@ -245,9 +244,8 @@ Result<int> ParseStatusReply(std::string_view reply, std::string_view command) {
 }
 
 Result<int> ParseSetupReply(std::string_view reply) {
-  auto lines = ExpectLines(reply, "S", 1, "one line \"pp\"");
-  if (!lines.ok()) return lines.status();
-  const std::string& line = lines.value().front();
+  BRDF_ASSIGN_OR_RETURN(auto lines, ExpectLines(reply, "S", 1, "one line \"pp\""));
+  const std::string& line = lines.front();
   const std::optional<int> code = ParseCode(line);
   if (!code) {
     return LineError("S", 1, line,
@@ -307,9 +305,9 @@ struct FiveFields {
 
 Result<FiveFields> ParseFiveFields(std::string_view reply, std::string_view command,
                                    std::string_view layout) {
-  auto lines = ExpectLines(reply, command, 1, "one line " + std::string(layout));
-  if (!lines.ok()) return lines.status();
-  const std::string& line = lines.value().front();
+  BRDF_ASSIGN_OR_RETURN(auto lines,
+                        ExpectLines(reply, command, 1, "one line " + std::string(layout)));
+  const std::string& line = lines.front();
   const auto fields = SplitFields(line);
   if (fields.size() != 5) return LineError(command, 1, line, std::string(layout) + " (5 fields)");
   const auto code = ParseCode(fields[0]);
@@ -334,30 +332,28 @@ Result<FiveFields> ParseFiveFields(std::string_view reply, std::string_view comm
 }  // namespace
 
 Result<ColorimetryReply> ParseColorimetryReply(std::string_view reply) {
-  auto f = ParseFiveFields(reply, kColorimetryCommand, "\"qq,U,Y.YYYEsee,.xxxx,.yyyy\"");
-  if (!f.ok()) return f.status();
-  return ColorimetryReply{f->quality_code, f->units_code, f->a, f->b, f->c};
+  BRDF_ASSIGN_OR_RETURN(
+      auto f, ParseFiveFields(reply, kColorimetryCommand, "\"qq,U,Y.YYYEsee,.xxxx,.yyyy\""));
+  return ColorimetryReply{f.quality_code, f.units_code, f.a, f.b, f.c};
 }
 
 Result<TristimulusReply> ParseTristimulusReply(std::string_view reply) {
-  auto f = ParseFiveFields(reply, kTristimulusCommand, "\"qq,U,X,Y,Z\"");
-  if (!f.ok()) return f.status();
-  return TristimulusReply{f->quality_code, f->units_code, f->a, f->b, f->c};
+  BRDF_ASSIGN_OR_RETURN(auto f, ParseFiveFields(reply, kTristimulusCommand, "\"qq,U,X,Y,Z\""));
+  return TristimulusReply{f.quality_code, f.units_code, f.a, f.b, f.c};
 }
 
 Result<std::string> ParseSerialNumberReply(std::string_view reply) {
-  auto lines = ExpectLines(reply, kSerialNumberCommand, 1, "one line with the serial number");
-  if (!lines.ok()) return lines.status();
-  return std::string(Trim(lines.value().front()));
+  BRDF_ASSIGN_OR_RETURN(
+      auto lines, ExpectLines(reply, kSerialNumberCommand, 1, "one line with the serial number"));
+  return std::string(Trim(lines.front()));
 }
 
 Result<SpectralLayout> ParseLayoutReply(std::string_view reply) {
   constexpr std::string_view kLayout =
       "\"pppp,bbb.b,ffff.,wwww.,iii.\" (points, bandwidth, first, last, step)";
-  auto lines =
-      ExpectLines(reply, kLayoutCommand, 1, std::string("one line ") + std::string(kLayout));
-  if (!lines.ok()) return lines.status();
-  const std::string& line = lines.value().front();
+  BRDF_ASSIGN_OR_RETURN(auto lines, ExpectLines(reply, kLayoutCommand, 1,
+                                                std::string("one line ") + std::string(kLayout)));
+  const std::string& line = lines.front();
   const auto fields = SplitFields(line);
   if (fields.size() != 5) return LineError(kLayoutCommand, 1, line, kLayout);
 
@@ -418,10 +414,9 @@ Result<SpectrumReply> ParseSpectrumReply(std::string_view reply,
   }
 
   SpectrumReply out;
-  Result<SpectrumHeader> header = ParseSpectrumHeader(lines[0], command);
-  if (!header.ok()) return header.status();
-  out.quality_code = header->quality_code;
-  out.units_code = header->units_code;
+  BRDF_ASSIGN_OR_RETURN(SpectrumHeader header, ParseSpectrumHeader(lines[0], command));
+  out.quality_code = header.quality_code;
+  out.units_code = header.units_code;
 
   const auto integrated = ParseNumber(lines[1]);
   if (!integrated) {

@@ -85,9 +85,8 @@ Status Pr650Spectroradiometer::WithSilenceHint(const Status& status, const CallC
 Status Pr650Spectroradiometer::OpenWithRtsDrop(const CallContext& ctx) {
   const pr650::SerialSettings settings{options_.port, options_.baud,
                                        options_.hardware_flow_control};
-  Result<std::unique_ptr<pr650::SerialLink>> made = link_factory_(settings, options_.log);
-  if (!made.ok()) return made.status();
-  std::unique_ptr<pr650::SerialLink> link = std::move(made).value();
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<pr650::SerialLink> link,
+                        link_factory_(settings, options_.log));
   BRDF_RETURN_IF_ERROR(link->Open(port_seen_));
   port_seen_ = true;
   // The meter only enters remote mode on a first command shortly after power-on; the drivers that
@@ -234,17 +233,15 @@ pr650::SetupFields Pr650Spectroradiometer::CurrentSetup() const {
 }
 
 Status Pr650Spectroradiometer::SendSetup(const SetupFields& fields, const CallContext& ctx) {
-  Result<std::string> command = pr650::FormatSetupCommand(fields);
-  if (!command.ok()) return command.status();
+  BRDF_ASSIGN_OR_RETURN(std::string command, pr650::FormatSetupCommand(fields));
   meter_setup_.reset();  // unknown until the meter accepts
-  Result<std::string> reply = Exchange(*command, 1, options_.measurement_timeout, ctx);
+  Result<std::string> reply = Exchange(command, 1, options_.measurement_timeout, ctx);
   if (!reply.ok()) return WithSilenceHint(reply.status(), ctx);
-  Result<int> code = pr650::ParseSetupReply(*reply);
-  if (!code.ok()) return code.status();
-  if (*code != 0) {
-    return DeviceError(*code, "PR-650 on " + options_.port + " rejected the setup " + *command +
-                                  ": " + pr650::DescribeSetupReply(*code) +
-                                  "; check the measurement settings (and the lens accessory)");
+  BRDF_ASSIGN_OR_RETURN(int code, pr650::ParseSetupReply(*reply));
+  if (code != 0) {
+    return DeviceError(code, "PR-650 on " + options_.port + " rejected the setup " + command +
+                                 ": " + pr650::DescribeSetupReply(code) +
+                                 "; check the measurement settings (and the lens accessory)");
   }
   meter_setup_ = fields;
   return Status::Ok();
@@ -257,16 +254,14 @@ Result<MeterIdentity> Pr650Spectroradiometer::Identify(const CallContext& ctx) {
   Result<std::string> serial_reply =
       Exchange(pr650::kSerialNumberCommand, 1, options_.reply_timeout, ctx);
   if (!serial_reply.ok()) return WithSilenceHint(serial_reply.status(), ctx);
-  Result<std::string> serial = pr650::ParseSerialNumberReply(*serial_reply);
-  if (!serial.ok()) return serial.status();
+  BRDF_ASSIGN_OR_RETURN(std::string serial, pr650::ParseSerialNumberReply(*serial_reply));
 
   Result<std::string> layout_reply =
       Exchange(pr650::kLayoutCommand, 1, options_.reply_timeout, ctx);
   if (!layout_reply.ok()) return WithSilenceHint(layout_reply.status(), ctx);
-  Result<pr650::SpectralLayout> layout = pr650::ParseLayoutReply(*layout_reply);
-  if (!layout.ok()) return layout.status();
-  grid_ = layout->grid();
-  return MeterIdentity{std::string(kModel), *serial, grid_};
+  BRDF_ASSIGN_OR_RETURN(pr650::SpectralLayout layout, pr650::ParseLayoutReply(*layout_reply));
+  grid_ = layout.grid();
+  return MeterIdentity{std::string(kModel), serial, grid_};
 }
 
 Status Pr650Spectroradiometer::Configure(const MeasurementSettings& settings,
@@ -286,15 +281,14 @@ Status Pr650Spectroradiometer::Configure(const MeasurementSettings& settings,
     Result<std::string> reply =
         Exchange(pr650::kFlickerCommand, 1, options_.measurement_timeout, ctx);
     if (!reply.ok()) return WithSilenceHint(reply.status(), ctx);
-    Result<pr650::FlickerReply> flicker = pr650::ParseFlickerReply(*reply);
-    if (!flicker.ok()) return flicker.status();
-    if (flicker->quality_code != 0) {
-      return DeviceError(flicker->quality_code,
+    BRDF_ASSIGN_OR_RETURN(pr650::FlickerReply flicker, pr650::ParseFlickerReply(*reply));
+    if (flicker.quality_code != 0) {
+      return DeviceError(flicker.quality_code,
                          "PR-650 on " + options_.port + " could not measure the lamp's flicker: " +
-                             pr650::DescribeQualityCode(flicker->quality_code) +
+                             pr650::DescribeQualityCode(flicker.quality_code) +
                              "; check the lamp, or configure without sync to source");
     }
-    Log("lamp flicker measured at " + std::to_string(flicker->frequency_hz) + " Hz");
+    Log("lamp flicker measured at " + std::to_string(flicker.frequency_hz) + " Hz");
   }
   configured_.reset();
   BRDF_RETURN_IF_ERROR(SendSetup(fields, ctx));
@@ -366,14 +360,13 @@ Result<MeasurementOutcome> Pr650Spectroradiometer::Measure(const CallContext& ct
   BRDF_RETURN_IF_ERROR(StartMeasuring(ctx));
   std::vector<std::string> notes;
   for (int attempt = 1;; ++attempt) {
-    Result<int> code = MeasureAndHold(ctx);
-    if (!code.ok()) return code.status();
-    const pr650::QualityDecision decision = Judge(*code, attempt, notes);
+    BRDF_ASSIGN_OR_RETURN(int code, MeasureAndHold(ctx));
+    const pr650::QualityDecision decision = Judge(code, attempt, notes);
     if (Accepted(decision)) {
       holds_measurement_ = true;
-      return Outcome(*code, decision, attempt, notes);
+      return Outcome(code, decision, attempt, notes);
     }
-    BRDF_RETURN_IF_ERROR(PrepareRemeasure(*code, decision, attempt, notes, ctx));
+    BRDF_RETURN_IF_ERROR(PrepareRemeasure(code, decision, attempt, notes, ctx));
   }
 }
 
@@ -381,9 +374,8 @@ Result<int> Pr650Spectroradiometer::MeasureAndHold(const CallContext& ctx) {
   constexpr std::string_view kCommand = pr650::kMeasureCommand;
   Result<std::string> reply = Exchange(kCommand, 1, MeasurementTimeout(), ctx);
   if (!reply.ok()) return WithMeasurementHint(reply.status(), ctx);
-  Result<int> code = pr650::ParseStatusReply(*reply, kCommand);
-  if (!code.ok()) return code.status();
-  if (*code == pr650::kNoMeasurementStatus) return NoMeasurement(kCommand);
+  BRDF_ASSIGN_OR_RETURN(int code, pr650::ParseStatusReply(*reply, kCommand));
+  if (code == pr650::kNoMeasurementStatus) return NoMeasurement(kCommand);
   return code;
 }
 
@@ -439,14 +431,14 @@ Result<SpectrumReport> Pr650Spectroradiometer::TransferSpectrum(const CallContex
 
 Result<SpectrumReport> Pr650Spectroradiometer::SpectrumFromReply(std::string_view reply,
                                                                  std::string_view command) const {
-  Result<pr650::SpectrumReply> spectrum = pr650::ParseSpectrumReply(reply, grid_, command);
-  if (!spectrum.ok()) return spectrum.status();
+  BRDF_ASSIGN_OR_RETURN(pr650::SpectrumReply spectrum,
+                        pr650::ParseSpectrumReply(reply, grid_, command));
   SpectrumReport report;
-  report.grid = spectrum->grid;
-  report.radiance = std::move(spectrum->values);
-  report.quality_code = spectrum->quality_code;
-  report.units_code = spectrum->units_code;
-  report.integrated = spectrum->integrated;
+  report.grid = spectrum.grid;
+  report.radiance = std::move(spectrum.values);
+  report.quality_code = spectrum.quality_code;
+  report.units_code = spectrum.units_code;
+  report.integrated = spectrum.integrated;
   return report;
 }
 
@@ -462,14 +454,13 @@ Result<MeasuredSpectrum> Pr650Spectroradiometer::MeasureSpectrum(const CallConte
     std::optional<int> m0_code;  // M0's status, judged already
     pr650::QualityDecision decision;
     if (!one_exchange) {
-      Result<int> status = MeasureAndHold(ctx);
-      if (!status.ok()) return status.status();
-      decision = Judge(*status, attempt, notes);
+      BRDF_ASSIGN_OR_RETURN(int status, MeasureAndHold(ctx));
+      decision = Judge(status, attempt, notes);
       if (!Accepted(decision)) {
-        BRDF_RETURN_IF_ERROR(PrepareRemeasure(*status, decision, attempt, notes, ctx));
+        BRDF_RETURN_IF_ERROR(PrepareRemeasure(status, decision, attempt, notes, ctx));
         continue;
       }
-      m0_code = *status;
+      m0_code = status;
       holds_measurement_ = true;
     }
     // The report's status line is the measurement's quality code in both modes (a meter may answer
@@ -506,16 +497,15 @@ Result<MeasuredSpectrum> Pr650Spectroradiometer::MeasureSpectrum(const CallConte
       }
     }
     if (!rejected) {
-      Result<SpectrumReport> report = SpectrumFromReply(*reply, command);
-      if (!report.ok()) return report.status();
+      BRDF_ASSIGN_OR_RETURN(SpectrumReport report, SpectrumFromReply(*reply, command));
       if (!code.has_value()) {  // cannot happen: a parsed report has a status line
         return ProtocolError("PR-650 reply to " + std::string(command) + " on " + options_.port +
                              " had no status line");
       }
       holds_measurement_ = true;
       MeasurementOutcome outcome = Outcome(*code, decision, attempt, notes);
-      FlagUnits(report->units_code, outcome);
-      return MeasuredSpectrum{std::move(outcome), std::move(*report)};
+      FlagUnits(report.units_code, outcome);
+      return MeasuredSpectrum{std::move(outcome), std::move(report)};
     }
     holds_measurement_ = false;
     BRDF_RETURN_IF_ERROR(PrepareRemeasure(*code, decision, attempt, notes, ctx));

@@ -70,10 +70,9 @@ Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
       until = last_byte + gap;
     }
 
-    Result<std::string> bytes = link.Read(until, ctx);
-    if (!bytes.ok()) return bytes.status();
-    if (!bytes->empty()) {
-      BRDF_RETURN_IF_ERROR(append(*bytes));
+    BRDF_ASSIGN_OR_RETURN(std::string bytes, link.Read(until, ctx));
+    if (!bytes.empty()) {
+      BRDF_RETURN_IF_ERROR(append(bytes));
       continue;
     }
 
@@ -82,9 +81,8 @@ Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
     if (!deadline_passed && !no_answer) continue;
 
     // One last look before giving up: a reply that arrived in the final moment is a reply.
-    Result<std::string> late = link.Read(clock.Now(), ctx);
-    if (!late.ok()) return late.status();
-    if (!late->empty()) BRDF_RETURN_IF_ERROR(append(*late));
+    BRDF_ASSIGN_OR_RETURN(std::string late, link.Read(clock.Now(), ctx));
+    if (!late.empty()) BRDF_RETURN_IF_ERROR(append(late));
     if (deadline_passed) {
       if (Complete(reply, lines)) return reply;
       if (reply.empty()) {

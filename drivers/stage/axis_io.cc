@@ -63,25 +63,22 @@ Result<DriveStatus> AxisIo::ReadStatus(const CallContext& ctx, BusPriority prior
   const bool adjacent = al.present() && (st.end() == al.address || al.end() == st.address);
   if (adjacent) {
     const RegisterField both{std::min(st.address, al.address), st.words + al.words};
-    auto regs = Read(both, ctx, priority, "status and alarm code");
-    if (!regs.ok()) return regs.status();
-    const auto st_at = regs->begin() + (st.address - both.address);
-    const auto al_at = regs->begin() + (al.address - both.address);
+    BRDF_ASSIGN_OR_RETURN(auto regs, Read(both, ctx, priority, "status and alarm code"));
+    const auto st_at = regs.begin() + (st.address - both.address);
+    const auto al_at = regs.begin() + (al.address - both.address);
     status_regs.assign(st_at, st_at + st.words);
     alarm_regs.assign(al_at, al_at + al.words);
   } else {
-    auto regs = Read(st, ctx, priority, "status");
-    if (!regs.ok()) return regs.status();
-    status_regs = std::move(*regs);
+    BRDF_ASSIGN_OR_RETURN(auto regs, Read(st, ctx, priority, "status"));
+    status_regs = std::move(regs);
   }
   DriveStatus out;
   out.raw = DecodeUnsigned(status_regs, profile_.word_order);
   out.flags = DecodeStatus(out.raw, profile_.status_bits);
   if (out.flags.alarm && al.present()) {
     if (alarm_regs.empty()) {
-      auto regs = Read(al, ctx, priority, "alarm code");
-      if (!regs.ok()) return regs.status();
-      alarm_regs = std::move(*regs);
+      BRDF_ASSIGN_OR_RETURN(auto regs, Read(al, ctx, priority, "alarm code"));
+      alarm_regs = std::move(regs);
     }
     out.alarm_code = static_cast<int>(DecodeUnsigned(alarm_regs, profile_.word_order));
   }
@@ -89,15 +86,14 @@ Result<DriveStatus> AxisIo::ReadStatus(const CallContext& ctx, BusPriority prior
 }
 
 Result<std::int32_t> AxisIo::ReadFeedbackCounts(const CallContext& ctx) const {
-  auto regs = Read(profile_.feedback_position, ctx, BusPriority::kNormal, "feedback position");
-  if (!regs.ok()) return regs.status();
-  return DecodeSigned(*regs, profile_.word_order);
+  BRDF_ASSIGN_OR_RETURN(
+      auto regs, Read(profile_.feedback_position, ctx, BusPriority::kNormal, "feedback position"));
+  return DecodeSigned(regs, profile_.word_order);
 }
 
 Result<double> AxisIo::ReadPositionDeg(const CallContext& ctx) const {
-  auto counts = ReadFeedbackCounts(ctx);
-  if (!counts.ok()) return counts.status();
-  return CountsToDeg(*counts);
+  BRDF_ASSIGN_OR_RETURN(auto counts, ReadFeedbackCounts(ctx));
+  return CountsToDeg(counts);
 }
 
 Status AxisIo::StartMove(double target_deg, const CallContext& ctx) const {

@@ -174,10 +174,9 @@ void ModbusStage::Disconnect() {
 }
 
 Status ModbusStage::CheckNoAlarm(const AxisIo& io, const CallContext& ctx) const {
-  auto status = io.ReadStatus(ctx);
-  if (!status.ok()) return status.status();
-  if (status->flags.alarm) {
-    return FailedPrecondition(io.name() + " has alarm " + AlarmHex(status->alarm_code) +
+  BRDF_ASSIGN_OR_RETURN(auto status, io.ReadStatus(ctx));
+  if (status.flags.alarm) {
+    return FailedPrecondition(io.name() + " has alarm " + AlarmHex(status.alarm_code) +
                               " set; remove its cause, then call ResetAlarm(" +
                               AxisName(io.axis()) + ") before moving");
   }
@@ -396,17 +395,15 @@ Result<AxisState> ModbusStage::ReadAxis(Axis axis, const CallContext& ctx) {
   if (io == nullptr) {
     return InvalidArgument(std::string("stage: this rig has no ") + AxisName(axis) + " axis");
   }
-  auto status = io->ReadStatus(ctx);
-  if (!status.ok()) return status.status();
-  auto pos = io->ReadPositionDeg(ctx);
-  if (!pos.ok()) return pos.status();
+  BRDF_ASSIGN_OR_RETURN(auto status, io->ReadStatus(ctx));
+  BRDF_ASSIGN_OR_RETURN(auto pos, io->ReadPositionDeg(ctx));
   AxisState s;
-  s.position_deg = *pos;
-  s.moving = status->flags.moving;
-  s.in_position = status->flags.in_position;
-  s.ready = status->flags.ready;
-  s.alarm = status->flags.alarm;
-  s.alarm_code = status->alarm_code;
+  s.position_deg = pos;
+  s.moving = status.flags.moving;
+  s.in_position = status.flags.in_position;
+  s.ready = status.flags.ready;
+  s.alarm = status.flags.alarm;
+  s.alarm_code = status.alarm_code;
   return s;
 }
 
@@ -417,9 +414,8 @@ Result<Pose> ModbusStage::ReadPose(const CallContext& ctx) {
   for (Axis axis : kAllAxes) {
     const AxisIo* io = IoFor(axis);
     if (io == nullptr) continue;
-    auto pos = io->ReadPositionDeg(ctx);
-    if (!pos.ok()) return pos.status();
-    *fields[static_cast<int>(axis)] = *pos;
+    BRDF_ASSIGN_OR_RETURN(auto pos, io->ReadPositionDeg(ctx));
+    *fields[static_cast<int>(axis)] = pos;
   }
   return pose;
 }
@@ -432,11 +428,10 @@ Status ModbusStage::ResetAlarm(Axis axis, const CallContext& ctx) {
   }
   BRDF_RETURN_IF_ERROR(
       PulseCommand({io}, config_.profile.alarm_reset, "ALM-RST", ctx, BusPriority::kNormal));
-  auto status = io->ReadStatus(ctx);
-  if (!status.ok()) return status.status();
-  if (status->flags.alarm) {
-    return DeviceError(status->alarm_code,
-                       io->name() + ": alarm " + AlarmHex(status->alarm_code) +
+  BRDF_ASSIGN_OR_RETURN(auto status, io->ReadStatus(ctx));
+  if (status.flags.alarm) {
+    return DeviceError(status.alarm_code,
+                       io->name() + ": alarm " + AlarmHex(status.alarm_code) +
                            " is still set after ALM-RST; its cause persists (overtravel, "
                            "obstruction, overheating): remove it at the rig, then reset again");
   }

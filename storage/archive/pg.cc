@@ -218,9 +218,9 @@ Result<PgResult> PgConnection::QueryPrepared(const std::string& name, std::strin
                                              PgParams params) {
   if (std::find(prepared_.begin(), prepared_.end(), name) == prepared_.end()) {
     const std::string text(sql);
-    Result<PgResult> prepared = Check(PQprepare(conn_, name.c_str(), text.c_str(), 0, nullptr),
-                                      "archive: preparing " + name);
-    if (!prepared.ok()) return prepared.status();
+    BRDF_RETURN_IF_ERROR(Check(PQprepare(conn_, name.c_str(), text.c_str(), 0, nullptr),
+                               "archive: preparing " + name)
+                             .status());
     prepared_.push_back(name);
   }
   params.Seal();

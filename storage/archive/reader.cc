@@ -78,9 +78,8 @@ Result<StepRecord> StepAt(const PgResult& r, int row, std::int64_t session) {
   StepRecord s;
   s.session_id = session;
   s.step_index = static_cast<int>(r.Int64(row, 0));
-  Result<StepKind> kind = ParseStepKind(r.Text(row, 1));
-  if (!kind.ok()) return kind.status();
-  s.kind = *kind;
+  BRDF_ASSIGN_OR_RETURN(StepKind kind, ParseStepKind(r.Text(row, 1)));
+  s.kind = kind;
   s.pose = {r.Double(row, 2), r.Double(row, 3), r.Double(row, 4), r.Double(row, 5)};
   s.prompt = r.OptionalText(row, 6);
   s.prompt_kind = r.OptionalText(row, 7);
@@ -90,9 +89,8 @@ Result<StepRecord> StepAt(const PgResult& r, int row, std::int64_t session) {
         Directions{r.Double(row, 9), r.Double(row, 10), r.Double(row, 11), r.Double(row, 12)};
   }
   s.label = std::string(r.Text(row, 13));
-  Result<StepState> state = ParseStepState(r.Text(row, 14));
-  if (!state.ok()) return state.status();
-  s.state = *state;
+  BRDF_ASSIGN_OR_RETURN(StepState state, ParseStepState(r.Text(row, 14)));
+  s.state = state;
   s.note = r.OptionalText(row, 15);
   s.completed_at = r.OptionalDouble(row, 16);
   return s;
@@ -103,9 +101,8 @@ Result<ReadingRecord> ReadingAt(const PgResult& r, int row, std::int64_t session
   g.id = r.Int64(row, 0);
   g.session_id = session;
   g.step_index = static_cast<int>(r.Int64(row, 1));
-  Result<ReadingKind> kind = ParseReadingKind(r.Text(row, 2));
-  if (!kind.ok()) return kind.status();
-  g.kind = *kind;
+  BRDF_ASSIGN_OR_RETURN(ReadingKind kind, ParseReadingKind(r.Text(row, 2)));
+  g.kind = kind;
   g.pose = {r.Double(row, 3), r.Double(row, 4), r.Double(row, 5), r.Double(row, 6)};
   g.directions = {r.Double(row, 7), r.Double(row, 8), r.Double(row, 9), r.Double(row, 10)};
   g.grid.start_nm = r.Double(row, 11);
@@ -149,13 +146,12 @@ Result<ReadingPointRecord> ReadingPointAt(const PgResult& r, int row, std::int64
 Result<std::shared_ptr<ArchiveReader>> ArchiveReader::Open(std::string conninfo) {
   std::shared_ptr<ArchiveReader> reader(new ArchiveReader(std::move(conninfo)));
   Status checked = reader->WithConnection([](PgConnection& conn) -> Status {
-    Result<int> version = ArchiveVersion(conn);
-    if (!version.ok()) return version.status();
-    if (*version != LatestArchiveVersion()) {
+    BRDF_ASSIGN_OR_RETURN(int version, ArchiveVersion(conn));
+    if (version != LatestArchiveVersion()) {
       return FailedPrecondition(
-          "the archive has schema version " + std::to_string(*version) + "; this brdf-archive " +
+          "the archive has schema version " + std::to_string(version) + "; this brdf-archive " +
           "reads version " + std::to_string(LatestArchiveVersion()) +
-          (*version < LatestArchiveVersion()
+          (version < LatestArchiveVersion()
                ? ": start a rig of this version with [archive] (it migrates the archive), or "
                  "run brdf-archive --migrate once with a role that may alter the schema"
                : ": upgrade brdf-archive"));
@@ -178,9 +174,8 @@ Status ArchiveReader::WithConnection(const std::function<Status(PgConnection&)>&
     }
     const bool reused = conn != nullptr;
     if (!conn) {
-      Result<std::unique_ptr<PgConnection>> opened = PgConnection::Open(conninfo_);
-      if (!opened.ok()) return opened.status();
-      conn = std::move(*opened);
+      BRDF_ASSIGN_OR_RETURN(std::unique_ptr<PgConnection> opened, PgConnection::Open(conninfo_));
+      conn = std::move(opened);
     }
     Status st = work(*conn);
     if (conn->healthy()) {
@@ -196,12 +191,11 @@ Status ArchiveReader::WithConnection(const std::function<Status(PgConnection&)>&
 Result<SessionRecord> ArchiveReader::GetSession(std::int64_t session) {
   Result<SessionRecord> out = NotFound("no " + SessionName(session) + " in the archive");
   BRDF_RETURN_IF_ERROR(WithConnection([&](PgConnection& conn) -> Status {
-    Result<PgResult> r = conn.QueryPrepared(
-        "archive_session",
-        "SELECT " + std::string(kSessionColumns) + " FROM sessions WHERE archive_id = $1",
-        PgParams().Add(session));
-    if (!r.ok()) return r.status();
-    if (r->rows() == 1) out = SessionAt(*r, 0);
+    BRDF_ASSIGN_OR_RETURN(PgResult r, conn.QueryPrepared("archive_session",
+                                                         "SELECT " + std::string(kSessionColumns) +
+                                                             " FROM sessions WHERE archive_id = $1",
+                                                         PgParams().Add(session)));
+    if (r.rows() == 1) out = SessionAt(r, 0);
     return Status::Ok();
   }));
   return out;
@@ -211,14 +205,12 @@ Result<std::vector<StepRecord>> ArchiveReader::GetSteps(std::int64_t session) {
   BRDF_RETURN_IF_ERROR(GetSession(session).status());
   std::vector<StepRecord> steps;
   BRDF_RETURN_IF_ERROR(WithConnection([&](PgConnection& conn) -> Status {
-    Result<PgResult> r =
-        conn.QueryPrepared("archive_steps", kStepsOfSession, PgParams().Add(session));
-    if (!r.ok()) return r.status();
+    BRDF_ASSIGN_OR_RETURN(
+        PgResult r, conn.QueryPrepared("archive_steps", kStepsOfSession, PgParams().Add(session)));
     steps.clear();
-    for (int i = 0; i < r->rows(); ++i) {
-      Result<StepRecord> step = StepAt(*r, i, session);
-      if (!step.ok()) return step.status();
-      steps.push_back(std::move(*step));
+    for (int i = 0; i < r.rows(); ++i) {
+      BRDF_ASSIGN_OR_RETURN(StepRecord step, StepAt(r, i, session));
+      steps.push_back(std::move(step));
     }
     return Status::Ok();
   }));
@@ -229,22 +221,21 @@ Result<std::vector<SessionEventRecord>> ArchiveReader::ListSessionEvents(std::in
   BRDF_RETURN_IF_ERROR(GetSession(session).status());
   std::vector<SessionEventRecord> events;
   BRDF_RETURN_IF_ERROR(WithConnection([&](PgConnection& conn) -> Status {
-    Result<PgResult> r =
-        conn.QueryPrepared("archive_events", kEventsOfSession, PgParams().Add(session));
-    if (!r.ok()) return r.status();
+    BRDF_ASSIGN_OR_RETURN(PgResult r, conn.QueryPrepared("archive_events", kEventsOfSession,
+                                                         PgParams().Add(session)));
     events.clear();
-    for (int i = 0; i < r->rows(); ++i) {
+    for (int i = 0; i < r.rows(); ++i) {
       SessionEventRecord e;
-      e.id = r->Int64(i, 0);
+      e.id = r.Int64(i, 0);
       e.session_id = session;
-      e.at = r->Double(i, 1);
-      Result<SessionState> state = ParseSessionState(std::string(r->Text(i, 2)));
+      e.at = r.Double(i, 1);
+      Result<SessionState> state = ParseSessionState(std::string(r.Text(i, 2)));
       if (!state.ok()) {
         return state.status().WithContext("archived event " + std::to_string(e.id) + " of " +
                                           SessionName(session));
       }
       e.state = *state;
-      e.reason = std::string(r->Text(i, 3));
+      e.reason = std::string(r.Text(i, 3));
       events.push_back(std::move(e));
     }
     return Status::Ok();
@@ -263,21 +254,20 @@ Result<std::vector<Record>> ArchiveReader::ReadingPage(
   std::vector<Record> readings;
   bool known = true;
   BRDF_RETURN_IF_ERROR(WithConnection([&](PgConnection& conn) -> Status {
-    Result<PgResult> r =
-        conn.QueryPrepared(statement, query, PgParams().Add(session).Add(after_id).Add(limit));
-    if (!r.ok()) return r.status();
+    BRDF_ASSIGN_OR_RETURN(
+        PgResult r,
+        conn.QueryPrepared(statement, query, PgParams().Add(session).Add(after_id).Add(limit)));
     readings.clear();
-    for (int i = 0; i < r->rows(); ++i) {
-      Result<Record> reading = read(*r, i, session);
-      if (!reading.ok()) return reading.status();
-      readings.push_back(std::move(*reading));
+    for (int i = 0; i < r.rows(); ++i) {
+      BRDF_ASSIGN_OR_RETURN(Record reading, read(r, i, session));
+      readings.push_back(std::move(reading));
     }
     if (readings.empty()) {  // none above after_id, or no such session
-      Result<PgResult> s = conn.QueryPrepared("archive_session_exists",
-                                              "SELECT 1 FROM sessions WHERE archive_id = $1",
-                                              PgParams().Add(session));
-      if (!s.ok()) return s.status();
-      known = s->rows() == 1;
+      BRDF_ASSIGN_OR_RETURN(PgResult s,
+                            conn.QueryPrepared("archive_session_exists",
+                                               "SELECT 1 FROM sessions WHERE archive_id = $1",
+                                               PgParams().Add(session)));
+      known = s.rows() == 1;
     }
     return Status::Ok();
   }));
@@ -299,19 +289,17 @@ Result<std::vector<ReadingPointRecord>> ArchiveReader::GetReadingPoints(std::int
 }
 
 Result<bool> ArchiveReader::Finished(std::int64_t session) {
-  Result<SessionRecord> record = GetSession(session);
-  if (!record.ok()) return record.status();
-  if (!IsTerminal(record->state)) return false;
+  BRDF_ASSIGN_OR_RETURN(SessionRecord record, GetSession(session));
+  if (!IsTerminal(record.state)) return false;
   bool finished = false;
   BRDF_RETURN_IF_ERROR(WithConnection([&](PgConnection& conn) -> Status {
-    Result<PgResult> r = conn.QueryPrepared("archive_finished", R"sql(
+    BRDF_ASSIGN_OR_RETURN(PgResult r, conn.QueryPrepared("archive_finished", R"sql(
 SELECT (SELECT count(*) FROM steps WHERE session_uuid = $1 AND state = 'done'
           AND kind IN ('reference', 'dark', 'sample'))
      = (SELECT count(*) FROM readings WHERE session_uuid = $1)
 )sql",
-                                            PgParams().Add(record->uuid));
-    if (!r.ok()) return r.status();
-    finished = r->Text(0, 0) == "t";
+                                                         PgParams().Add(record.uuid)));
+    finished = r.Text(0, 0) == "t";
     return Status::Ok();
   }));
   return finished;
@@ -370,13 +358,11 @@ Result<std::vector<SessionRecord>> ArchiveReader::ListSessions(const ArchiveSess
 
   std::vector<SessionRecord> sessions;
   BRDF_RETURN_IF_ERROR(WithConnection([&](PgConnection& conn) -> Status {
-    Result<PgResult> r = conn.Query(sql, params);
-    if (!r.ok()) return r.status();
+    BRDF_ASSIGN_OR_RETURN(PgResult r, conn.Query(sql, params));
     sessions.clear();
-    for (int i = 0; i < r->rows(); ++i) {
-      Result<SessionRecord> s = SessionAt(*r, i);
-      if (!s.ok()) return s.status();
-      sessions.push_back(std::move(*s));
+    for (int i = 0; i < r.rows(); ++i) {
+      BRDF_ASSIGN_OR_RETURN(SessionRecord s, SessionAt(r, i));
+      sessions.push_back(std::move(s));
     }
     return Status::Ok();
   }));

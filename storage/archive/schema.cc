@@ -167,12 +167,12 @@ int LatestArchiveVersion() {
 }
 
 Result<int> ArchiveVersion(PgConnection& conn) {
-  Result<PgResult> exists = conn.Query("SELECT to_regclass('archive_schema') IS NOT NULL");
-  if (!exists.ok()) return exists.status();
-  if (exists->Text(0, 0) != "t") return 0;
-  Result<PgResult> v = conn.Query("SELECT coalesce(max(version), 0) FROM archive_schema");
-  if (!v.ok()) return v.status();
-  return static_cast<int>(v->Int64(0, 0));
+  BRDF_ASSIGN_OR_RETURN(PgResult exists,
+                        conn.Query("SELECT to_regclass('archive_schema') IS NOT NULL"));
+  if (exists.Text(0, 0) != "t") return 0;
+  BRDF_ASSIGN_OR_RETURN(PgResult v,
+                        conn.Query("SELECT coalesce(max(version), 0) FROM archive_schema"));
+  return static_cast<int>(v.Int64(0, 0));
 }
 
 namespace {

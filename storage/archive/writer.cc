@@ -176,8 +176,7 @@ Status WriteReading(PgConnection& conn, const std::string& uuid, const ReadingRe
 }  // namespace
 
 Status WriteToArchive(PgConnection& conn, const std::string& rig, const ShipBatch& batch) {
-  Result<PgTransaction> tx = PgTransaction::Begin(conn);
-  if (!tx.ok()) return tx.status();
+  BRDF_ASSIGN_OR_RETURN(PgTransaction tx, PgTransaction::Begin(conn));
   for (const SessionRecord& s : batch.sessions) BRDF_RETURN_IF_ERROR(WriteSession(conn, rig, s));
   for (const StepRecord& s : batch.steps) {
     std::optional<std::string> uuid = UuidOf(batch, s.session_id);
@@ -211,7 +210,7 @@ Status WriteToArchive(PgConnection& conn, const std::string& rig, const ShipBatc
             .status()
             .WithContext("archiving event " + std::to_string(e.id) + " of session " + *uuid));
   }
-  return tx->Commit();
+  return tx.Commit();
 }
 
 }  // namespace brdf::storage

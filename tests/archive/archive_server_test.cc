@@ -39,17 +39,15 @@ class ArchiveProcess {
  public:
   static Result<std::unique_ptr<ArchiveProcess>> Start(const std::string& config,
                                                        const std::string& log) {
-    Result<std::string> binary =
-        BuiltProgram("brdf-archive", "daemon/brdf-archive", "BRDF_ARCHIVE_BINARY");
-    if (!binary.ok()) return binary.status();
+    BRDF_ASSIGN_OR_RETURN(std::string binary, BuiltProgram("brdf-archive", "daemon/brdf-archive",
+                                                           "BRDF_ARCHIVE_BINARY"));
     LaunchOptions options({"--config", config});
     options.stderr_to = LaunchOptions::Stderr::kAppendToFile;
     options.stderr_path = log;
-    Result<std::unique_ptr<ChildProcess>> child =
-        ChildProcess::Launch("brdf-archive", *binary, options);
-    if (!child.ok()) return child.status();
+    BRDF_ASSIGN_OR_RETURN(std::unique_ptr<ChildProcess> child,
+                          ChildProcess::Launch("brdf-archive", binary, options));
     std::unique_ptr<ArchiveProcess> a(new ArchiveProcess());
-    a->child_ = std::move(*child);
+    a->child_ = std::move(child);
     Result<std::string> line = a->child_->ReadLine(Clock::now() + 15s);
     if (!line.ok() || line->rfind(kListening, 0) != 0) {
       return Internal("brdf-archive did not start: " +

@@ -43,9 +43,8 @@ Status RecordStep(SessionStore& store, std::int64_t session, int i,
   if (kind == StepKind::kMove) return store.CompleteStep(session, i);
   ReadingRecord r = MakeReading(i, *ReadingKindFor(kind));
   if (kind == StepKind::kSample) r.reference_reading_id = reference;
-  Result<std::int64_t> id = store.CompleteStepWithReading(session, i, r);
-  if (!id.ok()) return id.status();
-  if (kind == StepKind::kReference) reference = *id;
+  BRDF_ASSIGN_OR_RETURN(std::int64_t id, store.CompleteStepWithReading(session, i, r));
+  if (kind == StepKind::kReference) reference = id;
   return Status::Ok();
 }
 

@@ -25,8 +25,7 @@ Result<std::string> BrdfctlBinary() {
 
 Result<CommandResult> RunBrdfctl(const std::vector<std::string>& args, const EnvVars& env,
                                  std::chrono::milliseconds timeout) {
-  Result<std::string> binary = BrdfctlBinary();
-  if (!binary.ok()) return binary.status();
+  BRDF_ASSIGN_OR_RETURN(std::string binary, BrdfctlBinary());
   LaunchOptions options;
   options.args = args;
   options.stderr_to = LaunchOptions::Stderr::kPipe;
@@ -34,7 +33,7 @@ Result<CommandResult> RunBrdfctl(const std::vector<std::string>& args, const Env
   options.unset_env = {"BRDF_ADDRESS", "BRDF_TOKEN"};
   options.set_env = env;
   CommandResult partial;
-  Result<CommandResult> run = RunToCompletion("brdfctl", *binary, options, timeout, &partial);
+  Result<CommandResult> run = RunToCompletion("brdfctl", binary, options, timeout, &partial);
   if (run.status().code() == StatusCode::kTimeout) {
     return Timeout("brdfctl " + (args.empty() ? std::string() : args[0]) +
                    " did not finish within " + std::to_string(timeout.count()) +

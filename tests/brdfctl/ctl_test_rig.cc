@@ -24,10 +24,9 @@ std::string CtlRig::modbus() const {
 
 Status CtlRig::Start() {
   if (dir_.path().empty()) return IoError("no temporary directory: " + dir_.error());
-  Result<SimRig> sim = StartSimRig(/*seed=*/3);
-  if (!sim.ok()) return sim.status();
-  sim_ = std::move(sim->sim);
-  sim_control_ = std::move(sim->control);
+  BRDF_ASSIGN_OR_RETURN(SimRig sim, StartSimRig(/*seed=*/3));
+  sim_ = std::move(sim.sim);
+  sim_control_ = std::move(sim.control);
 
   // Like deploy/quickstart.sh's configuration, with the meter's timings shortened for 50×.
   std::ostringstream toml;
@@ -54,10 +53,10 @@ Status CtlRig::Start() {
     out << toml.str();
     if (!out) return IoError("cannot write " + config);
   }
-  Result<std::unique_ptr<DaemonProcess>> daemon = DaemonProcess::Start(
-      {"--config", config, "--shutdown-timeout", "5"}, dir_.file("brdfd.log").string());
-  if (!daemon.ok()) return daemon.status();
-  daemon_ = std::move(*daemon);
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<DaemonProcess> daemon,
+                        DaemonProcess::Start({"--config", config, "--shutdown-timeout", "5"},
+                                             dir_.file("brdfd.log").string()));
+  daemon_ = std::move(daemon);
 
   // The devices connect in the background.
   const auto until = std::chrono::steady_clock::now() + 15s;

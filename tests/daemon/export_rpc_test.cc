@@ -149,18 +149,18 @@ class ExportRpcTest : public ::testing::Test {
   // brdf-export run on the daemon's database for the suite's session with `args` (the command
   // and its options, without -o); the file it wrote, or why it failed.
   static Result<std::string> ToolExport(std::vector<std::string> args) {
-    Result<std::string> tool =
-        BuiltProgram("brdf-export", "tools/brdf-export/brdf-export", "BRDF_EXPORT_BINARY");
-    if (!tool.ok()) return tool.status();
+    BRDF_ASSIGN_OR_RETURN(
+        std::string tool,
+        BuiltProgram("brdf-export", "tools/brdf-export/brdf-export", "BRDF_EXPORT_BINARY"));
     TempDir dir("brdf-export-rpc");
     const std::string path = dir.file("out").string();
     std::vector<std::string> all = {"--db", rig_->database(), "--session", *session_id_, "--quiet"};
     all.insert(all.end(), args.begin(), args.end());
     all.insert(all.end(), {"-o", path});
-    Result<CommandResult> run = RunToCompletion("brdf-export", *tool, LaunchOptions(all), 120s);
-    if (!run.ok()) return run.status();
-    if (run->exit_code != 0) {
-      return Internal("brdf-export exited " + std::to_string(run->exit_code) + ": " + run->err);
+    BRDF_ASSIGN_OR_RETURN(CommandResult run,
+                          RunToCompletion("brdf-export", tool, LaunchOptions(all), 120s));
+    if (run.exit_code != 0) {
+      return Internal("brdf-export exited " + std::to_string(run.exit_code) + ": " + run.err);
     }
     std::ifstream in(path, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), {});

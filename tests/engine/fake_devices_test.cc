@@ -19,9 +19,8 @@ class FakeDevicesTest : public ::testing::Test {
     return CallContext::WithTimeout(timeout, cancel);
   }
   Result<drivers::SpectrumReport> Read() {
-    Result<drivers::MeasuredSpectrum> taken = meter_.MeasureSpectrum(Ctx(), nullptr);
-    if (!taken.ok()) return taken.status();
-    return taken->report;
+    BRDF_ASSIGN_OR_RETURN(drivers::MeasuredSpectrum taken, meter_.MeasureSpectrum(Ctx(), nullptr));
+    return taken.report;
   }
 
   std::shared_ptr<FakeBench> bench_ = std::make_shared<FakeBench>();

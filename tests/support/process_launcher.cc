@@ -241,14 +241,14 @@ Result<CommandResult> RunToCompletion(const std::string& what, const std::string
   if (options.stderr_to == LaunchOptions::Stderr::kInherit) {
     options.stderr_to = LaunchOptions::Stderr::kPipe;
   }
-  Result<std::unique_ptr<ChildProcess>> child = ChildProcess::Launch(what, binary, options);
-  if (!child.ok()) return child.status();
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<ChildProcess> child,
+                        ChildProcess::Launch(what, binary, options));
   const auto deadline = Clock::now() + timeout;
   CommandResult result;
-  (*child)->ReadAll(deadline, result.out, result.err);
-  std::optional<int> code = (*child)->WaitUntil(deadline);
+  child->ReadAll(deadline, result.out, result.err);
+  std::optional<int> code = child->WaitUntil(deadline);
   if (!code) {
-    (*child)->Kill();
+    child->Kill();
     if (partial != nullptr) *partial = result;
     return Timeout(what + " did not finish within " + std::to_string(timeout.count()) + " ms");
   }

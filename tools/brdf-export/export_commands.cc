@@ -74,9 +74,8 @@ Result<exports::Session> LoadInput(const CommonOptions& c) {
         "session)");
   }
   if (c.session_id < 0) return InvalidArgument("no session: give --session N");
-  Result<std::unique_ptr<storage::SessionStore>> store = OpenExistingStore(c.db_path);
-  if (!store.ok()) return store.status();
-  return storage::LoadSessionReadings(**store, c.session_id);
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<storage::SessionStore> store, OpenExistingStore(c.db_path));
+  return storage::LoadSessionReadings(*store, c.session_id);
 }
 
 Result<std::vector<double>> ParseNumbers(const std::string& text, const char* what) {
@@ -109,39 +108,36 @@ void DescribeFillChain(const Interpolation& in, std::ostream& err) {
 Result<Interpolation> BuildInterpolator(const exports::Session& session, exports::Quantity q,
                                         const CommonOptions& c, const InterpChoice& choice,
                                         std::ostream& err) {
-  Result<interp::Method> method = interp::ParseMethod(choice.method);
-  if (!method.ok()) return method.status();
-  Result<exports::FillPolicy> policy = exports::ParseFillPolicy(choice.fill);
-  if (!policy.ok()) return policy.status();
-  Result<interp::Coordinates> coordinates = interp::ParseCoordinates(choice.coordinates);
-  if (!coordinates.ok()) return coordinates.status();
+  BRDF_ASSIGN_OR_RETURN(interp::Method method, interp::ParseMethod(choice.method));
+  BRDF_ASSIGN_OR_RETURN(exports::FillPolicy policy, exports::ParseFillPolicy(choice.fill));
+  BRDF_ASSIGN_OR_RETURN(interp::Coordinates coordinates,
+                        interp::ParseCoordinates(choice.coordinates));
   Result<interp::Trend> trend = interp::ParseTrend(choice.trend);
   if (!trend.ok()) return trend.status().WithContext("--trend");
   interp::Options options;
-  options.coordinates = *coordinates;
+  options.coordinates = coordinates;
   options.trend = *trend;
   options.mirror_phi = choice.mirror_phi;
   options.reciprocity = choice.reciprocity;
   if (!choice.scale.empty()) {
-    Result<std::vector<double>> scale = ParseNumbers(choice.scale, "--scale");
-    if (!scale.ok()) return scale.status();
-    options.axis_scale = *scale;
+    BRDF_ASSIGN_OR_RETURN(std::vector<double> scale, ParseNumbers(choice.scale, "--scale"));
+    options.axis_scale = scale;
   }
   if (exports::HasSeveralDialPositions(session)) {
     err << "brdf-export: warning: session " << session.id
         << " was measured at several dial positions γ (anisotropic); this export uses the "
            "isotropic reduction (θi, θo, φ) and folds them together\n";
   }
-  Result<exports::DerivedSamples> derived = exports::DeriveSamples(session, q, {c.exclude_flagged});
-  if (!derived.ok()) return derived.status();
-  if (!derived->skipped.empty()) {
-    err << "brdf-export: " << derived->skipped.size()
-        << " sample readings left out; the first: " << derived->skipped.front().reason << "\n";
+  BRDF_ASSIGN_OR_RETURN(exports::DerivedSamples derived,
+                        exports::DeriveSamples(session, q, {c.exclude_flagged}));
+  if (!derived.skipped.empty()) {
+    err << "brdf-export: " << derived.skipped.size()
+        << " sample readings left out; the first: " << derived.skipped.front().reason << "\n";
   }
-  Result<Interpolation> in = exports::BuildSessionInterpolant(std::move(*derived), *method, options,
-                                                              *policy, RunContext());
-  if (!in.ok()) return in.status();
-  DescribeFillChain(*in, err);
+  BRDF_ASSIGN_OR_RETURN(
+      Interpolation in,
+      exports::BuildSessionInterpolant(std::move(derived), method, options, policy, RunContext()));
+  DescribeFillChain(in, err);
   return in;
 }
 

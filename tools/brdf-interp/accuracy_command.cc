@@ -171,14 +171,13 @@ Result<Setup> ReadSetup(const AccuracyRequest& request) {
   setup.half = setup.incidence;
   setup.half.coordinates = interp::Coordinates::kHalfDifference;
   if (!request.scale.empty()) {
-    Result<std::vector<double>> s = ParseNumberList(request.scale, "--scale");
-    if (!s.ok()) return s.status();
-    setup.incidence.axis_scale = *s;
+    BRDF_ASSIGN_OR_RETURN(std::vector<double> s, ParseNumberList(request.scale, "--scale"));
+    setup.incidence.axis_scale = s;
   }
   if (!request.half_scale.empty()) {
-    Result<std::vector<double>> s = ParseNumberList(request.half_scale, "--half-scale");
-    if (!s.ok()) return s.status();
-    setup.half.axis_scale = *s;
+    BRDF_ASSIGN_OR_RETURN(std::vector<double> s,
+                          ParseNumberList(request.half_scale, "--half-scale"));
+    setup.half.axis_scale = s;
   }
   return setup;
 }
@@ -232,15 +231,14 @@ Result<Row> RunMethod(const char* method, const interp::Options& options, bool l
   Row row{method, options.coordinates, std::vector<interp::InterpStatus>(n),
           std::vector<double>(n * bands)};
   const bool in_logs = log_blend && std::string(method) != "nearest";
-  auto made = MakeNamedInterpolator(method, in_logs ? log_set : set, options);
-  if (!made.ok()) return made.status();
-  (*made)->SpectraAt(queries, row.status, row.spectra);
+  BRDF_ASSIGN_OR_RETURN(auto made, MakeNamedInterpolator(method, in_logs ? log_set : set, options));
+  made->SpectraAt(queries, row.status, row.spectra);
   for (interp::InterpStatus s : row.status) row.ok += s == interp::InterpStatus::kOk;
   if (in_logs) {
     for (double& v : row.spectra) v = std::exp(v);  // NaN rows stay NaN
   }
   std::vector<double> peak(bands);
-  if ((*made)->SpectrumAt(kPeakQuery, peak) == interp::InterpStatus::kOk) {
+  if (made->SpectrumAt(kPeakQuery, peak) == interp::InterpStatus::kOk) {
     if (in_logs) {
       for (double& v : peak) v = std::exp(v);
     }

@@ -41,10 +41,9 @@ Status ReadDemoRequest(const DemoRequest& request, std::vector<double>& query,
                        interp::Options& options) {
   query.assign(std::begin(kDemoQuery), std::end(kDemoQuery));
   if (!request.query.empty()) {
-    Result<std::vector<double>> q = ParseNumberList(request.query, "--query");
-    if (!q.ok()) return q.status();
-    if (q->size() != 3) return InvalidArgument("--query needs three angles: θi,θo,φ");
-    query = *q;
+    BRDF_ASSIGN_OR_RETURN(std::vector<double> q, ParseNumberList(request.query, "--query"));
+    if (q.size() != 3) return InvalidArgument("--query needs three angles: θi,θo,φ");
+    query = q;
   }
   options.mirror_phi = request.mirror_phi;
   options.reciprocity = request.reciprocity;
@@ -55,9 +54,8 @@ Status ReadDemoRequest(const DemoRequest& request, std::vector<double>& query,
   if (!trend.ok()) return trend.status().WithContext("--trend");
   options.trend = *trend;
   if (!request.scale.empty()) {
-    Result<std::vector<double>> scale = ParseNumberList(request.scale, "--scale");
-    if (!scale.ok()) return scale.status();
-    options.axis_scale = *scale;
+    BRDF_ASSIGN_OR_RETURN(std::vector<double> scale, ParseNumberList(request.scale, "--scale"));
+    options.axis_scale = scale;
   }
   return Status::Ok();
 }

@@ -29,9 +29,8 @@ Result<std::unique_ptr<interp::Interpolator>> MakeNamedInterpolator(
     }
     return interp::MakeOctantReferenceInterpolator(std::move(samples), options);
   }
-  Result<interp::Method> m = interp::ParseMethod(method);
-  if (!m.ok()) return m.status();
-  return interp::MakeInterpolator(*m, std::move(samples), options);
+  BRDF_ASSIGN_OR_RETURN(interp::Method m, interp::ParseMethod(method));
+  return interp::MakeInterpolator(m, std::move(samples), options);
 }
 
 Result<std::vector<double>> ParseNumberList(const std::string& text, const std::string& option) {

@@ -46,9 +46,8 @@ int Fail(const std::string& message) {
 // Fills the options from brdfd.toml's [stage] (transport, address, profile, axes' unit ids).
 Status FromConfig(const std::string& path, probe::ProbeOptions& o, std::string& profile,
                   std::string& profile_file) {
-  Result<brdf::daemon::Config> config = brdf::daemon::LoadConfig(path);
-  if (!config.ok()) return config.status();
-  const brdf::daemon::StageConfig& s = config->stage;
+  BRDF_ASSIGN_OR_RETURN(brdf::daemon::Config config, brdf::daemon::LoadConfig(path));
+  const brdf::daemon::StageConfig& s = config.stage;
   if (s.transport == "rtu") {
     o.bus.endpoint = stage::RtuEndpoint{s.device, s.baud, s.parity, 8, 1};
   } else {

@@ -25,21 +25,18 @@ Result<std::unique_ptr<Client>> Client::Create(const ClientOptions& options) {
   if (options.tls) {
     grpc::SslCredentialsOptions ssl;
     if (!options.ca_file.empty()) {
-      Result<std::string> ca = ReadPem(options.ca_file, "--ca");
-      if (!ca.ok()) return ca.status();
-      ssl.pem_root_certs = *ca;
+      BRDF_ASSIGN_OR_RETURN(std::string ca, ReadPem(options.ca_file, "--ca"));
+      ssl.pem_root_certs = ca;
     }
     if (options.cert_file.empty() != options.key_file.empty()) {
       return InvalidArgument(
           "--cert and --key go together (a client certificate needs its private key)");
     }
     if (!options.cert_file.empty()) {
-      Result<std::string> cert = ReadPem(options.cert_file, "--cert");
-      if (!cert.ok()) return cert.status();
-      Result<std::string> key = ReadPem(options.key_file, "--key");
-      if (!key.ok()) return key.status();
-      ssl.pem_cert_chain = *cert;
-      ssl.pem_private_key = *key;
+      BRDF_ASSIGN_OR_RETURN(std::string cert, ReadPem(options.cert_file, "--cert"));
+      BRDF_ASSIGN_OR_RETURN(std::string key, ReadPem(options.key_file, "--key"));
+      ssl.pem_cert_chain = cert;
+      ssl.pem_private_key = key;
     }
     credentials = grpc::SslCredentials(ssl);
   } else {

@@ -62,13 +62,11 @@ Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, inter
   in.derived = std::move(derived);
   in.method = method;
   in.options = options;
-  Result<std::shared_ptr<const interp::SampleSet>> set = ToSampleSet(in.derived);
-  if (!set.ok()) return set.status();
-  in.samples = *set;
-  Result<std::unique_ptr<interp::Interpolator>> chosen =
-      interp::MakeInterpolator(method, in.samples, options);
-  if (!chosen.ok()) return chosen.status();
-  in.interpolator = std::move(*chosen);
+  BRDF_ASSIGN_OR_RETURN(std::shared_ptr<const interp::SampleSet> set, ToSampleSet(in.derived));
+  in.samples = set;
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<interp::Interpolator> chosen,
+                        interp::MakeInterpolator(method, in.samples, options));
+  in.interpolator = std::move(chosen);
 
   std::vector<FillChain::Stage> stages;
   stages.push_back({Provenance::kInterpolated, InterpolatorSource(*in.interpolator)});
@@ -119,10 +117,9 @@ Result<RglExport> BuildSessionRgl(const Session& session, const SessionInterpola
     }
   }
   // Where the chain has no value (fill policy none), the nearest reading's.
-  Result<std::unique_ptr<interp::Interpolator>> nearest =
-      interp::MakeInterpolator(interp::Method::kNearest, in.samples, {});
-  if (!nearest.ok()) return nearest.status();
-  return BuildRgl(in.chain->Source(), InterpolatorSource(**nearest), in.derived.grid, *retro,
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<interp::Interpolator> nearest,
+                        interp::MakeInterpolator(interp::Method::kNearest, in.samples, {}));
+  return BuildRgl(in.chain->Source(), InterpolatorSource(*nearest), in.derived.grid, *retro,
                   options, control, ctx);
 }
 

@@ -64,13 +64,10 @@ Status CheckAxis(const char* name, const GridAxis& a, double span) {
 
 Result<RegularGrid> MakeRegularGrid(double step_theta_i_deg, double step_theta_o_deg,
                                     double step_phi_deg, GridPlacement placement) {
-  Result<GridAxis> ti = MakeAxis("θi", kTheta, step_theta_i_deg, placement);
-  if (!ti.ok()) return ti.status();
-  Result<GridAxis> to = MakeAxis("θo", kTheta, step_theta_o_deg, placement);
-  if (!to.ok()) return to.status();
-  Result<GridAxis> ph = MakeAxis("φ", kPhi, step_phi_deg, placement);
-  if (!ph.ok()) return ph.status();
-  return RegularGrid{*ti, *to, *ph};
+  BRDF_ASSIGN_OR_RETURN(GridAxis ti, MakeAxis("θi", kTheta, step_theta_i_deg, placement));
+  BRDF_ASSIGN_OR_RETURN(GridAxis to, MakeAxis("θo", kTheta, step_theta_o_deg, placement));
+  BRDF_ASSIGN_OR_RETURN(GridAxis ph, MakeAxis("φ", kPhi, step_phi_deg, placement));
+  return RegularGrid{ti, to, ph};
 }
 
 Status ValidateRegularGrid(const RegularGrid& grid) {

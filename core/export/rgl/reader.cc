@@ -77,9 +77,8 @@ Result<std::map<std::string, RglTensor>> ParseTensorFile(std::string_view b) {
 }
 
 Result<RglMaterial> RglMaterial::Parse(std::string_view bytes) {
-  Result<std::map<std::string, RglTensor>> parsed = ParseTensorFile(bytes);
-  if (!parsed.ok()) return parsed.status();
-  std::map<std::string, RglTensor>& f = *parsed;
+  BRDF_ASSIGN_OR_RETURN(auto parsed, ParseTensorFile(bytes));
+  std::map<std::string, RglTensor>& f = parsed;
   RglMaterial m;
   m.rgb_ = f.count("rgb") > 0 && f.count("spectra") == 0;
   const std::string values_name = m.rgb_ ? "rgb" : "spectra";

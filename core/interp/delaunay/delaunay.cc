@@ -137,13 +137,11 @@ Result<std::unique_ptr<DelaunayInterpolator>> DelaunayInterpolator::Create(
     distinct.insert(distinct.end(), scaled.begin(), scaled.end());
   }
 
-  Result<QhullTriangulation> triangulation = TriangulateWithQhull(distinct, dims);
-  if (!triangulation.ok()) return triangulation.status();
-  Result<SimplexLocator> locator =
-      SimplexLocator::Build(distinct, dims, std::move(triangulation).value());
-  if (!locator.ok()) return locator.status();
+  BRDF_ASSIGN_OR_RETURN(QhullTriangulation triangulation, TriangulateWithQhull(distinct, dims));
+  BRDF_ASSIGN_OR_RETURN(SimplexLocator locator,
+                        SimplexLocator::Build(distinct, dims, std::move(triangulation)));
   auto impl = std::make_unique<const Impl>(
-      Impl{std::move(samples), dims, scale, std::move(points), std::move(locator).value()});
+      Impl{std::move(samples), dims, scale, std::move(points), std::move(locator)});
   return std::unique_ptr<DelaunayInterpolator>(new DelaunayInterpolator(std::move(impl)));
 }
 
@@ -218,10 +216,9 @@ std::size_t DelaunayInterpolator::flat_simplex_count() const {
 
 Result<std::unique_ptr<Interpolator>> MakeDelaunayInterpolator(
     std::shared_ptr<const SampleSet> samples, const Options& options) {
-  Result<std::unique_ptr<DelaunayInterpolator>> made =
-      DelaunayInterpolator::Create(std::move(samples), options);
-  if (!made.ok()) return made.status();
-  return std::unique_ptr<Interpolator>(std::move(made).value());
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<DelaunayInterpolator> made,
+                        DelaunayInterpolator::Create(std::move(samples), options));
+  return std::unique_ptr<Interpolator>(std::move(made));
 }
 
 }  // namespace brdf::interp

@@ -551,10 +551,9 @@ OctantResult OctantInterpolator::EvaluateInto(std::span<const double> query,
 
 Result<std::unique_ptr<Interpolator>> MakeOctantInterpolator(
     std::shared_ptr<const SampleSet> samples, const Options& options) {
-  Result<std::unique_ptr<OctantInterpolator>> r =
-      OctantInterpolator::Create(std::move(samples), options);
-  if (!r.ok()) return r.status();
-  return std::unique_ptr<Interpolator>(std::move(r).value());
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<OctantInterpolator> r,
+                        OctantInterpolator::Create(std::move(samples), options));
+  return std::unique_ptr<Interpolator>(std::move(r));
 }
 
 }  // namespace brdf::interp

@@ -37,14 +37,12 @@ Result<std::string> BrdfdBinary() {
 Result<std::unique_ptr<DaemonProcess>> DaemonProcess::Start(const std::vector<std::string>& args,
                                                             const std::string& log_path,
                                                             std::chrono::milliseconds timeout) {
-  Result<std::string> binary = BrdfdBinary();
-  if (!binary.ok()) return binary.status();
+  BRDF_ASSIGN_OR_RETURN(std::string binary, BrdfdBinary());
   std::unique_ptr<DaemonProcess> d(new DaemonProcess());
   d->log_path_ = log_path;
-  Result<std::unique_ptr<ChildProcess>> child =
-      ChildProcess::Launch("brdfd", *binary, DaemonLaunch(args, log_path));
-  if (!child.ok()) return child.status();
-  d->child_ = std::move(*child);
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<ChildProcess> child,
+                        ChildProcess::Launch("brdfd", binary, DaemonLaunch(args, log_path)));
+  d->child_ = std::move(child);
 
   Result<std::string> line = d->child_->ReadLine(Clock::now() + timeout);
   if (line.status().code() == StatusCode::kTimeout) {
@@ -88,10 +86,9 @@ std::string DaemonProcess::log(std::size_t max_bytes) const {
 
 Result<DaemonRun> RunBrdfd(const std::vector<std::string>& args, const std::string& log_path,
                            std::chrono::milliseconds timeout) {
-  Result<std::string> binary = BrdfdBinary();
-  if (!binary.ok()) return binary.status();
+  BRDF_ASSIGN_OR_RETURN(std::string binary, BrdfdBinary());
   Result<CommandResult> run =
-      RunToCompletion("brdfd", *binary, DaemonLaunch(args, log_path), timeout);
+      RunToCompletion("brdfd", binary, DaemonLaunch(args, log_path), timeout);
   if (!run.ok()) {
     if (run.status().code() == StatusCode::kTimeout) {
       return Timeout("brdfd did not exit within " + std::to_string(timeout.count()) + " ms");

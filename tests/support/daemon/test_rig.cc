@@ -71,10 +71,9 @@ DaemonRig::~DaemonRig() {
 
 Status DaemonRig::StartSim(const std::vector<std::string>& extra) {
   if (dir_.path().empty()) return IoError("no temporary directory: " + dir_.error());
-  Result<SimRig> rig = StartSimRig(/*seed=*/11, extra);
-  if (!rig.ok()) return rig.status();
-  sim_ = std::move(rig->sim);
-  sim_control_ = std::move(rig->control);
+  BRDF_ASSIGN_OR_RETURN(SimRig rig, StartSimRig(/*seed=*/11, extra));
+  sim_ = std::move(rig.sim);
+  sim_control_ = std::move(rig.control);
   return Status::Ok();
 }
 
@@ -85,10 +84,10 @@ Status DaemonRig::StartDaemon(const std::string& toml) {
     out << (toml.empty() ? DaemonConfigToml(*sim_, database()) : toml);
     if (!out) return IoError("cannot write " + config_path());
   }
-  Result<std::unique_ptr<DaemonProcess>> daemon =
-      DaemonProcess::Start({"--config", config_path(), "--shutdown-timeout", "10"}, log_path());
-  if (!daemon.ok()) return daemon.status();
-  daemon_ = std::move(*daemon);
+  BRDF_ASSIGN_OR_RETURN(
+      std::unique_ptr<DaemonProcess> daemon,
+      DaemonProcess::Start({"--config", config_path(), "--shutdown-timeout", "10"}, log_path()));
+  daemon_ = std::move(daemon);
   channel_ = grpc::CreateChannel(daemon_->address(), grpc::InsecureChannelCredentials());
   control_ = v1::Control::NewStub(channel_);
   data_ = v1::Data::NewStub(channel_);
@@ -137,10 +136,9 @@ std::unique_ptr<grpc::ClientContext> DaemonRig::Context(const std::string& token
 }
 
 Result<v1::Session> DaemonRig::Submit(const std::string& plan_json, bool start_now) {
-  Result<v1::Plan> plan = plan::ParsePlanJson(plan_json);
-  if (!plan.ok()) return plan.status();
+  BRDF_ASSIGN_OR_RETURN(v1::Plan plan, plan::ParsePlanJson(plan_json));
   v1::SubmitPlanRequest request;
-  *request.mutable_plan() = *plan;
+  *request.mutable_plan() = plan;
   request.set_start_now(start_now);
   v1::SubmitPlanResponse response;
   grpc::Status st = control_->SubmitPlan(Context().get(), request, &response);

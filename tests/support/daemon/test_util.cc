@@ -52,9 +52,8 @@ std::string Text(sqlite3_stmt* s, int column) {
 }  // namespace
 
 Result<DbSessionCounts> CountSession(const std::string& database, std::int64_t session) {
-  Result<Db> db = OpenReadOnly(database);
-  if (!db.ok()) return db.status();
-  sqlite3* d = db->get();
+  BRDF_ASSIGN_OR_RETURN(Db db, OpenReadOnly(database));
+  sqlite3* d = db.get();
   DbSessionCounts c;
   BRDF_RETURN_IF_ERROR(Query(d,
                              "SELECT state, state_reason, total_steps, done_steps FROM sessions "
@@ -99,19 +98,17 @@ Result<DbSessionCounts> CountSession(const std::string& database, std::int64_t s
 }
 
 Result<std::string> StorageProblems(const std::string& database, std::int64_t session) {
-  Result<std::unique_ptr<storage::SessionStore>> store = storage::SessionStore::Open(database);
-  if (!store.ok()) return store.status();
-  Result<storage::IntegrityReport> report = (*store)->CheckSession(session);
-  if (!report.ok()) return report.status();
-  return report->ok() ? std::string() : report->Summary();
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<storage::SessionStore> store,
+                        storage::SessionStore::Open(database));
+  BRDF_ASSIGN_OR_RETURN(storage::IntegrityReport report, store->CheckSession(session));
+  return report.ok() ? std::string() : report.Summary();
 }
 
 Result<std::vector<AuditRow>> AuditRows(const std::string& database) {
-  Result<Db> db = OpenReadOnly(database);
-  if (!db.ok()) return db.status();
+  BRDF_ASSIGN_OR_RETURN(Db db, OpenReadOnly(database));
   std::vector<AuditRow> rows;
   BRDF_RETURN_IF_ERROR(
-      Query(db->get(), "SELECT role, actor, action, detail FROM audit ORDER BY id", 0,
+      Query(db.get(), "SELECT role, actor, action, detail FROM audit ORDER BY id", 0,
             [&rows](sqlite3_stmt* s) {
               rows.push_back(AuditRow{Text(s, 0), Text(s, 1), Text(s, 2), Text(s, 3)});
             }));
@@ -123,10 +120,9 @@ Result<std::vector<AuditRow>> AuditRows(const std::string& database) {
 namespace brdf::testing {
 
 Result<std::vector<DbStep>> SessionSteps(const std::string& database, std::int64_t session) {
-  Result<Db> db = OpenReadOnly(database);
-  if (!db.ok()) return db.status();
+  BRDF_ASSIGN_OR_RETURN(Db db, OpenReadOnly(database));
   std::vector<DbStep> steps;
-  BRDF_RETURN_IF_ERROR(Query(db->get(),
+  BRDF_RETURN_IF_ERROR(Query(db.get(),
                              "SELECT kind, state FROM steps WHERE session_id = ?1 ORDER BY "
                              "step_index",
                              session, [&steps](sqlite3_stmt* s) {

@@ -142,9 +142,8 @@ Result<std::unique_ptr<PgServer>> PgServer::Start(const Options& options) {
     // The directory must be reachable by nobody: its parents are /tmp-like (world-searchable).
   }
   ::chmod(s->dir_.c_str(), 0700);
-  Result<int> port = FreeTcpPort();
-  if (!port.ok()) return port.status();
-  s->port_ = *port;
+  BRDF_ASSIGN_OR_RETURN(int port, FreeTcpPort());
+  s->port_ = port;
   s->password_ = RandomHex(12);
   const std::string pwfile = s->dir_ + "/pwfile";
   {
@@ -152,13 +151,13 @@ Result<std::unique_ptr<PgServer>> PgServer::Start(const Options& options) {
     pw << s->password_ << "\n";
   }
   if (s->drop_privileges_) (void)::chown(pwfile.c_str(), s->uid_, s->gid_);
-  Result<int> code = Spawn({s->bin_ + "/initdb", "-D", s->dir_ + "/data", "-U", "brdf",
-                            "--pwfile=" + pwfile, "--auth=scram-sha-256", "-E", "UTF8",
-                            "--locale=C", "--no-sync"},
-                           s->dir_ + "/initdb.log", s->drop_privileges_, s->uid_, s->gid_, true);
-  if (!code.ok()) return code.status();
-  if (*code != 0) {
-    return IoError("initdb failed (exit " + std::to_string(*code) +
+  BRDF_ASSIGN_OR_RETURN(
+      int code,
+      Spawn({s->bin_ + "/initdb", "-D", s->dir_ + "/data", "-U", "brdf", "--pwfile=" + pwfile,
+             "--auth=scram-sha-256", "-E", "UTF8", "--locale=C", "--no-sync"},
+            s->dir_ + "/initdb.log", s->drop_privileges_, s->uid_, s->gid_, true));
+  if (code != 0) {
+    return IoError("initdb failed (exit " + std::to_string(code) +
                    "): " + ReadFile(s->dir_ + "/initdb.log"));
   }
   BRDF_RETURN_IF_ERROR(s->Launch());
@@ -166,14 +165,13 @@ Result<std::unique_ptr<PgServer>> PgServer::Start(const Options& options) {
 }
 
 Status PgServer::Launch() {
-  Result<int> pid =
-      Spawn({bin_ + "/postgres", "-D", dir_ + "/data", "-k", dir_, "-p", std::to_string(port_),
-             "-c", "listen_addresses=127.0.0.1", "-c", "fsync=off", "-c", "full_page_writes=off",
-             "-c", "shared_buffers=32MB", "-c", "max_connections=60", "-c",
-             "logging_collector=off"},
-            dir_ + "/postgres.log", drop_privileges_, uid_, gid_, false);
-  if (!pid.ok()) return pid.status();
-  pid_ = *pid;
+  BRDF_ASSIGN_OR_RETURN(
+      int pid, Spawn({bin_ + "/postgres", "-D", dir_ + "/data", "-k", dir_, "-p",
+                      std::to_string(port_), "-c", "listen_addresses=127.0.0.1", "-c", "fsync=off",
+                      "-c", "full_page_writes=off", "-c", "shared_buffers=32MB", "-c",
+                      "max_connections=60", "-c", "logging_collector=off"},
+                     dir_ + "/postgres.log", drop_privileges_, uid_, gid_, false));
+  pid_ = pid;
   return WaitReady();
 }
 

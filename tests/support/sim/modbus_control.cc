@@ -92,9 +92,8 @@ Status ModbusControl::SetMounted(sim::MountedTarget target) {
 }
 
 Result<sim::MountedTarget> ModbusControl::Mounted() {
-  auto r = ReadRegisters(map::kMountedTarget, 1);
-  if (!r.ok()) return r.status();
-  return static_cast<sim::MountedTarget>((*r)[0]);
+  BRDF_ASSIGN_OR_RETURN(auto r, ReadRegisters(map::kMountedTarget, 1));
+  return static_cast<sim::MountedTarget>(r[0]);
 }
 
 Status ModbusControl::PowerCycleMeter() {
@@ -132,9 +131,7 @@ Status ModbusControl::SetModbusFaults(const sim::ModbusFaults& f) {
 }
 
 Result<sim::SerialFaults> ModbusControl::SerialFaults() {
-  auto r = ReadRegisters(map::kSerialSilent, 10);
-  if (!r.ok()) return r.status();
-  const auto& v = *r;
+  BRDF_ASSIGN_OR_RETURN(const auto v, ReadRegisters(map::kSerialSilent, 10));
   sim::SerialFaults f;
   f.silent = v[0] != 0;
   f.garbage_next = v[1];
@@ -149,9 +146,7 @@ Result<sim::SerialFaults> ModbusControl::SerialFaults() {
 }
 
 Result<sim::ModbusFaults> ModbusControl::ModbusFaults() {
-  auto r = ReadRegisters(map::kModbusExceptionCode, 9);
-  if (!r.ok()) return r.status();
-  const auto& v = *r;
+  BRDF_ASSIGN_OR_RETURN(const auto v, ReadRegisters(map::kModbusExceptionCode, 9));
   sim::ModbusFaults f;
   f.exception_code = v[0];
   f.exception_count = v[1];
@@ -166,17 +161,15 @@ Result<sim::ModbusFaults> ModbusControl::ModbusFaults() {
 }
 
 Result<std::int32_t> ModbusControl::AxisCounts(int axis_unit) {
-  auto r = ReadFrom(axis_unit, kFeedbackPosition, 2);
-  if (!r.ok()) return r.status();
+  BRDF_ASSIGN_OR_RETURN(auto r, ReadFrom(axis_unit, kFeedbackPosition, 2));
   // High word first; unpacked by hand (libmodbus 3.1.6's macro shifts without a cast).
-  const std::uint32_t raw = (static_cast<std::uint32_t>((*r)[0]) << 16) | (*r)[1];
+  const std::uint32_t raw = (static_cast<std::uint32_t>(r[0]) << 16) | r[1];
   return static_cast<std::int32_t>(raw);
 }
 
 Result<double> ModbusControl::AxisDegrees(int axis_unit, double counts_per_degree) {
-  auto counts = AxisCounts(axis_unit);
-  if (!counts.ok()) return counts.status();
-  return *counts / counts_per_degree;
+  BRDF_ASSIGN_OR_RETURN(auto counts, AxisCounts(axis_unit));
+  return counts / counts_per_degree;
 }
 
 }  // namespace brdf::testing

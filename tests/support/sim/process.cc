@@ -23,14 +23,12 @@ Result<std::string> BrdfSimBinary() {
 
 Result<std::unique_ptr<SimProcess>> SimProcess::Start(const std::vector<std::string>& args,
                                                       std::chrono::milliseconds timeout) {
-  auto binary = BrdfSimBinary();
-  if (!binary.ok()) return binary.status();
+  BRDF_ASSIGN_OR_RETURN(auto binary, BrdfSimBinary());
 
   std::unique_ptr<SimProcess> sim(new SimProcess());
-  Result<std::unique_ptr<ChildProcess>> child =
-      ChildProcess::Launch("brdf-sim", *binary, LaunchOptions(args));
-  if (!child.ok()) return child.status();
-  sim->child_ = std::move(*child);
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<ChildProcess> child,
+                        ChildProcess::Launch("brdf-sim", binary, LaunchOptions(args)));
+  sim->child_ = std::move(child);
 
   const auto deadline = Clock::now() + timeout;
   for (;;) {
@@ -111,9 +109,8 @@ SimProcess::~SimProcess() {
 
 Result<CommandResult> RunBrdfSim(const std::vector<std::string>& args,
                                  std::chrono::milliseconds timeout) {
-  auto binary = BrdfSimBinary();
-  if (!binary.ok()) return binary.status();
-  return RunToCompletion("brdf-sim", *binary, LaunchOptions(args), timeout);
+  BRDF_ASSIGN_OR_RETURN(auto binary, BrdfSimBinary());
+  return RunToCompletion("brdf-sim", binary, LaunchOptions(args), timeout);
 }
 
 }  // namespace brdf::testing

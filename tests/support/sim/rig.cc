@@ -19,13 +19,13 @@ std::string SimRig::modbus_address() const {
 
 Result<SimRig> StartSimRig(int seed, const std::vector<std::string>& extra) {
   SimRig rig;
-  Result<std::unique_ptr<SimProcess>> sim = SimProcess::Start(FastSimArgs(seed, extra));
-  if (!sim.ok()) return sim.status();
-  rig.sim = std::move(*sim);
-  Result<std::unique_ptr<ModbusControl>> control = ModbusControl::Connect(
-      rig.sim->modbus_host(), rig.sim->modbus_port(), rig.sim->control_unit());
-  if (!control.ok()) return control.status();
-  rig.control = std::move(*control);
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<SimProcess> sim,
+                        SimProcess::Start(FastSimArgs(seed, extra)));
+  rig.sim = std::move(sim);
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<ModbusControl> control,
+                        ModbusControl::Connect(rig.sim->modbus_host(), rig.sim->modbus_port(),
+                                               rig.sim->control_unit()));
+  rig.control = std::move(control);
   return rig;
 }
 
