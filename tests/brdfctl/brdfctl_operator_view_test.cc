@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "tests/brdfctl/ctl_test_rig.h"
+#include "tests/support/plan_fixtures.h"
 
 namespace brdf::testing {
 namespace {
@@ -171,6 +172,55 @@ TEST_F(OperatorViewTest, WatchSaysTheHookNeedsAutoConfirmWhenItCannotAsk) {
   const CommandResult abort = Ctl({"abort", id, "--reason", "test over"});
   ASSERT_EQ(abort.exit_code, 0) << Describe(abort);
   EXPECT_EQ((*watcher)->WaitUntil(std::chrono::steady_clock::now() + 20s), 4) << ReadText(out);
+}
+
+// A reading whose integration time the meter changed (an overload halves it and measures again)
+// says so in `watch`, in `readings` and in the readings CSV, with the time it did use.
+TEST_F(OperatorViewTest, AReadingWhoseIntegrationTheMeterHalvedSaysSo) {
+  // 100 ms fixed; the next measurement overloads (quality 19) once.
+  const std::string plan = rig_.dir().file("tiny.json").string();
+  std::ofstream(plan) << plans::TinyPoseList().Json();
+  sim::SerialFaults faults;
+  faults.quality_code = 19;
+  faults.quality_count = 1;
+  ASSERT_TRUE(rig_.sim_control().SetSerialFaults(faults).ok());
+  const CommandResult submitted = Ctl({"submit", plan, "--start", "--quiet"});
+  ASSERT_EQ(submitted.exit_code, 0) << Describe(submitted);
+  ASSERT_EQ(Lines(submitted.out).size(), 1u) << Describe(submitted);
+  const std::string id = Lines(submitted.out)[0];
+  Result<CommandResult> watched =
+      rig_.Ctl({"watch", id, "--auto-confirm", "--no-progress", "--on-prompt",
+                "'" + *BrdfctlBinary() + "' sim-mount from-prompt --modbus " + rig_.modbus()},
+               kCtlOperatorToken, 60s);
+  ASSERT_TRUE(watched.ok()) << watched.status().ToString();
+  ASSERT_EQ(watched->exit_code, 0) << Describe(*watched);
+  const std::string halved = "integration halved from 100 to 50 ms";
+  EXPECT_NE(watched->out.find("integration changed by the meter: quality 19 ("), std::string::npos)
+      << Describe(*watched);
+  EXPECT_NE(watched->out.find(halved), std::string::npos) << Describe(*watched);
+  // Only the one reading says so.
+  EXPECT_EQ(watched->out.find(halved), watched->out.rfind(halved)) << Describe(*watched);
+
+  const CommandResult readings = Ctl({"readings", id});
+  ASSERT_EQ(readings.exit_code, 0) << Describe(readings);
+  int changed = 0;
+  for (const std::string& line : Lines(readings.out)) {
+    if (line.find(halved) == std::string::npos) continue;
+    ++changed;
+    EXPECT_NE(line.find("50 ms (changed by the meter: quality 19 ("), std::string::npos) << line;
+  }
+  EXPECT_EQ(changed, 1) << Describe(readings);
+
+  const CommandResult csv =
+      Ctl({"export", id, "csv", "--quantity", "radiance", "-o", "-", "--no-progress"});
+  ASSERT_EQ(csv.exit_code, 0) << Describe(csv);
+  int rows_changed = 0;
+  for (const std::string& line : Lines(csv.out)) {
+    if (line.empty() || line[0] == '#' || line.find(halved) == std::string::npos) continue;
+    ++rows_changed;
+    EXPECT_NE(line.find(",50,"), std::string::npos) << "integration_ms 50: " << line;
+  }
+  EXPECT_EQ(rows_changed, 1) << csv.out.substr(0, 3000);
 }
 
 }  // namespace
