@@ -157,6 +157,7 @@ detector_arm_motorized = true
 present = true
 [rig]
 name = "$r"
+time_scale = $time_scale
 [archive]
 credentials = "$d/archive.conninfo"
 retry_ms = 500

@@ -273,6 +273,9 @@ present = true
 [sample]
 white_reflectance = 0.99        # brdf-sim's white standard
 
+[rig]
+time_scale = $time_scale        # brdf-sim's --time-scale: estimates and ETAs are the simulator's
+
 [[auth.tokens]]
 name = "quickstart-operator"
 token = "$operator_token"

@@ -15,6 +15,7 @@ Reading ToReading(const ReadingRecord& r) {
   out.quality_code = r.quality_code;
   out.flagged = r.flagged;
   out.integration_ms = r.integration_ms;
+  out.integration_note = IntegrationNoteOf(r.note);
   out.reference_id = r.reference_reading_id;
   out.dark_id = r.dark_reading_id;
   return out;

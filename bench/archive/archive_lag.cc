@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <thread>
@@ -337,7 +338,7 @@ int main(int argc, char** argv) {
     brdf::v1::IsoDirection* d = batch_request.add_directions()->mutable_iso();
     d->set_theta_i(10 + (i * 37 % 600) / 10.0);
     d->set_theta_o(10 + (i * 53 % 700) / 10.0);
-    d->set_phi(-80 + (i * 71 % 1600) / 10.0);
+    d->set_phi(std::fabs(-80 + (i * 71 % 1600) / 10.0));  // φ in [0, 180]
   }
   auto stub_for = [](const std::string& address) {
     return brdf::v1::Interpolation::NewStub(

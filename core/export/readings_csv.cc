@@ -2,6 +2,7 @@
 
 #include <unordered_map>
 
+#include "core/csv_field.h"
 #include "core/export/grid/text.h"
 #include "core/export/number_text.h"
 
@@ -43,6 +44,9 @@ std::string Header(const Session& session, Quantity quantity, const WavelengthGr
        "quality policy kept the reading but flagged it; integration_ms: 0 = adaptive\n";
   h += "# reference_id, dark_id: the id of the reference reading this one is divided by and of "
        "the dark reading subtracted; empty = none\n";
+  h += "# integration_note: how the meter changed the integration time to take the reading (e.g. "
+       "\"quality 19 (overload): integration halved from 500 to 250 ms\"; integration_ms is the "
+       "time used); empty = the plan's\n";
   h += "# spectral columns: headed by wavelength in nm, " + std::to_string(grid.count) +
        " bands from " + FormatNumber(grid.start_nm) + " to " + FormatNumber(grid.last_nm()) +
        " every " + FormatNumber(grid.step_nm) + " nm\n";
@@ -55,7 +59,7 @@ std::string Header(const Session& session, Quantity quantity, const WavelengthGr
     h += "#   … and " + std::to_string(skipped.size() - kListedSkips) + " more\n";
   }
   h += "id,kind,alpha_deg,beta_deg,gamma_deg,delta_deg,theta_i_deg,phi_i_deg,theta_o_deg,"
-       "phi_o_deg,quality_code,flagged,integration_ms,reference_id,dark_id";
+       "phi_o_deg,quality_code,flagged,integration_ms,reference_id,dark_id,integration_note";
   for (std::size_t b = 0; b < grid.count; ++b) {
     h += ',';
     AppendNumber(h, grid.at(b));
@@ -78,6 +82,8 @@ void AppendRow(const Reading& r, std::span<const double> values, std::string& ou
   if (r.reference_id.has_value()) out += std::to_string(*r.reference_id);
   out += ',';
   if (r.dark_id.has_value()) out += std::to_string(*r.dark_id);
+  out += ',';
+  AppendCsvField(out, r.integration_note);
   for (double v : values) {
     out += ',';
     AppendNumber(out, v);

@@ -1,8 +1,9 @@
 // The readings of a session as CSV, one row per reading, with a '#' comment block that documents
 // the quantity, units and angle convention so that the file explains itself:
 //   id,kind,alpha_deg,beta_deg,gamma_deg,delta_deg,theta_i_deg,phi_i_deg,theta_o_deg,phi_o_deg,
-//   quality_code,flagged,integration_ms,reference_id,dark_id,<λ1>,<λ2>,…
-// Spectral columns are headed by wavelength in nm.
+//   quality_code,flagged,integration_ms,reference_id,dark_id,integration_note,<λ1>,<λ2>,…
+// Spectral columns are headed by wavelength in nm. integration_note says how the meter changed the
+// integration time (Reading.integration_note; quoted when it holds a comma), empty when it did not.
 //   radiance:            every reading (sample, reference, dark), raw as the meter reported it
 //                        (no dark subtracted: dark_id names the dark reading to subtract);
 //   reflectance, brdf:   the sample readings whose quantity can be computed (session_data.h);

@@ -4,6 +4,25 @@
 
 namespace brdf {
 
+std::string IntegrationNoteOf(std::string_view note) {
+  // The quality policy's words when it changes the integration time (drivers/pr650/
+  // quality_codes.cc: DecideQuality).
+  static constexpr std::string_view kChanges[] = {"integration halved", "integration doubled"};
+  std::string out;
+  while (!note.empty()) {
+    const std::size_t end = note.find("; ");
+    const std::string_view clause = note.substr(0, end);
+    for (std::string_view change : kChanges) {
+      if (clause.find(change) == std::string_view::npos) continue;
+      if (!out.empty()) out += "; ";
+      out += clause;
+      break;
+    }
+    note = end == std::string_view::npos ? std::string_view() : note.substr(end + 2);
+  }
+  return out;
+}
+
 const char* ReadingKindName(ReadingKind kind) {
   switch (kind) {
     case ReadingKind::kSample:

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/pose.h"
@@ -28,6 +29,9 @@ struct Reading {
   int quality_code = 0;    // the meter's quality code (0 = OK)
   bool flagged = false;    // kept but flagged by the quality policy
   int integration_ms = 0;  // 0 = adaptive
+  // How the meter changed the integration time to take it (IntegrationNoteOf its stored note);
+  // empty when it used the plan's.
+  std::string integration_note;
   std::optional<std::int64_t> reference_id;  // the I0 this reading is divided by
   std::optional<std::int64_t> dark_id;       // the D subtracted, when measured
 };
@@ -42,6 +46,11 @@ struct SessionReadings {
   std::optional<Spectrum> white_reflectance_spectrum;
   std::vector<Reading> readings;  // in id order (the order they were taken)
 };
+
+// The clauses of a reading's stored note (the meter's and its quality policy's notes joined by
+// "; ", storage ReadingRecord.note) that changed the integration time, joined by "; ", e.g.
+// "quality 19 (overload): integration halved from 500 to 250 ms"; empty when none did.
+std::string IntegrationNoteOf(std::string_view note);
 
 // ρw as the session gives it, else kWhiteStandardReflectance.
 double WhiteReflectanceOf(const SessionReadings& session);

@@ -60,15 +60,19 @@ grpc::Status ParseAppearance(const v1::AppearanceRequest& r, AppearanceSettings*
                           "got " +
                               std::to_string(r.light_size()));
     }
-    bool all_zero = true;
+    double largest = 0;
     for (int k = 0; k < 3; ++k) {
       if (!std::isfinite(r.light(k))) {
-        return InvalidField("light[" + std::to_string(k) + "]", "must be a finite number");
+        return InvalidField("light[" + std::to_string(k) + "]",
+                            "must be a finite number (got " + ShortNumber(r.light(k)) + ")");
       }
-      all_zero = all_zero && r.light(k) == 0;
-      out->sphere.light[static_cast<std::size_t>(k)] = r.light(k);
+      largest = std::max(largest, std::fabs(r.light(k)));
     }
-    if (all_zero) return InvalidField("light", "must not be (0, 0, 0): it is a direction");
+    if (largest == 0) return InvalidField("light", "must not be (0, 0, 0): it is a direction");
+    // Any non-zero length is a direction: scaled so that its length cannot overflow.
+    for (int k = 0; k < 3; ++k) {
+      out->sphere.light[static_cast<std::size_t>(k)] = r.light(k) / largest;
+    }
   }
   for (int k = 0; k < r.illuminants_size(); ++k) {
     const auto i = static_cast<v1::Illuminant>(r.illuminants(k));
@@ -339,6 +343,7 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
       cache_.Get(s.session, Quantity::kBrdf, s.method, s.options);
   if (!got.ok()) return ToGrpcStatus(got.status());
   const std::shared_ptr<const IndexSnapshot> index = std::move(*got);
+  if (grpc::Status st = CheckOptionsFit(s.options, *index); !st.ok()) return st;
   if (index->anisotropic) {
     return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
                         "RenderAppearance: session " + request->session_id() +

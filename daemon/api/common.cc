@@ -112,21 +112,20 @@ grpc::Status ParseSessionIdField(const std::string& text, const std::string& fie
   return grpc::Status::OK;
 }
 
-namespace {
-std::string Num(double v) {
+std::string ShortNumber(double v) {
   std::ostringstream out;
   out << v;
   return out.str();
 }
-}  // namespace
 
 Status CheckAngle(double value, double lo, double hi, const std::string& field) {
   if (!std::isfinite(value)) {
-    return InvalidArgument(field + ": must be a finite angle in degrees (got " + Num(value) + ")");
+    return InvalidArgument(field + ": must be a finite angle in degrees (got " +
+                           ShortNumber(value) + ")");
   }
   if (value < lo || value > hi) {
-    return InvalidArgument(field + ": " + Num(value) + "° is outside [" + Num(lo) + ", " + Num(hi) +
-                           "] degrees");
+    return InvalidArgument(field + ": " + ShortNumber(value) + "° is outside [" + ShortNumber(lo) +
+                           ", " + ShortNumber(hi) + "] degrees");
   }
   return Status::Ok();
 }

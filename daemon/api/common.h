@@ -85,6 +85,10 @@ grpc::Status ParseTrendField(int trend, interp::Trend* out);
 // Checks a finite angle within [lo, hi]; the message names `field` and the range.
 Status CheckAngle(double value, double lo, double hi, const std::string& field);
 
+// A number as an error message shows it: the shortest of iostream's default form ("180.5",
+// "1e+300", "inf").
+std::string ShortNumber(double v);
+
 // StreamReadingsRequest.kinds as a set (empty: every kind); INVALID_ARGUMENT naming "kinds[i]"
 // for a kind the API does not have.
 grpc::Status ParseReadingKinds(const v1::StreamReadingsRequest& request,

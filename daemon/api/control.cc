@@ -103,10 +103,12 @@ grpc::Status ControlService::ValidatePlan(grpc::ServerContext* /*context*/,
   }
   const double time_scale = request->time_scale();
   if (!std::isfinite(time_scale) || time_scale < 0) {
-    return InvalidField("time_scale", "must be a positive number (0 or unset: 1, a real rig)");
+    return InvalidField("time_scale",
+                        "must be a finite number > 0, or 0 (unset) for this rig's own ([rig] "
+                        "time_scale; 1 on a real rig) (got " +
+                            ShortNumber(time_scale) + ")");
   }
-  *response =
-      ToValidatePlanResponse(rig_->ValidatePlan(request->plan(), time_scale > 0 ? time_scale : 1));
+  *response = ToValidatePlanResponse(rig_->ValidatePlan(request->plan(), time_scale));
   return grpc::Status::OK;
 }
 

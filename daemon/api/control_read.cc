@@ -15,16 +15,27 @@ grpc::Status TimestampField(const v1::ListSessionsRequest& request, bool after,
                             std::optional<double>* out) {
   if (after ? !request.has_created_after() : !request.has_created_before()) return grpc::Status::OK;
   const google::protobuf::Timestamp& t = after ? request.created_after() : request.created_before();
+  const std::string field = after ? "created_after" : "created_before";
+  // google.protobuf.Timestamp's range: 0001-01-01T00:00:00Z … 9999-12-31T23:59:59Z.
+  constexpr std::int64_t kMinSeconds = -62135596800, kMaxSeconds = 253402300799;
+  if (t.seconds() < kMinSeconds || t.seconds() > kMaxSeconds) {
+    return InvalidField(field + ".seconds",
+                        std::to_string(t.seconds()) + " is outside " + std::to_string(kMinSeconds) +
+                            " … " + std::to_string(kMaxSeconds) +
+                            " (0001-01-01 … 9999-12-31, google.protobuf.Timestamp's range)");
+  }
   if (t.nanos() < 0 || t.nanos() > 999999999) {
-    return InvalidField(after ? "created_after" : "created_before",
-                        "nanos " + std::to_string(t.nanos()) + " is outside 0 … 999,999,999");
+    return InvalidField(field + ".nanos", std::to_string(t.nanos()) +
+                                              " is outside 0 … 999999999 (the fraction of "
+                                              "a second, google.protobuf.Timestamp's range)");
   }
   *out = ToUnixSeconds(t);
   return grpc::Status::OK;
 }
 
 // ListSessionsRequest's catalogue filters: INVALID_ARGUMENT naming the field for an unknown
-// state, a timestamp out of range (nanos outside 0…999,999,999) or created_before not after
+// state, a timestamp out of range (seconds outside 0001-01-01 … 9999-12-31, nanos outside
+// 0 … 999,999,999) or created_before not after
 // created_after.
 grpc::Status ParseCatalogueFilter(const v1::ListSessionsRequest& request, CatalogueFilter* out) {
   CatalogueFilter f;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/geometry.h"
+#include "daemon/index/build.h"
 #include "daemon/wire/enums.h"
 #include "daemon/wire/values.h"
 
@@ -20,9 +21,19 @@ InterpolationService::InterpolationService(IndexCache& cache, const Authenticato
 
 namespace {
 
-// Azimuths may be given in any of the usual conventions; these are wide enough for all of them.
-constexpr double kPhiMin = -180;
-constexpr double kPhiMax = 360;
+// The documented ranges (brdf.proto: IsoDirection, Directions, DirectionQuery). A relative
+// azimuth outside [0, 180] is refused: it is a caller's mix-up of conventions, not a point. An
+// azimuth of the four-angle form is periodic: any value in [−360, 360] names the same direction as
+// its remainder in (−180, 180] and is taken so.
+constexpr double kThetaMax = 90;
+constexpr double kRelativePhiMax = 180;
+constexpr double kAzimuthLimit = 360;
+constexpr const char* kThetaHint = "a polar angle from the sample normal; give 0 to 90";
+constexpr const char* kRelativePhiHint =
+    "the relative azimuth |φo − φi| folded into [0, 180] (180: the specular side, 0: the retro "
+    "side); give −φ for a negative φ, 360 − φ for one above 180, or use the four-angle form";
+constexpr const char* kAzimuthHint =
+    "an azimuth; give −360 to 360 (taken modulo 360 into (−180, 180])";
 
 struct Settings {
   interp::Method method = interp::Method::kOctant;
@@ -40,21 +51,29 @@ grpc::Status ParseSettings(int method, int quantity, const v1::InterpolationOpti
 // Ranges and finiteness, independent of the session. `field` is the DirectionQuery's path.
 grpc::Status CheckDirection(const v1::DirectionQuery& q, const std::string& field) {
   // The field's name is only put together for an error (a valid query costs no allocation).
-  auto check = [&field](double v, double lo, double hi, const char* suffix) {
+  auto check = [&field](double v, double lo, double hi, const char* suffix, const char* hint) {
     if (std::isfinite(v) && v >= lo && v <= hi) return grpc::Status::OK;
-    return ToGrpcStatus(CheckAngle(v, lo, hi, field + suffix));
+    const Status st = CheckAngle(v, lo, hi, field + suffix);
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        BoundedMessage(st.message() + ": " + hint));
   };
   grpc::Status st;
   switch (q.direction_case()) {
     case v1::DirectionQuery::kIso:
-      if (st = check(q.iso().theta_i(), 0, 90, ".iso.theta_i"); !st.ok()) return st;
-      if (st = check(q.iso().theta_o(), 0, 90, ".iso.theta_o"); !st.ok()) return st;
-      return check(q.iso().phi(), kPhiMin, kPhiMax, ".iso.phi");
+      if (st = check(q.iso().theta_i(), 0, kThetaMax, ".iso.theta_i", kThetaHint); !st.ok())
+        return st;
+      if (st = check(q.iso().theta_o(), 0, kThetaMax, ".iso.theta_o", kThetaHint); !st.ok())
+        return st;
+      return check(q.iso().phi(), 0, kRelativePhiMax, ".iso.phi", kRelativePhiHint);
     case v1::DirectionQuery::kFour:
-      if (st = check(q.four().theta_i(), 0, 90, ".four.theta_i"); !st.ok()) return st;
-      if (st = check(q.four().phi_i(), kPhiMin, kPhiMax, ".four.phi_i"); !st.ok()) return st;
-      if (st = check(q.four().theta_o(), 0, 90, ".four.theta_o"); !st.ok()) return st;
-      return check(q.four().phi_o(), kPhiMin, kPhiMax, ".four.phi_o");
+      if (st = check(q.four().theta_i(), 0, kThetaMax, ".four.theta_i", kThetaHint); !st.ok())
+        return st;
+      if (st = check(q.four().phi_i(), -kAzimuthLimit, kAzimuthLimit, ".four.phi_i", kAzimuthHint);
+          !st.ok())
+        return st;
+      if (st = check(q.four().theta_o(), 0, kThetaMax, ".four.theta_o", kThetaHint); !st.ok())
+        return st;
+      return check(q.four().phi_o(), -kAzimuthLimit, kAzimuthLimit, ".four.phi_o", kAzimuthHint);
     case v1::DirectionQuery::DIRECTION_NOT_SET:
       break;
   }
@@ -87,8 +106,8 @@ grpc::Status ToCoords(const v1::DirectionQuery& q, const IndexSnapshot& index,
     iso = ToIsotropic(
         Directions{q.four().theta_i(), q.four().phi_i(), q.four().theta_o(), q.four().phi_o()});
   } else {
-    // Fold φ into [0, 180] (φ and −φ, φ and φ + 360 are the same point of an isotropic sample),
-    // and φ = 0 at the normal, exactly as the readings were reduced.
+    // φ is in [0, 180] (CheckDirection); φ = 0 at the normal, exactly as the readings were
+    // reduced.
     iso = ToIsotropic(
         CanonicalDirections(IsoDirection{q.iso().theta_i(), q.iso().theta_o(), q.iso().phi()}));
   }
@@ -167,6 +186,11 @@ grpc::Status ParseInterpolationOptions(const v1::InterpolationOptions& options,
   return ParseCoordinatesField(options.coordinates(), &out->coordinates);
 }
 
+grpc::Status CheckOptionsFit(const interp::Options& options, const IndexSnapshot& index) {
+  // The cache keys all-1 scales as none, so a hit does not tell that their count fits.
+  return ToGrpcStatus(CheckIndexOptions(options, index.dims, index.session));
+}
+
 std::optional<grpc::Status> InterpolationService::AnswerIfReady(
     const v1::InterpolateRequest& request, v1::InterpolateResponse* response) {
   return Respond(request, response, /*may_load=*/false);
@@ -200,6 +224,7 @@ std::optional<grpc::Status> InterpolationService::Respond(const v1::InterpolateR
     index = cache_.FreshHit(id, settings.quantity, settings.method, settings.options);
     if (!index) return std::nullopt;
   }
+  if (grpc::Status st = CheckOptionsFit(settings.options, *index); !st.ok()) return st;
   std::array<double, 4> coords{};
   if (grpc::Status st = ToCoords(request.direction(), *index, "direction", &coords); !st.ok()) {
     return st;
@@ -291,6 +316,7 @@ grpc::Status InterpolationService::InterpolateBatch(
       cache_.Get(id, settings.quantity, settings.method, settings.options);
   if (!got.ok()) return ToGrpcStatus(got.status());
   const IndexSnapshot& index = **got;
+  if (grpc::Status st = CheckOptionsFit(settings.options, index); !st.ok()) return st;
   std::vector<double> coords;
   if (grpc::Status st = BatchCoords(*request, index, &coords); !st.ok()) return st;
 

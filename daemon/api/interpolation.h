@@ -1,16 +1,17 @@
 // The Interpolation service (brdf.proto): spectra at directions that were not measured, from the
 // session's index (index_cache.h). Every request is checked before any work: angles finite and
-// in range (θ in [0, 90], φ in [−180, 360]), the direction's form set, enums known, options
-// positive, batches of 1 … kMaxBatchDirections directions with chunks of at most kMaxChunkSize
-// (common.h: 100,000 directions; chunks of 256 results by default, at most 1,024).
-// Errors name the field and, in a batch, the index: INVALID_ARGUMENT "directions[17].iso.phi:
-// must be a finite angle …" (NaN, ±inf, out of range, no direction set, an empty batch, an
-// unknown enum, a chunk_size over the limit); NOT_FOUND for an unknown session; RESOURCE_EXHAUSTED
-// for more than kMaxBatchDirections directions (or a request over kMaxReceiveMessageBytes, which
-// gRPC refuses before it reaches the service).
-// Isotropic sessions take `iso` directions (φ folded into [0, 180], exact for an isotropic
-// sample) or `four` (reduced to iso); anisotropic sessions take `four` only (φ wrapped into
-// (−180, 180], the range of the stored readings).
+// in range (θ in [0, 90]; the relative azimuth φ of `iso` in [0, 180]; the azimuths φi, φo of
+// `four` in [−360, 360]), the direction's form set, enums known, options positive, batches of 1 …
+// kMaxBatchDirections directions with chunks of at most kMaxChunkSize (common.h: 100,000
+// directions; chunks of 256 results by default, at most 1,024). Errors name the field and, in a
+// batch, the index: INVALID_ARGUMENT "directions[17].iso.phi: must be a finite angle …" (NaN, ±inf,
+// out of range, no direction set, an empty batch, an unknown enum, a chunk_size over the limit);
+// NOT_FOUND for an unknown session; RESOURCE_EXHAUSTED for more than kMaxBatchDirections directions
+// (or a request over kMaxReceiveMessageBytes, which gRPC refuses before it reaches the service).
+// Isotropic sessions take `iso` directions or `four` (reduced to iso); anisotropic sessions take
+// `four` only (φi, φo taken modulo 360 into (−180, 180], the range of the stored readings).
+// Once the index is at hand, the options must fit it (CheckOptionsFit: axis_scale of the
+// session's dimension).
 // Interpolate with include_vertex_spectra also gives each vertex its sample's own spectrum, from
 // the snapshot the answer came from, in the answer's quantity (the paper's Figure 8 in one call).
 //
@@ -65,6 +66,12 @@ inline constexpr std::size_t kAppearanceCacheEntries = 8;
 // options.coordinates) into the interpolator's options.
 grpc::Status ParseInterpolationOptions(const v1::InterpolationOptions& options,
                                        interp::Options* out);
+
+// The options fit the session of `index`: axis_scale none or one value per axis of the index (3
+// isotropic, 4 anisotropic), symmetries and coordinates its kind allows (daemon/index/build.h:
+// CheckIndexOptions). Checked on every answer, a cache hit included: INVALID_ARGUMENT naming the
+// option.
+grpc::Status CheckOptionsFit(const interp::Options& options, const IndexSnapshot& index);
 
 // Interpolate is served on gRPC's completion-queue API by InterpolateLoop (interpolate_loop.h),
 // from threads of brdfd's own: the answer takes microseconds, so a loop thread computes it where

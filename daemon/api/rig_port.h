@@ -39,7 +39,7 @@ class RigPort {
   virtual Result<v1::Session> SubmitPlan(const v1::Plan& plan, const Actor& actor,
                                          bool start_now) = 0;
   // The plan checked and summarised against this rig, for devices `time_scale` (> 0) times
-  // faster; nothing stored.
+  // faster (0: the rig's own, its [rig] time_scale); nothing stored.
   virtual plan::PlanAnalysis ValidatePlan(const v1::Plan& plan, double time_scale) const = 0;
   virtual Result<v1::Session> Start(SessionId session, const Actor& actor) = 0;
   virtual Result<v1::Session> Pause(SessionId session, PauseMode mode, const Actor& actor) = 0;

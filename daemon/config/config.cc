@@ -373,6 +373,7 @@ void ReadOthers(TableReader& root, Config& c) {
   sample.Finish();
   TableReader rig = root.Sub("rig");
   rig.String("name", c.rig.name);
+  rig.Double("time_scale", c.rig.time_scale, 0, 10000, /*lo_open=*/true);
   rig.Finish();
   TableReader log = root.Sub("log");
   log.OneOf("level", c.log.level, {"trace", "debug", "info", "warn", "error", "critical", "off"});
@@ -518,6 +519,7 @@ plan::RigDescription ToRigDescription(const Config& config) {
   const int exchanges = config.meter.measure_with_spectrum ? 1 : 2;
   rig.reading_host_s = exchanges * (pacing_s + gap_s);
   rig.reading_host_after_s = config.meter.measure_with_spectrum ? gap_s : pacing_s + gap_s;
+  rig.time_scale = config.rig.time_scale;
   // stage_poll_s keeps RigDescription's default: the stage driver's poll_interval, which the
   // configuration does not set (tests/config checks they agree).
   return rig;

@@ -72,6 +72,8 @@
 //
 //   [rig]
 //   name = "rig-a"                      # names the sessions this rig records (default: host name)
+//   time_scale = 8                      # a simulated rig: brdf-sim's --time-scale (default 1),
+//                                       #   so that estimates and ETAs are the simulator's
 //
 //   [archive]                           # optional: ship everything recorded to a lab PostgreSQL
 //   credentials = "/etc/brdfd/archive.conninfo"  # file holding a libpq conninfo (host, dbname,
@@ -205,6 +207,9 @@ struct SampleConfig {
 
 struct RigConfig {
   std::string name;  // empty: the host name (RigName)
+  // How many times faster than real devices the rig's run (brdf-sim --time-scale); 1 for a real
+  // rig. The timing model divides device times by it: plan summaries, ETAs.
+  double time_scale = 1;
 };
 
 // [archive]: present when `credentials` is not empty.

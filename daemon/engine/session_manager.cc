@@ -470,13 +470,15 @@ void SessionManager::Shutdown(std::chrono::milliseconds timeout) {
 }
 
 plan::PlanAnalysis SessionManager::ValidatePlan(const v1::Plan& plan, double time_scale) const {
-  return plan::AnalyzePlan(plan, options_.rig_description, time_scale);
+  return plan::AnalyzePlan(plan, options_.rig_description,
+                           time_scale > 0 ? time_scale : options_.rig_description.time_scale);
 }
 
 Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor& actor,
                                                bool start_now,
                                                std::vector<plan::Problem>* problems) {
-  plan::PlanAnalysis analysis = plan::AnalyzePlan(plan, options_.rig_description);
+  plan::PlanAnalysis analysis =
+      plan::AnalyzePlan(plan, options_.rig_description, options_.rig_description.time_scale);
   if (!analysis.valid()) {
     const std::string listing = plan::FormatProblems(analysis.problems);
     if (problems != nullptr) *problems = analysis.problems;

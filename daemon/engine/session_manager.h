@@ -118,8 +118,9 @@ class SessionManager {
 
   // Checks and summarises a plan against this rig; stores nothing. The gRPC layer turns it into
   // a ValidatePlanResponse (wire/plan.h: ToValidatePlanResponse). The summary's times are for a rig
-  // whose devices run `time_scale` (> 0) times faster (plan::AnalyzePlan).
-  plan::PlanAnalysis ValidatePlan(const v1::Plan& plan, double time_scale = 1) const;
+  // whose devices run `time_scale` (> 0) times faster (plan::AnalyzePlan); 0: this rig's own
+  // (Options.rig_description.time_scale, the configuration's [rig] time_scale).
+  plan::PlanAnalysis ValidatePlan(const v1::Plan& plan, double time_scale = 0) const;
 
   // Validates, expands and stores the plan as a new QUEUED session (then starts it when
   // `start_now`, as Start would). A plan with problems: kInvalidArgument whose message lists

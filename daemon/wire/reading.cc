@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/geometry.h"
+#include "core/readings/reading.h"
 #include "daemon/wire/enums.h"
 #include "daemon/wire/values.h"
 
@@ -31,6 +32,7 @@ v1::Reading ToProtoReading(const storage::ReadingRecord& r, const ReadingExtras&
   out.set_flagged(r.flagged);
   if (r.flagged) out.set_flag_reason(r.note.empty() ? "flagged by the quality policy" : r.note);
   out.set_integration_ms(static_cast<std::uint32_t>(std::max(0, r.integration_ms)));
+  out.set_integration_note(IntegrationNoteOf(r.note));
   out.set_averages(extras.averages);
   out.set_reference_id(r.reference_reading_id.value_or(0));
   out.set_dark_id(r.dark_reading_id.value_or(0));

@@ -4,6 +4,7 @@
 // --on-prompt hook); a session started while another holds the rig says which one and that it
 // starts by itself, and shows no ETA; refusals use the operator's words and no server paths.
 #include <fcntl.h>
+#include <google/protobuf/util/json_util.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -15,7 +16,10 @@
 #include <sstream>
 #include <thread>
 
+#include "brdf/v1/brdf.pb.h"
 #include "tests/brdfctl/ctl_test_rig.h"
+#include "tests/support/plan_fixtures.h"
+#include "tests/support/sim/rig.h"
 
 namespace brdf::testing {
 namespace {
@@ -171,6 +175,93 @@ TEST_F(OperatorViewTest, WatchSaysTheHookNeedsAutoConfirmWhenItCannotAsk) {
   const CommandResult abort = Ctl({"abort", id, "--reason", "test over"});
   ASSERT_EQ(abort.exit_code, 0) << Describe(abort);
   EXPECT_EQ((*watcher)->WaitUntil(std::chrono::steady_clock::now() + 20s), 4) << ReadText(out);
+}
+
+// A reading whose integration time the meter changed (an overload halves it and measures again)
+// says so in `watch`, in `readings` and in the readings CSV, with the time it did use.
+TEST_F(OperatorViewTest, AReadingWhoseIntegrationTheMeterHalvedSaysSo) {
+  // 100 ms fixed; the next measurement overloads (quality 19) once.
+  const std::string plan = rig_.dir().file("tiny.json").string();
+  std::ofstream(plan) << plans::TinyPoseList().Json();
+  sim::SerialFaults faults;
+  faults.quality_code = 19;
+  faults.quality_count = 1;
+  ASSERT_TRUE(rig_.sim_control().SetSerialFaults(faults).ok());
+  const CommandResult submitted = Ctl({"submit", plan, "--start", "--quiet"});
+  ASSERT_EQ(submitted.exit_code, 0) << Describe(submitted);
+  ASSERT_EQ(Lines(submitted.out).size(), 1u) << Describe(submitted);
+  const std::string id = Lines(submitted.out)[0];
+  Result<CommandResult> watched =
+      rig_.Ctl({"watch", id, "--auto-confirm", "--no-progress", "--on-prompt",
+                "'" + *BrdfctlBinary() + "' sim-mount from-prompt --modbus " + rig_.modbus()},
+               kCtlOperatorToken, 60s);
+  ASSERT_TRUE(watched.ok()) << watched.status().ToString();
+  ASSERT_EQ(watched->exit_code, 0) << Describe(*watched);
+  const std::string halved = "integration halved from 100 to 50 ms";
+  EXPECT_NE(watched->out.find("integration changed by the meter: quality 19 ("), std::string::npos)
+      << Describe(*watched);
+  EXPECT_NE(watched->out.find(halved), std::string::npos) << Describe(*watched);
+  // Only the one reading says so.
+  EXPECT_EQ(watched->out.find(halved), watched->out.rfind(halved)) << Describe(*watched);
+
+  const CommandResult readings = Ctl({"readings", id});
+  ASSERT_EQ(readings.exit_code, 0) << Describe(readings);
+  int changed = 0;
+  for (const std::string& line : Lines(readings.out)) {
+    if (line.find(halved) == std::string::npos) continue;
+    ++changed;
+    EXPECT_NE(line.find("50 ms (changed by the meter: quality 19 ("), std::string::npos) << line;
+  }
+  EXPECT_EQ(changed, 1) << Describe(readings);
+
+  const CommandResult csv =
+      Ctl({"export", id, "csv", "--quantity", "radiance", "-o", "-", "--no-progress"});
+  ASSERT_EQ(csv.exit_code, 0) << Describe(csv);
+  int rows_changed = 0;
+  for (const std::string& line : Lines(csv.out)) {
+    if (line.empty() || line[0] == '#' || line.find(halved) == std::string::npos) continue;
+    ++rows_changed;
+    EXPECT_NE(line.find(",50,"), std::string::npos) << "integration_ms 50: " << line;
+  }
+  EXPECT_EQ(rows_changed, 1) << csv.out.substr(0, 3000);
+}
+
+// brdfd knows the simulator's time scale ([rig] time_scale, as quickstart.sh writes it), so the
+// first ETA brdfctl shows is the simulated rig's: the plan's estimate at that scale, not a real
+// rig's (issue 40: 10:45 falling to 1:02 for a 45 s demo).
+TEST_F(OperatorViewTest, TheFirstEtaIsTheSimulatedRigs) {
+  const std::string plan = rig_.dir().file("tiny.json").string();
+  std::ofstream(plan) << plans::TinyPoseList().Json();
+  auto summary = [&](double time_scale) {
+    const CommandResult r =
+        Ctl({"--json", "validate", plan, "--time-scale", std::to_string(time_scale)});
+    EXPECT_EQ(r.exit_code, 0) << Describe(r);
+    v1::ValidatePlanResponse reply;
+    EXPECT_TRUE(google::protobuf::util::JsonStringToMessage(Lines(r.out).at(0), &reply).ok())
+        << r.out;
+    return reply.summary();
+  };
+  const v1::PlanSummary simulated = summary(kSimTimeScale), real = summary(1);
+  const CommandResult submitted = Ctl({"submit", plan, "--start", "--quiet"});
+  ASSERT_EQ(submitted.exit_code, 0) << Describe(submitted);
+  const std::string id = Lines(submitted.out).at(0);
+  v1::Session session;
+  ASSERT_TRUE(Eventually([&] {
+    const CommandResult got = Ctl({"--json", "get", id});
+    return got.exit_code == 0 && !Lines(got.out).empty() &&
+           google::protobuf::util::JsonStringToMessage(Lines(got.out)[0], &session).ok() &&
+           session.state() == v1::SESSION_STATE_AWAITING_OPERATOR;
+  })) << session.DebugString();
+  // Waiting at its first prompt: every step but the first move is left.
+  EXPECT_LE(session.eta_s(), simulated.estimated_duration_s() + 1e-9);
+  EXPECT_GT(session.eta_s(), 0.9 * simulated.estimated_duration_s());
+  // A real rig's would be longer by most of the devices' time.
+  EXPECT_LT(session.eta_s(), real.estimated_duration_s() - 0.5 * real.physical_lower_bound_s())
+      << "simulated " << simulated.estimated_duration_s() << " s, real "
+      << real.estimated_duration_s() << " s";
+  const CommandResult shown = Ctl({"get", id});
+  EXPECT_NE(shown.out.find("ETA"), std::string::npos) << Describe(shown);
+  EXPECT_EQ(Ctl({"abort", id, "--reason", "test over"}).exit_code, 0);
 }
 
 }  // namespace

@@ -42,6 +42,8 @@ Status CtlRig::Start() {
        << "[stage]\ntransport = \"tcp\"\naddress = \"" << modbus() << "\"\n"
        << "response_timeout_ms = 300\ndetector_arm_motorized = true\n"
        << "[stage.axes.delta]\npresent = true\n"
+       // The simulator's speed-up, for the estimates and ETAs (as quickstart.sh writes it).
+       << "[rig]\ntime_scale = " << kSimTimeScale << "\n"
        << "[[auth.tokens]]\nname = \"ctl-operator\"\ntoken = \"" << kCtlOperatorToken
        << "\"\nrole = \"operator\"\n"
        << "[[auth.tokens]]\nname = \"ctl-analyst\"\ntoken = \"" << kCtlAnalystToken

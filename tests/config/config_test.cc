@@ -4,11 +4,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <tuple>
-
 #include <chrono>
 #include <fstream>
 #include <string>
+#include <tuple>
 
 #include "drivers/stage/modbus_stage.h"
 #include "tests/support/test_env.h"
@@ -80,6 +79,24 @@ TEST(ConfigTest, RigNameAndArchive) {
               HasSubstr("archive.conninfo"));
   EXPECT_THAT(Refusal("[archive]\ncredentials = \"f\"\nbatch_readings = 0\n"),
               HasSubstr("archive.batch_readings"));
+}
+
+// [rig] time_scale: a simulated rig's speed-up (brdf-sim --time-scale) reaches the timing model,
+// so that estimates and ETAs are the simulator's; 1 (a real rig) by default; > 0.
+TEST(ConfigTest, RigTimeScaleReachesTheTimingModel) {
+  const Result<Config> none = ParseConfig("", "empty.toml");
+  ASSERT_TRUE(none.ok());
+  EXPECT_EQ(none->rig.time_scale, 1);
+  EXPECT_EQ(ToRigDescription(*none).time_scale, 1);
+  const Result<Config> sim = ParseConfig("[rig]\ntime_scale = 8\n", "sim.toml");
+  ASSERT_TRUE(sim.ok()) << sim.status().ToString();
+  EXPECT_EQ(sim->rig.time_scale, 8);
+  EXPECT_EQ(ToRigDescription(*sim).time_scale, 8);
+  for (const char* bad : {"0", "-2", "10001", "\"fast\""}) {
+    EXPECT_THAT(Refusal(std::string("[rig]\ntime_scale = ") + bad + "\n"),
+                HasSubstr("rig.time_scale"))
+        << bad;
+  }
 }
 
 TEST(ConfigTest, FullFile) {
@@ -456,16 +473,15 @@ TEST(ConfigMeterModel, ModelPicksTheFamilyAndUnknownModelsAreRefused) {
   EXPECT_EQ(defaults->meter.model, MeterModel::kPr650);
   EXPECT_EQ(defaults->meter.char_gap_ms, 50);
   EXPECT_EQ(defaults->meter.nd_filter, "auto");
-  for (const auto& [key, family, name] :
-       {std::tuple{"pr650", MeterFamily::kPr650, "PR-650"},
-        std::tuple{"pr655", MeterFamily::kPr670, "PR-655"},
-        std::tuple{"pr670", MeterFamily::kPr670, "PR-670"},
-        std::tuple{"cs2000", MeterFamily::kCs2000, "CS-2000"},
-        std::tuple{"cs2000a", MeterFamily::kCs2000, "CS-2000A"},
-        std::tuple{"cs3000", MeterFamily::kCs2000, "CS-3000"}}) {
-    const Result<Config> r = ParseConfig(std::string("[meter]\nmodel = \"") + key +
-                                             "\"\nchar_gap_ms = 5\nnd_filter = \"off\"\n",
-                                         "meter.toml");
+  for (const auto& [key, family, name] : {std::tuple{"pr650", MeterFamily::kPr650, "PR-650"},
+                                          std::tuple{"pr655", MeterFamily::kPr670, "PR-655"},
+                                          std::tuple{"pr670", MeterFamily::kPr670, "PR-670"},
+                                          std::tuple{"cs2000", MeterFamily::kCs2000, "CS-2000"},
+                                          std::tuple{"cs2000a", MeterFamily::kCs2000, "CS-2000A"},
+                                          std::tuple{"cs3000", MeterFamily::kCs2000, "CS-3000"}}) {
+    const Result<Config> r = ParseConfig(
+        std::string("[meter]\nmodel = \"") + key + "\"\nchar_gap_ms = 5\nnd_filter = \"off\"\n",
+        "meter.toml");
     ASSERT_TRUE(r.ok()) << key << ": " << r.status().ToString();
     EXPECT_EQ(FamilyOf(r->meter.model), family) << key;
     EXPECT_STREQ(MeterModelName(r->meter.model), name);

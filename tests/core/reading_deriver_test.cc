@@ -99,3 +99,22 @@ TEST(ReadingDeriver, WhiteSpectrumNotCoveringTheGridGivesNoBrdfAndSaysWhy) {
 
 }  // namespace
 }  // namespace brdf
+
+namespace brdf {
+namespace {
+
+// The clauses of a stored note that changed the integration time, and only those.
+TEST(IntegrationNoteOf, KeepsTheClausesThatChangedTheIntegration) {
+  EXPECT_EQ(IntegrationNoteOf(""), "");
+  EXPECT_EQ(IntegrationNoteOf("code 18 (low light): accepted, flagged"), "");
+  EXPECT_EQ(IntegrationNoteOf("code 19 (overload): integration halved from 500 to 250 ms"),
+            "code 19 (overload): integration halved from 500 to 250 ms");
+  EXPECT_EQ(IntegrationNoteOf("code 19 (overload): integration halved from 500 to 250 ms; "
+                              "code 0 (OK); code 18 (low light), handled as quality 18: "
+                              "integration doubled from 250 to 500 ms; units code 2: uncalibrated"),
+            "code 19 (overload): integration halved from 500 to 250 ms; code 18 (low light), "
+            "handled as quality 18: integration doubled from 250 to 500 ms");
+}
+
+}  // namespace
+}  // namespace brdf

@@ -151,7 +151,7 @@ TEST_F(BrdfExportTool, CsvOfReadingsFromTheDatabase) {
   const Directions d{std::stod(row[6]), std::stod(row[7]), std::stod(row[8]), std::stod(row[9])};
   const std::vector<double> truth =
       AnalyticBrdf::PaintLike().EvaluateSpectrum(d, WavelengthGrid::Pr650());
-  EXPECT_NEAR(std::stod(row[15 + 50]), truth[50], 1e-9);
+  EXPECT_NEAR(std::stod(row[16 + 50]), truth[50], 1e-9);
   EXPECT_EQ(row[12], "250");
 }
 

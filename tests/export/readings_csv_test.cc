@@ -53,10 +53,22 @@ TEST(ReadingsCsv, HeaderDocumentsUnitsAnglesAndQuantity) {
 
     const auto rows = CsvRows(out.str());
     ASSERT_FALSE(rows.empty());
-    const std::vector<std::string> want = {
-        "id",           "kind",        "alpha_deg",      "beta_deg",     "gamma_deg",
-        "delta_deg",    "theta_i_deg", "phi_i_deg",      "theta_o_deg",  "phi_o_deg",
-        "quality_code", "flagged",     "integration_ms", "reference_id", "dark_id"};
+    const std::vector<std::string> want = {"id",
+                                           "kind",
+                                           "alpha_deg",
+                                           "beta_deg",
+                                           "gamma_deg",
+                                           "delta_deg",
+                                           "theta_i_deg",
+                                           "phi_i_deg",
+                                           "theta_o_deg",
+                                           "phi_o_deg",
+                                           "quality_code",
+                                           "flagged",
+                                           "integration_ms",
+                                           "reference_id",
+                                           "dark_id",
+                                           "integration_note"};
     ASSERT_EQ(rows[0].size(), want.size() + 101);
     for (std::size_t c = 0; c < want.size(); ++c) EXPECT_EQ(rows[0][c], want[c]);
     EXPECT_EQ(rows[0][want.size()], "380");
@@ -84,7 +96,7 @@ TEST(ReadingsCsv, RadianceRowsAreEveryReadingAsMeasured) {
     EXPECT_EQ(std::stod(row[6]), r.directions.theta_i);
     EXPECT_EQ(row[13], r.reference_id ? std::to_string(*r.reference_id) : "");
     for (std::size_t b = 0; b < 101; ++b) {
-      EXPECT_EQ(std::stod(row[15 + b]), r.spectrum.values[b]) << "shortest form reads back";
+      EXPECT_EQ(std::stod(row[16 + b]), r.spectrum.values[b]) << "shortest form reads back";
     }
   }
 }
@@ -105,7 +117,7 @@ TEST(ReadingsCsv, BrdfRowsEqualTheAnalyticBrdf) {
                        std::stod(rows[i][9])};
     const std::vector<double> truth = paint.EvaluateSpectrum(d, grid);
     for (std::size_t b = 0; b < grid.count; b += 25) {
-      EXPECT_NEAR(std::stod(rows[i][15 + b]), truth[b], 1e-12 * truth[b] + 1e-15);
+      EXPECT_NEAR(std::stod(rows[i][16 + b]), truth[b], 1e-12 * truth[b] + 1e-15);
     }
   }
 }
@@ -172,6 +184,29 @@ TEST(DeriveSamples, DarkIsSubtractedAndBrdfUsesTheReferenceIncidence) {
   const double ratio = std::cos(30 * M_PI / 180) / std::cos(60 * M_PI / 180);
   EXPECT_NEAR(f->samples[0].values[0], 0.4 * 0.95 / M_PI * ratio, 1e-15);
   EXPECT_EQ(f->samples[0].iso, (IsoDirection{60, 20, 90}));
+}
+
+// A reading whose integration the meter changed says so in its row (integration_note, quoted when
+// it holds a comma); the others leave the column empty.
+TEST(ReadingsCsv, IntegrationNoteSaysHowTheMeterChangedTheIntegration) {
+  Session session = SmallSession(/*with_dark=*/false);
+  ASSERT_GE(session.readings.size(), 3u);
+  session.readings[1].integration_ms = 250;
+  session.readings[1].integration_note =
+      "code 19 (overload): integration halved from 500 to 250 ms";
+  session.readings[2].integration_note = "code 18 (low light, weak signal): integration doubled";
+  std::ostringstream out;
+  ASSERT_TRUE(WriteReadingsCsv(session, Quantity::kRadiance, out).ok());
+  const std::string text = out.str();
+  const auto rows = CsvRows(text);
+  ASSERT_EQ(rows[0][15], "integration_note");
+  EXPECT_EQ(rows[1][15], "");
+  EXPECT_EQ(rows[2][12], "250");
+  EXPECT_EQ(rows[2][15], session.readings[1].integration_note);
+  EXPECT_NE(text.find(",\"code 18 (low light, weak signal): integration doubled\","),
+            std::string::npos);
+  EXPECT_NE(Joined(CommentLines(text)).find("integration_note: how the meter changed"),
+            std::string::npos);
 }
 
 }  // namespace

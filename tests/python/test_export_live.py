@@ -154,7 +154,7 @@ class LiveExport(unittest.TestCase):
         self.assertProgress(progress)
         header, rows = self.read_csv(path)
         self.assertEqual(header[0], "id")
-        self.assertEqual(len(header), 15 + 101)
+        self.assertEqual(len(header), 16 + 101)
         self.assertEqual(r.rows, len(self.readings))
         self.assertEqual(len(rows), r.rows)
         np.testing.assert_array_equal([int(row[0]) for row in rows], self.readings.ids)

@@ -2,6 +2,7 @@
 
 #include <charconv>
 
+#include "core/csv_field.h"
 #include "core/interp/csv_table.h"
 
 namespace brdf::interp_tool {
@@ -16,19 +17,6 @@ void AppendNumber(double x, std::string& out) {
   out.append(buffer, ec == std::errc() ? end : buffer);
 }
 
-void AppendField(std::string_view text, std::string& out) {
-  if (text.find_first_of(",\"\n\r") == std::string_view::npos) {
-    out.append(text);
-    return;
-  }
-  out += '"';
-  for (char c : text) {
-    if (c == '"') out += '"';
-    out += c;
-  }
-  out += '"';
-}
-
 std::string FormatHeader(const OutputLayout& layout) {
   std::string out;
   for (const char* name : interp::CoordinateColumns(layout.dims)) {
@@ -38,7 +26,7 @@ std::string FormatHeader(const OutputLayout& layout) {
   out += "status";
   for (const std::string& w : layout.wavelength_headers) {
     out += ',';
-    AppendField(w, out);
+    AppendCsvField(out, w);
   }
   if (layout.explain_vertices > 0) {
     for (int k = 0; k < layout.explain_vertices; ++k) out += ",v" + std::to_string(k);
@@ -72,7 +60,7 @@ void AppendRow(const OutputLayout& layout, std::span<const double> query,
       if (i < answer.vertices.size()) AppendNumber(answer.vertices[i].weight, out);
     }
     out += ',';
-    AppendField(answer.detail, out);
+    AppendCsvField(out, answer.detail);
   }
   out += '\n';
 }

@@ -35,7 +35,5 @@ void AppendRow(const OutputLayout& layout, std::span<const double> query,
                const interp::Interpolation& answer, std::string& out);
 // Shortest round-trip decimal form of x.
 void AppendNumber(double x, std::string& out);
-// A CSV field: quoted (with "" for ") when it holds a comma, a quote or a line break.
-void AppendField(std::string_view text, std::string& out);
 
 }  // namespace brdf::interp_tool

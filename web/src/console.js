@@ -19,6 +19,7 @@ export function createConsole(root, role, report, server = 'brdfd') {
   let events = [];
   let covered = [];             // sample readings' directions
   let lastReadingId = 0;
+  let changedReadings = [];     // readings whose integration time the meter changed
   let coverageBusy = false;
 
   const sessionsBody = el('tbody');
@@ -30,6 +31,7 @@ export function createConsole(root, role, report, server = 'brdfd') {
   const rig = el('div', { id: 'rig' });
   const coverage = el('div', { id: 'coverage', class: 'plot' });
   const eventList = el('ol', { id: 'events' });
+  const integrationNotes = el('ul', { id: 'integration-notes' });
   const history = el('div', { id: 'history' });
   let plan = null;
 
@@ -49,6 +51,7 @@ export function createConsole(root, role, report, server = 'brdfd') {
       el('div', { class: 'col wide' },
         el('h2', {}, 'Session'), detail,
         el('h3', {}, 'Hemisphere coverage (measured outgoing directions)'), coverage,
+        el('h3', {}, 'Readings whose integration time the meter changed'), integrationNotes,
         el('h3', {}, 'History (the states the session went through, as the rig recorded them)'), history,
         archive ? null : [el('h3', {}, 'Live events (since this page opened the session)'), eventList])));
 
@@ -190,10 +193,13 @@ export function createConsole(root, role, report, server = 'brdfd') {
     if (coverageBusy) return;
     coverageBusy = true;
     try {
-      await stream('Data/StreamReadings', { session_id: id, kinds: ['READING_KIND_SAMPLE'], after_id: String(lastReadingId) }, (r) => {
+      // Every kind: a reference or dark the meter changed is worth seeing too; only samples cover.
+      await stream('Data/StreamReadings', { session_id: id, after_id: String(lastReadingId) }, (r) => {
         lastReadingId = Math.max(lastReadingId, Number(r.id));
-        covered.push(r.directions);
+        if (r.kind === 'READING_KIND_SAMPLE') covered.push(r.directions);
+        if (r.integration_note) changedReadings.push(r);
       }, undefined, ['radiance']);
+      if (selected === id) renderIntegrationNotes();
       const Plotly = await plotly();
       Plotly.react(coverage, [{
         type: 'scatterpolar', mode: 'markers',
@@ -207,11 +213,20 @@ export function createConsole(root, role, report, server = 'brdfd') {
     finally { coverageBusy = false; }
   }
 
+  function renderIntegrationNotes() {
+    clear(integrationNotes).append(...(changedReadings.length
+      ? changedReadings.map((r) => el('li', { 'data-reading': r.id },
+        `reading ${r.id} (${String(r.kind).replace('READING_KIND_', '').toLowerCase()}, step ${r.step_index ?? 0}): ${r.integration_ms ?? 0} ms — ${r.integration_note}`))
+      : [el('li', { class: 'muted' }, 'none: every reading used the plan\'s integration time')]));
+  }
+
   async function select(id) {
     if (watch) watch.abort();
     selected = id;
     events = [];
     covered = [];
+    changedReadings = [];
+    clear(integrationNotes);
     lastReadingId = 0;
     clear(eventList);
     clear(history);

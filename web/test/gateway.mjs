@@ -47,6 +47,15 @@ try {
   r = await post('Control/ValidatePlan', { plan }, rig.operatorToken);
   check(r.status === 200 && r.json.valid === true && r.json.estimated_duration_s > 0, `the demo plan validates, estimated ${r.json.estimated_duration_s} s`);
 
+  // The API's documented ranges hold through the gateway too (the same handlers): a relative
+  // azimuth outside [0, 180] is refused naming the field, the value and the range.
+  const direction = (phi) => ({ session_id: '1', direction: { iso: { theta_i: 20, theta_o: 30, phi } } });
+  for (const phi of [-0.5, 180.5, 320]) {
+    r = await post('Interpolation/Interpolate', direction(phi), rig.analystToken);
+    check(r.status === 400 && r.json.code === 'INVALID_ARGUMENT' && r.json.message.includes('direction.iso.phi') && r.json.message.includes(String(phi)) && r.json.message.includes('[0, 180]'),
+      `Interpolate φ ${phi} → 400 naming direction.iso.phi and [0, 180] (${r.status} ${r.json?.message})`);
+  }
+
   r = await post('Control/ListSessions', '{"page_size": ', rig.operatorToken);
   check(r.status === 400 && r.json.code === 'INVALID_ARGUMENT' && /invalid JSON/.test(r.json.message), `malformed JSON → 400 (${r.json?.message})`);
   r = await post('Control/ListSessions', { page_sise: 3 }, rig.operatorToken);

@@ -61,15 +61,16 @@ async function stopProcess(p) {
   await new Promise((r) => { const t = setTimeout(() => { p.kill('SIGKILL'); r(); }, 8000); p.on('exit', () => { clearTimeout(t); r(); }); });
 }
 
-// `extraConfig`: TOML appended to brdfd's configuration (e.g. [rig] name and [archive]).
-export async function startRig({ timeScale = 40, extraConfig = '' } = {}) {
+// `extraConfig`: TOML appended to brdfd's configuration (e.g. [rig] name and [archive]);
+// `simArgs`: more brdf-sim options (e.g. an injected quality code).
+export async function startRig({ timeScale = 40, extraConfig = '', simArgs = [] } = {}) {
   const dir = mkdtempSync(join(tmpdir(), 'brdf-web-'));
   const operatorToken = 'op-' + Math.random().toString(36).slice(2) + 'xxxxxxxxxxxxxxxx';
   const analystToken = 'an-' + Math.random().toString(36).slice(2) + 'yyyyyyyyyyyyyyyy';
   const { openSync } = await import('node:fs');
   const simLog = join(dir, 'sim.log');
   const simProc = spawn(sim, ['--time-scale', String(timeScale), '--seed', '1', '--modbus-port', '0',
-    '--pr650-link', join(dir, 'pr650'), '--wake-window', '0', '--log-level', 'warn'],
+    '--pr650-link', join(dir, 'pr650'), '--wake-window', '0', '--log-level', 'warn', ...simArgs],
   { stdio: ['ignore', 'pipe', openSync(simLog, 'w')] });
   const simInfo = await waitFor(simProc, 'brdf-sim', { modbus: /^modbus-tcp (\S+)/, pr650: /^pr650 (\S+)/, ready: /^(ready)/ }, 20, simLog);
   const config = join(dir, 'brdfd.toml');

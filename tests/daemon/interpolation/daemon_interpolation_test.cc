@@ -295,17 +295,36 @@ TEST_F(DaemonInterpolationTest, InterpolatedSpectraFollowTheirProvenanceAndMatch
             << "); worst Delaunay error vs truth: " << worst_max << " of the spectrum's peak, "
             << worst_ratio << " of the allowed bound\n";
 
-  // Equivalent forms of a direction give the same answer: φ mirrored or turned by 360°, and the
-  // four-angle form of an isotropic direction.
+  // Equivalent forms of a direction give the same answer: the four-angle form of an isotropic
+  // direction, its azimuths mirrored or turned by 360° (brdf.proto: taken modulo 360). The
+  // relative azimuth of `iso` has one form: −φ and φ + 360 are refused, naming the field.
   {
     const IsoDirection q = queries.front();
-    for (v1::DirectionQuery form :
-         {Iso({q.theta_i, q.theta_o, -q.phi}), Iso({q.theta_i, q.theta_o, q.phi + 360})}) {
+    for (const auto& [phi_i, phi_o] : std::vector<std::pair<double, double>>{
+             {-25, -25 - q.phi}, {25 - 360, 25 + q.phi}, {25, 25 + q.phi - 360}}) {
+      v1::DirectionQuery form;
+      form.mutable_four()->set_theta_i(q.theta_i);
+      form.mutable_four()->set_phi_i(phi_i);
+      form.mutable_four()->set_theta_o(q.theta_o);
+      form.mutable_four()->set_phi_o(phi_o);
       v1::InterpolationResult same;
       ASSERT_TRUE(
           Interpolate(id, form, v1::INTERPOLATION_METHOD_DELAUNAY, v1::QUANTITY_BRDF, &same).ok());
       ASSERT_EQ(same.spectrum_size(), 101);
-      for (int b = 0; b < 101; ++b) EXPECT_DOUBLE_EQ(same.spectrum(b), singles.front().spectrum(b));
+      for (int b = 0; b < 101; ++b) {
+        EXPECT_NEAR(same.spectrum(b), singles.front().spectrum(b), 1e-12) << phi_i << ", " << phi_o;
+      }
+    }
+    std::vector<double> outside = {q.phi + 360};
+    if (q.phi > 0) outside.push_back(-q.phi);  // (−0 is 0, the same point)
+    for (double phi : outside) {
+      const v1::DirectionQuery form = Iso({q.theta_i, q.theta_o, phi});
+      v1::InterpolationResult refused;
+      const grpc::Status st =
+          Interpolate(id, form, v1::INTERPOLATION_METHOD_DELAUNAY, v1::QUANTITY_BRDF, &refused);
+      EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << form.DebugString();
+      EXPECT_NE(st.error_message().find("direction.iso.phi"), std::string::npos)
+          << st.error_message();
     }
     v1::DirectionQuery four;
     four.mutable_four()->set_theta_i(q.theta_i);

@@ -29,6 +29,8 @@ void PrintReading(std::ostream& out, const v1::Reading& r, bool spectra) {
     out << r.integration_ms() << " ms";
   }
   if (r.averages() > 1) out << " ×" << r.averages();
+  if (!r.integration_note().empty())
+    out << " (changed by the meter: " << r.integration_note() << ")";
   if (r.flagged()) out << "  FLAGGED (" << r.flag_reason() << ")";
   if (!r.label().empty()) out << "  \"" << r.label() << "\"";
   out << "\n";

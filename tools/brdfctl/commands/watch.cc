@@ -156,7 +156,13 @@ class Watcher {
     eta_.OnStep(step.kind(), step.eta_s(), now_s);
     view_.eta_s = eta_.Eta(step.eta_s());
     if (step.quality_code() >= 0) view_.quality_code = step.quality_code();
+    integration_note_.clear();
     if (step.reading_id() > 0 && !ctx_.json) FetchPose(step.reading_id());
+    if (options_.progress_bar && !integration_note_.empty()) {
+      // Worth a line of its own even under the bar: the reading is not what the plan asked for.
+      Note("reading " + std::to_string(step.reading_id()) +
+           ": integration changed by the meter: " + integration_note_);
+    }
     if (options_.progress_bar || ctx_.json) return;
     std::string line = "[" + std::to_string(view_.done_steps) + "/" +
                        std::to_string(view_.total_steps) + "] step " +
@@ -166,13 +172,17 @@ class Watcher {
               std::to_string(step.quality_code());
       if (step.flagged()) line += " (flagged)";
       if (view_.pose) line += ", " + PoseText(*view_.pose);
+      if (!integration_note_.empty()) {
+        line += ", integration changed by the meter: " + integration_note_;
+      }
     }
     line += ", ETA " + Duration(view_.eta_s);
     ctx_.out << line << std::endl;
   }
 
-  // The pose of a reading that just landed: its id is known, so ask for the readings after id − 1
-  // (without follow, the stream sends what is stored and closes). Best effort: the display only.
+  // The pose (and integration note) of a reading that just landed: its id is known, so ask for the
+  // readings after id − 1 (without follow, the stream sends what is stored and closes). Best
+  // effort: the display only.
   void FetchPose(std::int64_t reading_id) {
     v1::StreamReadingsRequest request;
     request.set_session_id(options_.session_id);
@@ -180,7 +190,10 @@ class Watcher {
     auto context = ctx_.client.UnaryContext();
     auto reader = ctx_.client.data().StreamReadings(context.get(), request);
     v1::Reading reading;
-    if (reader->Read(&reading) && reading.id() == reading_id) view_.pose = reading.pose();
+    if (reader->Read(&reading) && reading.id() == reading_id) {
+      view_.pose = reading.pose();
+      integration_note_ = reading.integration_note();
+    }
     context->TryCancel();
     reader->Finish();
   }
@@ -344,6 +357,7 @@ class Watcher {
   std::ostream& notes_;
   ProgressView view_;
   EtaCalibrator eta_;
+  std::string integration_note_;  // of the reading of the step being shown
   v1::SessionState state_ = v1::SESSION_STATE_UNSPECIFIED;
   std::string end_reason_;
   std::set<int> answered_;
