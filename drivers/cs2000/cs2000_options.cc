@@ -16,7 +16,7 @@ bool InRange(std::chrono::milliseconds d, long long lo_ms, long long hi_ms) {
 
 Status ValidateCs2000Options(const Cs2000Options& o) {
   if (o.port.empty()) return Bad("port is empty (e.g. /dev/ttyUSB0)");
-  if (!pr650::IsSupportedBaud(o.baud)) {
+  if (!serial::IsSupportedBaud(o.baud)) {
     return Bad("baud " + std::to_string(o.baud) + " is not a standard rate 1200–115200");
   }
   if (!(o.sync_frequency_hz >= 20 && o.sync_frequency_hz <= 200)) {

@@ -9,7 +9,7 @@
 #include "core/status.h"
 #include "drivers/cs2000/cs2000_protocol.h"
 #include "drivers/pr650/quality_codes.h"
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/serial_link.h"
 
 namespace brdf::drivers {
 
@@ -38,7 +38,7 @@ struct Cs2000Options {
   int max_measure_attempts = 4;  // measurements per Measure call, retries included
   // Keyed by the PR-650's quality codes: cs2000::PolicyCodeFor maps each ERxx onto one.
   pr650::QualityPolicy quality_policy = pr650::QualityPolicy::Defaults();
-  pr650::LogSink log;  // empty: stderr
+  serial::LogSink log;  // empty: stderr
 };
 
 // kConfigurationError naming the first bad option and its allowed range.

@@ -5,13 +5,14 @@
 #include <cstdio>
 
 #include "drivers/pr650/pr650_protocol.h"
+#include "drivers/serial/reply_lines.h"
 
 namespace brdf::drivers::cs2000 {
 
 namespace {
 
 using pr650::ParseNumber;
-using pr650::Printable;
+using serial::Printable;
 
 constexpr std::array<ErrorCodeInfo, 13> kCodes = {{
     {0, "invalid command string or number of parameters", kFailPolicyCode},

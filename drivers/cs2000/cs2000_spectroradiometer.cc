@@ -3,13 +3,14 @@
 #include <iostream>
 
 #include "drivers/pr650/pr650_protocol.h"
+#include "drivers/serial/reply_lines.h"
 
 namespace brdf::drivers {
 
 namespace {
 
-pr650::ChannelOptions ChannelFor(const Cs2000Options& o) {
-  pr650::ChannelOptions c;
+serial::ChannelOptions ChannelFor(const Cs2000Options& o) {
+  serial::ChannelOptions c;
   c.serial = {o.port, o.baud, o.hardware_flow_control, o.model};
   c.line_end = "\n";
   c.command_pacing = o.command_pacing;
@@ -27,7 +28,7 @@ Cs2000Options WithLog(Cs2000Options o) {
 }  // namespace
 
 Cs2000Spectroradiometer::Cs2000Spectroradiometer(Cs2000Options options,
-                                                 pr650::CommandChannel::LinkFactory link_factory)
+                                                 serial::CommandChannel::LinkFactory link_factory)
     : options_(WithLog(std::move(options))),
       channel_(ChannelFor(options_), std::move(link_factory)),
       model_(options_.model) {}
@@ -171,14 +172,14 @@ Result<cs2000::Reply> Cs2000Spectroradiometer::MeasureOnce(const CallContext& ct
   if (!start.ok()) return Lost(start.status());
   // A short measurement's completion may follow its measuring time closely enough to arrive in
   // the same read: the first line is the time, a second one the completion.
-  const std::vector<std::string> lines = pr650::SplitReplyLines(*start);
+  const std::vector<std::string> lines = serial::SplitReplyLines(*start);
   BRDF_ASSIGN_OR_RETURN(const cs2000::Reply first, cs2000::ParseReply(lines.front(), kCommand));
   if (!first.ok) return first;  // refused before measuring (e.g. over range at once)
   BRDF_ASSIGN_OR_RETURN(const int seconds, cs2000::ParseMeasuringTime(lines.front()));
   std::string completion = lines.size() > 1 ? lines[1] : std::string();
   if (lines.size() > 2) {
     return ProtocolError(Where() + " answered MEAS,1 with " + std::to_string(lines.size()) +
-                         " lines (\"" + pr650::Printable(*start) +
+                         " lines (\"" + serial::Printable(*start) +
                          "\"); expected the measuring time, then the completion");
   }
   if (completion.empty()) {

@@ -26,8 +26,8 @@
 
 #include "drivers/cs2000/cs2000_options.h"
 #include "drivers/cs2000/cs2000_protocol.h"
-#include "drivers/pr650/command_channel.h"
 #include "drivers/pr650/quality_loop.h"
+#include "drivers/serial/command_channel.h"
 #include "drivers/spectroradiometer.h"
 
 namespace brdf::drivers {
@@ -36,7 +36,7 @@ class Cs2000Spectroradiometer final : public Spectroradiometer {
  public:
   explicit Cs2000Spectroradiometer(
       Cs2000Options options,
-      pr650::CommandChannel::LinkFactory link_factory = pr650::MakeSerialLink);
+      serial::CommandChannel::LinkFactory link_factory = serial::MakeSerialLink);
   ~Cs2000Spectroradiometer() override;
 
   Status Connect(const CallContext& ctx) override;
@@ -71,7 +71,7 @@ class Cs2000Spectroradiometer final : public Spectroradiometer {
   void Log(const std::string& message) const;
 
   Cs2000Options options_;
-  pr650::CommandChannel channel_;
+  serial::CommandChannel channel_;
   bool connected_ = false;
   bool lost_connection_ = false;
   std::optional<Setup> configured_;

@@ -18,7 +18,7 @@ bool InRange(std::chrono::milliseconds d, long long lo_ms, long long hi_ms) {
 
 Status ValidatePr650Options(const Pr650Options& o) {
   if (o.port.empty()) return Bad("port is empty (e.g. /dev/ttyUSB0)");
-  if (!pr650::IsSupportedBaud(o.baud)) {
+  if (!serial::IsSupportedBaud(o.baud)) {
     return Bad("baud " + std::to_string(o.baud) + " is not a supported rate (the meter uses 9600)");
   }
   if (!InRange(o.command_pacing, 0, 10'000)) return Bad("command_pacing must be 0–10000 ms");

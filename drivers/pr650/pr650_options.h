@@ -8,7 +8,7 @@
 
 #include "core/status.h"
 #include "drivers/pr650/quality_codes.h"
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/serial_link.h"
 
 namespace brdf::drivers {
 
@@ -50,7 +50,7 @@ struct Pr650Options {
   pr650::QualityPolicy quality_policy = pr650::QualityPolicy::Defaults();
 
   // Diagnostics (tolerated pty limitations, retries, adaptations). Empty: written to stderr.
-  pr650::LogSink log;
+  serial::LogSink log;
 };
 
 // kConfigurationError naming the first bad option and its allowed range.

@@ -2,8 +2,9 @@
 
 #include <iostream>
 
-#include "drivers/pr650/context_wait.h"
 #include "drivers/pr650/quality_codes.h"
+#include "drivers/serial/context_wait.h"
+#include "drivers/serial/reply_lines.h"
 
 namespace brdf::drivers {
 
@@ -83,9 +84,9 @@ Status Pr650Spectroradiometer::WithSilenceHint(const Status& status, const CallC
 // ---- Connect -----------------------------------------------------------------------------------
 
 Status Pr650Spectroradiometer::OpenWithRtsDrop(const CallContext& ctx) {
-  const pr650::SerialSettings settings{options_.port, options_.baud,
-                                       options_.hardware_flow_control};
-  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<pr650::SerialLink> link,
+  const serial::SerialSettings settings{options_.port, options_.baud,
+                                        options_.hardware_flow_control};
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<serial::SerialLink> link,
                         link_factory_(settings, options_.log));
   BRDF_RETURN_IF_ERROR(link->Open(port_seen_));
   port_seen_ = true;
@@ -93,12 +94,12 @@ Status Pr650Spectroradiometer::OpenWithRtsDrop(const CallContext& ctx) {
   // work drop RTS for more than 50 ms (closing the port) before talking to it.
   BRDF_RETURN_IF_ERROR(link->SetRts(false));
   BRDF_RETURN_IF_ERROR(
-      pr650::WaitChecked(options_.rts_drop, ctx, "dropping RTS on " + options_.port));
+      serial::WaitChecked(options_.rts_drop, ctx, "dropping RTS on " + options_.port));
   link->Close();
   BRDF_RETURN_IF_ERROR(link->Open(true));
   BRDF_RETURN_IF_ERROR(link->SetRts(true));
   link_ = std::move(link);
-  return pr650::WaitChecked(options_.wake_settle, ctx, "letting the PR-650 settle after RTS");
+  return serial::WaitChecked(options_.wake_settle, ctx, "letting the PR-650 settle after RTS");
 }
 
 Status Pr650Spectroradiometer::Wake(const CallContext& ctx) {
@@ -166,9 +167,9 @@ Status Pr650Spectroradiometer::DiscardLateReply(const CallContext& ctx) {
   // A reply to an abandoned command may still be on its way (the meter finishes what it started);
   // wait for it so it is not read as the answer to the next command.
   Result<std::string> late =
-      pr650::ReadReply(*link_, {"an abandoned command", 1, until - now}, framing_, ctx);
+      serial::ReadReply(*link_, {"an abandoned command", 1, until - now}, framing_, ctx);
   if (late.ok()) {
-    Log("discarded a late reply on " + options_.port + ": \"" + pr650::Printable(*late) + "\"");
+    Log("discarded a late reply on " + options_.port + ": \"" + serial::Printable(*late) + "\"");
   } else if (late.status().code() == StatusCode::kCancelled ||
              late.status().code() == StatusCode::kDisconnected || ctx.expired()) {
     return late.status();
@@ -185,7 +186,7 @@ Result<std::string> Pr650Spectroradiometer::Exchange(std::string_view command, s
   if (status.ok()) {
     const auto now = ctx.clock().Now();
     if (now < next_command_at_) {
-      status = pr650::WaitChecked(next_command_at_ - now, ctx, "pacing PR-650 commands");
+      status = serial::WaitChecked(next_command_at_ - now, ctx, "pacing PR-650 commands");
     }
   }
   if (status.ok()) status = link_->FlushInput();
@@ -196,7 +197,7 @@ Result<std::string> Pr650Spectroradiometer::Exchange(std::string_view command, s
   }
   const auto sent_at = ctx.clock().Now();
   Result<std::string> reply =
-      status.ok() ? pr650::ReadReply(*link_, {command, lines, timeout, first_line}, framing_, ctx)
+      status.ok() ? serial::ReadReply(*link_, {command, lines, timeout, first_line}, framing_, ctx)
                   : Result<std::string>(status);
   next_command_at_ = ctx.clock().Now() + options_.command_pacing;
   if (reply.ok()) return reply;

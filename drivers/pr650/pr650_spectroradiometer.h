@@ -36,8 +36,8 @@
 
 #include "drivers/pr650/pr650_options.h"
 #include "drivers/pr650/pr650_protocol.h"
-#include "drivers/pr650/reply_reader.h"
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/reply_reader.h"
+#include "drivers/serial/serial_link.h"
 #include "drivers/spectroradiometer.h"
 
 namespace brdf::drivers {
@@ -45,11 +45,11 @@ namespace brdf::drivers {
 class Pr650Spectroradiometer final : public Spectroradiometer {
  public:
   // Makes the (closed) link for a port; tests may hand in their own transport.
-  using LinkFactory = std::function<Result<std::unique_ptr<pr650::SerialLink>>(
-      const pr650::SerialSettings&, pr650::LogSink)>;
+  using LinkFactory = std::function<Result<std::unique_ptr<serial::SerialLink>>(
+      const serial::SerialSettings&, serial::LogSink)>;
 
   explicit Pr650Spectroradiometer(Pr650Options options,
-                                  LinkFactory link_factory = pr650::MakeSerialLink);
+                                  LinkFactory link_factory = serial::MakeSerialLink);
   ~Pr650Spectroradiometer() override;
 
   Status Connect(const CallContext& ctx) override;
@@ -112,9 +112,9 @@ class Pr650Spectroradiometer final : public Spectroradiometer {
 
   Pr650Options options_;
   LinkFactory link_factory_;
-  pr650::FramingOptions framing_;
+  serial::FramingOptions framing_;
 
-  std::unique_ptr<pr650::SerialLink> link_;
+  std::unique_ptr<serial::SerialLink> link_;
   bool connected_ = false;
   bool port_seen_ = false;        // the port has opened before: a missing port has vanished
   bool lost_connection_ = false;  // the link went down under us (vs never connected)

@@ -18,7 +18,7 @@ bool InRange(std::chrono::milliseconds d, long long lo_ms, long long hi_ms) {
 
 Status ValidatePr670Options(const Pr670Options& o) {
   if (o.port.empty()) return Bad("port is empty (e.g. /dev/ttyACM0)");
-  if (!pr650::IsSupportedBaud(o.baud)) {
+  if (!serial::IsSupportedBaud(o.baud)) {
     return Bad("baud " + std::to_string(o.baud) + " is not a standard rate 1200–115200");
   }
   if (!InRange(o.char_gap, 0, 1'000)) return Bad("char_gap must be 0–1000 ms");

@@ -8,7 +8,7 @@
 
 #include "core/status.h"
 #include "drivers/pr650/quality_codes.h"
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/serial_link.h"
 
 namespace brdf::drivers {
 
@@ -40,7 +40,7 @@ struct Pr670Options {
   int max_measure_attempts = 4;  // measurements per Measure call, retries included
   // Keyed by the PR-650's quality codes: pr670::PolicyCodeFor maps each PR-670 code onto one.
   pr650::QualityPolicy quality_policy = pr650::QualityPolicy::Defaults();
-  pr650::LogSink log;  // empty: stderr
+  serial::LogSink log;  // empty: stderr
 };
 
 // kConfigurationError naming the first bad option and its allowed range.

@@ -4,14 +4,15 @@
 #include <cmath>
 
 #include "drivers/pr650/pr650_protocol.h"
+#include "drivers/serial/reply_lines.h"
 
 namespace brdf::drivers::pr670 {
 
 namespace {
 
 using pr650::ParseNumber;
-using pr650::Printable;
-using pr650::SplitReplyLines;
+using serial::Printable;
+using serial::SplitReplyLines;
 
 constexpr std::array<ResultCodeInfo, 4> kCodes = {{
     {0, "OK", 0},

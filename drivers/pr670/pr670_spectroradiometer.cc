@@ -2,15 +2,16 @@
 
 #include <iostream>
 
-#include "drivers/pr650/context_wait.h"
 #include "drivers/pr650/pr650_protocol.h"
+#include "drivers/serial/context_wait.h"
+#include "drivers/serial/reply_lines.h"
 
 namespace brdf::drivers {
 
 namespace {
 
-pr650::ChannelOptions ChannelFor(const Pr670Options& o) {
-  pr650::ChannelOptions c;
+serial::ChannelOptions ChannelFor(const Pr670Options& o) {
+  serial::ChannelOptions c;
   c.serial = {o.port, o.baud, o.hardware_flow_control, o.model};
   c.line_end = "\r";
   c.char_gap = o.char_gap;
@@ -29,7 +30,7 @@ Pr670Options WithLog(Pr670Options o) {
 }  // namespace
 
 Pr670Spectroradiometer::Pr670Spectroradiometer(Pr670Options options,
-                                               pr650::CommandChannel::LinkFactory link_factory)
+                                               serial::CommandChannel::LinkFactory link_factory)
     : options_(WithLog(std::move(options))),
       channel_(ChannelFor(options_), std::move(link_factory)),
       model_(options_.model) {
@@ -76,15 +77,15 @@ Status Pr670Spectroradiometer::EnterRemoteMode(const CallContext& ctx) {
   for (int attempt = 1; attempt <= options_.remote_attempts; ++attempt) {
     // Q first: a meter left in remote mode answers the next PHOTO only after leaving it.
     BRDF_RETURN_IF_ERROR(channel_.Send(pr670::kQuitCommand, ctx));
-    BRDF_RETURN_IF_ERROR(pr650::WaitChecked(options_.quit_settle, ctx,
-                                            "letting the meter leave "
-                                            "remote mode"));
+    BRDF_RETURN_IF_ERROR(serial::WaitChecked(options_.quit_settle, ctx,
+                                             "letting the meter leave "
+                                             "remote mode"));
     BRDF_RETURN_IF_ERROR(channel_.Send(pr670::kRemoteModeCommand, ctx));
     Result<std::string> answer =
         channel_.ReadMore(pr670::kRemoteModeCommand,
                           {.lines = 1, .first_byte_timeout = options_.remote_timeout}, ctx);
     if (answer.ok()) {
-      Log(Where() + " is in remote mode: \"" + pr650::Printable(*answer) + "\"");
+      Log(Where() + " is in remote mode: \"" + serial::Printable(*answer) + "\"");
       return Status::Ok();
     }
     last = answer.status();
@@ -201,7 +202,7 @@ Result<std::string> Pr670Spectroradiometer::MeasureOnce(
   const std::chrono::milliseconds timeout =
       Pr670MeasurementTimeout(options_, current.exposure_ms, current.averages);
   const std::size_t full = pr670::SpectrumReplyLines(grid_);
-  pr650::ReplyShape shape;
+  serial::ReplyShape shape;
   shape.lines = full;
   shape.first_byte_timeout = timeout;
   shape.first_line = on_header;

@@ -27,10 +27,10 @@
 #include <optional>
 #include <string>
 
-#include "drivers/pr650/command_channel.h"
 #include "drivers/pr650/quality_loop.h"
 #include "drivers/pr670/pr670_options.h"
 #include "drivers/pr670/pr670_protocol.h"
+#include "drivers/serial/command_channel.h"
 #include "drivers/spectroradiometer.h"
 
 namespace brdf::drivers {
@@ -39,7 +39,7 @@ class Pr670Spectroradiometer final : public Spectroradiometer {
  public:
   explicit Pr670Spectroradiometer(
       Pr670Options options,
-      pr650::CommandChannel::LinkFactory link_factory = pr650::MakeSerialLink);
+      serial::CommandChannel::LinkFactory link_factory = serial::MakeSerialLink);
   ~Pr670Spectroradiometer() override;
 
   Status Connect(const CallContext& ctx) override;
@@ -88,7 +88,7 @@ class Pr670Spectroradiometer final : public Spectroradiometer {
   void Log(const std::string& message) const;
 
   Pr670Options options_;
-  pr650::CommandChannel channel_;
+  serial::CommandChannel channel_;
   bool connected_ = false;
   bool lost_connection_ = false;
 

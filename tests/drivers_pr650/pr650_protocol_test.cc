@@ -7,8 +7,15 @@
 #include <cstdio>
 #include <string>
 
+#include "drivers/serial/reply_lines.h"
+
 namespace brdf::drivers::pr650 {
 namespace {
+
+using serial::CountCompleteLines;
+using serial::EndsWithLineEnd;
+using serial::Printable;
+using serial::SplitReplyLines;
 
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;

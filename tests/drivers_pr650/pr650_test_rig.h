@@ -101,7 +101,7 @@ inline sim::Pr650EndpointOptions FastEndpointOptions() {
 // Collects the driver's log lines.
 class LogCapture {
  public:
-  drivers::pr650::LogSink sink() {
+  drivers::serial::LogSink sink() {
     return [this](std::string_view line) {
       std::lock_guard lock(mu_);
       lines_.emplace_back(line);

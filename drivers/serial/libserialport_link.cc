@@ -1,4 +1,4 @@
-#include "drivers/pr650/libserialport_link.h"
+#include "drivers/serial/libserialport_link.h"
 
 #include <fcntl.h>
 #include <libserialport.h>
@@ -9,9 +9,9 @@
 #include <cstring>
 
 #include "drivers/exclusive_open.h"
-#include "drivers/pr650/fd_io.h"
+#include "drivers/serial/fd_io.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 namespace {
 
@@ -129,4 +129,4 @@ Status LibSerialPortLink::SetRts(bool on) {
   return Status::Ok();
 }
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

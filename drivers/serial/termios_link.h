@@ -3,9 +3,9 @@
 // fail with ENOTTY or EINVAL: those are logged and tolerated.
 #pragma once
 
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/serial_link.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 class TermiosLink final : public SerialLink {
  public:
@@ -32,4 +32,4 @@ class TermiosLink final : public SerialLink {
   int fd_ = -1;
 };
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

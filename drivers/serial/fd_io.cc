@@ -1,4 +1,4 @@
-#include "drivers/pr650/fd_io.h"
+#include "drivers/serial/fd_io.h"
 
 #include <poll.h>
 #include <unistd.h>
@@ -7,7 +7,7 @@
 #include <cerrno>
 #include <cstring>
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 namespace {
 
@@ -118,4 +118,4 @@ Status OpenError(int err, const std::string& port, bool seen_before) {
   }
 }
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

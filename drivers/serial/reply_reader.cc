@@ -1,8 +1,8 @@
-#include "drivers/pr650/reply_reader.h"
+#include "drivers/serial/reply_reader.h"
 
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/serial/reply_lines.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 namespace {
 
@@ -46,8 +46,8 @@ Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
       }
     }
     if (reply.size() > framing.max_reply_bytes) {
-      return ProtocolError(framing.device + " reply to " + command + " on " + link.port() + " exceeds " +
-                           std::to_string(framing.max_reply_bytes) +
+      return ProtocolError(framing.device + " reply to " + command + " on " + link.port() +
+                           " exceeds " + std::to_string(framing.max_reply_bytes) +
                            " bytes without ending: line noise or a wrong baud rate; check the "
                            "cable and that the meter is set to the configured baud rate");
     }
@@ -89,14 +89,14 @@ Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
         return Timeout(framing.device + " on " + link.port() + " did not answer " + command +
                        " before the call's deadline");
       }
-      return Timeout("call deadline passed while reading the " + framing.device + "'s reply to " + command +
-                     " on " + link.port() + " (" + Progress(reply, lines) + ")");
+      return Timeout("call deadline passed while reading the " + framing.device + "'s reply to " +
+                     command + " on " + link.port() + " (" + Progress(reply, lines) + ")");
     }
     if (reply.empty()) {
-      return Timeout(framing.device + " on " + link.port() + " did not answer " + command + " within " +
-                     std::to_string(Millis(request.first_byte_timeout)) + " ms");
+      return Timeout(framing.device + " on " + link.port() + " did not answer " + command +
+                     " within " + std::to_string(Millis(request.first_byte_timeout)) + " ms");
     }
   }
 }
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

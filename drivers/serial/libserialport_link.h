@@ -3,11 +3,11 @@
 // (sp_get_port_handle) so that a hang-up is told apart from "no data yet".
 #pragma once
 
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/serial_link.h"
 
 struct sp_port;
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 class LibSerialPortLink final : public SerialLink {
  public:
@@ -34,4 +34,4 @@ class LibSerialPortLink final : public SerialLink {
   int fd_ = -1;
 };
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

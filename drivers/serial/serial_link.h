@@ -23,7 +23,7 @@
 #include "core/call_context.h"
 #include "core/status.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 // Where the driver's diagnostics go (the daemon wires this to its logger).
 using LogSink = std::function<void(std::string_view message)>;
@@ -75,4 +75,4 @@ Result<std::unique_ptr<SerialLink>> MakeSerialLink(const SerialSettings& setting
 // Baud rates both implementations accept.
 bool IsSupportedBaud(int baud);
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

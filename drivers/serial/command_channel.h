@@ -19,10 +19,10 @@
 
 #include "core/call_context.h"
 #include "core/status.h"
-#include "drivers/pr650/reply_reader.h"
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/reply_reader.h"
+#include "drivers/serial/serial_link.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 struct ChannelOptions {
   using Millis = std::chrono::milliseconds;
@@ -93,4 +93,4 @@ class CommandChannel {
   std::optional<std::chrono::steady_clock::time_point> late_reply_until_;
 };
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

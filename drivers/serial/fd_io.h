@@ -10,7 +10,7 @@
 #include "core/call_context.h"
 #include "core/status.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 // The longest single wait inside any PR-650 I/O loop.
 inline constexpr std::chrono::milliseconds kWaitSlice{20};
@@ -29,4 +29,4 @@ Status OpenError(int err, const std::string& port, bool seen_before);
 // "serial port /dev/ttyUSB0 vanished (read: Input/output error); ..." for an errno (0: hang-up).
 Status VanishedError(const std::string& port, std::string_view during, int err);
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

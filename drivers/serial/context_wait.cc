@@ -1,8 +1,8 @@
-#include "drivers/pr650/context_wait.h"
+#include "drivers/serial/context_wait.h"
 
 #include <string>
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 Status WaitChecked(std::chrono::steady_clock::duration d, const CallContext& ctx,
                    std::string_view what) {
@@ -21,4 +21,4 @@ Status WaitChecked(std::chrono::steady_clock::duration d, const CallContext& ctx
   }
 }
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

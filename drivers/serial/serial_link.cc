@@ -1,4 +1,4 @@
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/serial_link.h"
 
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
@@ -6,10 +6,10 @@
 #include <climits>
 #include <cstdlib>
 
-#include "drivers/pr650/libserialport_link.h"
-#include "drivers/pr650/termios_link.h"
+#include "drivers/serial/libserialport_link.h"
+#include "drivers/serial/termios_link.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 bool IsSupportedBaud(int baud) {
   switch (baud) {
@@ -60,4 +60,4 @@ Result<std::unique_ptr<SerialLink>> MakeSerialLink(const SerialSettings& setting
   return std::unique_ptr<SerialLink>(std::make_unique<LibSerialPortLink>(settings, std::move(log)));
 }
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

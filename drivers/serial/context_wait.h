@@ -8,7 +8,7 @@
 #include "core/call_context.h"
 #include "core/status.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 // Sleeps `d` on the context's clock. kCancelled when cancelled meanwhile; kTimeout (without
 // sleeping) when the deadline comes before `d` is over. `what` names the wait in messages
@@ -16,4 +16,4 @@ namespace brdf::drivers::pr650 {
 Status WaitChecked(std::chrono::steady_clock::duration d, const CallContext& ctx,
                    std::string_view what);
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

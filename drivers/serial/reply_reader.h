@@ -15,9 +15,9 @@
 
 #include "core/call_context.h"
 #include "core/status.h"
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/serial_link.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 struct FramingOptions {
   // Silence after the last byte that ends a complete reply.
@@ -53,4 +53,4 @@ struct ReplyRequest {
 Result<std::string> ReadReply(SerialLink& link, const ReplyRequest& request,
                               const FramingOptions& framing, const CallContext& ctx);
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

@@ -1,11 +1,11 @@
-#include "drivers/pr650/command_channel.h"
+#include "drivers/serial/command_channel.h"
 
 #include <algorithm>
 
-#include "drivers/pr650/context_wait.h"
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/serial/context_wait.h"
+#include "drivers/serial/reply_lines.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 CommandChannel::CommandChannel(ChannelOptions options, LinkFactory link_factory)
     : options_(std::move(options)), link_factory_(std::move(link_factory)) {
@@ -145,4 +145,4 @@ Status CommandChannel::DiscardLateReply(const CallContext& ctx) {
   return Status::Ok();
 }
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

@@ -1,4 +1,4 @@
-#include "drivers/pr650/termios_link.h"
+#include "drivers/serial/termios_link.h"
 
 #include <fcntl.h>
 #include <sys/ioctl.h>
@@ -9,9 +9,9 @@
 #include <cstring>
 
 #include "drivers/exclusive_open.h"
-#include "drivers/pr650/fd_io.h"
+#include "drivers/serial/fd_io.h"
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 
 namespace {
 
@@ -143,4 +143,4 @@ Status TermiosLink::SetRts(bool on) {
   return Status::Ok();
 }
 
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial
