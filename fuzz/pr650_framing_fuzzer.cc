@@ -18,7 +18,7 @@
 
 #include "core/call_context.h"
 #include "core/clock.h"
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/protocol.h"
 #include "drivers/serial/reply_lines.h"
 #include "drivers/serial/reply_reader.h"
 #include "fuzz/fuzz_check.h"

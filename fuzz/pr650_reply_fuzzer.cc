@@ -1,4 +1,4 @@
-// Fuzz target: the PR-650 reply parser (drivers/pr650/pr650_protocol.h) and the line framing it
+// Fuzz target: the PR-650 reply parser (drivers/pr650/protocol.h) and the line framing it
 // rests on (drivers/serial/reply_lines.h). The input is one reply
 // as it came off the wire; every parser gets it, because the meter (or line noise) can send any
 // bytes in answer to any command. Beyond not crashing, each parser must keep its promises:
@@ -10,7 +10,7 @@
 #include <optional>
 #include <string>
 
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/protocol.h"
 #include "drivers/serial/reply_lines.h"
 #include "fuzz/fuzz_check.h"
 

@@ -7,7 +7,7 @@
 #include <memory>
 #include <thread>
 
-#include "drivers/cs2000/cs2000_spectroradiometer.h"
+#include "drivers/cs2000/spectroradiometer.h"
 #include "tests/drivers_meters/meter_test_rig.h"
 
 namespace brdf::testing {

@@ -12,8 +12,8 @@
 
 #include "core/call_context.h"
 #include "core/wavelength_grid.h"
-#include "drivers/cs2000/cs2000_options.h"
-#include "drivers/pr670/pr670_options.h"
+#include "drivers/cs2000/options.h"
+#include "drivers/pr670/options.h"
 #include "tools/brdf-sim/meter/cs2000_endpoint.h"
 #include "tools/brdf-sim/meter/pr670_endpoint.h"
 #include "tools/brdf-sim/sim_shared.h"

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <memory>
 
-#include "drivers/pr670/pr670_spectroradiometer.h"
+#include "drivers/pr670/spectroradiometer.h"
 #include "tests/drivers_meters/meter_test_rig.h"
 
 namespace brdf::testing {

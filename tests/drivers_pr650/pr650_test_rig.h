@@ -13,8 +13,8 @@
 #include <thread>
 #include <vector>
 
-#include "drivers/pr650/pr650_options.h"
-#include "drivers/pr650/pr650_spectroradiometer.h"
+#include "drivers/pr650/options.h"
+#include "drivers/pr650/spectroradiometer.h"
 #include "tools/brdf-sim/meter/pr650_endpoint.h"
 #include "tools/brdf-sim/sim_shared.h"
 

@@ -1,4 +1,4 @@
-#include "drivers/pr650/pr650_options.h"
+#include "drivers/pr650/options.h"
 
 #include <algorithm>
 

@@ -28,8 +28,8 @@
 #include <string>
 
 #include "drivers/pr650/quality_loop.h"
-#include "drivers/pr670/pr670_options.h"
-#include "drivers/pr670/pr670_protocol.h"
+#include "drivers/pr670/options.h"
+#include "drivers/pr670/protocol.h"
 #include "drivers/serial/command_channel.h"
 #include "drivers/spectroradiometer.h"
 

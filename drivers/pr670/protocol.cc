@@ -1,9 +1,9 @@
-#include "drivers/pr670/pr670_protocol.h"
+#include "drivers/pr670/protocol.h"
 
 #include <array>
 #include <cmath>
 
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/protocol.h"
 #include "drivers/serial/reply_lines.h"
 
 namespace brdf::drivers::pr670 {

@@ -1,10 +1,10 @@
-#include "drivers/cs2000/cs2000_protocol.h"
+#include "drivers/cs2000/protocol.h"
 
 #include <array>
 #include <cmath>
 #include <cstdio>
 
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/protocol.h"
 #include "drivers/serial/reply_lines.h"
 
 namespace brdf::drivers::cs2000 {

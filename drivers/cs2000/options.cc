@@ -1,4 +1,4 @@
-#include "drivers/cs2000/cs2000_options.h"
+#include "drivers/cs2000/options.h"
 
 namespace brdf::drivers {
 

@@ -1,4 +1,4 @@
-#include "drivers/pr670/pr670_options.h"
+#include "drivers/pr670/options.h"
 
 #include <algorithm>
 

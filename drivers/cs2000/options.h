@@ -7,7 +7,7 @@
 #include <string>
 
 #include "core/status.h"
-#include "drivers/cs2000/cs2000_protocol.h"
+#include "drivers/cs2000/protocol.h"
 #include "drivers/pr650/quality_codes.h"
 #include "drivers/serial/serial_link.h"
 

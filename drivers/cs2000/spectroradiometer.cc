@@ -1,8 +1,8 @@
-#include "drivers/cs2000/cs2000_spectroradiometer.h"
+#include "drivers/cs2000/spectroradiometer.h"
 
 #include <iostream>
 
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/protocol.h"
 #include "drivers/serial/reply_lines.h"
 
 namespace brdf::drivers {

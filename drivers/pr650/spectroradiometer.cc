@@ -1,4 +1,4 @@
-#include "drivers/pr650/pr650_spectroradiometer.h"
+#include "drivers/pr650/spectroradiometer.h"
 
 #include <iostream>
 

@@ -1,4 +1,4 @@
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/protocol.h"
 
 #include <charconv>
 #include <cmath>

@@ -7,9 +7,9 @@
 // operator's remedy: power-cycle it and connect within 5 s; XFER/CTRLR on CTRLR.
 //
 // Every exchange: wait out the pacing, empty the input buffer, write the command + LF, read the
-// reply (reply_reader.h), parse it (pr650_protocol.h). If a call is cancelled or times out while
-// the meter may still answer (an M0 takes up to 30 s), the next exchange first waits for and
-// discards that late reply, so it is never mistaken for the answer to a new command.
+// reply (drivers/serial/reply_reader.h), parse it (protocol.h). If a call is cancelled or times
+// out while the meter may still answer (an M0 takes up to 30 s), the next exchange first waits
+// for and discards that late reply, so it is never mistaken for the answer to a new command.
 //
 // M0 reply: the sources give only "000" for success. This driver reads it as a 3-digit status
 // whose value is the quality code ("018" = low light), and judges the report's own quality code
@@ -34,8 +34,8 @@
 #include <string_view>
 #include <vector>
 
-#include "drivers/pr650/pr650_options.h"
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/options.h"
+#include "drivers/pr650/protocol.h"
 #include "drivers/serial/reply_reader.h"
 #include "drivers/serial/serial_link.h"
 #include "drivers/spectroradiometer.h"

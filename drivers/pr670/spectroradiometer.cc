@@ -1,8 +1,8 @@
-#include "drivers/pr670/pr670_spectroradiometer.h"
+#include "drivers/pr670/spectroradiometer.h"
 
 #include <iostream>
 
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/protocol.h"
 #include "drivers/serial/context_wait.h"
 #include "drivers/serial/reply_lines.h"
 

@@ -24,8 +24,8 @@
 #include <optional>
 #include <string>
 
-#include "drivers/cs2000/cs2000_options.h"
-#include "drivers/cs2000/cs2000_protocol.h"
+#include "drivers/cs2000/options.h"
+#include "drivers/cs2000/protocol.h"
 #include "drivers/pr650/quality_loop.h"
 #include "drivers/serial/command_channel.h"
 #include "drivers/spectroradiometer.h"
