@@ -1,77 +1,31 @@
 #include "drivers/cs2000/spectroradiometer.h"
 
-#include <iostream>
-
 #include "drivers/pr650/protocol.h"
 #include "drivers/serial/reply_lines.h"
 
 namespace brdf::drivers {
 
-namespace {
-
-serial::ChannelOptions ChannelFor(const Cs2000Options& o) {
-  serial::ChannelOptions c;
-  c.serial = {o.port, o.baud, o.hardware_flow_control, o.model};
-  c.line_end = "\n";
-  c.command_pacing = o.command_pacing;
-  c.quiet_gap = o.quiet_gap;
-  c.stall_timeout = o.stall_timeout;
-  c.log = o.log;
-  return c;
-}
-
-Cs2000Options WithLog(Cs2000Options o) {
-  if (!o.log) o.log = [](std::string_view m) { std::clog << "cs2000: " << m << '\n'; };
-  return o;
-}
-
-}  // namespace
-
 Cs2000Spectroradiometer::Cs2000Spectroradiometer(Cs2000Options options,
                                                  serial::CommandChannel::LinkFactory link_factory)
-    : options_(WithLog(std::move(options))),
-      channel_(ChannelFor(options_), std::move(link_factory)),
-      model_(options_.model) {}
+    : options_(WithStderrLog(std::move(options), "cs2000")),
+      connection_(options_, "\n", std::chrono::milliseconds(0), std::move(link_factory)) {}
 
 Cs2000Spectroradiometer::~Cs2000Spectroradiometer() {
   Disconnect();
 }
 
-std::string Cs2000Spectroradiometer::Where() const {
-  return model_ + " on " + options_.port;
-}
-
-void Cs2000Spectroradiometer::Log(const std::string& message) const {
-  options_.log(message);
-}
-
-Status Cs2000Spectroradiometer::RequireConnected() const {
-  if (connected_) return Status::Ok();
-  if (lost_connection_) {
-    return Disconnected(Where() +
-                        " lost its connection earlier: connect again once the port is "
-                        "back");
-  }
-  return FailedPrecondition(Where() + " is not connected: call Connect first");
-}
-
 Status Cs2000Spectroradiometer::Lost(const Status& status) {
-  if (channel_.lost()) {
-    connected_ = false;
-    lost_connection_ = true;
+  if (connection_.NoteIfLost()) {
     holds_measurement_ = false;
     meter_setup_.reset();
   }
   return status;
 }
 
-Status Cs2000Spectroradiometer::Connect(const CallContext& ctx) {
-  if (connected_) return Status::Ok();
-  BRDF_RETURN_IF_ERROR(ValidateCs2000Options(options_));
-  channel_.Close();
-  Status status = channel_.Open();
+Status Cs2000Spectroradiometer::EnterRemoteMode(const CallContext& ctx) {
+  Status status;
   for (int attempt = 1; status.ok() && attempt <= options_.remote_attempts; ++attempt) {
-    Result<std::string> reply = channel_.Exchange(
+    Result<std::string> reply = connection_.channel().Exchange(
         cs2000::kRemoteOnCommand, {.lines = 1, .first_byte_timeout = options_.reply_timeout}, ctx);
     if (reply.ok()) {
       status = cs2000::ParseOkReply(*reply, cs2000::kRemoteOnCommand).status();
@@ -79,38 +33,36 @@ Status Cs2000Spectroradiometer::Connect(const CallContext& ctx) {
     }
     status = reply.status();
     if (status.code() != StatusCode::kTimeout || ctx.expired()) break;
-    Log("RMTS,1 attempt " + std::to_string(attempt) + " on " + options_.port + ": " +
-        status.ToString());
+    connection_.Log("RMTS,1 attempt " + std::to_string(attempt) + " on " + options_.port + ": " +
+                    status.ToString());
   }
   if (status.code() == StatusCode::kTimeout && !ctx.expired()) {
-    status =
-        Timeout(Where() + " did not answer RMTS,1 in " + std::to_string(options_.remote_attempts) +
-                " attempt(s): check that it is "
-                "switched on, that its cable is in (RS-232C: the baud rate set on the meter "
-                "matches [meter] baud) and that no other program has the port");
+    status = Timeout(connection_.Where() + " did not answer RMTS,1 in " +
+                     std::to_string(options_.remote_attempts) +
+                     " attempt(s): check that it is "
+                     "switched on, that its cable is in (RS-232C: the baud rate set on the meter "
+                     "matches [meter] baud) and that no other program has the port");
   }
-  if (!status.ok()) {
-    channel_.Close();
-    return status;
-  }
-  connected_ = true;
-  lost_connection_ = false;
+  return status;
+}
+
+Status Cs2000Spectroradiometer::Connect(const CallContext& ctx) {
+  if (connection_.connected()) return Status::Ok();
+  BRDF_RETURN_IF_ERROR(ValidateCs2000Options(options_));
+  BRDF_RETURN_IF_ERROR(connection_.Connect([&] { return EnterRemoteMode(ctx); }));
   meter_setup_.reset();
   holds_measurement_ = false;
   return Status::Ok();
 }
 
 void Cs2000Spectroradiometer::Disconnect() {
-  if (channel_.is_open() && connected_) {
+  connection_.Disconnect([this] {
     // Remote mode off, so the meter's own keys work again; best effort.
     const CallContext ctx = CallContext::WithTimeout(std::chrono::milliseconds(500));
-    (void)channel_.Exchange(cs2000::kRemoteOffCommand,
-                            {.lines = 1, .first_byte_timeout = std::chrono::milliseconds(400)},
-                            ctx);
-  }
-  channel_.Close();
-  connected_ = false;
-  lost_connection_ = false;
+    (void)connection_.channel().Exchange(
+        cs2000::kRemoteOffCommand,
+        {.lines = 1, .first_byte_timeout = std::chrono::milliseconds(400)}, ctx);
+  });
   holds_measurement_ = false;
   meter_setup_.reset();
 }
@@ -118,9 +70,9 @@ void Cs2000Spectroradiometer::Disconnect() {
 Result<cs2000::Reply> Cs2000Spectroradiometer::Ask(std::string_view command,
                                                    std::chrono::milliseconds timeout,
                                                    const CallContext& ctx) {
-  BRDF_RETURN_IF_ERROR(RequireConnected());
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
   Result<std::string> reply =
-      channel_.Exchange(command, {.lines = 1, .first_byte_timeout = timeout}, ctx);
+      connection_.channel().Exchange(command, {.lines = 1, .first_byte_timeout = timeout}, ctx);
   if (!reply.ok()) return Lost(reply.status());
   return cs2000::ParseOkReply(*reply, command);
 }
@@ -138,20 +90,21 @@ Status Cs2000Spectroradiometer::Apply(const Setup& setup, const CallContext& ctx
 }
 
 Result<MeterIdentity> Cs2000Spectroradiometer::Identify(const CallContext& ctx) {
-  BRDF_RETURN_IF_ERROR(RequireConnected());
-  Result<std::string> reply = channel_.Exchange(
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
+  Result<std::string> reply = connection_.channel().Exchange(
       cs2000::kIdentityCommand, {.lines = 1, .first_byte_timeout = options_.reply_timeout}, ctx);
   if (!reply.ok()) return Lost(reply.status());
   BRDF_ASSIGN_OR_RETURN(const cs2000::Identity id, cs2000::ParseIdentityReply(*reply));
-  model_ = id.model;
+  connection_.set_model(id.model);
   return MeterIdentity{id.model, id.serial_number, cs2000::Grid()};
 }
 
 Status Cs2000Spectroradiometer::Configure(const MeasurementSettings& settings,
                                           const CallContext& ctx) {
-  BRDF_RETURN_IF_ERROR(RequireConnected());
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
   if (settings.averages != 1) {
-    return InvalidArgument(Where() + " cannot average " + std::to_string(settings.averages) +
+    return InvalidArgument(connection_.Where() + " cannot average " +
+                           std::to_string(settings.averages) +
                            " measurements: the CS-2000 has no averaging setting; plan 1 average "
                            "(a longer integration time lowers the noise instead)");
   }
@@ -165,9 +118,9 @@ Status Cs2000Spectroradiometer::Configure(const MeasurementSettings& settings,
 }
 
 Result<cs2000::Reply> Cs2000Spectroradiometer::MeasureOnce(const CallContext& ctx) {
-  BRDF_RETURN_IF_ERROR(RequireConnected());
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
   constexpr std::string_view kCommand = cs2000::kMeasureCommand;
-  Result<std::string> start = channel_.Exchange(
+  Result<std::string> start = connection_.channel().Exchange(
       kCommand, {.lines = 1, .first_byte_timeout = options_.measure_start_timeout}, ctx);
   if (!start.ok()) return Lost(start.status());
   // A short measurement's completion may follow its measuring time closely enough to arrive in
@@ -178,23 +131,23 @@ Result<cs2000::Reply> Cs2000Spectroradiometer::MeasureOnce(const CallContext& ct
   BRDF_ASSIGN_OR_RETURN(const int seconds, cs2000::ParseMeasuringTime(lines.front()));
   std::string completion = lines.size() > 1 ? lines[1] : std::string();
   if (lines.size() > 2) {
-    return ProtocolError(Where() + " answered MEAS,1 with " + std::to_string(lines.size()) +
-                         " lines (\"" + serial::Printable(*start) +
+    return ProtocolError(connection_.Where() + " answered MEAS,1 with " +
+                         std::to_string(lines.size()) + " lines (\"" + serial::Printable(*start) +
                          "\"); expected the measuring time, then the completion");
   }
   if (completion.empty()) {
     const auto timeout = std::chrono::milliseconds(seconds * 1000LL) + options_.measurement_timeout;
     Result<std::string> done =
-        channel_.ReadMore(kCommand, {.lines = 1, .first_byte_timeout = timeout}, ctx);
+        connection_.channel().ReadMore(kCommand, {.lines = 1, .first_byte_timeout = timeout}, ctx);
     if (!done.ok()) {
       Status st = done.status();
       if (st.code() == StatusCode::kTimeout && !ctx.expired()) {
-        st = Timeout(Where() + " announced a measuring time of " + std::to_string(seconds) +
-                     " s but did not report the measurement done within " +
-                     std::to_string(timeout.count()) +
-                     " ms ([meter] measurement_timeout_ms is "
-                     "the margin); if it left remote mode or was switched off, it is connected "
-                     "again");
+        st = Timeout(
+            connection_.Where() + " announced a measuring time of " + std::to_string(seconds) +
+            " s but did not report the measurement done within " + std::to_string(timeout.count()) +
+            " ms ([meter] measurement_timeout_ms is "
+            "the margin); if it left remote mode or was switched off, it is connected "
+            "again");
       }
       return Lost(st);
     }
@@ -217,11 +170,11 @@ Status Cs2000Spectroradiometer::PrepareRemeasure(const pr650::QualityDecision& d
 }
 
 Result<MeasurementOutcome> Cs2000Spectroradiometer::Measure(const CallContext& ctx) {
-  BRDF_RETURN_IF_ERROR(RequireConnected());
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
   holds_measurement_ = false;
   if (configured_ && meter_setup_ != configured_) BRDF_RETURN_IF_ERROR(Apply(*configured_, ctx));
   pr650::QualityLoop loop(options_.quality_policy, options_.max_measure_attempts, dark_,
-                          options_.log, Where());
+                          options_.log, connection_.Where());
   for (;; loop.NextAttempt()) {
     const Setup current = meter_setup_.value_or(Setup{});
     BRDF_ASSIGN_OR_RETURN(const cs2000::Reply check, MeasureOnce(ctx));
@@ -245,17 +198,18 @@ Result<MeasurementOutcome> Cs2000Spectroradiometer::Measure(const CallContext& c
 }
 
 Result<SpectrumReport> Cs2000Spectroradiometer::TransferSpectrum(const CallContext& ctx) {
-  BRDF_RETURN_IF_ERROR(RequireConnected());
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
   if (!holds_measurement_) {
-    return FailedPrecondition(Where() + " holds no accepted measurement: call Measure first");
+    return FailedPrecondition(connection_.Where() +
+                              " holds no accepted measurement: call Measure first");
   }
   SpectrumReport report;
   report.grid = cs2000::Grid();
   report.radiance.reserve(report.grid.count);
   for (int block = 1; block <= cs2000::kBlocks; ++block) {
     const std::string command = cs2000::SpectralBlockCommand(block);
-    Result<std::string> reply =
-        channel_.Exchange(command, {.lines = 1, .first_byte_timeout = options_.reply_timeout}, ctx);
+    Result<std::string> reply = connection_.channel().Exchange(
+        command, {.lines = 1, .first_byte_timeout = options_.reply_timeout}, ctx);
     if (!reply.ok()) return Lost(reply.status());
     BRDF_ASSIGN_OR_RETURN(const std::vector<double> values,
                           cs2000::ParseSpectralBlock(*reply, block));

@@ -26,8 +26,8 @@
 
 #include "drivers/cs2000/options.h"
 #include "drivers/cs2000/protocol.h"
+#include "drivers/line_meter/connection.h"
 #include "drivers/pr650/quality_loop.h"
-#include "drivers/serial/command_channel.h"
 #include "drivers/spectroradiometer.h"
 
 namespace brdf::drivers {
@@ -41,7 +41,7 @@ class Cs2000Spectroradiometer final : public Spectroradiometer {
 
   Status Connect(const CallContext& ctx) override;
   void Disconnect() override;
-  bool connected() const override { return connected_; }
+  bool connected() const override { return connection_.connected(); }
 
   Result<MeterIdentity> Identify(const CallContext& ctx) override;
   Status Configure(const MeasurementSettings& settings, const CallContext& ctx) override;
@@ -57,7 +57,8 @@ class Cs2000Spectroradiometer final : public Spectroradiometer {
     friend bool operator==(const Setup&, const Setup&) = default;
   };
 
-  Status RequireConnected() const;
+  // RMTS,1 until the meter answers OK00 (on an open port).
+  Status EnterRemoteMode(const CallContext& ctx);
   // Sends `command`, reads its one-line reply and checks it is OK00.
   Result<cs2000::Reply> Ask(std::string_view command, std::chrono::milliseconds timeout,
                             const CallContext& ctx);
@@ -67,17 +68,12 @@ class Cs2000Spectroradiometer final : public Spectroradiometer {
   Status PrepareRemeasure(const pr650::QualityDecision& decision, int code,
                           pr650::QualityLoop& loop, const CallContext& ctx);
   Status Lost(const Status& status);
-  std::string Where() const;
-  void Log(const std::string& message) const;
 
   Cs2000Options options_;
-  serial::CommandChannel channel_;
-  bool connected_ = false;
-  bool lost_connection_ = false;
+  LineMeterConnection connection_;
   std::optional<Setup> configured_;
   std::optional<Setup> meter_setup_;
   bool dark_ = false;
-  std::string model_;
   bool holds_measurement_ = false;
 };
 

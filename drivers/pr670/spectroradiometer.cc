@@ -1,69 +1,25 @@
 #include "drivers/pr670/spectroradiometer.h"
 
-#include <iostream>
-
 #include "drivers/pr650/protocol.h"
 #include "drivers/serial/context_wait.h"
 #include "drivers/serial/reply_lines.h"
 
 namespace brdf::drivers {
 
-namespace {
-
-serial::ChannelOptions ChannelFor(const Pr670Options& o) {
-  serial::ChannelOptions c;
-  c.serial = {o.port, o.baud, o.hardware_flow_control, o.model};
-  c.line_end = "\r";
-  c.char_gap = o.char_gap;
-  c.command_pacing = o.command_pacing;
-  c.quiet_gap = o.quiet_gap;
-  c.stall_timeout = o.stall_timeout;
-  c.log = o.log;
-  return c;
-}
-
-Pr670Options WithLog(Pr670Options o) {
-  if (!o.log) o.log = [](std::string_view m) { std::clog << "pr670: " << m << '\n'; };
-  return o;
-}
-
-}  // namespace
-
 Pr670Spectroradiometer::Pr670Spectroradiometer(Pr670Options options,
                                                serial::CommandChannel::LinkFactory link_factory)
-    : options_(WithLog(std::move(options))),
-      channel_(ChannelFor(options_), std::move(link_factory)),
-      model_(options_.model) {
+    : options_(WithStderrLog(std::move(options), "pr670")),
+      connection_(options_, "\r", options_.char_gap, std::move(link_factory)) {
   // A PR-655 reports 101 bands, 4 nm apart; D120 tells either once identified.
-  if (model_ == "PR-655") grid_ = WavelengthGrid::Pr650();
+  if (options_.model == "PR-655") grid_ = WavelengthGrid::Pr650();
 }
 
 Pr670Spectroradiometer::~Pr670Spectroradiometer() {
   Disconnect();
 }
 
-std::string Pr670Spectroradiometer::Where() const {
-  return model_ + " on " + options_.port;
-}
-
-void Pr670Spectroradiometer::Log(const std::string& message) const {
-  options_.log(message);
-}
-
-Status Pr670Spectroradiometer::RequireConnected() const {
-  if (connected_) return Status::Ok();
-  if (lost_connection_) {
-    return Disconnected(Where() +
-                        " lost its connection earlier: connect again once the port is "
-                        "back");
-  }
-  return FailedPrecondition(Where() + " is not connected: call Connect first");
-}
-
 Status Pr670Spectroradiometer::Lost(const Status& status) {
-  if (channel_.lost()) {
-    connected_ = false;
-    lost_connection_ = true;
+  if (connection_.NoteIfLost()) {
     held_.reset();
     meter_setup_.reset();
   }
@@ -76,56 +32,48 @@ Status Pr670Spectroradiometer::EnterRemoteMode(const CallContext& ctx) {
   Status last;
   for (int attempt = 1; attempt <= options_.remote_attempts; ++attempt) {
     // Q first: a meter left in remote mode answers the next PHOTO only after leaving it.
-    BRDF_RETURN_IF_ERROR(channel_.Send(pr670::kQuitCommand, ctx));
+    BRDF_RETURN_IF_ERROR(connection_.channel().Send(pr670::kQuitCommand, ctx));
     BRDF_RETURN_IF_ERROR(serial::WaitChecked(options_.quit_settle, ctx,
                                              "letting the meter leave "
                                              "remote mode"));
-    BRDF_RETURN_IF_ERROR(channel_.Send(pr670::kRemoteModeCommand, ctx));
-    Result<std::string> answer =
-        channel_.ReadMore(pr670::kRemoteModeCommand,
-                          {.lines = 1, .first_byte_timeout = options_.remote_timeout}, ctx);
+    BRDF_RETURN_IF_ERROR(connection_.channel().Send(pr670::kRemoteModeCommand, ctx));
+    Result<std::string> answer = connection_.channel().ReadMore(
+        pr670::kRemoteModeCommand, {.lines = 1, .first_byte_timeout = options_.remote_timeout},
+        ctx);
     if (answer.ok()) {
-      Log(Where() + " is in remote mode: \"" + serial::Printable(*answer) + "\"");
+      connection_.Log(connection_.Where() + " is in remote mode: \"" + serial::Printable(*answer) +
+                      "\"");
       return Status::Ok();
     }
     last = answer.status();
     if (last.code() != StatusCode::kTimeout || ctx.expired()) return last;
-    Log("remote-mode attempt " + std::to_string(attempt) + " of " +
-        std::to_string(options_.remote_attempts) + " on " + options_.port + ": " + last.ToString());
+    connection_.Log("remote-mode attempt " + std::to_string(attempt) + " of " +
+                    std::to_string(options_.remote_attempts) + " on " + options_.port + ": " +
+                    last.ToString());
   }
-  return Timeout(Where() + " did not answer PHOTO in " + std::to_string(options_.remote_attempts) +
-                 " attempt(s) of " + std::to_string(options_.remote_timeout.count()) +
+  return Timeout(connection_.Where() + " did not answer PHOTO in " +
+                 std::to_string(options_.remote_attempts) + " attempt(s) of " +
+                 std::to_string(options_.remote_timeout.count()) +
                  " ms: the meter is not entering remote mode. Check that it is switched on and "
                  "its USB cable is in, that no other program has the port, and that its screen "
                  "is not in a menu; then connect again");
 }
 
 Status Pr670Spectroradiometer::Connect(const CallContext& ctx) {
-  if (connected_) return Status::Ok();
+  if (connection_.connected()) return Status::Ok();
   BRDF_RETURN_IF_ERROR(ValidatePr670Options(options_));
-  channel_.Close();
-  Status status = channel_.Open();
-  if (status.ok()) status = EnterRemoteMode(ctx);
-  if (!status.ok()) {
-    channel_.Close();
-    return status;
-  }
-  connected_ = true;
-  lost_connection_ = false;
+  BRDF_RETURN_IF_ERROR(connection_.Connect([&] { return EnterRemoteMode(ctx); }));
   meter_setup_.reset();  // a meter re-entering remote mode may not keep ours
   held_.reset();
   return Status::Ok();
 }
 
 void Pr670Spectroradiometer::Disconnect() {
-  if (channel_.is_open() && connected_) {
+  connection_.Disconnect([this] {
     // Leave remote mode, so the meter's own buttons work again; best effort.
     const CallContext ctx = CallContext::WithTimeout(std::chrono::seconds(1));
-    (void)channel_.Send(pr670::kQuitCommand, ctx);
-  }
-  channel_.Close();
-  connected_ = false;
-  lost_connection_ = false;
+    (void)connection_.channel().Send(pr670::kQuitCommand, ctx);
+  });
   held_.reset();
   meter_setup_.reset();
 }
@@ -135,9 +83,9 @@ void Pr670Spectroradiometer::Disconnect() {
 Result<std::string> Pr670Spectroradiometer::Ask(std::string_view command,
                                                 std::chrono::milliseconds timeout,
                                                 const CallContext& ctx) {
-  BRDF_RETURN_IF_ERROR(RequireConnected());
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
   Result<std::string> reply =
-      channel_.Exchange(command, {.lines = 1, .first_byte_timeout = timeout}, ctx);
+      connection_.channel().Exchange(command, {.lines = 1, .first_byte_timeout = timeout}, ctx);
   if (!reply.ok()) return Lost(reply.status());
   return reply;
 }
@@ -146,7 +94,7 @@ Status Pr670Spectroradiometer::SetOne(const std::string& command, const CallCont
   BRDF_ASSIGN_OR_RETURN(const std::string reply, Ask(command, options_.reply_timeout, ctx));
   BRDF_ASSIGN_OR_RETURN(const int code, pr670::ParseResultCode(reply, command));
   if (code != 0) {
-    return DeviceError(code, Where() + " refused " + command + ": result code " +
+    return DeviceError(code, connection_.Where() + " refused " + command + ": result code " +
                                  pr670::DescribeResultCode(code) +
                                  "; check the measurement settings against the meter's range");
   }
@@ -178,13 +126,13 @@ Result<MeterIdentity> Pr670Spectroradiometer::Identify(const CallContext& ctx) {
   BRDF_ASSIGN_OR_RETURN(const std::string layout_reply,
                         Ask(pr670::kLayoutCommand, options_.reply_timeout, ctx));
   BRDF_ASSIGN_OR_RETURN(grid_, pr670::ParseLayoutReply(layout_reply));
-  model_ = name;
+  connection_.set_model(name);
   return MeterIdentity{name, serial, grid_};
 }
 
 Status Pr670Spectroradiometer::Configure(const MeasurementSettings& settings,
                                          const CallContext& ctx) {
-  BRDF_RETURN_IF_ERROR(RequireConnected());
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
   const Setup setup{settings.integration_ms, settings.averages, settings.sync_to_source};
   BRDF_RETURN_IF_ERROR(pr670::ExposureCommand(setup.exposure_ms).status());
   BRDF_RETURN_IF_ERROR(pr670::AveragesCommand(setup.averages).status());
@@ -197,7 +145,7 @@ Status Pr670Spectroradiometer::Configure(const MeasurementSettings& settings,
 
 Result<std::string> Pr670Spectroradiometer::MeasureOnce(
     const CallContext& ctx, const std::function<void(std::string_view)>& on_header) {
-  BRDF_RETURN_IF_ERROR(RequireConnected());
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
   const Setup current = meter_setup_.value_or(Setup{});
   const std::chrono::milliseconds timeout =
       Pr670MeasurementTimeout(options_, current.exposure_ms, current.averages);
@@ -211,7 +159,8 @@ Result<std::string> Pr670Spectroradiometer::MeasureOnce(
     Result<int> code = pr670::ParseResultCode(line, pr670::kMeasureSpectrumCommand);
     return code.ok() && *code != 0 ? 1 : full;
   };
-  Result<std::string> reply = channel_.Exchange(pr670::kMeasureSpectrumCommand, shape, ctx);
+  Result<std::string> reply =
+      connection_.channel().Exchange(pr670::kMeasureSpectrumCommand, shape, ctx);
   if (!reply.ok()) {
     Status st = reply.status();
     if (st.code() == StatusCode::kTimeout && !ctx.expired()) {
@@ -267,11 +216,11 @@ Result<SpectrumReport> Pr670Spectroradiometer::ReportFrom(const std::string& rep
 
 Result<MeasuredSpectrum> Pr670Spectroradiometer::MeasureLoop(const CallContext& ctx,
                                                              const MeasuredCallback& measured) {
-  BRDF_RETURN_IF_ERROR(RequireConnected());
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
   held_.reset();
   if (configured_ && meter_setup_ != configured_) BRDF_RETURN_IF_ERROR(Apply(*configured_, ctx));
   pr650::QualityLoop loop(options_.quality_policy, options_.max_measure_attempts, dark_,
-                          options_.log, Where());
+                          options_.log, connection_.Where());
   for (;; loop.NextAttempt()) {
     const Setup current = meter_setup_.value_or(Setup{});
     std::optional<int> code;
@@ -290,7 +239,7 @@ Result<MeasuredSpectrum> Pr670Spectroradiometer::MeasureLoop(const CallContext& 
     BRDF_ASSIGN_OR_RETURN(const std::string reply, MeasureOnce(ctx, judge));
     if (!code) {
       BRDF_RETURN_IF_ERROR(pr670::ParseResultCode(reply, pr670::kMeasureSpectrumCommand).status());
-      return ProtocolError(Where() + ": M5 reply had no result code");  // unreachable
+      return ProtocolError(connection_.Where() + ": M5 reply had no result code");  // unreachable
     }
     if (!pr650::QualityLoop::Accepted(decision)) {
       BRDF_RETURN_IF_ERROR(PrepareRemeasure(decision, *code, loop, ctx));
@@ -311,9 +260,10 @@ Result<MeasurementOutcome> Pr670Spectroradiometer::Measure(const CallContext& ct
 
 Result<SpectrumReport> Pr670Spectroradiometer::TransferSpectrum(const CallContext& ctx) {
   (void)ctx;
-  BRDF_RETURN_IF_ERROR(RequireConnected());
+  BRDF_RETURN_IF_ERROR(connection_.RequireConnected());
   if (!held_) {
-    return FailedPrecondition(Where() + " holds no accepted measurement: call Measure first");
+    return FailedPrecondition(connection_.Where() +
+                              " holds no accepted measurement: call Measure first");
   }
   return *held_;
 }

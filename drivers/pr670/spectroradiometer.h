@@ -27,10 +27,10 @@
 #include <optional>
 #include <string>
 
+#include "drivers/line_meter/connection.h"
 #include "drivers/pr650/quality_loop.h"
 #include "drivers/pr670/options.h"
 #include "drivers/pr670/protocol.h"
-#include "drivers/serial/command_channel.h"
 #include "drivers/spectroradiometer.h"
 
 namespace brdf::drivers {
@@ -44,7 +44,7 @@ class Pr670Spectroradiometer final : public Spectroradiometer {
 
   Status Connect(const CallContext& ctx) override;
   void Disconnect() override;
-  bool connected() const override { return connected_; }
+  bool connected() const override { return connection_.connected(); }
 
   Result<MeterIdentity> Identify(const CallContext& ctx) override;
   Status Configure(const MeasurementSettings& settings, const CallContext& ctx) override;
@@ -66,7 +66,6 @@ class Pr670Spectroradiometer final : public Spectroradiometer {
   };
 
   Status EnterRemoteMode(const CallContext& ctx);
-  Status RequireConnected() const;
   // Sends one command and reads a one-line reply; notes a vanished port.
   Result<std::string> Ask(std::string_view command, std::chrono::milliseconds timeout,
                           const CallContext& ctx);
@@ -84,18 +83,13 @@ class Pr670Spectroradiometer final : public Spectroradiometer {
   Result<SpectrumReport> ReportFrom(const std::string& reply, int code,
                                     pr650::QualityLoop& loop) const;
   Status Lost(const Status& status);
-  std::string Where() const;
-  void Log(const std::string& message) const;
 
   Pr670Options options_;
-  serial::CommandChannel channel_;
-  bool connected_ = false;
-  bool lost_connection_ = false;
+  LineMeterConnection connection_;
 
   std::optional<Setup> configured_;   // what Configure asked for
   std::optional<Setup> meter_setup_;  // what the meter was last set to
   bool dark_ = false;
-  std::string model_;
   WavelengthGrid grid_{380, 2, 201};    // the PR-670's, until D120 tells
   std::optional<SpectrumReport> held_;  // the last accepted measurement's spectrum
 };
