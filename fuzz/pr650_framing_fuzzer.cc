@@ -1,4 +1,4 @@
-// Fuzz target: the PR-650 reply framing (drivers/pr650/reply_reader.h: ReadReply) driven from
+// Fuzz target: the PR-650 reply framing (drivers/serial/reply_reader.h: ReadReply) driven from
 // bytes. A scripted serial link delivers the input's chunks at the input's times on a virtual
 // clock, so the fuzzer controls both what the meter sends and when (pieces, pauses longer than
 // the quiet gap or the stall timeout, a vanishing port, a cancel), and a run takes microseconds.
@@ -18,8 +18,9 @@
 
 #include "core/call_context.h"
 #include "core/clock.h"
-#include "drivers/pr650/pr650_protocol.h"
-#include "drivers/pr650/reply_reader.h"
+#include "drivers/pr650/protocol.h"
+#include "drivers/serial/reply_lines.h"
+#include "drivers/serial/reply_reader.h"
 #include "fuzz/fuzz_check.h"
 
 namespace brdf::fuzz {
@@ -27,6 +28,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using namespace brdf::drivers::pr650;
+using namespace brdf::drivers::serial;
 
 // Time moves only when the link says so (a read that waits, a chunk that arrives later).
 class VirtualClock final : public Clock {

@@ -1,4 +1,5 @@
-// Fuzz target: the PR-650 reply parser (drivers/pr650/pr650_protocol.h). The input is one reply
+// Fuzz target: the PR-650 reply parser (drivers/pr650/protocol.h) and the line framing it
+// rests on (drivers/serial/reply_lines.h). The input is one reply
 // as it came off the wire; every parser gets it, because the meter (or line noise) can send any
 // bytes in answer to any command. Beyond not crashing, each parser must keep its promises:
 // lines hold no line ends and are never empty, Printable() is printable, accepted numbers are
@@ -9,13 +10,15 @@
 #include <optional>
 #include <string>
 
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/protocol.h"
+#include "drivers/serial/reply_lines.h"
 #include "fuzz/fuzz_check.h"
 
 namespace brdf::fuzz {
 namespace {
 
 using namespace brdf::drivers::pr650;
+using namespace brdf::drivers::serial;
 
 void CheckFraming(std::string_view reply) {
   const std::vector<std::string> lines = SplitReplyLines(reply);

@@ -39,7 +39,7 @@
 #include "core/plan/timing.h"
 #include "daemon/engine/rig.h"
 #include "daemon/engine/session_manager.h"
-#include "drivers/pr650/pr650_spectroradiometer.h"
+#include "drivers/pr650/spectroradiometer.h"
 #include "drivers/stage/modbus_stage.h"
 #include "storage/session_store.h"
 #include "tests/support/sim/modbus_control.h"

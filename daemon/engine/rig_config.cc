@@ -9,9 +9,9 @@
 
 #include "daemon/config/config.h"
 #include "daemon/engine/rig.h"
-#include "drivers/cs2000/cs2000_spectroradiometer.h"
-#include "drivers/pr650/pr650_spectroradiometer.h"
-#include "drivers/pr670/pr670_spectroradiometer.h"
+#include "drivers/cs2000/spectroradiometer.h"
+#include "drivers/pr650/spectroradiometer.h"
+#include "drivers/pr670/spectroradiometer.h"
 #include "drivers/stage/modbus_stage.h"
 #include "drivers/stage/profile_file.h"
 

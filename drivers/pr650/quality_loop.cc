@@ -2,8 +2,8 @@
 
 namespace brdf::drivers::pr650 {
 
-QualityLoop::QualityLoop(const QualityPolicy& policy, int max_attempts, bool dark, LogSink log,
-                         std::string where)
+QualityLoop::QualityLoop(const QualityPolicy& policy, int max_attempts, bool dark,
+                         serial::LogSink log, std::string where)
     : policy_(policy),
       max_attempts_(max_attempts),
       dark_(dark),

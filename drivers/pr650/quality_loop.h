@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "drivers/pr650/quality_codes.h"
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/serial_link.h"
 #include "drivers/spectroradiometer.h"
 
 namespace brdf::drivers::pr650 {
@@ -17,7 +17,7 @@ class QualityLoop {
  public:
   // `dark`: the reading is a dark one (MeasurementSettings::dark); `where` names the meter and its
   // port in the log ("PR-670 on /dev/ttyACM0").
-  QualityLoop(const QualityPolicy& policy, int max_attempts, bool dark, LogSink log,
+  QualityLoop(const QualityPolicy& policy, int max_attempts, bool dark, serial::LogSink log,
               std::string where);
 
   // Decides about the meter's `meter_code` (its words: `meaning`), handled as `policy_code`,
@@ -44,7 +44,7 @@ class QualityLoop {
   const QualityPolicy& policy_;
   int max_attempts_;
   bool dark_;
-  LogSink log_;
+  serial::LogSink log_;
   std::string where_;
   int attempt_ = 1;
   std::vector<std::string> notes_;

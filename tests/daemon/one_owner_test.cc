@@ -12,7 +12,7 @@
 #include <thread>
 
 #include "core/call_context.h"
-#include "drivers/pr650/serial_link.h"
+#include "drivers/serial/serial_link.h"
 #include "tests/support/daemon/test_rig.h"
 #include "tests/support/process_launcher.h"
 
@@ -118,8 +118,8 @@ TEST(OneOwnerPortTest, MeterPortHeldByAnotherProcessIsRefusedNamingIt) {
       ChildProcess::Launch("flock", "/usr/bin/flock", hold);
   ASSERT_TRUE(holder.ok()) << holder.status().ToString();
 
-  Result<std::unique_ptr<drivers::pr650::SerialLink>> link =
-      drivers::pr650::MakeSerialLink({port, 9600, false}, nullptr);
+  Result<std::unique_ptr<drivers::serial::SerialLink>> link =
+      drivers::serial::MakeSerialLink({port, 9600, false}, nullptr);
   ASSERT_TRUE(link.ok());
   Status opened = Status::Ok();
   // flock(1) takes the lock right after it starts: wait for it.

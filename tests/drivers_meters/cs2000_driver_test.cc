@@ -7,7 +7,7 @@
 #include <memory>
 #include <thread>
 
-#include "drivers/cs2000/cs2000_spectroradiometer.h"
+#include "drivers/cs2000/spectroradiometer.h"
 #include "tests/drivers_meters/meter_test_rig.h"
 
 namespace brdf::testing {
@@ -15,32 +15,12 @@ namespace {
 
 using ::testing::HasSubstr;
 
-class Cs2000Driver : public ::testing::Test {
+class Cs2000Driver : public MeterDriverTest<sim::Cs2000Endpoint, drivers::Cs2000Spectroradiometer> {
  protected:
+  Cs2000Driver() : MeterDriverTest(WavelengthGrid{380, 1, 401}) {}
   void SetUp() override {
-    sim::Cs2000EndpointOptions o{FastLine("\n", "20001234"), "CS-2000"};
-    endpoint_ = std::make_unique<sim::Cs2000Endpoint>(backend_, control_, o);
-    ASSERT_TRUE(endpoint_->Start().ok());
-    meter_ =
-        std::make_unique<drivers::Cs2000Spectroradiometer>(FastCs2000(endpoint_->path(), &log_));
+    Start(sim::Cs2000EndpointOptions{FastLine("\n", "20001234"), "CS-2000"}, FastCs2000);
   }
-  void TearDown() override {
-    meter_.reset();
-    endpoint_->Stop();
-  }
-  void ConnectAndConfigure(drivers::MeasurementSettings settings) {
-    Status connected = meter_->Connect(Ctx());
-    ASSERT_TRUE(connected.ok()) << connected.ToString();
-    Status configured = meter_->Configure(settings, Ctx());
-    ASSERT_TRUE(configured.ok()) << configured.ToString();
-  }
-  void Fault(std::function<void(sim::SerialFaults&)> set) { control_.UpdateSerial(set); }
-
-  GridBackend backend_{WavelengthGrid{380, 1, 401}};
-  sim::SimControl control_;
-  std::unique_ptr<sim::Cs2000Endpoint> endpoint_;
-  std::vector<std::string> log_;
-  std::unique_ptr<drivers::Cs2000Spectroradiometer> meter_;
 };
 
 TEST_F(Cs2000Driver, RemoteModeIdentityAndFourHundredOneValuesInFourBlocks) {

@@ -1,8 +1,8 @@
 // The CS-2000 protocol's pure side: commands, check codes, and every reply the driver parses.
-#include "drivers/cs2000/cs2000_protocol.h"
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include "drivers/cs2000/protocol.h"
 
 namespace brdf::drivers::cs2000 {
 namespace {

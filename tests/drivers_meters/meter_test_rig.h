@@ -1,19 +1,23 @@
 // What the PR-670 and CS-2000 driver tests stand on: a light source whose spectrum is known
 // exactly on any grid, brdf-sim's own meter endpoints on real pseudo-terminals (in this process),
-// and driver options shrunk so each test runs in milliseconds.
+// driver options shrunk so each test runs in milliseconds, and the fixture both use.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "core/call_context.h"
 #include "core/wavelength_grid.h"
-#include "drivers/cs2000/cs2000_options.h"
-#include "drivers/pr670/pr670_options.h"
+#include "drivers/cs2000/options.h"
+#include "drivers/line_meter/options.h"
+#include "drivers/pr670/options.h"
+#include "drivers/spectroradiometer.h"
 #include "tools/brdf-sim/meter/cs2000_endpoint.h"
 #include "tools/brdf-sim/meter/pr670_endpoint.h"
 #include "tools/brdf-sim/sim_shared.h"
@@ -78,37 +82,70 @@ inline sim::LineEndpointOptions FastLine(const std::string& eol, const std::stri
   return o;
 }
 
-// Driver options for a pty: short waits, a typing pace of 1 ms.
-inline drivers::Pr670Options FastPr670(const std::string& port, std::vector<std::string>* log) {
+// Driver options for a pty: short waits (and the PR-670's typing pace of 1 ms).
+inline void ShrinkLineMeterOptions(drivers::LineMeterOptions& o, const std::string& port,
+                                   std::vector<std::string>* log) {
   using std::chrono::milliseconds;
-  drivers::Pr670Options o;
   o.port = port;
-  o.char_gap = milliseconds(1);
   o.command_pacing = milliseconds(2);
   o.quiet_gap = milliseconds(15);
   o.stall_timeout = milliseconds(300);
   o.reply_timeout = milliseconds(500);
+  o.measurement_timeout = milliseconds(1500);
+  o.log = [log](std::string_view m) { log->emplace_back(m); };
+}
+
+inline drivers::Pr670Options FastPr670(const std::string& port, std::vector<std::string>* log) {
+  using std::chrono::milliseconds;
+  drivers::Pr670Options o;
+  ShrinkLineMeterOptions(o, port, log);
+  o.char_gap = milliseconds(1);
   o.quit_settle = milliseconds(10);
   o.remote_timeout = milliseconds(500);
-  o.measurement_timeout = milliseconds(1500);
   o.adaptive_exposure_max = milliseconds(500);
-  o.log = [log](std::string_view m) { log->emplace_back(m); };
   return o;
 }
 
 inline drivers::Cs2000Options FastCs2000(const std::string& port, std::vector<std::string>* log) {
-  using std::chrono::milliseconds;
   drivers::Cs2000Options o;
-  o.port = port;
-  o.command_pacing = milliseconds(2);
-  o.quiet_gap = milliseconds(15);
-  o.stall_timeout = milliseconds(300);
-  o.reply_timeout = milliseconds(500);
-  o.measure_start_timeout = milliseconds(1000);
-  o.measurement_timeout = milliseconds(1500);
-  o.log = [log](std::string_view m) { log->emplace_back(m); };
+  ShrinkLineMeterOptions(o, port, log);
+  o.measure_start_timeout = std::chrono::milliseconds(1000);
   return o;
 }
+
+// A driver test's fixture: `Endpoint` (brdf-sim's meter) on a pty, lit by a GridBackend on its
+// grid, and the `Meter` driver on its port with the fast options; the log the driver wrote.
+template <typename Endpoint, typename Meter>
+class MeterDriverTest : public ::testing::Test {
+ protected:
+  explicit MeterDriverTest(WavelengthGrid grid) : backend_{grid} {}
+
+  // Starts the endpoint with `options`, then builds the driver with `make_options(port, log)`.
+  template <typename EndpointOptions, typename MeterOptions>
+  void Start(const EndpointOptions& options,
+             MeterOptions (*make_options)(const std::string&, std::vector<std::string>*)) {
+    endpoint_ = std::make_unique<Endpoint>(backend_, control_, options);
+    ASSERT_TRUE(endpoint_->Start().ok());
+    meter_ = std::make_unique<Meter>(make_options(endpoint_->path(), &log_));
+  }
+  void TearDown() override {
+    meter_.reset();
+    endpoint_->Stop();
+  }
+  void ConnectAndConfigure(drivers::MeasurementSettings settings) {
+    Status connected = meter_->Connect(Ctx());
+    ASSERT_TRUE(connected.ok()) << connected.ToString();
+    Status configured = meter_->Configure(settings, Ctx());
+    ASSERT_TRUE(configured.ok()) << configured.ToString();
+  }
+  void Fault(std::function<void(sim::SerialFaults&)> set) { control_.UpdateSerial(set); }
+
+  GridBackend backend_;
+  sim::SimControl control_;
+  std::unique_ptr<Endpoint> endpoint_;
+  std::vector<std::string> log_;
+  std::unique_ptr<Meter> meter_;
+};
 
 // Whether `commands` holds `command`.
 inline bool Sent(const std::vector<std::string>& commands, const std::string& command) {

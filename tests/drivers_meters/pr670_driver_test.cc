@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <memory>
 
-#include "drivers/pr670/pr670_spectroradiometer.h"
+#include "drivers/pr670/spectroradiometer.h"
 #include "tests/drivers_meters/meter_test_rig.h"
 
 namespace brdf::testing {
@@ -15,31 +15,12 @@ namespace {
 
 using ::testing::HasSubstr;
 
-class Pr670Driver : public ::testing::Test {
+class Pr670Driver : public MeterDriverTest<sim::Pr670Endpoint, drivers::Pr670Spectroradiometer> {
  protected:
+  Pr670Driver() : MeterDriverTest(WavelengthGrid{380, 2, 201}) {}
   void SetUp() override {
-    sim::Pr670EndpointOptions o{FastLine("\r\n", "67012345"), "PR-670"};
-    endpoint_ = std::make_unique<sim::Pr670Endpoint>(backend_, control_, o);
-    ASSERT_TRUE(endpoint_->Start().ok());
-    meter_ = std::make_unique<drivers::Pr670Spectroradiometer>(FastPr670(endpoint_->path(), &log_));
+    Start(sim::Pr670EndpointOptions{FastLine("\r\n", "67012345"), "PR-670"}, FastPr670);
   }
-  void TearDown() override {
-    meter_.reset();
-    endpoint_->Stop();
-  }
-  void ConnectAndConfigure(drivers::MeasurementSettings settings) {
-    Status connected = meter_->Connect(Ctx());
-    ASSERT_TRUE(connected.ok()) << connected.ToString();
-    Status configured = meter_->Configure(settings, Ctx());
-    ASSERT_TRUE(configured.ok()) << configured.ToString();
-  }
-  void Fault(std::function<void(sim::SerialFaults&)> set) { control_.UpdateSerial(set); }
-
-  GridBackend backend_{WavelengthGrid{380, 2, 201}};
-  sim::SimControl control_;
-  std::unique_ptr<sim::Pr670Endpoint> endpoint_;
-  std::vector<std::string> log_;
-  std::unique_ptr<drivers::Pr670Spectroradiometer> meter_;
 };
 
 TEST_F(Pr670Driver, EntersRemoteModeIdentifiesAndReadsTwoHundredOneBands) {

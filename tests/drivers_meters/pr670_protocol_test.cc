@@ -1,8 +1,8 @@
 // The PR-670 protocol's pure side: commands, result codes, and every reply the driver parses.
-#include "drivers/pr670/pr670_protocol.h"
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include "drivers/pr670/protocol.h"
 
 namespace brdf::drivers::pr670 {
 namespace {

@@ -7,7 +7,7 @@
 
 #include <fstream>
 
-#include "drivers/pr650/pr650_spectroradiometer.h"
+#include "drivers/pr650/spectroradiometer.h"
 #include "tests/drivers_pr650/pr650_test_rig.h"
 
 namespace brdf::testing {

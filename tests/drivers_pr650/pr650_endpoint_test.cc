@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "core/wavelength_grid.h"
-#include "drivers/pr650/pr650_protocol.h"
+#include "drivers/pr650/protocol.h"
 #include "tests/drivers_pr650/pr650_test_rig.h"
 #include "tools/brdf-sim/meter/pr650_protocol.h"
 

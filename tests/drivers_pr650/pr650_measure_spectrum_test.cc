@@ -5,7 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "drivers/pr650/pr650_spectroradiometer.h"
+#include "drivers/pr650/spectroradiometer.h"
 #include "tests/drivers_pr650/pr650_test_rig.h"
 
 namespace brdf::testing {

@@ -1,14 +1,20 @@
 // The PR-650 reply parsers and command formatting, line by line, including malformed replies.
-#include "drivers/pr650/pr650_protocol.h"
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <string>
 
+#include "drivers/pr650/protocol.h"
+#include "drivers/serial/reply_lines.h"
+
 namespace brdf::drivers::pr650 {
 namespace {
+
+using serial::CountCompleteLines;
+using serial::EndsWithLineEnd;
+using serial::Printable;
+using serial::SplitReplyLines;
 
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "drivers/pr650/pr650_spectroradiometer.h"
+#include "drivers/pr650/spectroradiometer.h"
 #include "tests/drivers_pr650/pr650_test_rig.h"
 #include "tests/support/sim/process.h"
 

@@ -13,8 +13,8 @@
 #include <thread>
 #include <vector>
 
-#include "drivers/pr650/pr650_options.h"
-#include "drivers/pr650/pr650_spectroradiometer.h"
+#include "drivers/pr650/options.h"
+#include "drivers/pr650/spectroradiometer.h"
 #include "tools/brdf-sim/meter/pr650_endpoint.h"
 #include "tools/brdf-sim/sim_shared.h"
 
@@ -101,7 +101,7 @@ inline sim::Pr650EndpointOptions FastEndpointOptions() {
 // Collects the driver's log lines.
 class LogCapture {
  public:
-  drivers::pr650::LogSink sink() {
+  drivers::serial::LogSink sink() {
     return [this](std::string_view line) {
       std::lock_guard lock(mu_);
       lines_.emplace_back(line);

@@ -1,6 +1,6 @@
 // Framing: the reply reader against a scripted byte source standing in for the meter's serial
 // line (bytes arriving at set times, in pieces, with any line ends).
-#include "drivers/pr650/reply_reader.h"
+#include "drivers/serial/reply_reader.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <deque>
 #include <thread>
 
-namespace brdf::drivers::pr650 {
+namespace brdf::drivers::serial {
 namespace {
 
 using namespace std::chrono_literals;
@@ -198,4 +198,4 @@ TEST(ReadReply, CallDeadlineMidReplyIsATimeout) {
 }
 
 }  // namespace
-}  // namespace brdf::drivers::pr650
+}  // namespace brdf::drivers::serial

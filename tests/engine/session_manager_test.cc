@@ -15,7 +15,7 @@
 #include <thread>
 
 #include "core/geometry.h"
-#include "drivers/pr650/pr650_spectroradiometer.h"
+#include "drivers/pr650/spectroradiometer.h"
 #include "drivers/stage/modbus_stage.h"
 #include "storage/session_store.h"
 #include "tests/engine/engine_test_rig.h"
