@@ -9,7 +9,8 @@
 //                  one float64 per band (numpy.frombuffer(b, "<f8").reshape(n_components, bands))
 //   not_estimated  TEXT, one line per component left out ("name: why"), '' when none
 // The budget's values (the quantity itself) are not stored: they are derived again from the
-// raw readings. Internal to storage/.
+// raw readings. Shared by the rig's store and the lab archive (storage/archive/), whose table
+// reading_uncertainty has the same columns.
 #pragma once
 
 #include <cstdint>
