@@ -199,6 +199,7 @@ CREATE TABLE reading_uncertainty (
   reading_id    INTEGER PRIMARY KEY REFERENCES readings (id),
   quantity      TEXT    NOT NULL CHECK (quantity IN ('brdf', 'reflectance')),
   bands         INTEGER NOT NULL CHECK (bands > 0),
+  value         BLOB    NOT NULL CHECK (length(value) = 8 * bands),
   combined      BLOB    NOT NULL CHECK (length(combined) = 8 * bands),
   independent   BLOB    NOT NULL CHECK (length(independent) = 8 * bands),
   components    TEXT    NOT NULL,

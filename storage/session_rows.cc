@@ -19,8 +19,8 @@ const std::string_view kStepColumns =
 const std::string_view kReadingColumns =
     "id, session_id, step_index, kind, alpha, beta, gamma, delta, theta_i, phi_i, theta_o, phi_o, "
     "wl_start_nm, wl_step_nm, wl_count, spectrum, quality_code, flagged, integration_ms, attempts, "
-    "note, reference_reading_id, dark_reading_id, meter_serial, recorded_at, quantity, combined, "
-    "independent, components, contributions, not_estimated";
+    "note, reference_reading_id, dark_reading_id, meter_serial, recorded_at, quantity, value, "
+    "combined, independent, components, contributions, not_estimated";
 
 const std::string_view kReadingsWithUncertainty =
     "readings LEFT JOIN reading_uncertainty ON reading_uncertainty.reading_id = readings.id";
@@ -119,11 +119,12 @@ Result<ReadingRecord> ReadReading(const Statement& st, const std::string& path) 
   r.meter_serial = st.Text(23);
   r.recorded_at = st.Double(24);
   if (st.IsNull(25)) return r;  // not estimated
-  const Statement::Blob combined = st.BlobView(26), independent = st.BlobView(27),
-                        parts = st.BlobView(29);
-  const UncertaintyColumns columns{
-      st.Text(25), {combined.begin(), combined.end()}, {independent.begin(), independent.end()},
-      st.Text(28), {parts.begin(), parts.end()},       st.Text(30)};
+  auto bytes = [&st](int column) {
+    const Statement::Blob b = st.BlobView(column);
+    return std::vector<std::uint8_t>(b.begin(), b.end());
+  };
+  const UncertaintyColumns columns{st.Text(25), bytes(26), bytes(27),  bytes(28),
+                                   st.Text(29), bytes(30), st.Text(31)};
   BRDF_ASSIGN_OR_RETURN(r.uncertainty, FromColumn(DecodeUncertainty(columns, r.grid.count), path,
                                                   where + "'s uncertainty"));
   return r;

@@ -223,17 +223,18 @@ Status InsertUncertainty(Database& db, std::int64_t reading_id, std::size_t band
                          const UncertaintyColumns& u, const std::string& what) {
   BRDF_ASSIGN_OR_RETURN(
       Statement st,
-      db.Prepare("INSERT INTO reading_uncertainty (reading_id, quantity, bands, combined, "
+      db.Prepare("INSERT INTO reading_uncertainty (reading_id, quantity, bands, value, combined, "
                  "independent, components, contributions, not_estimated) "
-                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?)"));
+                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)"));
   st.Bind(1, reading_id)
       .Bind(2, u.quantity)
       .Bind(3, static_cast<std::int64_t>(bands))
-      .Bind(4, u.combined)
-      .Bind(5, u.independent)
-      .Bind(6, u.components)
-      .Bind(7, u.contributions)
-      .Bind(8, u.not_estimated);
+      .Bind(4, u.value)
+      .Bind(5, u.combined)
+      .Bind(6, u.independent)
+      .Bind(7, u.components)
+      .Bind(8, u.contributions)
+      .Bind(9, u.not_estimated);
   return st.Run().WithContext(what + ": its uncertainty");
 }
 

@@ -79,10 +79,12 @@ Result<UncertaintyColumns> EncodeUncertainty(const ReadingBudget& budget, std::s
     return InvalidArgument("a reading's uncertainty is of its BRDF or reflectance, not its " +
                            std::string(QuantityName(budget.quantity)));
   }
+  BRDF_RETURN_IF_ERROR(CheckBands(budget.value, bands, "value", false));
   BRDF_RETURN_IF_ERROR(CheckBands(budget.combined, bands, "combined", true));
   BRDF_RETURN_IF_ERROR(CheckBands(budget.independent, bands, "independent part", true));
   UncertaintyColumns out;
   out.quantity = QuantityName(budget.quantity);
+  out.value = EncodeSpectrum(budget.value);
   out.combined = EncodeSpectrum(budget.combined);
   out.independent = EncodeSpectrum(budget.independent);
   std::vector<double> all;
@@ -106,6 +108,9 @@ Result<ReadingBudget> DecodeUncertainty(const UncertaintyColumns& columns, std::
   Result<Quantity> quantity = ParseQuantity(columns.quantity);
   if (!quantity.ok()) return quantity.status().WithContext("its quantity");
   budget.quantity = *quantity;
+  Result<std::vector<double>> value = DecodeSpectrum(columns.value, bands);
+  if (!value.ok()) return value.status().WithContext("its value");
+  budget.value = std::move(*value);
   Result<std::vector<double>> combined = DecodeSpectrum(columns.combined, bands);
   if (!combined.ok()) return combined.status().WithContext("its combined uncertainty");
   budget.combined = std::move(*combined);

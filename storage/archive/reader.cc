@@ -29,7 +29,7 @@ constexpr std::string_view kReadingsOfSession = R"sql(
 SELECT rig_reading_id, step_index, kind, alpha, beta, gamma, delta, theta_i, phi_i, theta_o,
   phi_o, wl_start_nm, wl_step_nm, wl_count, spectrum, quality_code, flagged, integration_ms,
   attempts, note, reference_reading_id, dark_reading_id, meter_serial, recorded_at, quantity,
-  combined, independent, components, contributions, not_estimated
+  value, combined, independent, components, contributions, not_estimated
 FROM readings LEFT JOIN reading_uncertainty USING (session_uuid, step_index)
 WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id = $1)
   AND rig_reading_id > $2
@@ -130,9 +130,13 @@ Result<ReadingRecord> ReadingAt(const PgResult& r, int row, std::int64_t session
   g.meter_serial = std::string(r.Text(row, 22));
   g.recorded_at = r.Double(row, 23);
   if (r.IsNull(row, 24)) return g;  // not estimated
-  const UncertaintyColumns columns{
-      std::string(r.Text(row, 24)), r.Bytes(row, 25), r.Bytes(row, 26),
-      std::string(r.Text(row, 27)), r.Bytes(row, 28), std::string(r.Text(row, 29))};
+  const UncertaintyColumns columns{std::string(r.Text(row, 24)),
+                                   r.Bytes(row, 25),
+                                   r.Bytes(row, 26),
+                                   r.Bytes(row, 27),
+                                   std::string(r.Text(row, 28)),
+                                   r.Bytes(row, 29),
+                                   std::string(r.Text(row, 30))};
   Result<uncertainty::ReadingBudget> budget = DecodeUncertainty(columns, g.grid.count);
   if (!budget.ok()) {
     return budget.status().WithContext("archived reading " + std::to_string(g.id) + " of " +

@@ -156,6 +156,7 @@ CREATE TABLE reading_uncertainty (
   step_index    integer NOT NULL,
   quantity      text    NOT NULL CHECK (quantity IN ('brdf', 'reflectance')),
   bands         integer NOT NULL CHECK (bands > 0),
+  value         bytea   NOT NULL CHECK (length(value) = 8 * bands),
   combined      bytea   NOT NULL CHECK (length(combined) = 8 * bands),
   independent   bytea   NOT NULL CHECK (length(independent) = 8 * bands),
   components    text    NOT NULL,

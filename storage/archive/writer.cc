@@ -43,9 +43,9 @@ ON CONFLICT DO NOTHING
 )sql";
 
 constexpr std::string_view kInsertUncertainty = R"sql(
-INSERT INTO reading_uncertainty (session_uuid, step_index, quantity, bands, combined, independent,
-  components, contributions, not_estimated)
-VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9)
+INSERT INTO reading_uncertainty (session_uuid, step_index, quantity, bands, value, combined,
+  independent, components, contributions, not_estimated)
+VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10)
 ON CONFLICT DO NOTHING
 )sql";
 
@@ -160,6 +160,7 @@ Status WriteUncertainty(PgConnection& conn, const std::string& uuid, const Readi
       .Add(r.step_index)
       .Add(u->quantity)
       .Add(static_cast<std::int64_t>(r.grid.count))
+      .AddBytes(u->value)
       .AddBytes(u->combined)
       .AddBytes(u->independent)
       .Add(u->components)

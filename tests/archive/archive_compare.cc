@@ -14,7 +14,7 @@ void ExpectSameUncertainties(PgConnection& conn, const std::string& uuid,
                              const std::vector<ReadingRecord>& mine) {
   Result<PgResult> rows = conn.Query(
       "SELECT r.rig_reading_id, u.quantity, u.combined, u.independent, u.components, "
-      "u.contributions, u.not_estimated FROM reading_uncertainty u JOIN readings r "
+      "u.contributions, u.not_estimated, u.value FROM reading_uncertainty u JOIN readings r "
       "USING (session_uuid, step_index) WHERE session_uuid = $1 ORDER BY r.rig_reading_id",
       PgParams().Add(uuid));
   ASSERT_TRUE(rows.ok()) << rows.status().ToString();
@@ -31,6 +31,7 @@ void ExpectSameUncertainties(PgConnection& conn, const std::string& uuid,
     EXPECT_EQ(rows->Text(row, 4), want->components);
     EXPECT_EQ(rows->Bytes(row, 5), want->contributions) << "reading " << r.id;
     EXPECT_EQ(rows->Text(row, 6), want->not_estimated);
+    EXPECT_EQ(rows->Bytes(row, 7), want->value) << "reading " << r.id;
     ++row;
   }
   EXPECT_EQ(rows->rows(), row) << "the archive holds uncertainties of readings that have none";

@@ -164,6 +164,7 @@ TEST_F(ArchiveShipperTest, ShipsEverythingRecordedWithTheCatalogue) {
     if (!mine.has_value()) continue;
     ++with_budget;
     EXPECT_EQ(theirs->quantity, mine->quantity);
+    EXPECT_EQ(theirs->value, mine->value);
     EXPECT_EQ(theirs->combined, mine->combined);
     EXPECT_EQ(theirs->independent, mine->independent);
     EXPECT_EQ(theirs->not_estimated, mine->not_estimated);

@@ -33,6 +33,7 @@ ReadingBudget MakeBudget() {
       Component{"reference_signal", {Sharing::kReferenceReading, 1}, {-1e-5, -2e-5, -3e-5}},
       Component{"white_standard", {Sharing::kWhiteStandard, 7}, {5e-4, 6e-4, 7e-4}},
   };
+  b.value = {0.10, 0.12, 0.14};
   b.combined = {0.00051, 0.00064, 0.00077};
   b.independent = {1e-4, 2e-4, 3e-4};
   b.not_estimated = {"pose: the quantity's gradient over the pose is not known"};
@@ -50,7 +51,7 @@ void ExpectSameBudget(const ReadingBudget& got, const ReadingBudget& want) {
     EXPECT_EQ(got.components[i].shared, want.components[i].shared);
     EXPECT_EQ(got.components[i].contribution, want.components[i].contribution);
   }
-  EXPECT_TRUE(got.value.empty());
+  EXPECT_EQ(got.value, want.value);
 }
 
 struct Fixture {
@@ -173,12 +174,14 @@ TEST(ReadingUncertaintyTest, TheTableRefusesBlobsOfTheWrongLength) {
   auto db = Database::Open(f.dir.File("u.db"));
   ASSERT_TRUE(db.ok());
   Status bad = (*db)->Exec(
-      "INSERT INTO reading_uncertainty (reading_id, quantity, bands, combined, independent, "
-      "components, contributions) VALUES (1, 'brdf', 3, zeroblob(16), zeroblob(24), '', x'')");
+      "INSERT INTO reading_uncertainty (reading_id, quantity, bands, value, combined, independent, "
+      "components, contributions) VALUES (1, 'brdf', 3, zeroblob(24), zeroblob(16), zeroblob(24), "
+      "'', x'')");
   EXPECT_FALSE(bad.ok());
   Status quantity = (*db)->Exec(
-      "INSERT INTO reading_uncertainty (reading_id, quantity, bands, combined, independent, "
-      "components, contributions) VALUES (1, 'radiance', 3, zeroblob(24), zeroblob(24), '', x'')");
+      "INSERT INTO reading_uncertainty (reading_id, quantity, bands, value, combined, independent, "
+      "components, contributions) VALUES (1, 'radiance', 3, zeroblob(24), zeroblob(24), "
+      "zeroblob(24), '', x'')");
   EXPECT_FALSE(quantity.ok());
 }
 
@@ -202,6 +205,9 @@ TEST(UncertaintyColumnsTest, RoundTripAndDamagedColumnsAreNamed) {
   damaged = *columns;
   damaged.contributions.pop_back();
   EXPECT_THAT(DecodeUncertainty(damaged, 3).status().message(), HasSubstr("contributions"));
+  damaged = *columns;
+  damaged.value.resize(16);
+  EXPECT_THAT(DecodeUncertainty(damaged, 3).status().message(), HasSubstr("its value"));
 
   ReadingBudget negative = MakeBudget();
   negative.combined[0] = -1;

@@ -124,6 +124,7 @@ inline uncertainty::ReadingBudget MakeBudget(int step, const WavelengthGrid& gri
     b.independent.push_back(own[i]);
   }
   b.not_estimated = {"pose: the quantity's gradient over the pose is not known"};
+  for (std::size_t i = 0; i < grid.count; ++i) b.value.push_back(0.01 * step + 1e-4 * i);
   return b;
 }
 
