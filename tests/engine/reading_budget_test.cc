@@ -11,6 +11,7 @@
 #include <map>
 
 #include "core/readings/derive.h"
+#include "daemon/wire/reading.h"
 #include "storage/session_store.h"
 #include "tests/engine/engine_test_rig.h"
 #include "tests/support/plan_fixtures.h"
@@ -129,6 +130,43 @@ TEST(ReadingBudgetEngineTest, EverySampleIsStoredWithItsBudgetSharedWhereItIsSha
   EXPECT_GT(samples, 0);
   EXPECT_GT(with_drift, 0);
   EXPECT_LT(with_drift, samples);
+}
+
+// The API's Reading carries the stored budget: components with their sharing, the shared reading's
+// id only for a reference or dark (the session's are named by session_id), values per band.
+TEST(ReadingBudgetEngineTest, TheApisReadingCarriesTheBudget) {
+  BudgetSession session(Settings(), plans::SmallRotation());
+  int checked = 0;
+  for (const storage::ReadingRecord& r : session.readings()) {
+    const v1::Reading proto = daemon::ToProtoReading(r, {});
+    if (r.kind != ReadingKind::kSample) {
+      EXPECT_FALSE(proto.has_uncertainty());
+      continue;
+    }
+    ASSERT_TRUE(proto.has_uncertainty());
+    const v1::ReadingUncertainty& u = proto.uncertainty();
+    EXPECT_EQ(u.quantity(), v1::QUANTITY_BRDF);
+    ASSERT_EQ(u.combined_size(), static_cast<int>(r.grid.count));
+    EXPECT_EQ(u.value(10), r.uncertainty->value[10]);
+    EXPECT_EQ(u.combined(10), r.uncertainty->combined[10]);
+    EXPECT_EQ(u.independent(10), r.uncertainty->independent[10]);
+    ASSERT_EQ(u.components_size(), static_cast<int>(r.uncertainty->components.size()));
+    for (const v1::UncertaintyComponent& c : u.components()) {
+      if (c.name() == "reference_signal") {
+        EXPECT_EQ(c.sharing(), v1::UNCERTAINTY_SHARING_REFERENCE_READING);
+        EXPECT_EQ(c.shared_id(), *r.reference_reading_id);
+      } else if (c.name() == "white_standard") {
+        EXPECT_EQ(c.sharing(), v1::UNCERTAINTY_SHARING_WHITE_STANDARD);
+        EXPECT_EQ(c.shared_id(), 0);
+      } else if (c.name() == "sample_signal") {
+        EXPECT_EQ(c.sharing(), v1::UNCERTAINTY_SHARING_INDEPENDENT);
+      }
+      EXPECT_EQ(c.contribution_size(), static_cast<int>(r.grid.count)) << c.name();
+    }
+    EXPECT_EQ(u.not_estimated_size(), static_cast<int>(r.uncertainty->not_estimated.size()));
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
 }
 
 TEST(ReadingBudgetEngineTest, ThePlansWhiteUncertaintyWinsOverTheConfigurations) {
