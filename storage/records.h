@@ -14,6 +14,7 @@
 #include "core/readings/reading.h"
 #include "core/session_state.h"
 #include "core/status.h"
+#include "core/uncertainty/budget.h"
 #include "core/wavelength_grid.h"
 
 namespace brdf::storage {
@@ -129,6 +130,10 @@ struct ReadingRecord {
   std::optional<std::int64_t> dark_reading_id;       // the D subtracted, when measured
   std::string meter_serial;
   UnixSeconds recorded_at = 0;  // 0: the store uses its clock
+  // The budget of the reading's BRDF or reflectance per band (docs/uncertainty.md), stored with
+  // the reading (schema v5). nullopt: not estimated -- every reading stored before v5, darks and
+  // references. Read back without its `value` (derived again from the raw readings).
+  std::optional<uncertainty::ReadingBudget> uncertainty;
 };
 
 // Where a reading was taken, without its spectrum: what a plot of a session's readings needs

@@ -189,11 +189,31 @@ CREATE TRIGGER session_event_changed AFTER UPDATE OF state, state_reason ON sess
 INSERT INTO archive_marks (name, value) VALUES ('events', 0);
 )sql";
 
-constexpr std::array<Migration, 4> kMigrations{{
+// Version 5: each reading's uncertainty budget (docs/uncertainty.md), a row per reading that has
+// one, written in the same transaction as the reading. A reading without a row -- every reading
+// stored before version 5, and darks and references -- is "not estimated", never zero. The blobs
+// are little-endian float64 per band like the spectrum (uncertainty_columns.h); `bands` repeats the
+// reading's wl_count so that the CHECKs can hold the lengths.
+constexpr std::string_view kV5 = R"sql(
+CREATE TABLE reading_uncertainty (
+  reading_id    INTEGER PRIMARY KEY REFERENCES readings (id),
+  quantity      TEXT    NOT NULL CHECK (quantity IN ('brdf', 'reflectance')),
+  bands         INTEGER NOT NULL CHECK (bands > 0),
+  value         BLOB    NOT NULL CHECK (length(value) = 8 * bands),
+  combined      BLOB    NOT NULL CHECK (length(combined) = 8 * bands),
+  independent   BLOB    NOT NULL CHECK (length(independent) = 8 * bands),
+  components    TEXT    NOT NULL,
+  contributions BLOB    NOT NULL CHECK (length(contributions) % (8 * bands) = 0),
+  not_estimated TEXT    NOT NULL DEFAULT ''
+);
+)sql";
+
+constexpr std::array<Migration, 5> kMigrations{{
     {1, "create sessions, steps, readings, devices and audit", kV1},
     {2, "give every session a UUID and its rig's name", kV2},
     {3, "keep an outbox and marks for shipping to the lab archive", kV3},
     {4, "keep every session's history of states (session_events)", kV4},
+    {5, "keep each reading's uncertainty budget (reading_uncertainty)", kV5},
 }};
 
 std::string Hex(std::int64_t v) {

@@ -1,5 +1,5 @@
 // The database schema and its migrations. The full description is in storage/schema.md; in short
-// (schema version 4):
+// (schema version 5):
 //
 //   sessions  id, name, plan_kind, plan_json (the plan as submitted), state, state_reason,
 //             created_at, started_at, finished_at, created_by_role, total_steps, done_steps
@@ -24,6 +24,11 @@
 //             devices, audit; v4: events)
 //   session_events (v4)  id, session_id, at, state, reason: one row when a session is created
 //             and one per change of its state or reason, written by triggers
+//   reading_uncertainty (v5)  reading_id (PK), quantity (brdf|reflectance), bands, value,
+//             combined, independent (BLOBs of float64 per band), components (text lines
+//             "name sharing id"), contributions (BLOB), not_estimated: a sample reading's
+//             uncertainty budget, written with the reading; no row: not estimated
+//             (uncertainty_columns.h)
 //
 // Timestamps are Unix seconds (REAL, UTC). Angles are degrees. Enumerations are lower-case words
 // guarded by CHECK constraints.

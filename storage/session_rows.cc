@@ -2,6 +2,7 @@
 
 #include "core/status.h"
 #include "storage/spectrum_blob.h"
+#include "storage/uncertainty_columns.h"
 
 namespace brdf::storage {
 
@@ -18,7 +19,11 @@ const std::string_view kStepColumns =
 const std::string_view kReadingColumns =
     "id, session_id, step_index, kind, alpha, beta, gamma, delta, theta_i, phi_i, theta_o, phi_o, "
     "wl_start_nm, wl_step_nm, wl_count, spectrum, quality_code, flagged, integration_ms, attempts, "
-    "note, reference_reading_id, dark_reading_id, meter_serial, recorded_at";
+    "note, reference_reading_id, dark_reading_id, meter_serial, recorded_at, quantity, value, "
+    "combined, independent, components, contributions, not_estimated";
+
+const std::string_view kReadingsWithUncertainty =
+    "readings LEFT JOIN reading_uncertainty ON reading_uncertainty.reading_id = readings.id";
 
 const std::string_view kEventColumns = "id, session_id, at, state, reason";
 
@@ -113,6 +118,15 @@ Result<ReadingRecord> ReadReading(const Statement& st, const std::string& path) 
   r.dark_reading_id = st.OptionalInt64(22);
   r.meter_serial = st.Text(23);
   r.recorded_at = st.Double(24);
+  if (st.IsNull(25)) return r;  // not estimated
+  auto bytes = [&st](int column) {
+    const Statement::Blob b = st.BlobView(column);
+    return std::vector<std::uint8_t>(b.begin(), b.end());
+  };
+  const UncertaintyColumns columns{st.Text(25), bytes(26), bytes(27),  bytes(28),
+                                   st.Text(29), bytes(30), st.Text(31)};
+  BRDF_ASSIGN_OR_RETURN(r.uncertainty, FromColumn(DecodeUncertainty(columns, r.grid.count), path,
+                                                  where + "'s uncertainty"));
   return r;
 }
 

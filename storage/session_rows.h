@@ -24,9 +24,10 @@ Result<T> FromColumn(Result<T> parsed, const std::string& path, const std::strin
 
 extern const std::string_view kSessionColumns;
 extern const std::string_view kStepColumns;
-extern const std::string_view kReadingColumns;
-extern const std::string_view kEventColumns;         // session_events (v4)
-extern const std::string_view kReadingPointColumns;  // readings, without the spectrum
+extern const std::string_view kReadingColumns;  // select them FROM kReadingsWithUncertainty
+extern const std::string_view kReadingsWithUncertainty;  // readings LEFT JOIN reading_uncertainty
+extern const std::string_view kEventColumns;             // session_events (v4)
+extern const std::string_view kReadingPointColumns;      // readings, without the spectrum
 
 // A row whose enumeration text does not parse has been damaged outside brdfd: kIoError naming
 // `path` and what to run.

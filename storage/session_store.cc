@@ -8,6 +8,7 @@
 #include "storage/schema.h"
 #include "storage/session_rows.h"
 #include "storage/spectrum_blob.h"
+#include "storage/uncertainty_columns.h"
 #include "storage/uuid.h"
 
 namespace brdf::storage {
@@ -204,6 +205,37 @@ Status InsertReading(Database& db, std::int64_t session, int step_index,
       .Bind(23, reading.meter_serial)
       .Bind(24, recorded_at);
   return st.Run().WithContext(what);
+}
+
+// The reading's uncertainty budget in its columns, or nullopt when it has none (not estimated).
+Result<std::optional<UncertaintyColumns>> UncertaintyOf(const ReadingRecord& r) {
+  if (!r.uncertainty.has_value()) return std::optional<UncertaintyColumns>();
+  if (r.kind != ReadingKind::kSample) {
+    return InvalidArgument("only a sample reading has an uncertainty budget, not a " +
+                           std::string(ToString(r.kind)) + " reading");
+  }
+  BRDF_ASSIGN_OR_RETURN(UncertaintyColumns columns,
+                        EncodeUncertainty(*r.uncertainty, r.grid.count));
+  return std::optional<UncertaintyColumns>(std::move(columns));
+}
+
+Status InsertUncertainty(Database& db, std::int64_t reading_id, std::size_t bands,
+                         const UncertaintyColumns& u, const std::string& what) {
+  BRDF_ASSIGN_OR_RETURN(
+      Statement st,
+      db.Prepare("INSERT INTO reading_uncertainty (reading_id, quantity, bands, value, combined, "
+                 "independent, components, contributions, not_estimated) "
+                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)"));
+  st.Bind(1, reading_id)
+      .Bind(2, u.quantity)
+      .Bind(3, static_cast<std::int64_t>(bands))
+      .Bind(4, u.value)
+      .Bind(5, u.combined)
+      .Bind(6, u.independent)
+      .Bind(7, u.components)
+      .Bind(8, u.contributions)
+      .Bind(9, u.not_estimated);
+  return st.Run().WithContext(what + ": its uncertainty");
 }
 
 // The pending step done at `recorded_at`, and counted in the session's done_steps.
@@ -510,6 +542,8 @@ Result<std::int64_t> SessionStore::CompleteStepWithReading(std::int64_t session,
   const std::string what = "storing the reading of " + StepName(session, step_index);
   if (Status valid = ValidateReading(reading); !valid.ok()) return valid.WithContext(what);
   const std::vector<std::uint8_t> blob = EncodeSpectrum(reading.spectrum);
+  Result<std::optional<UncertaintyColumns>> uncertainty = UncertaintyOf(reading);
+  if (!uncertainty.ok()) return uncertainty.status().WithContext(what);
   const UnixSeconds recorded_at = reading.recorded_at != 0 ? reading.recorded_at : Now();
 
   MutexLock lock(write_mu_);
@@ -520,6 +554,9 @@ Result<std::int64_t> SessionStore::CompleteStepWithReading(std::int64_t session,
   BRDF_RETURN_IF_ERROR(RequireStepTakes(db, session, step_index, reading, what));
   BRDF_RETURN_IF_ERROR(InsertReading(db, session, step_index, reading, blob, recorded_at, what));
   const std::int64_t id = db.last_insert_rowid();
+  if (uncertainty->has_value()) {
+    BRDF_RETURN_IF_ERROR(InsertUncertainty(db, id, reading.grid.count, **uncertainty, what));
+  }
   BRDF_RETURN_IF_ERROR(MarkStepDone(db, session, step_index, recorded_at, what));
   BRDF_RETURN_IF_ERROR(tx.Commit().WithContext(what));
   return id;
@@ -584,7 +621,7 @@ namespace {
 template <typename Record>
 Result<std::vector<Record>> ReadingPage(ReaderPool& readers, const std::string& path,
                                         std::int64_t session, std::int64_t after_id, int limit,
-                                        std::string_view columns,
+                                        std::string_view columns, std::string_view from,
                                         Result<Record> (*read)(const Statement&,
                                                                const std::string&)) {
   if (limit <= 0) {
@@ -594,9 +631,9 @@ Result<std::vector<Record>> ReadingPage(ReaderPool& readers, const std::string& 
   BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers.Acquire());
   BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   BRDF_RETURN_IF_ERROR(RequireSession(*db, session));
-  BRDF_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(columns) +
-                                                  " FROM readings WHERE session_id = ? AND id > ? "
-                                                  "ORDER BY id LIMIT ?"));
+  BRDF_ASSIGN_OR_RETURN(
+      Statement st, db->Prepare("SELECT " + std::string(columns) + " FROM " + std::string(from) +
+                                " WHERE session_id = ? AND id > ? ORDER BY id LIMIT ?"));
   st.Bind(1, session).Bind(2, after_id).Bind(3, limit);
   std::vector<Record> out;
   while (true) {
@@ -613,20 +650,21 @@ Result<std::vector<Record>> ReadingPage(ReaderPool& readers, const std::string& 
 Result<std::vector<ReadingRecord>> SessionStore::GetReadings(std::int64_t session,
                                                              std::int64_t after_id, int limit) {
   return ReadingPage<ReadingRecord>(*readers_, path_, session, after_id, limit, kReadingColumns,
-                                    &ReadReading);
+                                    kReadingsWithUncertainty, &ReadReading);
 }
 
 Result<std::vector<ReadingPointRecord>> SessionStore::GetReadingPoints(std::int64_t session,
                                                                        std::int64_t after_id,
                                                                        int limit) {
   return ReadingPage<ReadingPointRecord>(*readers_, path_, session, after_id, limit,
-                                         kReadingPointColumns, &ReadReadingPoint);
+                                         kReadingPointColumns, "readings", &ReadReadingPoint);
 }
 
 Result<ReadingRecord> SessionStore::GetReading(std::int64_t reading_id) {
   BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
-  BRDF_ASSIGN_OR_RETURN(Statement st, db->Prepare("SELECT " + std::string(kReadingColumns) +
-                                                  " FROM readings WHERE id = ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db->Prepare("SELECT " + std::string(kReadingColumns) + " FROM " +
+                                    std::string(kReadingsWithUncertainty) + " WHERE id = ?"));
   st.Bind(1, reading_id);
   BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
   if (!row) return NotFound("no reading " + S(reading_id) + " in the database");

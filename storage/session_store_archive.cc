@@ -112,9 +112,9 @@ Status ReadChangedSteps(Database& db, const std::string& path, const OutboxChang
 // Up to `limit` readings past batch.readings_through, which moves to the last.
 Status ReadNewReadings(Database& db, const std::string& path, int limit, ShipBatch& batch,
                        std::set<std::int64_t>& named) {
-  BRDF_ASSIGN_OR_RETURN(Statement st,
-                        db.Prepare("SELECT " + std::string(kReadingColumns) +
-                                   " FROM readings WHERE id > ? ORDER BY id LIMIT ?"));
+  BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("SELECT " + std::string(kReadingColumns) +
+                                                 " FROM " + std::string(kReadingsWithUncertainty) +
+                                                 " WHERE id > ? ORDER BY id LIMIT ?"));
   st.Bind(1, batch.readings_through).Bind(2, limit);
   while (true) {
     BRDF_ASSIGN_OR_RETURN(bool row, st.Step());

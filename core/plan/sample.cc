@@ -40,6 +40,15 @@ void CheckSample(const v1::Sample& sample, ProblemSink& sink) {
              "must be in (0, 1] (got " + std::to_string(sample.white_reflectance()) +
                  "); give the white standard's certified reflectance, e.g. 0.99");
   }
+  if (sample.has_white_reflectance_uncertainty()) {
+    const double u = sample.white_reflectance_uncertainty();
+    if (!std::isfinite(u) || u < 0 || u > 0.5) {
+      sink.Add("sample.whiteReflectanceUncertainty",
+               "must be in [0, 0.5] (got " + std::to_string(u) +
+                   "); give the standard uncertainty (k = 1) of ρw, e.g. 0.005 for a certificate's "
+                   "±0.01 at k = 2");
+    }
+  }
   if (!sample.has_white_reflectance_spectrum()) return;
   const v1::WhiteReflectanceSpectrum& s = sample.white_reflectance_spectrum();
   const std::string path = "sample.whiteReflectanceSpectrum";
@@ -77,6 +86,13 @@ std::optional<double> WhiteReflectanceOf(const v1::Plan& plan) {
     return std::nullopt;
   }
   return plan.sample().white_reflectance();
+}
+
+std::optional<double> WhiteReflectanceUncertaintyOf(const v1::Plan& plan) {
+  if (!plan.has_sample() || !plan.sample().has_white_reflectance_uncertainty()) {
+    return std::nullopt;
+  }
+  return plan.sample().white_reflectance_uncertainty();
 }
 
 }  // namespace brdf::plan

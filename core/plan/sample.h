@@ -17,7 +17,8 @@ inline constexpr std::size_t kMaxSampleDescriptionLength = 4096;
 // Most tags a sample may carry.
 inline constexpr int kMaxSampleTags = 64;
 
-// Problems with plan.sample: texts too long, an empty tag, ρw outside (0, 1], a ρw spectrum with
+// Problems with plan.sample: texts too long, an empty tag, ρw outside (0, 1], u(ρw) outside
+// [0, 0.5], a ρw spectrum with
 // a step ≤ 0, fewer than 2 values or a value outside (0, 1]. Paths "sample.<field>".
 void CheckSample(const v1::Sample& sample, ProblemSink& sink);
 
@@ -26,5 +27,9 @@ std::optional<Spectrum> WhiteReflectanceSpectrumOf(const v1::Plan& plan);
 
 // ρw as one number when the sample block gives one and no spectrum; nullopt otherwise.
 std::optional<double> WhiteReflectanceOf(const v1::Plan& plan);
+
+// u(ρw), the standard uncertainty of the white standard's reflectance, when the sample block
+// gives it; nullopt otherwise (the daemon's [sample] white_reflectance_uncertainty then).
+std::optional<double> WhiteReflectanceUncertaintyOf(const v1::Plan& plan);
 
 }  // namespace brdf::plan

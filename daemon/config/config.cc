@@ -363,6 +363,25 @@ void ReadArchive(TableReader& root, Config& c) {
   t.Finish();
 }
 
+// [uncertainty]: the terms of each reading's budget.
+void ReadUncertainty(TableReader& root, Config& c) {
+  TableReader t = root.Sub("uncertainty");
+  UncertaintyConfig& u = c.uncertainty;
+  t.Bool("enabled", u.enabled);
+  t.Double("wavelength_nm", u.wavelength_nm, 0, 10);
+  t.Double("stray_light", u.stray_light, 0, 0.1);
+  t.Double("stage_repeatability_deg", u.stage_repeatability_deg, 0, 5);
+  t.Double("stage_alignment_deg", u.stage_alignment_deg, 0, 5);
+  double rate = 0;
+  if (t.Double("lamp_drift_per_hour", rate, -0.5, 0.5)) u.lamp_drift_per_hour = rate;
+  t.Double("meter_full_scale", u.meter_full_scale, 0, 1e6, /*lo_open=*/true);
+  t.Double("meter_full_well_counts", u.meter_full_well_counts, 0, 1e12, /*lo_open=*/true);
+  t.Double("meter_read_noise_counts", u.meter_read_noise_counts, 0, 1e9);
+  t.Double("meter_adaptive_fill", u.meter_adaptive_fill, 0, 1, /*lo_open=*/true);
+  t.Double("meter_gain_repeatability", u.meter_gain_repeatability, 0, 0.2);
+  t.Finish();
+}
+
 // The small tables: [storage], [sample], [rig], [log].
 void ReadOthers(TableReader& root, Config& c) {
   TableReader storage = root.Sub("storage");
@@ -370,6 +389,7 @@ void ReadOthers(TableReader& root, Config& c) {
   storage.Finish();
   TableReader sample = root.Sub("sample");
   sample.Double("white_reflectance", c.sample.white_reflectance, 0, 1, /*lo_open=*/true);
+  sample.Double("white_reflectance_uncertainty", c.sample.white_reflectance_uncertainty, 0, 0.5);
   sample.Finish();
   TableReader rig = root.Sub("rig");
   rig.String("name", c.rig.name);
@@ -449,6 +469,7 @@ Result<Config> ParseConfig(std::string_view toml_text, std::string_view source) 
   ReadAuth(root, c);
   ReadWeb(root, c);
   ReadOthers(root, c);
+  ReadUncertainty(root, c);
   root.Finish();
   BRDF_RETURN_IF_ERROR(problems.status());
   return c;

@@ -69,6 +69,20 @@
 //
 //   [sample]
 //   white_reflectance = 0.99            # ρw of the white standard (the RS-3), in (0, 1]
+//   white_reflectance_uncertainty = 0.0058  # u(ρw), k = 1, 0 … 0.5 (default 0.01/√3: ± 1 %)
+//
+//   [uncertainty]                       # each sample reading's budget (docs/uncertainty.md)
+//   enabled = true                      # false: readings are stored "not estimated"
+//   wavelength_nm = 1.155               # u(Δλ), 0 … 10 (the PR-650's ±2 nm as rectangular)
+//   stray_light = 0                     # u(s), fraction of the white's signal, 0 … 0.1
+//   stage_repeatability_deg = 0         # per axis and move, 0 … 5 (+ resolution from the axes)
+//   stage_alignment_deg = 0             # per axis, the same at every move, 0 … 5
+//   lamp_drift_per_hour = 0.002         # relative, −0.5 … 0.5, used with a single reference
+//   meter_full_scale = 0.04             # the meter's noise model (assumed: brdf-sim's detector)
+//   meter_full_well_counts = 2e5        #   counts at full scale, > 0
+//   meter_read_noise_counts = 20        #   ≥ 0
+//   meter_adaptive_fill = 0.5           #   fill adaptive integration aims at, (0, 1]
+//   meter_gain_repeatability = 0        #   relative, per measurement, 0 … 0.2
 //
 //   [rig]
 //   name = "rig-a"                      # names the sessions this rig records (default: host name)
@@ -203,6 +217,26 @@ struct StageConfig {
 
 struct SampleConfig {
   double white_reflectance = 0.99;
+  // u(ρw), standard uncertainty (k = 1): the paper's 99 % ± 1 % read as a rectangular bound,
+  // 0.01 / √3 (docs/uncertainty.md, "The white standard"). A plan's sample block may override it.
+  double white_reflectance_uncertainty = 0.0057735026918962576;
+};
+
+// [uncertainty]: the configured terms of each sample reading's budget (docs/uncertainty.md). The
+// meter's noise-model defaults are brdf-sim's detector: assumptions for a real meter.
+struct UncertaintyConfig {
+  bool enabled = true;                        // estimate and store a budget with each sample
+  double wavelength_nm = 1.1547005383792515;  // u(Δλ): the PR-650's ±2 nm, rectangular
+  double stray_light = 0;                     // u(s), a fraction of the white's net signal
+  double stage_repeatability_deg = 0;         // per axis, each move; the resolution is added from
+                                              //   [stage.axes.*] counts_per_degree
+  double stage_alignment_deg = 0;             // per axis, the same at every move
+  std::optional<double> lamp_drift_per_hour;  // with a single reference; unset: not estimated
+  double meter_full_scale = 0.04;  // W·m⁻²·sr⁻¹·nm⁻¹·s that fills the detector
+  double meter_full_well_counts = 2e5;
+  double meter_read_noise_counts = 20;
+  double meter_adaptive_fill = 0.5;
+  double meter_gain_repeatability = 0;  // relative, per measurement, not reduced by averaging
 };
 
 struct RigConfig {
@@ -245,6 +279,7 @@ struct Config {
   MeterConfig meter;
   StageConfig stage;
   SampleConfig sample;
+  UncertaintyConfig uncertainty;
   RigConfig rig;
   ArchiveConfig archive;
   std::vector<TokenConfig> tokens;  // [[auth.tokens]]

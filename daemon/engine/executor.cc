@@ -3,8 +3,10 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <utility>
 
+#include "core/plan/sample.h"
 #include "core/plan/timing.h"
 #include "daemon/engine/reading_step.h"
 #include "daemon/engine/retry.h"
@@ -14,6 +16,11 @@
 
 namespace brdf::daemon {
 namespace {
+
+// Unix seconds now, the clock the store stamps readings with (recorded_at).
+double WallSeconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
 
 std::string StepName(const storage::StepRecord& step) {
   std::string name = "step " + std::to_string(step.step_index);
@@ -39,6 +46,7 @@ struct Executor::Context {
   std::optional<std::int64_t> last_dark;
   StageKnowledge stage;
   MeterKnowledge meter;
+  std::optional<ReadingBudgeter> budgeter;  // Options::uncertainty set
   std::uint32_t next_move_first_attempt = 1;
 
   void MarkDone(int index) {
@@ -121,11 +129,19 @@ bool Executor::Load(Context& c, const std::string& where) {
   }
   c.settings = (*plan)->settings;
   c.sample_fixed = c.session.plan_kind == "sample_fixed";
+  if (options_.uncertainty.has_value()) {
+    c.budgeter.emplace(*options_.uncertainty, session_,
+                       c.session.white_reflectance.value_or(kWhiteStandardReflectance),
+                       plan::WhiteReflectanceSpectrumOf((*plan)->plan),
+                       plan::WhiteReflectanceUncertaintyOf((*plan)->plan),
+                       static_cast<int>(c.settings.measurement.averages));
+  }
   TallySteps(c);
   // The latest reference and dark of the session so far: later samples are divided by them.
   Status scan = store_->ForEachReading(session_, [&c](const storage::ReadingRecord& r) {
     if (r.kind == storage::ReadingKind::kReference) c.last_reference = r.id;
     if (r.kind == storage::ReadingKind::kDark) c.last_dark = r.id;
+    if (c.budgeter.has_value()) c.budgeter->Observe(r, r.recorded_at);
     return Status::Ok();
   });
   if (!scan.ok()) {
@@ -310,11 +326,24 @@ ReadingRequest Executor::PlanReading(const Context& c, int index) {
 }
 
 Status Executor::CommitReading(Context& c, int index, storage::ReadingRecord& reading) {
+  const double now = WallSeconds();
+  if (c.budgeter.has_value() && reading.kind == storage::ReadingKind::kSample) {
+    // Its uncertainty goes into the same transaction; one that cannot be estimated is stored
+    // "not estimated" and the reading kept.
+    Result<uncertainty::ReadingBudget> budget = c.budgeter->Estimate(reading, now);
+    if (budget.ok()) {
+      reading.uncertainty = std::move(*budget);
+    } else {
+      spdlog::debug("session {}: uncertainty of step {} not estimated: {}", session_, index,
+                    budget.status().message());
+    }
+  }
   // The reading and the step's done mark in one transaction (the move, if pipelined, runs on).
   BRDF_ASSIGN_OR_RETURN(std::int64_t id, store_->CompleteStepWithReading(session_, index, reading));
   reading.id = id;
   reading.session_id = session_;
   reading.step_index = index;
+  if (c.budgeter.has_value()) c.budgeter->Observe(reading, now);
   if (reading.kind == storage::ReadingKind::kReference) c.last_reference = id;
   if (reading.kind == storage::ReadingKind::kDark) c.last_dark = id;
   c.MarkDone(index);

@@ -47,6 +47,7 @@
 #include "core/plan/plan_settings.h"
 #include "core/session_state.h"
 #include "core/status.h"
+#include "daemon/engine/reading_budget.h"
 #include "daemon/engine/rig.h"
 #include "daemon/sessions/session_plan.h"
 #include "storage/records.h"
@@ -91,6 +92,9 @@ class Executor {
     std::chrono::milliseconds device_call_timeout{std::chrono::minutes(10)};
     // Clock for device deadlines and retry backoff.
     const Clock* clock = &Clock::Real();
+    // Each sample reading's uncertainty budget, stored with it (reading_budget.h); nullopt:
+    // readings are stored "not estimated".
+    std::optional<ReadingBudgetSettings> uncertainty;
   };
 
   Executor(std::int64_t session, std::shared_ptr<storage::SessionStore> store, Rig& rig,

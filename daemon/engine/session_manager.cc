@@ -315,6 +315,7 @@ struct SessionManager::Impl final : public ExecutorHost {
     Executor::Options options;
     options.pipelining = owner.options_.pipelining;
     options.clock = owner.options_.clock;
+    options.uncertainty = owner.options_.uncertainty;
     auto executor = std::make_shared<Executor>(id, owner.store_, rig, *this, options);
     current = executor;
     running_thread = std::thread([this, executor] {

@@ -54,6 +54,7 @@
 #include "core/session_state.h"
 #include "core/status.h"
 #include "daemon/engine/event_bus.h"
+#include "daemon/engine/reading_budget.h"
 #include "daemon/engine/rig.h"
 #include "daemon/sessions/pause_mode.h"
 #include "daemon/sessions/session_id.h"
@@ -89,6 +90,8 @@ class SessionManager {
     std::size_t watcher_queue_capacity = 256;
     // Clock for waits (retry backoff) and device deadlines; tests may scale it.
     const Clock* clock = &Clock::Real();
+    // Each sample reading's uncertainty budget (reading_budget.h); nullopt: not estimated.
+    std::optional<ReadingBudgetSettings> uncertainty;
   };
 
   // Takes a shared store (the Data service and the index cache read it too) and the rig. Starts

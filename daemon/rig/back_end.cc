@@ -65,6 +65,7 @@ Status RigBackEnd::StartManager(const Config& config, std::unique_ptr<Rig> rig) 
   }
   options.rig_description = ToRigDescription(config);
   options.white_reflectance = config.sample.white_reflectance;
+  options.uncertainty = ReadingBudgetSettingsFrom(config);
   options.rig_name = RigName(config);
   if (Status adopted = store_->AdoptUnnamedSessions(options.rig_name); !adopted.ok()) {
     spdlog::critical("naming the rig of older sessions failed: {}", adopted.ToString());

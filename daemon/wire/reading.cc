@@ -15,7 +15,45 @@ double MicroDegrees(double degrees) {
   return std::round(degrees * 1e6) / 1e6;
 }
 
+v1::UncertaintySharing ToProtoSharing(uncertainty::Sharing sharing) {
+  switch (sharing) {
+    case uncertainty::Sharing::kIndependent:
+      return v1::UNCERTAINTY_SHARING_INDEPENDENT;
+    case uncertainty::Sharing::kReferenceReading:
+      return v1::UNCERTAINTY_SHARING_REFERENCE_READING;
+    case uncertainty::Sharing::kDarkReading:
+      return v1::UNCERTAINTY_SHARING_DARK_READING;
+    case uncertainty::Sharing::kWhiteStandard:
+      return v1::UNCERTAINTY_SHARING_WHITE_STANDARD;
+    case uncertainty::Sharing::kInstrument:
+      return v1::UNCERTAINTY_SHARING_INSTRUMENT;
+  }
+  return v1::UNCERTAINTY_SHARING_UNSPECIFIED;
+}
+
+bool SharedThroughAReading(uncertainty::Sharing sharing) {
+  return sharing == uncertainty::Sharing::kReferenceReading ||
+         sharing == uncertainty::Sharing::kDarkReading;
+}
+
 }  // namespace
+
+v1::ReadingUncertainty ToProtoUncertainty(const uncertainty::ReadingBudget& budget) {
+  v1::ReadingUncertainty out;
+  out.set_quantity(ToProtoQuantity(budget.quantity));
+  out.mutable_value()->Add(budget.value.begin(), budget.value.end());
+  out.mutable_combined()->Add(budget.combined.begin(), budget.combined.end());
+  out.mutable_independent()->Add(budget.independent.begin(), budget.independent.end());
+  for (const uncertainty::Component& c : budget.components) {
+    v1::UncertaintyComponent* p = out.add_components();
+    p->set_name(c.name);
+    p->set_sharing(ToProtoSharing(c.shared.kind));
+    if (SharedThroughAReading(c.shared.kind)) p->set_shared_id(c.shared.id);
+    p->mutable_contribution()->Add(c.contribution.begin(), c.contribution.end());
+  }
+  for (const std::string& why : budget.not_estimated) out.add_not_estimated(why);
+  return out;
+}
 
 v1::Reading ToProtoReading(const storage::ReadingRecord& r, const ReadingExtras& extras) {
   v1::Reading out;
@@ -40,6 +78,7 @@ v1::Reading ToProtoReading(const storage::ReadingRecord& r, const ReadingExtras&
   *out.mutable_taken_at() = ToTimestamp(r.recorded_at);
   auto label = extras.step_labels.find(r.step_index);
   if (label != extras.step_labels.end()) out.set_label(label->second);
+  if (r.uncertainty.has_value()) *out.mutable_uncertainty() = ToProtoUncertainty(*r.uncertainty);
   return out;
 }
 

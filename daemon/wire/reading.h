@@ -18,6 +18,9 @@ struct ReadingExtras {
   std::uint32_t averages = 1;
 };
 v1::Reading ToProtoReading(const storage::ReadingRecord& record, const ReadingExtras& extras);
+// A stored budget as the API shows it (Reading.uncertainty). Components shared through the
+// session carry shared_id 0 (the reading's session_id names it).
+v1::ReadingUncertainty ToProtoUncertainty(const uncertainty::ReadingBudget& budget);
 
 // Appends one reading to the columns (id, pose, isotropic directions, flagged). The angles are
 // for plotting and picking: rounded to a micro-degree, far below any stage's resolution (a

@@ -5,6 +5,7 @@
 
 #include "storage/archive/schema.h"
 #include "storage/spectrum_blob.h"
+#include "storage/uncertainty_columns.h"
 
 namespace brdf::storage {
 namespace {
@@ -27,8 +28,10 @@ ORDER BY step_index
 constexpr std::string_view kReadingsOfSession = R"sql(
 SELECT rig_reading_id, step_index, kind, alpha, beta, gamma, delta, theta_i, phi_i, theta_o,
   phi_o, wl_start_nm, wl_step_nm, wl_count, spectrum, quality_code, flagged, integration_ms,
-  attempts, note, reference_reading_id, dark_reading_id, meter_serial, recorded_at
-FROM readings WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id = $1)
+  attempts, note, reference_reading_id, dark_reading_id, meter_serial, recorded_at, quantity,
+  value, combined, independent, components, contributions, not_estimated
+FROM readings LEFT JOIN reading_uncertainty USING (session_uuid, step_index)
+WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id = $1)
   AND rig_reading_id > $2
 ORDER BY rig_reading_id LIMIT $3
 )sql";
@@ -123,6 +126,20 @@ Result<ReadingRecord> ReadingAt(const PgResult& r, int row, std::int64_t session
   g.dark_reading_id = r.OptionalInt64(row, 21);
   g.meter_serial = std::string(r.Text(row, 22));
   g.recorded_at = r.Double(row, 23);
+  if (r.IsNull(row, 24)) return g;  // not estimated
+  const UncertaintyColumns columns{std::string(r.Text(row, 24)),
+                                   r.Bytes(row, 25),
+                                   r.Bytes(row, 26),
+                                   r.Bytes(row, 27),
+                                   std::string(r.Text(row, 28)),
+                                   r.Bytes(row, 29),
+                                   std::string(r.Text(row, 30))};
+  Result<uncertainty::ReadingBudget> budget = DecodeUncertainty(columns, g.grid.count);
+  if (!budget.ok()) {
+    return budget.status().WithContext("archived reading " + std::to_string(g.id) + " of " +
+                                       SessionName(session) + ": its uncertainty");
+  }
+  g.uncertainty = std::move(*budget);
   return g;
 }
 

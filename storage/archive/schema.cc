@@ -147,10 +147,32 @@ CREATE TABLE session_events (
 );
 )sql";
 
-constexpr std::array<ArchiveMigration, 3> kArchiveMigrations{{
+// Version 4: each sample reading's uncertainty budget, as the rig stores it (its schema v5;
+// docs/uncertainty.md), keyed like the reading. A reading without a row is "not estimated" --
+// every reading shipped before, darks and references.
+constexpr std::string_view kArchiveV4 = R"sql(
+CREATE TABLE reading_uncertainty (
+  session_uuid  uuid    NOT NULL,
+  step_index    integer NOT NULL,
+  quantity      text    NOT NULL CHECK (quantity IN ('brdf', 'reflectance')),
+  bands         integer NOT NULL CHECK (bands > 0),
+  value         bytea   NOT NULL CHECK (length(value) = 8 * bands),
+  combined      bytea   NOT NULL CHECK (length(combined) = 8 * bands),
+  independent   bytea   NOT NULL CHECK (length(independent) = 8 * bands),
+  components    text    NOT NULL,
+  contributions bytea   NOT NULL CHECK (length(contributions) % (8 * bands) = 0),
+  not_estimated text    NOT NULL DEFAULT '',
+  archived_at   timestamptz NOT NULL DEFAULT now(),
+  PRIMARY KEY (session_uuid, step_index),
+  FOREIGN KEY (session_uuid, step_index) REFERENCES readings (session_uuid, step_index)
+);
+)sql";
+
+constexpr std::array<ArchiveMigration, 4> kArchiveMigrations{{
     {1, "create sessions, steps, readings, devices and audit", kArchiveV1},
     {2, "number the sessions for brdf-archive (sessions.archive_id)", kArchiveV2},
     {3, "keep each session's history of states (session_events)", kArchiveV3},
+    {4, "keep each reading's uncertainty budget (reading_uncertainty)", kArchiveV4},
 }};
 
 // "BRDF": the advisory lock key that serialises migrations across rigs and servers.

@@ -4,6 +4,7 @@
 
 #include "core/plan/plan_json.h"
 #include "storage/spectrum_blob.h"
+#include "storage/uncertainty_columns.h"
 
 namespace brdf::storage {
 namespace {
@@ -38,6 +39,13 @@ INSERT INTO readings (session_uuid, step_index, rig_reading_id, kind, alpha, bet
   recorded_at)
 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16, $17, $18, $19, $20,
   $21, $22, $23, $24, $25)
+ON CONFLICT DO NOTHING
+)sql";
+
+constexpr std::string_view kInsertUncertainty = R"sql(
+INSERT INTO reading_uncertainty (session_uuid, step_index, quantity, bands, value, combined,
+  independent, components, contributions, not_estimated)
+VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10)
 ON CONFLICT DO NOTHING
 )sql";
 
@@ -141,6 +149,28 @@ Status WriteStep(PgConnection& conn, const std::string& uuid, const StepRecord& 
       .WithContext("archiving step " + std::to_string(s.step_index) + " of session " + uuid);
 }
 
+// The reading's uncertainty budget, when it has one (none: not estimated, no row).
+Status WriteUncertainty(PgConnection& conn, const std::string& uuid, const ReadingRecord& r,
+                        const std::string& what) {
+  if (!r.uncertainty.has_value()) return Status::Ok();
+  Result<UncertaintyColumns> u = EncodeUncertainty(*r.uncertainty, r.grid.count);
+  if (!u.ok()) return u.status().WithContext(what);
+  PgParams p;
+  p.Add(uuid)
+      .Add(r.step_index)
+      .Add(u->quantity)
+      .Add(static_cast<std::int64_t>(r.grid.count))
+      .AddBytes(u->value)
+      .AddBytes(u->combined)
+      .AddBytes(u->independent)
+      .Add(u->components)
+      .AddBytes(u->contributions)
+      .Add(u->not_estimated);
+  return conn.QueryPrepared("insert_uncertainty", kInsertUncertainty, std::move(p))
+      .status()
+      .WithContext(what + ": its uncertainty");
+}
+
 Status WriteReading(PgConnection& conn, const std::string& uuid, const ReadingRecord& r) {
   PgParams p;
   p.Add(uuid)
@@ -168,9 +198,11 @@ Status WriteReading(PgConnection& conn, const std::string& uuid, const ReadingRe
       .Add(r.dark_reading_id)
       .Add(r.meter_serial)
       .Add(r.recorded_at);
-  return conn.QueryPrepared("insert_reading", kInsertReading, std::move(p))
-      .status()
-      .WithContext("archiving reading " + std::to_string(r.id) + " of session " + uuid);
+  const std::string what = "archiving reading " + std::to_string(r.id) + " of session " + uuid;
+  BRDF_RETURN_IF_ERROR(conn.QueryPrepared("insert_reading", kInsertReading, std::move(p))
+                           .status()
+                           .WithContext(what));
+  return WriteUncertainty(conn, uuid, r, what);
 }
 
 }  // namespace

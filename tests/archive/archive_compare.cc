@@ -4,8 +4,38 @@
 
 #include "storage/archive/pg.h"
 #include "storage/spectrum_blob.h"
+#include "storage/uncertainty_columns.h"
 
 namespace brdf::storage::testing {
+
+// The archive's reading_uncertainty rows of a session are the readings' budgets, byte for byte:
+// a row for each reading that has one, none for the others (not estimated).
+void ExpectSameUncertainties(PgConnection& conn, const std::string& uuid,
+                             const std::vector<ReadingRecord>& mine) {
+  Result<PgResult> rows = conn.Query(
+      "SELECT r.rig_reading_id, u.quantity, u.combined, u.independent, u.components, "
+      "u.contributions, u.not_estimated, u.value FROM reading_uncertainty u JOIN readings r "
+      "USING (session_uuid, step_index) WHERE session_uuid = $1 ORDER BY r.rig_reading_id",
+      PgParams().Add(uuid));
+  ASSERT_TRUE(rows.ok()) << rows.status().ToString();
+  int row = 0;
+  for (const ReadingRecord& r : mine) {
+    if (!r.uncertainty.has_value()) continue;
+    ASSERT_LT(row, rows->rows()) << "reading " << r.id << "'s uncertainty is not archived";
+    Result<UncertaintyColumns> want = EncodeUncertainty(*r.uncertainty, r.grid.count);
+    ASSERT_TRUE(want.ok()) << want.status().ToString();
+    EXPECT_EQ(rows->Int64(row, 0), r.id);
+    EXPECT_EQ(rows->Text(row, 1), want->quantity);
+    EXPECT_EQ(rows->Bytes(row, 2), want->combined) << "reading " << r.id;
+    EXPECT_EQ(rows->Bytes(row, 3), want->independent) << "reading " << r.id;
+    EXPECT_EQ(rows->Text(row, 4), want->components);
+    EXPECT_EQ(rows->Bytes(row, 5), want->contributions) << "reading " << r.id;
+    EXPECT_EQ(rows->Text(row, 6), want->not_estimated);
+    EXPECT_EQ(rows->Bytes(row, 7), want->value) << "reading " << r.id;
+    ++row;
+  }
+  EXPECT_EQ(rows->rows(), row) << "the archive holds uncertainties of readings that have none";
+}
 
 // Every reading and every event of every session of `store` is in the archive exactly once with
 // the same content, and the archive holds no other reading or event of those sessions.
@@ -62,6 +92,7 @@ void ExpectArchiveHoldsExactly(const std::string& conninfo, SessionStore& store,
       EXPECT_EQ(theirs->Int64(i, 8), r.quality_code);
     }
     total += theirs->rows();
+    ExpectSameUncertainties(**conn, s.uuid, *mine);
 
     // The session's history of states, event by event.
     Result<std::vector<SessionEventRecord>> events = store.ListSessionEvents(s.id);

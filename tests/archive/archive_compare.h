@@ -9,7 +9,8 @@ namespace brdf::storage::testing {
 
 // Every session of `store` is in the archive (at `conninfo`) under `rig` with the same state,
 // steps and counts, and every reading is there exactly once with the same id, step, kind, spectrum
-// bytes, timestamp, reference, angles, flag and quality code; the archive holds no other reading
+// bytes, timestamp, reference, angles, flag, quality code and uncertainty budget (none: none);
+// the archive holds no other reading
 // of that rig; likewise each session's events (id, time, state, reason). Reports through gtest's
 // EXPECT/ASSERT.
 void ExpectArchiveHoldsExactly(const std::string& conninfo, SessionStore& store,

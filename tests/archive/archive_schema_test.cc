@@ -3,15 +3,14 @@
 // and an unreachable server as what they are -- without the password in the message.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-
 #include <spdlog/sinks/ringbuffer_sink.h>
 #include <spdlog/spdlog.h>
 
 #include <cstring>
 #include <memory>
 #include <string>
-#include <vector>
 #include <thread>
+#include <vector>
 
 #include "storage/archive/pg.h"
 #include "storage/archive/schema.h"
@@ -48,9 +47,10 @@ TEST_F(ArchiveSchemaTest, NewArchiveGetsTheLatestSchemaAndMigratingAgainIsANoOp)
   ASSERT_TRUE(MigrateArchive(*conn).ok());
   EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM archive_schema"),
             std::to_string(LatestArchiveVersion()));
-  EXPECT_EQ(*pg_->Psql("SELECT string_agg(table_name, ',' ORDER BY table_name) FROM "
-                       "information_schema.tables WHERE table_schema = 'public'"),
-            "archive_schema,audit,devices,readings,session_events,sessions,steps");
+  EXPECT_EQ(
+      *pg_->Psql("SELECT string_agg(table_name, ',' ORDER BY table_name) FROM "
+                 "information_schema.tables WHERE table_schema = 'public'"),
+      "archive_schema,audit,devices,reading_uncertainty,readings,session_events,sessions,steps");
 }
 
 TEST_F(ArchiveSchemaTest, TwoConnectionsMigratingAtOnceBothSucceed) {

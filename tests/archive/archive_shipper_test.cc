@@ -43,6 +43,7 @@ Status RecordStep(SessionStore& store, std::int64_t session, int i,
   if (kind == StepKind::kMove) return store.CompleteStep(session, i);
   ReadingRecord r = MakeReading(i, *ReadingKindFor(kind));
   if (kind == StepKind::kSample) r.reference_reading_id = reference;
+  if (kind == StepKind::kSample && i % 2 == 0) r.uncertainty = testing::MakeBudget(i, r.grid, 1);
   BRDF_ASSIGN_OR_RETURN(std::int64_t id, store.CompleteStepWithReading(session, i, r));
   if (kind == StepKind::kReference) reference = id;
   return Status::Ok();
@@ -148,6 +149,32 @@ TEST_F(ArchiveShipperTest, ShipsEverythingRecordedWithTheCatalogue) {
     EXPECT_EQ((*archived)[i].reason, (*recorded)[i].reason);
   }
   EXPECT_EQ((*reader)->ListSessionEvents(archive_id + 1000).status().code(), StatusCode::kNotFound);
+  // …and its readings with their uncertainty budgets, or none (not estimated), as the rig's.
+  auto archived_readings = (*reader)->GetReadings(archive_id, 0, 1000);
+  ASSERT_TRUE(archived_readings.ok()) << archived_readings.status().ToString();
+  auto recorded_readings = store->GetReadings(*id, 0, 1000);
+  ASSERT_TRUE(recorded_readings.ok());
+  ASSERT_EQ(archived_readings->size(), recorded_readings->size());
+  int with_budget = 0;
+  for (std::size_t i = 0; i < archived_readings->size(); ++i) {
+    const auto& theirs = (*archived_readings)[i].uncertainty;
+    const auto& mine = (*recorded_readings)[i].uncertainty;
+    ASSERT_EQ(theirs.has_value(), mine.has_value()) << "reading " << (*recorded_readings)[i].id;
+    if (!mine.has_value()) continue;
+    ++with_budget;
+    EXPECT_EQ(theirs->quantity, mine->quantity);
+    EXPECT_EQ(theirs->value, mine->value);
+    EXPECT_EQ(theirs->combined, mine->combined);
+    EXPECT_EQ(theirs->independent, mine->independent);
+    EXPECT_EQ(theirs->not_estimated, mine->not_estimated);
+    ASSERT_EQ(theirs->components.size(), mine->components.size());
+    for (std::size_t c = 0; c < mine->components.size(); ++c) {
+      EXPECT_EQ(theirs->components[c].name, mine->components[c].name);
+      EXPECT_EQ(theirs->components[c].shared, mine->components[c].shared);
+      EXPECT_EQ(theirs->components[c].contribution, mine->components[c].contribution);
+    }
+  }
+  EXPECT_EQ(with_budget, 16);  // the samples of even steps: 2, 4, 6, 8 of each ten
 }
 
 // The archive commits a batch and the rig dies before it records its marks: the batch is sent

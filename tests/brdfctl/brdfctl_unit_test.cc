@@ -13,6 +13,7 @@
 #include "tools/brdfctl/commands/sim_mount.h"
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/output/text_format.h"
+#include "tools/brdfctl/output/uncertainty_text.h"
 #include "tools/brdfctl/plan_file.h"
 #include "tools/brdfctl/rpc_error.h"
 #include "tools/brdfctl/watch/eta_calibrator.h"
@@ -43,6 +44,24 @@ TEST(RpcError, NamesTheCallTheCodeAndTheMessage) {
   const std::string down = DescribeRpcError(
       grpc::Status(grpc::StatusCode::UNAVAILABLE, "connection refused"), "ListSessions", "h:7");
   EXPECT_NE(down.find("h:7"), std::string::npos) << down;
+}
+
+TEST(UncertaintyText, ExpandedUncertaintyOfTheBrdfOrNotEstimated) {
+  v1::Reading sample;
+  sample.set_kind(v1::READING_KIND_SAMPLE);
+  EXPECT_EQ(UncertaintySummary(sample, 2), "± not estimated");
+  v1::ReadingUncertainty* u = sample.mutable_uncertainty();
+  u->set_quantity(v1::QUANTITY_BRDF);
+  for (double v : {0.1, 0.2, 0.0, 0.4}) u->add_value(v);
+  for (double c : {0.001, 0.002, 0.5, 0.008}) u->add_combined(c);
+  // U / |f| at k = 2: 2 %, 2 %, (f = 0: left out), 4 %: median 2 %, range 2–4 %.
+  EXPECT_EQ(UncertaintySummary(sample, 2), "brdf ±2 % (k=2; 2–4 % over bands)");
+  EXPECT_EQ(UncertaintySummary(sample, 1), "brdf ±1 % (k=1; 1–2 % over bands)");
+  EXPECT_EQ(UncertaintyBand(*u, 1, 2), "brdf 0.2 ± 0.004 sr⁻¹ (k=2)");
+  EXPECT_EQ(UncertaintyBand(*u, 7, 2), "");
+  v1::Reading dark;
+  dark.set_kind(v1::READING_KIND_DARK);
+  EXPECT_EQ(UncertaintySummary(dark, 2), "");
 }
 
 TEST(TextFormat, ShortNamesAndDurations) {

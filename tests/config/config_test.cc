@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <string>
 #include <tuple>
@@ -304,6 +305,56 @@ TEST(ConfigTest, SyntaxErrorsAreStatusesNotExceptions) {
   EXPECT_THAT(Refusal("a = \"unterminated\n"), HasSubstr("not valid TOML"));
   EXPECT_THAT(Refusal("[log]\nlevel = \"info\"\n[log]\nlevel = \"debug\"\n"),
               HasSubstr("not valid TOML"));  // table defined twice
+}
+
+TEST(ConfigTest, UncertaintyTermsWithTheirDefaultsAndRanges) {
+  const Result<Config> defaults = ParseConfig("", "empty.toml");
+  ASSERT_TRUE(defaults.ok());
+  EXPECT_NEAR(defaults->sample.white_reflectance_uncertainty, 0.01 / std::sqrt(3.0), 1e-15);
+  EXPECT_TRUE(defaults->uncertainty.enabled);
+  EXPECT_NEAR(defaults->uncertainty.wavelength_nm, 2 / std::sqrt(3.0), 1e-15);
+  EXPECT_FALSE(defaults->uncertainty.lamp_drift_per_hour.has_value());
+  EXPECT_DOUBLE_EQ(defaults->uncertainty.meter_full_well_counts, 2e5);
+
+  const Result<Config> set = ParseConfig(R"([sample]
+white_reflectance_uncertainty = 0.005
+[uncertainty]
+enabled = false
+wavelength_nm = 1.0
+stray_light = 0.0002
+stage_repeatability_deg = 0.02
+stage_alignment_deg = 0.01
+lamp_drift_per_hour = -0.002
+meter_full_scale = 0.05
+meter_full_well_counts = 1e5
+meter_read_noise_counts = 10
+meter_adaptive_fill = 0.6
+meter_gain_repeatability = 0.001
+)",
+                                         "u.toml");
+  ASSERT_TRUE(set.ok()) << set.status().ToString();
+  EXPECT_DOUBLE_EQ(set->sample.white_reflectance_uncertainty, 0.005);
+  const UncertaintyConfig& u = set->uncertainty;
+  EXPECT_FALSE(u.enabled);
+  EXPECT_DOUBLE_EQ(u.wavelength_nm, 1.0);
+  EXPECT_DOUBLE_EQ(u.stray_light, 0.0002);
+  EXPECT_DOUBLE_EQ(u.stage_repeatability_deg, 0.02);
+  EXPECT_DOUBLE_EQ(u.stage_alignment_deg, 0.01);
+  EXPECT_EQ(u.lamp_drift_per_hour, -0.002);
+  EXPECT_DOUBLE_EQ(u.meter_full_scale, 0.05);
+  EXPECT_DOUBLE_EQ(u.meter_full_well_counts, 1e5);
+  EXPECT_DOUBLE_EQ(u.meter_read_noise_counts, 10);
+  EXPECT_DOUBLE_EQ(u.meter_adaptive_fill, 0.6);
+  EXPECT_DOUBLE_EQ(u.meter_gain_repeatability, 0.001);
+
+  EXPECT_THAT(Refusal("[sample]\nwhite_reflectance_uncertainty = 0.6\n"),
+              HasSubstr("sample.white_reflectance_uncertainty"));
+  EXPECT_THAT(Refusal("[uncertainty]\nwavelength_nm = -1\n"),
+              HasSubstr("uncertainty.wavelength_nm"));
+  EXPECT_THAT(Refusal("[uncertainty]\nmeter_full_scale = 0\n"),
+              HasSubstr("uncertainty.meter_full_scale"));
+  EXPECT_THAT(Refusal("[uncertainty]\nstray = 0.1\n"), HasSubstr("unknown key uncertainty.stray"));
+  EXPECT_THAT(Refusal("[uncertainty]\nenabled = 1\n"), HasSubstr("must be true or false"));
 }
 
 TEST(ConfigTest, WrongTypes) {

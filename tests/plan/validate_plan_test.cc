@@ -46,6 +46,31 @@ TEST(ValidatePlanTest, ExamplePlansAreValid) {
   }
 }
 
+TEST(ValidatePlanTest, WhiteReflectanceUncertaintyIsCheckedAndGiven) {
+  const v1::Plan good = PlanFromJson(R"({
+    "name": "u", "poseList": {"poses": [{"alpha": 10, "beta": 0, "delta": 30}]},
+    "sample": {"whiteReflectance": 0.99, "whiteReflectanceUncertainty": 0.005}
+  })");
+  EXPECT_TRUE(ValidatePlan(good, RigDescription{}).empty())
+      << FormatProblems(ValidatePlan(good, RigDescription{}));
+  EXPECT_EQ(WhiteReflectanceUncertaintyOf(good), 0.005);
+  const v1::Plan none = PlanFromJson(R"({
+    "name": "u", "poseList": {"poses": [{"alpha": 10, "beta": 0, "delta": 30}]},
+    "sample": {"whiteReflectance": 0.99}
+  })");
+  EXPECT_FALSE(WhiteReflectanceUncertaintyOf(none).has_value());
+  for (const char* value : {"-0.001", "0.51", "2"}) {
+    const v1::Plan bad = PlanFromJson(std::string(R"({
+      "name": "u", "poseList": {"poses": [{"alpha": 10, "beta": 0, "delta": 30}]},
+      "sample": {"whiteReflectanceUncertainty": )") +
+                                      value + "}}");
+    const std::vector<Problem> problems = ValidatePlan(bad, RigDescription{});
+    ASSERT_EQ(problems.size(), 1u) << value;
+    EXPECT_EQ(problems[0].field_path, "sample.whiteReflectanceUncertainty");
+    EXPECT_THAT(problems[0].message, HasSubstr("[0, 0.5]"));
+  }
+}
+
 TEST(ValidatePlanTest, SampleBlockIsCheckedAndGivesRhoW) {
   const v1::Plan good = PlanFromJson(R"({
     "name": "gloss", "poseList": {"poses": [{"alpha": 10, "beta": 0, "delta": 30}]},

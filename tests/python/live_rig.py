@@ -71,10 +71,17 @@ class _Lines:
 class LiveRig:
     """A running brdf-sim + brdfd pair; use as a context manager or call start()/stop()."""
 
-    def __init__(self, sim_path, daemon_path, white_reflectance=0.99):
+    def __init__(self, sim_path, daemon_path, white_reflectance=0.99, seed=7, sim_args=(),
+                 extra_config=""):
+        """seed, sim_args: brdf-sim's --seed and further flags (a material, error sources);
+        extra_config: TOML appended to brdfd's configuration (e.g. an [uncertainty] table)."""
         self.sim_path = sim_path
         self.daemon_path = daemon_path
         self.white_reflectance = white_reflectance
+        self.seed = seed
+        self.sim_args = list(sim_args)
+        self.extra_config = extra_config
+        self.sample_extra = ""  # more [sample] keys, e.g. "white_reflectance_uncertainty = 0.005"
         self.dir = tempfile.mkdtemp(prefix="brdf_pyclient_")
         self.operator_token = secrets.token_hex(16)
         self.analyst_token = secrets.token_hex(16)
@@ -103,9 +110,10 @@ class LiveRig:
             return ""
 
     def start(self, timeout=30.0):
-        self.sim = self._spawn([self.sim_path, "--time-scale", str(TIME_SCALE), "--seed", "7",
-                                "--wake-window", "0", "--no-pacing", "--modbus-port", "0",
-                                "--log-level", "warn"], "sim.log")
+        self.sim = self._spawn([self.sim_path, "--time-scale", str(TIME_SCALE), "--seed",
+                                str(self.seed), "--wake-window", "0", "--no-pacing",
+                                "--modbus-port", "0", "--log-level", "warn"] + self.sim_args,
+                               "sim.log")
         lines = _Lines(self.sim.stdout)
         deadline = time.monotonic() + timeout
         try:
@@ -176,7 +184,7 @@ detector_arm_motorized = true
 {axes}
 [sample]
 white_reflectance = {self.white_reflectance}
-
+{self.sample_extra}
 [[auth.tokens]]
 name = "test-operator"
 token = "{self.operator_token}"
@@ -189,7 +197,7 @@ role = "analyst"
 
 [log]
 level = "warn"
-"""
+""" + self.extra_config
 
     def set_mounted(self, what):
         """Puts "sample", "white" or "dark" in front of the simulated meter (the control unit)."""

@@ -88,6 +88,70 @@ class Readings(unittest.TestCase):
             self.rs.to_dataarray("luminance")
 
 
+class ReadingUncertainties(unittest.TestCase):
+    """A reading's stored budget (brdf.v1.Reading.uncertainty) through ReadingSet, its DataFrame
+    and its BRDF DataArray; readings without one are NaN (not estimated), never 0."""
+
+    @staticmethod
+    def reading(rid, kind, budget=None):
+        r = brdf_client.brdf_pb2.Reading(id=rid, session_id="3", kind=kind)
+        r.grid.start_nm, r.grid.step_nm, r.grid.count = 380, 4, 3
+        r.radiance.extend([0.1, 0.2, 0.3])
+        if budget is not None:
+            u = r.uncertainty
+            u.quantity = brdf_client.brdf_pb2.QUANTITY_BRDF
+            u.value.extend([0.10, 0.11, 0.12])
+            u.combined.extend(budget)
+            u.independent.extend([b / 2 for b in budget])
+            c = u.components.add(name="reference_signal",
+                                 sharing=brdf_client.brdf_pb2.UNCERTAINTY_SHARING_REFERENCE_READING,
+                                 shared_id=1)
+            c.contribution.extend([-1e-4, -2e-4, -3e-4])
+            u.not_estimated.append("pose: the quantity's gradient over the pose is not known")
+        return r
+
+    def setUp(self):
+        pb = brdf_client.brdf_pb2
+        self.rs = brdf_client.ReadingSet.from_protos([
+            self.reading(1, pb.READING_KIND_REFERENCE),
+            self.reading(2, pb.READING_KIND_SAMPLE, [0.002, 0.003, 0.004]),
+            self.reading(3, pb.READING_KIND_SAMPLE)])
+
+    def test_budget_and_columns(self):
+        np.testing.assert_array_equal(self.rs.brdf_uncertainty[1], [0.002, 0.003, 0.004])
+        np.testing.assert_array_equal(self.rs.brdf_uncertainty_independent[1],
+                                      [0.001, 0.0015, 0.002])
+        self.assertTrue(np.isnan(self.rs.brdf_uncertainty[0]).all())
+        self.assertTrue(np.isnan(self.rs.brdf_uncertainty[2]).all())
+        b = self.rs.budgets[1]
+        self.assertEqual(b.quantity, "brdf")
+        self.assertEqual(b.components["reference_signal"].sharing, "reference_reading")
+        self.assertEqual(b.components["reference_signal"].shared_id, 1)
+        np.testing.assert_array_equal(b.value, [0.10, 0.11, 0.12])
+        self.assertEqual(len(b.not_estimated), 1)
+        self.assertIsNone(self.rs.budgets[2])
+        df = self.rs.to_dataframe()
+        self.assertEqual(list(df.uncertainty_estimated), [False, True, False])
+        picked = self.rs.of_kind("sample")
+        np.testing.assert_array_equal(picked.brdf_uncertainty[0], [0.002, 0.003, 0.004])
+        both = brdf_client.ReadingSet.concat([self.rs, picked])
+        self.assertEqual(both.brdf_uncertainty.shape, (5, 3))
+
+    def test_brdf_dataarray_carries_the_uncertainty(self):
+        f = self.rs.to_dataarray("brdf")
+        u = f.brdf_uncertainty.sel(reading=2).values
+        np.testing.assert_array_equal(u, [0.002, 0.003, 0.004])
+        self.assertTrue(np.isnan(f.brdf_uncertainty.sel(reading=3).values).all())
+        self.assertEqual(f.brdf_uncertainty.attrs["units"], "sr⁻¹")
+        self.assertIn("brdf_uncertainty_independent", f.coords)
+        self.assertNotIn("brdf_uncertainty", self.rs.to_dataarray().coords)
+
+    def test_synthetic_sets_are_not_estimated(self):
+        rs = synthetic.make_session()
+        self.assertEqual(rs.brdf_uncertainty.shape, rs.spectra.shape)
+        self.assertTrue(np.isnan(rs.brdf_uncertainty).all())
+
+
 class Grids(unittest.TestCase):
     def setUp(self):
         self.dir = tempfile.mkdtemp(prefix="brdf_grid_offline_")

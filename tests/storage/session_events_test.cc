@@ -193,7 +193,7 @@ TEST(SessionEventsMigrationTest, Version3FileGetsOneEventPerSessionAndAnEventsMa
 
   auto raw = Database::Open(path);
   ASSERT_TRUE(raw.ok());
-  EXPECT_EQ(*SchemaVersion(**raw), 4);
+  EXPECT_EQ(*SchemaVersion(**raw), LatestSchemaVersion());
   EXPECT_EQ(*(*raw)->QueryInt64("SELECT value FROM archive_marks WHERE name = 'events'"), 0);
 }
 

@@ -1,10 +1,10 @@
 // storage/session_readings.h: a stored session handed out as core/readings values, with what the
 // derivation needs of the session itself -- ρw as stored, and ρw(λ) from the plan's sample block.
 #include "storage/session_readings.h"
-#include "storage/session_store.h"
 
 #include <gtest/gtest.h>
 
+#include "storage/session_store.h"
 #include "storage_test_util.h"
 
 namespace brdf::storage {

@@ -105,6 +105,29 @@ inline ReadingRecord MakeReading(int step, ReadingKind kind,
   return r;
 }
 
+// An uncertainty budget for the sample reading of step `step`: distinct per step and band, one
+// independent and one shared component (through reference `reference`), one term not estimated.
+inline uncertainty::ReadingBudget MakeBudget(int step, const WavelengthGrid& grid,
+                                             std::int64_t reference) {
+  uncertainty::ReadingBudget b;
+  b.quantity = step % 4 == 0 ? Quantity::kBrdf : Quantity::kReflectance;
+  std::vector<double> own(grid.count), shared(grid.count);
+  for (std::size_t i = 0; i < grid.count; ++i) {
+    own[i] = 1e-4 * (step + 1) + 1e-7 * static_cast<double>(i);
+    shared[i] = -2e-5 * (step + 1);
+  }
+  b.components = {
+      {"sample_signal", {}, own},
+      {"reference_signal", {uncertainty::Sharing::kReferenceReading, reference}, shared}};
+  for (std::size_t i = 0; i < grid.count; ++i) {
+    b.combined.push_back(std::hypot(own[i], shared[i]));
+    b.independent.push_back(own[i]);
+  }
+  b.not_estimated = {"pose: the quantity's gradient over the pose is not known"};
+  for (std::size_t i = 0; i < grid.count; ++i) b.value.push_back(0.01 * step + 1e-4 * i);
+  return b;
+}
+
 // The reading kind that step i of the standard plan produces (kSample for moves: unused).
 inline ReadingKind ReadingKindOfStep(int i) {
   return ReadingKindFor(KindOfStep(i)).value_or(ReadingKind::kSample);

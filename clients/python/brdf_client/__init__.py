@@ -39,7 +39,7 @@ from .grid_datasets import open_grid
 from .interpolation import InterpolationBatch, InterpolationResult, Vertex
 from .netcdf import write_netcdf
 from .plans import to_plan
-from .readings import ReadingSet
+from .readings import ReadingSet, UncertaintyBudget, UncertaintyComponent
 from .queries import candidate_queries, pick_query
 from .spectra import reading_spectrum, vertex_spectra
 
@@ -56,6 +56,7 @@ __all__ = [
     "ExportResult", "FailedPrecondition", "InterpolationBatch", "InterpolationResult",
     "InvalidArgument", "NotFound", "PROTO_PACKAGE", "PermissionDenied", "ReadingSet",
     "candidate_queries", "pick_query",
+    "UncertaintyBudget", "UncertaintyComponent",
     "Unauthenticated", "Unavailable", "Vertex", "__version__", "about", "brdf_pb2",
     "half_diff_from_incidence", "incidence_from_half_diff", "open_grid", "plan_pb2",
     "reading_spectrum", "to_plan", "vertex_spectra", "write_netcdf",

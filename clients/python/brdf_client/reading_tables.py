@@ -6,6 +6,7 @@ DataArray (reading × wavelength). ReadingSet.to_dataframe / to_dataarray call t
     rad = data.to_dataarray()                  # radiance, W·m⁻²·sr⁻¹·nm⁻¹, every reading
     f = data.to_dataarray("brdf")              # sr⁻¹, the sample readings (ρw: white_reflectance)
     f.sel(wavelength=550, method="nearest").plot.line(x="reading")
+    u = f.brdf_uncertainty                     # its standard uncertainty (k = 1), NaN: not estimated
 """
 
 from typing import TYPE_CHECKING, Any, Dict
@@ -25,6 +26,12 @@ COLUMN_UNITS = {**{c: labels.ANGLE_UNITS for c in POSE + DIRECTIONS + ("phi",)},
                 "integration_ms": "ms"}
 
 
+def _estimated(readings: "ReadingSet") -> np.ndarray:
+    """Per reading: True when it carries an uncertainty budget."""
+    budgets = readings.budgets if readings.budgets is not None else np.full(len(readings), None)
+    return np.array([b is not None for b in budgets], dtype=np.bool_)
+
+
 def _columns(readings: "ReadingSet") -> Dict[str, Any]:
     """Per-reading values by column name (everything but the spectra)."""
     cols: Dict[str, Any] = {"kind": readings.kinds, "step_index": readings.step_index,
@@ -36,7 +43,8 @@ def _columns(readings: "ReadingSet") -> Dict[str, Any]:
     cols["phi"] = readings.iso[:, 2]
     cols.update(quality=readings.quality, flagged=readings.flagged,
                 flag_reason=readings.flag_reasons, reference_id=readings.reference_ids,
-                dark_id=readings.dark_ids, integration_ms=readings.integration_ms)
+                dark_id=readings.dark_ids, integration_ms=readings.integration_ms,
+                uncertainty_estimated=_estimated(readings))
     return cols
 
 
@@ -46,7 +54,8 @@ def readings_dataframe(readings: "ReadingSet") -> Any:
     Columns: kind ("sample", "reference", "dark"), step_index, label; the pose alpha, beta,
     gamma, delta and the directions theta_i, phi_i, theta_o, phi_o, phi (φ = |φo − φi|, 180°
     specular), degrees; quality (the meter's code), flagged, flag_reason; reference_id, dark_id
-    (the readings a sample is divided by / a dark subtracted from it; 0: none); integration_ms.
+    (the readings a sample is divided by / a dark subtracted from it; 0: none); integration_ms;
+    uncertainty_estimated (the reading has an uncertainty budget: ReadingSet.budgets).
     `df.attrs["units"]` gives each column's unit, `df.attrs["wavelength_nm"]` the spectra's bands
     (the spectra themselves: to_dataarray).
     """
@@ -71,6 +80,18 @@ def _derived_spectra(readings: "ReadingSet", quantity: str, white_reflectance: f
     return rows, values
 
 
+def _uncertainty_coords(readings: "ReadingSet", rows: Any) -> Dict[str, Any]:
+    """The BRDF's standard uncertainties as (reading, wavelength) coordinates."""
+    name = labels.uncertainty_name("brdf")
+    u_attrs = {"long_name": "standard uncertainty (k = 1) of the BRDF", "units": "sr⁻¹",
+               "note": "NaN: not estimated; docs/uncertainty.md"}
+    ind_attrs = dict(u_attrs, long_name="its part independent of every other reading")
+    return {name: (("reading", "wavelength"), np.asarray(readings.brdf_uncertainty)[rows], u_attrs),
+            name + "_independent": (("reading", "wavelength"),
+                                    np.asarray(readings.brdf_uncertainty_independent)[rows],
+                                    ind_attrs)}
+
+
 def readings_dataarray(readings: "ReadingSet", quantity: str = "radiance",
                        white_reflectance: float = 0.99) -> Any:
     """The readings' spectra as an xarray DataArray (reading × wavelength).
@@ -80,7 +101,10 @@ def readings_dataarray(readings: "ReadingSet", quantity: str = "radiance",
     brdf_client.spectra; NaN rows where a reading cannot be converted). white_reflectance: ρw,
     the daemon's [sample] white_reflectance, for "brdf".
     Coordinates: reading (ids), wavelength (nm), and along reading: kind, alpha … delta,
-    theta_i, phi_i, theta_o, phi_o, phi, flagged.
+    theta_i, phi_i, theta_o, phi_o, phi, flagged. For "brdf" also brdf_uncertainty and
+    brdf_uncertainty_independent (reading × wavelength): the standard uncertainty (k = 1) brdfd
+    stored with each reading and its part independent of the others, sr⁻¹; NaN where not
+    estimated. (The budget is of the BRDF; radiance and reflectance carry none.)
     """
     if quantity not in QUANTITIES:
         raise ValueError(f"unknown quantity {quantity!r}; use one of {', '.join(QUANTITIES)}")
@@ -101,5 +125,6 @@ def readings_dataarray(readings: "ReadingSet", quantity: str = "radiance",
     attrs: Dict[str, Any] = labels.quantity_attrs(quantity)
     if quantity == "brdf":
         attrs["white_reflectance"] = white_reflectance
+        coords.update(_uncertainty_coords(readings, rows))
     return xr.DataArray(values, dims=("reading", "wavelength"), coords=coords, name=quantity,
                         attrs=attrs)

@@ -3,15 +3,77 @@
 brdfd stores every reading raw (spectral radiance as the meter reported it, with its pose and
 provenance); a ReadingSet holds n of them column-wise, so analysis code can slice by kind, pose
 or direction without loops. Units: degrees for angles, nm for wavelengths, W·m⁻²·sr⁻¹·nm⁻¹ for
-radiance (brdf.proto).
+radiance (brdf.proto). Each sample reading may carry the uncertainty budget brdfd stored with it
+(docs/uncertainty.md): the standard uncertainty of its BRDF per band and its components.
 """
 
 import dataclasses
-from typing import Any, Iterable, Optional, Sequence, Union
+from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import names
+
+# brdf.v1.UncertaintySharing's short names, by enum number.
+SHARINGS = {1: "independent", 2: "reference_reading", 3: "dark_reading", 4: "white_standard",
+            5: "instrument"}
+
+
+@dataclasses.dataclass
+class UncertaintyComponent:
+    """One named component of a reading's uncertainty (brdf.v1.UncertaintyComponent).
+
+    sharing: "independent", "reference_reading", "dark_reading", "white_standard" or
+    "instrument"; shared_id: the reference or dark reading it is shared through (0: the
+    session's); contribution: (m,) signed cⱼ · u(xⱼ) per band, in the quantity's unit. Two readings
+    sharing a component through the same (sharing, shared_id) covary by the product of their
+    contributions; independent ones never covary."""
+
+    sharing: str
+    shared_id: int
+    contribution: np.ndarray
+
+
+@dataclasses.dataclass
+class UncertaintyBudget:
+    """A reading's uncertainty budget (brdf.v1.ReadingUncertainty), per band of its grid.
+
+    quantity: "brdf" (sr⁻¹) or "reflectance"; value: the quantity the budget was evaluated at;
+    combined: the standard uncertainty u_c (k = 1); independent: its part independent of every
+    other reading; components: by name; not_estimated: "name: why" of the terms left out."""
+
+    quantity: str
+    value: np.ndarray
+    combined: np.ndarray
+    independent: np.ndarray
+    components: Dict[str, UncertaintyComponent]
+    not_estimated: List[str]
+
+    @classmethod
+    def from_proto(cls, u: Any) -> "UncertaintyBudget":
+        """From a brdf.v1.ReadingUncertainty."""
+        return cls(
+            quantity=names.quantity_name(u.quantity),
+            value=np.array(u.value, dtype=float), combined=np.array(u.combined, dtype=float),
+            independent=np.array(u.independent, dtype=float),
+            components={c.name: UncertaintyComponent(SHARINGS.get(c.sharing, "unspecified"),
+                                                     int(c.shared_id),
+                                                     np.array(c.contribution, dtype=float))
+                        for c in u.components},
+            not_estimated=list(u.not_estimated))
+
+
+def _budgets(readings: Sequence[Any], m: int) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(budgets, u, u_independent): each reading's UncertaintyBudget or None, and the BRDF's
+    standard uncertainties (n, m), NaN where not estimated (never 0)."""
+    budgets = np.array([UncertaintyBudget.from_proto(r.uncertainty)
+                        if r.HasField("uncertainty") else None for r in readings], dtype=object)
+    u = np.full((len(readings), m), np.nan)
+    u_ind = np.full((len(readings), m), np.nan)
+    for i, b in enumerate(budgets):
+        if b is not None and b.quantity == "brdf" and len(b.combined) == m:
+            u[i], u_ind[i] = b.combined, b.independent
+    return budgets, u, u_ind
 
 
 def grid_wavelengths(grid: Any) -> np.ndarray:
@@ -39,6 +101,13 @@ class ReadingSet:
       dark_ids:       (n,) the DARK reading subtracted from a SAMPLE/REFERENCE reading; 0: none.
       integration_ms: (n,) integration time actually used, ms.
       labels:         (n,) str, the plan step's label.
+      brdf_uncertainty: (n, m) the standard uncertainty (k = 1) of each sample reading's BRDF,
+                      sr⁻¹, from the budget brdfd stored with it; NaN where not estimated
+                      (references, darks, readings from before budgets) — never 0.
+      brdf_uncertainty_independent: (n, m) its part independent of every other reading; NaN
+                      likewise. The rest of u² is shared (white standard, reference, …): see
+                      budgets, and docs/uncertainty.md for combining readings.
+      budgets:        (n,) object: each reading's UncertaintyBudget, or None (not estimated).
     """
 
     ids: np.ndarray
@@ -56,6 +125,19 @@ class ReadingSet:
     dark_ids: np.ndarray
     integration_ms: np.ndarray
     labels: np.ndarray
+    brdf_uncertainty: Optional[np.ndarray] = None
+    brdf_uncertainty_independent: Optional[np.ndarray] = None
+    budgets: Optional[np.ndarray] = None
+
+    def __post_init__(self) -> None:
+        # Sets built without budgets (older code, synthetic data): every reading not estimated.
+        n, m = len(self.ids), len(self.wavelengths)
+        if self.brdf_uncertainty is None:
+            self.brdf_uncertainty = np.full((n, m), np.nan)
+        if self.brdf_uncertainty_independent is None:
+            self.brdf_uncertainty_independent = np.full((n, m), np.nan)
+        if self.budgets is None:
+            self.budgets = np.full(n, None, dtype=object)
 
     def __len__(self) -> int:
         return len(self.ids)
@@ -122,7 +204,9 @@ class ReadingSet:
             reference_ids=np.array([r.reference_id for r in readings], dtype=np.int64),
             dark_ids=np.array([r.dark_id for r in readings], dtype=np.int64),
             integration_ms=np.array([r.integration_ms for r in readings], dtype=int),
-            labels=np.array([r.label for r in readings], dtype=object))
+            labels=np.array([r.label for r in readings], dtype=object),
+            **dict(zip(("budgets", "brdf_uncertainty", "brdf_uncertainty_independent"),
+                       _budgets(readings, grid.count))))
 
     @classmethod
     def concat(cls, sets: Iterable["ReadingSet"]) -> "ReadingSet":

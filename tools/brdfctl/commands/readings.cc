@@ -7,6 +7,7 @@
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/output/json.h"
 #include "tools/brdfctl/output/text_format.h"
+#include "tools/brdfctl/output/uncertainty_text.h"
 #include "tools/brdfctl/rpc_error.h"
 
 namespace brdf::ctl {
@@ -18,7 +19,7 @@ bool ParseKind(const std::string& name, v1::ReadingKind* kind) {
   return v1::ReadingKind_Parse(upper, kind) && *kind != v1::READING_KIND_UNSPECIFIED;
 }
 
-void PrintReading(std::ostream& out, const v1::Reading& r, bool spectra) {
+void PrintReading(std::ostream& out, const v1::Reading& r, bool spectra, double k) {
   out << r.id() << "  step " << r.step_index() << "  " << ReadingKindName(r.kind()) << "  "
       << PoseText(r.pose());
   if (r.kind() == v1::READING_KIND_SAMPLE) out << "  " << IsoText(r.iso());
@@ -33,12 +34,15 @@ void PrintReading(std::ostream& out, const v1::Reading& r, bool spectra) {
     out << " (changed by the meter: " << r.integration_note() << ")";
   if (r.flagged()) out << "  FLAGGED (" << r.flag_reason() << ")";
   if (!r.label().empty()) out << "  \"" << r.label() << "\"";
+  const std::string uncertainty = UncertaintySummary(r, k);
+  if (!uncertainty.empty()) out << "  " << uncertainty;
   out << "\n";
   if (!spectra) return;
   const v1::WavelengthGrid& g = r.grid();
   for (int i = 0; i < r.radiance_size(); ++i) {
-    out << "    " << Num(g.start_nm() + i * g.step_nm()) << " nm  " << Num(r.radiance(i), 8)
-        << "\n";
+    out << "    " << Num(g.start_nm() + i * g.step_nm()) << " nm  " << Num(r.radiance(i), 8);
+    if (r.has_uncertainty()) out << "  " << UncertaintyBand(r.uncertainty(), i, k);
+    out << "\n";
   }
 }
 
@@ -66,14 +70,15 @@ int RunReadings(CommandContext& ctx, const ReadingsOptions& options) {
   v1::Reading reading;
   std::size_t count = 0;
   if (!ctx.json) {
-    ctx.out << "id  step  kind  pose (stage readings)  direction  quality  integration  label\n";
+    ctx.out << "id  step  kind  pose (stage readings)  direction  quality  integration  label  "
+            << "± (k=" << Num(options.k, 3) << ")\n";
   }
   while (reader->Read(&reading)) {
     ++count;
     if (ctx.json) {
       PrintJsonLine(ctx.out, reading);
     } else {
-      PrintReading(ctx.out, reading, options.spectra);
+      PrintReading(ctx.out, reading, options.spectra, options.k);
       if (options.follow) ctx.out.flush();
     }
   }
@@ -97,6 +102,10 @@ Runner AddReadingsOptions(CLI::App& cmd) {
       ->delimiter(',');
   cmd.add_option("--after-id", options->after_id, "only readings with a larger id");
   cmd.add_flag("--spectra", options->spectra, "also print each spectrum");
+  cmd.add_option("--k", options->k,
+                 "coverage factor of the ± columns: U = k · u of each sample's BRDF (default 2, "
+                 "about 95 %)")
+      ->check(CLI::PositiveNumber);
   return OnDaemon([options](CommandContext& ctx) { return RunReadings(ctx, *options); });
 }
 
