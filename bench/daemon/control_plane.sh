@@ -64,10 +64,26 @@ for ((i = 0; i < 200; i++)); do
 done
 
 echo "== control calls idle, then with $streams analyst streams and 8 Interpolate clients" >&2
+load_start="$(cut -d" " -f1-3 /proc/loadavg | tr " " /)"
+rss_idle_kb="$(rss_kb "$brdfd_pid")"
+sample_rss "$brdfd_pid" "$work/rss.samples" 0.5 &
+sampler=$!
+pids+=("$sampler")
 line="$("$bin/bench_control_plane" --address "$address" --operator-token "$operator_token" \
   --analyst-token "$analyst_token" --pause-session "$paused" --data-session 1 \
   --streams "$streams")" || rc=$?
-echo "$line"
+rss_ended_kb="$(rss_kb "$brdfd_pid")"
+settle="${BENCH_SETTLE_S:-60}"
+sleep "$settle"
+stop_pid "$sampler"
+rss_peak_kb="$(awk 'BEGIN { m = 0 } $2 > m { m = $2 } END { print m }' "$work/rss.samples")"
+rss_settled_kb="$(rss_kb "$brdfd_pid")"
+# The memory goal (issue 40): the streams grow RSS by at most 200 MB over idle, and RSS is back
+# within 50 MB of idle a minute after they end.
+echo "$line rss_idle_mb=$((rss_idle_kb / 1024)) rss_peak_mb=$((rss_peak_kb / 1024))" \
+  "rss_growth_mb=$(((rss_peak_kb - rss_idle_kb) / 1024)) rss_at_end_mb=$((rss_ended_kb / 1024))" \
+  "rss_after_${settle}s_mb=$((rss_settled_kb / 1024))" \
+  "rss_left_mb=$(((rss_settled_kb - rss_idle_kb) / 1024)) loadavg_start=$load_start loadavg_end=$(cut -d' ' -f1-3 /proc/loadavg | tr ' ' /)"
 "$ctl" get "$paused" | head -3 >&2
 echo "brdfd VmHWM $(awk '$1 == "VmHWM:" { print $2 }' "/proc/$brdfd_pid/status") kB, threads $(awk '$1 == "Threads:" { print $2 }' "/proc/$brdfd_pid/status")" >&2
 exit "${rc:-0}"
