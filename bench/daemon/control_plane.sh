@@ -2,10 +2,12 @@
 # The control plane under analyst load (issue 20): PauseSession and GetRigStatus latency on an idle
 # brdfd, then with 1,000 analyst streams open (400 WatchSession and 300 StreamReadings read as
 # they come, 200 InterpolateBatch and 100 Export never read) and 8 clients calling Interpolate,
-# in the same run; prints bench_control_plane's line (ratios loaded ÷ idle, goal ≤ 3, no control
-# call failed). The daemon runs against brdf-sim with a 10,000-reading session (bench_storage)
-# for the data calls and a paused session (started, then paused at its first prompt) for the
-# verbs. Usage: bench/daemon/control_plane.sh [BUILD_DIR] (default: build-bench; builds what it
+# in the same run; prints bench_control_plane's line (ratios loaded ÷ idle; goal p50 ≤ 3× and
+# p99 ≤ 5×, no control call failed; the analysts' client threads run at nice 10, the operator's
+# at 0) and brdfd's VmRSS: idle, at its peak, and BENCH_SETTLE_S (60) after the streams ended
+# (goal: at most 200 MB over idle at the peak, within 50 MB of idle after a minute). The daemon
+# runs against brdf-sim with a 10,000-reading session (bench_storage) for the data calls and a
+# paused session (started, then paused at its first prompt) for the verbs. Usage: bench/daemon/control_plane.sh [BUILD_DIR] (default: build-bench; builds what it
 # needs unless BENCH_NO_BUILD=1). BENCH_STREAMS (default 1000), BENCH_KEEP=1 keeps the logs.
 set -euo pipefail
 

@@ -65,6 +65,7 @@ void InterpolateLoop::Start() {
   }
   // Analysts' calls: below the control plane when the cores are busy (rpc/thread_priority.h).
   slow_lane_ = std::thread([this] {
+    NameThisThread("interp-slow");
     (void)SetThisThreadNice(kInterpolateNice);
     SlowLane();
   });
@@ -72,6 +73,7 @@ void InterpolateLoop::Start() {
     const int cpu = cpus_.empty() ? -1 : cpus_[i % cpus_.size()];
     loops_.emplace_back([this, q = queues_[i].get(), cpu] {
       if (cpu >= 0) PinToCpu(cpu);
+      NameThisThread("interp-loop");
       (void)SetThisThreadNice(kInterpolateNice);
       Serve(q);
     });

@@ -40,6 +40,7 @@ void ControlLoop::Start() {
   for (auto& method : methods_) method->Ask();
   for (int i = 0; i < threads_; ++i) {
     loops_.emplace_back([this] {
+      NameThisThread("ctl-plane");
       RaisePriority();
       Serve();
     });

@@ -20,4 +20,8 @@ inline constexpr int kStreamNice = 10;
 // setpriority on the calling thread (its tid); false when not allowed (the value stays).
 bool SetThisThreadNice(int nice);
 
+// The calling thread's name as ps, top and /proc/PID/task/TID/comm show it (at most 15
+// characters): "ctl-plane" (the control plane), "interp-loop" and "interp-slow" (Interpolate).
+void NameThisThread(const char* name);
+
 }  // namespace brdf::daemon
