@@ -66,6 +66,11 @@ for ((i = 0; i < 200; i++)); do
 done
 
 echo "== control calls idle, then with $streams analyst streams and 8 Interpolate clients" >&2
+# Idle with the data session's index built (one Interpolate, as any analyst's first call): the
+# memory figures then compare the streams, not the index cache.
+BRDF_TOKEN="$analyst_token" "$ctl" interpolate 1 --theta-i 30 --theta-o 30 --phi 10 >/dev/null ||
+  true
+sleep 2
 load_start="$(cut -d" " -f1-3 /proc/loadavg | tr " " /)"
 rss_idle_kb="$(rss_kb "$brdfd_pid")"
 sample_rss "$brdfd_pid" "$work/rss.samples" 0.5 &
