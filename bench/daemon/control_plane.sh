@@ -2,10 +2,12 @@
 # The control plane under analyst load (issue 20): PauseSession and GetRigStatus latency on an idle
 # brdfd, then with 1,000 analyst streams open (400 WatchSession and 300 StreamReadings read as
 # they come, 200 InterpolateBatch and 100 Export never read) and 8 clients calling Interpolate,
-# in the same run; prints bench_control_plane's line (ratios loaded ÷ idle, goal ≤ 3, no control
-# call failed). The daemon runs against brdf-sim with a 10,000-reading session (bench_storage)
-# for the data calls and a paused session (started, then paused at its first prompt) for the
-# verbs. Usage: bench/daemon/control_plane.sh [BUILD_DIR] (default: build-bench; builds what it
+# in the same run; prints bench_control_plane's line (ratios loaded ÷ idle; goal p50 ≤ 3× and
+# p99 ≤ 5×, no control call failed; the analysts' client threads run at nice 10, the operator's
+# at 0) and brdfd's VmRSS: idle, at its peak, and BENCH_SETTLE_S (60) after the streams ended
+# (goal: at most 200 MB over idle at the peak, within 50 MB of idle after a minute). The daemon
+# runs against brdf-sim with a 10,000-reading session (bench_storage) for the data calls and a
+# paused session (started, then paused at its first prompt) for the verbs. Usage: bench/daemon/control_plane.sh [BUILD_DIR] (default: build-bench; builds what it
 # needs unless BENCH_NO_BUILD=1). BENCH_STREAMS (default 1000), BENCH_KEEP=1 keeps the logs.
 set -euo pipefail
 
@@ -64,10 +66,31 @@ for ((i = 0; i < 200; i++)); do
 done
 
 echo "== control calls idle, then with $streams analyst streams and 8 Interpolate clients" >&2
+# Idle with the data session's index built (one Interpolate, as any analyst's first call): the
+# memory figures then compare the streams, not the index cache.
+BRDF_TOKEN="$analyst_token" "$ctl" interpolate 1 --theta-i 30 --theta-o 30 --phi 10 >/dev/null ||
+  true
+sleep 2
+load_start="$(cut -d" " -f1-3 /proc/loadavg | tr " " /)"
+rss_idle_kb="$(rss_kb "$brdfd_pid")"
+sample_rss "$brdfd_pid" "$work/rss.samples" 0.5 &
+sampler=$!
+pids+=("$sampler")
 line="$("$bin/bench_control_plane" --address "$address" --operator-token "$operator_token" \
   --analyst-token "$analyst_token" --pause-session "$paused" --data-session 1 \
   --streams "$streams")" || rc=$?
-echo "$line"
+rss_ended_kb="$(rss_kb "$brdfd_pid")"
+settle="${BENCH_SETTLE_S:-60}"
+sleep "$settle"
+stop_pid "$sampler"
+rss_peak_kb="$(awk 'BEGIN { m = 0 } $2 > m { m = $2 } END { print m }' "$work/rss.samples")"
+rss_settled_kb="$(rss_kb "$brdfd_pid")"
+# The memory goal (issue 40): the streams grow RSS by at most 200 MB over idle, and RSS is back
+# within 50 MB of idle a minute after they end.
+echo "$line rss_idle_mb=$((rss_idle_kb / 1024)) rss_peak_mb=$((rss_peak_kb / 1024))" \
+  "rss_growth_mb=$(((rss_peak_kb - rss_idle_kb) / 1024)) rss_at_end_mb=$((rss_ended_kb / 1024))" \
+  "rss_after_${settle}s_mb=$((rss_settled_kb / 1024))" \
+  "rss_left_mb=$(((rss_settled_kb - rss_idle_kb) / 1024)) loadavg_start=$load_start loadavg_end=$(cut -d' ' -f1-3 /proc/loadavg | tr ' ' /)"
 "$ctl" get "$paused" | head -3 >&2
 echo "brdfd VmHWM $(awk '$1 == "VmHWM:" { print $2 }' "/proc/$brdfd_pid/status") kB, threads $(awk '$1 == "Threads:" { print $2 }' "/proc/$brdfd_pid/status")" >&2
 exit "${rc:-0}"

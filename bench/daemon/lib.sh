@@ -102,3 +102,16 @@ level = "warn"
 ${config_extra:-}
 EOT
 }
+
+# brdfd's (any process's) resident memory now, kB: VmRSS of /proc/$1/status (0 once it is gone).
+rss_kb() { awk '$1 == "VmRSS:" { print $2; found = 1 } END { if (!found) print 0 }' "/proc/$1/status" 2>/dev/null || echo 0; }
+
+# Appends "SECONDS_SINCE_START RSS_KB THREADS FDS" for process $1 to file $2 every $3 s until it
+# is stopped (run it in the background) or the process is gone.
+sample_rss() {
+  local start=$SECONDS
+  while [[ -d "/proc/$1" ]]; do
+    echo "$((SECONDS - start)) $(rss_kb "$1") $(awk '$1 == "Threads:" { print $2 }' "/proc/$1/status" 2>/dev/null || echo 0) $(find "/proc/$1/fd" -mindepth 1 -maxdepth 1 2>/dev/null | wc -l)" >>"$2"
+    sleep "$3"
+  done
+}

@@ -91,6 +91,10 @@ void AppendRow(const Reading& r, std::span<const double> values, std::string& ou
   out += '\n';
 }
 
+// Rows are handed to the stream this many bytes at a time (the stream may be a slow client's:
+// brdfd holds no more than this of the text).
+constexpr std::size_t kFlushBytes = 64 * 1024;
+
 Status Flush(std::ostream& out, std::string& text) {
   out.write(text.data(), static_cast<std::streamsize>(text.size()));
   text.clear();
@@ -123,22 +127,29 @@ Result<ReadingsCsvReport> WriteReadingsCsv(const Session& session, Quantity quan
     BRDF_RETURN_IF_ERROR(Flush(out, text));
     for (const Reading& r : session.readings) {
       AppendRow(r, r.spectrum.values, text);
-      if (text.size() > (1u << 20)) BRDF_RETURN_IF_ERROR(Flush(out, text));
+      if (text.size() > kFlushBytes) BRDF_RETURN_IF_ERROR(Flush(out, text));
     }
     BRDF_RETURN_IF_ERROR(Flush(out, text));
     return report;
   }
 
-  BRDF_ASSIGN_OR_RETURN(DerivedSamples derived, DeriveSamples(session, quantity, options));
+  BRDF_ASSIGN_OR_RETURN(const DerivedSamples derived, DeriveSamples(session, quantity, options));
+  return WriteDerivedReadingsCsv(session, quantity, derived, out);
+}
+
+Result<ReadingsCsvReport> WriteDerivedReadingsCsv(const Session& session, Quantity quantity,
+                                                  const DerivedSamples& derived,
+                                                  std::ostream& out) {
+  ReadingsCsvReport report;
   std::unordered_map<std::int64_t, const Reading*> by_id;
   for (const Reading& r : session.readings) by_id.emplace(r.id, &r);
   report.rows = derived.samples.size();
   report.skipped = derived.skipped;
-  text = Header(session, quantity, derived.grid, report.rows, derived.skipped);
+  std::string text = Header(session, quantity, derived.grid, report.rows, derived.skipped);
   BRDF_RETURN_IF_ERROR(Flush(out, text));
   for (const DerivedSample& s : derived.samples) {
     AppendRow(*by_id.at(s.reading_id), s.values, text);
-    if (text.size() > (1u << 20)) BRDF_RETURN_IF_ERROR(Flush(out, text));
+    if (text.size() > kFlushBytes) BRDF_RETURN_IF_ERROR(Flush(out, text));
   }
   BRDF_RETURN_IF_ERROR(Flush(out, text));
   return report;

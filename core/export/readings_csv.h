@@ -29,4 +29,10 @@ struct ReadingsCsvReport {
 Result<ReadingsCsvReport> WriteReadingsCsv(const Session& session, Quantity quantity,
                                            std::ostream& out, const DeriveOptions& options = {});
 
+// The same file (reflectance or BRDF) from samples derived beforehand, `derived` =
+// DeriveSamples(session, quantity, options): for callers that share one derivation between
+// several exports of a session (brdfd's Data.Export, daemon/api/export_loads.h).
+Result<ReadingsCsvReport> WriteDerivedReadingsCsv(const Session& session, Quantity quantity,
+                                                  const DerivedSamples& derived, std::ostream& out);
+
 }  // namespace brdf::exports

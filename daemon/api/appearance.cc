@@ -38,6 +38,13 @@ struct AppearanceSettings {
   std::vector<v1::Illuminant> illuminants;
 };
 
+// What a render holds, bytes (for the memory budget, rpc/memory_budget.h): per pixel of the
+// sphere its spectrum (~101 bands) and, per illuminant, its RGBA twice (the image and the answer).
+std::uint64_t AppearanceBytes(const AppearanceSettings& s) {
+  const auto pixels = static_cast<std::uint64_t>(s.sphere.size) * s.sphere.size;
+  return pixels * (101 * 8 + 2 * 4 * std::max<std::uint64_t>(1, s.illuminants.size()));
+}
+
 grpc::Status ParseAppearance(const v1::AppearanceRequest& r, AppearanceSettings* out) {
   if (grpc::Status st = ParseSessionIdField(r.session_id(), "session_id", &out->session);
       !st.ok()) {
@@ -364,6 +371,8 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
   if (Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir); !cie.ok()) {
     st = ToGrpcStatus(cie.status());
     lasting = true;  // the installation's: the same for every call
+  } else if (grpc::Status budget = slot->Reserve(AppearanceBytes(s)); !budget.ok()) {
+    st = budget;
   } else if (slot->Work() && !context->IsCancelled()) {
     ++appearance_renders_;
     st = Render(cache_, stopping_, *context, s, *cie, index, rendered.get(), &lasting);

@@ -60,8 +60,8 @@ grpc::Status DataService::Serve(grpc::ServerContext& context,
 
 grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportRequest* request,
                                  grpc::ServerWriter<v1::ExportChunk>* writer) {
-  return ExportSession(*context, *request, *writer, auth_, streams_, stopping_,
-                       catalogue_.reader());
+  return ExportSession(*context, *request, *writer, auth_, streams_, stopping_, catalogue_.reader(),
+                       export_loads_);
 }
 
 }  // namespace brdf::daemon

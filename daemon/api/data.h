@@ -10,6 +10,7 @@
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/api/common.h"
+#include "daemon/api/export_loads.h"
 #include "daemon/api/session_catalogue.h"
 #include "daemon/api/stream_readings.h"
 #include "daemon/rpc/auth.h"
@@ -49,6 +50,7 @@ class DataService final : public v1::Data::Service {
   const StopSignal& stopping_;
   StreamRegistry& streams_;
   std::string program_;
+  SharedSessionLoads export_loads_;  // the sessions the exports in flight hold
 };
 
 }  // namespace brdf::daemon

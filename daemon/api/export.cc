@@ -37,6 +37,7 @@
 #include "core/export/run_control.h"
 #include "core/export/session_data.h"
 #include "core/export/spectral_rgb.h"
+#include "daemon/api/export_loads.h"
 #include "daemon/api/export_session.h"
 #include "data/cie_tables.h"
 #include "storage/session_readings.h"
@@ -50,6 +51,10 @@ constexpr std::uint32_t kDefaultExportChunkBytes = 1024 * 1024;
 constexpr std::uint32_t kMaxExportChunkBytes = 4 * 1024 * 1024 - 1024;
 // Exports have no deadline of their own beyond the client's; this caps a client without one.
 constexpr std::chrono::hours kLongestExport{24};
+// The first data message holds at most this much; each one the client takes doubles the next, up
+// to the request's chunk_bytes. A client that never reads so leaves at most this much (and its
+// serialized copy) waiting in brdfd, not a whole chunk_bytes (issue 40).
+constexpr std::size_t kFirstExportChunkBytes = 32 * 1024;
 // A progress message goes out when the fraction moved by this much (or the stage changed).
 constexpr double kProgressStep = 0.005;
 // RGL: the largest θi slice count and warped-square resolution a request may ask (the file is
@@ -70,6 +75,7 @@ class ExportStream {
         slot_(slot),
         stopping_(stopping),
         chunk_bytes_(chunk_bytes),
+        next_chunk_bytes_(std::min(chunk_bytes, kFirstExportChunkBytes)),
         cancel_(std::move(cancel)) {}
 
   void Progress(const std::string& stage, double fraction) {
@@ -91,11 +97,11 @@ class ExportStream {
   bool Append(const char* data, std::size_t n) {
     CheckCancelled();
     while (n > 0 && !broken_) {
-      const std::size_t take = std::min(n, chunk_bytes_ - buffer_.size());
+      const std::size_t take = std::min(n, next_chunk_bytes_ - buffer_.size());
       buffer_.append(data, take);
       data += take;
       n -= take;
-      if (buffer_.size() == chunk_bytes_) SendBuffer();
+      if (buffer_.size() == next_chunk_bytes_) SendBuffer();
     }
     return !broken_;
   }
@@ -128,13 +134,16 @@ class ExportStream {
     }
   }
 
+  // The buffer's bytes move into the message (no copy kept while the write waits), and the
+  // next chunk may be twice as large once this one was taken.
   void SendBuffer() {
     v1::ExportChunk chunk;
     chunk.mutable_data()->set_offset(offset_);
-    chunk.mutable_data()->set_content(buffer_);
     offset_ += buffer_.size();
-    buffer_.clear();
+    chunk.mutable_data()->set_content(std::move(buffer_));
+    buffer_ = std::string();
     Send(chunk);
+    next_chunk_bytes_ = std::min(chunk_bytes_, 2 * next_chunk_bytes_);
   }
 
   void Send(const v1::ExportChunk& chunk) {
@@ -150,6 +159,7 @@ class ExportStream {
   StreamRegistry::Slot& slot_;
   const StopSignal& stopping_;
   const std::size_t chunk_bytes_;
+  std::size_t next_chunk_bytes_;  // the next data message's size, ≤ chunk_bytes_
   CancelToken cancel_;
   std::string buffer_;
   std::uint64_t offset_ = 0;  // bytes sent
@@ -392,15 +402,26 @@ void AddFill(const exports::FillTally& tally, v1::ExportReport* report) {
 
 // Each export writes its file to `out` (through the stream) and fills the report; progress runs
 // from `base` to 1 across the export's own work.
-Status ExportReadingsCsv(const exports::Session& session, const ExportSettings& s,
-                         ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
+// Reflectance and BRDF from the derivation the exports of this copy of the session share
+// (export_loads.h); radiance straight from the readings.
+Status ExportReadingsCsv(const std::shared_ptr<const exports::Session>& session,
+                         const ExportSettings& s, SharedSessionLoads& loads, ExportStream& stream,
+                         std::ostream& out, v1::ExportReport* report) {
   stream.Progress("writing readings", 0.1);
-  BRDF_ASSIGN_OR_RETURN(exports::ReadingsCsvReport csv,
-                        exports::WriteReadingsCsv(session, s.quantity, out, {s.exclude_flagged}));
-  report->set_rows(csv.rows);
-  AddSkipped(csv.skipped, report);
-  report->set_summary(std::to_string(csv.rows) + " rows (" + exports::QuantityName(s.quantity) +
-                      "), " + std::to_string(csv.skipped.size()) + " sample readings left out");
+  Result<exports::ReadingsCsvReport> csv = Internal("unset");
+  if (s.quantity == exports::Quantity::kRadiance) {
+    csv = exports::WriteReadingsCsv(*session, s.quantity, out, {s.exclude_flagged});
+  } else {
+    Result<std::shared_ptr<const exports::DerivedSamples>> derived =
+        loads.Derived(session, s.quantity, s.exclude_flagged);
+    if (!derived.ok()) return derived.status();
+    csv = exports::WriteDerivedReadingsCsv(*session, s.quantity, **derived, out);
+  }
+  if (!csv.ok()) return csv.status();
+  report->set_rows(csv->rows);
+  AddSkipped(csv->skipped, report);
+  report->set_summary(std::to_string(csv->rows) + " rows (" + exports::QuantityName(s.quantity) +
+                      "), " + std::to_string(csv->skipped.size()) + " sample readings left out");
   return Status();
 }
 
@@ -503,12 +524,60 @@ Status ExportRgl(const exports::Session& session, const ExportSettings& s, const
   return Status();
 }
 
+// What an export holds besides its session's readings, bytes (for the memory budget,
+// rpc/memory_budget.h), with `bands` values per spectrum: a few chunks; the interpolant's derived
+// samples (about the readings' size again); a grid's window of slices, a MERL or RGL table.
+std::uint64_t WorkingBytes(const ExportSettings& s, std::size_t bands, std::uint64_t readings) {
+  constexpr std::uint64_t kMerlCells = 90ULL * 90 * 180;
+  constexpr std::uint64_t kBatchCells = 16384;  // a batch of the fill chain, per thread
+  const std::uint64_t chunks = 3ULL * s.chunk_bytes;
+  const std::uint64_t spectrum = 8ULL * bands + 64;
+  const std::uint64_t interpolant = readings + 2 * kBatchCells * spectrum;
+  switch (s.format) {
+    case v1::EXPORT_FORMAT_READINGS_CSV:
+      return chunks;  // its derived samples are shared by the exports of the session
+    case v1::EXPORT_FORMAT_MERL_BINARY:
+      return chunks + interpolant + kMerlCells * 3 * 8;
+    case v1::EXPORT_FORMAT_RGL_BSDF: {
+      const std::uint64_t nodes = s.rgl.sample_res;
+      return chunks + interpolant + 2ULL * 4 * s.rgl.theta_i_count * nodes * nodes * bands;
+    }
+    default: {
+      Result<exports::RegularGrid> grid = exports::MakeRegularGrid(
+          s.steps[0], s.steps[1], s.steps[2],
+          s.nodes ? exports::GridPlacement::kNodes : exports::GridPlacement::kCellCentres);
+      const std::uint64_t cells =
+          grid.ok() ? grid->theta_i.count * grid->theta_o.count * grid->phi.count : 0;
+      return chunks + interpolant + std::min<std::uint64_t>(cells, 65536) * (spectrum + 32);
+    }
+  }
+}
+
+// The session, shared with the exports of it in flight (export_loads.h), and its memory reserved:
+// the readings when this call loaded them, and what the export will hold (WorkingBytes).
+grpc::Status LoadAndReserve(const ExportSettings& s, storage::SessionReader& reader,
+                            SharedSessionLoads& loads, StreamRegistry::Slot& slot,
+                            std::shared_ptr<const exports::Session>* session) {
+  bool loaded = false;
+  Result<std::shared_ptr<const exports::Session>> got = loads.Load(reader, s.session_id, &loaded);
+  if (!got.ok()) return ToGrpcStatus(got.status());
+  const std::uint64_t readings = SharedSessionLoads::BytesOf(**got);
+  const std::size_t bands =
+      (*got)->readings.empty() ? 101 : (*got)->readings.front().spectrum.values.size();
+  if (grpc::Status st = slot.Reserve((loaded ? readings : 0) + WorkingBytes(s, bands, readings));
+      !st.ok()) {
+    return st;
+  }
+  *session = *std::move(got);
+  return grpc::Status::OK;
+}
+
 }  // namespace
 
 grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest& request,
                            grpc::ServerWriter<v1::ExportChunk>& writer, const Authenticator& auth,
                            StreamRegistry& streams, const StopSignal& stopping,
-                           storage::SessionReader& reader) {
+                           storage::SessionReader& reader, SharedSessionLoads& loads) {
   Caller caller;
   if (grpc::Status st = auth.CallerOf(context, &caller); !st.ok()) return st;
   std::unique_ptr<StreamRegistry::Slot> slot;
@@ -517,6 +586,8 @@ grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest
     return st;
   ExportSettings settings;
   if (grpc::Status st = ParseRequest(request, &settings); !st.ok()) return st;
+  // The chunks first: refused before anything is loaded when the budget is spent.
+  if (grpc::Status st = slot->Reserve(3ULL * settings.chunk_bytes); !st.ok()) return st;
 
   CancelToken cancel;
   Result<CallContext> ctx = ExportContext(context, cancel);
@@ -526,8 +597,10 @@ grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest
   std::ostream out(&buffer);
 
   stream.Progress("loading readings", 0);
-  Result<exports::Session> session = storage::LoadSessionReadings(reader, settings.session_id);
-  if (!session.ok()) return ToGrpcStatus(session.status());
+  std::shared_ptr<const exports::Session> session;
+  if (grpc::Status st = LoadAndReserve(settings, reader, loads, *slot, &session); !st.ok()) {
+    return st;
+  }
   stream.Progress("loading readings", 0.05);
 
   v1::ExportReport report;
@@ -541,7 +614,7 @@ grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest
   Status st;
   switch (settings.format) {
     case v1::EXPORT_FORMAT_READINGS_CSV:
-      st = ExportReadingsCsv(*session, settings, stream, out, &report);
+      st = ExportReadingsCsv(session, settings, loads, stream, out, &report);
       break;
     case v1::EXPORT_FORMAT_MERL_BINARY:
       st = ExportMerl(*session, settings, *ctx, stream, out, &report);

@@ -1,12 +1,14 @@
 // Data.Export's work (data.h), over any SessionCatalogue's reader (the rig's store, the archive):
 // the caller authorized (kRead), a stream slot taken, the request checked, the session loaded
-// through `reader`, the requested export computed by core/export, and its bytes streamed as
-// progress, the file in chunks, then the report. The same session gives the same file from either
-// server. Defined in export.cc.
+// through `reader` (or shared with the exports of it in flight: `loads`, export_loads.h) and the
+// export's memory reserved (the stream registry's budget), the requested export computed by
+// core/export, and its bytes streamed as progress, the file in chunks, then the report. The same
+// session gives the same file from either server. Defined in export.cc.
 #pragma once
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/api/common.h"
+#include "daemon/api/export_loads.h"
 #include "daemon/rpc/auth.h"
 #include "daemon/rpc/stream_registry.h"
 #include "storage/session_reader.h"
@@ -16,6 +18,6 @@ namespace brdf::daemon {
 grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest& request,
                            grpc::ServerWriter<v1::ExportChunk>& writer, const Authenticator& auth,
                            StreamRegistry& streams, const StopSignal& stopping,
-                           storage::SessionReader& reader);
+                           storage::SessionReader& reader, SharedSessionLoads& loads);
 
 }  // namespace brdf::daemon

@@ -11,6 +11,8 @@
 #include <optional>
 #include <utility>
 
+#include "daemon/rpc/thread_priority.h"
+
 namespace brdf::daemon {
 namespace {
 
@@ -61,11 +63,18 @@ void InterpolateLoop::Start() {
   for (auto& queue : queues_) {
     for (int i = 0; i < kRequestsAhead; ++i) Request(queue.get());
   }
-  slow_lane_ = std::thread([this] { SlowLane(); });
+  // Analysts' calls: below the control plane when the cores are busy (rpc/thread_priority.h).
+  slow_lane_ = std::thread([this] {
+    NameThisThread("interp-slow");
+    (void)SetThisThreadNice(kInterpolateNice);
+    SlowLane();
+  });
   for (std::size_t i = 0; i < queues_.size(); ++i) {
     const int cpu = cpus_.empty() ? -1 : cpus_[i % cpus_.size()];
     loops_.emplace_back([this, q = queues_[i].get(), cpu] {
       if (cpu >= 0) PinToCpu(cpu);
+      NameThisThread("interp-loop");
+      (void)SetThisThreadNice(kInterpolateNice);
       Serve(q);
     });
   }

@@ -276,22 +276,37 @@ grpc::Status CheckBatch(const v1::InterpolateBatchRequest& request, SessionId* i
   return grpc::Status::OK;
 }
 
-// The batch's directions in the index's coordinates, row-major (the index's dims per row).
+// Directions [first, first + count) of the batch in the index's coordinates, row-major (the
+// index's dims per row).
 grpc::Status BatchCoords(const v1::InterpolateBatchRequest& request, const IndexSnapshot& index,
-                         std::vector<double>* coords) {
-  const int n = request.directions_size();
+                         int first, int count, std::vector<double>* coords) {
   const auto d = static_cast<std::size_t>(index.dims);
-  coords->assign(static_cast<std::size_t>(n) * d, 0);
-  for (int i = 0; i < n; ++i) {
+  coords->assign(static_cast<std::size_t>(count) * d, 0);
+  for (int k = 0; k < count; ++k) {
+    const int i = first + k;
     std::array<double, 4> at{};
     if (grpc::Status st =
             ToCoords(request.directions(i), index, "directions[" + std::to_string(i) + "]", &at);
         !st.ok()) {
       return st;
     }
-    std::copy_n(at.begin(), d, coords->begin() + static_cast<std::ptrdiff_t>(i * d));
+    std::copy_n(at.begin(), d, coords->begin() + static_cast<std::ptrdiff_t>(k * d));
   }
   return grpc::Status::OK;
+}
+
+// A batch is answered a slice of this many chunks at a time: the next slice is evaluated only
+// once the last chunk of this one was taken by the transport (the writer blocks under flow
+// control), so a batch holds at most a slice's answers ahead of its client, however long it is.
+constexpr int kSliceChunks = 4;
+
+// What a batch holds while it streams, bytes (for the memory budget, rpc/memory_budget.h): its
+// request (as received and parsed), and per slice the coordinates, the octant method's sort and
+// blends (~200 bytes a query) and the chunks of full answers (~1.2 kB each with provenance).
+std::uint64_t BatchBytes(const v1::InterpolateBatchRequest& request, int chunk) {
+  const auto n = static_cast<std::uint64_t>(request.directions_size());
+  const std::uint64_t slice = std::min<std::uint64_t>(n, std::uint64_t{kSliceChunks} * chunk);
+  return 3 * request.ByteSizeLong() + slice * (200 + 1200) + 2ULL * chunk * 1200;
 }
 
 }  // namespace
@@ -310,6 +325,7 @@ grpc::Status InterpolationService::InterpolateBatch(
   Settings settings;
   int chunk = 0;
   if (grpc::Status st = CheckBatch(*request, &id, &settings, &chunk); !st.ok()) return st;
+  if (grpc::Status st = slot->Reserve(BatchBytes(*request, chunk)); !st.ok()) return st;
 
   // One snapshot for the whole batch: every result sees the same readings.
   Result<std::shared_ptr<const IndexSnapshot>> got =
@@ -317,12 +333,19 @@ grpc::Status InterpolationService::InterpolateBatch(
   if (!got.ok()) return ToGrpcStatus(got.status());
   const IndexSnapshot& index = **got;
   if (grpc::Status st = CheckOptionsFit(settings.options, index); !st.ok()) return st;
-  std::vector<double> coords;
-  if (grpc::Status st = BatchCoords(*request, index, &coords); !st.ok()) return st;
 
-  // The whole batch in one EvaluateEach (the octant method sorts it by cell), its answers
-  // streamed chunk by chunk as they come, in order.
+  // A slice of kSliceChunks chunks at a time in one EvaluateEach (the octant method sorts it by
+  // cell), its answers streamed chunk by chunk as they come, in order.
   const int n = request->directions_size();
+  const int slice = kSliceChunks * chunk;
+  // Every direction's form checked against the session before the first result goes out.
+  for (int first = 0; first < n; first += slice) {
+    std::vector<double> probe;
+    if (grpc::Status st = BatchCoords(*request, index, first, std::min(slice, n - first), &probe);
+        !st.ok()) {
+      return st;
+    }
+  }
   grpc::Status outcome = grpc::Status::OK;
   v1::InterpolateBatchChunk out;
   auto start_chunk = [&](int first) {
@@ -343,8 +366,7 @@ grpc::Status InterpolationService::InterpolateBatch(
     out.set_first_index(static_cast<std::uint32_t>(first));
     return true;
   };
-  index.interpolator->EvaluateEach(coords, [&](std::size_t k, interp::Interpolation&& answer) {
-    const int i = static_cast<int>(k);
+  auto take = [&](int i, interp::Interpolation&& answer) {
     if (i % chunk == 0 && !start_chunk(i)) return false;
     ToResult(request->directions(i), std::move(answer), settings, index, VertexSpectra::kOmit,
              out.add_results());
@@ -354,8 +376,20 @@ grpc::Status InterpolationService::InterpolateBatch(
       outcome = grpc::Status(grpc::StatusCode::CANCELLED, "InterpolateBatch: the client went away");
       return false;
     }
+    out.Clear();
     return true;
-  });
+  };
+  std::vector<double> coords;
+  for (int first = 0; first < n && outcome.ok(); first += slice) {
+    const int count = std::min(slice, n - first);
+    if (grpc::Status st = BatchCoords(*request, index, first, count, &coords); !st.ok()) return st;
+    bool going = true;
+    index.interpolator->EvaluateEach(coords, [&](std::size_t k, interp::Interpolation&& answer) {
+      going = take(first + static_cast<int>(k), std::move(answer));
+      return going;
+    });
+    if (!going) break;
+  }
   return outcome;
 }
 

@@ -205,6 +205,8 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerConfig& config, const 
   // on: every lock gRPC takes records the lock in a global graph, about a tenth of the CPU of a
   // small call. Upstream release builds have it off; so do we (process-wide, before any call).
   absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
+  // glibc's arenas capped before the server's threads start (rpc/memory_budget.h).
+  ConfigureAllocator();
 
   if (Status st = CheckCpusAvailable(config.interpolate_cpus); !st.ok()) return st;
   std::unique_ptr<Server> server(new Server(config, back_end, auth));
@@ -253,12 +255,13 @@ void Server::LogLimits(const ServerConfig& config) const {
       "limits: requests up to {} bytes (larger: RESOURCE_EXHAUSTED), InterpolateBatch up to {} "
       "directions in chunks of up to {} results, notes up to {} bytes, pages up to {} sessions, "
       "open streams up to {} per token, {} analyst, {} operator, {} without a token (a stream "
-      "not read for {} s is cancelled), {} call threads, control plane on {} thread(s), "
+      "not read for {} s is cancelled), heavy calls within a memory budget of {} MB, {} call "
+      "threads, control plane on {} thread(s), "
       "Interpolate on {} loop thread(s){}",
       kMaxReceiveMessageBytes, kMaxBatchDirections, kMaxChunkSize, kMaxNoteBytes, kMaxPageSize,
       config.max_streams_per_token, config.max_streams_analyst, config.max_streams_operator,
-      config.max_streams_unauthenticated, config.stream_stall_timeout_s, ServerThreadCap(config),
-      control_loop_.threads(), interpolate_loop_.threads(),
+      config.max_streams_unauthenticated, config.stream_stall_timeout_s, config.memory_budget_mb,
+      ServerThreadCap(config), control_loop_.threads(), interpolate_loop_.threads(),
       tls_ ? (config.tls->client_ca.empty() ? "; TLS" : "; TLS, client certificates required")
            : "; plaintext");
 }

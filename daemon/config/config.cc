@@ -123,6 +123,7 @@ void ReadServer(TableReader& root, Problems& problems, Config& c) {
   t.Int("max_streams_operator", c.server.max_streams_operator, 1, 100000);
   t.Int("max_streams_unauthenticated", c.server.max_streams_unauthenticated, 0, 100000);
   t.Int("stream_stall_timeout_s", c.server.stream_stall_timeout_s, 1, 86400);
+  t.Int("memory_budget_mb", c.server.memory_budget_mb, 16, 1048576);
   ReadInterpolateCpus(t, problems, c);
   ReadTls(t, problems, c);
   t.Finish();

@@ -12,6 +12,7 @@
 //   listen = "127.0.0.1:50051"          # host:port (port 0: any free port) or "unix:/path"
 //   interpolate_threads = 1             # Interpolate's loop threads (default: one per 2 cores)
 //   interpolate_cpus = [1]              # pin them to these CPUs (default: not pinned)
+//   memory_budget_mb = 2048             # heavy calls (exports, batches) refused beyond it
 //   [server.tls]                        # optional; cert and key together; client_ca → mTLS
 //   cert = "/etc/brdfd/server.crt"
 //   key = "/etc/brdfd/server.key"
@@ -144,6 +145,11 @@ struct ServerConfig {
   // A stream whose client has read nothing for this long (one message waiting to be sent the
   // whole time) is cancelled, freeing what it holds (an export's file).
   int stream_stall_timeout_s = 60;
+  // The heavy calls' memory budget, MB (daemon/rpc/memory_budget.h): InterpolateBatch, Export and
+  // RenderAppearance reserve what they will hold; a call that would take the reservations beyond
+  // it, or that arrives while brdfd's resident memory is beyond it, fails with RESOURCE_EXHAUSTED
+  // naming the key.
+  int memory_budget_mb = 2048;
 };
 
 struct StorageConfig {

@@ -1,23 +1,17 @@
 #include "daemon/rpc/control_loop.h"
 
 #include <spdlog/spdlog.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 
+#include "daemon/rpc/thread_priority.h"
+
 namespace brdf::daemon {
 namespace {
 
-// The control plane's threads ask for nice -5 (ahead of everything else in brdfd, the streams'
-// work runs at +10: stream_registry.h). Allowed with CAP_SYS_NICE or RLIMIT_NICE ≥ 25 (the
-// systemd unit's LimitNICE); otherwise they stay at 0, still ahead of the streams' work.
-constexpr int kControlNice = -5;
-
 void RaisePriority() {
-  if (::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), kControlNice) != 0) {
+  if (!SetThisThreadNice(kControlNice)) {
     spdlog::debug("control plane: cannot raise its threads' priority (nice {}): {}; they run at 0",
                   kControlNice, std::strerror(errno));
   }
@@ -46,6 +40,7 @@ void ControlLoop::Start() {
   for (auto& method : methods_) method->Ask();
   for (int i = 0; i < threads_; ++i) {
     loops_.emplace_back([this] {
+      NameThisThread("ctl-plane");
       RaisePriority();
       Serve();
     });

@@ -1,27 +1,16 @@
 #include "daemon/rpc/stream_registry.h"
 
 #include <spdlog/spdlog.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <algorithm>
+
+#include "daemon/rpc/thread_priority.h"
 
 namespace brdf::daemon {
 namespace {
 
 // Room beyond the stream caps in the synchronous pool: the analysts' unary calls and the pollers.
 constexpr int kUnaryThreads = 64;
-
-// A stream's thread runs at this nice value while the stream is open (lower priority than the
-// control plane's threads, at -5 or 0, and Interpolate's loop, at 0). Going back to 0 afterwards
-// needs CAP_SYS_NICE or RLIMIT_NICE; without them the pool thread stays at this value, which only
-// slows the analysts' calls it serves later, never the control plane.
-constexpr int kStreamNice = 10;
-
-void SetThreadNice(int nice) {
-  (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), nice);
-}
 
 std::int64_t NowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -60,6 +49,7 @@ StreamRegistry::StreamRegistry(const ServerConfig& config, bool tokens_configure
     : limits_(config),
       per_token_(tokens_configured),
       stall_timeout_(std::chrono::seconds(config.stream_stall_timeout_s)),
+      budget_(config.memory_budget_mb),
       work_permits_(static_cast<int>(std::max(1U, std::thread::hardware_concurrency() / 2))) {
   watchdog_ = std::thread([this] { Watchdog(); });
 }
@@ -115,28 +105,48 @@ grpc::Status StreamRegistry::Open(grpc::ServerContextBase& context, const Caller
     entries_.emplace(id, std::move(entry));
     slot->reset(new Slot(this, id, raw, computes));
   }
-  SetThreadNice(kStreamNice);
-  if (computes) (*slot)->holding_ = AcquireWork(context);
+  (void)SetThisThreadNice(kStreamNice);
+  if (computes) (*slot)->holding_ = AcquireWork(context, (*slot)->entry_->token);
   return grpc::Status::OK;
 }
 
-bool StreamRegistry::AcquireWork(const grpc::ServerContextBase& context) {
+bool StreamRegistry::AcquireWork(const grpc::ServerContextBase& context, const std::string& token) {
   MutexLock lock(work_mu_);
-  while (working_ >= work_permits_) {
+  ++work_waiting_[token];
+  // A free permit goes to the token holding the fewest among those waiting for one.
+  auto my_turn = [&]() REQUIRES(work_mu_) {
+    if (working_ >= work_permits_) return false;
+    const auto mine = work_held_.find(token);
+    const int held = mine == work_held_.end() ? 0 : mine->second;
+    for (const auto& [other, waiting] : work_waiting_) {
+      const auto theirs = work_held_.find(other);
+      if (other != token && (theirs == work_held_.end() ? 0 : theirs->second) < held) return false;
+    }
+    return true;
+  };
+  bool got = true;
+  while (!my_turn()) {
     // The synchronous API has no wake-up for a cancelled call: look now and then.
-    if (context.IsCancelled()) return false;
+    if (context.IsCancelled()) {
+      got = false;
+      break;
+    }
     work_cv_.WaitFor(work_mu_, std::chrono::milliseconds(100));
   }
+  if (--work_waiting_[token] == 0) work_waiting_.erase(token);
+  if (!got) return false;
   ++working_;
+  ++work_held_[token];
   return true;
 }
 
-void StreamRegistry::ReleaseWork() {
+void StreamRegistry::ReleaseWork(const std::string& token) {
   {
     MutexLock lock(work_mu_);
     --working_;
+    if (--work_held_[token] <= 0) work_held_.erase(token);
   }
-  work_cv_.NotifyOne();
+  work_cv_.NotifyAll();
 }
 
 void StreamRegistry::Release(std::uint64_t id) {
@@ -151,6 +161,7 @@ void StreamRegistry::Release(std::uint64_t id) {
     if (per_token_ && --per_token_open_[e.token] <= 0) per_token_open_.erase(e.token);
   }
   entries_.erase(it);
+  budget_.AskTrim();
 }
 
 int StreamRegistry::open() const {
@@ -164,6 +175,7 @@ void StreamRegistry::Watchdog() {
   MutexLock lock(mu_);
   while (!stop_) {
     stop_cv_.WaitFor(mu_, period);
+    budget_.TrimIfDue();
     const std::int64_t now = NowNs();
     const std::int64_t limit =
         std::chrono::duration_cast<std::chrono::nanoseconds>(stall_timeout_).count();
@@ -183,17 +195,25 @@ void StreamRegistry::Watchdog() {
 
 StreamRegistry::Slot::~Slot() {
   Close();
+  reservations_.clear();
   registry_->Release(id_);
-  SetThreadNice(0);
+  (void)SetThisThreadNice(0);
 }
 
 void StreamRegistry::Slot::Close() {
-  if (holding_) registry_->ReleaseWork();
+  if (holding_) registry_->ReleaseWork(entry_->token);
   holding_ = false;
 }
 
+grpc::Status StreamRegistry::Slot::Reserve(std::uint64_t bytes) {
+  std::unique_ptr<MemoryBudget::Reservation> reservation;
+  grpc::Status st = registry_->budget_.Reserve(entry_->rpc, bytes, &reservation);
+  if (st.ok()) reservations_.push_back(std::move(reservation));
+  return st;
+}
+
 bool StreamRegistry::Slot::Work() {
-  if (!holding_) holding_ = registry_->AcquireWork(*entry_->context);
+  if (!holding_) holding_ = registry_->AcquireWork(*entry_->context, entry_->token);
   return holding_;
 }
 
@@ -204,7 +224,7 @@ void StreamRegistry::Slot::BeginWrite() {
 
 void StreamRegistry::Slot::EndWrite() {
   entry_->write_since_ns.store(0);
-  if (computes_) holding_ = registry_->AcquireWork(*entry_->context);
+  if (computes_) holding_ = registry_->AcquireWork(*entry_->context, entry_->token);
 }
 
 }  // namespace brdf::daemon

@@ -12,10 +12,16 @@
 // Bounded work: a stream that computes what it sends (Export, InterpolateBatch: opened with
 // `computes`; RenderAppearance takes one with Slot::Work once it knows it must render) works only
 // while it holds one of a few work permits (one per two cores), and gives its permit back while a
-// write waits for the client. A thousand exports then take turns on the
+// write waits for the client. Permits are shared fairly between tokens: a free one goes to the
+// waiting token that holds the fewest, so one analyst's hundred exports do not keep another's one
+// waiting behind them. A thousand exports then take turns on the
 // cores instead of all running at once. Every stream's thread runs at nice 10 while the stream is
 // open (back to 0 after), below the control plane's threads and Interpolate's loop, which get a
 // core when they need one.
+//
+// Memory: a heavy stream reserves what it will hold from the memory budget (Slot::Reserve,
+// memory_budget.h) once it knows its request; the watchdog gives freed memory back to the system
+// after streams end (MemoryBudget::TrimIfDue).
 //
 // Stall deadline (stream_stall_timeout_s): a stream writes through its Slot; a write that has
 // waited that long (the client read nothing meanwhile: HTTP/2 flow control holds the message)
@@ -34,10 +40,12 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <vector>
 
 #include "core/mutex.h"
 #include "daemon/config/config.h"
 #include "daemon/rpc/auth.h"
+#include "daemon/rpc/memory_budget.h"
 
 namespace brdf::daemon {
 
@@ -67,6 +75,10 @@ class StreamRegistry {
     }
     // Releases the work permit (if any) before it goes away.
     void Close();
+    // Reserves `bytes` of the memory budget (memory_budget.h) for the rest of the stream: OK, or
+    // RESOURCE_EXHAUSTED naming [server] memory_budget_mb. A stream may reserve more as it learns
+    // what it needs; all is given back when the stream ends.
+    grpc::Status Reserve(std::uint64_t bytes);
     // Takes a work permit now if it holds none: for a call that learns only after Open whether it
     // has work to do (RenderAppearance, on a cache miss). Waits for one; false when the call was
     // cancelled meanwhile.
@@ -83,6 +95,7 @@ class StreamRegistry {
     Entry* entry_;
     const bool computes_;
     bool holding_ = false;  // a work permit
+    std::vector<std::unique_ptr<MemoryBudget::Reservation>> reservations_;
   };
 
   // `tokens_configured`: false when the API is open (auth disabled): no per-token cap. Starts
@@ -98,6 +111,9 @@ class StreamRegistry {
   grpc::Status Open(grpc::ServerContextBase& context, const Caller* caller, std::string_view rpc,
                     std::unique_ptr<Slot>* slot, bool computes = false);
 
+  // The heavy calls' memory budget ([server] memory_budget_mb).
+  MemoryBudget& budget() { return budget_; }
+
   // Work permits: one per two cores, at least one.
   int work_permits() const { return work_permits_; }
 
@@ -107,9 +123,11 @@ class StreamRegistry {
 
  private:
   void Release(std::uint64_t id);
-  // Waits for a work permit (false: `context` was cancelled meanwhile); gives one back.
-  bool AcquireWork(const grpc::ServerContextBase& context);
-  void ReleaseWork();
+  // Waits for a work permit for a stream of `token` ("": without a token); false: `context` was
+  // cancelled meanwhile. A free permit goes to the waiting token that holds the fewest. Gives one
+  // back.
+  bool AcquireWork(const grpc::ServerContextBase& context, const std::string& token);
+  void ReleaseWork(const std::string& token);
   void Watchdog();
 
   const ServerConfig limits_;
@@ -126,10 +144,13 @@ class StreamRegistry {
   int operator_open_ GUARDED_BY(mu_) = 0;
   int unauthenticated_open_ GUARDED_BY(mu_) = 0;
   std::atomic<std::uint64_t> stalled_{0};
+  MemoryBudget budget_;
   const int work_permits_;
   Mutex work_mu_;
   CondVar work_cv_;
   int working_ GUARDED_BY(work_mu_) = 0;
+  std::map<std::string, int> work_held_ GUARDED_BY(work_mu_);     // permits held, per token
+  std::map<std::string, int> work_waiting_ GUARDED_BY(work_mu_);  // streams waiting, per token
   std::thread watchdog_;
 };
 

@@ -259,6 +259,16 @@ TEST(ConfigTest, StreamCapsAndStallTimeout) {
               HasSubstr("server.stream_stall_timeout_s"));
 }
 
+TEST(ConfigTest, MemoryBudget) {
+  Result<Config> r = ParseConfig("[server]\nmemory_budget_mb = 512\n");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->server.memory_budget_mb, 512);
+  Result<Config> defaults = ParseConfig("");
+  ASSERT_TRUE(defaults.ok());
+  EXPECT_EQ(defaults->server.memory_budget_mb, 2048);
+  EXPECT_THAT(Refusal("[server]\nmemory_budget_mb = 15\n"), HasSubstr("server.memory_budget_mb"));
+}
+
 TEST(ConfigTest, InterpolateLoopThreadsAndCpus) {
   Result<Config> r = ParseConfig("[server]\ninterpolate_threads = 2\ninterpolate_cpus = [1, 0]\n");
   ASSERT_TRUE(r.ok()) << r.status().ToString();

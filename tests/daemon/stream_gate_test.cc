@@ -24,15 +24,6 @@ using grpc::StatusCode;
 
 constexpr const char* kSecondAnalystToken = "an2-token-5d1e0f7a99c34b12";
 
-long RssKb(pid_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  }
-  return -1;
-}
-
 // The rig's configuration with `server_keys` added to [server] and a second analyst token.
 std::string ConfigWith(const DaemonRig& rig, const std::string& server_keys) {
   std::string toml = DaemonConfigToml(rig.sim(), rig.database());
@@ -88,7 +79,7 @@ TEST_F(StreamGateTest, UnauthenticatedLargeRequestsAreRefusedBeforeTheyAreRead) 
   const pid_t pid = rig_.daemon()->pid();
   v1::RigStatus status;
   ASSERT_TRUE(rig_.control().GetRigStatus(DaemonRig::Context().get(), {}, &status).ok());
-  const long before = RssKb(pid);
+  const long before = ResidentKb(pid);
   ASSERT_GT(before, 0);
 
   v1::SubmitPlanRequest big;
@@ -108,7 +99,7 @@ TEST_F(StreamGateTest, UnauthenticatedLargeRequestsAreRefusedBeforeTheyAreRead) 
   for (const grpc::Status& r : results) {
     EXPECT_EQ(r.error_code(), StatusCode::UNAUTHENTICATED) << r.error_message();
   }
-  const long after = RssKb(pid);
+  const long after = ResidentKb(pid);
   // Reading them would cost 8 × 15 MiB (and their parsing as much again): 120 MB and more. The
   // transport still takes in part of each body before the refusal goes out (HTTP/2 flow-control
   // windows): 1.4 to 19 MB in six runs on a loaded machine (2026-12-05), so the bound is a quarter

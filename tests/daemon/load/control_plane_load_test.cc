@@ -8,8 +8,14 @@
 // streams some of them still finished in time, at 400 GetRigStatus, Health and Pause failed).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -29,6 +35,49 @@ const std::string kLongPlan = PlanFixture("control plane under load")
                                   .SampleRotation({30, 30, 10}, {0, 60, 5}, 10)
                                   .Measurement(100, 1)
                                   .Retry(3, 0);
+
+// Each thread of process `pid` as /proc shows it: its name (comm) and nice value.
+struct ThreadNice {
+  std::string name;
+  int nice = 0;
+};
+std::vector<ThreadNice> Threads(pid_t pid) {
+  std::vector<ThreadNice> threads;
+  const std::filesystem::path tasks = "/proc/" + std::to_string(pid) + "/task";
+  std::error_code error;
+  for (const auto& task : std::filesystem::directory_iterator(tasks, error)) {
+    std::ifstream comm(task.path() / "comm"), stat(task.path() / "stat");
+    ThreadNice t;
+    std::getline(comm, t.name);
+    std::string line;
+    std::getline(stat, line);
+    // Fields after the name's closing parenthesis: state is field 3, nice field 19.
+    std::istringstream rest(line.substr(line.rfind(')') + 2));
+    std::string field;
+    for (int i = 3; i <= 19 && rest >> field; ++i) {
+      if (i == 19) t.nice = std::stoi(field);
+    }
+    threads.push_back(t);
+  }
+  return threads;
+}
+
+// The median of `n` GetRigStatus calls, ms (every call must succeed).
+double MedianRigStatusMs(DaemonRig& rig, int n) {
+  std::vector<double> ms;
+  for (int i = 0; i < n; ++i) {
+    const auto begin = std::chrono::steady_clock::now();
+    v1::RigStatus status;
+    const grpc::Status s =
+        rig.control().GetRigStatus(DaemonRig::Context(kOperatorToken, 10s).get(), {}, &status);
+    EXPECT_TRUE(s.ok()) << s.error_code() << " " << s.error_message();
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin)
+                     .count());
+    std::this_thread::sleep_for(2ms);
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}
 
 // A stream held open by the test: its reader and context (cancelled at the end).
 struct Held {
@@ -55,6 +104,8 @@ TEST(ControlPlaneLoadTest, OperatorCallsAnswerWhile400AnalystStreamsAreOpen) {
   const v1::Session recording = rig.WaitFor(
       id, [](const v1::Session& s) { return s.progress().done_samples() >= 2; }, 45s);
   ASSERT_GE(recording.progress().done_samples(), 2u) << rig.log();
+  (void)MedianRigStatusMs(rig, 20);  // warm-up
+  const double idle_ms = MedianRigStatusMs(rig, 40);
 
   // The analysts' streams, over 8 connections of their own.
   std::vector<std::shared_ptr<grpc::Channel>> channels;
@@ -178,6 +229,31 @@ TEST(ControlPlaneLoadTest, OperatorCallsAnswerWhile400AnalystStreamsAreOpen) {
     ASSERT_TRUE(s.ok()) << s.error_code() << " " << s.error_message();
     EXPECT_TRUE(within(begin)) << "ResumeSession took too long";
   }
+  // Control before analysis (issue 40): under the load the control plane's threads run ahead of
+  // Interpolate's loop, and those ahead of the streams' threads (nice values from /proc); and
+  // GetRigStatus' median stays within a generous bound of the idle one (the bench's goal is 3×).
+  const double loaded_ms = MedianRigStatusMs(rig, 40);
+  int control = 0, interpolate = 0, streams_at_10 = 0;
+  for (const ThreadNice& t : Threads(rig.daemon()->pid())) {
+    if (t.name == "ctl-plane") {
+      ++control;
+      EXPECT_LE(t.nice, 0) << "a control plane thread";
+    } else if (t.name == "interp-loop" || t.name == "interp-slow") {
+      ++interpolate;
+      EXPECT_EQ(t.nice, 5) << t.name;
+    } else if (t.nice == 10) {
+      ++streams_at_10;
+    }
+  }
+  EXPECT_EQ(control, 2) << "the control plane's threads, named ctl-plane";
+  EXPECT_GE(interpolate, 2) << "Interpolate's loop and slow lane";
+  EXPECT_GE(streams_at_10, kStreams / 2) << "the streams' threads run at nice 10";
+  EXPECT_LT(loaded_ms, 10 * idle_ms + 10)
+      << "GetRigStatus median " << loaded_ms << " ms under load, " << idle_ms << " ms idle";
+  std::printf(
+      "GetRigStatus median: idle %.3f ms, with %d streams and 2 Interpolate clients %.3f ms\n",
+      idle_ms, kStreams, loaded_ms);
+
   stop = true;
   for (std::thread& t : clients) t.join();
   EXPECT_GT(interpolated.load(), 0);

@@ -36,16 +36,6 @@ const std::string kLongPlan = PlanFixture("load test")
                                   .Measurement(100, 1)
                                   .Retry(3, 0);
 
-// VmRSS of `pid` in kB; -1 when it cannot be read (the process is gone).
-long RssKb(pid_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  }
-  return -1;
-}
-
 // Counts calls and keeps the first unexpected failures.
 class Tally {
  public:
@@ -177,7 +167,7 @@ TEST(LoadTest, WatchersAndAnalystsWhileASessionRecordsKeepMemoryFlatAndCallsSucc
   std::vector<std::pair<std::chrono::steady_clock::duration, long>> samples;
   const auto begin = std::chrono::steady_clock::now();
   while (std::chrono::steady_clock::now() - begin < kLoadDuration) {
-    const long rss = RssKb(pid);
+    const long rss = ResidentKb(pid);
     ASSERT_GT(rss, 0) << "brdfd is gone\n" << rig.log();
     samples.emplace_back(std::chrono::steady_clock::now() - begin, rss);
     std::this_thread::sleep_for(250ms);

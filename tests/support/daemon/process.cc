@@ -98,4 +98,13 @@ Result<DaemonRun> RunBrdfd(const std::vector<std::string>& args, const std::stri
   return DaemonRun{run->exit_code, Tail(log_path, 100000)};
 }
 
+long ResidentKb(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
+
 }  // namespace brdf::testing

@@ -22,6 +22,10 @@ namespace brdf::testing {
 
 Result<std::string> BrdfdBinary();
 
+// The resident memory (VmRSS) of process `pid`, kB, from /proc; -1 when it cannot be read (the
+// process is gone).
+long ResidentKb(pid_t pid);
+
 class DaemonProcess {
  public:
   // Starts brdfd with `args` (e.g. {"--config", path}); its log is appended to `log_path`.
