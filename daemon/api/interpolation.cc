@@ -295,6 +295,21 @@ grpc::Status BatchCoords(const v1::InterpolateBatchRequest& request, const Index
   return grpc::Status::OK;
 }
 
+// Every direction of the batch checked against the session, a slice at a time, so that a bad
+// one is refused before the first result goes out.
+grpc::Status CheckBatchDirections(const v1::InterpolateBatchRequest& request,
+                                  const IndexSnapshot& index, int slice) {
+  const int n = request.directions_size();
+  std::vector<double> probe;
+  for (int first = 0; first < n; first += slice) {
+    if (grpc::Status st = BatchCoords(request, index, first, std::min(slice, n - first), &probe);
+        !st.ok()) {
+      return st;
+    }
+  }
+  return grpc::Status::OK;
+}
+
 // A batch is answered a slice of this many chunks at a time: the next slice is evaluated only
 // once the last chunk of this one was taken by the transport (the writer blocks under flow
 // control), so a batch holds at most a slice's answers ahead of its client, however long it is.
@@ -338,14 +353,7 @@ grpc::Status InterpolationService::InterpolateBatch(
   // cell), its answers streamed chunk by chunk as they come, in order.
   const int n = request->directions_size();
   const int slice = kSliceChunks * chunk;
-  // Every direction's form checked against the session before the first result goes out.
-  for (int first = 0; first < n; first += slice) {
-    std::vector<double> probe;
-    if (grpc::Status st = BatchCoords(*request, index, first, std::min(slice, n - first), &probe);
-        !st.ok()) {
-      return st;
-    }
-  }
+  if (grpc::Status st = CheckBatchDirections(*request, index, slice); !st.ok()) return st;
   grpc::Status outcome = grpc::Status::OK;
   v1::InterpolateBatchChunk out;
   auto start_chunk = [&](int first) {

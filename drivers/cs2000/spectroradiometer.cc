@@ -24,7 +24,7 @@ Status Cs2000Spectroradiometer::Lost(const Status& status) {
 
 Status Cs2000Spectroradiometer::EnterRemoteMode(const CallContext& ctx) {
   Status status;
-  for (int attempt = 1; status.ok() && attempt <= options_.remote_attempts; ++attempt) {
+  for (int attempt = 1; attempt <= options_.remote_attempts; ++attempt) {
     Result<std::string> reply = connection_.channel().Exchange(
         cs2000::kRemoteOnCommand, {.lines = 1, .first_byte_timeout = options_.reply_timeout}, ctx);
     if (reply.ok()) {

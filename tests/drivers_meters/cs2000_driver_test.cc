@@ -110,6 +110,17 @@ TEST_F(Cs2000Driver, AVanishingPortDuringTheSpectrumIsADisconnect) {
   EXPECT_TRUE(meter_->TransferSpectrum(Ctx()).ok());
 }
 
+TEST_F(Cs2000Driver, ASilentMeterIsAskedRemoteModeAsOftenAsConfiguredThenTimesOut) {
+  Fault([](sim::SerialFaults& f) { f.silent = true; });
+  Status connected = meter_->Connect(Ctx());
+  EXPECT_EQ(connected.code(), StatusCode::kTimeout) << connected.ToString();
+  EXPECT_THAT(connected.message(), HasSubstr("did not answer RMTS,1 in 2 attempt(s)"));
+  int asked = 0;
+  for (const std::string& c : endpoint_->commands()) asked += c == "RMTS,1" ? 1 : 0;
+  EXPECT_EQ(asked, 2);  // remote_attempts' default
+  EXPECT_FALSE(meter_->connected());
+}
+
 TEST_F(Cs2000Driver, DisconnectSwitchesRemoteModeOff) {
   ConnectAndConfigure({200, 1, false});
   meter_->Disconnect();
