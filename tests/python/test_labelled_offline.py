@@ -146,6 +146,20 @@ class ReadingUncertainties(unittest.TestCase):
         self.assertIn("brdf_uncertainty_independent", f.coords)
         self.assertNotIn("brdf_uncertainty", self.rs.to_dataarray().coords)
 
+    def test_integration_notes_follow_their_readings(self):
+        pb = brdf_client.brdf_pb2
+        halved = self.reading(4, pb.READING_KIND_SAMPLE)
+        halved.integration_ms = 50
+        halved.integration_note = "quality 19 (overload): integration halved from 100 to 50 ms"
+        rs = brdf_client.ReadingSet.from_protos([self.reading(1, pb.READING_KIND_REFERENCE),
+                                                 halved])
+        self.assertEqual(list(rs.integration_notes), ["", halved.integration_note])
+        self.assertEqual(list(rs.to_dataframe().integration_note), ["", halved.integration_note])
+        self.assertEqual(list(rs.of_kind("sample").integration_notes), [halved.integration_note])
+        both = brdf_client.ReadingSet.concat([rs, self.rs])
+        self.assertEqual(list(both.integration_notes), ["", halved.integration_note, "", "", ""])
+        self.assertEqual(list(synthetic.make_session().integration_notes[:2]), ["", ""])
+
     def test_synthetic_sets_are_not_estimated(self):
         rs = synthetic.make_session()
         self.assertEqual(rs.brdf_uncertainty.shape, rs.spectra.shape)

@@ -44,6 +44,7 @@ def _columns(readings: "ReadingSet") -> Dict[str, Any]:
     cols.update(quality=readings.quality, flagged=readings.flagged,
                 flag_reason=readings.flag_reasons, reference_id=readings.reference_ids,
                 dark_id=readings.dark_ids, integration_ms=readings.integration_ms,
+                integration_note=readings.integration_notes,
                 uncertainty_estimated=_estimated(readings))
     return cols
 
@@ -54,7 +55,8 @@ def readings_dataframe(readings: "ReadingSet") -> Any:
     Columns: kind ("sample", "reference", "dark"), step_index, label; the pose alpha, beta,
     gamma, delta and the directions theta_i, phi_i, theta_o, phi_o, phi (φ = |φo − φi|, 180°
     specular), degrees; quality (the meter's code), flagged, flag_reason; reference_id, dark_id
-    (the readings a sample is divided by / a dark subtracted from it; 0: none); integration_ms;
+    (the readings a sample is divided by / a dark subtracted from it; 0: none); integration_ms,
+    integration_note (how the meter changed the integration time; "" when it did not);
     uncertainty_estimated (the reading has an uncertainty budget: ReadingSet.budgets).
     `df.attrs["units"]` gives each column's unit, `df.attrs["wavelength_nm"]` the spectra's bands
     (the spectra themselves: to_dataarray).

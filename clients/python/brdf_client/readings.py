@@ -100,6 +100,8 @@ class ReadingSet:
       reference_ids:  (n,) the REFERENCE reading a SAMPLE reading is divided by; 0 otherwise.
       dark_ids:       (n,) the DARK reading subtracted from a SAMPLE/REFERENCE reading; 0: none.
       integration_ms: (n,) integration time actually used, ms.
+      integration_notes: (n,) str, how the meter's quality policy changed the integration time to
+                      take it (e.g. halved after an overload); "" when it used the plan's.
       labels:         (n,) str, the plan step's label.
       brdf_uncertainty: (n, m) the standard uncertainty (k = 1) of each sample reading's BRDF,
                       sr⁻¹, from the budget brdfd stored with it; NaN where not estimated
@@ -125,6 +127,7 @@ class ReadingSet:
     dark_ids: np.ndarray
     integration_ms: np.ndarray
     labels: np.ndarray
+    integration_notes: Optional[np.ndarray] = None
     brdf_uncertainty: Optional[np.ndarray] = None
     brdf_uncertainty_independent: Optional[np.ndarray] = None
     budgets: Optional[np.ndarray] = None
@@ -132,6 +135,8 @@ class ReadingSet:
     def __post_init__(self) -> None:
         # Sets built without budgets (older code, synthetic data): every reading not estimated.
         n, m = len(self.ids), len(self.wavelengths)
+        if self.integration_notes is None:
+            self.integration_notes = np.full(n, "", dtype=object)
         if self.brdf_uncertainty is None:
             self.brdf_uncertainty = np.full((n, m), np.nan)
         if self.brdf_uncertainty_independent is None:
@@ -204,6 +209,7 @@ class ReadingSet:
             reference_ids=np.array([r.reference_id for r in readings], dtype=np.int64),
             dark_ids=np.array([r.dark_id for r in readings], dtype=np.int64),
             integration_ms=np.array([r.integration_ms for r in readings], dtype=int),
+            integration_notes=np.array([r.integration_note for r in readings], dtype=object),
             labels=np.array([r.label for r in readings], dtype=object),
             **dict(zip(("budgets", "brdf_uncertainty", "brdf_uncertainty_independent"),
                        _budgets(readings, grid.count))))
