@@ -47,22 +47,7 @@ for entry in $plans; do
   mkdir -p "$dir"
   echo "== $name at time scale $scale" >&2
 
-  "$sim" --time-scale "$scale" --seed 1 --modbus-port 0 --pr650-link "$dir/pr650" --wake-window 0 \
-    --log-level debug >"$dir/sim.out" 2>"$dir/sim.log" </dev/null &
-  sim_pid=$!
-  pids+=("$sim_pid")
-  wait_line "$dir/sim.out" '^ready' 20
-  modbus="$(awk '$1 == "modbus-tcp" { print $2 }' "$dir/sim.out")"
-  write_config "$dir/brdfd.db" "$dir/pr650" "$modbus" >"$dir/brdfd.toml"
-  "$brdfd" --config "$dir/brdfd.toml" --shutdown-timeout 3 >"$dir/brdfd.out" 2>"$dir/brdfd.log" \
-    </dev/null &
-  brdfd_pid=$!
-  pids+=("$brdfd_pid")
-  wait_line "$dir/brdfd.out" '^brdfd listening on' 20
-  export BRDF_ADDRESS
-  BRDF_ADDRESS="$(awk '/^brdfd listening on/ { print $4 }' "$dir/brdfd.out")"
-  export BRDF_TOKEN="$operator_token"
-  wait_for_rig_connected "$ctl"
+  start_rig_on_sim "$dir" "$scale" debug
 
   "$ctl" validate "$plan" --time-scale "$scale" | sed 's/^/   /' >&2
   summary="$("$ctl" --json validate "$plan" --time-scale "$scale")"

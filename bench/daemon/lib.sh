@@ -57,6 +57,32 @@ wait_for_rig_connected() {
   return 1
 }
 
+# Starts brdf-sim at time scale $2 (log level $3, its PR-650 on the link $1/pr650) and brdfd on
+# the configuration write_config writes to $1/brdfd.toml (database $1/brdfd.db), their output in
+# $1/{sim,brdfd}.{out,log}; waits until the rig is connected. Uses the script's `sim`, `brdfd` and
+# `ctl`; sets sim_pid, brdfd_pid (both added to `pids`) and modbus (the simulator's host:port), and
+# exports BRDF_ADDRESS and BRDF_TOKEN (the operator's).
+# shellcheck disable=SC2154  # sim, brdfd and ctl are the sourcing script's
+start_rig_on_sim() {
+  local dir="$1" scale="$2" level="$3"
+  "$sim" --time-scale "$scale" --seed 1 --modbus-port 0 --pr650-link "$dir/pr650" --wake-window 0 \
+    --log-level "$level" >"$dir/sim.out" 2>"$dir/sim.log" </dev/null &
+  sim_pid=$!
+  pids+=("$sim_pid")
+  wait_line "$dir/sim.out" '^ready' 20
+  modbus="$(awk '$1 == "modbus-tcp" { print $2 }' "$dir/sim.out")"
+  write_config "$dir/brdfd.db" "$dir/pr650" "$modbus" >"$dir/brdfd.toml"
+  "$brdfd" --config "$dir/brdfd.toml" --shutdown-timeout 3 >"$dir/brdfd.out" 2>"$dir/brdfd.log" \
+    </dev/null &
+  brdfd_pid=$!
+  pids+=("$brdfd_pid")
+  wait_line "$dir/brdfd.out" '^brdfd listening on' 20
+  export BRDF_ADDRESS
+  BRDF_ADDRESS="$(awk '/^brdfd listening on/ { print $4 }' "$dir/brdfd.out")"
+  export BRDF_TOKEN="$operator_token"
+  wait_for_rig_connected "$ctl"
+}
+
 # brdfd's configuration on stdout, with both tokens: $1 database, $2 meter port, $3 Modbus
 # host:port, $4 more [server] lines. A script may set config_axis_speed (deg/s of α, β and δ;
 # unset: the defaults) and config_extra (TOML appended at the end, in tables of its own).

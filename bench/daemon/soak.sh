@@ -40,21 +40,7 @@ source "$here/lib.sh"
 bench_workdir_and_cleanup /tmp/brdfd-soak.XXXXXX
 load_start="$(cut -d' ' -f1-3 /proc/loadavg | tr ' ' /)"
 
-"$sim" --time-scale "$scale" --seed 1 --modbus-port 0 --pr650-link "$work/pr650" --wake-window 0 \
-  --log-level warn >"$work/sim.out" 2>"$work/sim.log" </dev/null &
-pids+=("$!")
-wait_line "$work/sim.out" '^ready' 20
-modbus="$(awk '$1 == "modbus-tcp" { print $2 }' "$work/sim.out")"
-write_config "$work/brdfd.db" "$work/pr650" "$modbus" >"$work/brdfd.toml"
-"$brdfd" --config "$work/brdfd.toml" --shutdown-timeout 3 >"$work/brdfd.out" 2>"$work/brdfd.log" \
-  </dev/null &
-brdfd_pid=$!
-pids+=("$brdfd_pid")
-wait_line "$work/brdfd.out" '^brdfd listening on' 20
-export BRDF_ADDRESS
-BRDF_ADDRESS="$(awk '/^brdfd listening on/ { print $4 }' "$work/brdfd.out")"
-export BRDF_TOKEN="$operator_token"
-wait_for_rig_connected "$ctl"
+start_rig_on_sim "$work" "$scale" warn
 deadline=$((SECONDS + duration))
 running() { ((SECONDS < deadline)); }
 
