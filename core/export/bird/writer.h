@@ -1,6 +1,6 @@
-// A session's sample readings as a BiRD universal BRDF file (Lanevski et al., "Universal BRDF
-// data format", Color Res. Appl. 47(5), 2022; the BiRD project's JSON schema v1.0, draft
-// 2020-12). docs/bird-format.md says what each field holds and how brdfd fills it. In short:
+// A session's sample readings as a BiRD universal BRDF file (Lanevski et al., Color Res. Appl.
+// 47(5), 2022; the BiRD project's JSON schema v1.0, draft 2020-12). docs/bird-format.md says
+// what each field holds and how brdfd fills it. In short:
 //   metadata   the session's provenance: its id and time, the instrument (the meter's model and
 //              serial as recorded), the sample and white standard (ρw and u(ρw)), the plan, the
 //              software; what brdfd does not record is said to be so (docs/bird-format.md);
