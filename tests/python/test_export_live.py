@@ -394,6 +394,37 @@ class LiveExport(unittest.TestCase):
                  path], capture_output=True, text=True)
             self.assertEqual(check.returncode, 0, check.stdout + check.stderr)
 
+    def test_bird_json_leaves_ubrdf_out_when_a_reading_has_no_budget(self):
+        # A reading as one recorded before budgets were stored: its budget row taken out of the
+        # daemon's database for this test, and put back after.
+        import sqlite3
+        samples = self.readings.of_kind("sample")
+        reading_id = int(samples.ids[len(samples) // 2])
+        db = sqlite3.connect(os.path.join(self.rig.dir, "brdfd.db"), timeout=10)
+        try:
+            row = db.execute("SELECT * FROM reading_uncertainty WHERE reading_id = ?",
+                             (reading_id,)).fetchone()
+            self.assertIsNotNone(row)
+            with db:
+                db.execute("DELETE FROM reading_uncertainty WHERE reading_id = ?", (reading_id,))
+            path = self.path("no-budget-bird.json")
+            r = self.client.export(self.session_id, "bird", path)
+        finally:
+            with db:
+                db.execute(f"INSERT OR IGNORE INTO reading_uncertainty VALUES "
+                           f"({','.join('?' * len(row))})", row)
+            db.close()
+        n, m = len(samples), len(samples.wavelengths)
+        self.assertEqual(r.rows, n * m)
+        self.assertEqual(len(r.warnings), 1, r.warnings)
+        self.assertIn(f"uBRDF is left out: 1 of the {n} written readings", r.warnings[0])
+        with open(path, encoding="utf-8") as f:
+            doc = json.load(f)
+        self.assertNotIn("uBRDF", doc["data"])
+        self.assertEqual(len(doc["data"]["BRDF"]["values"]), n * m)
+        self.assertIn("uBRDF is left out: 1 of the", doc["metadata"]["comments"])
+        self.assertEqual(doc["metadata"]["adhoc_section"]["brdfd"]["readings_with_budget"], n - 1)
+
     def test_bird_json_is_always_the_brdf(self):
         path = self.path("reflectance-bird.json")
         e = self.assertCode(grpc.StatusCode.INVALID_ARGUMENT, self.client.export,
