@@ -14,6 +14,7 @@ packages=(
   python3 python3-numpy python3-grpcio python3-protobuf python3-serial
   python3-scipy python3-matplotlib colord-data
   python3-pandas python3-xarray python3-tqdm python3-netcdf4 python3-venv python3-pip python3-setuptools python3-ipykernel python3-nbclient python3-nbformat mypy # clients/python: labelled data, install, notebook, types
+  python3-jsonschema # tests: the BiRD export checked against its required fields (docs/bird-format.md)
   # the lab archive: libpq for brdfd and brdf-archive; the server and psql for its tests
   libpq-dev postgresql-15 postgresql-client-15
   # the web console: its HTTP server, and the browser its tests drive

@@ -39,6 +39,13 @@ class SessionReader {
   // The session's history of states: one event when it was created and one per change of its
   // state or reason, in the order they happened (ascending event id).
   virtual Result<std::vector<SessionEventRecord>> ListSessionEvents(std::int64_t session) = 0;
+  // The devices recorded with the session (the meter's model and serial), oldest first. The
+  // default, for a reader that keeps none: an empty list (the BiRD export then says "not
+  // recorded").
+  virtual Result<std::vector<DeviceRecord>> GetSessionDevices(std::int64_t session) {
+    (void)session;
+    return std::vector<DeviceRecord>{};
+  }
 };
 
 }  // namespace brdf::storage

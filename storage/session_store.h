@@ -161,6 +161,9 @@ class SessionStore final : public SessionReader {
   // Records a device once per (session, kind, model, serial); later calls keep first_seen.
   Status RecordDevice(const DeviceRecord& device);
   Result<std::vector<DeviceRecord>> GetDevices(std::optional<std::int64_t> session);
+  Result<std::vector<DeviceRecord>> GetSessionDevices(std::int64_t session) override {
+    return GetDevices(session);
+  }
 
   Status AppendAudit(const AuditRecord& entry);
   // The newest `limit` (> 0) entries, newest first; of one session, or of all when nullopt.

@@ -37,6 +37,7 @@
 #include "core/export/run_control.h"
 #include "core/export/session_data.h"
 #include "core/export/spectral_rgb.h"
+#include "daemon/api/export_bird.h"
 #include "daemon/api/export_loads.h"
 #include "daemon/api/export_session.h"
 #include "data/cie_tables.h"
@@ -276,12 +277,13 @@ grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
     case v1::EXPORT_FORMAT_GRID_CSV:
     case v1::EXPORT_FORMAT_MERL_BINARY:
     case v1::EXPORT_FORMAT_RGL_BSDF:
+    case v1::EXPORT_FORMAT_BIRD_JSON:
       out->format = r.format();
       break;
     default:
       return InvalidField("format",
-                          "give one of READINGS_CSV, GRID_NPY, GRID_CSV, MERL_BINARY, RGL_BSDF "
-                          "(got " +
+                          "give one of READINGS_CSV, GRID_NPY, GRID_CSV, MERL_BINARY, RGL_BSDF, "
+                          "BIRD_JSON (got " +
                               std::to_string(r.format()) + ")");
   }
   if (grpc::Status st = ParseQuantityField(r.quantity(), &out->quantity); !st.ok()) return st;
@@ -290,6 +292,9 @@ grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
   }
   if (r.format() == v1::EXPORT_FORMAT_RGL_BSDF && out->quantity != exports::Quantity::kBrdf) {
     return InvalidField("quantity", "an RGL file holds the BRDF; leave quantity unset or BRDF");
+  }
+  if (r.format() == v1::EXPORT_FORMAT_BIRD_JSON && out->quantity != exports::Quantity::kBrdf) {
+    return InvalidField("quantity", "a BiRD file holds the BRDF; leave quantity unset or BRDF");
   }
   if (grpc::Status st = ParseFillField(r.fill(), &out->fill); !st.ok()) return st;
   if (grpc::Status st = ParseRglFields(r, out); !st.ok()) return st;
@@ -353,6 +358,8 @@ std::string FileName(const ExportSettings& s) {
       return base + "-grid-" + q + ".csv";
     case v1::EXPORT_FORMAT_RGL_BSDF:
       return base + (s.rgb ? "-rgb" : "") + ".bsdf";
+    case v1::EXPORT_FORMAT_BIRD_JSON:
+      return base + "-bird.json";
     default:
       return base + ".binary";
   }
@@ -536,6 +543,8 @@ std::uint64_t WorkingBytes(const ExportSettings& s, std::size_t bands, std::uint
   switch (s.format) {
     case v1::EXPORT_FORMAT_READINGS_CSV:
       return chunks;  // its derived samples are shared by the exports of the session
+    case v1::EXPORT_FORMAT_BIRD_JSON:
+      return chunks + readings;  // u_c per reading and band: about the spectra's size
     case v1::EXPORT_FORMAT_MERL_BINARY:
       return chunks + interpolant + kMerlCells * 3 * 8;
     case v1::EXPORT_FORMAT_RGL_BSDF: {
@@ -606,6 +615,7 @@ grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest
   v1::ExportReport report;
   report.set_file_name(FileName(settings));
   if (settings.format != v1::EXPORT_FORMAT_READINGS_CSV &&
+      settings.format != v1::EXPORT_FORMAT_BIRD_JSON &&
       exports::HasSeveralDialPositions(*session)) {
     report.add_warnings("session " + request.session_id() +
                         " was measured at several dial positions γ (anisotropic); this export "
@@ -621,6 +631,13 @@ grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest
       break;
     case v1::EXPORT_FORMAT_RGL_BSDF:
       st = ExportRgl(*session, settings, *ctx, stream, out, &report);
+      break;
+    case v1::EXPORT_FORMAT_BIRD_JSON:
+      stream.Progress("writing the BiRD file", 0.1);
+      st = ExportBirdJson(
+          session, settings.exclude_flagged, reader, loads,
+          [&stream](double f) { stream.Progress("writing the BiRD file", 0.1 + 0.9 * f); }, out,
+          &report);
       break;
     default:
       st = ExportGrid(*session, settings, *ctx, stream, out, &report);

@@ -49,6 +49,12 @@ FROM session_events WHERE session_uuid = (SELECT uuid FROM sessions WHERE archiv
 ORDER BY rig_event_id
 )sql";
 
+constexpr std::string_view kDevicesOfSession = R"sql(
+SELECT rig_device_id, kind, model, serial, first_seen
+FROM devices WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id = $1)
+ORDER BY rig_device_id
+)sql";
+
 std::string SessionName(std::int64_t id) {
   return "session " + std::to_string(id);
 }
@@ -258,6 +264,23 @@ Result<std::vector<SessionEventRecord>> ArchiveReader::ListSessionEvents(std::in
     return Status::Ok();
   }));
   return events;
+}
+
+Result<std::vector<DeviceRecord>> ArchiveReader::GetSessionDevices(std::int64_t session) {
+  BRDF_RETURN_IF_ERROR(GetSession(session).status());
+  std::vector<DeviceRecord> devices;
+  BRDF_RETURN_IF_ERROR(WithConnection([&](PgConnection& conn) -> Status {
+    BRDF_ASSIGN_OR_RETURN(PgResult r, conn.QueryPrepared("archive_devices", kDevicesOfSession,
+                                                         PgParams().Add(session)));
+    devices.clear();
+    for (int i = 0; i < r.rows(); ++i) {
+      devices.push_back(DeviceRecord{r.Int64(i, 0), session, std::string(r.Text(i, 1)),
+                                     std::string(r.Text(i, 2)), std::string(r.Text(i, 3)),
+                                     r.Double(i, 4)});
+    }
+    return Status::Ok();
+  }));
+  return devices;
 }
 
 template <typename Record>

@@ -61,6 +61,9 @@ class ArchiveReader final : public SessionReader {
                                                            int limit) override;
   // The events shipped so far (schema v3's session_events), in the rig's order.
   Result<std::vector<SessionEventRecord>> ListSessionEvents(std::int64_t session) override;
+  // The devices shipped with the session, in the rig's order (ids the rig's; session_id this
+  // archive's id).
+  Result<std::vector<DeviceRecord>> GetSessionDevices(std::int64_t session) override;
   // True when the session has ended (completed, aborted, failed) and the reading of every
   // measuring step it did is in the archive: nothing more will arrive.
   Result<bool> Finished(std::int64_t session);

@@ -138,6 +138,12 @@ TEST_F(ArchiveShipperTest, ShipsEverythingRecordedWithTheCatalogue) {
   const std::int64_t archive_id = std::stoll(*pg_->Psql("SELECT archive_id FROM sessions"));
   auto archived = (*reader)->ListSessionEvents(archive_id);
   ASSERT_TRUE(archived.ok()) << archived.status().ToString();
+  auto devices = (*reader)->GetSessionDevices(archive_id);  // the BiRD export's meter model
+  ASSERT_TRUE(devices.ok()) << devices.status().ToString();
+  ASSERT_EQ(devices->size(), 1u);
+  EXPECT_EQ((*devices)[0].model, "PR-650");
+  EXPECT_EQ((*devices)[0].serial, "60954201");
+  EXPECT_EQ((*devices)[0].session_id, archive_id);
   auto recorded = store->ListSessionEvents(*id);
   ASSERT_TRUE(recorded.ok());
   ASSERT_EQ(archived->size(), recorded->size());

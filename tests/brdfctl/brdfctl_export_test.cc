@@ -246,6 +246,39 @@ TEST_F(BrdfctlExportTest, RglReadsBackAndTheFillIsReported) {
   EXPECT_FALSE(std::filesystem::exists(Path("rgb.npy")));
 }
 
+// bird: a BiRD universal BRDF JSON file that tools/check/bird_validate.py finds holding what the
+// format requires (tests/python/bird_required.schema.json), one point per sample reading and band;
+// another quantity or an interpolation option is the user's error, leaving no file.
+TEST_F(BrdfctlExportTest, BirdJsonHoldsWhatTheFormatRequires) {
+  const std::string json = Path("session-bird.json");
+  const CommandResult r = Ctl({"export", id_, "bird", "-o", json, "--json"});
+  ASSERT_EQ(r.exit_code, 0) << Describe(r);
+  EXPECT_FALSE(std::filesystem::exists(json + ".partial"));
+  v1::ExportReport report;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(Lines(r.out).at(0), &report).ok())
+      << r.out;
+  EXPECT_EQ(report.file_name(), "session-" + id_ + "-bird.json");
+  EXPECT_GT(report.rows(), 0u);
+  EXPECT_EQ(report.rows() % 101, 0u) << "one point per reading and band (101 bands)";
+  EXPECT_EQ(report.warnings_size(), 0) << "every reading has a budget: uBRDF is written";
+  const CommandResult check =
+      RunShell(std::string("/usr/bin/python3 '") + BRDF_TEST_SOURCE_DIR +
+               "/tools/check/bird_validate.py' '" + BRDF_TEST_SOURCE_DIR + "/tests/python' '" +
+               json + "' --top bird_required.schema.json 2>&1");
+  EXPECT_EQ(check.exit_code, 0) << Describe(check);
+  EXPECT_NE(check.out.find("0 violation(s)"), std::string::npos) << check.out;
+
+  for (const std::vector<std::string>& bad : {std::vector<std::string>{"--quantity", "reflectance"},
+                                              {"--fill", "none"},
+                                              {"--trend", "bivariate"}}) {
+    std::vector<std::string> args = {"export", id_, "bird", "-o", Path("bad.json")};
+    args.insert(args.end(), bad.begin(), bad.end());
+    const CommandResult refused = Ctl(args);
+    EXPECT_EQ(refused.exit_code, 2) << bad[0] << ": " << Describe(refused);
+    EXPECT_FALSE(std::filesystem::exists(Path("bad.json")));
+  }
+}
+
 // appearance: the colours under both illuminants, and the spheres as PPM files whose header and
 // size are a PPM's (P6, 24 × 24 pixels, 255) with lit (not white, not black) pixels; the JSON
 // form parses as the AppearanceResponse; an unknown illuminant is the user's error.

@@ -13,6 +13,7 @@ or brdf-sim is not built.
 
 import concurrent.futures
 import csv
+import json
 import os
 import shutil
 import subprocess
@@ -319,6 +320,117 @@ class LiveExport(unittest.TestCase):
                    d(rng.uniform(0, 40, n)), d(rng.uniform(0, 360, n)))
         self.assertTrue(np.all(np.isfinite(f)))
         self.assertTrue(np.all(f.mean(axis=1) > 0), "a direction without a value")
+
+    # --- BiRD universal BRDF JSON ---------------------------------------------------------------------
+
+    def test_bird_json_meets_the_formats_requirements_with_every_budget(self):
+        import jsonschema  # Debian's python3-jsonschema (deploy/install-deps.sh)
+        path = self.path("sample-bird.json")
+        progress = Progress()
+        r = self.client.export(self.session_id, "bird", path, on_progress=progress)
+        self.assertEqual((r.format, r.file_name),
+                         ("bird_json", f"session-{self.session_id}-bird.json"))
+        self.assertOnlyFile(path)
+        self.assertProgress(progress)
+        with open(path, encoding="utf-8") as f:
+            doc = json.load(f)
+        with open(os.path.join(HERE, "bird_required.schema.json"), encoding="utf-8") as f:
+            schema = json.load(f)
+        errors = [f"{'/'.join(map(str, e.absolute_path))}: {e.message[:200]}"
+                  for e in jsonschema.Draft202012Validator(schema).iter_errors(doc)]
+        self.assertEqual(errors, [])
+        # One point per sample reading and band, every array as long, uBRDF written (every
+        # reading of this session has a budget) and equal to the budgets' u_c.
+        samples = self.readings.of_kind("sample")
+        n, m = len(samples), len(samples.wavelengths)
+        self.assertGreater(n, 0)
+        self.assertEqual(r.rows, n * m)
+        self.assertEqual(r.skipped_readings, 0)
+        self.assertEqual(r.warnings, [])
+        data = doc["data"]
+        for column in ("theta_i", "phi_i", "theta_r", "phi_r", "wavelength_r", "BRDF", "uBRDF"):
+            self.assertEqual(len(data[column]["values"]), n * m, column)
+        ids = np.array(data["adhoc_variables"]["reading_id"]["values"]).reshape(n, m)
+        np.testing.assert_array_equal(ids[:, 0], samples.ids)
+        self.assertTrue(np.all(ids == ids[:, :1]))
+        np.testing.assert_array_equal(np.array(data["wavelength_r"]["values"]).reshape(n, m),
+                                      np.tile(samples.wavelengths, (n, 1)))
+        u = np.array(data["uBRDF"]["values"]).reshape(n, m)
+        np.testing.assert_allclose(u, samples.brdf_uncertainty, rtol=1e-12, atol=0)
+        theta = np.array(data["theta_r"]["values"]).reshape(n, m)[:, 0]
+        np.testing.assert_allclose(theta, samples.directions[:, 2], atol=1e-9)
+        phi = np.array(data["phi_i"]["values"]).reshape(n, m)[:, 0]
+        np.testing.assert_allclose(phi, np.mod(samples.directions[:, 1], 360.0), atol=1e-9)
+        # The BRDF is the readings CSV's, point for point (negatives written as 0).
+        csv_path = os.path.join(os.path.dirname(path), "brdf.csv")
+        self.client.export(self.session_id, "csv", csv_path)
+        header, rows = self.read_csv(csv_path)
+        self.assertEqual([float(h) for h in header[-m:]], list(samples.wavelengths))
+        brdf = np.array([[float(x) for x in row[-m:]] for row in rows])
+        np.testing.assert_allclose(np.array(data["BRDF"]["values"]).reshape(n, m),
+                                   np.maximum(brdf, 0.0), rtol=1e-12, atol=0)
+        # Provenance as recorded.
+        meta = doc["metadata"]
+        brdfd = meta["adhoc_section"]["brdfd"]
+        self.assertEqual(meta["software"]["name"], "brdfd")
+        self.assertRegex(meta["software"]["version"], r"^\d+\.\d+\.\d+$")
+        self.assertEqual(brdfd["session_id"], int(self.session_id))
+        self.assertEqual(brdfd["plan_name"], PLAN["name"])
+        self.assertEqual(brdfd["readings_with_budget"], n)
+        self.assertTrue(brdfd["meter_serial"] and brdfd["meter_serial"] != "not recorded by brdfd")
+        self.assertNotEqual(brdfd["meter_model"], "not recorded by brdfd")  # the devices table
+        self.assertEqual(meta["instrumentation"]["detection_system"]["model"],
+                         brdfd["meter_model"])
+        self.assertEqual(meta["sample"]["comments"],
+                         "id not recorded by brdfd; " + PLAN["sampleDescription"])
+        self.assertGreater(brdfd["white_standard"]["standard_uncertainty"], 0)
+        self.assertTrue(meta["id"].startswith("urn:uuid:"), meta["id"])
+        # The BiRD project's own schema, when its files are at hand (they are not part of the
+        # repository; docs/bird-format.md, "Checking a file").
+        public = os.environ.get("BIRD_SCHEMA_DIR")
+        if public:
+            check = subprocess.run(
+                [sys.executable, os.path.join(ROOT, "tools", "check", "bird_validate.py"), public,
+                 path], capture_output=True, text=True)
+            self.assertEqual(check.returncode, 0, check.stdout + check.stderr)
+
+    def test_bird_json_leaves_ubrdf_out_when_a_reading_has_no_budget(self):
+        # A reading as one recorded before budgets were stored: its budget row taken out of the
+        # daemon's database for this test, and put back after.
+        import sqlite3
+        samples = self.readings.of_kind("sample")
+        reading_id = int(samples.ids[len(samples) // 2])
+        db = sqlite3.connect(os.path.join(self.rig.dir, "brdfd.db"), timeout=10)
+        try:
+            row = db.execute("SELECT * FROM reading_uncertainty WHERE reading_id = ?",
+                             (reading_id,)).fetchone()
+            self.assertIsNotNone(row)
+            with db:
+                db.execute("DELETE FROM reading_uncertainty WHERE reading_id = ?", (reading_id,))
+            path = self.path("no-budget-bird.json")
+            r = self.client.export(self.session_id, "bird", path)
+        finally:
+            with db:
+                db.execute(f"INSERT OR IGNORE INTO reading_uncertainty VALUES "
+                           f"({','.join('?' * len(row))})", row)
+            db.close()
+        n, m = len(samples), len(samples.wavelengths)
+        self.assertEqual(r.rows, n * m)
+        self.assertEqual(len(r.warnings), 1, r.warnings)
+        self.assertIn(f"uBRDF is left out: 1 of the {n} written readings", r.warnings[0])
+        with open(path, encoding="utf-8") as f:
+            doc = json.load(f)
+        self.assertNotIn("uBRDF", doc["data"])
+        self.assertEqual(len(doc["data"]["BRDF"]["values"]), n * m)
+        self.assertIn("uBRDF is left out: 1 of the", doc["metadata"]["comments"])
+        self.assertEqual(doc["metadata"]["adhoc_section"]["brdfd"]["readings_with_budget"], n - 1)
+
+    def test_bird_json_is_always_the_brdf(self):
+        path = self.path("reflectance-bird.json")
+        e = self.assertCode(grpc.StatusCode.INVALID_ARGUMENT, self.client.export,
+                            self.session_id, "bird", path, quantity="reflectance")
+        self.assertIn("quantity", e.message)
+        self.assertEqual(os.listdir(os.path.dirname(path)), [])
 
     # --- failures leave no file -------------------------------------------------------------------
 

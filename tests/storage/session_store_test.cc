@@ -545,6 +545,12 @@ TEST_F(SessionStoreTest, DevicesAreRecordedOncePerSession) {
   EXPECT_EQ((*mine)[0].serial, "60954201");
   EXPECT_LT((*mine)[0].first_seen, kEpoch + 1000);
   EXPECT_EQ((*mine)[1].kind, "rotation_stage");
+  // The same through the SessionReader interface (the BiRD export's meter model).
+  SessionReader& reader = *store_;
+  auto through_reader = reader.GetSessionDevices(session);
+  ASSERT_TRUE(through_reader.ok());
+  ASSERT_EQ(through_reader->size(), 2u);
+  EXPECT_EQ((*through_reader)[0].model, "PR-650");
 }
 
 TEST_F(SessionStoreTest, AuditIsReturnedNewestFirst) {

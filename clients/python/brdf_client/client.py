@@ -448,13 +448,16 @@ class BrdfClient:
             (nθi, nθo, nφ, bands), NaN where the method cannot fill a cell), "merl" (a MERL
             .binary, 90 × 90 × 180 linear sRGB, −1 where unfilled), "rgl" (an RGL material .bsdf
             for Mitsuba 3 and pbrt-v4, spectral or with rgb=True linear sRGB; read it with
-            brdf_client.rgl.read_rgl); or "grid_npy", "grid_csv".
+            brdf_client.rgl.read_rgl), "bird" (a BiRD universal BRDF JSON file: one point per
+            sample reading and band with its BRDF and uBRDF, the combined standard uncertainty
+            of the reading's stored budget, and the session's provenance; docs/bird-format.md);
+            or "grid_npy", "grid_csv", "bird_json".
         path: the file; an existing folder: the daemon's file name (session-3-grid-brdf.npy, ...)
             in it. The bytes go to `path`.partial, which is renamed to `path` only once the
             report has arrived and the bytes are complete, so a failed or interrupted export never
             leaves a truncated file (the partial file is removed).
         quantity: csv and grids: "brdf" (sr⁻¹; None: the daemon's default, BRDF), "reflectance"
-            or "radiance" (csv: every reading, raw). MERL is always the BRDF.
+            or "radiance" (csv: every reading, raw). MERL, RGL and BiRD are always the BRDF.
         method, axis_scale, mirror_phi, coordinates, trend: grids, MERL and RGL, as interpolate() (a
             grid's .json sidecar records them). reciprocity: also
             use the θi↔θo swapped readings; None: on for MERL and RGL (a cell stands for a pair of

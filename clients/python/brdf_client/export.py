@@ -1,8 +1,9 @@
 """Session exports (Data.Export): the request from Python arguments, and what an export produced.
 
 brdfd writes a session as a file — the readings as CSV, the session's interpolator on a regular
-(θi, θo, φ) grid as a NumPy .npy or CSV, a MERL .binary, or an RGL material .bsdf (spectral or
-RGB; brdf_client.rgl reads it) — and streams it back: progress
+(θi, θo, φ) grid as a NumPy .npy or CSV, a MERL .binary, an RGL material .bsdf (spectral or
+RGB; brdf_client.rgl reads it), or a BiRD universal BRDF JSON file (the sample readings with
+their uncertainties and the session's provenance; docs/bird-format.md) — and streams it back: progress
 messages, the file's bytes in order, then a report. BrdfClient.export saves the bytes; this module
 builds the ExportRequest the way `brdfctl export` does (same words, same defaults) and turns the
 report into an ExportResult. The formats are described in tools/brdf-export/README.md.
@@ -30,6 +31,8 @@ FORMATS = {
     "merl_binary": brdf_pb2.EXPORT_FORMAT_MERL_BINARY,
     "rgl": brdf_pb2.EXPORT_FORMAT_RGL_BSDF,
     "rgl_bsdf": brdf_pb2.EXPORT_FORMAT_RGL_BSDF,
+    "bird": brdf_pb2.EXPORT_FORMAT_BIRD_JSON,
+    "bird_json": brdf_pb2.EXPORT_FORMAT_BIRD_JSON,
 }
 # Formats whose cells the fill policy covers, and the policies by name.
 FILLED_FORMATS = frozenset((brdf_pb2.EXPORT_FORMAT_GRID_NPY, brdf_pb2.EXPORT_FORMAT_GRID_CSV,
@@ -39,7 +42,8 @@ GRID_FORMATS = frozenset((brdf_pb2.EXPORT_FORMAT_GRID_NPY, brdf_pb2.EXPORT_FORMA
 
 
 def format_name(value: int) -> str:
-    """ExportFormat number → "readings_csv", "grid_npy", "grid_csv", "merl_binary", "rgl_bsdf"."""
+    """ExportFormat number → "readings_csv", "grid_npy", "grid_csv", "merl_binary", "rgl_bsdf",
+    "bird_json"."""
     name = brdf_pb2.ExportFormat.Name(value)
     return name[len("EXPORT_FORMAT_"):].lower()
 
@@ -48,8 +52,8 @@ def export_format(fmt: Union[str, int], path: "str | os.PathLike[str]" = "") -> 
     """`fmt` as an ExportFormat number.
 
     fmt: "csv" (the readings), "grid" (the regular grid: CSV when `path` ends in ".csv", else
-    .npy), "merl", "rgl"; or the proto's names "readings_csv", "grid_npy", "grid_csv",
-    "merl_binary", "rgl_bsdf";
+    .npy), "merl", "rgl", "bird" (BiRD universal BRDF JSON); or the proto's names "readings_csv",
+    "grid_npy", "grid_csv", "merl_binary", "rgl_bsdf", "bird_json";
     or an ExportFormat number. Anything else raises ValueError listing the accepted words.
     """
     if isinstance(fmt, str) and fmt.strip().lower() == "grid":
@@ -58,12 +62,13 @@ def export_format(fmt: Union[str, int], path: "str | os.PathLike[str]" = "") -> 
     if isinstance(fmt, str):
         key = fmt.strip().lower().replace("-", "_")
         if key not in FORMATS:
-            raise ValueError(f"unknown export format {fmt!r}; use csv, grid, merl, rgl (or "
-                             "readings_csv, grid_npy, grid_csv, merl_binary, rgl_bsdf)")
+            raise ValueError(f"unknown export format {fmt!r}; use csv, grid, merl, rgl, bird (or "
+                             "readings_csv, grid_npy, grid_csv, merl_binary, rgl_bsdf, "
+                             "bird_json)")
         return FORMATS[key]
     value = int(fmt)
     if value not in brdf_pb2.ExportFormat.values() or value == 0:
-        raise ValueError(f"unknown export format {fmt!r}; use csv, grid, merl or rgl")
+        raise ValueError(f"unknown export format {fmt!r}; use csv, grid, merl, rgl or bird")
     return value
 
 
@@ -126,12 +131,14 @@ class ExportResult:
 
     Attributes:
       path:        the file written (the `path` given, or the daemon's file name in that folder).
-      format:      "readings_csv", "grid_npy", "grid_csv", "merl_binary" or "rgl_bsdf".
+      format:      "readings_csv", "grid_npy", "grid_csv", "merl_binary", "rgl_bsdf" or
+                   "bird_json".
       file_name:   the daemon's name for the file, e.g. "session-3-grid-brdf.npy".
       bytes:       size of the file (checked against the bytes received).
       summary:     one line, e.g. "16200 cells: 15012 ok, 1188 NaN (1100 empty_octant, …)".
       rows:        readings CSV: rows written (readings; for reflectance and BRDF the sample
-                   readings that could be converted).
+                   readings that could be converted); BiRD JSON: points written (readings ×
+                   bands).
       cells, filled_cells, unfilled_cells: grids, MERL and RGL: cells in the file, with a value,
                    without one (NaN in a grid; −1 in a MERL file, below-horizon cells excluded;
                    RGL: the nodes of all θi slices).
@@ -143,7 +150,8 @@ class ExportResult:
       description: grid .npy: the axes, wavelengths, quantity, unit, method, options (mirror_phi,
                    reciprocity, coordinates, axis_scale), fill and counts (the
                    report's description_json, parsed); else None.
-      warnings:    things to know, e.g. several dial positions γ folded together.
+      warnings:    things to know, e.g. several dial positions γ folded together, or (BiRD)
+                   uBRDF left out because a reading has no uncertainty budget.
       fill:        grids, MERL, RGL: where the cells' values came from, {"policy": "chain" or
                    "none", "interpolated": n, "fallback": n, "model": n, "empty": n,
                    "model_fraction": x}; None for the readings CSV.

@@ -36,6 +36,11 @@ std::string Megabytes(std::uint64_t bytes) {
   return text;
 }
 
+// True for the exports that interpolate (grid, merl, rgl); csv and bird write the readings.
+bool Interpolates(const ExportOptions& o) {
+  return o.what != "csv" && o.what != "bird";
+}
+
 // The request's format from `what` (and, for a grid, --format or the output's extension).
 int SetFormat(const ExportOptions& o, std::ostream& err, v1::ExportRequest* request) {
   if (o.what == "csv") {
@@ -54,8 +59,10 @@ int SetFormat(const ExportOptions& o, std::ostream& err, v1::ExportRequest* requ
     request->set_format(v1::EXPORT_FORMAT_MERL_BINARY);
   } else if (o.what == "rgl") {
     request->set_format(v1::EXPORT_FORMAT_RGL_BSDF);
+  } else if (o.what == "bird") {
+    request->set_format(v1::EXPORT_FORMAT_BIRD_JSON);
   } else {
-    return Invalid(err, "'" + o.what + "': export csv, grid, merl or rgl");
+    return Invalid(err, "'" + o.what + "': export csv, grid, merl, rgl or bird");
   }
   return kExitOk;
 }
@@ -73,9 +80,9 @@ int SetQuantityAndFill(const ExportOptions& o, std::ostream& err, v1::ExportRequ
     return Invalid(err, "--quantity '" + o.quantity + "': use radiance, reflectance or brdf");
   }
   const bool rgl = o.what == "rgl";
-  if ((o.what == "merl" || rgl) && o.quantity != "brdf") {
-    return Invalid(
-        err, std::string(rgl ? "an RGL" : "a MERL") + " file holds the BRDF: leave out --quantity");
+  if ((o.what == "merl" || rgl || o.what == "bird") && o.quantity != "brdf") {
+    const char* file = rgl ? "an RGL" : o.what == "bird" ? "a BiRD" : "a MERL";
+    return Invalid(err, std::string(file) + " file holds the BRDF: leave out --quantity");
   }
   if (!rgl && (o.rgb || o.theta_i_count != 0 || o.resolution != 0)) {
     return Invalid(err, "--rgb, --theta-i and --resolution are for rgl exports");
@@ -90,7 +97,7 @@ int SetQuantityAndFill(const ExportOptions& o, std::ostream& err, v1::ExportRequ
   } else {
     return Invalid(err, "--fill '" + o.fill + "': use chain or none");
   }
-  if (o.what == "csv" && o.fill != "chain") {
+  if (!Interpolates(o) && o.fill != "chain") {
     return Invalid(err, "--fill is for grid, merl and rgl exports");
   }
   return kExitOk;
@@ -112,7 +119,7 @@ int SetInterpolation(const ExportOptions& o, std::ostream& err, v1::ExportReques
   if (!ParseCoordinatesName(o.coordinates, &coordinates)) {
     return Invalid(err, "--coordinates '" + o.coordinates + "': use incidence or half-diff");
   }
-  if (o.what == "csv" && coordinates != v1::INTERPOLATION_COORDINATES_INCIDENCE) {
+  if (!Interpolates(o) && coordinates != v1::INTERPOLATION_COORDINATES_INCIDENCE) {
     return Invalid(err, "--coordinates is for grid, merl and rgl exports");
   }
   options->set_coordinates(coordinates);
@@ -120,7 +127,7 @@ int SetInterpolation(const ExportOptions& o, std::ostream& err, v1::ExportReques
   if (!ParseTrendName(o.trend, &trend)) {
     return Invalid(err, "--trend '" + o.trend + "': use none or bivariate");
   }
-  if (o.what == "csv" && trend != v1::INTERPOLATION_TREND_NONE) {
+  if (!Interpolates(o) && trend != v1::INTERPOLATION_TREND_NONE) {
     return Invalid(err, "--trend is for grid, merl and rgl exports");
   }
   options->set_trend(trend);
@@ -378,9 +385,9 @@ int RunExport(CommandContext& ctx, const ExportOptions& o) {
 namespace {
 
 void AddFileFlags(CLI::App& cmd, ExportOptions& o) {
-  cmd.add_option("what", o.what, "csv, grid, merl or rgl")
+  cmd.add_option("what", o.what, "csv, grid, merl, rgl or bird (BiRD universal BRDF JSON)")
       ->required()
-      ->check(CLI::IsMember({"csv", "grid", "merl", "rgl"}));
+      ->check(CLI::IsMember({"csv", "grid", "merl", "rgl", "bird"}));
   cmd.add_option("-o,--output", o.output,
                  "the file (default: the daemon's name for it, e.g. "
                  "session-1-grid-brdf.npy); - for standard output (csv)");
@@ -454,7 +461,7 @@ Runner AddExportOptions(CLI::App& cmd) {
 void RegisterExportCommand(CommandRegistry& registry) {
   registry.Add({"export",
                 "a session as a file: readings CSV, a regular grid (.npy or CSV), a MERL .binary, "
-                "an RGL .bsdf",
+                "an RGL .bsdf, a BiRD universal BRDF JSON",
                 "", AddExportOptions});
 }
 
