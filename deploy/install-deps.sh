@@ -9,7 +9,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   libserialport-dev libmodbus-dev libspdlog-dev libfmt-dev libsqlite3-dev sqlite3
-  libqhull-dev libtomlplusplus-dev libcli11-dev libsystemd-dev
+  libqhull-dev libcgal-dev libtomlplusplus-dev libcli11-dev libsystemd-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-grpcio python3-protobuf python3-serial
   python3-scipy python3-matplotlib colord-data

@@ -5,7 +5,7 @@
 //     readings ingested per second: CompleteStepWithReading, one transaction per reading (reading
 //     and done mark), synchronous=FULL (storage/sqlite.cc), 101-band PR-650 spectra, on the disk
 //     FILE is on. Stops after N readings or S seconds, whichever first.
-//   create --db FILE --readings N
+//   create --db FILE --readings N [--bands 101|201|401]
 //     a COMPLETED isotropic session of N sample readings (plus its white reference and dark) as
 //     brdfd would have stored it: what the memory figure loads into brdfd and the web explorer's
 //     bench (web/bench/explorer_50k.mjs) shows. Put FILE on a tmpfs (the one-fsync-per-reading
@@ -102,8 +102,8 @@ class RigPoses {
 // Writes the reference, the dark and `samples` sample readings at the rig's poses (RigPoses);
 // calls `tick` after each sample (false: stop).
 template <typename Tick>
-Result<int> Fill(storage::SessionStore& store, std::int64_t session, int samples, Tick tick) {
-  const WavelengthGrid grid = WavelengthGrid::Pr650();
+Result<int> Fill(storage::SessionStore& store, std::int64_t session, int samples,
+                 const WavelengthGrid& grid, Tick tick) {
   BRDF_ASSIGN_OR_RETURN(RigPoses poses, RigPoses::Make());
   // The white reference's spectrum I0 (lamp and detector 10° off the normal), the dark D; a
   // sample's radiance is D + (I0 − D)·f·π/ρw·cos θi/cos θi,ref for the paint's BRDF f, i.e. what
@@ -164,6 +164,7 @@ Result<int> Fill(storage::SessionStore& store, std::int64_t session, int samples
 int main(int argc, char** argv) {
   std::string db;
   int readings = 50000;
+  int bands = 101;
   double seconds = 5;
   CLI::App app(
       "bench_storage: SQLite ingest rate, and sessions of N readings for the memory figure");
@@ -176,7 +177,13 @@ int main(int argc, char** argv) {
   CLI::App* create = app.add_subcommand("create", "a completed session of N sample readings");
   create->add_option("--db", db, "database file (created)")->required();
   create->add_option("--readings", readings, "sample readings")->check(CLI::Range(1, 10000000));
+  create
+      ->add_option("--bands", bands,
+                   "bands from 380 to 780 nm: 101 (PR-650, 4 nm), 201 (PR-670, 2 nm) or 401 "
+                   "(CS-2000, 1 nm)")
+      ->check(CLI::IsMember({101, 201, 401}));
   CLI11_PARSE(app, argc, argv);
+  const WavelengthGrid grid{380, 400.0 / (bands - 1), static_cast<std::size_t>(bands)};
 
   std::filesystem::remove(db);
   Result<std::unique_ptr<storage::SessionStore>> store = storage::SessionStore::Open(db);
@@ -195,7 +202,7 @@ int main(int argc, char** argv) {
       start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   const bool timed = ingest->parsed();
   Result<int> written =
-      Fill(**store, *session, readings, [&] { return !timed || Clock::now() < until; });
+      Fill(**store, *session, readings, grid, [&] { return !timed || Clock::now() < until; });
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   if (!written.ok()) {
     std::fprintf(stderr, "bench_storage: %s\n", written.status().ToString().c_str());

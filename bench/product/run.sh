@@ -2,7 +2,9 @@
 # The product operations end to end (issue 19, item 5), each beside scipy doing the same job from
 # the same data, interleaved repetitions, medians:
 #   1. `brdfctl export 1 grid --steps 1,1,2` of a completed 50,000-reading session held by a real
-#      brdfd (90 × 90 × 90 cell centres × 101 bands, a 589 MB .npy streamed to the client's disk),
+#      brdfd (90 × 90 × 90 cell centres × 101 bands, a 589 MB .npy streamed to the client's disk;
+#      × 401 bands 2.4 GB), beside dd copying the same bytes to the same disk (issue 41's goals:
+#      at least 5× scipy end to end, within 2× of dd),
 #      octant and --method delaunay, against scipy's LinearNDInterpolator over the session's
 #      sample readings (`brdfctl export 1 csv`, BRDF) on the same cells, written to a .npy;
 #   2. InterpolateBatch of 100,000 random directions (θi, θo ∈ [0, 90), φ ∈ [0, 180)) over gRPC
@@ -13,7 +15,8 @@
 # run. The session is written by bench_storage (random directions, as bench/daemon's memory figure).
 #
 # Usage: bench/product/run.sh [BUILD_DIR]   (default: $BRDF_BENCH_BUILD, then build-bench)
-#   Builds what it needs (-j2) unless BENCH_NO_BUILD=1. Environment: BENCH_REPS (3),
+#   Builds what it needs (-j2) unless BENCH_NO_BUILD=1. Environment: BENCH_BANDS ("101 401": a
+#   whole run per band count, one after the other), BENCH_REPS (3),
 #   BENCH_BRDFD (another brdfd binary, e.g. an older build, for a before/after), BENCH_KEEP=1.
 set -euo pipefail
 
@@ -22,6 +25,17 @@ root="$(cd "$here/../.." && pwd)"
 build="${1:-${BRDF_BENCH_BUILD:-$root/build-bench}}"
 case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
 reps="${BENCH_REPS:-3}"
+# Band counts: each one is a whole run of its own (a session of that grid, 380–780 nm), one after
+# the other; the build is made once.
+bands="${BENCH_BANDS:-101 401}"
+if [[ "$bands" == *" "* ]]; then
+  no_build="${BENCH_NO_BUILD:-0}"
+  for b in $bands; do
+    BENCH_BANDS="$b" BENCH_NO_BUILD="$no_build" "$0" "$@" || exit $?
+    no_build=1
+  done
+  exit 0
+fi
 # Debian's python3 has numpy and scipy; a pyenv shim earlier on PATH may not (as bench/run.sh).
 py="${PYTHON:-}"
 if [[ -z "$py" ]]; then
@@ -58,7 +72,7 @@ echo "scipy $("$py" -c 'import scipy; print(scipy.__version__)'); uptime at star
 
 token="bench-analyst-$(od -An -N8 -tx1 /dev/urandom | tr -d ' \n')"
 echo "== a completed 50,000-reading session (bench_storage create, on $shm_parent)" >&2
-"$build/bench/daemon/bench_storage" create --db "$shm/s50k.db" --readings 50000 >&2
+"$build/bench/daemon/bench_storage" create --db "$shm/s50k.db" --readings 50000 --bands "$bands" >&2
 # No rig: nothing at the meter port or the Modbus address (brdfd starts without its devices).
 cat >"$work/brdfd.toml" <<TOML
 [server]
@@ -103,7 +117,7 @@ batch delaunay "" >/dev/null
 
 field() { tr ' ' '\n' <<<"$1" | awk -F= -v k="$2" '$1 == k { print $2 }'; }
 now() { date +%s.%N; }
-declare -a g_oct g_del g_scipy g_scipy_c b_oct b_del b_scipy b_scipy_c
+declare -a g_oct g_dd g_del g_scipy g_scipy_c b_oct b_del b_scipy b_scipy_c
 # scipy's total, and its compute alone (triangulation, interpolation, the .npy) without reading the CSV.
 total() { "$py" -c 'import json, sys; print("%.2f" % json.loads(sys.argv[1])["total_s"])' "$1"; }
 compute() { "$py" -c 'import json, sys; j = json.loads(sys.argv[1]); print("%.2f" % (j["build_s"] + j["interp_s"]))' "$1"; }
@@ -111,6 +125,10 @@ for ((r = 0; r < reps; r++)); do
   echo "== repetition $((r + 1)) of $reps" >&2
   t0=$(now); "$ctl" --timeout 600 export 1 grid --steps 1,1,2 -o "$work/grid-octant.npy" --no-progress >&2; t1=$(now)
   g_oct+=("$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.2f", b - a }')")
+  # The disk's speed for the same bytes: the file just written, copied by dd to the same directory
+  # (from the page cache; neither side syncs).
+  t0=$(now); dd if="$work/grid-octant.npy" of="$work/grid-dd.npy" bs=4M status=none; t1=$(now)
+  g_dd+=("$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.2f", b - a }')")
   t0=$(now); "$ctl" --timeout 600 export 1 grid --steps 1,1,2 --method delaunay -o "$work/grid-delaunay.npy" --no-progress >&2; t1=$(now)
   g_del+=("$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.2f", b - a }')")
   s="$("$py" "$here/scipy_side.py" grid "$work/readings.csv" "$work/grid-scipy.npy" 1 1 2)"
@@ -144,9 +162,11 @@ pair_ratio() {
     sort -g | awk '{ v[NR] = $1 } END { printf "%.2f×", (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
 }
 echo
-echo "== product operations end to end, 50,000-reading session (medians of $reps, interleaved)"
+echo "== product operations end to end, 50,000-reading session, $bands bands (medians of $reps, interleaved)"
 printf '%-62s %s\n' "figure" "value"
-printf '%-62s %s\n' "grid 1°×1°×2° (729,000 cells × 101 bands), brdfctl export, octant" "$(med "${g_oct[@]}") s (all: ${g_oct[*]})"
+printf '%-62s %s\n' "grid 1°×1°×2° (729,000 cells × $bands bands), brdfctl export, octant" "$(med "${g_oct[@]}") s (all: ${g_oct[*]})"
+printf '%-62s %s\n' "  dd of the same bytes to the same disk" "$(med "${g_dd[@]}") s (all: ${g_dd[*]})"
+printf '%-62s %s\n' "  ours ÷ dd: octant (goal ≤ 2×)" "$(pair_ratio g_oct g_dd)"
 printf '%-62s %s\n' "  the same, --method delaunay" "$(med "${g_del[@]}") s (all: ${g_del[*]})"
 printf '%-62s %s\n' "  scipy LinearNDInterpolator, same samples and cells, to .npy" "$(med "${g_scipy[@]}") s (all: ${g_scipy[*]})"
 printf '%-62s %s\n' "    of which triangulation + interpolation + .npy" "$(med "${g_scipy_c[@]}") s (all: ${g_scipy_c[*]})"

@@ -204,6 +204,7 @@ struct ExportSettings {
   std::size_t chunk_bytes = kDefaultExportChunkBytes;
   exports::FillPolicy fill = exports::FillPolicy::kChain;
   bool rgb = false;                // RGL
+  bool float32 = false;            // grid .npy: '<f4'
   exports::SessionRglOptions rgl;  // RGL: θi slices and resolution (rgb weights added later)
 };
 
@@ -298,6 +299,12 @@ grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
   }
   if (grpc::Status st = ParseFillField(r.fill(), &out->fill); !st.ok()) return st;
   if (grpc::Status st = ParseRglFields(r, out); !st.ok()) return st;
+  if (r.float32() && r.format() != v1::EXPORT_FORMAT_GRID_NPY) {
+    return InvalidField("float32",
+                        "is for grids as .npy (format GRID_NPY): a MERL file is float64 by its "
+                        "format, an RGL file float32 already, CSV text; leave it unset");
+  }
+  out->float32 = r.float32();
   if (grpc::Status st = ParseMethodField(r.method(), &out->method); !st.ok()) return st;
   const v1::InterpolationOptions& o = r.options();
   if (o.axis_scale_size() != 0 && o.axis_scale_size() != 3) {
@@ -446,8 +453,10 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
                                      s.quantity,
                                      interp::MethodName(s.method),
                                      in.derived.samples.size(),
-                                     in.derived.skipped.size()};
-  exports::NpyGridWriter npy(out);
+                                     in.derived.skipped.size(),
+                                     s.float32 ? "float32" : "float64"};
+  exports::NpyGridWriter npy(out,
+                             s.float32 ? exports::NpyType::kFloat32 : exports::NpyType::kFloat64);
   exports::CsvGridWriter csv(out, info);
   const bool as_npy = s.format == v1::EXPORT_FORMAT_GRID_NPY;
   exports::GridSink& sink = as_npy ? static_cast<exports::GridSink&>(npy) : csv;

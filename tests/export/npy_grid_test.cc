@@ -147,6 +147,43 @@ TEST(Npy, GridFileHoldsTheValuesInCOrderAsLittleEndianDoubles) {
   EXPECT_EQ(memory.spectrum(2, 3, 4)[1], 25 + 100 * 52.5 + 1e4 * 135 + 1e6);
 }
 
+TEST(Npy, Float32GridHoldsEachValueRoundedToTheNearestFloat) {
+  Result<RegularGrid> grid = MakeRegularGrid(10, 15, 30, GridPlacement::kCellCentres);
+  ASSERT_TRUE(grid.ok());
+  const WavelengthGrid bands{400, 100, 3};
+  std::ostringstream out;
+  NpyGridWriter npy(out, NpyType::kFloat32);
+  MemoryGrid memory;
+  ASSERT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), npy).ok());
+  ASSERT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), memory).ok());
+  const std::string bytes = out.str();
+  const ParsedNpy p = ParseNpy(bytes);
+  ASSERT_TRUE(p.ok);
+  EXPECT_EQ(p.descr, "<f4");
+  EXPECT_EQ(p.shape, (std::vector<std::size_t>{9, 6, 6, 3}));
+  ASSERT_EQ(bytes.size(), p.data_offset + 9 * 6 * 6 * 3 * 4);
+  std::size_t nan = 0;
+  for (std::size_t i = 0; i < memory.values().size(); ++i) {
+    std::uint32_t bits = 0;
+    for (int b = 0; b < 4; ++b) {
+      bits |=
+          static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[p.data_offset + 4 * i + b]))
+          << (8 * b);
+    }
+    float v;
+    std::memcpy(&v, &bits, 4);
+    const double want = memory.values()[i];
+    if (std::isnan(want)) {
+      EXPECT_TRUE(std::isnan(v));
+      ++nan;
+    } else {
+      EXPECT_EQ(v, static_cast<float>(want)) << "value " << i;
+      EXPECT_LE(std::abs(static_cast<double>(v) - want), std::abs(want) * 6e-8) << "value " << i;
+    }
+  }
+  EXPECT_LT(nan, memory.values().size());
+}
+
 TEST(Grid, CellsTheSourceCannotFillAreNaNAndCounted) {
   Result<RegularGrid> grid = MakeRegularGrid(5, 5, 5, GridPlacement::kCellCentres);
   ASSERT_TRUE(grid.ok());

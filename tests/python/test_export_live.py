@@ -203,6 +203,26 @@ class LiveExport(unittest.TestCase):
         self.assertEqual(r.description["nan_cells"], r.unfilled_cells)
         self.assertEqual(r.description["quantity"], "brdf")
 
+    def test_grid_npy_as_float32(self):
+        """float32=True: the same grid in half the bytes, each value the float64 grid's rounded
+        to float32, and the sidecar says the dtype; other formats refuse it."""
+        wide_path = self.path("wide.npy")
+        wide = self.client.export(self.session_id, "grid", wide_path, **GRID_STEPS)
+        a = np.load(wide_path)
+        narrow_path = self.path("narrow.npy")
+        narrow = self.client.export(self.session_id, "grid", narrow_path, float32=True,
+                                    **GRID_STEPS)
+        b = np.load(narrow_path)
+        self.assertEqual(b.dtype, np.float32)
+        self.assertEqual(b.shape, a.shape)
+        self.assertLess(narrow.bytes, wide.bytes * 0.51)
+        self.assertEqual(wide.description["dtype"], "float64")
+        self.assertEqual(narrow.description["dtype"], "float32")
+        self.assertTrue(np.array_equal(np.isnan(a), np.isnan(b)))
+        self.assertTrue(np.array_equal(a.astype(np.float32), b, equal_nan=True))
+        with self.assertRaisesRegex(ValueError, "float32"):
+            self.client.export(self.session_id, "merl", self.path("x.binary"), float32=True)
+
     def test_grid_in_half_difference_coordinates(self):
         """The .json sidecar (ExportResult.description) records the coordinates; the values
         differ from the incidence grid's."""

@@ -196,6 +196,9 @@ int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
   if (format != "npy" && format != "csv") {
     return Fail(err, "grid", InvalidArgument("--format '" + format + "': use npy or csv"));
   }
+  if (o.float32 && format != "npy") {
+    return Fail(err, "grid", InvalidArgument("--float32 is for .npy grids, not CSV"));
+  }
   if (format == "npy" && c.output == "-") {
     return Fail(err, "grid", InvalidArgument("an .npy grid needs a file: give -o PATH.npy"));
   }
@@ -205,7 +208,8 @@ int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
   if (!in.ok()) return Fail(err, "grid", in.status());
 
   const WavelengthGrid bands = in->derived.grid;
-  const double bytes = static_cast<double>(grid->cells()) * static_cast<double>(bands.count) * 8;
+  const double bytes =
+      static_cast<double>(grid->cells()) * static_cast<double>(bands.count) * (o.float32 ? 4 : 8);
   err << "brdf-export grid: " << grid->theta_i.count << " × " << grid->theta_o.count << " × "
       << grid->phi.count << " cells × " << bands.count << " bands ("
       << (format == "npy" ? "" : "at least ") << bytes / 1e6 << " MB) by " << o.interp.method
@@ -218,8 +222,10 @@ int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
                                      *q,
                                      o.interp.method,
                                      in->derived.samples.size(),
-                                     in->derived.skipped.size()};
-  exports::NpyGridWriter npy((*file)->stream());
+                                     in->derived.skipped.size(),
+                                     o.float32 ? "float32" : "float64"};
+  exports::NpyGridWriter npy((*file)->stream(),
+                             o.float32 ? exports::NpyType::kFloat32 : exports::NpyType::kFloat64);
   exports::CsvGridWriter csv((*file)->stream(), info);
   exports::GridSink& sink = format == "npy" ? static_cast<exports::GridSink&>(npy) : csv;
   ProgressLine line(err, "brdf-export grid", StderrIsTerminal());

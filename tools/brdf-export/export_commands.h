@@ -50,6 +50,7 @@ struct GridOptions {
   std::string steps = "1,1,1";  // dθi,dθo,dφ in degrees, or one value for all three
   bool nodes = false;           // grid nodes 0…90 (both ends) instead of cell centres
   std::string format;           // npy or csv; empty: from the output's extension (.csv → csv)
+  bool float32 = false;         // npy: float32 instead of float64
 };
 
 struct MerlOptions {

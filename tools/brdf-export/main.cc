@@ -92,6 +92,8 @@ int main(int argc, char** argv) {
   grid_cmd->add_flag("--nodes", grid.nodes,
                      "sample the nodes 0, step, …, 90 (180) instead of the cell centres");
   grid_cmd->add_option("--format", grid.format, "npy or csv (default: from -o's extension)");
+  grid_cmd->add_flag("--float32", grid.float32,
+                     "npy: float32 instead of float64, half the bytes (the .json says dtype)");
 
   MerlOptions merl;
   CLI::App* merl_cmd = app.add_subcommand(

@@ -439,12 +439,12 @@ class BrdfClient:
                on_progress: Optional[Callable[[str, float], Any]] = None,
                timeout: Optional[float] = None, coordinates: Union[str, int, None] = None,
                trend: Union[str, int, None] = None, progress: Optional[bool] = None,
-               sidecar: bool = False) -> ExportResult:
+               sidecar: bool = False, float32: bool = False) -> ExportResult:
         """Has the daemon export the session as a file and saves it at `path`; returns an
         ExportResult (file name, bytes, summary, rows, cells, filled_cells, shape, ...).
 
         fmt: "csv" (the readings, one row each), "grid" (the session's interpolator on a regular
-            (θi, θo, φ) grid: CSV when `path` ends in ".csv", else NumPy .npy, float64 of shape
+            (θi, θo, φ) grid: CSV when `path` ends in ".csv", else NumPy .npy, float64 (or float32) of shape
             (nθi, nθo, nφ, bands), NaN where the method cannot fill a cell), "merl" (a MERL
             .binary, 90 × 90 × 180 linear sRGB, −1 where unfilled), "rgl" (an RGL material .bsdf
             for Mitsuba 3 and pbrt-v4, spectral or with rgb=True linear sRGB; read it with
@@ -479,6 +479,8 @@ class BrdfClient:
             export (the daemon stops) and removes the partial file.
         sidecar: grid .npy: also write its description as `path`.json, as brdfctl does
             (brdf_client.open_grid reads the pair).
+        float32: grid .npy: float32 instead of float64, half the bytes (the sidecar's "dtype"
+            says which); ValueError for other formats.
 
         Raises BrdfError with the daemon's code and message (NOT_FOUND for an unknown session,
         INVALID_ARGUMENT for bad steps or options, FAILED_PRECONDITION for a session without
@@ -497,7 +499,7 @@ class BrdfClient:
                                  step_phi=step_phi, grid_nodes=grid_nodes,
                                  exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes,
                                  fill=fill, rgb=rgb, rgl_theta_i_count=rgl_theta_i_count,
-                                 rgl_resolution=rgl_resolution)
+                                 rgl_resolution=rgl_resolution, float32=float32)
         partial = (os.path.join(path, f"brdf_client-export-{session_id}") if into_folder
                    else path) + ".partial"
         call = self._data.Export(request, metadata=self._metadata, timeout=timeout)

@@ -80,7 +80,7 @@ def export_request(session_id: str, fmt: Union[str, int], path: str = "", *,
                    exclude_flagged: bool = False, chunk_bytes: int = 0, fill: str = "chain",
                    rgb: bool = False, rgl_theta_i_count: int = 0, rgl_resolution: int = 0,
                    coordinates: Union[str, int, None] = None,
-                   trend: Union[str, int, None] = None) -> Any:
+                   trend: Union[str, int, None] = None, float32: bool = False) -> Any:
     """The ExportRequest for BrdfClient.export's arguments (which document them).
 
     As brdfctl: reciprocity None means on for MERL and RGL (a cell stands for a pair of
@@ -93,6 +93,8 @@ def export_request(session_id: str, fmt: Union[str, int], path: str = "", *,
     if not rgl and (rgb or rgl_theta_i_count or rgl_resolution):
         raise ValueError(f"rgb, rgl_theta_i_count and rgl_resolution are for RGL exports, not "
                          f"{format_name(value)}")
+    if float32 and value != brdf_pb2.EXPORT_FORMAT_GRID_NPY:
+        raise ValueError(f"float32 is for grids as .npy, not {format_name(value)}")
     fill_key = str(fill).strip().lower()
     if fill_key not in FILLS:
         raise ValueError(f"unknown fill {fill!r}; use chain or none")
@@ -122,7 +124,7 @@ def export_request(session_id: str, fmt: Union[str, int], path: str = "", *,
         step_theta_i=step_theta_i, step_theta_o=step_theta_o, step_phi=step_phi,
         grid_nodes=grid_nodes, exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes,
         fill=FILLS[fill_key] if value in FILLED_FORMATS else 0, rgb=rgb,
-        rgl_theta_i_count=rgl_theta_i_count, rgl_resolution=rgl_resolution)
+        rgl_theta_i_count=rgl_theta_i_count, rgl_resolution=rgl_resolution, float32=float32)
 
 
 @dataclasses.dataclass

@@ -1,6 +1,7 @@
 #include "core/export/fill/session_interpolant.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <utility>
@@ -32,12 +33,31 @@ RetroProfile RetroFromModel(const fit::CookTorranceFit& model) {
   return p;
 }
 
+// SplitMix64's finaliser (Steele, Lea and Flood 2014): a fixed, well-mixed key per sample index.
+std::uint64_t MixedKey(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
 }  // namespace
+
+std::vector<std::size_t> ModelFitSamples(std::size_t count) {
+  std::vector<std::size_t> chosen(count);
+  for (std::size_t i = 0; i < count; ++i) chosen[i] = i;
+  if (count <= kModelFitSamples) return chosen;
+  const auto by_key = [](std::size_t a, std::size_t b) { return MixedKey(a) < MixedKey(b); };
+  std::nth_element(chosen.begin(), chosen.begin() + kModelFitSamples, chosen.end(), by_key);
+  chosen.resize(kModelFitSamples);
+  std::sort(chosen.begin(), chosen.end());
+  return chosen;
+}
 
 Result<fit::CookTorranceFit> FitSampleModel(const interp::SampleSet& samples,
                                             const WavelengthGrid& grid, const CallContext& ctx) {
   fit::Observations data(grid);
-  for (std::size_t i = 0; i < samples.size(); ++i) {
+  for (const std::size_t i : ModelFitSamples(samples.size())) {
     const std::span<const double> c = samples.coords(i);
     if (Status st = data.Add(IsoDirection{c[0], c[1], c[2]}, samples.spectrum(i)); !st.ok()) {
       return st.WithContext("reading " + std::to_string(samples.id(i)));

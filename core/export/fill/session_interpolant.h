@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/call_context.h"
 #include "core/export/fill/chain.h"
@@ -47,9 +48,20 @@ Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, inter
                                                    const interp::Options& options,
                                                    FillPolicy policy, const CallContext& ctx);
 
-// The fill chain's model: the Cook-Torrance (GGX) model fitted to every sample of `samples`
-// (coordinates θi, θo, φ; spectra on `grid`), in the set's order. Errors: a sample the fit refuses
-// (naming its reading), a failed fit, kCancelled / kTimeout from `ctx`.
+// The most samples the fill chain's model is fitted to. A model of four parameters per band is
+// determined long before this many; a 50,000-reading session took 7 s to fit in full against
+// about 1 s for this subset (docs/export.md, "The fill chain").
+inline constexpr std::size_t kModelFitSamples = 8192;
+
+// Which samples of a set of `count` the model is fitted to: all of them up to kModelFitSamples,
+// else kModelFitSamples chosen by a fixed hash of their index (the same for the same count, in
+// no pattern a rig's regular grid of poses could alias with), in ascending order.
+std::vector<std::size_t> ModelFitSamples(std::size_t count);
+
+// The fill chain's model: the Cook-Torrance (GGX) model fitted to the samples of `samples`
+// that ModelFitSamples chooses (coordinates θi, θo, φ; spectra on `grid`), in the set's order.
+// Errors: a sample the fit refuses (naming its reading), a failed fit, kCancelled / kTimeout
+// from `ctx`.
 Result<fit::CookTorranceFit> FitSampleModel(const interp::SampleSet& samples,
                                             const WavelengthGrid& grid, const CallContext& ctx);
 

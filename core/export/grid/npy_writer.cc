@@ -6,8 +6,17 @@
 
 namespace brdf::exports {
 
-std::string NpyHeader(std::span<const std::size_t> shape) {
-  std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (";
+const char* NpyDescr(NpyType type) {
+  return type == NpyType::kFloat32 ? "<f4" : "<f8";
+}
+
+const char* NpyTypeName(NpyType type) {
+  return type == NpyType::kFloat32 ? "float32" : "float64";
+}
+
+std::string NpyHeader(std::span<const std::size_t> shape, NpyType type) {
+  std::string dict =
+      std::string("{'descr': '") + NpyDescr(type) + "', 'fortran_order': False, 'shape': (";
   for (std::size_t i = 0; i < shape.size(); ++i) {
     if (i > 0) dict += ", ";
     dict += std::to_string(shape[i]);
@@ -45,12 +54,27 @@ void AppendLittleEndian(std::span<const double> values, std::string& out) {
   }
 }
 
+void AppendLittleEndianFloat32(std::span<const double> values, std::string& out) {
+  const std::size_t at = out.size();
+  out.resize(at + values.size() * sizeof(float));
+  char* dst = out.data() + at;
+  for (double v : values) {
+    const auto bits = std::bit_cast<std::uint32_t>(static_cast<float>(v));
+    if constexpr (std::endian::native == std::endian::little) {
+      std::memcpy(dst, &bits, sizeof bits);
+      dst += sizeof bits;
+    } else {
+      for (int b = 0; b < 4; ++b) *dst++ = static_cast<char>((bits >> (8 * b)) & 0xff);
+    }
+  }
+}
+
 Status NpyGridWriter::Begin(const RegularGrid& grid, const WavelengthGrid& bands) {
   grid_ = grid;
   next_slice_ = 0;
   const std::size_t shape[4] = {grid.theta_i.count, grid.theta_o.count, grid.phi.count,
                                 bands.count};
-  const std::string header = NpyHeader(shape);
+  const std::string header = NpyHeader(shape, type_);
   out_.write(header.data(), static_cast<std::streamsize>(header.size()));
   if (!out_) return IoError("writing the .npy header failed: is the disk full or read-only?");
   return Status::Ok();
@@ -64,7 +88,11 @@ Status NpyGridWriter::WriteSlice(std::size_t theta_i_index, std::span<const doub
   }
   ++next_slice_;
   buffer_.clear();
-  AppendLittleEndian(values, buffer_);
+  if (type_ == NpyType::kFloat32) {
+    AppendLittleEndianFloat32(values, buffer_);
+  } else {
+    AppendLittleEndian(values, buffer_);
+  }
   out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
   if (!out_) {
     return IoError("writing the .npy data failed at θi slice " + std::to_string(theta_i_index) +

@@ -123,7 +123,8 @@ std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& b
                                 const GridExportInfo& info, const GridReport& report,
                                 const InterpolantInfo& how) {
   std::string j = "{\n";
-  j += "  \"format\": \"brdfd regular grid (.npy, float64, C order)\",\n";
+  j += "  \"format\": \"brdfd regular grid (.npy, " + info.dtype + ", C order)\",\n";
+  j += "  \"dtype\": " + JsonString(info.dtype) + ",\n";
   j += "  \"axes\": [\"theta_i\", \"theta_o\", \"phi\", \"band\"],\n";
   j += "  \"shape\": [" + std::to_string(grid.theta_i.count) + ", " +
        std::to_string(grid.theta_o.count) + ", " + std::to_string(grid.phi.count) + ", " +

@@ -18,9 +18,10 @@ struct GridExportInfo {
   std::int64_t session_id = 0;
   std::string session_name;
   Quantity quantity = Quantity::kBrdf;
-  std::string method;       // the interpolation method ("octant", …)
-  std::size_t samples = 0;  // sample readings the interpolator was built from
-  std::size_t skipped = 0;  // sample readings left out
+  std::string method;             // the interpolation method ("octant", …)
+  std::size_t samples = 0;        // sample readings the interpolator was built from
+  std::size_t skipped = 0;        // sample readings left out
+  std::string dtype = "float64";  // the .npy's element type ("float64" or "float32")
 };
 
 // How the interpolant was made, so that two grids made differently can be told apart.

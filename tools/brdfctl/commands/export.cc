@@ -87,6 +87,10 @@ int SetQuantityAndFill(const ExportOptions& o, std::ostream& err, v1::ExportRequ
   if (!rgl && (o.rgb || o.theta_i_count != 0 || o.resolution != 0)) {
     return Invalid(err, "--rgb, --theta-i and --resolution are for rgl exports");
   }
+  if (o.float32 && request->format() != v1::EXPORT_FORMAT_GRID_NPY) {
+    return Invalid(err, "--float32 is for grid exports to .npy");
+  }
+  request->set_float32(o.float32);
   request->set_rgb(o.rgb);
   request->set_rgl_theta_i_count(o.theta_i_count);
   request->set_rgl_resolution(o.resolution);
@@ -430,6 +434,8 @@ void AddInterpolationFlags(CLI::App& cmd, ExportOptions& o) {
 
 void AddRglAndReadingFlags(CLI::App& cmd, ExportOptions& o, bool& no_progress) {
   cmd.add_flag("--rgb", o.rgb, "rgl: linear sRGB under D65 (field rgb) instead of spectra");
+  cmd.add_flag("--float32", o.float32,
+               "grid .npy: float32 instead of float64, half the bytes (the .json says dtype)");
   cmd.add_option("--theta-i", o.theta_i_count, "rgl: θi slices (default 24)");
   cmd.add_option("--resolution", o.resolution,
                  "rgl: nodes per side of the warped square (default 48)");

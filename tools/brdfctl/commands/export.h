@@ -42,6 +42,7 @@ struct ExportOptions {
   bool no_reciprocity = false;  // merl, rgl: reciprocity is on by default; this turns it off
   std::string fill = "chain";   // grid, merl, rgl: chain or none
   bool rgb = false;             // rgl: linear sRGB under D65 instead of spectra
+  bool float32 = false;         // grid .npy: float32 instead of float64
   unsigned theta_i_count = 0;   // rgl: θi slices; 0: the daemon's default (24)
   unsigned resolution = 0;      // rgl: nodes per side of the warped square; 0: 48
   bool exclude_flagged = false;
