@@ -4,6 +4,7 @@
 //   brdf-export --db PATH --session N rgl [--rgb] [--method M] -o OUT.bsdf
 //   brdf-export --db PATH --session N merl [--method M] [--probe θi,φi,θo,φo]… -o OUT.binary
 //   brdf-export --db PATH --session N fit  [--model lambert|cook-torrance|both] -o OUT.csv
+//   brdf-export fit --readings READINGS.csv [--model …] -o OUT.csv
 //   (--demo instead of --db/--session: a synthetic paint-like session on the paper's grid)
 #include <CLI/CLI.hpp>
 #include <iostream>
@@ -121,6 +122,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   fit_cmd->add_flag("--per-band", fit.per_band,
                     "fit the roughness α and F0 per band (default: shared by all bands)");
+  fit_cmd->add_option("--readings", fit.readings_csv,
+                      "fit a readings CSV of the BRDF (brdf-export csv, brdfctl export) instead "
+                      "of --db/--session; its u_<λ> columns weight the fit");
 
   for (CLI::App* sub : {csv_cmd, grid_cmd, merl_cmd, rgl_cmd, fit_cmd}) sub->fallthrough();
 
