@@ -214,7 +214,8 @@ std::vector<double> CookTorranceNormalMatrix(const Observations& data, std::size
 }
 
 // The standard uncertainties of bands [b0, b1)'s parameters into fit.band_u. kd or ks at 0 is at
-// its bound and not counted free; α and F0 are free when some band has a lobe (ks > 0).
+// its bound and not counted free; α and F0 are free when some band has a lobe (ks > 0) and they
+// are inside their ranges.
 // `group`: the statistics of these bands alone (for the unweighted scaling); its note goes to
 // `note` when that is still empty.
 void CookTorranceUncertainties(const Observations& data, std::size_t b0, std::size_t b1,
@@ -227,7 +228,10 @@ void CookTorranceUncertainties(const Observations& data, std::size_t b0, std::si
     free[2 * (b - b0) + 1] = fit.band[b].ks > 0;
     lobe = lobe || fit.band[b].ks > 0;
   }
-  free[n - 2] = free[n - 1] = lobe;
+  // α at its clamp and F0 at 0 or 1 (the logistic's ends) are at their bounds too.
+  const double alpha = fit.band[b0].alpha, f0 = fit.band[b0].f0;
+  free[n - 2] = lobe && alpha > kAlphaMin * (1 + 1e-9) && alpha < kAlphaMax * (1 - 1e-9);
+  free[n - 1] = lobe && f0 > 1e-6 && f0 < 1 - 1e-6;
   const std::vector<double> u =
       ParameterUncertainties(CookTorranceNormalMatrix(data, b0, b1, fit.band), n, free, group);
   for (std::size_t b = b0; b < b1; ++b) {

@@ -85,7 +85,8 @@ std::string FitReportCsv(const FitReportInfo& info, const LambertFit* lambert,
   h += "# residuals: rms = √(Σ r² / n) in sr⁻¹; rel_rms = √(Σ r² / Σ f²) (0 = perfect, 1 = no "
        "better than f = 0)\n";
   if (lambert != nullptr) {
-    h += "# lambert: f = ρ(λ) / π, ρ = π · mean f (closed form); overall " +
+    h += "# lambert: f = ρ(λ) / π, ρ = π · mean f, weighted when the fit is (closed form); "
+         "overall " +
          ResidualText(lambert->overall) + "; " + ChiSquareText(lambert->statistics) + "\n";
   }
   if (ct != nullptr) {

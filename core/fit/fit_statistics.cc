@@ -75,7 +75,9 @@ std::vector<double> ParameterUncertainties(const std::vector<double>& normal, st
                                                        : std::numeric_limits<double>::quiet_NaN());
   for (std::size_t i = 0; i < m; ++i) u[index[i]] = std::sqrt(cov[i * m + i] * scale);
   if (m < n && stats.note.empty()) {
-    stats.note = "parameters at a bound (kd or ks = 0) have no uncertainty (nan)";
+    stats.note =
+        "parameters at a bound (kd or ks = 0, F0 = 0 or 1, α at its limit) have no uncertainty "
+        "(nan): they were not free";
   }
   return u;
 }

@@ -15,6 +15,7 @@
 #include "core/fit/fit_statistics.h"
 #include "core/fit/models.h"
 #include "core/geometry.h"
+#include "tests/fit/fit_test_data.h"
 
 namespace brdf::fit {
 namespace {
@@ -22,26 +23,10 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kAlpha = 0.25, kF0 = 0.2;
 
-CallContext LongContext() {
-  return CallContext::WithTimeout(std::chrono::hours(1));
-}
-
-// The paper's rig grid: 2,153 distinct (θi, θo, φ).
-std::vector<IsoDirection> PaperDirections() {
-  Result<std::vector<Pose>> poses = ExpandSampleRotationGrid(GridSpec{});
-  EXPECT_TRUE(poses.ok());
-  std::vector<IsoDirection> iso;
-  for (const Pose& p : *poses) iso.push_back(ToIsotropic(PoseToDirections(p)));
-  return DistinctIsoPoints(iso);
-}
-
-double KdAt(double nm) {
-  const double u = (nm - 600) / 80;
-  return 0.2 + 0.5 * std::exp(-u * u);
-}
-double KsAt(double nm) {
-  return 0.8 + 0.4 * (nm - 380) / 400;
-}
+using testing::KdAt;
+using testing::KsAt;
+using testing::LongContext;
+using testing::PaperDirections;
 
 // A broad retro-reflective lobe (peak when the detector looks back along the lamp), which no
 // Cook-Torrance lobe has: kr · exp((cos γ − 1) / w), γ the angle between ωi and ωo.
