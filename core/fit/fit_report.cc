@@ -33,7 +33,7 @@ std::string CookTorranceShared(const CookTorranceFit& ct) {
 
 // "χ²/dof = 1.02 (χ² = …, dof = …)" when weighted, else why there is none.
 std::string ChiSquareText(const FitStatistics& s) {
-  if (!s.weighted) return "χ²/dof: none (unweighted: the readings carry no uncertainty)";
+  if (!s.weighted) return "χ²/dof: none (unweighted: not every reading carries an uncertainty)";
   return "χ²/dof = " + Short(s.chi2_per_dof) + " (χ² = " + Short(s.chi2) +
          ", dof = " + Short(s.dof) + " = " + std::to_string(s.values) + " values − " +
          std::to_string(s.parameters) + " parameters)";

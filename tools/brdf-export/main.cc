@@ -55,6 +55,21 @@ void AddInterpOptions(CLI::App& app, InterpChoice& c, bool reciprocity_by_defaul
   }
 }
 
+// The fit subcommand and its options.
+CLI::App* AddFitCommand(CLI::App& app, FitCommandOptions& fit) {
+  CLI::App* fit_cmd =
+      app.add_subcommand("fit", "fit Lambert and Cook-Torrance (GGX) per wavelength; CSV report");
+  fit_cmd->add_option("--model", fit.model, "lambert, cook-torrance or both")
+      ->check(CLI::IsMember({"lambert", "cook-torrance", "both"}))
+      ->capture_default_str();
+  fit_cmd->add_flag("--per-band", fit.per_band,
+                    "fit the roughness α and F0 per band (default: shared by all bands)");
+  fit_cmd->add_option("--readings", fit.readings_csv,
+                      "fit a readings CSV of the BRDF (brdf-export csv, brdfctl export) instead "
+                      "of --db/--session; its u_<λ> columns weight the fit");
+  return fit_cmd;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -115,16 +130,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
 
   FitCommandOptions fit;
-  CLI::App* fit_cmd =
-      app.add_subcommand("fit", "fit Lambert and Cook-Torrance (GGX) per wavelength; CSV report");
-  fit_cmd->add_option("--model", fit.model, "lambert, cook-torrance or both")
-      ->check(CLI::IsMember({"lambert", "cook-torrance", "both"}))
-      ->capture_default_str();
-  fit_cmd->add_flag("--per-band", fit.per_band,
-                    "fit the roughness α and F0 per band (default: shared by all bands)");
-  fit_cmd->add_option("--readings", fit.readings_csv,
-                      "fit a readings CSV of the BRDF (brdf-export csv, brdfctl export) instead "
-                      "of --db/--session; its u_<λ> columns weight the fit");
+  CLI::App* fit_cmd = AddFitCommand(app, fit);
 
   for (CLI::App* sub : {csv_cmd, grid_cmd, merl_cmd, rgl_cmd, fit_cmd}) sub->fallthrough();
 
