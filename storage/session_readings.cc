@@ -1,9 +1,28 @@
 #include "storage/session_readings.h"
 
+#include <cmath>
+
 #include "core/plan/plan_json.h"
 #include "core/plan/sample.h"
 
 namespace brdf::storage {
+namespace {
+
+// √(Σ uⱼ²) per band over the components that are not the BRDF's scale (docs/uncertainty.md: for
+// the reflectance drop the white standard and the reference's cosine).
+std::vector<double> RatioPartOf(const uncertainty::ReadingBudget& budget) {
+  std::vector<double> sum(budget.combined.size(), 0.0);
+  for (const uncertainty::Component& c : budget.components) {
+    if (c.name == "white_standard" || c.name == "reference_pose") continue;
+    for (std::size_t b = 0; b < sum.size() && b < c.contribution.size(); ++b) {
+      sum[b] += c.contribution[b] * c.contribution[b];
+    }
+  }
+  for (double& v : sum) v = std::sqrt(v);
+  return sum;
+}
+
+}  // namespace
 
 Reading ToReading(const ReadingRecord& r) {
   Reading out;
@@ -18,6 +37,10 @@ Reading ToReading(const ReadingRecord& r) {
   out.integration_note = IntegrationNoteOf(r.note);
   out.reference_id = r.reference_reading_id;
   out.dark_id = r.dark_reading_id;
+  if (r.uncertainty.has_value()) {
+    out.brdf_u = r.uncertainty->combined;
+    out.brdf_u_of_ratio = RatioPartOf(*r.uncertainty);
+  }
   return out;
 }
 

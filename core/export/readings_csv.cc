@@ -50,6 +50,13 @@ std::string Header(const Session& session, Quantity quantity, const WavelengthGr
   h += "# spectral columns: headed by wavelength in nm, " + std::to_string(grid.count) +
        " bands from " + FormatNumber(grid.start_nm) + " to " + FormatNumber(grid.last_nm()) +
        " every " + FormatNumber(grid.step_nm) + " nm\n";
+  if (quantity != Quantity::kRadiance) {
+    h += "# uncertainty columns: u_<λ> after the values, the standard uncertainty (k = 1, " +
+         std::string(QuantityUnit(quantity)) +
+         ") of each value from the reading's budget (docs/uncertainty.md: combined, shared terms "
+         "such as the white standard's included); empty = not estimated for that reading, nan = "
+         "undefined in that band\n";
+  }
   h += "# rows: " + std::to_string(rows) +
        "; sample readings left out: " + std::to_string(skipped.size()) + "\n";
   for (std::size_t i = 0; i < skipped.size() && i < kListedSkips; ++i) {
@@ -64,11 +71,18 @@ std::string Header(const Session& session, Quantity quantity, const WavelengthGr
     h += ',';
     AppendNumber(h, grid.at(b));
   }
+  for (std::size_t b = 0; quantity != Quantity::kRadiance && b < grid.count; ++b) {
+    h += ",u_";
+    AppendNumber(h, grid.at(b));
+  }
   h += '\n';
   return h;
 }
 
-void AppendRow(const Reading& r, std::span<const double> values, std::string& out) {
+// `u`: nullptr for a file without u columns (radiance); else the values' uncertainties, empty
+// when not estimated (empty fields).
+void AppendRow(const Reading& r, std::span<const double> values, std::string& out,
+               const std::vector<double>* u = nullptr) {
   out += std::to_string(r.id);
   out += ',';
   out += ReadingKindName(r.kind);
@@ -87,6 +101,11 @@ void AppendRow(const Reading& r, std::span<const double> values, std::string& ou
   for (double v : values) {
     out += ',';
     AppendNumber(out, v);
+  }
+  if (u != nullptr && u->empty()) out.append(values.size(), ',');
+  for (std::size_t b = 0; u != nullptr && b < u->size(); ++b) {
+    out += ',';
+    AppendNumber(out, (*u)[b]);
   }
   out += '\n';
 }
@@ -148,7 +167,7 @@ Result<ReadingsCsvReport> WriteDerivedReadingsCsv(const Session& session, Quanti
   std::string text = Header(session, quantity, derived.grid, report.rows, derived.skipped);
   BRDF_RETURN_IF_ERROR(Flush(out, text));
   for (const DerivedSample& s : derived.samples) {
-    AppendRow(*by_id.at(s.reading_id), s.values, text);
+    AppendRow(*by_id.at(s.reading_id), s.values, text, &s.u);
     if (text.size() > kFlushBytes) BRDF_RETURN_IF_ERROR(Flush(out, text));
   }
   BRDF_RETURN_IF_ERROR(Flush(out, text));

@@ -2,7 +2,13 @@
 // the quantity, units and angle convention so that the file explains itself:
 //   id,kind,alpha_deg,beta_deg,gamma_deg,delta_deg,theta_i_deg,phi_i_deg,theta_o_deg,phi_o_deg,
 //   quality_code,flagged,integration_ms,reference_id,dark_id,integration_note,<λ1>,<λ2>,…
-// Spectral columns are headed by wavelength in nm. integration_note says how the meter changed the
+//   [,u_<λ1>,u_<λ2>,…]   (reflectance and BRDF only)
+// Spectral columns are headed by wavelength in nm. The u_<λ> columns (after the values) hold each
+// value's standard uncertainty (k = 1, the same unit) from the reading's budget
+// (docs/uncertainty.md): empty when the reading has none (not estimated: a session recorded before
+// budgets, or without [uncertainty]), nan where it is undefined. Readers that take the numeric
+// headers as the spectrum keep working: the u columns' headers are not numbers
+// (readings_csv_reader.h reads both layouts). integration_note says how the meter changed the
 // integration time (Reading.integration_note; quoted when it holds a comma), empty when it did not.
 //   radiance:            every reading (sample, reference, dark), raw as the meter reported it
 //                        (no dark subtracted: dark_id names the dark reading to subtract);

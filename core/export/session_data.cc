@@ -7,6 +7,28 @@
 #include "core/readings/derive.h"
 
 namespace brdf::exports {
+namespace {
+
+// The standard uncertainty of `quantity` for one sample (DerivedSample::u), or empty.
+std::vector<double> UncertaintyOf(const Reading& r, Quantity quantity, const SampleQuantities& q) {
+  const std::size_t n = q.of(quantity).size();
+  if (quantity == Quantity::kBrdf) {
+    return r.brdf_u.size() == n ? r.brdf_u : std::vector<double>();
+  }
+  if (quantity != Quantity::kReflectance || r.brdf_u_of_ratio.size() != n ||
+      !q.has(Quantity::kBrdf)) {
+    return {};
+  }
+  const std::vector<double>& f = q.of(Quantity::kBrdf);
+  const std::vector<double>& refl = q.of(Quantity::kReflectance);
+  std::vector<double> u(n);
+  for (std::size_t b = 0; b < n; ++b) {
+    u[b] = f[b] != 0 ? r.brdf_u_of_ratio[b] * std::abs(refl[b] / f[b]) : std::nan("");
+  }
+  return u;
+}
+
+}  // namespace
 
 Result<DerivedSamples> DeriveSamples(const Session& session, Quantity quantity,
                                      const DeriveOptions& options) {
@@ -36,8 +58,10 @@ Result<DerivedSamples> DeriveSamples(const Session& session, Quantity quantity,
       out.skipped.push_back({r.id, derived->reason(quantity)});
       continue;
     }
+    std::vector<double> u = UncertaintyOf(r, quantity, *derived);
     out.samples.push_back(DerivedSample{r.id, r.directions, ToIsotropic(r.directions),
-                                        std::move(derived->values[static_cast<int>(quantity)])});
+                                        std::move(derived->values[static_cast<int>(quantity)]),
+                                        std::move(u)});
   }
   if (sample_readings == 0) {
     return FailedPrecondition("session " + std::to_string(session.id) +

@@ -42,6 +42,10 @@ struct DerivedSample {
   Directions directions;
   IsoDirection iso;            // ToIsotropic(directions)
   std::vector<double> values;  // one per band of DerivedSamples::grid
+  // The values' standard uncertainties (k = 1, same unit) from the reading's budget: the BRDF's
+  // (Reading::brdf_u), the reflectance's (Reading::brdf_u_of_ratio · R / f, NaN where f = 0);
+  // empty when the reading has none (not estimated) and for radiance.
+  std::vector<double> u;
 };
 
 struct SkippedReading {

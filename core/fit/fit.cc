@@ -26,23 +26,31 @@ double Logit(double p) {
   return std::log(p / (1 - p));
 }
 
-// Per-band sums for the linear part f ≈ kd·a + ks·b with a = 1/π.
+double Weight(const Observations& data, std::size_t i, std::size_t b) {
+  if (!data.weighted()) return 1.0;
+  const double u = data.uncertainty(i, b);
+  return 1.0 / (u * u);
+}
+
+// One band's weighted sums for the linear part f ≈ kd·a + ks·s with a = 1/π:
+// Σw, Σw f, Σw f² (fixed) and Σw s, Σw s², Σw s f (for the lobe shape s being tried).
 struct BandSums {
-  double sff = 0, sf = 0;
+  double sw = 0, swf = 0, swff = 0;
+  double sws = 0, swss = 0, swsf = 0;
 };
 
-// The best non-negative (kd, ks) for one band and its sum of squared residuals, from the sums.
+// The best non-negative (kd, ks) for one band and its weighted sum of squared residuals.
 struct LinearSolution {
   double kd = 0, ks = 0, sse = 0;
 };
 
-LinearSolution SolveBand(double n, double sb, double sbb, const BandSums& s, double sbf) {
+LinearSolution SolveBand(const BandSums& s) {
   const double a = 1.0 / kPi;
-  const double saa = n * a * a, sab = a * sb, saf = a * s.sf;
+  const double saa = s.sw * a * a, sab = a * s.sws, saf = a * s.swf, sbb = s.swss, sbf = s.swsf;
   auto sse = [&](double kd, double ks) {
-    return s.sff - 2 * (kd * saf + ks * sbf) + kd * kd * saa + 2 * kd * ks * sab + ks * ks * sbb;
+    return s.swff - 2 * (kd * saf + ks * sbf) + kd * kd * saa + 2 * kd * ks * sab + ks * ks * sbb;
   };
-  LinearSolution best{0, 0, s.sff};
+  LinearSolution best{0, 0, s.swff};
   auto consider = [&](double kd, double ks) {
     if (!(kd >= 0) || !(ks >= 0)) return;
     const double e = sse(kd, ks);
@@ -59,42 +67,39 @@ LinearSolution SolveBand(double n, double sb, double sbb, const BandSums& s, dou
 }
 
 // The variable-projection objective over bands [b0, b1): evaluates the lobe shape for (α, F0)
-// at every observation and solves each band's (kd, ks).
+// at every observation and solves each band's (kd, ks), weighted when the data are.
 class Projection {
  public:
   Projection(const Observations& data, std::size_t b0, std::size_t b1)
-      : data_(data), b0_(b0), b1_(b1), sums_(b1 - b0), spec_(data.size()), sbf_(b1 - b0) {
+      : data_(data), b0_(b0), b1_(b1), sums_(b1 - b0), spec_(data.size()) {
     geometry_.reserve(data.size());
     for (std::size_t i = 0; i < data.size(); ++i) {
       geometry_.push_back(LobeGeometryOf(data.direction(i)));
       for (std::size_t b = b0; b < b1; ++b) {
-        const double f = data.value(i, b);
-        sums_[b - b0].sff += f * f;
-        sums_[b - b0].sf += f;
+        const double f = data.value(i, b), w = Weight(data, i, b);
+        BandSums& s = sums_[b - b0];
+        s.sw += w;
+        s.swf += w * f;
+        s.swff += w * f * f;
       }
     }
   }
 
-  // Solves for (α, F0) and returns the total SSE; fills `out` (b1 − b0 solutions) when given.
+  // Solves for (α, F0) and returns the total (weighted) SSE; fills `out` (b1 − b0 solutions)
+  // when given.
   double Evaluate(double alpha, double f0, std::vector<LinearSolution>* out) {
-    double sb = 0, sbb = 0;
     for (std::size_t i = 0; i < data_.size(); ++i) {
-      const double s = CookTorranceSpecularAt(geometry_[i], alpha, f0);
-      spec_[i] = s;
-      sb += s;
-      sbb += s * s;
+      spec_[i] = CookTorranceSpecularAt(geometry_[i], alpha, f0);
     }
-    std::fill(sbf_.begin(), sbf_.end(), 0.0);
-    for (std::size_t i = 0; i < data_.size(); ++i) {
-      const double s = spec_[i];
-      const std::span<const double> f = data_.spectrum(i);
-      for (std::size_t b = b0_; b < b1_; ++b) sbf_[b - b0_] += s * f[b];
+    if (data_.weighted()) {
+      AccumulateWeighted();
+    } else {
+      AccumulateUnweighted();
     }
     double total = 0;
     if (out != nullptr) out->clear();
-    for (std::size_t b = b0_; b < b1_; ++b) {
-      const LinearSolution sol =
-          SolveBand(static_cast<double>(data_.size()), sb, sbb, sums_[b - b0_], sbf_[b - b0_]);
+    for (BandSums& s : sums_) {
+      const LinearSolution sol = SolveBand(s);
       total += sol.sse;
       if (out != nullptr) out->push_back(sol);
     }
@@ -102,12 +107,44 @@ class Projection {
   }
 
  private:
+  // Σ s and Σ s² are the same for every band when all weights are 1.
+  void AccumulateUnweighted() {
+    double sb = 0, sbb = 0;
+    for (double s : spec_) {
+      sb += s;
+      sbb += s * s;
+    }
+    for (BandSums& s : sums_) {
+      s.sws = sb;
+      s.swss = sbb;
+      s.swsf = 0;
+    }
+    for (std::size_t i = 0; i < data_.size(); ++i) {
+      const double s = spec_[i];
+      const std::span<const double> f = data_.spectrum(i);
+      for (std::size_t b = b0_; b < b1_; ++b) sums_[b - b0_].swsf += s * f[b];
+    }
+  }
+  void AccumulateWeighted() {
+    for (BandSums& s : sums_) s.sws = s.swss = s.swsf = 0;
+    for (std::size_t i = 0; i < data_.size(); ++i) {
+      const double s = spec_[i];
+      const std::span<const double> f = data_.spectrum(i);
+      for (std::size_t b = b0_; b < b1_; ++b) {
+        const double u = data_.uncertainty(i, b), ws = s / (u * u);
+        BandSums& sum = sums_[b - b0_];
+        sum.sws += ws;
+        sum.swss += ws * s;
+        sum.swsf += ws * f[b];
+      }
+    }
+  }
+
   const Observations& data_;
   std::size_t b0_, b1_;
   std::vector<BandSums> sums_;
   std::vector<LobeGeometry> geometry_;
   std::vector<double> spec_;
-  std::vector<double> sbf_;
 };
 
 struct SearchResult {
@@ -146,6 +183,63 @@ SearchResult Search(Projection& projection, const CookTorranceOptions& options,
   return best;
 }
 
+// JᵀWJ of bands [b0, b1) over (kd, ks of each band, then α, F0) at the fit in `band`: kd and ks
+// enter linearly (∂f/∂kd = 1/π, ∂f/∂ks = s); the lobe's ∂s/∂α and ∂s/∂F0 by central differences.
+std::vector<double> CookTorranceNormalMatrix(const Observations& data, std::size_t b0,
+                                             std::size_t b1,
+                                             const std::vector<CookTorranceParams>& band) {
+  const std::size_t nb = b1 - b0, n = 2 * nb + 2;
+  const double alpha = band[b0].alpha, f0 = band[b0].f0;
+  const double ha = 1e-4 * alpha, hf = 1e-3;
+  std::vector<double> m(n * n, 0.0);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const LobeGeometry g = LobeGeometryOf(data.direction(i));
+    const double s = CookTorranceSpecularAt(g, alpha, f0);
+    const double dsa =
+        (CookTorranceSpecularAt(g, alpha + ha, f0) - CookTorranceSpecularAt(g, alpha - ha, f0)) /
+        (2 * ha);
+    const double dsf =
+        (CookTorranceSpecularAt(g, alpha, f0 + hf) - CookTorranceSpecularAt(g, alpha, f0 - hf)) /
+        (2 * hf);
+    for (std::size_t b = b0; b < b1; ++b) {
+      const double w = Weight(data, i, b), ks = band[b].ks;
+      const std::size_t at[4] = {2 * (b - b0), 2 * (b - b0) + 1, n - 2, n - 1};
+      const double d[4] = {1.0 / kPi, s, ks * dsa, ks * dsf};
+      for (int p = 0; p < 4; ++p) {
+        for (int q = 0; q < 4; ++q) m[at[p] * n + at[q]] += w * d[p] * d[q];
+      }
+    }
+  }
+  return m;
+}
+
+// The standard uncertainties of bands [b0, b1)'s parameters into fit.band_u. kd or ks at 0 is at
+// its bound and not counted free; α and F0 are free when some band has a lobe (ks > 0) and they
+// are inside their ranges.
+// `group`: the statistics of these bands alone (for the unweighted scaling); its note goes to
+// `note` when that is still empty.
+void CookTorranceUncertainties(const Observations& data, std::size_t b0, std::size_t b1,
+                               FitStatistics group, CookTorranceFit& fit, std::string& note) {
+  const std::size_t nb = b1 - b0, n = 2 * nb + 2;
+  std::vector<bool> free(n, false);
+  bool lobe = false;
+  for (std::size_t b = b0; b < b1; ++b) {
+    free[2 * (b - b0)] = fit.band[b].kd > 0;
+    free[2 * (b - b0) + 1] = fit.band[b].ks > 0;
+    lobe = lobe || fit.band[b].ks > 0;
+  }
+  // α at its clamp and F0 at 0 or 1 (the logistic's ends) are at their bounds too.
+  const double alpha = fit.band[b0].alpha, f0 = fit.band[b0].f0;
+  free[n - 2] = lobe && alpha > kAlphaMin * (1 + 1e-9) && alpha < kAlphaMax * (1 - 1e-9);
+  free[n - 1] = lobe && f0 > 1e-6 && f0 < 1 - 1e-6;
+  const std::vector<double> u =
+      ParameterUncertainties(CookTorranceNormalMatrix(data, b0, b1, fit.band), n, free, group);
+  for (std::size_t b = b0; b < b1; ++b) {
+    fit.band_u[b] = CookTorranceParams{u[2 * (b - b0)], u[2 * (b - b0) + 1], u[n - 2], u[n - 1]};
+  }
+  if (note.empty()) note = group.note;
+}
+
 }  // namespace
 
 const char* ParameterSharingName(ParameterSharing s) {
@@ -177,17 +271,42 @@ Result<LambertFit> FitLambert(const Observations& data) {
   }
   LambertFit fit;
   fit.grid = data.grid();
-  const std::size_t nb = data.bands();
-  fit.albedo.assign(nb, 0.0);
-  for (std::size_t i = 0; i < data.size(); ++i) {
-    for (std::size_t b = 0; b < nb; ++b) fit.albedo[b] += data.value(i, b);
+  const std::size_t nb = data.bands(), n = data.size();
+  std::vector<double> sw(nb, 0.0), swf(nb, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t b = 0; b < nb; ++b) {
+      const double w = Weight(data, i, b);
+      sw[b] += w;
+      swf[b] += w * data.value(i, b);
+    }
   }
-  for (double& a : fit.albedo) a = a / static_cast<double>(data.size()) * kPi;
+  fit.albedo.resize(nb);
+  for (std::size_t b = 0; b < nb; ++b) fit.albedo[b] = swf[b] / sw[b] * kPi;
   auto model = [&](std::size_t, std::size_t b) { return LambertBrdf(fit.albedo[b]); };
-  for (std::size_t b = 0; b < nb; ++b)
+  for (std::size_t b = 0; b < nb; ++b) {
     fit.band_residuals.push_back(ResidualsOf(data, b, b + 1, model));
+    // u(ρ) = π / √Σw; unweighted, scaled by the band's residual variance Σ r² / (n − 1).
+    const double r2 = fit.band_residuals[b].rms * fit.band_residuals[b].rms;
+    const double scale = data.weighted() ? 1.0
+                         : n > 1         ? r2 * static_cast<double>(n) / static_cast<double>(n - 1)
+                                         : std::numeric_limits<double>::quiet_NaN();
+    fit.albedo_u.push_back(kPi * std::sqrt(scale / sw[b]));
+  }
   fit.overall = ResidualsOf(data, 0, nb, model);
+  fit.statistics = StatisticsOf(data.weighted(), WeightedSumOfSquares(data, model), n * nb, nb);
   return fit;
+}
+
+double WeightedSumOfSquares(const Observations& data,
+                            const std::function<double(std::size_t, std::size_t)>& model) {
+  double sum = 0;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    for (std::size_t b = 0; b < data.bands(); ++b) {
+      const double r = model(i, b) - data.value(i, b);
+      sum += Weight(data, i, b) * r * r;
+    }
+  }
+  return sum;
 }
 
 Result<CookTorranceFit> FitCookTorrance(const Observations& data,
@@ -214,6 +333,7 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
   fit.grid = data.grid();
   fit.sharing = options.sharing;
   fit.band.resize(nb);
+  fit.band_u.resize(nb);
   fit.converged = true;
 
   auto record = [&](std::size_t b0, std::size_t b1, const SearchResult& s,
@@ -225,6 +345,7 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
     fit.converged = fit.converged && s.converged;
   };
   const std::size_t groups = options.sharing == ParameterSharing::kPerBand ? nb : 1;
+  std::string note;
   for (std::size_t g = 0; g < groups; ++g) {
     const std::size_t b0 = groups == 1 ? 0 : g, b1 = groups == 1 ? nb : g + 1;
     Projection projection(data, b0, b1);
@@ -235,8 +356,12 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
                      std::to_string(groups) + " searches; allow more time");
     }
     std::vector<LinearSolution> sol;
-    projection.Evaluate(s.alpha, s.f0, &sol);
+    const double sse = projection.Evaluate(s.alpha, s.f0, &sol);
     record(b0, b1, s, sol);
+    const std::size_t group_parameters = 2 * (b1 - b0) + 2;
+    CookTorranceUncertainties(
+        data, b0, b1, StatisticsOf(data.weighted(), sse, data.size() * (b1 - b0), group_parameters),
+        fit, note);
     if (options.progress)
       options.progress(static_cast<double>(g + 1) / static_cast<double>(groups));
   }
@@ -247,6 +372,10 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
   for (std::size_t b = 0; b < nb; ++b)
     fit.band_residuals.push_back(ResidualsOf(data, b, b + 1, model));
   fit.overall = ResidualsOf(data, 0, nb, model);
+  const std::size_t parameters = groups == 1 ? 2 * nb + 2 : 4 * nb;
+  fit.statistics = StatisticsOf(data.weighted(), WeightedSumOfSquares(data, model),
+                                data.size() * nb, parameters);
+  fit.statistics.note = note;
   return fit;
 }
 

@@ -1,7 +1,9 @@
 // Evaluation of analytic reflection models against measured BRDFs, wavelength by wavelength (the
 // paper's "evaluation of existing analytic models"): Lambert, and Cook-Torrance with a GGX
-// distribution (models.h). Least squares on the BRDF values themselves (sr⁻¹), every observation
-// weighted alike.
+// distribution (models.h). Least squares on the BRDF values themselves (sr⁻¹): weighted by 1/u²
+// when every observation carries its standard uncertainty u (Observations::weighted()), else every
+// value alike. Each fit reports its parameters' standard uncertainties and χ²/dof
+// (fit_statistics.h: unscaled (JᵀWJ)⁻¹ when weighted, scaled by the residual variance when not).
 //
 // Cook-Torrance's parameters: kd(λ) and ks(λ) per band; the roughness α and Schlick's F0 shared
 // by all bands (default: the microfacet geometry does not depend on wavelength, and a coloured
@@ -16,6 +18,7 @@
 #include <vector>
 
 #include "core/call_context.h"
+#include "core/fit/fit_statistics.h"
 #include "core/fit/models.h"
 #include "core/fit/observations.h"
 #include "core/status.h"
@@ -32,7 +35,9 @@ struct Residuals {
 
 struct LambertFit {
   WavelengthGrid grid;
-  std::vector<double> albedo;             // ρ per band: π · mean(f), the least-squares albedo
+  std::vector<double> albedo;             // ρ per band: π · (weighted) mean f, least squares
+  std::vector<double> albedo_u;           // its standard uncertainty per band
+  FitStatistics statistics;               // all bands: values N·B, parameters B
   std::vector<Residuals> band_residuals;  // per band
   Residuals overall;                      // all bands together
 };
@@ -56,7 +61,11 @@ struct CookTorranceOptions {
 struct CookTorranceFit {
   WavelengthGrid grid;
   ParameterSharing sharing = ParameterSharing::kSharedAcrossBands;
-  std::vector<CookTorranceParams> band;   // per band (α and F0 the same in every band if shared)
+  std::vector<CookTorranceParams> band;  // per band (α and F0 the same in every band if shared)
+  // Standard uncertainties of band's fields (the same α and F0 in every band if shared); NaN for
+  // a kd or ks at its bound 0 and where the data do not determine a parameter (statistics.note).
+  std::vector<CookTorranceParams> band_u;
+  FitStatistics statistics;               // all bands: parameters 2B + 2 (shared) or 4B (per band)
   std::vector<Residuals> band_residuals;  // per band
   Residuals overall;
   int evaluations = 0;     // objective evaluations in all
@@ -68,6 +77,10 @@ struct CookTorranceFit {
 // from `ctx`.
 Result<CookTorranceFit> FitCookTorrance(const Observations& data,
                                         const CookTorranceOptions& options, const CallContext& ctx);
+
+// Σ w r² over `data` (w = 1/u² when data.weighted(), else 1) for a per-band model.
+double WeightedSumOfSquares(const Observations& data,
+                            const std::function<double(std::size_t obs, std::size_t band)>& model);
 
 // Residuals of any per-band model over `data`: model(i, band) is its value at observation i.
 Residuals ResidualsOf(const Observations& data, std::size_t band_begin, std::size_t band_end,

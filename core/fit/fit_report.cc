@@ -27,18 +27,46 @@ std::string ResidualText(const Residuals& r) {
 
 std::string CookTorranceShared(const CookTorranceFit& ct) {
   if (ct.band.empty() || ct.sharing != ParameterSharing::kSharedAcrossBands) return "";
-  return ": α = " + Short(ct.band.front().alpha) + ", F0 = " + Short(ct.band.front().f0);
+  return ": α = " + Short(ct.band.front().alpha) + " ± " + Short(ct.band_u.front().alpha) +
+         ", F0 = " + Short(ct.band.front().f0) + " ± " + Short(ct.band_u.front().f0) + " (k = 1)";
+}
+
+// "χ²/dof = 1.02 (χ² = …, dof = …)" when weighted, else why there is none.
+std::string ChiSquareText(const FitStatistics& s) {
+  if (!s.weighted) return "χ²/dof: none (unweighted: not every reading carries an uncertainty)";
+  return "χ²/dof = " + Short(s.chi2_per_dof) + " (χ² = " + Short(s.chi2) +
+         ", dof = " + Short(s.dof) + " = " + std::to_string(s.values) + " values − " +
+         std::to_string(s.parameters) + " parameters)";
+}
+
+std::string WeightingLine(const FitReportInfo& info, bool weighted) {
+  if (weighted) {
+    return "# weighting: every value by 1/u², u its reading's combined standard uncertainty "
+           "(docs/uncertainty.md); parameter uncertainties (_u, k = 1) from (JᵀWJ)⁻¹ at the "
+           "optimum, not scaled by χ²/dof: χ²/dof ≫ 1 says the model does not describe the data "
+           "within their uncertainty, and then the _u understate how uncertain the parameters "
+           "are\n";
+  }
+  return "# weighting: none, every value alike (" + std::to_string(info.with_uncertainty) + " of " +
+         std::to_string(info.observations) +
+         " readings carry an uncertainty; a weighted fit needs all); parameter uncertainties (_u, "
+         "k = 1) from (JᵀJ)⁻¹ scaled by the residual variance Σ r² / dof, which assumes noise of "
+         "one size everywhere; no χ²\n";
 }
 
 }  // namespace
 
 std::string FitSummary(const LambertFit* lambert, const CookTorranceFit* ct) {
   std::string s;
-  if (lambert != nullptr) s += "Lambert: " + ResidualText(lambert->overall) + "\n";
+  if (lambert != nullptr) {
+    s += "Lambert: " + ResidualText(lambert->overall) + "; " + ChiSquareText(lambert->statistics) +
+         "\n";
+  }
   if (ct != nullptr) {
     s += "Cook-Torrance GGX (α, F0 " + std::string(ParameterSharingName(ct->sharing)) + ")" +
          CookTorranceShared(*ct) + ": " + ResidualText(ct->overall) +
-         (ct->converged ? "" : " (search stopped at its evaluation cap)") + "\n";
+         (ct->converged ? "" : " (search stopped at its evaluation cap)") + "; " +
+         ChiSquareText(ct->statistics) + "\n";
   }
   return s;
 }
@@ -50,12 +78,16 @@ std::string FitReportCsv(const FitReportInfo& info, const LambertFit* lambert,
   if (!info.session_name.empty()) h += " \"" + info.session_name + "\"";
   h += "\n# data: BRDF f(λ) in sr⁻¹ of " + std::to_string(info.observations) +
        " sample readings (" + std::to_string(info.left_out) +
-       " left out), fitted band by band by least squares on f, every value weighted alike\n";
+       " left out), fitted band by band by least squares on f\n";
+  const bool weighted = (lambert != nullptr && lambert->statistics.weighted) ||
+                        (ct != nullptr && ct->statistics.weighted);
+  h += WeightingLine(info, weighted);
   h += "# residuals: rms = √(Σ r² / n) in sr⁻¹; rel_rms = √(Σ r² / Σ f²) (0 = perfect, 1 = no "
        "better than f = 0)\n";
   if (lambert != nullptr) {
-    h += "# lambert: f = ρ(λ) / π, ρ = π · mean f (closed form); overall " +
-         ResidualText(lambert->overall) + "\n";
+    h += "# lambert: f = ρ(λ) / π, ρ = π · mean f, weighted when the fit is (closed form); "
+         "overall " +
+         ResidualText(lambert->overall) + "; " + ChiSquareText(lambert->statistics) + "\n";
   }
   if (ct != nullptr) {
     h += "# cook_torrance: f = kd/π + ks · D · F · G1(ωi) G1(ωo) / (4 cos θi cos θo), GGX D with "
@@ -65,23 +97,29 @@ std::string FitReportCsv(const FitReportInfo& info, const LambertFit* lambert,
          CookTorranceShared(*ct) + "; Nelder-Mead over (α, F0), (kd, ks) solved exactly; " +
          std::to_string(ct->evaluations) + " evaluations" +
          (ct->converged ? "" : ", stopped at the evaluation cap") + "\n";
-    h += "# cook_torrance overall " + ResidualText(ct->overall) + "\n";
+    h += "# cook_torrance overall " + ResidualText(ct->overall) + "; " +
+         ChiSquareText(ct->statistics) + "\n";
+    if (!ct->statistics.note.empty()) h += "# cook_torrance: " + ct->statistics.note + "\n";
   }
   if (lambert == nullptr && ct == nullptr) return h;
   h += "wavelength_nm";
-  if (lambert != nullptr) h += ",lambert_albedo,lambert_rms,lambert_rel_rms";
-  if (ct != nullptr) h += ",ct_kd,ct_ks,ct_alpha,ct_f0,ct_rms,ct_rel_rms";
+  if (lambert != nullptr) h += ",lambert_albedo,lambert_albedo_u,lambert_rms,lambert_rel_rms";
+  if (ct != nullptr) {
+    h += ",ct_kd,ct_kd_u,ct_ks,ct_ks_u,ct_alpha,ct_alpha_u,ct_f0,ct_f0_u,ct_rms,ct_rel_rms";
+  }
   h += '\n';
   const WavelengthGrid grid = lambert != nullptr ? lambert->grid : ct->grid;
   for (std::size_t b = 0; b < grid.count; ++b) {
     h += Num(grid.at(b));
     if (lambert != nullptr) {
-      h += ',' + Num(lambert->albedo[b]) + ',' + Num(lambert->band_residuals[b].rms) + ',' +
-           Num(lambert->band_residuals[b].relative_rms);
+      h += ',' + Num(lambert->albedo[b]) + ',' + Num(lambert->albedo_u[b]) + ',' +
+           Num(lambert->band_residuals[b].rms) + ',' + Num(lambert->band_residuals[b].relative_rms);
     }
     if (ct != nullptr) {
       const CookTorranceParams& p = ct->band[b];
-      h += ',' + Num(p.kd) + ',' + Num(p.ks) + ',' + Num(p.alpha) + ',' + Num(p.f0) + ',' +
+      const CookTorranceParams& u = ct->band_u[b];
+      h += ',' + Num(p.kd) + ',' + Num(u.kd) + ',' + Num(p.ks) + ',' + Num(u.ks) + ',' +
+           Num(p.alpha) + ',' + Num(u.alpha) + ',' + Num(p.f0) + ',' + Num(u.f0) + ',' +
            Num(ct->band_residuals[b].rms) + ',' + Num(ct->band_residuals[b].relative_rms);
     }
     h += '\n';

@@ -34,6 +34,13 @@ struct Reading {
   std::string integration_note;
   std::optional<std::int64_t> reference_id;  // the I0 this reading is divided by
   std::optional<std::int64_t> dark_id;       // the D subtracted, when measured
+  // The standard uncertainty (k = 1, sr⁻¹) of the reading's BRDF per band: its stored budget's
+  // combined (docs/uncertainty.md). Empty when not estimated (darks, references, readings stored
+  // before budgets existed).
+  std::vector<double> brdf_u;
+  // The part of brdf_u the reflectance R = (I − D) / (I0 − D) carries too: without the white
+  // standard's and the reference pose's terms, which scale the BRDF only; u(R) = this · R / f.
+  std::vector<double> brdf_u_of_ratio;
 };
 
 // A session's readings, with what the derivation needs of the session itself.

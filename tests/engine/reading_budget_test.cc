@@ -12,6 +12,7 @@
 
 #include "core/readings/derive.h"
 #include "daemon/wire/reading.h"
+#include "storage/session_readings.h"
 #include "storage/session_store.h"
 #include "tests/engine/engine_test_rig.h"
 #include "tests/support/plan_fixtures.h"
@@ -73,17 +74,7 @@ std::map<std::int64_t, std::vector<double>> DerivedBrdf(
   ReadingDeriver deriver(white_reflectance);
   std::map<std::int64_t, std::vector<double>> out;
   for (const storage::ReadingRecord& r : readings) {
-    Reading reading{r.id,
-                    r.kind,
-                    r.pose,
-                    r.directions,
-                    {r.grid, r.spectrum},
-                    r.quality_code,
-                    r.flagged,
-                    r.integration_ms,
-                    "",
-                    r.reference_reading_id,
-                    r.dark_reading_id};
+    const Reading reading = storage::ToReading(r);
     std::optional<SampleQuantities> q = deriver.Fold(reading);
     if (q.has_value() && q->has(Quantity::kBrdf)) out[r.id] = q->of(Quantity::kBrdf);
   }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -230,9 +231,76 @@ TEST_F(BrdfExportTool, FitReportsParametersAndResiduals) {
   const auto rows = CsvRows(text);
   ASSERT_EQ(rows.size(), 102u);
   EXPECT_EQ(rows[0].front(), "wavelength_nm");
-  EXPECT_EQ(rows[0].size(), 10u);
+  EXPECT_EQ(rows[0].size(), 15u);  // each parameter with its _u
+  EXPECT_NE(text.find(",ct_alpha,ct_alpha_u,"), std::string::npos);
   EXPECT_NE(r.err.find("Lambert: RMS"), std::string::npos) << r.err;
+  // The stored readings carry no budget: an unweighted fit, and it says so.
+  EXPECT_NE(r.err.find("unweighted"), std::string::npos) << r.err;
+  EXPECT_NE(text.find("# weighting: none"), std::string::npos);
   EXPECT_NE(r.err.find("Cook-Torrance GGX"), std::string::npos) << r.err;
+}
+
+// The path from a session to a weighted fit: the readings CSV of the BRDF with its u_<λ> columns
+// filled (here 2 % of each value, standing in for the budgets) is fitted weighted and reports
+// χ²/dof; the same file without the u columns (an older export) is fitted unweighted.
+TEST_F(BrdfExportTool, FitOfAReadingsCsvIsWeightedByItsUncertaintyColumns) {
+  ToolRun r = Exec(SessionArgs() + " csv --quantity brdf -o " + File("brdf.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream in(ReadFile(File("brdf.csv")));
+  std::string with_u, without_u, line;
+  std::size_t first_value = 0, bands = 0;
+  while (std::getline(in, line)) {
+    if (line.starts_with("#")) {
+      with_u += line + "\n";
+      without_u += line + "\n";
+      continue;
+    }
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+    if (line.ends_with(',')) f.emplace_back();
+    if (f[0] == "id") {
+      for (first_value = 0; f[first_value] != "380"; ++first_value) {
+      }
+      bands = (f.size() - first_value) / 2;
+      ASSERT_EQ(f[first_value + bands], "u_380");
+    } else {
+      ASSERT_EQ(f[first_value + bands], "") << "the stored readings carry no budget";
+      for (std::size_t b = 0; b < bands; ++b) {
+        f[first_value + bands + b] = std::to_string(0.02 * std::stod(f[first_value + b]) + 1e-4);
+      }
+    }
+    std::string joined, short_joined;
+    for (std::size_t c = 0; c < f.size(); ++c) {
+      joined += (c ? "," : "") + f[c];
+      if (c < first_value + bands) short_joined += (c ? "," : "") + f[c];
+    }
+    with_u += joined + "\n";
+    without_u += short_joined + "\n";
+  }
+  std::ofstream(File("brdf_u.csv")) << with_u;
+  std::ofstream(File("brdf_old.csv")) << without_u;
+
+  r = Exec("fit --readings " + File("brdf_u.csv") + " -o " + File("fit_u.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("weighted by their uncertainties"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("χ²/dof = "), std::string::npos) << r.err;
+  const std::string report = ReadFile(File("fit_u.csv"));
+  EXPECT_NE(report.find("# weighting: every value by 1/u²"), std::string::npos);
+  EXPECT_EQ(CsvRows(report).size(), 102u);
+
+  r = Exec("fit --readings " + File("brdf_old.csv") + " -o " + File("fit_old.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("unweighted"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("χ²/dof: none"), std::string::npos) << r.err;
+
+  r = Exec("fit --readings " + File("missing.csv") + " -o " + File("x.csv"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("cannot open the readings CSV"), std::string::npos) << r.err;
+  ASSERT_EQ(Exec(SessionArgs() + " csv --quantity radiance -o " + File("rad.csv")).exit_code, 0);
+  r = Exec("fit --readings " + File("rad.csv") + " -o " + File("x.csv"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--quantity brdf"), std::string::npos) << r.err;
 }
 
 TEST_F(BrdfExportTool, ErrorsNameWhatWasWrongAndExitTwo) {

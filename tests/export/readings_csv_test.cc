@@ -69,11 +69,21 @@ TEST(ReadingsCsv, HeaderDocumentsUnitsAnglesAndQuantity) {
                                            "reference_id",
                                            "dark_id",
                                            "integration_note"};
-    ASSERT_EQ(rows[0].size(), want.size() + 101);
+    // Reflectance and BRDF: the values' standard uncertainties u_<λ> after the values.
+    const bool with_u = q != Quantity::kRadiance;
+    ASSERT_EQ(rows[0].size(), want.size() + (with_u ? 202 : 101));
     for (std::size_t c = 0; c < want.size(); ++c) EXPECT_EQ(rows[0][c], want[c]);
     EXPECT_EQ(rows[0][want.size()], "380");
     EXPECT_EQ(rows[0][want.size() + 1], "384");
-    EXPECT_EQ(rows[0].back(), "780");
+    EXPECT_EQ(rows[0][want.size() + 100], "780");
+    EXPECT_EQ(rows[0].back(), with_u ? "u_780" : "780");
+    if (with_u) {
+      EXPECT_EQ(rows[0][want.size() + 101], "u_380");
+      EXPECT_NE(comments.find("uncertainty columns: u_<λ>"), std::string::npos);
+      // The synthetic session's readings carry no budget: empty u fields.
+      EXPECT_EQ(rows[1].size(), rows[0].size());
+      EXPECT_EQ(rows[1].back(), "");
+    }
   }
 }
 
@@ -207,6 +217,41 @@ TEST(ReadingsCsv, IntegrationNoteSaysHowTheMeterChangedTheIntegration) {
             std::string::npos);
   EXPECT_NE(Joined(CommentLines(text)).find("integration_note: how the meter changed"),
             std::string::npos);
+}
+
+// Readings with a budget write its standard uncertainty per band: the BRDF's as stored, the
+// reflectance's without the BRDF's scale terms, scaled by R / f. Readings without one leave the
+// fields empty.
+TEST(ReadingsCsv, UncertaintyColumnsHoldEachReadingsBudget) {
+  Session session = SmallSession(/*with_dark=*/false);
+  std::int64_t without = -1;
+  for (Reading& r : session.readings) {
+    if (r.kind != ReadingKind::kSample) continue;
+    if (without < 0) {
+      without = r.id;  // the first sample keeps no budget
+      continue;
+    }
+    r.brdf_u.assign(101, 0.002);
+    r.brdf_u_of_ratio.assign(101, 0.001);
+  }
+  std::ostringstream brdf, refl;
+  ASSERT_TRUE(WriteReadingsCsv(session, Quantity::kBrdf, brdf).ok());
+  ASSERT_TRUE(WriteReadingsCsv(session, Quantity::kReflectance, refl).ok());
+  const auto f = CsvRows(brdf.str()), r = CsvRows(refl.str());
+  ASSERT_EQ(f.size(), r.size());
+  for (std::size_t i = 1; i < f.size(); ++i) {
+    const bool has = std::stoll(f[i][0]) != without;
+    for (std::size_t b = 0; b < 101; b += 20) {
+      if (!has) {
+        EXPECT_EQ(f[i][117 + b], "");
+        EXPECT_EQ(r[i][117 + b], "");
+        continue;
+      }
+      EXPECT_EQ(std::stod(f[i][117 + b]), 0.002);
+      const double ratio = std::stod(r[i][16 + b]) / std::stod(f[i][16 + b]);
+      EXPECT_NEAR(std::stod(r[i][117 + b]), 0.001 * ratio, 1e-12 * ratio);
+    }
+  }
 }
 
 }  // namespace

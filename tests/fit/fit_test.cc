@@ -15,32 +15,17 @@
 #include "core/fit/models.h"
 #include "core/fit/nelder_mead.h"
 #include "core/geometry.h"
+#include "tests/fit/fit_test_data.h"
 
 namespace brdf::fit {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-CallContext LongContext(CancelToken token = CancelToken()) {
-  return CallContext::WithTimeout(std::chrono::hours(1), std::move(token));
-}
-
-// The paper's rig grid: 2,153 distinct (θi, θo, φ).
-std::vector<IsoDirection> PaperDirections() {
-  Result<std::vector<Pose>> poses = ExpandSampleRotationGrid(GridSpec{});
-  EXPECT_TRUE(poses.ok());
-  std::vector<IsoDirection> iso;
-  for (const Pose& p : *poses) iso.push_back(ToIsotropic(PoseToDirections(p)));
-  return DistinctIsoPoints(iso);
-}
-
-double KdAt(double nm) {
-  const double u = (nm - 600) / 80;
-  return 0.2 + 0.5 * std::exp(-u * u);
-}
-double KsAt(double nm) {
-  return 0.8 + 0.4 * (nm - 380) / 400;
-}
+using testing::KdAt;
+using testing::KsAt;
+using testing::LongContext;
+using testing::PaperDirections;
 
 Observations FromCookTorrance(const WavelengthGrid& grid, double alpha, double f0) {
   Observations data(grid);

@@ -4,12 +4,15 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "storage/session_store.h"
 #include "storage_test_util.h"
 
 namespace brdf::storage {
 namespace {
 
+using testing::MakeBudget;
 using testing::MakeNewSession;
 using testing::MakeReading;
 using testing::MakeSteps;
@@ -48,6 +51,34 @@ TEST(SessionReadingsTest, TheSampleBlocksWhiteSpectrumComesWithTheReadings) {
   Result<SessionReadings> bad = LoadSessionReadings(**store, *broken);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("stored plan does not parse"), std::string::npos);
+}
+
+// A reading's stored budget reaches the exports and fits: its combined u as brdf_u, and the part
+// the reflectance shares (without the white standard's and the reference pose's terms).
+TEST(SessionReadingsTest, AReadingsBudgetComesWithItAsItsStandardUncertainty) {
+  const WavelengthGrid grid{500, 100, 2};
+  ReadingRecord rec = MakeReading(2, ReadingKind::kSample);
+  uncertainty::ReadingBudget b = MakeBudget(2, grid, 1);
+  b.components.push_back(
+      {"white_standard", {uncertainty::Sharing::kWhiteStandard, 1}, {4e-4, 5e-4}});
+  b.components.push_back(
+      {"reference_pose", {uncertainty::Sharing::kReferenceReading, 1}, {1e-4, 1e-4}});
+  for (std::size_t i = 0; i < grid.count; ++i) {
+    double sum = 0;
+    for (const uncertainty::Component& c : b.components)
+      sum += c.contribution[i] * c.contribution[i];
+    b.combined[i] = std::sqrt(sum);
+  }
+  rec.uncertainty = b;
+  const Reading r = ToReading(rec);
+  EXPECT_EQ(r.brdf_u, b.combined);
+  ASSERT_EQ(r.brdf_u_of_ratio.size(), 2u);
+  for (std::size_t i = 0; i < grid.count; ++i) {
+    EXPECT_DOUBLE_EQ(r.brdf_u_of_ratio[i],
+                     std::hypot(b.components[0].contribution[i], b.components[1].contribution[i]));
+  }
+  // Not estimated: nothing.
+  EXPECT_TRUE(ToReading(MakeReading(3, ReadingKind::kSample)).brdf_u.empty());
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -19,11 +20,13 @@
 #include "core/export/merl/writer.h"
 #include "core/export/number_text.h"
 #include "core/export/readings_csv.h"
+#include "core/export/readings_csv_reader.h"
 #include "core/export/rgl/writer.h"
 #include "core/export/synthetic_session.h"
 #include "core/fit/fit.h"
 #include "core/fit/fit_report.h"
 #include "core/fit/models.h"
+#include "core/geometry.h"
 #include "data/cie_tables.h"
 #include "storage/session_readings.h"
 #include "storage/session_store.h"
@@ -351,6 +354,57 @@ int RunRgl(const CommonOptions& c, const RglCommandOptions& o, std::ostream& err
   return kExitOk;
 }
 
+namespace {
+
+// What a fit runs on: the observations and what the report says of them.
+struct FitInput {
+  fit::Observations data;
+  fit::FitReportInfo info;
+};
+
+// The BRDF of a stored (or the demo) session's sample readings, with their budgets' u.
+Result<FitInput> FitInputFromSession(const CommonOptions& c, std::ostream& err) {
+  BRDF_ASSIGN_OR_RETURN(const exports::Session session, LoadInput(c));
+  if (exports::HasSeveralDialPositions(session)) {
+    err << "brdf-export: warning: session " << session.id
+        << " was measured at several dial positions γ; the models are isotropic\n";
+  }
+  BRDF_ASSIGN_OR_RETURN(
+      const exports::DerivedSamples derived,
+      exports::DeriveSamples(session, exports::Quantity::kBrdf, {c.exclude_flagged}));
+  FitInput in{fit::Observations(derived.grid), {session.id, session.name, 0, 0, 0}};
+  for (const exports::DerivedSample& s : derived.samples) {
+    BRDF_RETURN_IF_ERROR(
+        in.data.Add(s.iso, s.values, s.u).WithContext("reading " + std::to_string(s.reading_id)));
+  }
+  in.info.left_out = derived.skipped.size();
+  return in;
+}
+
+// The sample rows of a readings CSV of the BRDF, with their u_<λ> columns when present.
+Result<FitInput> FitInputFromCsv(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return NotFound("cannot open the readings CSV " + path);
+  std::stringstream text;
+  text << file.rdbuf();
+  BRDF_ASSIGN_OR_RETURN(const exports::ReadingsCsv csv,
+                        exports::ParseReadingsCsv(text.str(), path));
+  if (csv.quantity != "brdf") {
+    return InvalidArgument(path + " holds " + (csv.quantity.empty() ? "no named" : csv.quantity) +
+                           " quantity; the fit needs the BRDF: export with --quantity brdf");
+  }
+  FitInput in{fit::Observations(csv.grid), {csv.session_id, csv.session_name, 0, 0, 0}};
+  for (const exports::ReadingsCsvRow& row : csv.rows) {
+    if (!row.kind.empty() && row.kind != "sample") continue;
+    BRDF_RETURN_IF_ERROR(in.data.Add(ToIsotropic(row.directions), row.values, row.u)
+                             .WithContext(path + ", reading " + std::to_string(row.id)));
+  }
+  if (in.data.size() == 0) return FailedPrecondition(path + " has no sample readings");
+  return in;
+}
+
+}  // namespace
+
 int RunFit(const CommonOptions& c, const FitCommandOptions& o, std::ostream& err) {
   const bool lambert = o.model == "lambert" || o.model == "both";
   const bool ct = o.model == "cook-torrance" || o.model == "both";
@@ -358,21 +412,15 @@ int RunFit(const CommonOptions& c, const FitCommandOptions& o, std::ostream& err
     return Fail(err, "fit",
                 InvalidArgument("--model '" + o.model + "': use lambert, cook-torrance or both"));
   }
-  Result<exports::Session> session = LoadInput(c);
-  if (!session.ok()) return Fail(err, "fit", session.status());
-  if (exports::HasSeveralDialPositions(*session)) {
-    err << "brdf-export: warning: session " << session->id
-        << " was measured at several dial positions γ; the models are isotropic\n";
+  if (!o.readings_csv.empty() && (c.demo || !c.db_path.empty())) {
+    return Fail(err, "fit", InvalidArgument("give either --readings or --db/--demo, not both"));
   }
-  Result<exports::DerivedSamples> derived =
-      exports::DeriveSamples(*session, exports::Quantity::kBrdf, {c.exclude_flagged});
-  if (!derived.ok()) return Fail(err, "fit", derived.status());
-  fit::Observations data(derived->grid);
-  for (const exports::DerivedSample& s : derived->samples) {
-    if (Status st = data.Add(s.iso, s.values); !st.ok()) {
-      return Fail(err, "fit", st.WithContext("reading " + std::to_string(s.reading_id)));
-    }
-  }
+  Result<FitInput> input =
+      o.readings_csv.empty() ? FitInputFromSession(c, err) : FitInputFromCsv(o.readings_csv);
+  if (!input.ok()) return Fail(err, "fit", input.status());
+  const fit::Observations& data = input->data;
+  input->info.observations = data.size();
+  input->info.with_uncertainty = data.with_uncertainty();
   std::optional<fit::LambertFit> lambert_fit;
   std::optional<fit::CookTorranceFit> ct_fit;
   if (lambert) {
@@ -393,13 +441,16 @@ int RunFit(const CommonOptions& c, const FitCommandOptions& o, std::ostream& err
   }
   Result<std::unique_ptr<OutputFile>> file = OutputFile::Open(c.output);
   if (!file.ok()) return Fail(err, "fit", file.status());
-  const fit::FitReportInfo info{session->id, session->name, data.size(), derived->skipped.size()};
   const fit::LambertFit* l = lambert_fit ? &*lambert_fit : nullptr;
   const fit::CookTorranceFit* t = ct_fit ? &*ct_fit : nullptr;
-  (*file)->stream() << fit::FitReportCsv(info, l, t);
+  (*file)->stream() << fit::FitReportCsv(input->info, l, t);
   if (Status st = (*file)->Commit(); !st.ok()) return Fail(err, "fit", st);
-  err << "brdf-export fit: session " << session->id << ", " << data.size() << " BRDF readings ("
-      << derived->skipped.size() << " left out) → " << c.output << "\n"
+  err << "brdf-export fit: session " << input->info.session_id << ", " << data.size()
+      << " BRDF readings (" << input->info.left_out << " left out; "
+      << (data.weighted()
+              ? "weighted by their uncertainties"
+              : std::to_string(data.with_uncertainty()) + " with an uncertainty: unweighted")
+      << ") → " << c.output << "\n"
       << fit::FitSummary(l, t);
   return kExitOk;
 }

@@ -70,6 +70,9 @@ struct RglCommandOptions {
 struct FitCommandOptions {
   std::string model = "both";  // lambert, cook-torrance, both
   bool per_band = false;       // α and F0 per band instead of shared
+  // Instead of --db/--session: a readings CSV of the BRDF (brdf-export csv, brdfd's Data.Export
+  // READINGS_CSV); its u_<λ> columns, when every row has them, weight the fit.
+  std::string readings_csv;
 };
 
 // `out` receives what a command prints besides its file (probe rows); `err` messages/progress.
@@ -80,6 +83,8 @@ int RunMerl(const CommonOptions& common, const MerlOptions& options, std::ostrea
 // The RGL material (.bsdf, core/export/rgl/writer.h): the microfacet distribution from the
 // session's retro-reflection readings, else from a fitted Cook-Torrance (GGX) model.
 int RunRgl(const CommonOptions& common, const RglCommandOptions& options, std::ostream& err);
+// Weighted by the readings' uncertainties (their budgets, or a CSV's u_<λ> columns) when every
+// reading has one, else unweighted; the report says which, with χ²/dof when weighted.
 int RunFit(const CommonOptions& common, const FitCommandOptions& options, std::ostream& err);
 
 }  // namespace brdf::export_tool

@@ -4,6 +4,7 @@
 //   brdf-export --db PATH --session N rgl [--rgb] [--method M] -o OUT.bsdf
 //   brdf-export --db PATH --session N merl [--method M] [--probe θi,φi,θo,φo]… -o OUT.binary
 //   brdf-export --db PATH --session N fit  [--model lambert|cook-torrance|both] -o OUT.csv
+//   brdf-export fit --readings READINGS.csv [--model …] -o OUT.csv
 //   (--demo instead of --db/--session: a synthetic paint-like session on the paper's grid)
 #include <CLI/CLI.hpp>
 #include <iostream>
@@ -52,6 +53,21 @@ void AddInterpOptions(CLI::App& app, InterpChoice& c, bool reciprocity_by_defaul
   } else {
     app.add_flag("--reciprocity", c.reciprocity, "add the swapped copies (θo, θi, φ)");
   }
+}
+
+// The fit subcommand and its options.
+CLI::App* AddFitCommand(CLI::App& app, FitCommandOptions& fit) {
+  CLI::App* fit_cmd =
+      app.add_subcommand("fit", "fit Lambert and Cook-Torrance (GGX) per wavelength; CSV report");
+  fit_cmd->add_option("--model", fit.model, "lambert, cook-torrance or both")
+      ->check(CLI::IsMember({"lambert", "cook-torrance", "both"}))
+      ->capture_default_str();
+  fit_cmd->add_flag("--per-band", fit.per_band,
+                    "fit the roughness α and F0 per band (default: shared by all bands)");
+  fit_cmd->add_option("--readings", fit.readings_csv,
+                      "fit a readings CSV of the BRDF (brdf-export csv, brdfctl export) instead "
+                      "of --db/--session; its u_<λ> columns weight the fit");
+  return fit_cmd;
 }
 
 }  // namespace
@@ -116,13 +132,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
 
   FitCommandOptions fit;
-  CLI::App* fit_cmd =
-      app.add_subcommand("fit", "fit Lambert and Cook-Torrance (GGX) per wavelength; CSV report");
-  fit_cmd->add_option("--model", fit.model, "lambert, cook-torrance or both")
-      ->check(CLI::IsMember({"lambert", "cook-torrance", "both"}))
-      ->capture_default_str();
-  fit_cmd->add_flag("--per-band", fit.per_band,
-                    "fit the roughness α and F0 per band (default: shared by all bands)");
+  CLI::App* fit_cmd = AddFitCommand(app, fit);
 
   for (CLI::App* sub : {csv_cmd, grid_cmd, merl_cmd, rgl_cmd, fit_cmd}) sub->fallthrough();
 

@@ -1,0 +1,85 @@
+#include "core/fit/fit_statistics.h"
+
+#include <cmath>
+#include <limits>
+
+namespace brdf::fit {
+
+FitStatistics StatisticsOf(bool weighted, double sum_of_squares, std::size_t values,
+                           std::size_t parameters) {
+  FitStatistics s;
+  s.weighted = weighted;
+  s.values = values;
+  s.parameters = parameters;
+  s.chi2 = sum_of_squares;
+  s.dof = values > parameters ? static_cast<double>(values - parameters) : 0.0;
+  s.chi2_per_dof =
+      weighted && s.dof > 0 ? s.chi2 / s.dof : std::numeric_limits<double>::quiet_NaN();
+  s.covariance_scaled = !weighted;
+  return s;
+}
+
+std::vector<double> InvertSymmetric(std::vector<double> a, std::size_t n) {
+  // Cholesky a = L Lᵀ in place (lower triangle), then a⁻¹ = L⁻ᵀ L⁻¹.
+  for (std::size_t j = 0; j < n; ++j) {
+    double d = a[j * n + j];
+    for (std::size_t k = 0; k < j; ++k) d -= a[j * n + k] * a[j * n + k];
+    if (!(d > 0) || !std::isfinite(d)) return {};
+    const double l = std::sqrt(d);
+    a[j * n + j] = l;
+    for (std::size_t i = j + 1; i < n; ++i) {
+      double s = a[i * n + j];
+      for (std::size_t k = 0; k < j; ++k) s -= a[i * n + k] * a[j * n + k];
+      a[i * n + j] = s / l;
+    }
+  }
+  std::vector<double> inv_l(n * n, 0.0);  // L⁻¹, lower triangular
+  for (std::size_t j = 0; j < n; ++j) {
+    inv_l[j * n + j] = 1.0 / a[j * n + j];
+    for (std::size_t i = j + 1; i < n; ++i) {
+      double s = 0;
+      for (std::size_t k = j; k < i; ++k) s -= a[i * n + k] * inv_l[k * n + j];
+      inv_l[i * n + j] = s / a[i * n + i];
+    }
+  }
+  std::vector<double> inv(n * n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j <= i; ++j) {
+      double s = 0;
+      for (std::size_t k = i; k < n; ++k) s += inv_l[k * n + i] * inv_l[k * n + j];
+      inv[i * n + j] = inv[j * n + i] = s;
+    }
+  }
+  return inv;
+}
+
+std::vector<double> ParameterUncertainties(const std::vector<double>& normal, std::size_t n,
+                                           const std::vector<bool>& free, FitStatistics& stats) {
+  std::vector<double> u(n, std::numeric_limits<double>::quiet_NaN());
+  std::vector<std::size_t> index;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (free[i]) index.push_back(i);
+  }
+  const std::size_t m = index.size();
+  std::vector<double> block(m * m);
+  for (std::size_t i = 0; i < m; ++i) {
+    for (std::size_t j = 0; j < m; ++j) block[i * m + j] = normal[index[i] * n + index[j]];
+  }
+  const std::vector<double> cov = InvertSymmetric(std::move(block), m);
+  if (cov.empty() && m > 0) {
+    stats.note = "the parameters' covariance is singular (the data do not determine them all)";
+    return u;
+  }
+  const double scale = stats.weighted ? 1.0
+                                      : (stats.dof > 0 ? stats.chi2 / stats.dof
+                                                       : std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t i = 0; i < m; ++i) u[index[i]] = std::sqrt(cov[i * m + i] * scale);
+  if (m < n && stats.note.empty()) {
+    stats.note =
+        "parameters at a bound (kd or ks = 0, F0 = 0 or 1, α at its limit) have no uncertainty "
+        "(nan): they were not free";
+  }
+  return u;
+}
+
+}  // namespace brdf::fit
