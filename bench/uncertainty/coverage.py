@@ -89,7 +89,8 @@ def truth(sim, material, d):
 
 
 def run_session(sim, daemon, material, seed, plan, errors):
-    """One session's sample readings: a dict of f, u, truth (n, m), the budgets, wavelengths."""
+    """One session's sample readings: a dict of f, u, truth (n, m), the budgets, wavelengths and
+    directions (n, 4: θi φi θo φo)."""
     rig = live_rig.LiveRig(sim, daemon, seed=seed, sim_args=sim_flags(material, errors),
                            extra_config=budget_config(errors))
     rig.sample_extra = f"white_reflectance_uncertainty = {RHO_W * errors['white_error']}\n"
@@ -118,7 +119,8 @@ def run_session(sim, daemon, material, seed, plan, errors):
     return {"f": np.array([b.value for b in data.budgets]),
             "u": np.asarray(data.brdf_uncertainty),
             "t": np.array([truth(sim, material, d) for d in data.directions]),
-            "budgets": list(data.budgets), "wl": np.asarray(data.wavelengths)}
+            "budgets": list(data.budgets), "wl": np.asarray(data.wavelengths),
+            "directions": np.asarray(data.directions)}
 
 
 def component_shares(budgets, ok):
