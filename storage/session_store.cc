@@ -562,6 +562,51 @@ Result<std::int64_t> SessionStore::CompleteStepWithReading(std::int64_t session,
   return id;
 }
 
+namespace {
+
+// The grid size of sample reading `reading` of `session`, or why it cannot take a budget.
+Result<std::size_t> SampleBands(Database& db, std::int64_t session, std::int64_t reading,
+                                const std::string& what) {
+  BRDF_ASSIGN_OR_RETURN(
+      Statement st,
+      db.Prepare("SELECT kind, wl_count FROM readings WHERE id = ? AND session_id = ?"));
+  st.Bind(1, reading).Bind(2, session);
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
+  const std::string name = "reading " + std::to_string(reading);
+  if (!row) return NotFound(what + ": " + name + " is not one of the session's readings");
+  if (st.Text(0) != ToString(ReadingKind::kSample)) {
+    return InvalidArgument(what + ": " + name + " is a " + st.Text(0) +
+                           " reading; only a sample reading has an uncertainty budget");
+  }
+  return static_cast<std::size_t>(st.Int64(1));
+}
+
+}  // namespace
+
+Status SessionStore::ReplaceReadingUncertainties(
+    std::int64_t session,
+    const std::vector<std::pair<std::int64_t, uncertainty::ReadingBudget>>& budgets) {
+  const std::string what =
+      "replacing the uncertainty budgets of session " + std::to_string(session);
+  MutexLock lock(write_mu_);
+  Database& db = *writer_;
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
+  BRDF_RETURN_IF_ERROR(SessionStateOf(db, session).status());
+  for (const auto& [reading, budget] : budgets) {
+    BRDF_ASSIGN_OR_RETURN(std::size_t bands, SampleBands(db, session, reading, what));
+    Result<UncertaintyColumns> columns = EncodeUncertainty(budget, bands);
+    if (!columns.ok()) {
+      return columns.status().WithContext(what + ": reading " + std::to_string(reading));
+    }
+    BRDF_ASSIGN_OR_RETURN(Statement del,
+                          db.Prepare("DELETE FROM reading_uncertainty WHERE reading_id = ?"));
+    del.Bind(1, reading);
+    BRDF_RETURN_IF_ERROR(del.Run().WithContext(what));
+    BRDF_RETURN_IF_ERROR(InsertUncertainty(db, reading, bands, *columns, what));
+  }
+  return tx.Commit().WithContext(what);
+}
+
 Status SessionStore::CompleteStep(std::int64_t session, int step_index) {
   return MarkStepFinished(session, step_index, StepState::kDone, std::nullopt, false);
 }

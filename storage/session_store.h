@@ -25,6 +25,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/mutex.h"
@@ -130,6 +131,18 @@ class SessionStore final : public SessionReader {
   //   kIoError             the disk refused the write (nothing of it was kept).
   Result<std::int64_t> CompleteStepWithReading(std::int64_t session, int step_index,
                                                const ReadingRecord& reading);
+
+  // Replaces the uncertainty budgets of sample readings of `session` (reading id, budget), all in
+  // ONE transaction: the budgets a finished session estimates again with what only the whole
+  // session knows (docs/uncertainty.md). After any crash the database holds either every new
+  // budget or every old one.
+  //   kNotFound            no such session, or a reading id that is not one of its readings;
+  //   kInvalidArgument     a reading that is not a sample, or a budget that does not fit its
+  //                        reading's grid (nothing is written);
+  //   kIoError             the disk refused the write (nothing of it was kept).
+  Status ReplaceReadingUncertainties(
+      std::int64_t session,
+      const std::vector<std::pair<std::int64_t, uncertainty::ReadingBudget>>& budgets);
 
   // Marks a move or prompt step done (measuring steps complete with their reading or are skipped).
   Status CompleteStep(std::int64_t session, int step_index);

@@ -87,8 +87,15 @@ Status CheckInputs(const BudgetInputs& in) {
   }
   if (s.ok() && in.pose_gradient.has_value()) {
     for (int a = 0; a < 4 && s.ok(); ++a) {
-      s = CheckSize((*in.pose_gradient)[a], n, std::string("the gradient along ") + kAxisNames[a],
-                    false);
+      const std::vector<double>& g = (*in.pose_gradient)[a];
+      if (g.empty()) continue;  // that axis: not estimated
+      s = CheckSize(g, n, std::string("the gradient along ") + kAxisNames[a], false);
+      for (double x : g) {
+        if (s.ok() && !std::isfinite(x)) {
+          s = InvalidArgument(std::string("the gradient along ") + kAxisNames[a] +
+                              " must be finite");
+        }
+      }
     }
   }
   return s.ok() ? CheckTerms(in) : s;
@@ -218,7 +225,8 @@ void AddWavelengthAndStray(const BudgetInputs& in, const Evaluation& e, ReadingB
 }
 
 // pose_repeatability (independent) and pose_alignment_<axis> (the instrument's), through the
-// gradient; the reference's share of β's alignment joins pose_alignment_beta.
+// gradient; the reference's share of β's alignment joins pose_alignment_beta. An axis whose
+// gradient is unknown (empty) and whose pose is uncertain is named in not_estimated.
 void AddPose(const BudgetInputs& in, const Evaluation& e, ReadingBudget& budget) {
   if (!in.pose_gradient.has_value()) {
     budget.not_estimated.push_back("pose: the quantity's gradient over the pose is not known");
@@ -230,6 +238,16 @@ void AddPose(const BudgetInputs& in, const Evaluation& e, ReadingBudget& budget)
   std::vector<double> repeat(n, 0.0);
   for (int a = 0; a < 4; ++a) {
     const std::vector<double>& g = (*in.pose_gradient)[a];
+    const bool uncertain = stage.repeatability_deg[a] > 0 || stage.alignment_deg[a] > 0;
+    if (g.empty()) {
+      if (uncertain) {
+        budget.not_estimated.push_back(std::string("pose_") + kAxisNames[a] +
+                                       ": no neighbouring reading along " + kAxisNames[a] +
+                                       " to estimate the gradient (zero for an isotropic sample "
+                                       "on gamma)");
+      }
+      continue;
+    }
     std::vector<double> align(n);
     for (std::size_t b = 0; b < n; ++b) {
       const double gr = g[b] * stage.repeatability_deg[a];

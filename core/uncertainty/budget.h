@@ -92,7 +92,8 @@ struct BudgetInputs {
   double theta_i_deg = 0;                   // the sample reading's incidence
   double theta_r_deg = 0;                   // the reference's incidence
   std::optional<LampDrift> drift;           // nullopt: not estimated
-  // ∂f/∂(α, β, γ, δ) per band, per degree, of the quantity; nullopt: pose not estimated.
+  // ∂f/∂(α, β, γ, δ) per band, per degree, of the quantity (pose_gradient.h); nullopt: pose not
+  // estimated; an empty axis: that axis not estimated (named when its pose is uncertain).
   std::optional<std::array<std::vector<double>, 4>> pose_gradient;
   BudgetTerms terms;
 };

@@ -103,9 +103,28 @@ void Executor::Run() {
     return;
   }
   if (c.pending == 0) {
+    EstimateBudgetsAgain(c, where);
     Result<SessionState> done =
         host_.ApplyEvent(session_, SessionEvent::kFinish, "every step done");
     if (done.ok()) spdlog::info("{}: completed", where);
+  }
+}
+
+void Executor::EstimateBudgetsAgain(Context& c, const std::string& where) {
+  if (!c.budgeter.has_value()) return;
+  std::vector<storage::ReadingRecord> samples;
+  Status scan = store_->ForEachReading(session_, [&samples](const storage::ReadingRecord& r) {
+    if (r.kind == storage::ReadingKind::kSample) samples.push_back(r);
+    return Status::Ok();
+  });
+  if (scan.ok()) {
+    scan = store_->ReplaceReadingUncertainties(session_, c.budgeter->EstimateSession(samples));
+  }
+  if (!scan.ok()) {
+    spdlog::warn(
+        "{}: the budgets estimated at commit are kept (estimating them again with the "
+        "whole session failed: {})",
+        where, scan.message());
   }
 }
 

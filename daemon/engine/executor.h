@@ -144,6 +144,10 @@ class Executor {
   // its id, the session's latest reference / dark follow it, and the host hears of the completed
   // step with the reading. The store's error otherwise (nothing changed).
   Status CommitReading(Context& c, int index, storage::ReadingRecord& reading);
+  // Every step done: each sample's budget estimated again with the whole session (its pose
+  // through the neighbours, the drift to the next reference) and stored in one transaction. On
+  // failure the budgets stored at commit stay (they name the pose "not estimated").
+  void EstimateBudgetsAgain(Context& c, const std::string& where);
   // After the reading before it is committed: waits for the pipelined move; on success writes
   // its done mark (advanced = 2), on failure reports a fault and leaves the move for the loop to
   // run again as its second attempt, or stops when it may not be retried.

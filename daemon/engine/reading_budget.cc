@@ -87,8 +87,9 @@ Result<std::vector<double>> ReadingBudgeter::WhiteOn(const WavelengthGrid& grid)
   return std::move(on_grid.values);
 }
 
-Result<uncertainty::ReadingBudget> ReadingBudgeter::Estimate(const storage::ReadingRecord& sample,
-                                                             double time_s) const {
+Result<uncertainty::ReadingBudget> ReadingBudgeter::Estimate(
+    const storage::ReadingRecord& sample, double time_s,
+    std::optional<uncertainty::PoseGradient> pose_gradient) const {
   const std::string name = "reading at step " + std::to_string(sample.step_index);
   if (!sample.reference_reading_id.has_value()) {
     return FailedPrecondition(name + " names no reference reading");
@@ -115,7 +116,30 @@ Result<uncertainty::ReadingBudget> ReadingBudgeter::Estimate(const storage::Read
   in.theta_r_deg = ref->second.theta_i;
   BRDF_ASSIGN_OR_RETURN(in.drift, DriftOf(ref->first, time_s));
   in.terms = settings_.terms;
+  in.pose_gradient = std::move(pose_gradient);
   return uncertainty::EstimateReadingBudget(in);
+}
+
+std::vector<std::pair<std::int64_t, uncertainty::ReadingBudget>> ReadingBudgeter::EstimateSession(
+    const std::vector<storage::ReadingRecord>& samples) const {
+  // First the values (the gradient needs every neighbour's), then the budgets with the gradient.
+  std::vector<const storage::ReadingRecord*> known;
+  std::vector<uncertainty::PosedValue> posed;
+  for (const storage::ReadingRecord& r : samples) {
+    Result<uncertainty::ReadingBudget> first = Estimate(r, r.recorded_at);
+    if (!first.ok()) continue;
+    known.push_back(&r);
+    posed.push_back({r.pose, r.directions.theta_i, std::move(first->value)});
+  }
+  const std::vector<uncertainty::PoseGradient> gradients =
+      uncertainty::EstimatePoseGradients(posed);
+  std::vector<std::pair<std::int64_t, uncertainty::ReadingBudget>> out;
+  for (std::size_t i = 0; i < known.size(); ++i) {
+    Result<uncertainty::ReadingBudget> budget =
+        Estimate(*known[i], known[i]->recorded_at, gradients[i]);
+    if (budget.ok()) out.emplace_back(known[i]->id, std::move(*budget));
+  }
+  return out;
 }
 
 }  // namespace brdf::daemon

@@ -1,19 +1,23 @@
-// Each sample reading's uncertainty budget, estimated as the executor commits it
-// (docs/uncertainty.md): the session's references and darks so far, the plan's averages and
-// white standard, and the configured terms go into core/uncertainty's EstimateReadingBudget. The
-// budget is of the BRDF. What a reading's commit cannot know yet stays "not estimated" in the
-// budget: the pose (no neighbouring readings yet) and, until the session has two references and
-// no rate is configured, the lamp drift.
+// Each sample reading's uncertainty budget (docs/uncertainty.md): estimated as the executor
+// commits the reading, from the session's references and darks so far, the plan's averages and
+// white standard, and the configured terms (core/uncertainty's EstimateReadingBudget), and
+// estimated again when the session's last step is done (EstimateSession), when the whole session
+// is known: the pose term through the gradient the neighbouring readings give
+// (core/uncertainty/pose_gradient.h) and the lamp drift between the reference before and after.
+// At commit the pose stays "not estimated" (no neighbours yet), and the lamp drift too until the
+// session has two references or a configured rate.
 #pragma once
 
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/spectrum.h"
 #include "core/status.h"
 #include "core/uncertainty/budget.h"
+#include "core/uncertainty/pose_gradient.h"
 #include "daemon/config/config.h"
 #include "storage/records.h"
 
@@ -46,9 +50,18 @@ class ReadingBudgeter {
   void Observe(const storage::ReadingRecord& reading, double time_s);
 
   // The budget of sample reading `sample` taken at `time_s`, or why it cannot be estimated (it
-  // names no reference or an unknown one, a band of the reference is dark, …).
-  Result<uncertainty::ReadingBudget> Estimate(const storage::ReadingRecord& sample,
-                                              double time_s) const;
+  // names no reference or an unknown one, a band of the reference is dark, …). pose_gradient:
+  // the reading's (pose_gradient.h); nullopt: the pose is not estimated.
+  Result<uncertainty::ReadingBudget> Estimate(
+      const storage::ReadingRecord& sample, double time_s,
+      std::optional<uncertainty::PoseGradient> pose_gradient = std::nullopt) const;
+
+  // The budgets of a finished session's sample readings (`samples`, each at its recorded_at),
+  // once every reference has been observed: each with its pose gradient from the others and
+  // the lamp drift between its reference and the next. (id, budget) for each sample whose budget
+  // can be estimated; one that cannot (see Estimate) is left out, its stored budget kept.
+  std::vector<std::pair<std::int64_t, uncertainty::ReadingBudget>> EstimateSession(
+      const std::vector<storage::ReadingRecord>& samples) const;
 
  private:
   struct Kept {

@@ -1,14 +1,19 @@
-// Each sample reading's uncertainty budget, estimated as the executor commits it
-// (daemon/engine/reading_budget.h): sessions on the fake rig store a budget with every sample --
-// shared through the reference, dark, white standard and instrument it really shares -- whose
-// white-standard term is the derived BRDF times u(ρw) / ρw; without settings they store none.
+// Each sample reading's uncertainty budget (daemon/engine/reading_budget.h): estimated as the
+// executor commits it (the pose not yet, the drift from the references so far) and again when the
+// session's last step is done, with the pose through the neighbouring readings and the drift to
+// the next reference. Sessions on the fake rig store a budget with every sample -- shared through
+// the reference, dark, white standard and instrument it really shares -- whose white-standard term
+// is the derived BRDF times u(ρw) / ρw; without settings they store none.
 #include "daemon/engine/reading_budget.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <string>
+#include <vector>
 
 #include "core/readings/derive.h"
 #include "daemon/wire/reading.h"
@@ -117,18 +122,79 @@ TEST(ReadingBudgetEngineTest, EverySampleIsStoredWithItsBudgetSharedWhereItIsSha
       EXPECT_GT(b.combined[band], std::abs(white->contribution[band]));
       EXPECT_GT(b.combined[band], b.independent[band]);
     }
-    // Committed without neighbours: the pose is not estimated; the lamp drift is once the
-    // session has a second reference (its first pair gives the rate).
-    bool pose_missing = false;
-    for (const std::string& why : b.not_estimated) pose_missing |= why.rfind("pose:", 0) == 0;
-    EXPECT_TRUE(pose_missing);
-    const bool second = references.size() >= 2;
-    EXPECT_EQ(Find(b, "lamp_drift") != nullptr, second) << "reading " << r.id;
-    with_drift += second ? 1 : 0;
+    // Estimated again at the session's end: the pose through the neighbours (here with zero
+    // uncertainty, so nothing is named missing), the lamp drift for every reading, the session
+    // having more than one reference.
+    EXPECT_NE(Find(b, "pose_repeatability"), nullptr) << "reading " << r.id;
+    EXPECT_TRUE(b.not_estimated.empty()) << "reading " << r.id << ": " << b.not_estimated[0];
+    with_drift += Find(b, "lamp_drift") != nullptr ? 1 : 0;
   }
   EXPECT_GT(samples, 0);
-  EXPECT_GT(with_drift, 0);
-  EXPECT_LT(with_drift, samples);
+  EXPECT_GE(references.size(), 2u);
+  EXPECT_EQ(with_drift, samples);
+}
+
+// As committed, a reading knows only the references before it and no neighbours: the pose is not
+// estimated, nor the drift before a second reference (or a configured rate).
+TEST(ReadingBudgetEngineTest, AtCommitThePoseAndAFirstIntervalsDriftAreNotEstimated) {
+  BudgetSession session(Settings(), plans::SmallRotation());
+  daemon::ReadingBudgeter budgeter(Settings(), session.id(), 0.99, std::nullopt, std::nullopt, 1);
+  int references = 0, checked = 0;
+  for (const storage::ReadingRecord& r : session.readings()) {
+    if (r.kind != ReadingKind::kSample) {
+      budgeter.Observe(r, r.recorded_at);
+      references += r.kind == ReadingKind::kReference ? 1 : 0;
+      continue;
+    }
+    Result<uncertainty::ReadingBudget> b = budgeter.Estimate(r, r.recorded_at);
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    bool pose_missing = false, drift_missing = false;
+    for (const std::string& why : b->not_estimated) {
+      pose_missing |= why.rfind("pose:", 0) == 0;
+      drift_missing |= why.rfind("lamp_drift:", 0) == 0;
+    }
+    EXPECT_TRUE(pose_missing);
+    EXPECT_EQ(drift_missing, references < 2) << "reading " << r.id;
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+}
+
+// With an uncertain stage, the session's end gives each sample its pose term along the axes its
+// neighbours span (α, β, δ on the rotation grid) and names the axes they do not (always γ).
+TEST(ReadingBudgetEngineTest, AtTheSessionsEndThePoseComesFromTheNeighbours) {
+  daemon::ReadingBudgetSettings settings = Settings();
+  settings.terms.stage.repeatability_deg = {0.1, 0.1, 0.1, 0.1};
+  BudgetSession session(settings, plans::SmallRotation());
+  int checked = 0;
+  std::map<std::string, int> estimated;
+  for (const storage::ReadingRecord& r : session.readings()) {
+    if (r.kind != ReadingKind::kSample) continue;
+    ASSERT_TRUE(r.uncertainty.has_value());
+    const uncertainty::Component* pose = Find(*r.uncertainty, "pose_repeatability");
+    ASSERT_NE(pose, nullptr) << "reading " << r.id;
+    double largest = 0;
+    for (double u : pose->contribution) largest = std::max(largest, std::abs(u));
+    EXPECT_GT(largest, 0) << "reading " << r.id;
+    std::map<std::string, int> missing;
+    for (const std::string& why : r.uncertainty->not_estimated) {
+      ++missing[why.substr(0, why.find(':'))];
+    }
+    EXPECT_EQ(missing.count("pose_gamma"), 1u) << "reading " << r.id;
+    for (const auto& [name, count] : missing) {
+      EXPECT_TRUE(name == "pose_alpha" || name == "pose_beta" || name == "pose_gamma" ||
+                  name == "pose_delta")
+          << "reading " << r.id << " misses " << name;
+    }
+    for (const char* axis : {"pose_alpha", "pose_beta", "pose_delta"}) {
+      estimated[axis] += missing.count(axis) == 0 ? 1 : 0;
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+  for (const char* axis : {"pose_alpha", "pose_beta", "pose_delta"}) {
+    EXPECT_GT(estimated[axis], 0) << axis << " was estimated for no reading";
+  }
 }
 
 // The API's Reading carries the stored budget: components with their sharing, the shared reading's

@@ -185,6 +185,46 @@ TEST(ReadingUncertaintyTest, TheTableRefusesBlobsOfTheWrongLength) {
   EXPECT_FALSE(quantity.ok());
 }
 
+// A finished session's budgets estimated again replace the stored ones, all or none.
+TEST(ReadingUncertaintyTest, BudgetsAreReplacedInOneTransactionAllOrNone) {
+  Fixture f;
+  ReadingRecord with = MakeReading(2, ReadingKind::kSample, kGrid);
+  with.reference_reading_id = 1;
+  with.uncertainty = MakeBudget();
+  auto first = f.store->CompleteStepWithReading(f.session, 2, with);
+  ASSERT_TRUE(first.ok()) << first.status().ToString();
+  ReadingRecord without = MakeReading(3, ReadingKind::kSample, kGrid);
+  auto second = f.store->CompleteStepWithReading(f.session, 3, without);
+  ASSERT_TRUE(second.ok());
+
+  ReadingBudget again = MakeBudget();
+  again.components.push_back(Component{"pose_repeatability", {}, {1e-6, 2e-6, 3e-6}});
+  again.not_estimated = {"pose_gamma: no neighbouring reading along gamma"};
+  // One bad entry (the reference, which takes no budget) and nothing changes.
+  Status refused = f.store->ReplaceReadingUncertainties(f.session, {{*first, again}, {1, again}});
+  EXPECT_EQ(refused.code(), StatusCode::kInvalidArgument) << refused.ToString();
+  EXPECT_THAT(refused.message(), HasSubstr("reading 1 is a reference reading"));
+  ExpectSameBudget(*f.store->GetReading(*first)->uncertainty, MakeBudget());
+  // A reading of another session (or none) is not found; nothing changes either.
+  refused = f.store->ReplaceReadingUncertainties(f.session, {{*first, again}, {999, again}});
+  EXPECT_EQ(refused.code(), StatusCode::kNotFound) << refused.ToString();
+  ExpectSameBudget(*f.store->GetReading(*first)->uncertainty, MakeBudget());
+  // A budget that does not fit its reading's grid: refused, nothing changes.
+  ReadingBudget short_one = again;
+  short_one.combined.pop_back();
+  refused = f.store->ReplaceReadingUncertainties(f.session, {{*first, short_one}});
+  EXPECT_EQ(refused.code(), StatusCode::kInvalidArgument) << refused.ToString();
+  ExpectSameBudget(*f.store->GetReading(*first)->uncertainty, MakeBudget());
+
+  // Both replaced: the one stored at commit and the one that had none.
+  ASSERT_TRUE(
+      f.store->ReplaceReadingUncertainties(f.session, {{*first, again}, {*second, again}}).ok());
+  ExpectSameBudget(*f.store->GetReading(*first)->uncertainty, again);
+  ExpectSameBudget(*f.store->GetReading(*second)->uncertainty, again);
+  EXPECT_EQ(f.store->ReplaceReadingUncertainties(f.session + 100, {}).code(),
+            StatusCode::kNotFound);
+}
+
 TEST(UncertaintyColumnsTest, RoundTripAndDamagedColumnsAreNamed) {
   auto columns = EncodeUncertainty(MakeBudget(), 3);
   ASSERT_TRUE(columns.ok()) << columns.status().ToString();
