@@ -237,7 +237,7 @@ struct TypedStream final : Stream {
   std::unique_ptr<grpc::ClientAsyncReader<Message>> reader;
   Message message;
   bool read = false;  // false: never read after the start
-  State state = kStarting;
+  std::atomic<State> state{kStarting};
 
   void Proceed(bool ok) override {
     switch (state) {
@@ -260,7 +260,15 @@ struct TypedStream final : Stream {
         return;
     }
   }
-  void Cancel() override { context.TryCancel(); }
+  // Ends the stream; one never read is finished here, so that how it ended (a refusal by the
+  // memory budget or a stream cap: RESOURCE_EXHAUSTED) is counted as for the others.
+  void Cancel() override {
+    if (!read) {  // Finish first: after TryCancel the status would be CANCELLED
+      state = kFinishing;
+      reader->Finish(&status, this);
+    }
+    context.TryCancel();
+  }
 };
 
 template <class Message, class Request, class Prepare>

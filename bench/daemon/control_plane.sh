@@ -13,7 +13,8 @@
 # 10,000-reading session (bench_storage) for the data calls and a paused session (started, then
 # paused at its first prompt) for the verbs.
 # Usage: bench/daemon/control_plane.sh [BUILD_DIR] (default: build-bench; builds what it needs
-# unless BENCH_NO_BUILD=1). BENCH_STREAMS (default 1000), BENCH_KEEP=1 keeps the logs.
+# unless BENCH_NO_BUILD=1). BENCH_STREAMS (default 1000), BENCH_MEMORY_BUDGET_MB ([server]
+# memory_budget_mb; default the daemon's), BENCH_KEEP=1 keeps the logs.
 set -euo pipefail
 
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -48,7 +49,8 @@ pr650="$(awk '$1 == "pr650" { print $2 }' "$work/sim.out")"
 # One analyst token holds all the streams: the per-token cap is raised to let it.
 write_config "$work/bench.db" "$pr650" "$modbus" "max_streams_per_token = $((streams + 24))
 max_streams_analyst = $((streams + 24))
-stream_stall_timeout_s = 600" >"$work/brdfd.toml"
+stream_stall_timeout_s = 600${BENCH_MEMORY_BUDGET_MB:+
+memory_budget_mb = $BENCH_MEMORY_BUDGET_MB}" >"$work/brdfd.toml"
 "$brdfd" --config "$work/brdfd.toml" >"$work/brdfd.out" 2>"$work/brdfd.log" </dev/null &
 brdfd_pid=$!
 pids+=("$brdfd_pid")
