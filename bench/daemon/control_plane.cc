@@ -6,7 +6,12 @@
 // (loaded ÷ idle; issue 40's goal: ≤ 3 for the medians, ≤ 5 for the p99s), failed control calls,
 // and how the streams fared (opened, refused by a cap).
 //
-// The analysts' client threads run at nice 10, the operator's (the measuring thread) at 0.
+// The operator's client runs in a process of its own (forked before any channel exists), as
+// brdfctl or the web console do in the lab: in the analysts' process its calls would share gRPC's
+// pollers with their 1,000 streams and 8 Interpolate threads, and measure that process's own
+// queue (GetRigStatus 5-7x idle that way, 1.3x from its own process, brdfd alike). With
+// --operator-in-load-process it measures from the analysts' process as before. The analysts'
+// client threads run at nice 10, the operator's at 0.
 //
 // The session given by --pause-session must be PAUSED: each PauseSession is then a real call of
 // the verb that answers "already paused" (a control call that changes nothing, so it can be
@@ -14,6 +19,7 @@
 #include <grpcpp/grpcpp.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -21,6 +27,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <thread>
@@ -41,6 +48,7 @@ struct Options {
   int streams = 1000;
   int interpolate_clients = 8;
   int calls = 200;  // control calls per phase (half PauseSession, half GetRigStatus)
+  bool operator_in_load_process = false;
 };
 
 std::unique_ptr<grpc::ClientContext> Context(const std::string& token, std::chrono::seconds d) {
@@ -118,6 +126,100 @@ ControlFigures MeasureControl(const Options& o, brdf::v1::Control::Stub& control
   return f;
 }
 
+// The operator's client in a process of its own: each byte its parent writes asks for one
+// MeasureControl, whose figures come back over the other pipe.
+class OperatorProcess {
+ public:
+  // Forks before the caller makes any gRPC channel (gRPC does not survive a fork).
+  explicit OperatorProcess(const Options& o) {
+    int ask[2], answer[2];
+    if (::pipe(ask) != 0 || ::pipe(answer) != 0) Die("pipe");
+    pid_ = ::fork();
+    if (pid_ < 0) Die("fork");
+    if (pid_ == 0) {
+      ::close(ask[1]);
+      ::close(answer[0]);
+      Serve(o, ask[0], answer[1]);
+      std::_Exit(0);
+    }
+    ::close(ask[0]);
+    ::close(answer[1]);
+    ask_ = ask[1];
+    answer_ = answer[0];
+  }
+  ~OperatorProcess() {
+    ::close(ask_);
+    ::close(answer_);
+    (void)::waitpid(pid_, nullptr, 0);
+  }
+  ControlFigures Measure() {
+    const char go = 'm';
+    WriteAll(ask_, &go, 1);
+    ControlFigures f;
+    f.pause_ms = ReadSeries(answer_);
+    f.status_ms = ReadSeries(answer_);
+    ReadAll(answer_, &f.failed, sizeof f.failed);
+    std::size_t n = 0;
+    ReadAll(answer_, &n, sizeof n);
+    f.first_failure.resize(n);
+    ReadAll(answer_, f.first_failure.data(), n);
+    return f;
+  }
+
+ private:
+  static void Die(const char* what) {
+    std::perror(what);
+    std::exit(2);
+  }
+  static void WriteAll(int fd, const void* data, std::size_t n) {
+    const char* p = static_cast<const char*>(data);
+    while (n > 0) {
+      const ssize_t w = ::write(fd, p, n);
+      if (w <= 0) Die("operator pipe (write)");
+      p += w;
+      n -= static_cast<std::size_t>(w);
+    }
+  }
+  static void ReadAll(int fd, void* data, std::size_t n) {
+    char* p = static_cast<char*>(data);
+    while (n > 0) {
+      const ssize_t r = ::read(fd, p, n);
+      if (r <= 0) Die("operator pipe (read)");
+      p += r;
+      n -= static_cast<std::size_t>(r);
+    }
+  }
+  static std::vector<double> ReadSeries(int fd) {
+    std::size_t n = 0;
+    ReadAll(fd, &n, sizeof n);
+    std::vector<double> v(n);
+    ReadAll(fd, v.data(), n * sizeof(double));
+    return v;
+  }
+  static void WriteSeries(int fd, const std::vector<double>& v) {
+    const std::size_t n = v.size();
+    WriteAll(fd, &n, sizeof n);
+    WriteAll(fd, v.data(), n * sizeof(double));
+  }
+  static void Serve(const Options& o, int ask, int answer) {
+    auto control = brdf::v1::Control::NewStub(NewChannel(o.address, 0));
+    char go = 0;
+    while (::read(ask, &go, 1) == 1) {
+      const ControlFigures f = MeasureControl(o, *control);
+      WriteSeries(answer, f.pause_ms);
+      WriteSeries(answer, f.status_ms);
+      WriteAll(answer, &f.failed, sizeof f.failed);
+      const std::size_t n = f.first_failure.size();
+      WriteAll(answer, &n, sizeof n);
+      WriteAll(answer, f.first_failure.data(), n);
+    }
+  }
+
+  pid_t pid_ = -1;
+  int ask_ = -1;
+  int answer_ = -1;
+};
+
 // One analyst stream on the streams' completion queue.
 struct Stream {
   virtual ~Stream() = default;
@@ -135,7 +237,7 @@ struct TypedStream final : Stream {
   std::unique_ptr<grpc::ClientAsyncReader<Message>> reader;
   Message message;
   bool read = false;  // false: never read after the start
-  State state = kStarting;
+  std::atomic<State> state{kStarting};
 
   void Proceed(bool ok) override {
     switch (state) {
@@ -158,7 +260,15 @@ struct TypedStream final : Stream {
         return;
     }
   }
-  void Cancel() override { context.TryCancel(); }
+  // Ends the stream; one never read is finished here, so that how it ended (a refusal by the
+  // memory budget or a stream cap: RESOURCE_EXHAUSTED) is counted as for the others.
+  void Cancel() override {
+    if (!read) {  // Finish first: after TryCancel the status would be CANCELLED
+      state = kFinishing;
+      reader->Finish(&status, this);
+    }
+    context.TryCancel();
+  }
 };
 
 template <class Message, class Request, class Prepare>
@@ -185,13 +295,25 @@ int main(int argc, char** argv) {
   app.add_option("--streams", o.streams);
   app.add_option("--interpolate-clients", o.interpolate_clients);
   app.add_option("--calls", o.calls);
+  app.add_flag("--operator-in-load-process", o.operator_in_load_process,
+               "measure the control calls from the analysts' process (shares its gRPC pollers)");
   CLI11_PARSE(app, argc, argv);
   using namespace brdf::v1;
 
-  auto control = Control::NewStub(NewChannel(o.address, 0));
+  // The operator's calls: from its own process (forked first) or from this one.
+  std::unique_ptr<OperatorProcess> operator_process;
+  std::unique_ptr<Control::Stub> control;
+  if (o.operator_in_load_process) {
+    control = Control::NewStub(NewChannel(o.address, 0));
+  } else {
+    operator_process = std::make_unique<OperatorProcess>(o);
+  }
+  auto measure = [&] {
+    return operator_process ? operator_process->Measure() : MeasureControl(o, *control);
+  };
   // Warm-up, then the idle daemon.
-  (void)MeasureControl(Options{o}, *control);
-  const ControlFigures idle = MeasureControl(o, *control);
+  (void)measure();
+  const ControlFigures idle = measure();
 
   // The streams, over 8 connections (gRPC caps concurrent streams per connection at 100 by
   // default on the client side: 1,000 streams need ≥ 10 connections; 16 to be safe).
@@ -283,7 +405,7 @@ int main(int argc, char** argv) {
   }
   std::this_thread::sleep_for(std::chrono::seconds(1));
   const auto loaded_begin = Clock::now();
-  const ControlFigures loaded = MeasureControl(o, *control);
+  const ControlFigures loaded = measure();
   const double loaded_s = std::chrono::duration<double>(Clock::now() - loaded_begin).count();
   const long interpolated = interpolations.load();
   stop = true;
@@ -312,14 +434,15 @@ int main(int argc, char** argv) {
       "idle_pause_p50_ms=%.3f idle_pause_p99_ms=%.3f idle_status_p50_ms=%.3f "
       "idle_status_p99_ms=%.3f loaded_pause_p50_ms=%.3f loaded_pause_p99_ms=%.3f "
       "loaded_status_p50_ms=%.3f loaded_status_p99_ms=%.3f pause_ratio=%.2f status_ratio=%.2f "
-      "pause_p99_ratio=%.2f status_p99_ratio=%.2f control_failed=%d%s%s\n",
+      "pause_p99_ratio=%.2f status_p99_ratio=%.2f control_failed=%d operator=%s%s%s\n",
       o.streams, kinds[0], kinds[1], kinds[2], kinds[3], first_read, refused, o.interpolate_clients,
       static_cast<double>(interpolated) / loaded_s, interpolate_failures.load(), ip50,
       Quantile(idle.pause_ms, 0.99), is50, Quantile(idle.status_ms, 0.99), lp50,
       Quantile(loaded.pause_ms, 0.99), ls50, Quantile(loaded.status_ms, 0.99),
       ip50 > 0 ? lp50 / ip50 : 0, is50 > 0 ? ls50 / is50 : 0,
       Ratio(loaded.pause_ms, idle.pause_ms, 0.99), Ratio(loaded.status_ms, idle.status_ms, 0.99),
-      idle.failed + loaded.failed, idle.failed + loaded.failed > 0 ? " first_failure=" : "",
+      idle.failed + loaded.failed, o.operator_in_load_process ? "load-process" : "own-process",
+      idle.failed + loaded.failed > 0 ? " first_failure=" : "",
       (idle.first_failure + loaded.first_failure).c_str());
   if (refused > 0) std::fprintf(stderr, "a refused stream: %s\n", refusal.c_str());
   return idle.failed + loaded.failed == 0 ? 0 : 1;

@@ -1,14 +1,20 @@
 #!/usr/bin/env bash
-# The control plane under analyst load (issue 20): PauseSession and GetRigStatus latency on an idle
-# brdfd, then with 1,000 analyst streams open (400 WatchSession and 300 StreamReadings read as
-# they come, 200 InterpolateBatch and 100 Export never read) and 8 clients calling Interpolate,
-# in the same run; prints bench_control_plane's line (ratios loaded ÷ idle; goal p50 ≤ 3× and
-# p99 ≤ 5×, no control call failed; the analysts' client threads run at nice 10, the operator's
-# at 0) and brdfd's VmRSS: idle, at its peak, and BENCH_SETTLE_S (60) after the streams ended
-# (goal: at most 200 MB over idle at the peak, within 50 MB of idle after a minute). The daemon
-# runs against brdf-sim with a 10,000-reading session (bench_storage) for the data calls and a
-# paused session (started, then paused at its first prompt) for the verbs. Usage: bench/daemon/control_plane.sh [BUILD_DIR] (default: build-bench; builds what it
-# needs unless BENCH_NO_BUILD=1). BENCH_STREAMS (default 1000), BENCH_KEEP=1 keeps the logs.
+# The control plane under analyst load (issues 20, 40): PauseSession and GetRigStatus latency on
+# an idle brdfd, then with 1,000 analyst streams open (400 WatchSession and 300 StreamReadings read
+# as they come, 200 InterpolateBatch and 100 Export never read) and 8 clients calling Interpolate,
+# in the same run. Prints one line of key=value figures (bench_control_plane's): the ratios
+# loaded ÷ idle (goal: pause_ratio and status_ratio ≤ 3, pause_p99_ratio and status_p99_ratio ≤ 5,
+# control_failed=0) and brdfd's VmRSS: idle, at its peak, and BENCH_SETTLE_S (60) after the
+# streams ended (goal: rss_growth_mb ≤ 200, rss_left_mb ≤ 50), with the load average at start and
+# end (the machine's other work shows there: compare runs by their ratios, not their times).
+# The operator's calls come from a process of their own at nice 0, as brdfctl's do; the analysts'
+# client threads run at nice 10 (BENCH_OPERATOR_IN_LOAD_PROCESS=1: the operator's calls from the
+# analysts' process, as before 2026-12-06). The daemon runs against brdf-sim with a
+# 10,000-reading session (bench_storage) for the data calls and a paused session (started, then
+# paused at its first prompt) for the verbs.
+# Usage: bench/daemon/control_plane.sh [BUILD_DIR] (default: build-bench; builds what it needs
+# unless BENCH_NO_BUILD=1). BENCH_STREAMS (default 1000), BENCH_MEMORY_BUDGET_MB ([server]
+# memory_budget_mb; default the daemon's), BENCH_KEEP=1 keeps the logs.
 set -euo pipefail
 
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -43,7 +49,8 @@ pr650="$(awk '$1 == "pr650" { print $2 }' "$work/sim.out")"
 # One analyst token holds all the streams: the per-token cap is raised to let it.
 write_config "$work/bench.db" "$pr650" "$modbus" "max_streams_per_token = $((streams + 24))
 max_streams_analyst = $((streams + 24))
-stream_stall_timeout_s = 600" >"$work/brdfd.toml"
+stream_stall_timeout_s = 600${BENCH_MEMORY_BUDGET_MB:+
+memory_budget_mb = $BENCH_MEMORY_BUDGET_MB}" >"$work/brdfd.toml"
 "$brdfd" --config "$work/brdfd.toml" >"$work/brdfd.out" 2>"$work/brdfd.log" </dev/null &
 brdfd_pid=$!
 pids+=("$brdfd_pid")
@@ -78,7 +85,7 @@ sampler=$!
 pids+=("$sampler")
 line="$("$bin/bench_control_plane" --address "$address" --operator-token "$operator_token" \
   --analyst-token "$analyst_token" --pause-session "$paused" --data-session 1 \
-  --streams "$streams")" || rc=$?
+  --streams "$streams" ${BENCH_OPERATOR_IN_LOAD_PROCESS:+--operator-in-load-process})" || rc=$?
 rss_ended_kb="$(rss_kb "$brdfd_pid")"
 settle="${BENCH_SETTLE_S:-60}"
 sleep "$settle"

@@ -50,7 +50,7 @@ StreamRegistry::StreamRegistry(const ServerConfig& config, bool tokens_configure
       per_token_(tokens_configured),
       stall_timeout_(std::chrono::seconds(config.stream_stall_timeout_s)),
       budget_(config.memory_budget_mb),
-      work_permits_(static_cast<int>(std::max(1U, std::thread::hardware_concurrency() / 2))) {
+      work_(static_cast<int>(std::max(1U, std::thread::hardware_concurrency() / 2))) {
   watchdog_ = std::thread([this] { Watchdog(); });
 }
 
@@ -111,42 +111,7 @@ grpc::Status StreamRegistry::Open(grpc::ServerContextBase& context, const Caller
 }
 
 bool StreamRegistry::AcquireWork(const grpc::ServerContextBase& context, const std::string& token) {
-  MutexLock lock(work_mu_);
-  ++work_waiting_[token];
-  // A free permit goes to the token holding the fewest among those waiting for one.
-  auto my_turn = [&]() REQUIRES(work_mu_) {
-    if (working_ >= work_permits_) return false;
-    const auto mine = work_held_.find(token);
-    const int held = mine == work_held_.end() ? 0 : mine->second;
-    for (const auto& [other, waiting] : work_waiting_) {
-      const auto theirs = work_held_.find(other);
-      if (other != token && (theirs == work_held_.end() ? 0 : theirs->second) < held) return false;
-    }
-    return true;
-  };
-  bool got = true;
-  while (!my_turn()) {
-    // The synchronous API has no wake-up for a cancelled call: look now and then.
-    if (context.IsCancelled()) {
-      got = false;
-      break;
-    }
-    work_cv_.WaitFor(work_mu_, std::chrono::milliseconds(100));
-  }
-  if (--work_waiting_[token] == 0) work_waiting_.erase(token);
-  if (!got) return false;
-  ++working_;
-  ++work_held_[token];
-  return true;
-}
-
-void StreamRegistry::ReleaseWork(const std::string& token) {
-  {
-    MutexLock lock(work_mu_);
-    --working_;
-    if (--work_held_[token] <= 0) work_held_.erase(token);
-  }
-  work_cv_.NotifyAll();
+  return work_.Acquire(token, [&context] { return context.IsCancelled(); });
 }
 
 void StreamRegistry::Release(std::uint64_t id) {
@@ -201,7 +166,7 @@ StreamRegistry::Slot::~Slot() {
 }
 
 void StreamRegistry::Slot::Close() {
-  if (holding_) registry_->ReleaseWork(entry_->token);
+  if (holding_) registry_->work_.Release(entry_->token);
   holding_ = false;
 }
 

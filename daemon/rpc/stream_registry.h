@@ -12,9 +12,9 @@
 // Bounded work: a stream that computes what it sends (Export, InterpolateBatch: opened with
 // `computes`; RenderAppearance takes one with Slot::Work once it knows it must render) works only
 // while it holds one of a few work permits (one per two cores), and gives its permit back while a
-// write waits for the client. Permits are shared fairly between tokens: a free one goes to the
-// waiting token that holds the fewest, so one analyst's hundred exports do not keep another's one
-// waiting behind them. A thousand exports then take turns on the
+// write waits for the client. Permits are shared fairly between tokens (work_permits.h): a free
+// one goes to the waiting token that holds the fewest, so one analyst's hundred exports do not
+// keep another's one waiting behind them. A thousand exports then take turns on the
 // cores instead of all running at once. Every stream's thread runs at nice 10 while the stream is
 // open (back to 0 after), below the control plane's threads and Interpolate's loop, which get a
 // core when they need one.
@@ -46,6 +46,7 @@
 #include "daemon/config/config.h"
 #include "daemon/rpc/auth.h"
 #include "daemon/rpc/memory_budget.h"
+#include "daemon/rpc/work_permits.h"
 
 namespace brdf::daemon {
 
@@ -115,7 +116,7 @@ class StreamRegistry {
   MemoryBudget& budget() { return budget_; }
 
   // Work permits: one per two cores, at least one.
-  int work_permits() const { return work_permits_; }
+  int work_permits() const { return work_.permits(); }
 
   // Streams open now, and streams cancelled for not reading since the start.
   int open() const;
@@ -124,10 +125,8 @@ class StreamRegistry {
  private:
   void Release(std::uint64_t id);
   // Waits for a work permit for a stream of `token` ("": without a token); false: `context` was
-  // cancelled meanwhile. A free permit goes to the waiting token that holds the fewest. Gives one
-  // back.
+  // cancelled meanwhile.
   bool AcquireWork(const grpc::ServerContextBase& context, const std::string& token);
-  void ReleaseWork(const std::string& token);
   void Watchdog();
 
   const ServerConfig limits_;
@@ -145,12 +144,7 @@ class StreamRegistry {
   int unauthenticated_open_ GUARDED_BY(mu_) = 0;
   std::atomic<std::uint64_t> stalled_{0};
   MemoryBudget budget_;
-  const int work_permits_;
-  Mutex work_mu_;
-  CondVar work_cv_;
-  int working_ GUARDED_BY(work_mu_) = 0;
-  std::map<std::string, int> work_held_ GUARDED_BY(work_mu_);     // permits held, per token
-  std::map<std::string, int> work_waiting_ GUARDED_BY(work_mu_);  // streams waiting, per token
+  WorkPermits work_;
   std::thread watchdog_;
 };
 
