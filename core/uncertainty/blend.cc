@@ -16,11 +16,10 @@ struct Blended {
   const ReadingBudget* budget = nullptr;
 };
 
-// A shared input: Σ wᵢ uⱼ,ᵢ per band over the vertices that share it.
+// A shared input (name, sharing, id); its Σ wᵢ uⱼ,ᵢ per band is row `row` of the sums.
 struct SharedInput {
   const std::string* name = nullptr;
   SharedThrough through;
-  std::vector<double> sum;
 };
 
 Result<std::vector<Blended>> MergeByReading(std::span<const BlendVertex> vertices) {
@@ -43,7 +42,7 @@ Result<std::vector<Blended>> MergeByReading(std::span<const BlendVertex> vertice
 }
 
 Status CheckBands(const Blended& b, std::size_t bands) {
-  bool fits = b.budget->combined.size() == bands;
+  bool fits = b.budget->combined.size() == bands && b.budget->independent.size() == bands;
   for (const Component& c : b.budget->components) fits = fits && c.contribution.size() == bands;
   if (fits) return Status::Ok();
   return InvalidArgument("reading " + std::to_string(b.reading_id) +
@@ -55,27 +54,33 @@ void AddNotEstimated(std::vector<std::string>& list, const std::string& entry) {
   if (std::find(list.begin(), list.end(), entry) == list.end()) list.push_back(entry);
 }
 
-// Adds one reading's weighted components: independent ones squared into `independent`, shared
-// ones linearly into their input's sum.
+// row[k] += w · u[k] for k < n (restrict: the compiler keeps w in a register).
+void AddScaled(double* __restrict row, const double* __restrict u, double w, std::size_t n) {
+  for (std::size_t k = 0; k < n; ++k) row[k] += w * u[k];
+}
+
+// Adds one reading: its independent part (the budget's, sqrt(Σ independent uⱼ²)) squared and
+// weighted into `independent`, its shared components linearly into their input's row of `sums`
+// (inputs.size() rows of `bands` values).
 void AddReading(const Blended& b, std::vector<double>& independent,
-                std::vector<SharedInput>& inputs) {
+                std::vector<SharedInput>& inputs, std::vector<double>& sums) {
   const std::size_t bands = independent.size();
+  const double w = b.weight;
+  const double w2 = w * w;
+  const double* ind = b.budget->independent.data();
+  for (std::size_t k = 0; k < bands; ++k) independent[k] += w2 * ind[k] * ind[k];
   for (const Component& c : b.budget->components) {
-    if (c.shared.kind == Sharing::kIndependent) {
-      for (std::size_t k = 0; k < bands; ++k) {
-        const double u = b.weight * c.contribution[k];
-        independent[k] += u * u;
-      }
-      continue;
-    }
+    if (c.shared.kind == Sharing::kIndependent) continue;
     auto input = std::find_if(inputs.begin(), inputs.end(), [&](const SharedInput& s) {
       return s.through == c.shared && *s.name == c.name;
     });
     if (input == inputs.end()) {
-      inputs.push_back(SharedInput{&c.name, c.shared, std::vector<double>(bands, 0.0)});
+      inputs.push_back(SharedInput{&c.name, c.shared});
+      sums.resize(sums.size() + bands, 0.0);
       input = inputs.end() - 1;
     }
-    for (std::size_t k = 0; k < bands; ++k) input->sum[k] += b.weight * c.contribution[k];
+    AddScaled(sums.data() + static_cast<std::size_t>(input - inputs.begin()) * bands,
+              c.contribution.data(), w, bands);
   }
 }
 
@@ -89,6 +94,9 @@ Result<BlendedUncertainty> BlendMeasurementUncertainty(std::span<const BlendVert
   BlendedUncertainty out;
   std::vector<double> independent(n, 0.0);
   std::vector<SharedInput> inputs;
+  std::vector<double> sums;
+  inputs.reserve(16);
+  sums.reserve(16 * n);
   for (const Blended& b : readings) {
     if (b.budget == nullptr) {
       AddNotEstimated(out.not_estimated, "reading " + std::to_string(b.reading_id) +
@@ -99,15 +107,19 @@ Result<BlendedUncertainty> BlendMeasurementUncertainty(std::span<const BlendVert
     for (const std::string& entry : b.budget->not_estimated) {
       AddNotEstimated(out.not_estimated, entry);
     }
-    AddReading(b, independent, inputs);
+    AddReading(b, independent, inputs, sums);
   }
-  out.shared.assign(n, 0.0);
-  out.measurement.assign(n, 0.0);
+  // Σ over inputs of their squared sums, accumulated row by row into `shared2`.
+  std::vector<double>& shared2 = out.shared;
+  shared2.assign(n, 0.0);
+  for (std::size_t row = 0; row < inputs.size(); ++row) {
+    const double* sum = sums.data() + row * n;
+    for (std::size_t k = 0; k < n; ++k) shared2[k] += sum[k] * sum[k];
+  }
+  out.measurement.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
-    double shared2 = 0;
-    for (const SharedInput& s : inputs) shared2 += s.sum[k] * s.sum[k];
-    out.shared[k] = std::sqrt(shared2);
-    out.measurement[k] = std::sqrt(shared2 + independent[k]);
+    out.measurement[k] = std::sqrt(shared2[k] + independent[k]);
+    shared2[k] = std::sqrt(shared2[k]);
   }
   return out;
 }

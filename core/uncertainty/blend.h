@@ -43,8 +43,10 @@ struct BlendedUncertainty {
 };
 
 // The blend's measurement uncertainty over `bands` bands. Errors (kInvalidArgument, naming the
-// reading): a non-finite weight, a budget whose components or combined do not have `bands`
-// values, bands < 1. No vertex with a budget gives zeros with every vertex named as not estimated.
+// reading): a non-finite weight, a budget whose components, combined or independent do not have
+// `bands` values, bands < 1. A budget's independent part is taken as it is stored (sqrt of its
+// independent components' squares, budget.h). No vertex with a budget gives zeros with every vertex
+// named as not estimated.
 Result<BlendedUncertainty> BlendMeasurementUncertainty(std::span<const BlendVertex> vertices,
                                                        int bands);
 

@@ -1,5 +1,7 @@
 #include "daemon/api/interpolation_uncertainty.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <span>
 #include <string>
@@ -10,6 +12,21 @@
 namespace brdf::daemon {
 namespace {
 
+// Room for an answer's vertices without allocating (octant: 4 or 5; Delaunay: dims + 1); a
+// larger answer goes to the heap.
+constexpr std::size_t kInline = 8;
+
+template <typename T>
+struct Scratch {
+  std::array<T, kInline> inline_items{};
+  std::vector<T> heap;
+  std::span<T> Take(std::size_t n) {
+    if (n <= kInline) return {inline_items.data(), n};
+    heap.resize(n);
+    return heap;
+  }
+};
+
 // The measurement part into `u`; false (with the reason in not_estimated) when there is none.
 bool AddMeasurement(const interp::Interpolation& answer, const IndexSnapshot& index,
                     v1::InterpolationUncertainty* u) {
@@ -19,10 +36,11 @@ bool AddMeasurement(const interp::Interpolation& answer, const IndexSnapshot& in
                          QuantityName(index.quantity) + "; ask for quantity BRDF");
     return false;
   }
-  std::vector<uncertainty::BlendVertex> vertices;
-  vertices.reserve(answer.vertices.size());
-  for (const interp::Vertex& v : answer.vertices) {
-    vertices.push_back({v.id, v.weight, index.budgets.at(v.index)});
+  Scratch<uncertainty::BlendVertex> scratch;
+  const std::span<uncertainty::BlendVertex> vertices = scratch.Take(answer.vertices.size());
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    const interp::Vertex& v = answer.vertices[i];
+    vertices[i] = {v.id, v.weight, index.budgets.at(v.index)};
   }
   Result<uncertainty::BlendedUncertainty> blended =
       uncertainty::BlendMeasurementUncertainty(vertices, index.grid.count);
@@ -45,13 +63,13 @@ bool AddInterpolation(const interp::Interpolation& answer, const IndexSnapshot& 
         "octant or delaunay for an estimate");
     return false;
   }
-  std::vector<double> weights;
-  std::vector<std::span<const double>> spectra;
-  weights.reserve(answer.vertices.size());
-  spectra.reserve(answer.vertices.size());
-  for (const interp::Vertex& v : answer.vertices) {
-    weights.push_back(v.weight);
-    spectra.push_back(index.samples->spectrum(v.index));
+  Scratch<double> weight_scratch;
+  Scratch<std::span<const double>> spectrum_scratch;
+  const std::span<double> weights = weight_scratch.Take(answer.vertices.size());
+  const std::span<std::span<const double>> spectra = spectrum_scratch.Take(weights.size());
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    weights[i] = answer.vertices[i].weight;
+    spectra[i] = index.samples->spectrum(answer.vertices[i].index);
   }
   const std::vector<double> spread =
       uncertainty::InterpolationSpread(weights, spectra, answer.spectrum);
@@ -67,12 +85,13 @@ void AddInterpolationUncertainty(const interp::Interpolation& answer, const Inde
   v1::InterpolationUncertainty* u = out->mutable_uncertainty();
   const bool measured = AddMeasurement(answer, index, u);
   const bool interpolated = AddInterpolation(answer, index, u);
-  const std::size_t bands = answer.spectrum.size();
-  u->mutable_combined()->Reserve(static_cast<int>(bands));
-  for (std::size_t k = 0; k < bands; ++k) {
-    const double m = measured ? u->measurement(static_cast<int>(k)) : 0.0;
-    const double i = interpolated ? u->interpolation(static_cast<int>(k)) : 0.0;
-    u->add_combined(std::hypot(m, i));
+  const int bands = static_cast<int>(answer.spectrum.size());
+  google::protobuf::RepeatedField<double>* combined = u->mutable_combined();
+  combined->Resize(bands, 0.0);
+  for (int k = 0; k < bands; ++k) {
+    const double m = measured && k < u->measurement_size() ? u->measurement(k) : 0.0;
+    const double i = interpolated && k < u->interpolation_size() ? u->interpolation(k) : 0.0;
+    combined->Set(k, std::sqrt(m * m + i * i));
   }
 }
 
