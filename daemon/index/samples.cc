@@ -52,10 +52,12 @@ void IndexSamples::Add(Quantity q, const storage::ReadingRecord& record,
     return;
   }
   if (q == Quantity::kBrdf) {
+    // Only a budget of the BRDF blends with the BRDF; any other counts as not estimated.
+    const bool of_brdf =
+        record.uncertainty.has_value() && record.uncertainty->quantity == Quantity::kBrdf;
     working_.brdf_budgets.Add(
-        record.uncertainty.has_value()
-            ? std::make_shared<const uncertainty::ReadingBudget>(*record.uncertainty)
-            : nullptr);
+        of_brdf ? std::make_shared<const uncertainty::ReadingBudget>(*record.uncertainty)
+                : nullptr);
   }
 }
 
