@@ -32,6 +32,9 @@ inline constexpr int kMaxBatchDirections = 100000;
 // 101 bands with provenance are ~1.2 MB, well under a client's default 4 MiB receive limit).
 inline constexpr std::uint32_t kDefaultChunkSize = 256;
 inline constexpr std::uint32_t kMaxChunkSize = 1024;
+// With include_uncertainty a result carries four more spectra (~4.5 kB a result): at most 512
+// (~2.3 MB) per chunk.
+inline constexpr std::uint32_t kMaxUncertainChunkSize = 512;
 // Free texts (abort reason, prompt note) are stored in the audit log; longer ones are refused.
 inline constexpr std::size_t kMaxNoteBytes = 4096;
 // A session id is a positive decimal number of at most 18 digits; ids and page tokens longer than

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/geometry.h"
+#include "daemon/api/interpolation_uncertainty.h"
 #include "daemon/index/build.h"
 #include "daemon/wire/enums.h"
 #include "daemon/wire/values.h"
@@ -117,12 +118,15 @@ grpc::Status ToCoords(const v1::DirectionQuery& q, const IndexSnapshot& index,
 
 // Whether each vertex carries its sample's spectrum (InterpolateRequest.include_vertex_spectra).
 enum class VertexSpectra { kOmit, kInclude };
+// Whether the answer carries its uncertainty (include_uncertainty).
+enum class WithUncertainty { kOmit, kInclude };
 
 // One answer as the API gives it.
 void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const Settings& settings,
               const IndexSnapshot& index, VertexSpectra vertex_spectra,
-              v1::InterpolationResult* out) {
+              WithUncertainty with_uncertainty, v1::InterpolationResult* out) {
   *out->mutable_query() = query;
+  if (with_uncertainty == WithUncertainty::kInclude) AddInterpolationUncertainty(r, index, out);
   out->set_status(ToProtoInterpStatus(r.status));
   out->set_method(ToProtoMethod(r.method));
   out->set_quantity(ToProtoQuantity(settings.quantity));
@@ -150,11 +154,11 @@ void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const 
 
 void Evaluate(const v1::DirectionQuery& query, const std::array<double, 4>& coords,
               const Settings& settings, const IndexSnapshot& index, VertexSpectra vertex_spectra,
-              v1::InterpolationResult* out) {
+              WithUncertainty with_uncertainty, v1::InterpolationResult* out) {
   ToResult(query,
            index.interpolator->Evaluate(
                std::span<const double>(coords.data(), static_cast<std::size_t>(index.dims))),
-           settings, index, vertex_spectra, out);
+           settings, index, vertex_spectra, with_uncertainty, out);
 }
 
 grpc::Status SessionOf(const std::string& text, SessionId* id) {
@@ -231,6 +235,7 @@ std::optional<grpc::Status> InterpolationService::Respond(const v1::InterpolateR
   }
   Evaluate(request.direction(), coords, settings, *index,
            request.include_vertex_spectra() ? VertexSpectra::kInclude : VertexSpectra::kOmit,
+           request.include_uncertainty() ? WithUncertainty::kInclude : WithUncertainty::kOmit,
            response->mutable_result());
   return grpc::Status::OK;
 }
@@ -264,6 +269,12 @@ grpc::Status CheckBatch(const v1::InterpolateBatchRequest& request, SessionId* i
                                           " results per chunk; at most " +
                                           std::to_string(kMaxChunkSize) +
                                           " (0: " + std::to_string(kDefaultChunkSize) + ")");
+  }
+  if (request.include_uncertainty() && request.chunk_size() > kMaxUncertainChunkSize) {
+    return InvalidField("chunk_size", std::to_string(request.chunk_size()) +
+                                          " results per chunk with include_uncertainty; at most " +
+                                          std::to_string(kMaxUncertainChunkSize) +
+                                          " (each result carries four more spectra)");
   }
   *chunk = static_cast<int>(request.chunk_size() == 0 ? kDefaultChunkSize : request.chunk_size());
   for (int i = 0; i < n; ++i) {
@@ -321,7 +332,9 @@ constexpr int kSliceChunks = 4;
 std::uint64_t BatchBytes(const v1::InterpolateBatchRequest& request, int chunk) {
   const auto n = static_cast<std::uint64_t>(request.directions_size());
   const std::uint64_t slice = std::min<std::uint64_t>(n, std::uint64_t{kSliceChunks} * chunk);
-  return 3 * request.ByteSizeLong() + slice * (200 + 1200) + 2ULL * chunk * 1200;
+  // With uncertainty: four more spectra per answer (~3.3 kB on the PR-650's grid).
+  const std::uint64_t answer = request.include_uncertainty() ? 1200 + 3300 : 1200;
+  return 3 * request.ByteSizeLong() + slice * (200 + answer) + 2ULL * chunk * answer;
 }
 
 }  // namespace
@@ -374,10 +387,12 @@ grpc::Status InterpolationService::InterpolateBatch(
     out.set_first_index(static_cast<std::uint32_t>(first));
     return true;
   };
+  const WithUncertainty with_uncertainty =
+      request->include_uncertainty() ? WithUncertainty::kInclude : WithUncertainty::kOmit;
   auto take = [&](int i, interp::Interpolation&& answer) {
     if (i % chunk == 0 && !start_chunk(i)) return false;
     ToResult(request->directions(i), std::move(answer), settings, index, VertexSpectra::kOmit,
-             out.add_results());
+             with_uncertainty, out.add_results());
     if (out.results_size() < chunk && i + 1 < n) return true;
     // Blocks while the client is slow to read (flow control); false: the client went away.
     if (!slot->Write(writer, out)) {

@@ -198,6 +198,7 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
   snapshot->skipped = published.skipped[qi];
   snapshot->skipped_detail = published.skipped_detail[qi];
   snapshot->samples = published.sets[qi];
+  if (quantity == Quantity::kBrdf) snapshot->budgets = published.brdf_budgets;
   snapshot->interpolator =
       std::shared_ptr<const interp::Interpolator>(std::move(made.interpolator));
   Keep(*entry, key, snapshot);
@@ -330,6 +331,7 @@ std::size_t IndexCache::EntryBytes(const Entry& entry) {
   for (const auto& set : entry.samples->published().sets) {
     if (set) bytes += SetBytes(*set);
   }
+  bytes += entry.samples->published().brdf_budgets.bytes();
   for (const KeptIndex& kept : entry.indexes) bytes += IndexBytes(*kept.index->samples);
   return bytes;
 }

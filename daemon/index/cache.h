@@ -59,6 +59,7 @@
 #include "core/readings/quantity.h"
 #include "core/status.h"
 #include "core/wavelength_grid.h"
+#include "daemon/index/budgets.h"
 #include "daemon/sessions/session_id.h"
 #include "daemon/sessions/session_plan.h"
 #include "storage/records.h"
@@ -85,6 +86,9 @@ struct IndexSnapshot {
   std::string skipped_detail;
   std::shared_ptr<const interp::SampleSet> samples;
   std::shared_ptr<const interp::Interpolator> interpolator;
+  // BRDF snapshots: the samples' uncertainty budgets, position for position (null: not
+  // estimated); empty for other quantities (the stored budgets are of the BRDF).
+  BudgetList budgets;
 };
 
 struct IndexKey;  // index_build.h

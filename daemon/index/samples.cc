@@ -28,7 +28,7 @@ bool IndexSamples::Fold(const storage::ReadingRecord& record) {
   for (int i = 0; i < kQuantityCount; ++i) {
     const Quantity q = static_cast<Quantity>(i);
     if (derived->has(q)) {
-      Add(q, record.id, coords, derived->of(q));
+      Add(q, record, coords, derived->of(q));
     } else {
       Skip(q, derived->reason(q));
     }
@@ -36,8 +36,9 @@ bool IndexSamples::Fold(const storage::ReadingRecord& record) {
   return true;
 }
 
-void IndexSamples::Add(Quantity q, std::int64_t id, std::span<const double> coords,
-                       const std::vector<double>& values) {
+void IndexSamples::Add(Quantity q, const storage::ReadingRecord& record,
+                       std::span<const double> coords, const std::vector<double>& values) {
+  const std::int64_t id = record.id;
   const int i = static_cast<int>(q);
   std::shared_ptr<interp::SampleSet>& set = grown_[i];
   if (!set) {
@@ -48,6 +49,15 @@ void IndexSamples::Add(Quantity q, std::int64_t id, std::span<const double> coor
   }
   if (Status st = set->Add(id, coords, values); !st.ok()) {
     Skip(q, "reading " + std::to_string(id) + ": " + st.message());
+    return;
+  }
+  if (q == Quantity::kBrdf) {
+    // Only a budget of the BRDF blends with the BRDF; any other counts as not estimated.
+    const bool of_brdf =
+        record.uncertainty.has_value() && record.uncertainty->quantity == Quantity::kBrdf;
+    working_.brdf_budgets.Add(
+        of_brdf ? std::make_shared<const uncertainty::ReadingBudget>(*record.uncertainty)
+                : nullptr);
   }
 }
 

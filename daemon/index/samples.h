@@ -22,6 +22,7 @@
 #include "core/readings/derive.h"
 #include "core/readings/quantity.h"
 #include "core/wavelength_grid.h"
+#include "daemon/index/budgets.h"
 #include "storage/records.h"
 
 namespace brdf::daemon {
@@ -35,6 +36,9 @@ class IndexSamples {
     std::array<std::size_t, kQuantityCount> skipped{};
     std::array<std::string, kQuantityCount> skipped_detail;
     std::int64_t through_id = 0;  // every reading with id ≤ this was folded
+    // The BRDF set's readings' uncertainty budgets, position for position (the stored budgets
+    // are of the BRDF; docs/uncertainty.md).
+    BudgetList brdf_budgets;
   };
 
   // anisotropic: (θi, φi, θo, φo) coordinates, else (θi, θo, φ); ρw (and ρw(λ) when the plan's
@@ -60,7 +64,7 @@ class IndexSamples {
   WavelengthGrid grid() const { return deriver_.grid().value_or(WavelengthGrid::Pr650()); }
 
  private:
-  void Add(Quantity q, std::int64_t id, std::span<const double> coords,
+  void Add(Quantity q, const storage::ReadingRecord& record, std::span<const double> coords,
            const std::vector<double>& values);
   void Skip(Quantity q, const std::string& why);
 

@@ -297,7 +297,8 @@ void BrdfctlProcessTest::CheckInterpolate() {
   ASSERT_EQ(r.exit_code, 0) << Describe(r);
   EXPECT_NE(r.out.find("octant: ok"), std::string::npos) << Describe(r);
 
-  // The table: one row per band, 380 … 780 nm, the interpolated value then four vertex values.
+  // The table: one row per band, 380 … 780 nm, the interpolated value, its expanded
+  // uncertainties (± measurement, ± interpolation, ± total; k = 2), then four vertex values.
   std::vector<std::pair<double, std::vector<double>>> rows;
   double weight_sum = -1;
   int vertices = 0;
@@ -316,8 +317,12 @@ void BrdfctlProcessTest::CheckInterpolate() {
     const double nm = std::strtod(first.c_str(), &end);
     if (first.empty() || *end != '\0') continue;
     std::vector<double> values;
-    double v = 0;
-    while (in >> v) values.push_back(v);
+    std::string cell;
+    while (in >> cell) {
+      if (cell.rfind("±", 0) == 0) cell = cell.substr(std::string("±").size());
+      values.push_back(std::strtod(cell.c_str(), &end));
+      if (*end != '\0') break;
+    }
     rows.emplace_back(nm, values);
   }
   EXPECT_EQ(vertices, 4) << Describe(r);
@@ -326,8 +331,12 @@ void BrdfctlProcessTest::CheckInterpolate() {
   EXPECT_DOUBLE_EQ(rows.front().first, 380);
   EXPECT_DOUBLE_EQ(rows.back().first, 780);
   for (const auto& [nm, values] : rows) {
-    ASSERT_EQ(values.size(), 5u) << "at " << nm << " nm";
-    for (double v : values) EXPECT_TRUE(std::isfinite(v) && v > 0) << v << " at " << nm << " nm";
+    ASSERT_EQ(values.size(), 8u) << "at " << nm << " nm";
+    for (double v : values) EXPECT_TRUE(std::isfinite(v) && v >= 0) << v << " at " << nm << " nm";
+    EXPECT_GT(values[0], 0) << "at " << nm << " nm";
+    EXPECT_GT(values[1], 0) << "a measurement uncertainty at " << nm << " nm";
+    // The total is the quadrature sum of the two (each printed to 3 digits).
+    EXPECT_NEAR(values[3], std::hypot(values[1], values[2]), 0.01 * values[3]) << nm << " nm";
   }
 
   // And it is the sample's BRDF: within 25 % of the simulator's ground truth at 560 nm.
@@ -356,6 +365,10 @@ void BrdfctlProcessTest::CheckInterpolate() {
   ASSERT_EQ(reply->result().spectrum_size(), 101);
   EXPECT_NEAR(reply->result().spectrum(45), rows[45].second[0],
               1e-5 * std::fabs(rows[45].second[0]));
+  // The JSON carries the uncertainty the table shows (k = 2 there, standard here).
+  ASSERT_EQ(reply->result().uncertainty().combined_size(), 101);
+  EXPECT_NEAR(2 * reply->result().uncertainty().combined(45), rows[45].second[3],
+              0.01 * rows[45].second[3]);
 }
 
 // interpolate where the method cannot: exit 4 with the status.

@@ -255,6 +255,62 @@ class Interpolations(unittest.TestCase):
         self.assertEqual(failed.sizes["wavelength"], 5)
 
 
+class InterpolationUncertainties(unittest.TestCase):
+    """InterpolationResult.uncertainty from brdf.v1.InterpolationResult (include_uncertainty),
+    through InterpolationBatch's (N, m) arrays and the Datasets; answers without one are NaN
+    there (not asked or not estimated), never 0."""
+
+    @staticmethod
+    def proto(with_uncertainty, interpolation=True):
+        pb = brdf_client.brdf_pb2
+        r = pb.InterpolationResult(status=pb.INTERPOLATION_STATUS_OK,
+                                   method=pb.INTERPOLATION_METHOD_OCTANT,
+                                   quantity=pb.QUANTITY_BRDF)
+        r.query.iso.theta_i, r.query.iso.theta_o, r.query.iso.phi = 30, 40, 50
+        r.grid.start_nm, r.grid.step_nm, r.grid.count = 380, 4, 3
+        r.spectrum.extend([0.10, 0.11, 0.12])
+        r.vertices.add(reading_id=7, weight=1.0).coords.extend([30, 40, 50])
+        if with_uncertainty:
+            u = r.uncertainty
+            u.measurement.extend([0.003, 0.004, 0.005])
+            u.shared.extend([0.002, 0.003, 0.004])
+            if interpolation:
+                u.interpolation.extend([0.004, 0.003, 0.0])
+            u.combined.extend([0.005, 0.005, 0.005])
+            u.not_estimated.append("reading 9: no uncertainty budget (not estimated)")
+        return r
+
+    def test_result_batch_and_dataset(self):
+        with_u = InterpolationResult.from_proto(self.proto(True))
+        without = InterpolationResult.from_proto(self.proto(False))
+        self.assertIsNone(without.uncertainty)
+        u = with_u.uncertainty
+        self.assertIsInstance(u, brdf_client.InterpolationUncertainty)
+        np.testing.assert_array_equal(u.measurement, [0.003, 0.004, 0.005])
+        np.testing.assert_array_equal(u.shared, [0.002, 0.003, 0.004])
+        np.testing.assert_array_equal(u.interpolation, [0.004, 0.003, 0.0])
+        np.testing.assert_array_equal(u.combined, [0.005, 0.005, 0.005])
+        self.assertEqual(u.not_estimated, ["reading 9: no uncertainty budget (not estimated)"])
+
+        nearest = InterpolationResult.from_proto(self.proto(True, interpolation=False))
+        batch = InterpolationBatch([with_u, without, nearest])
+        np.testing.assert_array_equal(batch.u_combined[0], [0.005, 0.005, 0.005])
+        self.assertTrue(np.isnan(batch.u_combined[1]).all())   # not asked: NaN, not 0
+        np.testing.assert_array_equal(batch.u_measurement[2], [0.003, 0.004, 0.005])
+        self.assertTrue(np.isnan(batch.u_interpolation[2]).all())  # not estimated
+
+        ds = batch.to_dataset()
+        name = uncertainty_name("brdf")
+        self.assertEqual(ds[name].dims, ("direction", "wavelength"))
+        np.testing.assert_array_equal(ds[name].values[0], [0.005, 0.005, 0.005])
+        self.assertTrue(np.isnan(ds[name + "_interpolation"].values[2]).all())
+        self.assertIn("k = 1", ds.attrs["uncertainty"])
+        one = with_u.to_dataset()
+        np.testing.assert_array_equal(one[name + "_measurement"].values, [0.003, 0.004, 0.005])
+        # Answers without uncertainty keep the old layout and its note.
+        self.assertNotIn(name, without.to_dataset())
+
+
 class Angles(unittest.TestCase):
     def test_known_directions_and_round_trip(self):
         np.testing.assert_allclose(incidence_from_half_diff(0, 30, 0), (30, 30, 180), atol=1e-9)

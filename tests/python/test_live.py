@@ -271,6 +271,29 @@ class LiveSession(unittest.TestCase):
         if delaunay.ok:
             self.assertAlmostEqual(float(delaunay.weights.sum()), 1.0, places=9)
 
+    def test_interpolate_with_uncertainty(self):
+        """uncertainty=True: the measurement part carries the white standard shared by every
+        vertex whole (at least Σ w·u_white of the vertices' stored budgets), the combined is the
+        quadrature sum of it and the interpolation term, and the batch gives the same."""
+        sid = self.session.session_id
+        q = self.picked().query
+        r = self.client.interpolate(sid, *q, uncertainty=True)
+        self.assertIsNone(self.client.interpolate(sid, *q).uncertainty)
+        u = r.uncertainty
+        self.assertIsNotNone(u)
+        for part in (u.measurement, u.shared, u.interpolation, u.combined):
+            self.assertEqual(part.shape, (101,))
+        self.assertTrue(np.all(u.measurement > 0))
+        np.testing.assert_allclose(u.combined, np.hypot(u.measurement, u.interpolation),
+                                   rtol=1e-12)
+        budgets = dict(zip(self.readings.ids, self.readings.budgets))
+        white = sum(v.weight * budgets[v.reading_id].components["white_standard"].contribution
+                    for v in r.vertices)
+        self.assertTrue(np.all(u.shared >= white * (1 - 1e-12)))
+        batch = self.client.interpolate_batch(sid, [q, q], uncertainty=True, progress=False)
+        np.testing.assert_array_equal(batch.u_combined[1], u.combined)
+        np.testing.assert_array_equal(batch.u_measurement[0], u.measurement)
+
     def test_appearance_colour_and_sphere(self):
         sid = self.session.session_id
         look = self.client.appearance(sid, sphere_size=32, mirror_phi=True, reciprocity=True)

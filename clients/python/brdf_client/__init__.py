@@ -36,7 +36,8 @@ from .errors import (BrdfError, Cancelled, DataLoss, DeadlineExceeded, FailedPre
 from .events import Event
 from .export import ExportResult
 from .grid_datasets import open_grid
-from .interpolation import InterpolationBatch, InterpolationResult, Vertex
+from .interpolation import (InterpolationBatch, InterpolationResult, InterpolationUncertainty,
+                            Vertex)
 from .netcdf import write_netcdf
 from .plans import to_plan
 from .readings import ReadingSet, UncertaintyBudget, UncertaintyComponent
@@ -54,6 +55,7 @@ def about() -> Dict[str, str]:
 __all__ = [
     "BrdfClient", "BrdfError", "Cancelled", "DataLoss", "DeadlineExceeded", "Event",
     "ExportResult", "FailedPrecondition", "InterpolationBatch", "InterpolationResult",
+    "InterpolationUncertainty",
     "InvalidArgument", "NotFound", "PROTO_PACKAGE", "PermissionDenied", "ReadingSet",
     "candidate_queries", "pick_query",
     "UncertaintyBudget", "UncertaintyComponent",

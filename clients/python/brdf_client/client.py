@@ -568,7 +568,8 @@ class BrdfClient:
                     quantity: Union[str, int] = "brdf",
                     axis_scale: Optional[Sequence[float]] = None, mirror_phi: bool = False,
                     reciprocity: bool = False, coordinates: Union[str, int, None] = None,
-                    trend: Union[str, int, None] = None) -> InterpolationResult:
+                    trend: Union[str, int, None] = None,
+                    uncertainty: bool = False) -> InterpolationResult:
         """The spectrum at one direction, from the session's SAMPLE readings.
 
         Direction, degrees: (theta_i, theta_o, phi) for isotropic sessions (φ = |φo − φi| in
@@ -583,6 +584,8 @@ class BrdfClient:
         trend: "bivariate" blends the readings' residuals from a smooth f(θh, θd) fitted to all
             of them and adds it back (closer near a sharp specular peak; isotropic sessions only;
             docs/interpolation.md, "Bivariate trend"); None or "none": the readings' spectra.
+        uncertainty: also the spectrum's standard uncertainties (result.uncertainty: measurement,
+            shared, interpolation, combined per band; docs/uncertainty.md "Interpolated values").
 
         Returns an InterpolationResult (.to_dataset(): labelled, xarray). A direction the method
         cannot fill is not an error: check result.ok / result.status ("empty_octant",
@@ -604,7 +607,8 @@ class BrdfClient:
             quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"),
             direction=direction_query(direction),
             options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates,
-                                          trend))
+                                          trend),
+            include_uncertainty=uncertainty)
         response = self._unary(self._interp.Interpolate, request, "Interpolation.Interpolate")
         return InterpolationResult.from_proto(response.result)
 
@@ -636,19 +640,22 @@ class BrdfClient:
                           timeout: Optional[float] = None,
                           coordinates: Union[str, int, None] = None,
                           trend: Union[str, int, None] = None,
-                          progress: Optional[bool] = None) -> InterpolationBatch:
+                          progress: Optional[bool] = None,
+                          uncertainty: bool = False) -> InterpolationBatch:
         """Spectra at many directions: `directions` is (N, 3) (θi, θo, φ) or (N, 4)
         (θi, φi, θo, φo), degrees. Returns an InterpolationBatch in the order asked (spectra
         (N, m) with NaN rows where the method could not fill the direction; .to_dataset():
         labelled, xarray). progress: a tqdm bar of the directions answered (None: when someone
-        watches); Ctrl-C cancels the stream."""
+        watches); Ctrl-C cancels the stream. uncertainty: also each spectrum's standard
+        uncertainties (batch.u_measurement, .u_interpolation, .u_combined, (N, m); each
+        result's .uncertainty); chunk_size is then at most 512."""
         queries = [direction_query(d) for d in directions]
         request = brdf_pb2.InterpolateBatchRequest(
             session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
             quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"), directions=queries,
             options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates,
                                           trend),
-            chunk_size=chunk_size)
+            chunk_size=chunk_size, include_uncertainty=uncertainty)
         results: List[Optional[InterpolationResult]] = [None] * len(queries)
         with Bar(progress, total=len(queries), desc=f"interpolating ({names.method_name(request.method)})",
                  unit="direction") as bar:

@@ -9,7 +9,10 @@ Layout (labels.py: names and units). A batch: the quantity's values (direction, 
 rows where no spectrum; status and detail (direction); the direction's angles as coordinates along
 direction (theta_i, theta_o, phi, or theta_i, phi_i, theta_o, phi_o); vertex_reading_id
 (direction, vertex; 0 where an answer has fewer vertices), vertex_weight and vertex_coords
-(direction, vertex, axis; NaN there). One answer: the same without the direction dimension.
+(direction, vertex, axis; NaN there). Answers asked with uncertainty=True add the standard
+uncertainties (k = 1) as {quantity}_uncertainty (combined), {quantity}_uncertainty_measurement and
+{quantity}_uncertainty_interpolation (direction, wavelength; NaN where not estimated).
+One answer: the same without the direction dimension.
 A computed grid: the values (axis1, axis2, axis3, wavelength) and status / provenance per cell.
 """
 
@@ -52,6 +55,28 @@ def _vertices(results: Sequence["InterpolationResult"], axes: Tuple[str, ...]) -
     }
 
 
+def _uncertainties(results: Sequence["InterpolationResult"], quantity: str,
+                   m: int) -> Dict[str, Any]:
+    """The answers' uncertainty variables, or none when no answer carries one."""
+    if not any(r.uncertainty is not None for r in results):
+        return {}
+    out: Dict[str, Any] = {}
+    name = labels.uncertainty_name(quantity)
+    units = labels.quantity_attrs(quantity).get("units", "")
+    for part, suffix, what in (("combined", "", "combined"),
+                               ("measurement", "_measurement", "from the readings' budgets"),
+                               ("interpolation", "_interpolation", "the interpolant's own")):
+        rows = np.full((len(results), m), np.nan)
+        for i, r in enumerate(results):
+            values = getattr(r.uncertainty, part) if r.uncertainty is not None else ()
+            if r.ok and len(values) == m:
+                rows[i] = values
+        out[name + suffix] = (("direction", "wavelength"), rows,
+                              {"long_name": f"standard uncertainty (k = 1), {what}",
+                               "units": units})
+    return out
+
+
 def _answers(results: Sequence["InterpolationResult"], wavelengths: np.ndarray,
              spectra: np.ndarray) -> Any:
     """The Dataset of answers over (direction, wavelength, vertex, axis)."""
@@ -77,7 +102,13 @@ def _answers(results: Sequence["InterpolationResult"], wavelengths: np.ndarray,
         "detail": ("direction", np.array([r.detail for r in results], dtype=object)),
         **_vertices(results, axes),
     }
-    return xr.Dataset(data_vars, coords=coords, attrs=_attrs(method, quantity))
+    uncertainties = _uncertainties(results, quantity, len(wavelengths))
+    data_vars.update(uncertainties)
+    attrs = _attrs(method, quantity)
+    if uncertainties:
+        attrs["uncertainty"] = (f"{labels.uncertainty_name(quantity)}: standard uncertainty "
+                                "(k = 1); docs/uncertainty.md, 'Interpolated values'")
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 
 def batch_dataset(batch: "InterpolationBatch") -> Any:

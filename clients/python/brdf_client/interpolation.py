@@ -34,6 +34,38 @@ class Vertex:
 
 
 @dataclasses.dataclass
+class InterpolationUncertainty:
+    """The standard uncertainties (k = 1) of an interpolated spectrum, per band, in its
+    quantity's unit (brdf.v1.InterpolationUncertainty; docs/uncertainty.md, "Interpolated
+    values"). Multiply by k (2: about 95 %) for an expanded uncertainty.
+
+    measurement:   (m,) from the blended readings' budgets, shared terms (white standard, the
+                   same reference, dark, instrument) correlated; empty when not estimated (a
+                   quantity other than the BRDF).
+    shared:        (m,) the part of `measurement` more readings would not reduce.
+    interpolation: (m,) the interpolant's own error, estimated from the vertices' spread; empty
+                   when not estimated (nearest).
+    combined:      (m,) sqrt(measurement² + interpolation²) of what was estimated.
+    not_estimated: what is left out, each "what: why" (never silently zero).
+    """
+
+    measurement: np.ndarray
+    shared: np.ndarray
+    interpolation: np.ndarray
+    combined: np.ndarray
+    not_estimated: List[str]
+
+    @classmethod
+    def from_proto(cls, u: Any) -> "InterpolationUncertainty":
+        """Converts a brdf.v1.InterpolationUncertainty."""
+        return cls(measurement=np.array(u.measurement, dtype=float),
+                   shared=np.array(u.shared, dtype=float),
+                   interpolation=np.array(u.interpolation, dtype=float),
+                   combined=np.array(u.combined, dtype=float),
+                   not_estimated=list(u.not_estimated))
+
+
+@dataclasses.dataclass
 class InterpolationResult:
     """The answer for one direction.
 
@@ -48,6 +80,8 @@ class InterpolationResult:
       spectrum:    (m,) in the quantity's unit; empty unless ok.
       vertices:    the blended readings (octant and Delaunay: 4 for isotropic; nearest: 1).
       detail:      the daemon's note (which octant was empty, which tetrahedron enclosed).
+      uncertainty: the spectrum's InterpolationUncertainty when asked for (uncertainty=True)
+                   and ok; else None (not asked, which is not an uncertainty of zero).
     """
 
     query: np.ndarray
@@ -59,6 +93,7 @@ class InterpolationResult:
     spectrum: np.ndarray
     vertices: List[Vertex]
     detail: str
+    uncertainty: Optional[InterpolationUncertainty] = None
 
     @property
     def ok(self) -> bool:
@@ -122,7 +157,9 @@ class InterpolationResult:
             spectrum=np.array(result.spectrum, dtype=float),
             vertices=[Vertex(v.reading_id, np.array(v.coords, dtype=float), v.weight)
                       for v in result.vertices],
-            detail=result.detail)
+            detail=result.detail,
+            uncertainty=(InterpolationUncertainty.from_proto(result.uncertainty)
+                         if result.HasField("uncertainty") else None))
 
 
 class InterpolationBatch:
@@ -134,6 +171,10 @@ class InterpolationBatch:
       spectra:     (N, m), NaN rows where no spectrum could be built.
       ok:          (N,) bool.
       statuses:    (N,) str.
+      u_measurement, u_interpolation, u_combined: (N, m) standard uncertainties (k = 1) of the
+                   spectra when the batch asked for them (uncertainty=True); NaN where an answer
+                   has none (not OK, not asked, or that part not estimated: see
+                   results[i].uncertainty.not_estimated).
     """
 
     def __init__(self, results: Iterable[InterpolationResult]) -> None:
@@ -145,8 +186,19 @@ class InterpolationBatch:
         for i, r in enumerate(self.results):
             if r.ok and len(r.spectrum) == m:
                 self.spectra[i] = r.spectrum
+        self.u_measurement = self._uncertainty_rows("measurement", m)
+        self.u_interpolation = self._uncertainty_rows("interpolation", m)
+        self.u_combined = self._uncertainty_rows("combined", m)
         self.ok = np.array([r.ok for r in self.results], dtype=bool)
         self.statuses = np.array([r.status for r in self.results], dtype=object)
+
+    def _uncertainty_rows(self, part: str, m: int) -> np.ndarray:
+        rows = np.full((len(self.results), m), np.nan)
+        for i, r in enumerate(self.results):
+            values = getattr(r.uncertainty, part) if r.uncertainty is not None else ()
+            if r.ok and len(values) == m:
+                rows[i] = values
+        return rows
 
     def __len__(self) -> int:
         return len(self.results)

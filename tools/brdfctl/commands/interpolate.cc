@@ -91,6 +91,7 @@ int BuildRequest(CommandContext& ctx, const InterpolateOptions& o,
   }
   request->set_method(method);
   request->set_quantity(quantity);
+  request->set_include_uncertainty(o.uncertainty);
   if (o.phi) {
     v1::IsoDirection* d = request->mutable_direction()->mutable_iso();
     d->set_theta_i(o.theta_i);
@@ -179,17 +180,46 @@ void PrintVertices(std::ostream& out, const v1::InterpolationResult& result,
   if (!note.empty()) out << "  " << note << "\n";
 }
 
-// The table of wavelength and value (every Nth band), with a column per vertex spectrum.
+// "±" and k times band b of `values`, or "-" when it has no such band.
+std::string PlusMinus(const google::protobuf::RepeatedField<double>& values, int b, double k) {
+  return b < values.size() ? "±" + Num(k * values.Get(b), 3) : "-";
+}
+
+// The uncertainty's header cells (none without one).
+std::string UncertaintyHeader(const v1::InterpolationResult& result) {
+  if (!result.has_uncertainty()) return "";
+  return Cell("± meas.", 12) + Cell("± interp.", 12) + Cell("± total", 12);
+}
+
+// What the ± columns are, and what they leave out.
+void PrintUncertaintyNote(std::ostream& out, const v1::InterpolationResult& result, double k) {
+  if (!result.has_uncertainty()) return;
+  out << "  ± columns: expanded uncertainties U = k·u, k = " << Num(k, 3)
+      << " (meas.: the readings' budgets, shared terms correlated; interp.: the vertices' "
+         "spread; total: both)\n";
+  for (const std::string& s : result.uncertainty().not_estimated()) {
+    out << "  not estimated: " << s << "\n";
+  }
+}
+
+// The table of wavelength and value (every Nth band), with its ± columns and a column per
+// vertex spectrum.
 void PrintSpectra(std::ostream& out, const v1::InterpolationResult& result,
-                  const std::vector<v1::InterpolationResult>& vertex_results, int every) {
+                  const std::vector<v1::InterpolationResult>& vertex_results, int every, double k) {
   const v1::WavelengthGrid& g = result.grid();
-  out << "\n" << Cell("λ (nm)", 9) << Cell("interpolated", 14);
+  const v1::InterpolationUncertainty& u = result.uncertainty();
+  out << "\n" << Cell("λ (nm)", 9) << Cell("interpolated", 14) << UncertaintyHeader(result);
   for (std::size_t i = 0; i < vertex_results.size(); ++i) {
     out << Cell("v" + std::to_string(i + 1), 14);
   }
   out << "\n";
   for (int b = 0; b<result.spectrum_size(); b += every> 0 ? every : 1) {
     out << Cell(Num(g.start_nm() + b * g.step_nm()), 9) << Cell(Num(result.spectrum(b), 6), 14);
+    if (result.has_uncertainty()) {
+      out << Cell(PlusMinus(u.measurement(), b, k), 12)
+          << Cell(PlusMinus(u.interpolation(), b, k), 12)
+          << Cell(PlusMinus(u.combined(), b, k), 12);
+    }
     for (const v1::InterpolationResult& r : vertex_results) {
       out << Cell(b < r.spectrum_size() ? Num(r.spectrum(b), 6) : "-", 14);
     }
@@ -222,7 +252,8 @@ void PrintReadable(std::ostream& out, const InterpolateOptions& o,
   if (!result.detail().empty()) out << "  " << result.detail() << "\n";
   if (o.explain && result.vertices_size() > 0) PrintVertices(out, result, vertex_spectra.note);
   if (result.status() == v1::INTERPOLATION_STATUS_OK) {
-    PrintSpectra(out, result, vertex_spectra.results, o.every);
+    PrintSpectra(out, result, vertex_spectra.results, o.every, o.k);
+    PrintUncertaintyNote(out, result, o.k);
   }
 }
 
@@ -320,6 +351,9 @@ void AddMethodFlags(CLI::App& cmd, InterpolateOptions& o) {
   cmd.add_option("--every", o.every, "print every Nth wavelength")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd.add_option("--k", o.k, "coverage factor of the ± columns: U = k · u (default 2, about 95 %)")
+      ->check(CLI::PositiveNumber);
+  cmd.add_flag("!--no-uncertainty", o.uncertainty, "leave the ± columns out");
   cmd.add_flag("--mirror-phi", o.mirror_phi, "also use readings mirrored to −φ");
   cmd.add_flag("--reciprocity", o.reciprocity, "also use readings with θi and θo swapped");
   cmd.add_option("--scale", o.axis_scale, "per-axis distance multipliers a,b,c[,d]")

@@ -4,6 +4,10 @@
 // --explain adds the blended readings: their ids, positions and weights, and each one's own
 // spectrum next to the interpolated one (fetched with one InterpolateBatch call, nearest method,
 // at the vertices' positions), so the blend can be checked by eye.
+// The table carries the expanded uncertainties U = k · u (--k, default 2) of the interpolated
+// value: the measurement part (the blended readings' budgets, shared terms correlated), the
+// interpolation term and their combination (InterpolationResult.uncertainty, docs/uncertainty.md
+// "Interpolated values"), and names what was not estimated; --no-uncertainty leaves them out.
 // --json: the InterpolateResponse on one line; with --explain then one InterpolationResult line
 // per vertex. Exit 4 when the method gives no spectrum there (status and detail are printed).
 #pragma once
@@ -33,6 +37,8 @@ struct InterpolateOptions {
   std::string coordinates = "incidence";  // incidence or half-diff (isotropic sessions)
   std::string trend = "none";             // none or bivariate (isotropic sessions)
   int every = 1;                          // print every Nth band
+  double k = 2;                           // coverage factor of the ± columns
+  bool uncertainty = true;                // ask for and show the uncertainty
 };
 
 int RunInterpolate(CommandContext& ctx, const InterpolateOptions& options);

@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""Do interpolated values' k = 2 intervals hold the truth as often as they claim? (issue 37,
+deliverable 6; docs/uncertainty.md, "Interpolated values").
+
+For each material and seed: brdf-sim with the material and its error sources on, brdfd with the
+matching [uncertainty] terms (the same as coverage.py, whose helpers this script uses), a plan run
+to completion, then one InterpolateBatch with uncertainties at random directions (θi, θo uniform
+in [0, --theta-max], φ in [0, 180]) while the rig is still up, and every OK answer compared, band
+by band, with `brdf-sim truth` at its direction. Prints per run and over all: the fraction of
+(direction, band) pairs whose interval y ± k·u holds the truth with u the combined uncertainty,
+the same with the measurement part alone and with the interpolation term scaled by 0.25, 0.5 and
+0.75 (what a calibrated estimator would give), the normalised errors' spread, and the median k·u
+against the median actual error (the goal: intervals at most 2× the error, coverage 93–97 %).
+
+    bench/uncertainty/coverage_interp.py --materials paint clay --seeds 1 2 --directions 2000
+
+Needs a build with brdf-sim, brdfd and the Python stubs (BRDF_BUILD_DIR, default build/).
+"""
+
+import argparse
+import json
+import os
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+import coverage  # noqa: E402  pylint: disable=wrong-import-position
+from coverage import live_rig, BrdfClient, names  # noqa: E402  pylint: disable=wrong-import-position
+
+
+def iso_truth(sim, material, d):
+    """brdf-sim's truth at an isotropic direction (θi, θo, φ): φi = 0, φo = φ."""
+    return coverage.truth(sim, material, (d[0], 0.0, d[1], d[2]))
+
+
+def interpolate_session(sim, daemon, material, seed, plan, errors, directions, method):
+    """The batch's answers at `directions` once the plan completed: (ok, y, u, u_meas, wl)."""
+    rig = live_rig.LiveRig(sim, daemon, seed=seed, sim_args=coverage.sim_flags(material, errors),
+                           extra_config=coverage.budget_config(errors))
+    rig.sample_extra = f"white_reflectance_uncertainty = {0.99 * errors['white_error']}\n"
+    rig.start()
+    try:
+        client = BrdfClient(rig.address, rig.operator_token)
+        client.wait_ready(10)
+
+        def act(prompt):
+            what = coverage.PROMPT_ACTIONS.get(names.prompt_kind_name(prompt.kind))
+            if what:
+                rig.set_mounted(what)
+
+        s = client.submit_plan(plan, start_now=True)
+        final = client.wait(s.session_id, on_prompt=act, timeout=600, stop_states=("paused",))
+        if names.state_name(final.state) != "completed":
+            raise RuntimeError(f"session ended {names.state_name(final.state)}")
+        batch = client.interpolate_batch(s.session_id, directions, method=method,
+                                         uncertainty=True, progress=False)
+        client.close()
+    finally:
+        rig.stop()
+        rig.cleanup()
+    return batch.ok, batch.spectra, batch.u_combined, batch.u_measurement, batch.wavelengths
+
+
+def summarise(label, y, u, u_meas, t, k):
+    ok = np.isfinite(y) & np.isfinite(u) & (u > 0) & np.isfinite(t)
+    err = np.abs(y - t)
+    row = {"run": label, "answers": int(y.shape[0]),
+           "coverage": float((err <= k * u)[ok].mean()),
+           "coverage_measurement_only": float((err <= k * u_meas)[ok & np.isfinite(u_meas)].mean()),
+           "z_sd": float(np.std(((y - t) / u)[ok])),
+           "median_kU": float(np.median((k * u)[ok])), "median_error": float(np.median(err[ok])),
+           "median_rel_kU": float(np.median((k * u / np.abs(t))[ok & (t != 0)]))}
+    row["kU_over_error"] = row["median_kU"] / row["median_error"] if row["median_error"] else None
+    u_int = np.sqrt(np.maximum(u * u - u_meas * u_meas, 0.0))
+    for scale in (0.25, 0.5, 0.75):
+        scaled = np.hypot(u_meas, scale * u_int)
+        row[f"coverage_interp_x{scale}"] = float((err <= k * scaled)[ok].mean())
+    print(json.dumps(row), flush=True)
+    return (err <= k * u)[ok], ((y - t) / u)[ok], (k * u)[ok], err[ok]
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n", maxsplit=1)[0])
+    p.add_argument("--materials", nargs="+", default=["paint", "glossy", "clay", "gold",
+                                                      "blue-plastic"])
+    p.add_argument("--seeds", nargs="+", type=int, default=[1, 2])
+    p.add_argument("--plan", default=os.path.join(coverage.ROOT, "examples", "plans",
+                                                  "demo.json"))
+    p.add_argument("--directions", type=int, default=2000)
+    p.add_argument("--theta-max", type=float, default=80.0)
+    p.add_argument("--method", default="octant")
+    p.add_argument("--k", type=float, default=2.0)
+    args = p.parse_args()
+    errors = dict(coverage.ERRORS)
+    sim, daemon = live_rig.binaries()
+    if not sim or not daemon:
+        sys.exit("build brdf-sim and brdfd first (BRDF_BUILD_DIR)")
+    with open(args.plan, encoding="utf-8") as fh:
+        plan = json.load(fh)
+    print(json.dumps({"errors": errors, "k": args.k, "plan": os.path.basename(args.plan),
+                      "directions": args.directions, "method": args.method,
+                      "theta_max": args.theta_max}))
+    parts = []
+    for material in args.materials:
+        path = os.path.join(coverage.ROOT, "deploy", "materials", material + ".toml")
+        for seed in args.seeds:
+            rng = np.random.default_rng(seed)
+            dirs = np.column_stack([rng.uniform(0, args.theta_max, args.directions),
+                                    rng.uniform(0, args.theta_max, args.directions),
+                                    rng.uniform(0, 180, args.directions)])
+            ok, y, u, u_meas, _ = interpolate_session(sim, daemon, path, seed, plan, errors,
+                                                      dirs, args.method)
+            t = np.full_like(y, np.nan)
+            for i in np.flatnonzero(ok):
+                t[i] = iso_truth(sim, path, dirs[i])
+            parts.append(summarise(f"{material} seed {seed} ({int(ok.sum())} ok)",
+                                   y[ok], u[ok], u_meas[ok], t[ok], args.k))
+    inside, z, ku, err = (np.concatenate([p[i] for p in parts]) for i in range(4))
+    print(json.dumps({"run": "all", "pairs": int(inside.size), "coverage": float(inside.mean()),
+                      "z_sd": float(np.std(z)), "median_kU": float(np.median(ku)),
+                      "median_error": float(np.median(err)),
+                      "kU_over_error": float(np.median(ku) / np.median(err))}))
+
+
+if __name__ == "__main__":
+    main()

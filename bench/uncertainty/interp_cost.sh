@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# What asking for uncertainties costs Interpolate and InterpolateBatch (issue 37, deliverable 6:
+# at most 1.5× the time without): records examples/plans/demo.json on brdf-sim through brdfd (87
+# sample readings, each with its stored budget), then bench_interp_uncertainty times, in the same
+# run, Interpolate (sequential calls) and InterpolateBatch (one call) at random directions with
+# and without include_uncertainty, alternating which goes first, and prints medians and ratios.
+#
+# Usage: bench/uncertainty/interp_cost.sh [BUILD_DIR]   (default ./build; builds brdfd, brdf-sim,
+#        brdfctl and bench_interp_uncertainty unless BENCH_NO_BUILD=1)
+# Environment: COST_CALLS (Interpolate calls per timing, 2000), COST_DIRECTIONS (batch size,
+# 20000), COST_REPS (5), COST_METHOD (octant), BENCH_KEEP=1 keeps the work directory.
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+build="${1:-$root/build}"
+case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
+
+if [[ "${BENCH_NO_BUILD:-0}" != 1 ]]; then
+  echo "== building brdfd, brdf-sim, brdfctl, bench_interp_uncertainty (-j2)" >&2
+  cmake --build "$build" -j2 --target brdfd brdf-sim brdfctl bench_interp_uncertainty >&2
+fi
+brdfd="$build/daemon/brdfd"
+sim="$build/tools/brdf-sim/brdf-sim"
+ctl="$build/tools/brdfctl/brdfctl"
+bench="$build/bench/uncertainty/bench_interp_uncertainty"
+
+# shellcheck source=bench/daemon/lib.sh
+source "$root/bench/daemon/lib.sh"
+bench_workdir_and_cleanup /tmp/brdfd-interp-cost.XXXXXX
+config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
+
+echo "interpolated values' uncertainty: cost — $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) CPUs"
+echo "load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
+start_rig_on_sim "$work" 8 warn
+session="$("$ctl" submit "$root/examples/plans/demo.json" --start --quiet)"
+on_prompt="$(printf '%q sim-mount from-prompt --modbus %q' "$ctl" "$modbus")"
+"$ctl" watch "$session" --auto-confirm --on-prompt "$on_prompt" --exit-on-pause \
+  >"$work/watch.out" 2>&1 </dev/null
+budgets="$(sqlite3 -readonly "$work/brdfd.db" \
+  "SELECT count(*) FROM reading_uncertainty u JOIN readings r ON r.id = u.reading_id
+   WHERE r.session_id = $session")"
+echo "session $session recorded (demo plan); sample readings with a budget: $budgets"
+
+"$bench" --address "$BRDF_ADDRESS" --token "$analyst_token" --session "$session" \
+  --calls "${COST_CALLS:-2000}" --directions "${COST_DIRECTIONS:-20000}" \
+  --reps "${COST_REPS:-5}" --method "${COST_METHOD:-octant}"
+echo "load at end: $(cut -d' ' -f1-3 /proc/loadavg)"

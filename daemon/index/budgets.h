@@ -1,0 +1,42 @@
+// BudgetList: the uncertainty budgets of a sample set's readings, position for position (budget
+// i is the one of the set's sample i; null: the reading has none, "not estimated"). An
+// interpolated value's measurement uncertainty blends its vertices' budgets
+// (core/uncertainty/blend.h), found here by the vertex's position in the set.
+//
+// Shared like interp::SampleSet: storage in chunks of kChunk budgets, a copy shares them and Add
+// on a copy writes into a chunk of its own (the last, partly filled one is copied first when
+// another list holds it too), so a snapshot's list never changes while later readings are added.
+// Not thread-safe for Add; a published list is read-only and may be read by many threads.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "core/uncertainty/budget.h"
+
+namespace brdf::daemon {
+
+class BudgetList {
+ public:
+  static constexpr std::size_t kChunk = 128;
+
+  // Appends the next sample's budget (null: not estimated).
+  void Add(std::shared_ptr<const uncertainty::ReadingBudget> budget);
+
+  std::size_t size() const { return size_; }
+  // Sample i's budget, or null when it has none or i is beyond the list.
+  const uncertainty::ReadingBudget* at(std::size_t i) const {
+    return i < size_ ? (*chunks_[i / kChunk])[i % kChunk].get() : nullptr;
+  }
+  // Memory held by the budgets, roughly (for the cache's bound).
+  std::size_t bytes() const { return bytes_; }
+
+ private:
+  using Chunk = std::vector<std::shared_ptr<const uncertainty::ReadingBudget>>;
+  std::vector<std::shared_ptr<Chunk>> chunks_;
+  std::size_t size_ = 0;
+  std::size_t bytes_ = 0;
+};
+
+}  // namespace brdf::daemon

@@ -1,0 +1,167 @@
+// core/uncertainty/blend: an interpolated value's measurement uncertainty from its vertices'
+// budgets, shared terms correlated, and the interpolation term from the vertices' spread.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include "core/uncertainty/blend.h"
+
+namespace brdf::uncertainty {
+namespace {
+
+Component Make(const std::string& name, Sharing kind, std::int64_t id, std::vector<double> c) {
+  return Component{name, SharedThrough{kind, id}, std::move(c)};
+}
+
+// A budget of the given components, combined and independent filled in as the budget does.
+ReadingBudget Budget(std::vector<Component> components) {
+  ReadingBudget b;
+  const std::size_t bands = components.front().contribution.size();
+  b.combined.assign(bands, 0.0);
+  b.independent.assign(bands, 0.0);
+  for (const Component& c : components) {
+    for (std::size_t k = 0; k < bands; ++k) {
+      b.combined[k] += c.contribution[k] * c.contribution[k];
+      if (c.shared.kind == Sharing::kIndependent) {
+        b.independent[k] += c.contribution[k] * c.contribution[k];
+      }
+    }
+  }
+  for (double& v : b.combined) v = std::sqrt(v);
+  for (double& v : b.independent) v = std::sqrt(v);
+  b.components = std::move(components);
+  return b;
+}
+
+TEST(BlendUncertainty, SharedWhiteStandardAddsLinearly) {
+  // Two vertices whose only term is the session's white standard: one error seen by both, so the
+  // blend carries Σ wᵢ uᵢ, not the quadrature sum.
+  const ReadingBudget a =
+      Budget({Make("white_standard", Sharing::kWhiteStandard, 7, {0.02, 0.04})});
+  const ReadingBudget b =
+      Budget({Make("white_standard", Sharing::kWhiteStandard, 7, {0.04, 0.02})});
+  const std::vector<BlendVertex> v = {{1, 0.25, &a}, {2, 0.75, &b}};
+  Result<BlendedUncertainty> u = BlendMeasurementUncertainty(v, 2);
+  ASSERT_TRUE(u.ok()) << u.status().message();
+  EXPECT_NEAR(u->measurement[0], 0.25 * 0.02 + 0.75 * 0.04, 1e-15);
+  EXPECT_NEAR(u->measurement[1], 0.25 * 0.04 + 0.75 * 0.02, 1e-15);
+  EXPECT_NEAR(u->shared[0], u->measurement[0], 1e-15);
+  EXPECT_TRUE(u->not_estimated.empty());
+}
+
+TEST(BlendUncertainty, IndependentTermsAddInQuadrature) {
+  const ReadingBudget a = Budget({Make("sample_signal", Sharing::kIndependent, 0, {0.03})});
+  const ReadingBudget b = Budget({Make("sample_signal", Sharing::kIndependent, 0, {0.04})});
+  const std::vector<BlendVertex> v = {{1, 0.5, &a}, {2, 0.5, &b}};
+  Result<BlendedUncertainty> u = BlendMeasurementUncertainty(v, 1);
+  ASSERT_TRUE(u.ok());
+  EXPECT_NEAR(u->measurement[0], std::hypot(0.5 * 0.03, 0.5 * 0.04), 1e-15);
+  EXPECT_EQ(u->shared[0], 0.0);
+}
+
+TEST(BlendUncertainty, DifferentReferencesDoNotCorrelateButTheSameOneDoes) {
+  // reference_signal shared through reference 10 by vertices 1 and 2, through 11 by vertex 3.
+  const ReadingBudget a =
+      Budget({Make("reference_signal", Sharing::kReferenceReading, 10, {-0.01})});
+  const ReadingBudget b =
+      Budget({Make("reference_signal", Sharing::kReferenceReading, 10, {-0.02})});
+  const ReadingBudget c =
+      Budget({Make("reference_signal", Sharing::kReferenceReading, 11, {-0.03})});
+  const std::vector<BlendVertex> v = {{1, 0.2, &a}, {2, 0.3, &b}, {3, 0.5, &c}};
+  Result<BlendedUncertainty> u = BlendMeasurementUncertainty(v, 1);
+  ASSERT_TRUE(u.ok());
+  const double same = 0.2 * -0.01 + 0.3 * -0.02;
+  EXPECT_NEAR(u->measurement[0], std::hypot(same, 0.5 * -0.03), 1e-15);
+}
+
+TEST(BlendUncertainty, SignedContributionsOfOneInputCancel) {
+  // The lamp drift seen with opposite signs by two readings of one reference interval: a blend
+  // in the middle cancels it, as the covariance of a linear drift says.
+  const ReadingBudget a = Budget({Make("lamp_drift", Sharing::kReferenceReading, 4, {0.01})});
+  const ReadingBudget b = Budget({Make("lamp_drift", Sharing::kReferenceReading, 4, {-0.01})});
+  const std::vector<BlendVertex> v = {{1, 0.5, &a}, {2, 0.5, &b}};
+  Result<BlendedUncertainty> u = BlendMeasurementUncertainty(v, 1);
+  ASSERT_TRUE(u.ok());
+  EXPECT_NEAR(u->measurement[0], 0.0, 1e-18);
+}
+
+TEST(BlendUncertainty, SameNameThroughAnotherKindIsAnotherInput) {
+  const ReadingBudget a = Budget({Make("x", Sharing::kInstrument, 3, {0.01})});
+  const ReadingBudget b = Budget({Make("x", Sharing::kWhiteStandard, 3, {0.01})});
+  const std::vector<BlendVertex> v = {{1, 0.5, &a}, {2, 0.5, &b}};
+  Result<BlendedUncertainty> u = BlendMeasurementUncertainty(v, 1);
+  ASSERT_TRUE(u.ok());
+  EXPECT_NEAR(u->measurement[0], std::hypot(0.005, 0.005), 1e-15);
+}
+
+TEST(BlendUncertainty, AReadingBlendedTwiceIsOneReading) {
+  // A mirrored copy keeps its reading's id: its independent noise is the same draw.
+  const ReadingBudget a = Budget({Make("sample_signal", Sharing::kIndependent, 0, {0.02})});
+  const std::vector<BlendVertex> v = {{1, 0.5, &a}, {1, 0.5, &a}};
+  Result<BlendedUncertainty> u = BlendMeasurementUncertainty(v, 1);
+  ASSERT_TRUE(u.ok());
+  EXPECT_NEAR(u->measurement[0], 0.02, 1e-15);
+}
+
+TEST(BlendUncertainty, AVertexWithoutABudgetIsNamedNotCountedAsZero) {
+  ReadingBudget a = Budget({Make("sample_signal", Sharing::kIndependent, 0, {0.02})});
+  a.not_estimated = {"pose_repeatability: no gradient yet"};
+  ReadingBudget b = a;
+  const std::vector<BlendVertex> v = {{1, 0.5, &a}, {2, 0.25, &b}, {3, 0.25, nullptr}};
+  Result<BlendedUncertainty> u = BlendMeasurementUncertainty(v, 1);
+  ASSERT_TRUE(u.ok());
+  EXPECT_NEAR(u->measurement[0], std::hypot(0.01, 0.005), 1e-15);
+  ASSERT_EQ(u->not_estimated.size(), 2u);  // the pose once, and reading 3
+  EXPECT_EQ(u->not_estimated[0], "pose_repeatability: no gradient yet");
+  EXPECT_NE(u->not_estimated[1].find("reading 3"), std::string::npos);
+  EXPECT_NE(u->not_estimated[1].find("not estimated"), std::string::npos);
+}
+
+TEST(BlendUncertainty, MixedTermsCombineByGum52) {
+  // Both vertices: an independent signal term, the white standard (shared), and each its own dark.
+  const ReadingBudget a = Budget({Make("sample_signal", Sharing::kIndependent, 0, {0.03}),
+                                  Make("white_standard", Sharing::kWhiteStandard, 9, {0.05}),
+                                  Make("dark_signal", Sharing::kDarkReading, 20, {0.01})});
+  const ReadingBudget b = Budget({Make("sample_signal", Sharing::kIndependent, 0, {0.01}),
+                                  Make("white_standard", Sharing::kWhiteStandard, 9, {0.07}),
+                                  Make("dark_signal", Sharing::kDarkReading, 21, {0.02})});
+  const std::vector<BlendVertex> v = {{1, 0.6, &a}, {2, 0.4, &b}};
+  Result<BlendedUncertainty> u = BlendMeasurementUncertainty(v, 1);
+  ASSERT_TRUE(u.ok());
+  const double white = 0.6 * 0.05 + 0.4 * 0.07;
+  const double shared2 = white * white + 0.006 * 0.006 + 0.008 * 0.008;
+  const double ind2 = 0.018 * 0.018 + 0.004 * 0.004;
+  EXPECT_NEAR(u->shared[0], std::sqrt(shared2), 1e-15);
+  EXPECT_NEAR(u->measurement[0], std::sqrt(shared2 + ind2), 1e-15);
+  // Treating all as independent would understate it.
+  EXPECT_GT(u->measurement[0], std::hypot(0.6 * a.combined[0], 0.4 * b.combined[0]));
+}
+
+TEST(BlendUncertainty, BadInputIsNamed) {
+  const ReadingBudget a = Budget({Make("sample_signal", Sharing::kIndependent, 0, {0.03, 0.01})});
+  const std::vector<BlendVertex> wrong_bands = {{5, 1.0, &a}};
+  Result<BlendedUncertainty> u = BlendMeasurementUncertainty(wrong_bands, 3);
+  ASSERT_FALSE(u.ok());
+  EXPECT_NE(u.status().message().find("reading 5"), std::string::npos);
+  const std::vector<BlendVertex> nan_weight = {{6, std::nan(""), &a}};
+  EXPECT_FALSE(BlendMeasurementUncertainty(nan_weight, 2).ok());
+  EXPECT_FALSE(BlendMeasurementUncertainty(nan_weight, 0).ok());
+}
+
+TEST(InterpolationSpread, ZeroAtAReadingAndTheWeightedSpreadElsewhere) {
+  const std::vector<double> f1 = {1.0, 2.0};
+  const std::vector<double> f2 = {3.0, 2.0};
+  const std::vector<std::span<const double>> spectra = {f1, f2};
+  const std::vector<double> at_reading = {1.0, 0.0};
+  EXPECT_EQ(InterpolationSpread(at_reading, spectra, f1), (std::vector<double>{0.0, 0.0}));
+  const std::vector<double> half = {0.5, 0.5};
+  const std::vector<double> blend = {2.0, 2.0};
+  const std::vector<double> u = InterpolationSpread(half, spectra, blend);
+  EXPECT_NEAR(u[0], 1.0, 1e-15);  // sqrt(0.5·1 + 0.5·1)
+  EXPECT_EQ(u[1], 0.0);           // the vertices agree in this band
+}
+
+}  // namespace
+}  // namespace brdf::uncertainty
