@@ -9,6 +9,8 @@ one, so both see the same machine load. Figures are medians over the repetitions
   data sets   rig      the paper's rig grid (2,153 points), queries = random rig poses
                        (α ∈ [0,70], β ∈ [-175,180], δ ∈ [0,146.25], converted like the grid)
               random   50,000 uniform points in [0,90)×[0,90)×[0,360), queries uniform there
+              random401  the same points and queries, 401-band spectra (1 nm; when random401.csv
+                       is in the work folder)
               aniso4d  4D anisotropic set (θi, φi, θo, φo), uniform in [0,90)×[0,360)×[0,90)×[0,360)
   orders      random   as generated
               sorted   the same queries sorted along a Morton (Z-order) curve
@@ -127,6 +129,11 @@ def main():
         ("aniso4d", os.path.join(args.work, "aniso4d.csv"),
          lambda n: box_queries(n, [90, 360, 90, 360], 103)),
     ]
+    # The same 50,000 points and queries as `random` with 401-band spectra (1 nm, a CS-2000's
+    # grid), beside the 101-band case: what a 4× longer spectrum costs each side.
+    random401 = os.path.join(args.work, "random401.csv")
+    if os.path.exists(random401):
+        sets.insert(2, ("random401", random401, lambda n: box_queries(n, [90, 90, 360], 102)))
     drv = Driver(args.driver)
     results = {"load_start": load_start, "sets": {}, "runs": [], "checks": [], "grid": []}
     rows = []  # (set, order, method, median q/s, median cpu µs/query, failed fraction, ref)
@@ -146,7 +153,8 @@ def main():
         info = drv.ask(f"samples {name} {path}")
         lnd, lnd_build_s, _ = timed(lambda: LinearNDInterpolator(pts, vals))
         kdt, kdt_build_s, _ = timed(lambda: cKDTree(pts))
-        results["sets"][name] = {"points": len(pts), "dims": d, "queries": n_q, "ours_build_s": info["build_s"],
+        results["sets"][name] = {"points": len(pts), "dims": d, "bands": vals.shape[1], "queries": n_q,
+                                 "ours_build_s": info["build_s"],
                                  "scipy_build_s": {"LinearNDInterpolator": lnd_build_s, "cKDTree": kdt_build_s}}
         for order in orders:
             drv.ask(f"queries {name}_{order} {qpaths[order]}")
@@ -220,17 +228,18 @@ def main():
               "nearest": "scipy_kdt"}
     by = {(r[0], r[1], r[2]): r for r in rows}
     print()
-    print(f"Our interpolation vs scipy {__import__('scipy').__version__}: single thread, 101 bands, "
+    print(f"Our interpolation vs scipy {__import__('scipy').__version__}: single thread, 101 bands "
+          f"(random401: 401), "
           f"median of {args.reps} interleaved repetitions (wall clock)")
     print(f"load average at start {load_start[0]:.2f} {load_start[1]:.2f} {load_start[2]:.2f}, "
           f"at end {results['load_end'][0]:.2f} {results['load_end'][1]:.2f} {results['load_end'][2]:.2f}"
           f" (2 cores)")
-    hdr = f"{'data set':<22} {'query order':<12} {'method':<28} {'queries/s':>11} {'CPU µs/q':>9} {'failed':>7} {'× scipy':>8}"
+    hdr = f"{'data set':<27} {'query order':<12} {'method':<28} {'queries/s':>11} {'CPU µs/q':>9} {'failed':>7} {'× scipy':>8}"
     print(hdr)
     print("-" * len(hdr))
     for name, _, _ in sets:
         info = results["sets"][name]
-        label = f"{name} N={info['points']:,} {info['dims']}D"
+        label = f"{name} N={info['points']:,} {info['dims']}D {info['bands']}b"
         for order in ("random", "sorted"):
             for method in ["scipy_lnd", "octant", "octant_full", "delaunay", "scipy_kdt", "nearest"]:
                 r = by.get((name, order, method))
@@ -241,7 +250,7 @@ def main():
                     ref = by[(name, order, ref_of[method])]
                     ratio = f"{r[3] / ref[3]:.1f}×"
                 fail = "" if r[5] is None else f"{100 * r[5]:.2f}%"
-                print(f"{label:<22} {order:<12} {names[method]:<28} {r[3]:>11,.0f} {r[4]:>9.2f} {fail:>7} {ratio:>8}")
+                print(f"{label:<27} {order:<12} {names[method]:<28} {r[3]:>11,.0f} {r[4]:>9.2f} {fail:>7} {ratio:>8}")
         print()
     print("Index build (s): " + "; ".join(
         f"{n}: ours octant {s['ours_build_s']['octant']:.3f}, nearest {s['ours_build_s']['nearest']:.3f}"
@@ -262,6 +271,14 @@ def main():
               f"({g['n'] / statistics.median(g['wall_s']):,.0f} queries/s), {statistics.median(g['cpu_s']):.2f} s CPU, "
               f"ok {g['ok']:,} of {g['n']:,}")
     bad = sum(c["mismatches"] for c in results["checks"]) + gc["mismatches"]
+    if "random401" in results["sets"]:
+        print("401 bands beside 101 (the random set's points and queries, random order; CPU µs a query,"
+              " which the machine's load moves less than wall clock):")
+        for method in ("octant", "octant_full", "delaunay", "scipy_lnd"):
+            a, b = by.get(("random", "random", method)), by.get(("random401", "random", method))
+            if a and b:
+                print(f"  {names[method]:<28} 101 bands {a[4]:6.2f} µs, 401 bands {b[4]:6.2f} µs "
+                      f"({b[4] / a[4]:.2f}×); queries/s {a[3]:,.0f} → {b[3]:,.0f}")
 
     # The issue's targets, as measured here. Wall-clock ratios follow the machine's load; the CPU
     # ratio (CPU time per query, scipy's over ours) is shown beside them.
@@ -269,12 +286,12 @@ def main():
     print("× scipy: our queries/s over scipy's on the same data, queries and order (octant and Delaunay"
           " against LinearNDInterpolator, nearest against cKDTree).")
     print("Targets (issue 6):")
-    for name in ("rig", "random"):
+    for name in ("rig", "random", "random401"):
         ours, ref = by.get((name, "random", "octant")), by.get((name, "random", "scipy_lnd"))
         if ours is None or ref is None:
             continue
         ratio, cpu_ratio = ours[3] / ref[3], ref[4] / ours[4]
-        print(f"  octant, 1 thread, random order, {name:<6} >= 10× scipy: {ratio:5.1f}× wall, "
+        print(f"  octant, 1 thread, random order, {name:<9} >= 10× scipy: {ratio:5.1f}× wall, "
               f"{cpu_ratio:5.1f}× CPU  {'met' if ratio >= 10 else 'NOT met'}")
     checks_ok = bad == 0
     print(f"  octant answers identical to the O(N) reference: {'met' if checks_ok else 'NOT met'}"

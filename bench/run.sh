@@ -47,6 +47,7 @@ echo
 interp="$build/tools/brdf-interp/brdf-interp"
 "$interp" synth --grid paper -o "$work/rig.csv" 2>/dev/null
 "$interp" synth --grid random 50000 --seed 12 -o "$work/random.csv" 2>/dev/null
+"$interp" synth --grid random 50000 --seed 12 --bands 401 -o "$work/random401.csv" 2>/dev/null
 "$interp" synth --grid random "$points4d" --seed 13 --dims 4 -o "$work/aniso4d.csv" 2>/dev/null
 
 echo "== (a) micro-benchmarks (Google Benchmark; items/s = queries, builds or blends per second, 1 thread)"

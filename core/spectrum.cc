@@ -17,11 +17,6 @@ std::string Fmt(double v) {
   return s.str();
 }
 
-std::string GridText(const WavelengthGrid& g) {
-  return Fmt(g.start_nm) + "–" + Fmt(g.last_nm()) + " nm every " + Fmt(g.step_nm) + " nm (" +
-         std::to_string(g.count) + " bands)";
-}
-
 std::string BandText(const WavelengthGrid& g, std::size_t k) {
   return Fmt(g.at(k)) + " nm (band " + std::to_string(k) + ")";
 }
@@ -69,6 +64,11 @@ Result<Spectrum> ScaleByWhite(const Spectrum& in, const std::string& in_name, Wh
 }
 
 }  // namespace
+
+std::string GridText(const WavelengthGrid& g) {
+  return Fmt(g.start_nm) + "–" + Fmt(g.last_nm()) + " nm every " + Fmt(g.step_nm) + " nm (" +
+         std::to_string(g.count) + " bands)";
+}
 
 Status ValidateSpectrum(const Spectrum& s, const std::string& what) {
   if (!s.grid.valid()) {

@@ -28,6 +28,9 @@ inline constexpr double kWhiteStandardReflectance = 0.99;
 
 // Checks that the grid is valid, that there is one value per band and that every value is finite.
 // `what` names the spectrum in the message ("sample reading", "white reference", ...).
+// A grid in the operator's words: "380–780 nm every 4 nm (101 bands)".
+std::string GridText(const WavelengthGrid& g);
+
 Status ValidateSpectrum(const Spectrum& s, const std::string& what);
 
 // R = I / I0, or (I − D) / (I0 − D) with a dark reading. Errors (kInvalidArgument): an invalid

@@ -82,6 +82,9 @@ struct SessionRecord {
   std::string config_json;
   std::string uuid;  // global identity: a random (version 4) UUID, lower-case with hyphens
   std::string rig;   // the rig that recorded it; '' for sessions older than rig naming
+  // The session's wavelength grid: its first reading's (CompleteStepWithReading refuses a reading
+  // on another); nullopt before the first reading.
+  std::optional<WavelengthGrid> grid;
 };
 
 // One planned step. Steps are numbered 0, 1, 2, … in execution order.

@@ -9,7 +9,11 @@ namespace brdf::storage {
 const std::string_view kSessionColumns =
     "id, name, plan_kind, plan_json, state, state_reason, created_at, started_at, finished_at, "
     "created_by_role, total_steps, done_steps, white_reflectance, meter_serial, config_json, "
-    "uuid, rig";
+    "uuid, rig, "
+    // The session's grid: its first reading's (readings_by_session finds it).
+    "(SELECT wl_start_nm FROM readings WHERE session_id = sessions.id ORDER BY id LIMIT 1), "
+    "(SELECT wl_step_nm FROM readings WHERE session_id = sessions.id ORDER BY id LIMIT 1), "
+    "(SELECT wl_count FROM readings WHERE session_id = sessions.id ORDER BY id LIMIT 1)";
 
 const std::string_view kStepColumns =
     "session_id, step_index, kind, alpha, beta, gamma, delta, prompt, prompt_kind, "
@@ -61,6 +65,9 @@ Result<SessionRecord> ReadSession(const Statement& st, const std::string& path) 
   s.config_json = st.Text(14);
   s.uuid = st.Text(15);
   s.rig = st.Text(16);
+  if (!st.IsNull(19)) {
+    s.grid = WavelengthGrid{st.Double(17), st.Double(18), static_cast<std::size_t>(st.Int64(19))};
+  }
   return s;
 }
 

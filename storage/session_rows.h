@@ -22,7 +22,7 @@ Result<T> FromColumn(Result<T> parsed, const std::string& path, const std::strin
                  "; run CheckSession or sqlite3 " + path + " 'PRAGMA integrity_check'");
 }
 
-extern const std::string_view kSessionColumns;
+extern const std::string_view kSessionColumns;  // select them FROM sessions (unaliased)
 extern const std::string_view kStepColumns;
 extern const std::string_view kReadingColumns;  // select them FROM kReadingsWithUncertainty
 extern const std::string_view kReadingsWithUncertainty;  // readings LEFT JOIN reading_uncertainty

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "core/spectrum.h"
 #include "core/status.h"
 #include "storage/schema.h"
 #include "storage/session_rows.h"
@@ -166,6 +167,25 @@ Status RequireStepTakes(Database& db, std::int64_t session, int step_index,
                            .WithContext(what));
   return RequireLinkedReading(db, session, reading.dark_reading_id, ReadingKind::kDark, "dark")
       .WithContext(what);
+}
+
+// A session holds one wavelength grid, its first reading's: a reading on another (a meter of
+// another model put in mid-session) is refused, so every export and index of it has one grid.
+Status RequireSessionGrid(Database& db, std::int64_t session, const ReadingRecord& reading,
+                          const std::string& what) {
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db.Prepare("SELECT wl_start_nm, wl_step_nm, wl_count FROM readings "
+                                   "WHERE session_id = ? ORDER BY id LIMIT 1"));
+  st.Bind(1, session);
+  BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
+  if (!row) return Status::Ok();
+  const WavelengthGrid first{st.Double(0), st.Double(1), static_cast<std::size_t>(st.Int64(2))};
+  if (first == reading.grid) return Status::Ok();
+  return FailedPrecondition(what + ": the reading is on " + GridText(reading.grid) + " but " +
+                            SessionName(session) + " holds readings on " + GridText(first) +
+                            " (its first reading's); a session keeps one wavelength grid: "
+                            "measure with a meter of that grid, or start a new session for this "
+                            "meter");
 }
 
 // The reading's row (its spectrum encoded as `blob`).
@@ -552,6 +572,7 @@ Result<std::int64_t> SessionStore::CompleteStepWithReading(std::int64_t session,
   BRDF_ASSIGN_OR_RETURN(SessionState state, SessionStateOf(db, session));
   BRDF_RETURN_IF_ERROR(RequireStarted(session, state, what));
   BRDF_RETURN_IF_ERROR(RequireStepTakes(db, session, step_index, reading, what));
+  BRDF_RETURN_IF_ERROR(RequireSessionGrid(db, session, reading, what));
   BRDF_RETURN_IF_ERROR(InsertReading(db, session, step_index, reading, blob, recorded_at, what));
   const std::int64_t id = db.last_insert_rowid();
   if (uncertainty->has_value()) {

@@ -128,6 +128,8 @@ class SessionStore final : public SessionReader {
   //   kInvalidArgument     the step takes no reading (move, prompt), the reading's kind does not
   //                        match the step, the spectrum does not match its grid, or the reference/
   //                        dark reading named is not one of this session's of that kind;
+  //   kFailedPrecondition  the reading's wavelength grid is not the session's (its first
+  //                        reading's): a session keeps one grid;
   //   kIoError             the disk refused the write (nothing of it was kept).
   Result<std::int64_t> CompleteStepWithReading(std::int64_t session, int step_index,
                                                const ReadingRecord& reading);

@@ -39,10 +39,11 @@ struct AppearanceSettings {
 };
 
 // What a render holds, bytes (for the memory budget, rpc/memory_budget.h): per pixel of the
-// sphere its spectrum (~101 bands) and, per illuminant, its RGBA twice (the image and the answer).
-std::uint64_t AppearanceBytes(const AppearanceSettings& s) {
+// sphere its spectrum (`bands`, the session's grid: 101 to 401) and, per illuminant, its RGBA
+// twice (the image and the answer).
+std::uint64_t AppearanceBytes(const AppearanceSettings& s, std::size_t bands) {
   const auto pixels = static_cast<std::uint64_t>(s.sphere.size) * s.sphere.size;
-  return pixels * (101 * 8 + 2 * 4 * std::max<std::uint64_t>(1, s.illuminants.size()));
+  return pixels * (bands * 8 + 2 * 4 * std::max<std::uint64_t>(1, s.illuminants.size()));
 }
 
 grpc::Status ParseAppearance(const v1::AppearanceRequest& r, AppearanceSettings* out) {
@@ -371,7 +372,8 @@ grpc::Status InterpolationService::RenderAppearance(grpc::ServerContext* context
   if (Result<data::CieTables> cie = data::LoadCieTables(data::kDefaultColordDir); !cie.ok()) {
     st = ToGrpcStatus(cie.status());
     lasting = true;  // the installation's: the same for every call
-  } else if (grpc::Status budget = slot->Reserve(AppearanceBytes(s)); !budget.ok()) {
+  } else if (grpc::Status budget = slot->Reserve(AppearanceBytes(s, index->grid.count));
+             !budget.ok()) {
     st = budget;
   } else if (slot->Work() && !context->IsCancelled()) {
     ++appearance_renders_;

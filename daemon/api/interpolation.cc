@@ -328,12 +328,12 @@ constexpr int kSliceChunks = 4;
 
 // What a batch holds while it streams, bytes (for the memory budget, rpc/memory_budget.h): its
 // request (as received and parsed), and per slice the coordinates, the octant method's sort and
-// blends (~200 bytes a query) and the chunks of full answers (~1.2 kB each with provenance).
-std::uint64_t BatchBytes(const v1::InterpolateBatchRequest& request, int chunk) {
+// blends (~200 bytes a query) and the chunks of full answers (ResultBytes: ~1.2 kB each with
+// provenance at 101 bands, ~3.6 kB at 401; four more spectra with the uncertainty).
+std::uint64_t BatchBytes(const v1::InterpolateBatchRequest& request, int chunk, std::size_t bands) {
   const auto n = static_cast<std::uint64_t>(request.directions_size());
   const std::uint64_t slice = std::min<std::uint64_t>(n, std::uint64_t{kSliceChunks} * chunk);
-  // With uncertainty: four more spectra per answer (~3.3 kB on the PR-650's grid).
-  const std::uint64_t answer = request.include_uncertainty() ? 1200 + 3300 : 1200;
+  const std::uint64_t answer = ResultBytes(bands, request.include_uncertainty());
   return 3 * request.ByteSizeLong() + slice * (200 + answer) + 2ULL * chunk * answer;
 }
 
@@ -353,7 +353,6 @@ grpc::Status InterpolationService::InterpolateBatch(
   Settings settings;
   int chunk = 0;
   if (grpc::Status st = CheckBatch(*request, &id, &settings, &chunk); !st.ok()) return st;
-  if (grpc::Status st = slot->Reserve(BatchBytes(*request, chunk)); !st.ok()) return st;
 
   // One snapshot for the whole batch: every result sees the same readings.
   Result<std::shared_ptr<const IndexSnapshot>> got =
@@ -361,6 +360,13 @@ grpc::Status InterpolationService::InterpolateBatch(
   if (!got.ok()) return ToGrpcStatus(got.status());
   const IndexSnapshot& index = **got;
   if (grpc::Status st = CheckOptionsFit(settings.options, index); !st.ok()) return st;
+  // A chunk stays under half a client's receive limit whatever the session's grid (the same
+  // answer in more chunks; clients place results by first_index).
+  chunk = static_cast<int>(MaxChunkResults(static_cast<std::uint32_t>(chunk), index.grid.count,
+                                           request->include_uncertainty()));
+  if (grpc::Status st = slot->Reserve(BatchBytes(*request, chunk, index.grid.count)); !st.ok()) {
+    return st;
+  }
 
   // A slice of kSliceChunks chunks at a time in one EvaluateEach (the octant method sorts it by
   // cell), its answers streamed chunk by chunk as they come, in order.

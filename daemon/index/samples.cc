@@ -15,6 +15,7 @@ IndexSamples::IndexSamples(bool anisotropic, double white_reflectance,
 bool IndexSamples::Fold(const storage::ReadingRecord& record) {
   if (record.id <= working_.through_id) return false;
   working_.through_id = record.id;
+  if (!first_grid_.has_value()) first_grid_ = record.grid;
   std::optional<SampleQuantities> derived = deriver_.Fold(storage::ToReading(record));
   if (!derived.has_value()) return true;  // a reference or a dark: kept for the samples after it
   const Directions& d = record.directions;

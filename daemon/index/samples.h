@@ -60,8 +60,12 @@ class IndexSamples {
   const State& published() const { return published_; }
   bool anisotropic() const { return anisotropic_; }
   int dims() const { return anisotropic_ ? 4 : 3; }
-  // The session's grid (its first usable sample reading's); PR-650's before there is one.
-  WavelengthGrid grid() const { return deriver_.grid().value_or(WavelengthGrid::Pr650()); }
+  // The session's grid: its first usable sample reading's, else its first reading's (a white
+  // reference alone already tells it; storage keeps one grid per session). Before any reading
+  // nothing can be answered and the PR-650's is only the answers' label.
+  WavelengthGrid grid() const {
+    return deriver_.grid().value_or(first_grid_.value_or(WavelengthGrid::Pr650()));
+  }
 
  private:
   void Add(Quantity q, const storage::ReadingRecord& record, std::span<const double> coords,
@@ -70,6 +74,7 @@ class IndexSamples {
 
   const bool anisotropic_;
   ReadingDeriver deriver_;
+  std::optional<WavelengthGrid> first_grid_;  // the first reading's, of any kind
   State published_;
   State working_;  // published_ plus what was folded since; grown_ holds its sets that grew
   std::array<std::shared_ptr<interp::SampleSet>, kQuantityCount> grown_;

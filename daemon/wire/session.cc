@@ -55,6 +55,7 @@ v1::Session ToProtoSession(const SessionFacts& f) {
   }
   s.set_uuid(rec.uuid);
   s.set_rig(rec.rig);
+  if (rec.grid.has_value()) *s.mutable_grid() = ToProtoGrid(*rec.grid);
   if (f.summary != nullptr) *s.mutable_summary() = ToProtoSummary(*f.summary);
   SetProgress(f, state, &s);
   if (f.eta_s.has_value()) s.set_eta_s(*f.eta_s);

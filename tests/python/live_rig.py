@@ -72,15 +72,18 @@ class LiveRig:
     """A running brdf-sim + brdfd pair; use as a context manager or call start()/stop()."""
 
     def __init__(self, sim_path, daemon_path, white_reflectance=0.99, seed=7, sim_args=(),
-                 extra_config=""):
+                 extra_config="", meter="pr650"):
         """seed, sim_args: brdf-sim's --seed and further flags (a material, error sources);
-        extra_config: TOML appended to brdfd's configuration (e.g. an [uncertainty] table)."""
+        extra_config: TOML appended to brdfd's configuration (e.g. an [uncertainty] table);
+        meter: brdf-sim's --meter and brdfd's [meter] model (pr650; pr670, pr655: 201 or 101
+        bands; cs2000, cs2000a, cs3000: 401 bands)."""
         self.sim_path = sim_path
         self.daemon_path = daemon_path
         self.white_reflectance = white_reflectance
         self.seed = seed
         self.sim_args = list(sim_args)
         self.extra_config = extra_config
+        self.meter = meter
         self.sample_extra = ""  # more [sample] keys, e.g. "white_reflectance_uncertainty = 0.005"
         self.dir = tempfile.mkdtemp(prefix="brdf_pyclient_")
         self.operator_token = secrets.token_hex(16)
@@ -112,7 +115,8 @@ class LiveRig:
     def start(self, timeout=30.0):
         self.sim = self._spawn([self.sim_path, "--time-scale", str(TIME_SCALE), "--seed",
                                 str(self.seed), "--wake-window", "0", "--no-pacing",
-                                "--modbus-port", "0", "--log-level", "warn"] + self.sim_args,
+                                "--modbus-port", "0", "--log-level", "warn",
+                                "--meter", self.meter] + self.sim_args,
                                "sim.log")
         lines = _Lines(self.sim.stdout)
         deadline = time.monotonic() + timeout
@@ -120,7 +124,7 @@ class LiveRig:
             while True:
                 line = lines.next(deadline)
                 key, _, value = line.partition(" ")
-                if key == "pr650":
+                if key == self.meter:  # the meter's port line is named after --meter
                     self.pr650 = value
                 elif key == "modbus-tcp":
                     self.modbus_host, _, port = value.rpartition(":")
@@ -153,6 +157,8 @@ class LiveRig:
         for name, unit in (("alpha", 1), ("beta", 2), ("delta", 4)):
             axes += (f"[stage.axes.{name}]\nunit_id = {unit}\nspeed_deg_s = 30\n"
                      + ("present = true\n" if name == "delta" else ""))
+        # The PR-655/670's commands are typed a character at a time: keep the gap short.
+        typed = "char_gap_ms = 1\n" if self.meter in ("pr655", "pr670") else ""
         return f"""# brdfd for brdf-sim, written by tests/python/live_rig.py
 [server]
 listen = "127.0.0.1:0"
@@ -161,8 +167,9 @@ listen = "127.0.0.1:0"
 database = "{self.dir}/brdfd.db"
 
 [meter]
+model = "{self.meter}"
 port = "{self.pr650}"
-pacing_ms = 5
+{typed}pacing_ms = 5
 quiet_gap_ms = 20
 reply_timeout_ms = 1000
 measurement_timeout_ms = 5000

@@ -49,6 +49,25 @@ TEST(TruthFormatTest, TextHasOneBandPerLineAndRoundTrips) {
   EXPECT_EQ(k, grid.count);
 }
 
+// `brdf-sim --meter cs2000 truth ...`: the truth on the meter's grid, 401 bands every 1 nm.
+TEST(TruthFormatTest, TheTruthIsOnTheMetersGrid) {
+  TruthQuery q;
+  q.directions = {35, 0, 50, 150};
+  q.json = true;
+  const WavelengthGrid cs2000{380, 1, 401};
+  const std::string json = FormatTruth(q, SampleMaterial(false, false), cs2000);
+  const auto nm = JsonArray(json, "wavelength_nm");
+  const auto brdf = JsonArray(json, "brdf");
+  ASSERT_EQ(nm.size(), 401u);
+  ASSERT_EQ(brdf.size(), 401u);
+  EXPECT_EQ(nm.front(), 380);
+  EXPECT_EQ(nm[1], 381);
+  EXPECT_EQ(nm.back(), 780);
+  const std::vector<double> truth =
+      SampleMaterial(false, false).EvaluateSpectrum(q.directions, cs2000);
+  for (std::size_t k = 0; k < truth.size(); ++k) EXPECT_EQ(brdf[k], truth[k]) << k;
+}
+
 TEST(TruthFormatTest, JsonCarriesDirectionsAndSpectrum) {
   TruthQuery q;
   q.directions = {20, 30, 40, 250};

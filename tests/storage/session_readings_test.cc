@@ -81,5 +81,57 @@ TEST(SessionReadingsTest, AReadingsBudgetComesWithItAsItsStandardUncertainty) {
   EXPECT_TRUE(ToReading(MakeReading(3, ReadingKind::kSample)).brdf_u.empty());
 }
 
+// A session keeps one wavelength grid, its first reading's (issue 41): the session record says
+// it once there is a reading, and a reading on another grid is refused without being stored.
+TEST(SessionReadingsTest, ASessionKeepsItsFirstReadingsGridAndRefusesAnother) {
+  TempDir dir;
+  auto store = SessionStore::Open(dir.File("rig.db"));
+  ASSERT_TRUE(store.ok());
+  auto id = (*store)->CreateSession(MakeNewSession(), MakeSteps(4));
+  ASSERT_TRUE(id.ok());
+  ASSERT_TRUE((*store)->SetSessionState(*id, SessionState::kRunning, "").ok());
+  Result<SessionRecord> before = (*store)->GetSession(*id);
+  ASSERT_TRUE(before.ok());
+  EXPECT_FALSE(before->grid.has_value()) << "no reading yet, no grid";
+
+  const WavelengthGrid cs2000{380, 1, 401};
+  ASSERT_TRUE((*store)
+                  ->CompleteStepWithReading(*id, 1, MakeReading(1, ReadingKind::kReference, cs2000))
+                  .ok());
+  Result<std::int64_t> mixed = (*store)->CompleteStepWithReading(
+      *id, 2, MakeReading(2, ReadingKind::kSample, WavelengthGrid::Pr650()));
+  ASSERT_FALSE(mixed.ok());
+  EXPECT_EQ(mixed.status().code(), StatusCode::kFailedPrecondition);
+  const std::string& why = mixed.status().message();
+  EXPECT_NE(why.find("380–780 nm every 4 nm (101 bands)"), std::string::npos) << why;
+  EXPECT_NE(why.find("380–780 nm every 1 nm (401 bands)"), std::string::npos) << why;
+  EXPECT_NE(why.find("start a new session"), std::string::npos) << why;
+  // Nothing of it was kept: the step is still pending and takes a reading on the session's grid.
+  ASSERT_TRUE(
+      (*store)->CompleteStepWithReading(*id, 2, MakeReading(2, ReadingKind::kSample, cs2000)).ok());
+  auto readings = (*store)->GetReadings(*id, 0, 10);
+  ASSERT_TRUE(readings.ok());
+  ASSERT_EQ(readings->size(), 2u);
+  for (const ReadingRecord& r : *readings) EXPECT_EQ(r.grid, cs2000);
+
+  Result<SessionRecord> after = (*store)->GetSession(*id);
+  ASSERT_TRUE(after.ok());
+  ASSERT_TRUE(after->grid.has_value());
+  EXPECT_EQ(*after->grid, cs2000);
+  auto all = (*store)->ListSessions();
+  ASSERT_TRUE(all.ok());
+  ASSERT_EQ(all->size(), 1u);
+  EXPECT_EQ(all->front().grid, std::optional<WavelengthGrid>(cs2000));
+
+  // Another session is free to have another grid.
+  auto other = (*store)->CreateSession(MakeNewSession("pr650"), MakeSteps(3));
+  ASSERT_TRUE(other.ok());
+  ASSERT_TRUE((*store)->SetSessionState(*other, SessionState::kRunning, "").ok());
+  ASSERT_TRUE(
+      (*store)->CompleteStepWithReading(*other, 1, MakeReading(1, ReadingKind::kReference)).ok());
+  EXPECT_EQ((*store)->GetSession(*other)->grid,
+            std::optional<WavelengthGrid>(WavelengthGrid::Pr650()));
+}
+
 }  // namespace
 }  // namespace brdf::storage

@@ -151,10 +151,13 @@ TEST_F(SessionStoreTest, SessionAndStepsAreCreatedInOneTransaction) {
 
 TEST_F(SessionStoreTest, ReadingRoundTripsWithItsSpectrumBitExact) {
   const std::int64_t session = NewRunningSession(12);
-  auto ref = store_->CompleteStepWithReading(session, 1, MakeReading(1, ReadingKind::kReference));
+  // A PR-670's grid, for the reference too: a session keeps one grid.
+  const WavelengthGrid pr670{380, 2, 201};
+  auto ref =
+      store_->CompleteStepWithReading(session, 1, MakeReading(1, ReadingKind::kReference, pr670));
   ASSERT_TRUE(ref.ok()) << ref.status().ToString();
 
-  ReadingRecord in = MakeReading(2, ReadingKind::kSample, WavelengthGrid{380, 2, 201});
+  ReadingRecord in = MakeReading(2, ReadingKind::kSample, pr670);
   in.spectrum[0] = -0.0;
   in.spectrum[1] = std::numeric_limits<double>::denorm_min();
   in.spectrum[2] = 1.0 / 3.0;

@@ -2,7 +2,8 @@
 //   brdf-interp SAMPLES.csv QUERIES.csv [--method M] [--threads N] [--scale a,b,c[,d]]
 //               [--mirror-phi] [--reciprocity] [--explain] [-o OUT.csv]
 //   brdf-interp demo  [--method M] [--query θi,θo,φ] [...]    (also: brdf-interp --demo)
-//   brdf-interp synth --grid paper|random N [--seed S] [--dims 3|4] [--coordinates-only] -o F
+//   brdf-interp synth --grid paper|random N [--seed S] [--dims 3|4] [--bands 101|201|401]
+//                     [--coordinates-only] -o F
 #include <CLI/CLI.hpp>
 #include <iostream>
 
@@ -121,6 +122,10 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthRequest& synth, std::vector<std::s
       ->capture_default_str();
   synth_cmd->add_flag("--coordinates-only", synth.coordinates_only,
                       "write the coordinate columns only (a queries file)");
+  synth_cmd
+      ->add_option("--bands", synth.bands,
+                   "spectra on 380–780 nm: 101 (4 nm), 201 (2 nm) or 401 (1 nm) bands")
+      ->capture_default_str();
   synth_cmd->add_option("-o,--output", synth.output_path, "output CSV (default: standard output)");
   return synth_cmd;
 }

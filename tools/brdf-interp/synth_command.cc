@@ -33,7 +33,12 @@ int RunSynth(const SynthRequest& request, std::ostream& err) {
     return fail(InvalidArgument("--grid '" + request.grid + "': use paper or random N"));
   }
 
-  const WavelengthGrid wavelengths = WavelengthGrid::Pr650();
+  if (request.bands != 101 && request.bands != 201 && request.bands != 401) {
+    return fail(InvalidArgument("--bands " + std::to_string(request.bands) +
+                                ": use 101, 201 or 401 (380–780 nm every 4, 2 or 1 nm)"));
+  }
+  const WavelengthGrid wavelengths{380, 400.0 / static_cast<double>(request.bands - 1),
+                                   request.bands};
   const auto d = static_cast<std::size_t>(points.dims);
   std::string text;
   for (const char* name : interp::CoordinateColumns(points.dims)) {
@@ -77,8 +82,10 @@ int RunSynth(const SynthRequest& request, std::ostream& err) {
   if (!s.ok()) return fail(s);
   err << "brdf-interp synth: " << points.size() << " " << request.grid << " points"
       << (request.grid == "paper" ? " (" + std::to_string(points.poses) + " poses)" : "")
-      << (request.coordinates_only ? ", coordinates only" : ", 101-band analytic spectra") << " → "
-      << out->name() << "\n";
+      << (request.coordinates_only
+              ? std::string(", coordinates only")
+              : ", " + std::to_string(wavelengths.count) + "-band analytic spectra")
+      << " → " << out->name() << "\n";
   return kExitOk;
 }
 

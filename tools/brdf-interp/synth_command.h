@@ -2,6 +2,7 @@
 // --coordinates-only a queries CSV of the same points.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <ostream>
 #include <string>
@@ -14,6 +15,8 @@ struct SynthRequest {
   std::uint64_t seed = 1;
   int dims = 3;  // random only; the paper's grid is 3D
   bool coordinates_only = false;
+  std::size_t bands =
+      101;  // 380–780 nm: 101 (4 nm, PR-650), 201 (2 nm, PR-670), 401 (1 nm, CS-2000)
   std::string output_path;  // "" or "-": standard output
 };
 

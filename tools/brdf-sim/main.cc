@@ -218,7 +218,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "brdf-sim: %s\n", sample.status().ToString().c_str());
       return kUsageError;
     }
-    std::fputs(FormatTruth(truth, *sample).c_str(), stdout);
+    // On the meter's grid (--meter before `truth`): what a session on that meter holds.
+    std::fputs(FormatTruth(truth, *sample, OpticsFor(config).grid).c_str(), stdout);
     return 0;
   }
 

@@ -46,7 +46,7 @@ Result<std::unique_ptr<Client>> Client::Create(const ClientOptions& options) {
     credentials = grpc::InsecureChannelCredentials();
   }
   grpc::ChannelArguments args;
-  // Readings and batch answers carry 101-band spectra; allow large messages.
+  // Readings and batch answers carry spectra of 101 to 401 bands; allow large messages.
   args.SetMaxReceiveMessageSize(64 * 1024 * 1024);
   client->channel_ = grpc::CreateCustomChannel(options.address, credentials, args);
   client->control_ = v1::Control::NewStub(client->channel_);

@@ -86,11 +86,18 @@ export function createExplorer(root, report) {
     return [fig7a, fig7b];
   }
 
+  const sessionBands = new Map();  // session id → bands of its grid (Session.grid)
+
   // `listing`: Control.ListSessions's answer when the caller has it already.
   async function listSessions(listing) {
     const r = listing || await call('Control/ListSessions', { page_size: 100 });
     clear(sessionSelect);
-    for (const s of r.sessions) sessionSelect.append(el('option', { value: s.session_id }, `${s.name || s.session_id} (${stateName(s.state)})`));
+    // Each session with its state and, once it has a reading, its grid's bands (101 for a PR-650,
+    // 201 for a PR-670, 401 for a CS-2000).
+    for (const s of r.sessions) {
+      if (s.grid?.count) sessionBands.set(s.session_id, Number(s.grid.count));
+      sessionSelect.append(el('option', { value: s.session_id }, `${s.name || s.session_id} (${stateName(s.state)}${s.grid?.count ? `, ${s.grid.count} bands` : ''})`));
+    }
     // The newest session with readings first.
     // (brdf-archive's listing has no sample counts: there, a session with steps done.)
     for (const s of r.sessions) {
@@ -264,7 +271,7 @@ export function createExplorer(root, report) {
   function showGridSize() {
     const d = Number(gridStep.value);
     const cells = (90 / d) * (90 / d) * (180 / d);
-    const bands = polarData?.count;
+    const bands = polarData?.count ?? sessionBands.get(session);
     document.getElementById('grid-size').textContent = `${cells.toLocaleString('en')} cells` + (bands ? `, .npy ≈ ${(cells * bands * 8 / 1e6).toFixed(1)} MB` : '');
   }
   gridStep.addEventListener('change', showGridSize);

@@ -272,6 +272,9 @@ try {
   await shot(analyst, '08-analyst-console');
   await analyst.goto(`${rig.url}#explorer`);
   await analyst.waitForSelector('#explorer-session option');
+  // The session list says each measured session's grid (Session.grid): the PR-650's 101 bands.
+  const options = await analyst.$$eval('#explorer-session option', (os) => os.map((o) => o.textContent));
+  check(options.some((o) => /, 101 bands\)$/.test(o)), `a measured session shows its grid's bands (${options.join(' | ')})`);
   await shot(analyst, '09-analyst-explorer');
   check(errors.length === 0, `no errors in the browser console${errors.length ? `: ${errors.join(' | ')}` : ''}`);
 } catch (e) {

@@ -116,7 +116,9 @@ class BrdfClient:
             token = os.environ.get("BRDF_TOKEN") or None
         self._metadata: Tuple[Tuple[str, str], ...] = (
             (("authorization", f"Bearer {token}"),) if token else ())
-        options: List[Tuple[str, str]] = []
+        # Readings and batch chunks of a 401-band meter (a CS-2000) come near gRPC's default
+        # 4 MiB; allow larger messages, as brdfctl does.
+        options: List[Tuple[str, Any]] = [("grpc.max_receive_message_length", 64 * 1024 * 1024)]
         if server_name:
             options.append(("grpc.ssl_target_name_override", server_name))
         if tls or root_certificates or client_certificate or client_key:

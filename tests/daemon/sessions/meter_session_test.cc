@@ -2,7 +2,8 @@
 // with --meter, brdfd configured with [meter] model, a small pose-list plan (a reference, a dark,
 // two poses) run to completion through the gRPC API. The rig shows the meter's own model and
 // serial number (brdfctl rig prints the same fields), and every reading carries the meter's grid
-// (201 bands for a PR-670, 101 for a PR-655, 401 for a CS-2000) and as many values.
+// (201 bands for a PR-670, 101 for a PR-655, 401 for a CS-2000) and as many values; the session
+// says that grid (Session.grid).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -78,6 +79,18 @@ TEST_P(MeterSessionTest, ADemoSessionRunsOnTheMeterWithItsOwnGrid) {
   op_ = std::make_unique<GrpcOperator>(rig_, id);
   const v1::Session done = rig_.WaitForState(id, v1::SESSION_STATE_COMPLETED, 90s);
   ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED) << done.DebugString();
+  // The session says its grid (its readings'), in GetSession and in the listing.
+  EXPECT_EQ(done.grid().count(), static_cast<std::uint32_t>(m.bands));
+  EXPECT_DOUBLE_EQ(done.grid().start_nm(), m.first_nm);
+  EXPECT_DOUBLE_EQ(done.grid().step_nm(), m.step_nm);
+  {
+    v1::ListSessionsRequest list_request;
+    v1::ListSessionsResponse listed;
+    ASSERT_TRUE(
+        rig_.control().ListSessions(DaemonRig::Context().get(), list_request, &listed).ok());
+    ASSERT_EQ(listed.sessions_size(), 1);
+    EXPECT_EQ(listed.sessions(0).grid().count(), static_cast<std::uint32_t>(m.bands));
+  }
 
   // The rig shows the meter as it identified itself.
   v1::GetRigStatusRequest request;

@@ -72,8 +72,8 @@ std::string FormatTruth(const TruthQuery& q) {
   return FormatTruth(q, SampleMaterial(q.anisotropic, q.glossy));
 }
 
-std::string FormatTruth(const TruthQuery& q, const material::Material& sample) {
-  const WavelengthGrid grid = WavelengthGrid::Pr650();
+std::string FormatTruth(const TruthQuery& q, const material::Material& sample,
+                        const WavelengthGrid& grid) {
   const std::vector<double> f = sample.EvaluateSpectrum(q.directions, grid);
   const Directions& d = q.directions;
   std::string out;

@@ -12,12 +12,14 @@
 
 namespace brdf::sim {
 
-// The true BRDF (sr⁻¹) of `sample` at 380–780 nm every 4 nm for the query's directions.
+// The true BRDF (sr⁻¹) of `sample` on `grid` (the meter's: 380–780 nm every 4 nm for the PR-650,
+// 2 nm for a PR-670, 1 nm for a CS-2000) for the query's directions.
 // Text: a comment line naming the sample and the directions, then "<nm> <value>" per band.
 // JSON: {"theta_i":…, "phi_i":…, "theta_o":…, "phi_o":…, "anisotropic":…, "sample":"<name>",
 //        "unit":"sr^-1", "wavelength_nm":[…], "brdf":[…]}. Values print with 17 significant
 // digits (round-trip).
-std::string FormatTruth(const TruthQuery& query, const material::Material& sample);
+std::string FormatTruth(const TruthQuery& query, const material::Material& sample,
+                        const WavelengthGrid& grid = WavelengthGrid::Pr650());
 // The same for the built-in sample the query's --anisotropic or --glossy names.
 std::string FormatTruth(const TruthQuery& query);
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/plan/rig_description.h"
+#include "core/spectrum.h"
 #include "tools/brdfctl/output/text_format.h"
 
 namespace brdf::ctl {
@@ -18,6 +19,10 @@ std::string ProgressText(const v1::Progress& p) {
   return out;
 }
 
+std::string GridText(const v1::WavelengthGrid& g) {
+  return brdf::GridText(WavelengthGrid{g.start_nm(), g.step_nm(), g.count()});
+}
+
 std::string SessionLine(const v1::Session& s) {
   std::string out = s.session_id() + "  " + StateName(s.state()) + "  " +
                     std::to_string(s.progress().done_steps()) + "/" +
@@ -25,6 +30,7 @@ std::string SessionLine(const v1::Session& s) {
   if (s.eta_s() > 0) out += "  ETA " + Duration(s.eta_s());
   out += "  " + s.name();
   if (!s.rig().empty()) out += "  (rig " + s.rig() + ")";
+  if (s.has_grid()) out += "  " + std::to_string(s.grid().count()) + " bands";
   return out;
 }
 
@@ -85,6 +91,7 @@ void PrintSessionDetail(std::ostream& out, const v1::Session& s) {
   out << "  progress     " << ProgressText(s.progress()) << "\n";
   if (s.eta_s() > 0) out << "  ETA          " << Duration(s.eta_s()) << "\n";
   if (s.current_step() >= 0) out << "  step         " << s.current_step() << "\n";
+  if (s.has_grid()) out << "  wavelengths  " << GridText(s.grid()) << "\n";
   if (s.last_quality_code() >= 0) {
     out << "  last quality " << s.last_quality_code() << (s.last_quality_code() == 0 ? " (ok)" : "")
         << "\n";

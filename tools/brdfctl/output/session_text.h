@@ -12,7 +12,11 @@ namespace brdf::ctl {
 // "45/120 steps, 30/90 sample readings (37%)".
 std::string ProgressText(const v1::Progress& progress);
 
-// One line: "3  running  45/120 steps …  demo (reduced grid)".
+// "380–780 nm every 1 nm (401 bands)".
+std::string GridText(const v1::WavelengthGrid& grid);
+
+// One line: "3  running  45/120 steps …  demo (reduced grid)  401 bands" (bands once it has a
+// reading).
 std::string SessionLine(const v1::Session& session);
 
 // Several lines: state, progress, ETA, pending prompt (with the answer command), last fault,
