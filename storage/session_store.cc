@@ -625,6 +625,13 @@ Status SessionStore::ReplaceReadingUncertainties(
     BRDF_RETURN_IF_ERROR(del.Run().WithContext(what));
     BRDF_RETURN_IF_ERROR(InsertUncertainty(db, reading, bands, *columns, what));
   }
+  // The archive has the budgets it was shipped with: it replaces them (ship_batch.h).
+  BRDF_ASSIGN_OR_RETURN(
+      Statement outbox,
+      db.Prepare("INSERT INTO archive_outbox (session_id, step_index) SELECT ?, ? "
+                 "WHERE (SELECT value FROM archive_marks WHERE name = 'enabled') = 1"));
+  outbox.Bind(1, session).Bind(2, kOutboxBudgetsReplaced);
+  BRDF_RETURN_IF_ERROR(outbox.Run().WithContext(what));
   return tx.Commit().WithContext(what);
 }
 

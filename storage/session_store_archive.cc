@@ -32,6 +32,7 @@ Status FillUuids(Database& db, const std::set<std::int64_t>& ids,
 // Changes noted in the outbox: which sessions, which sessions with all their steps, which steps.
 struct OutboxChanges {
   std::set<std::int64_t> sessions, all_steps;
+  std::set<std::int64_t> budgets;  // sessions whose readings' budgets were replaced
   std::set<std::pair<std::int64_t, int>> steps;
   int count = 0;  // outbox entries read
 };
@@ -50,7 +51,9 @@ Status ReadOutbox(Database& db, int max_changes, OutboxChanges& changes, ShipBat
     const std::int64_t session = st.Int64(1);
     changes.sessions.insert(session);
     if (st.IsNull(2)) continue;
-    if (st.Int64(2) < 0) {
+    if (st.Int64(2) == kOutboxBudgetsReplaced) {
+      changes.budgets.insert(session);
+    } else if (st.Int64(2) < 0) {
       changes.all_steps.insert(session);
     } else {
       changes.steps.insert({session, st.Int(2)});
@@ -105,6 +108,26 @@ Status ReadChangedSteps(Database& db, const std::string& path, const OutboxChang
       batch.steps.push_back(std::move(s));
     }
     one.Reset();
+  }
+  return Status::Ok();
+}
+
+// The readings at or below the readings mark (the archive has them) of the sessions whose budgets
+// were replaced, with their budgets as they are now.
+Status ReadRebudgeted(Database& db, const std::string& path, const std::set<std::int64_t>& sessions,
+                      ShipBatch& batch) {
+  BRDF_ASSIGN_OR_RETURN(Statement st, db.Prepare("SELECT " + std::string(kReadingColumns) +
+                                                 " FROM " + std::string(kReadingsWithUncertainty) +
+                                                 " WHERE session_id = ? AND id <= ? ORDER BY id"));
+  for (std::int64_t id : sessions) {
+    st.Bind(1, id).Bind(2, batch.readings_through);
+    while (true) {
+      BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
+      if (!row) break;
+      BRDF_ASSIGN_OR_RETURN(ReadingRecord r, ReadReading(st, path));
+      if (r.uncertainty.has_value()) batch.rebudgeted.push_back(std::move(r));
+    }
+    st.Reset();
   }
   return Status::Ok();
 }
@@ -216,6 +239,7 @@ Result<ShipBatch> SessionStore::NextShipBatch(int max_readings, int max_changes)
   BRDF_ASSIGN_OR_RETURN(batch.devices_through, Mark(*db, "devices"));
   BRDF_ASSIGN_OR_RETURN(batch.audit_through, Mark(*db, "audit"));
   BRDF_ASSIGN_OR_RETURN(batch.events_through, Mark(*db, "events"));
+  BRDF_RETURN_IF_ERROR(ReadRebudgeted(*db, path_, changes.budgets, batch));
   // Rows may name sessions not shipped yet: next time.
   if (changes.count >= max_changes) return batch;
 

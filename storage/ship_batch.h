@@ -14,6 +14,10 @@
 
 namespace brdf::storage {
 
+// archive_outbox's step_index for "the session's readings' uncertainty budgets were replaced"
+// (-1: every step of the session; NULL: the session's row; ≥ 0: that step).
+inline constexpr std::int64_t kOutboxBudgetsReplaced = -2;
+
 struct ShipBatch {
   std::int64_t outbox_through = 0;  // the last outbox entry covered (0: none)
   std::vector<SessionRecord> sessions;
@@ -22,7 +26,11 @@ struct ShipBatch {
   std::vector<DeviceRecord> devices;
   std::vector<AuditRecord> audit;
   std::vector<SessionEventRecord> events;  // (v4) of sessions in `uuids`
-  std::int64_t readings_through = 0;       // marks after this batch
+  // Readings the archive has already (at or below the readings mark) whose uncertainty budgets the
+  // rig replaced since (SessionStore::ReplaceReadingUncertainties, at a session's end): the
+  // archive replaces theirs. Sessions in `uuids`.
+  std::vector<ReadingRecord> rebudgeted;
+  std::int64_t readings_through = 0;  // marks after this batch
   std::int64_t devices_through = 0;
   std::int64_t audit_through = 0;
   std::int64_t events_through = 0;
@@ -30,7 +38,7 @@ struct ShipBatch {
 
   bool empty() const {
     return sessions.empty() && steps.empty() && readings.empty() && devices.empty() &&
-           audit.empty() && events.empty() && outbox_through == 0;
+           audit.empty() && events.empty() && rebudgeted.empty() && outbox_through == 0;
   }
 };
 

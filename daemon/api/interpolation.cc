@@ -337,6 +337,17 @@ std::uint64_t BatchBytes(const v1::InterpolateBatchRequest& request, int chunk, 
   return 3 * request.ByteSizeLong() + slice * (200 + answer) + 2ULL * chunk * answer;
 }
 
+// A chunk stays under half a client's receive limit whatever the session's grid (the same answer
+// in more chunks; clients place results by first_index); then the batch's memory is reserved
+// (RESOURCE_EXHAUSTED naming [server] memory_budget_mb when it does not fit).
+grpc::Status FitChunkAndReserve(const v1::InterpolateBatchRequest& request,
+                                const IndexSnapshot& index, StreamRegistry::Slot& slot,
+                                int* chunk) {
+  *chunk = static_cast<int>(MaxChunkResults(static_cast<std::uint32_t>(*chunk), index.grid.count,
+                                            request.include_uncertainty()));
+  return slot.Reserve(BatchBytes(request, *chunk, index.grid.count));
+}
+
 }  // namespace
 
 grpc::Status InterpolationService::InterpolateBatch(
@@ -360,13 +371,7 @@ grpc::Status InterpolationService::InterpolateBatch(
   if (!got.ok()) return ToGrpcStatus(got.status());
   const IndexSnapshot& index = **got;
   if (grpc::Status st = CheckOptionsFit(settings.options, index); !st.ok()) return st;
-  // A chunk stays under half a client's receive limit whatever the session's grid (the same
-  // answer in more chunks; clients place results by first_index).
-  chunk = static_cast<int>(MaxChunkResults(static_cast<std::uint32_t>(chunk), index.grid.count,
-                                           request->include_uncertainty()));
-  if (grpc::Status st = slot->Reserve(BatchBytes(*request, chunk, index.grid.count)); !st.ok()) {
-    return st;
-  }
+  if (grpc::Status st = FitChunkAndReserve(*request, index, *slot, &chunk); !st.ok()) return st;
 
   // A slice of kSliceChunks chunks at a time in one EvaluateEach (the octant method sorts it by
   // cell), its answers streamed chunk by chunk as they come, in order.

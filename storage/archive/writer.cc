@@ -49,6 +49,10 @@ VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10)
 ON CONFLICT DO NOTHING
 )sql";
 
+constexpr std::string_view kDeleteUncertainty = R"sql(
+DELETE FROM reading_uncertainty WHERE session_uuid = $1 AND step_index = $2
+)sql";
+
 constexpr std::string_view kInsertDevice = R"sql(
 INSERT INTO devices (rig, rig_device_id, session_uuid, kind, model, serial, first_seen)
 VALUES ($1, $2, $3, $4, $5, $6, $7) ON CONFLICT DO NOTHING
@@ -171,6 +175,18 @@ Status WriteUncertainty(PgConnection& conn, const std::string& uuid, const Readi
       .WithContext(what + ": its uncertainty");
 }
 
+// A reading's budget as the rig has it now, in place of the one it was shipped with.
+Status ReplaceUncertainty(PgConnection& conn, const std::string& uuid, const ReadingRecord& r) {
+  const std::string what = "replacing the uncertainty of reading " + std::to_string(r.id) +
+                           " (step " + std::to_string(r.step_index) + ") of session " + uuid;
+  PgParams p;
+  p.Add(uuid).Add(r.step_index);
+  BRDF_RETURN_IF_ERROR(conn.QueryPrepared("delete_uncertainty", kDeleteUncertainty, std::move(p))
+                           .status()
+                           .WithContext(what));
+  return WriteUncertainty(conn, uuid, r, what);
+}
+
 Status WriteReading(PgConnection& conn, const std::string& uuid, const ReadingRecord& r) {
   PgParams p;
   p.Add(uuid)
@@ -219,6 +235,11 @@ Status WriteToArchive(PgConnection& conn, const std::string& rig, const ShipBatc
     std::optional<std::string> uuid = UuidOf(batch, r.session_id);
     if (!uuid) return Internal("reading " + std::to_string(r.id) + "'s session has no uuid");
     BRDF_RETURN_IF_ERROR(WriteReading(conn, *uuid, r));
+  }
+  for (const ReadingRecord& r : batch.rebudgeted) {
+    std::optional<std::string> uuid = UuidOf(batch, r.session_id);
+    if (!uuid) return Internal("reading " + std::to_string(r.id) + "'s session has no uuid");
+    BRDF_RETURN_IF_ERROR(ReplaceUncertainty(conn, *uuid, r));
   }
   for (const DeviceRecord& d : batch.devices) {
     PgParams p;

@@ -121,7 +121,8 @@ class ArchiveServerTest : public PgServerTest {
     PgServerTest::SetUp();
     if (!PgReady()) return;
     rig_ = std::make_unique<DaemonRig>();
-    ASSERT_TRUE(rig_->StartSim().ok());
+    const Status sim = rig_->StartSim();
+    ASSERT_TRUE(sim.ok()) << sim.ToString();
     const std::string cred = rig_->dir().file("archive.conninfo").string();
     ASSERT_TRUE(PgServer::WriteCredentials(cred, pg_->conninfo()).ok());
     const std::string toml = DaemonConfigToml(rig_->sim(), rig_->database()) +

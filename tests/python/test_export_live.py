@@ -385,10 +385,15 @@ class LiveExport(unittest.TestCase):
         csv_path = os.path.join(os.path.dirname(path), "brdf.csv")
         self.client.export(self.session_id, "csv", csv_path)
         header, rows = self.read_csv(csv_path)
-        self.assertEqual([float(h) for h in header[-m:]], list(samples.wavelengths))
-        brdf = np.array([[float(x) for x in row[-m:]] for row in rows])
+        # The CSV's spectrum columns are headed by the wavelength, its uncertainties by u_<λ>.
+        values = [i for i, h in enumerate(header) if h.replace(".", "").isdigit()]
+        uncertain = [header.index(f"u_{header[i]}") for i in values]
+        self.assertEqual([float(header[i]) for i in values], list(samples.wavelengths))
+        brdf = np.array([[float(row[i]) for i in values] for row in rows])
         np.testing.assert_allclose(np.array(data["BRDF"]["values"]).reshape(n, m),
                                    np.maximum(brdf, 0.0), rtol=1e-12, atol=0)
+        np.testing.assert_allclose(u, np.array([[float(row[i]) for i in uncertain]
+                                                for row in rows]), rtol=1e-12, atol=0)
         # Provenance as recorded.
         meta = doc["metadata"]
         brdfd = meta["adhoc_section"]["brdfd"]

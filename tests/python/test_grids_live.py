@@ -154,10 +154,14 @@ class Live401Bands(unittest.TestCase):  # pylint: disable=too-many-public-method
             path = self.path(f"readings-{quantity}.csv")
             r = self.client.export(self.session_id, "csv", path, quantity=quantity)
             header, rows = self.read_csv(path)
-            self.assertEqual(len(header), 16 + BANDS, quantity)
-            np.testing.assert_array_equal([float(h) for h in header[-BANDS:]], WAVELENGTHS)
+            # BRDF (and reflectance) rows carry a standard uncertainty per band after the values.
+            columns = 16 + BANDS * (2 if quantity == "brdf" else 1)
+            self.assertEqual(len(header), columns, quantity)
+            np.testing.assert_array_equal([float(h) for h in header[16:16 + BANDS]], WAVELENGTHS)
+            if quantity == "brdf":
+                self.assertEqual(header[16 + BANDS:], [f"u_{h}" for h in header[16:16 + BANDS]])
             self.assertEqual(len(rows), r.rows)
-            self.assertTrue(all(len(row) == 16 + BANDS for row in rows))
+            self.assertTrue(all(len(row) == columns for row in rows))
             if quantity == "radiance":
                 self.assertEqual(r.rows, len(self.readings.ids))
 

@@ -50,7 +50,7 @@ Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, inter
 
 // The most samples the fill chain's model is fitted to. A model of four parameters per band is
 // determined long before this many; a 50,000-reading session took 7 s to fit in full against
-// about 1 s for this subset (docs/export.md, "The fill chain").
+// about 1 s for this subset (tools/brdf-export/README.md, "Fill policy").
 inline constexpr std::size_t kModelFitSamples = 8192;
 
 // Which samples of a set of `count` the model is fitted to: all of them up to kModelFitSamples,

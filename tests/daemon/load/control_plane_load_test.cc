@@ -51,8 +51,11 @@ std::vector<ThreadNice> Threads(pid_t pid) {
     std::getline(comm, t.name);
     std::string line;
     std::getline(stat, line);
+    // A thread that ended between the listing and the reading has no stat: not counted.
+    const std::size_t name_end = line.rfind(')');
+    if (name_end == std::string::npos || name_end + 2 > line.size()) continue;
     // Fields after the name's closing parenthesis: state is field 3, nice field 19.
-    std::istringstream rest(line.substr(line.rfind(')') + 2));
+    std::istringstream rest(line.substr(name_end + 2));
     std::string field;
     for (int i = 3; i <= 19 && rest >> field; ++i) {
       if (i == 19) t.nice = std::stoi(field);
@@ -171,6 +174,18 @@ TEST(ControlPlaneLoadTest, OperatorCallsAnswerWhile400AnalystStreamsAreOpen) {
   std::atomic<bool> stop{false};
   std::atomic<int> interpolated{0};
   std::vector<std::thread> clients;
+  // However the test ends (a failed ASSERT returns early), the clients stop and are joined: a
+  // joinable thread left behind would abort the whole program without the failure's message.
+  struct JoinClients {
+    std::atomic<bool>& stop;
+    std::vector<std::thread>& threads;
+    ~JoinClients() {
+      stop = true;
+      for (std::thread& t : threads) {
+        if (t.joinable()) t.join();
+      }
+    }
+  } join_clients{stop, clients};
   for (int c = 0; c < 2; ++c) {
     clients.emplace_back([&] {
       auto stub = v1::Interpolation::NewStub(rig.channel());
