@@ -1,46 +1,14 @@
 #include "core/export/bird/json_out.h"
 
 #include <cmath>
-#include <cstdio>
 
+#include "core/export/json_text.h"
 #include "core/export/number_text.h"
 
 namespace brdf::exports {
 namespace {
 
 constexpr std::size_t kFlushBytes = 64 * 1024;
-
-void AppendEscaped(std::string& out, std::string_view text) {
-  out += '"';
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char hex[8];
-          std::snprintf(hex, sizeof hex, "\\u%04x", static_cast<unsigned>(c));
-          out += hex;
-        } else {
-          out += c;  // UTF-8 passes through unchanged
-        }
-    }
-  }
-  out += '"';
-}
 
 }  // namespace
 
@@ -86,14 +54,14 @@ void JsonOut::Close(char bracket) {
 
 void JsonOut::Key(std::string_view key) {
   BeforeValue();
-  AppendEscaped(buffer_, key);
+  AppendJsonString(buffer_, key);
   buffer_ += ':';
   after_key_ = true;
 }
 
 void JsonOut::String(std::string_view text) {
   BeforeValue();
-  AppendEscaped(buffer_, text);
+  AppendJsonString(buffer_, text);
   Flush();
 }
 

@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "core/export/json_text.h"
 #include "core/export/number_text.h"
 
 namespace brdf::exports {
@@ -21,25 +22,6 @@ std::string AxisText(const char* name, const GridAxis& a) {
   return std::string(name) + ": " + std::to_string(a.count) + " values from " +
          FormatNumber(a.start_deg) + " to " + FormatNumber(a.at(a.count - 1)) + " every " +
          FormatNumber(a.step_deg);
-}
-
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    const auto u = static_cast<unsigned char>(c);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (u < 0x20) {
-      static const char* kHex = "0123456789abcdef";
-      out += "\\u00";
-      out += kHex[u >> 4];
-      out += kHex[u & 15];
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
 }
 
 std::string AxisJson(const GridAxis& a) {
