@@ -113,30 +113,50 @@ TEST(Npy, HeaderParsesAndAlignsTheData) {
   EXPECT_NE(NpyHeader(std::vector<std::size_t>{5}).find("(5,)"), std::string::npos);
 }
 
-TEST(Npy, GridFileHoldsTheValuesInCOrderAsLittleEndianDoubles) {
-  Result<RegularGrid> grid = MakeRegularGrid(10, 15, 30, GridPlacement::kCellCentres);
-  ASSERT_TRUE(grid.ok());
-  const WavelengthGrid bands{400, 100, 3};
-  std::ostringstream out;
-  NpyGridWriter npy(out);
+// PatternSource on a 9 × 6 × 6 grid of 3 bands, written as .npy of `type` and kept in memory.
+struct PatternNpy {
+  std::string bytes;
+  ParsedNpy parsed;
   MemoryGrid memory;
-  ASSERT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), npy).ok());
-  ASSERT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), memory).ok());
-  const std::string bytes = out.str();
-  const ParsedNpy p = ParseNpy(bytes);
-  ASSERT_TRUE(p.ok);
-  EXPECT_EQ(p.shape, (std::vector<std::size_t>{9, 6, 6, 3}));
-  ASSERT_EQ(bytes.size(), p.data_offset + 9 * 6 * 6 * 3 * 8);
-  for (std::size_t i = 0; i < memory.values().size(); ++i) {
-    std::uint64_t bits = 0;
-    for (int b = 0; b < 8; ++b) {
-      bits |=
-          static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[p.data_offset + 8 * i + b]))
-          << (8 * b);
-    }
-    double v;
-    std::memcpy(&v, &bits, 8);
-    const double want = memory.values()[i];
+};
+PatternNpy WritePatternNpy(NpyType type) {
+  PatternNpy out;
+  Result<RegularGrid> grid = MakeRegularGrid(10, 15, 30, GridPlacement::kCellCentres);
+  EXPECT_TRUE(grid.ok());
+  if (!grid.ok()) return out;
+  const WavelengthGrid bands{400, 100, 3};
+  std::ostringstream file;
+  NpyGridWriter npy(file, type);
+  EXPECT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), npy).ok());
+  EXPECT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), out.memory).ok());
+  out.bytes = file.str();
+  out.parsed = ParseNpy(out.bytes);
+  return out;
+}
+
+// Value `i` of the file's data as little-endian IEEE-754 `Float`, whatever the host's order.
+template <typename Float, typename Bits>
+Float LittleEndianValue(const PatternNpy& f, std::size_t i) {
+  Bits bits = 0;
+  for (std::size_t b = 0; b < sizeof(Bits); ++b) {
+    bits |= static_cast<Bits>(
+                static_cast<unsigned char>(f.bytes[f.parsed.data_offset + sizeof(Bits) * i + b]))
+            << (8 * b);
+  }
+  Float v;
+  std::memcpy(&v, &bits, sizeof v);
+  return v;
+}
+
+TEST(Npy, GridFileHoldsTheValuesInCOrderAsLittleEndianDoubles) {
+  const PatternNpy f = WritePatternNpy(NpyType::kFloat64);
+  ASSERT_TRUE(f.parsed.ok);
+  EXPECT_EQ(f.parsed.descr, "<f8");
+  EXPECT_EQ(f.parsed.shape, (std::vector<std::size_t>{9, 6, 6, 3}));
+  ASSERT_EQ(f.bytes.size(), f.parsed.data_offset + 9 * 6 * 6 * 3 * 8);
+  for (std::size_t i = 0; i < f.memory.values().size(); ++i) {
+    const double v = LittleEndianValue<double, std::uint64_t>(f, i);
+    const double want = f.memory.values()[i];
     if (std::isnan(want)) {
       EXPECT_TRUE(std::isnan(v));
     } else {
@@ -144,35 +164,19 @@ TEST(Npy, GridFileHoldsTheValuesInCOrderAsLittleEndianDoubles) {
     }
   }
   // Cell (θi index 2, θo index 3, φ index 4), band 1: θi 25, θo 52.5, φ 135.
-  EXPECT_EQ(memory.spectrum(2, 3, 4)[1], 25 + 100 * 52.5 + 1e4 * 135 + 1e6);
+  EXPECT_EQ(f.memory.spectrum(2, 3, 4)[1], 25 + 100 * 52.5 + 1e4 * 135 + 1e6);
 }
 
 TEST(Npy, Float32GridHoldsEachValueRoundedToTheNearestFloat) {
-  Result<RegularGrid> grid = MakeRegularGrid(10, 15, 30, GridPlacement::kCellCentres);
-  ASSERT_TRUE(grid.ok());
-  const WavelengthGrid bands{400, 100, 3};
-  std::ostringstream out;
-  NpyGridWriter npy(out, NpyType::kFloat32);
-  MemoryGrid memory;
-  ASSERT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), npy).ok());
-  ASSERT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), memory).ok());
-  const std::string bytes = out.str();
-  const ParsedNpy p = ParseNpy(bytes);
-  ASSERT_TRUE(p.ok);
-  EXPECT_EQ(p.descr, "<f4");
-  EXPECT_EQ(p.shape, (std::vector<std::size_t>{9, 6, 6, 3}));
-  ASSERT_EQ(bytes.size(), p.data_offset + 9 * 6 * 6 * 3 * 4);
+  const PatternNpy f = WritePatternNpy(NpyType::kFloat32);
+  ASSERT_TRUE(f.parsed.ok);
+  EXPECT_EQ(f.parsed.descr, "<f4");
+  EXPECT_EQ(f.parsed.shape, (std::vector<std::size_t>{9, 6, 6, 3}));
+  ASSERT_EQ(f.bytes.size(), f.parsed.data_offset + 9 * 6 * 6 * 3 * 4);
   std::size_t nan = 0;
-  for (std::size_t i = 0; i < memory.values().size(); ++i) {
-    std::uint32_t bits = 0;
-    for (int b = 0; b < 4; ++b) {
-      bits |=
-          static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[p.data_offset + 4 * i + b]))
-          << (8 * b);
-    }
-    float v;
-    std::memcpy(&v, &bits, 4);
-    const double want = memory.values()[i];
+  for (std::size_t i = 0; i < f.memory.values().size(); ++i) {
+    const float v = LittleEndianValue<float, std::uint32_t>(f, i);
+    const double want = f.memory.values()[i];
     if (std::isnan(want)) {
       EXPECT_TRUE(std::isnan(v));
       ++nan;
@@ -181,7 +185,7 @@ TEST(Npy, Float32GridHoldsEachValueRoundedToTheNearestFloat) {
       EXPECT_LE(std::abs(static_cast<double>(v) - want), std::abs(want) * 6e-8) << "value " << i;
     }
   }
-  EXPECT_LT(nan, memory.values().size());
+  EXPECT_LT(nan, f.memory.values().size());
 }
 
 TEST(Grid, CellsTheSourceCannotFillAreNaNAndCounted) {
