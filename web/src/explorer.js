@@ -49,6 +49,12 @@ function combinedName(u) {
   return u.measurement?.length ? 'measurement and interpolation' : 'interpolation only';
 }
 
+// An answer's combined uncertainty in one band; undefined where neither of its parts was
+// estimated (its combined is then 0, which is not an uncertainty of zero).
+function combinedAt(u, at) {
+  return u?.measurement?.length || u?.interpolation?.length ? u.combined?.[at] : undefined;
+}
+
 // What an uncertainty leaves out ("interpolation: the nearest method blends one reading…"), as
 // a list under `id`; nothing when it leaves nothing out.
 function notEstimated(id, texts) {
@@ -353,7 +359,7 @@ export function createExplorer(root, report) {
     const theta = polarData.angles.filter((_, i) => ok[i]).map((a) => a + 90);
     const results = polarData.results.filter((_, i) => ok[i]);
     const r = results.map((res) => res.spectrum[at]);
-    Plotly.react(polar, [...polarBand(theta, r, results.map((res) => res.uncertainty?.combined?.[at])), { type: 'scatterpolar', mode: 'lines+markers', theta, r, name: `θi ${polarData.thetaI}°`, line: { color: BLUE }, marker: { color: BLUE } }],
+    Plotly.react(polar, [...polarBand(theta, r, results.map((res) => combinedAt(res.uncertainty, at))), { type: 'scatterpolar', mode: 'lines+markers', theta, r, name: `θi ${polarData.thetaI}°`, line: { color: BLUE }, marker: { color: BLUE } }],
       { height: 380, margin: { t: 30 }, title: { text: `BRDF (sr⁻¹) in the plane of incidence, θi ${polarData.thetaI}°, ${nm} nm (${polarData.used})` }, polar: { sector: [0, 180], angularaxis: { rotation: 180, direction: 'clockwise', tickvals: [0, 30, 60, 90, 120, 150, 180], ticktext: ['−90° lamp side', '−60°', '−30°', 'normal', '30°', '60°', '90° specular side'] } } }, PLOT);
   }
 
