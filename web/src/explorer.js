@@ -49,10 +49,14 @@ function combinedName(u) {
   return u.measurement?.length ? 'measurement and interpolation' : 'interpolation only';
 }
 
-// An answer's combined uncertainty in one band; undefined where neither of its parts was
-// estimated (its combined is then 0, which is not an uncertainty of zero).
+// An answer's combined uncertainty in one band: its `combined`, or sqrt(measurement² +
+// interpolation²) where a batch answer leaves combined out; undefined where neither part was
+// estimated (combined is then 0, which is not an uncertainty of zero).
 function combinedAt(u, at) {
-  return u?.measurement?.length || u?.interpolation?.length ? u.combined?.[at] : undefined;
+  const m = u?.measurement?.[at];
+  const i = u?.interpolation?.[at];
+  if (m === undefined && i === undefined) return undefined;
+  return u.combined?.length ? u.combined[at] : Math.hypot(m ?? 0, i ?? 0);
 }
 
 // What an uncertainty leaves out ("interpolation: the nearest method blends one reading…"), as

@@ -85,14 +85,20 @@ const figure8Bands = (page) => page.evaluate(() => {
 });
 const setCoverage = (page, k) => page.$eval('#coverage-k', (e, v) => { e.value = v; e.dispatchEvent(new Event('change')); }, String(k));
 
-// Figure 8 with the paper's method: bands ± k·u whose half-widths are k times the gateway's
-// combined and measurement uncertainties for the same direction, finite and non-negative; k = 1
-// halves them; the nearest method draws the measurement band alone and says why.
-async function checkFigure8Bands(page, sessionId) {
-  await page.select('#method', 'INTERPOLATION_METHOD_OCTANT');
+// Figure 8 asked again with the form as it is.
+async function interpolateAgain(page) {
   await page.evaluate(() => { document.getElementById('interp-status')?.remove(); });
   await clickId(page, 'interpolate');
   await page.waitForSelector('#interp-status');
+}
+
+// Figure 8 with the paper's method: bands ± k·u whose half-widths are k times the gateway's
+// combined and measurement uncertainties for the same direction, finite and non-negative; k = 1
+// halves them; the nearest method draws the measurement band alone and says why, a reflectance
+// answer the interpolation term's alone.
+async function checkFigure8Bands(page, sessionId) {
+  await page.select('#method', 'INTERPOLATION_METHOD_OCTANT');
+  await interpolateAgain(page);
   const iso = await page.evaluate(() => ({ theta_i: Number(document.getElementById('q-theta-i').value), theta_o: Number(document.getElementById('q-theta-o').value), phi: Number(document.getElementById('q-phi').value) }));
   const request = { session_id: sessionId, method: 'INTERPOLATION_METHOD_OCTANT', quantity: 'QUANTITY_BRDF', options: { coordinates: 'INTERPOLATION_COORDINATES_INCIDENCE', trend: 'INTERPOLATION_TREND_NONE' }, direction: { iso }, include_uncertainty: true };
   const u = (await gateway('Interpolation/Interpolate', request)).result.uncertainty;
@@ -111,13 +117,18 @@ async function checkFigure8Bands(page, sessionId) {
   check(['combined', 'measurement'].every((p) => k1[p].k === 1 && k1[p].name.includes('k = 1 (≈68 %)') && k1[p].half.every((h, i) => close(2 * h, k2[p].half[i]))), 'k = 1 halves both bands\' half-widths');
   await setCoverage(page, 2);
   await page.select('#method', 'INTERPOLATION_METHOD_NEAREST');
-  await page.evaluate(() => { document.getElementById('interp-status')?.remove(); });
-  await clickId(page, 'interpolate');
-  await page.waitForSelector('#interp-status');
+  await interpolateAgain(page);
   const nearest = await figure8Bands(page);
   const notes = await page.$$eval('#interp-not-estimated li', (l) => l.map((e) => e.textContent));
   check(Object.keys(nearest).join() === 'measurement' && notes.some((t) => /^interpolation: the nearest method/.test(t)), `nearest: the measurement band alone, the interpolation term named as not estimated (${notes.length} notes)`);
   await page.select('#method', 'INTERPOLATION_METHOD_OCTANT');
+  await page.select('#quantity', 'QUANTITY_REFLECTANCE');
+  await interpolateAgain(page);
+  const reflectance = await figure8Bands(page);
+  const why = await page.$$eval('#interp-not-estimated li', (l) => l.map((e) => e.textContent));
+  check(Object.keys(reflectance).join() === 'combined' && /interpolation only/.test(reflectance.combined.name) && reflectance.combined.half.some((h) => h > 0) && why.some((t) => /^measurement: the readings' budgets are of the BRDF/.test(t)),
+    `reflectance: the interpolation term's band alone, the measurement part named as not estimated (${reflectance.combined?.name})`);
+  await page.select('#quantity', 'QUANTITY_BRDF');
 }
 
 // The polar plot's band ± k·u (combined) around its curve: a closed outline around every point,

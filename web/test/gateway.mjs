@@ -59,7 +59,8 @@ async function checkUncertaintyOverJson() {
   check(r.status === 200 && r.json.result.status === 'INTERPOLATION_STATUS_OK' && !('uncertainty' in r.json.result), `Interpolate without include_uncertainty → no uncertainty (${r.status})`);
   r = await post('Interpolation/Interpolate', { ...at, include_uncertainty: true }, rig.analystToken);
   const u = r.json?.result?.uncertainty;
-  const same = (a, b) => a.length === b.length && a.every((v, i) => Math.abs(v - b[i]) <= 1e-12 * Math.max(1, Math.abs(b[i])));
+  // Equal to float precision (an answer's uncertainty may travel as float, the budget as double).
+  const same = (a, b) => a.length === b.length && a.every((v, i) => Math.abs(v - b[i]) <= 1e-6 * Math.abs(b[i]) + 1e-30);
   check(r.status === 200 && finiteNonNegative(u?.measurement, bands) && finiteNonNegative(u.combined, bands) && same(u.measurement, budget.combined) && same(u.combined, u.measurement),
     `Interpolate with include_uncertainty: the nearest reading's measurement part is its stored budget, combined equals it (${u?.measurement?.length} bands)`);
   check(Array.isArray(u?.interpolation) && u.interpolation.length === 0 && Array.isArray(u.shared) && u.not_estimated.some((t) => /^interpolation: the nearest method/.test(t)),
@@ -67,8 +68,9 @@ async function checkUncertaintyOverJson() {
   const directions = readings.map((m) => ({ iso: m.iso }));
   const chunks = await messages('Interpolation/InterpolateBatch', { session_id: id, method: 'INTERPOLATION_METHOD_NEAREST', directions, include_uncertainty: true }, rig.analystToken);
   const results = chunks.flatMap((c) => c.results);
-  check(results.length === 3 && results.every((x) => x.status === 'INTERPOLATION_STATUS_OK' && finiteNonNegative(x.uncertainty?.combined, bands)),
-    `InterpolateBatch with include_uncertainty: each result's combined uncertainty, per band (${results.map((x) => x.uncertainty?.combined?.length).join(', ')})`);
+  const byId = new Map(readings.map((m) => [m.id, m.uncertainty.combined]));
+  check(results.length === 3 && results.every((x) => x.status === 'INTERPOLATION_STATUS_OK' && finiteNonNegative(x.uncertainty?.measurement, bands) && same(x.uncertainty.measurement, byId.get(x.vertices[0].reading_id))),
+    `InterpolateBatch with include_uncertainty: each result's measurement part, per band, its reading's budget (${results.map((x) => x.uncertainty?.measurement?.length).join(', ')})`);
   const plain = (await messages('Interpolation/InterpolateBatch', { session_id: id, method: 'INTERPOLATION_METHOD_NEAREST', directions }, rig.analystToken)).flatMap((c) => c.results);
   check(plain.length === 3 && plain.every((x) => !('uncertainty' in x)), 'InterpolateBatch without it → no uncertainty');
 }
