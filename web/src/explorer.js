@@ -17,6 +17,8 @@ const POINT_COLUMNS = ['ids', 'alpha', 'beta', 'delta', 'theta_i', 'theta_o', 'p
 // The coverage factors offered, with the coverage each stands for (docs/uncertainty.md,
 // "Expanded uncertainty").
 const COVERAGE = { 2: 'k = 2 (≈95 %)', 1: 'k = 1 (≈68 %)' };
+// A reading's spectra: each quantity's legend name and y axis.
+const QUANTITY_AXES = { QUANTITY_RADIANCE: ['radiance (W·m⁻²·sr⁻¹·nm⁻¹)', 'y'], QUANTITY_REFLECTANCE: ['reflectance', 'y2'], QUANTITY_BRDF: ['BRDF (sr⁻¹)', 'y2'] };
 const BLUE = '#1f77b4'; // plotly's first colour, kept by the polar curve drawn after its band
 
 // The median of k·u / |y| over the bands, as a percentage ("1.3 %"); '' without u.
@@ -245,8 +247,6 @@ export function createExplorer(root, report) {
     }
     return reading?.id === String(id) ? reading.uncertainty ?? null : null;
   }
-
-  const QUANTITY_AXES = { QUANTITY_RADIANCE: ['radiance (W·m⁻²·sr⁻¹·nm⁻¹)', 'y'], QUANTITY_REFLECTANCE: ['reflectance', 'y2'], QUANTITY_BRDF: ['BRDF (sr⁻¹)', 'y2'] };
 
   // The clicked reading's spectra, the quantity its budget is of (the BRDF) with error bars
   // ± k·u_c, and what its budget leaves out.
