@@ -286,7 +286,8 @@ TEST_F(BrdfExportTool, FitOfAReadingsCsvIsWeightedByItsUncertaintyColumns) {
   EXPECT_NE(r.err.find("weighted by their uncertainties"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("χ²/dof = "), std::string::npos) << r.err;
   const std::string report = ReadFile(File("fit_u.csv"));
-  EXPECT_NE(report.find("# weighting: every value by 1/u²"), std::string::npos);
+  EXPECT_NE(report.find("# weighting: weighted, independent: every value by 1/u²"),
+            std::string::npos);
   EXPECT_EQ(CsvRows(report).size(), 102u);
 
   r = Exec("fit --readings " + File("brdf_old.csv") + " -o " + File("fit_old.csv"));
