@@ -1,5 +1,6 @@
 #include "core/fit/band_covariance.h"
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -7,20 +8,61 @@
 
 namespace brdf::fit {
 
-Result<BandCovariance> BandCovariance::Of(const Observations& data, std::size_t band) {
+namespace {
+
+// The fraction contribution / value of `source` in every band when it is the same for every
+// observation (to 1e-9, bands where both are 0 aside) and every observation names it; else empty.
+std::vector<double> ScaleFractions(const Observations& data, std::size_t source) {
+  std::vector<double> fraction(data.bands(), std::nan(""));
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const SharedTerm* term = nullptr;
+    for (const SharedTerm& t : data.shared(i)) {
+      if (t.source == source) term = &t;
+    }
+    if (term == nullptr) return {};
+    for (std::size_t b = 0; b < data.bands(); ++b) {
+      const double c = term->contribution[b], f = data.value(i, b);
+      if (c == 0 && f == 0) continue;
+      if (f == 0) return {};
+      if (std::isnan(fraction[b])) fraction[b] = c / f;
+      if (std::abs(c / f - fraction[b]) > 1e-9 * std::abs(fraction[b])) return {};
+    }
+  }
+  for (double& x : fraction) {
+    if (std::isnan(x)) x = 0;
+  }
+  return fraction;
+}
+
+}  // namespace
+
+std::vector<ScaleSource> ScaleSourcesOf(const Observations& data) {
+  std::vector<ScaleSource> scales;
+  if (data.weighting() != Weighting::kGeneralised) return scales;
+  for (std::size_t s = 0; s < data.shared_sources().size(); ++s) {
+    std::vector<double> fraction = ScaleFractions(data, s);
+    if (!fraction.empty()) scales.push_back({s, std::move(fraction)});
+  }
+  return scales;
+}
+
+Result<BandCovariance> BandCovariance::Of(const Observations& data, std::size_t band,
+                                          const std::vector<ScaleSource>& leave_out) {
   BandCovariance v;
   const std::size_t n = data.size();
   const bool weighted = data.weighted();
   v.inv_d_.resize(n, 1.0);
   v.offsets_.assign(1, 0);
   std::vector<std::size_t> column(data.shared_sources().size(), SIZE_MAX);
+  std::vector<bool> left_out(data.shared_sources().size(), false);
+  for (const ScaleSource& s : leave_out) left_out[s.source] = true;
   for (std::size_t i = 0; i < n; ++i) {
     if (weighted) {
       const double u = data.independent_uncertainty(i, band);
       v.inv_d_[i] = 1.0 / (u * u);
       for (const SharedTerm& t : data.shared(i)) {
         const double c = t.contribution[band];
-        if (c == 0) continue;
+        if (c == 0 || left_out[t.source]) continue;
         if (column[t.source] == SIZE_MAX) column[t.source] = v.k_++;
         v.entries_.push_back({column[t.source], c});
       }
@@ -109,11 +151,12 @@ std::vector<double> BandCovariance::Gram(std::span<const std::vector<double>> co
   return g;
 }
 
-Result<std::vector<BandCovariance>> CovariancesOf(const Observations& data) {
+Result<std::vector<BandCovariance>> CovariancesOf(const Observations& data,
+                                                  const std::vector<ScaleSource>& leave_out) {
   std::vector<BandCovariance> all;
   all.reserve(data.bands());
   for (std::size_t b = 0; b < data.bands(); ++b) {
-    BRDF_ASSIGN_OR_RETURN(BandCovariance v, BandCovariance::Of(data, b));
+    BRDF_ASSIGN_OR_RETURN(BandCovariance v, BandCovariance::Of(data, b, leave_out));
     all.push_back(std::move(v));
   }
   return all;

@@ -18,11 +18,25 @@
 
 namespace brdf::fit {
 
+// A shared source that is a scale of every value: named by every observation, its contributions
+// in each band one fraction of the values (the white standard's, f · u(ρw)/ρw). It moves a whole
+// band as the models' linear parameters do (kd and ks together; ρ), so it cannot show in the
+// residuals; in V, with contributions taken at the measured values, it would let a model far from
+// the data shrink toward 0 at a cost of only 1/fraction² per band (Peelle's puzzle). The fits
+// leave it out of V and add it to those parameters' uncertainties instead.
+struct ScaleSource {
+  std::size_t source = 0;        // in data.shared_sources()
+  std::vector<double> fraction;  // per band: contribution / value
+};
+std::vector<ScaleSource> ScaleSourcesOf(const Observations& data);
+
 class BandCovariance {
  public:
-  // V of `band` for `data` (unweighted data: V = I). kFailedPrecondition when M cannot be
-  // factored (contributions so large or small that it is not numerically positive definite).
-  static Result<BandCovariance> Of(const Observations& data, std::size_t band);
+  // V of `band` for `data` (unweighted data: V = I), without the sources in `leave_out`.
+  // kFailedPrecondition when M cannot be factored (contributions so large or small that it is
+  // not numerically positive definite).
+  static Result<BandCovariance> Of(const Observations& data, std::size_t band,
+                                   const std::vector<ScaleSource>& leave_out = {});
 
   std::size_t size() const { return inv_d_.size(); }  // observations
   std::size_t shared_sources() const { return k_; }   // sources with a contribution in the band
@@ -50,7 +64,9 @@ class BandCovariance {
   std::vector<double> chol_;  // L of M = L Lᵀ, k × k
 };
 
-// One BandCovariance per band of `data`, and their errors naming the band.
-Result<std::vector<BandCovariance>> CovariancesOf(const Observations& data);
+// One BandCovariance per band of `data` without the sources in `leave_out`, and their errors
+// naming the band.
+Result<std::vector<BandCovariance>> CovariancesOf(const Observations& data,
+                                                  const std::vector<ScaleSource>& leave_out = {});
 
 }  // namespace brdf::fit

@@ -27,6 +27,18 @@ double Logit(double p) {
   return std::log(p / (1 - p));
 }
 
+// Σ of the scale sources' fraction² in `band` (band_covariance.h's ScaleSource).
+double ScaleVariance(const std::vector<ScaleSource>& scales, std::size_t band) {
+  double v = 0;
+  for (const ScaleSource& s : scales) v += s.fraction[band] * s.fraction[band];
+  return v;
+}
+
+// A linear parameter's u with the scale sources' share of its value added (NaN stays NaN).
+double WithScales(double u, double value, double fraction2) {
+  return std::sqrt(u * u + fraction2 * value * value);
+}
+
 // One band's values over all observations.
 std::vector<double> BandValues(const Observations& data, std::size_t band) {
   std::vector<double> f(data.size());
@@ -263,7 +275,8 @@ Result<LambertFit> FitLambert(const Observations& data) {
   if (data.size() == 0) {
     return FailedPrecondition("Lambert fit: no observations (no usable BRDF readings)");
   }
-  Result<std::vector<BandCovariance>> made = CovariancesOf(data);
+  const std::vector<ScaleSource> scales = ScaleSourcesOf(data);
+  Result<std::vector<BandCovariance>> made = CovariancesOf(data, scales);
   if (!made.ok()) return made.status().WithContext("Lambert fit");
   const std::vector<BandCovariance>& covariance = *made;
   LambertFit fit;
@@ -285,10 +298,12 @@ Result<LambertFit> FitLambert(const Observations& data) {
     const double scale = data.weighted() ? 1.0
                          : n > 1         ? r2 * static_cast<double>(n) / static_cast<double>(n - 1)
                                          : std::numeric_limits<double>::quiet_NaN();
-    fit.albedo_u.push_back(kPi * std::sqrt(scale / sw[b]));
+    fit.albedo_u.push_back(
+        WithScales(kPi * std::sqrt(scale / sw[b]), fit.albedo[b], ScaleVariance(scales, b)));
   }
   fit.overall = ResidualsOf(data, 0, nb, model);
   fit.statistics = StatisticsOf(data, WeightedSumOfSquares(data, covariance, model), n * nb, nb);
+  fit.statistics.scale_terms = scales.size();
   return fit;
 }
 
@@ -322,7 +337,8 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
   if (!(options.f0_start > 0 && options.f0_start < 1)) {
     return InvalidArgument("Cook-Torrance fit: f0_start must lie strictly between 0 and 1");
   }
-  Result<std::vector<BandCovariance>> made = CovariancesOf(data);
+  const std::vector<ScaleSource> scales = ScaleSourcesOf(data);
+  Result<std::vector<BandCovariance>> made = CovariancesOf(data, scales);
   if (!made.ok()) return made.status().WithContext("Cook-Torrance fit");
   const std::vector<BandCovariance>& covariance = *made;
   const std::size_t nb = data.bands();
@@ -366,13 +382,19 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
   auto model = [&](std::size_t i, std::size_t b) {
     return CookTorranceBrdf(data.direction(i), fit.band[b]);
   };
-  for (std::size_t b = 0; b < nb; ++b)
+  for (std::size_t b = 0; b < nb; ++b) {
     fit.band_residuals.push_back(ResidualsOf(data, b, b + 1, model));
+    // A scale of the whole band moves kd and ks together (not α, F0).
+    const double f2 = ScaleVariance(scales, b);
+    fit.band_u[b].kd = WithScales(fit.band_u[b].kd, fit.band[b].kd, f2);
+    fit.band_u[b].ks = WithScales(fit.band_u[b].ks, fit.band[b].ks, f2);
+  }
   fit.overall = ResidualsOf(data, 0, nb, model);
   const std::size_t parameters = groups == 1 ? 2 * nb + 2 : 4 * nb;
   fit.statistics = StatisticsOf(data, WeightedSumOfSquares(data, covariance, model),
                                 data.size() * nb, parameters);
   fit.statistics.note = note;
+  fit.statistics.scale_terms = scales.size();
   return fit;
 }
 

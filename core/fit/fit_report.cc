@@ -50,6 +50,12 @@ std::string WeightingLine(const FitReportInfo& info, const FitStatistics& s) {
            "budgets' independent variances, one column b per shared source (white standard, "
            "reference reading, dark, instrument) with each reading's contribution "
            "(docs/uncertainty.md); χ² = Σ rᵀV⁻¹r" +
+           (s.scale_terms > 0
+                ? "; " + std::to_string(s.scale_terms) +
+                      " of them a scale of every reading (the white standard's): left out of V, "
+                      "where it cannot show in the residuals, and added to the _u of kd, ks and "
+                      "the albedo"
+                : std::string()) +
            covariance;
   }
   if (s.weighting == Weighting::kIndependent) {

@@ -22,9 +22,12 @@ namespace brdf::fit {
 struct FitStatistics {
   bool weighted = false;  // weighted by the data's uncertainties; false: all alike
   Weighting weighting = Weighting::kUnweighted;  // how (kUnweighted exactly when !weighted)
-  std::size_t shared_terms = 0;                  // the shared sources in V (kGeneralised)
-  std::size_t values = 0;                        // values fitted
-  std::size_t parameters = 0;                    // parameters fitted
+  std::size_t shared_terms = 0;                  // the shared sources named (kGeneralised)
+  // Of those, scales of every value (band_covariance.h's ScaleSource): left out of V and added
+  // to the linear parameters' uncertainties (kd, ks; ρ).
+  std::size_t scale_terms = 0;
+  std::size_t values = 0;          // values fitted
+  std::size_t parameters = 0;      // parameters fitted
   double chi2 = 0;                 // Σ rᵀV⁻¹r (weighted); Σ r² in sr⁻² (unweighted)
   double dof = 0;                  // values − parameters
   double chi2_per_dof = 0;         // χ²/dof; NaN when unweighted (no noise to compare with)
