@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/uncertainty/blend.h"
+#include "core/uncertainty/interpolation_calibration.h"
 
 namespace brdf::daemon {
 namespace {
@@ -71,8 +72,13 @@ bool AddInterpolation(const interp::Interpolation& answer, const IndexSnapshot& 
     weights[i] = answer.vertices[i].weight;
     spectra[i] = index.samples->spectrum(answer.vertices[i].index);
   }
-  const std::vector<double> spread =
-      uncertainty::InterpolationSpread(weights, spectra, answer.spectrum);
+  std::vector<double> spread = uncertainty::InterpolationSpread(weights, spectra, answer.spectrum);
+  // Calibrated against the session's held-out readings (index/interpolation_calibration.h).
+  const uncertainty::InterpolationCalibration& calibration = index.calibration->Get(index);
+  if (!uncertainty::ApplyInterpolationCalibration(calibration, spread)) {
+    u->add_not_estimated("interpolation: not calibrated (" + calibration.detail +
+                         "); the vertices' spread as it is");
+  }
   u->mutable_interpolation()->Add(spread.begin(), spread.end());
   return true;
 }
