@@ -31,9 +31,9 @@ struct InterpolatedInputs {
 
 // One answer's uncertainty per band, standard uncertainties (k = 1) in the answer's unit.
 struct InterpolatedUncertainty {
-  std::vector<double> measurement;    // empty: not estimated (the reason in not_estimated)
-  std::vector<double> shared;         // the shared part of measurement; empty with it
-  std::vector<double> interpolation;  // empty: not estimated
+  std::vector<double> measurement;         // empty: not estimated (the reason in not_estimated)
+  std::vector<double> shared;              // the shared part of measurement; empty with it
+  std::vector<double> interpolation;       // empty: not estimated
   std::vector<std::string> not_estimated;  // "measurement: …", "interpolation: …", vertices' own
 };
 

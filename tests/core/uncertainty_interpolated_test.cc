@@ -54,8 +54,7 @@ TEST(InterpolatedUncertainty, BlendOfASharedAndAnIndependentTermByHand) {
   // = 0.001² + 0.009²; measurement = sqrt(0.0045² + 0.001² + 0.009²) = 0.010111874...
   ASSERT_EQ(u.measurement.size(), 1u);
   EXPECT_NEAR(u.shared[0], 0.0045, 1e-15);
-  EXPECT_NEAR(u.measurement[0], std::sqrt(0.0045 * 0.0045 + 0.001 * 0.001 + 0.009 * 0.009),
-              1e-15);
+  EXPECT_NEAR(u.measurement[0], std::sqrt(0.0045 * 0.0045 + 0.001 * 0.001 + 0.009 * 0.009), 1e-15);
   EXPECT_NEAR(u.measurement[0], 0.0101118742, 1e-9);
   // Interpolation: y = 0.45; sqrt(0.25·(0.30 − 0.45)² + 0.75·(0.50 − 0.45)²) = sqrt(0.0075).
   ASSERT_EQ(u.interpolation.size(), 1u);
@@ -100,8 +99,7 @@ TEST(InterpolatedUncertainty, NearestHasNoInterpolationTermAndAFailedAnswerNothi
 
   v.answer.status = interp::InterpStatus::kEmptyOctant;
   const InterpolatedUncertainty none = EstimateInterpolatedUncertainty(v.answer, v.Inputs());
-  EXPECT_TRUE(none.measurement.empty() && none.interpolation.empty() &&
-              none.not_estimated.empty());
+  EXPECT_TRUE(none.measurement.empty() && none.interpolation.empty() && none.not_estimated.empty());
 }
 
 }  // namespace

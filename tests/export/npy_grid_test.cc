@@ -383,7 +383,8 @@ interp::InterpStatus PlanesSource(const IsoDirection& at, std::span<double> row)
   const interp::InterpStatus st = PatternSource(at, row.first(bands));
   if (st != interp::InterpStatus::kOk) return st;
   for (std::size_t p = 1; p < kUncertainPlanes; ++p) {
-    for (std::size_t b = 0; b < bands; ++b) row[p * bands + b] = 0.001 * static_cast<double>(p) * row[b];
+    for (std::size_t b = 0; b < bands; ++b)
+      row[p * bands + b] = 0.001 * static_cast<double>(p) * row[b];
   }
   return st;
 }
@@ -400,8 +401,8 @@ TEST(Npy, UncertaintyPlanesGoToFilesOfTheValuesShapeAndDtype) {
     sinks.push_back(writers.back().get());
   }
   PlaneSplitSink split(sinks);
-  Result<GridReport> report = ResampleOnGrid(PlanesSource, *grid, bands, {}, LongContext(), split,
-                                             kUncertainPlanes);
+  Result<GridReport> report =
+      ResampleOnGrid(PlanesSource, *grid, bands, {}, LongContext(), split, kUncertainPlanes);
   ASSERT_TRUE(report.ok()) << report.status().ToString();
   MemoryGrid plain;
   ASSERT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), plain).ok());

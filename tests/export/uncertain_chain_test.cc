@@ -1,6 +1,8 @@
 // fill/uncertain_chain: a session's fill chain answering each direction with its uncertainty —
 // at a reading's pose the measurement part is that reading's budget, NaN where a blended reading
 // has none, model cells carry the model's residual RMS; and the sidecar's "uncertainty" object.
+#include "core/export/fill/uncertain_chain.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,13 +11,14 @@
 #include <vector>
 
 #include "core/export/fill/session_interpolant.h"
-#include "core/export/fill/uncertain_chain.h"
 #include "export_test_util.h"
 
 namespace brdf::exports {
 namespace {
 
-CallContext LongContext() { return CallContext::WithTimeout(std::chrono::hours(1)); }
+CallContext LongContext() {
+  return CallContext::WithTimeout(std::chrono::hours(1));
+}
 
 // Each sample gets a budget of 1 % shared (the session's white standard) and 2 % independent.
 void AddBudgets(DerivedSamples& derived) {
@@ -67,8 +70,8 @@ TEST(UncertainChain, AtAReadingsPoseTheMeasurementPartIsItsBudget) {
   std::optional<testing::PaintGridSamples> paint = testing::PaintLikeGridSamples();
   ASSERT_TRUE(paint.has_value());
   AddBudgets(paint->derived);
-  Result<SessionInterpolant> in = BuildSessionInterpolant(
-      paint->derived, interp::Method::kOctant, {}, FillPolicy::kNone, LongContext());
+  Result<SessionInterpolant> in = BuildSessionInterpolant(paint->derived, interp::Method::kOctant,
+                                                          {}, FillPolicy::kNone, LongContext());
   ASSERT_TRUE(in.ok()) << in.status().ToString();
   const UncertainChain chain = MakeUncertainChain(*in);
   const auto [index, row] = AnsweredSample(chain, paint->derived);
@@ -88,8 +91,8 @@ TEST(UncertainChain, AtAReadingsPoseTheMeasurementPartIsItsBudget) {
 TEST(UncertainChain, ABlendedReadingWithoutBudgetMakesTheMeasurementPartNaN) {
   std::optional<testing::PaintGridSamples> paint = testing::PaintLikeGridSamples();
   ASSERT_TRUE(paint.has_value());
-  Result<SessionInterpolant> in = BuildSessionInterpolant(
-      paint->derived, interp::Method::kOctant, {}, FillPolicy::kNone, LongContext());
+  Result<SessionInterpolant> in = BuildSessionInterpolant(paint->derived, interp::Method::kOctant,
+                                                          {}, FillPolicy::kNone, LongContext());
   ASSERT_TRUE(in.ok());
   const UncertainChain chain = MakeUncertainChain(*in);
   const Row row = AnsweredSample(chain, paint->derived).second;
@@ -107,8 +110,8 @@ TEST(UncertainChain, ModelCellsCarryTheModelsResidualRms) {
   std::optional<testing::PaintGridSamples> paint = testing::PaintLikeGridSamples();
   ASSERT_TRUE(paint.has_value());
   AddBudgets(paint->derived);
-  Result<SessionInterpolant> in = BuildSessionInterpolant(
-      paint->derived, interp::Method::kOctant, {}, FillPolicy::kChain, LongContext());
+  Result<SessionInterpolant> in = BuildSessionInterpolant(paint->derived, interp::Method::kOctant,
+                                                          {}, FillPolicy::kChain, LongContext());
   ASSERT_TRUE(in.ok()) << in.status().ToString();
   ASSERT_TRUE(in->model.has_value());
   const UncertainChain chain = MakeUncertainChain(*in);
@@ -130,10 +133,10 @@ TEST(UncertainChain, SidecarNamesEachFileItsUnitAndK) {
   UncertaintyCoverage c;
   c.samples = 10;
   c.without_budget = 2;
-  const std::string j = UncertaintyJson(
-      c, Quantity::kBrdf,
-      {{UncertainPlane::kCombined, "s-grid-brdf.u.npy"},
-       {UncertainPlane::kMeasurement, "s-grid-brdf.u_measurement.npy"}});
+  const std::string j =
+      UncertaintyJson(c, Quantity::kBrdf,
+                      {{UncertainPlane::kCombined, "s-grid-brdf.u.npy"},
+                       {UncertainPlane::kMeasurement, "s-grid-brdf.u_measurement.npy"}});
   EXPECT_NE(j.find("\"k\": 1"), std::string::npos);
   EXPECT_NE(j.find("\"u\": {\"file\": \"s-grid-brdf.u.npy\""), std::string::npos) << j;
   EXPECT_NE(j.find("\"u_measurement\": {\"file\": \"s-grid-brdf.u_measurement.npy\""),

@@ -23,8 +23,8 @@ std::span<double> Plane(std::span<double> row, UncertainPlane p, std::size_t ban
 }
 
 // One answer's row: the value, then its uncertainty planes (NaN where a part is missing).
-void WriteAnswer(const interp::Interpolation& answer,
-                 const uncertainty::InterpolatedInputs& inputs, std::span<double> row) {
+void WriteAnswer(const interp::Interpolation& answer, const uncertainty::InterpolatedInputs& inputs,
+                 std::span<double> row) {
   const std::size_t bands = answer.spectrum.size();
   std::copy(answer.spectrum.begin(), answer.spectrum.end(), row.begin());
   const uncertainty::InterpolatedUncertainty u =
@@ -75,7 +75,7 @@ SpectrumSource InterpolatorWithUncertainty(const interp::Interpolator& interpola
 // combined u, no measurement part.
 SpectrumSource ModelWithSpread(const fit::CookTorranceFit& model, std::vector<double> spread) {
   return [params = model.band, spread = std::move(spread)](const IsoDirection& at,
-                                                          std::span<double> row) {
+                                                           std::span<double> row) {
     const std::size_t bands = params.size();
     for (std::size_t b = 0; b < bands; ++b) {
       const double u = b < spread.size() ? spread[b] : kNaN;
@@ -179,13 +179,15 @@ std::string UncertaintyJson(const UncertaintyCoverage& c, Quantity quantity,
          ", \"what\": " + JsonString(PlaneMeaning(files[k].plane)) + "}";
   }
   j += "}, \"nan\": " +
-       JsonString("NaN in every array where the value is NaN (no stage of the fill chain had "
-                  "one); u_measurement (and u) NaN where a blended reading has no uncertainty "
-                  "budget or the quantity has none, and in model cells; u_interpolation (and u) "
-                  "NaN for the nearest method (one vertex)");
+       JsonString(
+           "NaN in every array where the value is NaN (no stage of the fill chain had "
+           "one); u_measurement (and u) NaN where a blended reading has no uncertainty "
+           "budget or the quantity has none, and in model cells; u_interpolation (and u) "
+           "NaN for the nearest method (one vertex)");
   j += ", \"samples\": " + std::to_string(c.samples) +
        ", \"samples_without_budget\": " + std::to_string(c.without_budget);
-  j += ", \"measurement_not_estimated\": " + (c.no_budgets.empty() ? "null" : JsonString(c.no_budgets));
+  j += ", \"measurement_not_estimated\": " +
+       (c.no_budgets.empty() ? "null" : JsonString(c.no_budgets));
   j += ", \"budgets_not_estimated\": " + JsonList(c.not_estimated);
   j += ", \"model_residual_rms\": " + JsonNumbers(c.model_spread);
   j += ", \"docs\": \"docs/uncertainty.md, Exports\"}";

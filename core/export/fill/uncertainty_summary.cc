@@ -81,12 +81,13 @@ Result<std::string> UncertaintySummaryJson(const SessionInterpolant& in, const s
                         ResampleOnGrid(uncertain.chain->Source(), grid, in.derived.grid, control,
                                        ctx, split, kUncertainPlanes));
   const WavelengthGrid& bands = in.derived.grid;
-  std::string j = "{\n  \"format\": " + JsonString(format) +
-                  ",\n  \"what\": \"the uncertainty of the export's cells, which the format "
-                  "cannot hold: per band, the median and 95th percentile of the relative standard "
-                  "uncertainty (u / f, k = 1) over the cells of a 5-degree (theta_i, theta_o, "
-                  "phi) grid of the hemisphere, answered as the export's cells are (the same "
-                  "interpolation, fill chain and uncertainty as a grid export with uncertainty)\",\n";
+  std::string j =
+      "{\n  \"format\": " + JsonString(format) +
+      ",\n  \"what\": \"the uncertainty of the export's cells, which the format "
+      "cannot hold: per band, the median and 95th percentile of the relative standard "
+      "uncertainty (u / f, k = 1) over the cells of a 5-degree (theta_i, theta_o, "
+      "phi) grid of the hemisphere, answered as the export's cells are (the same "
+      "interpolation, fill chain and uncertainty as a grid export with uncertainty)\",\n";
   j += "  \"k\": 1,\n  \"wavelength_nm\": {\"start\": " + FormatNumber(bands.start_nm) +
        ", \"step\": " + FormatNumber(bands.step_nm) +
        ", \"count\": " + std::to_string(bands.count) + "},\n";

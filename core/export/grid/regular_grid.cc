@@ -163,9 +163,10 @@ Status PlaneSplitSink::Begin(const RegularGrid& grid, const WavelengthGrid& band
 Status PlaneSplitSink::WriteSlice(std::size_t theta_i_index, std::span<const double> values,
                                   std::span<const interp::InterpStatus> statuses) {
   const std::size_t planes = sinks_.size();
-  if (values.size() != statuses.size() * planes * bands_ || plane_.size() != statuses.size() * bands_) {
-    return Internal("PlaneSplitSink: slice " + std::to_string(theta_i_index) +
-                    " does not hold " + std::to_string(planes) + " planes per cell");
+  if (values.size() != statuses.size() * planes * bands_ ||
+      plane_.size() != statuses.size() * bands_) {
+    return Internal("PlaneSplitSink: slice " + std::to_string(theta_i_index) + " does not hold " +
+                    std::to_string(planes) + " planes per cell");
   }
   for (std::size_t p = 0; p < planes; ++p) {
     if (sinks_[p] == nullptr) continue;

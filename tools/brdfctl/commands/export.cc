@@ -215,7 +215,8 @@ class ExportProgressLine {
 };
 
 // Where part `p` of the report goes beside `path`: PATH's stem, ".<name>", and the extension of
-// the daemon's name for it ("x.npy", u → "x.u.npy"; "x.binary", uncertainty → "x.uncertainty.json").
+// the daemon's name for it ("x.npy", u → "x.u.npy"; "x.binary", uncertainty →
+// "x.uncertainty.json").
 std::string PartPath(const std::string& path, const v1::ExportPart& p) {
   const auto extension_of = [](const std::string& name) {
     const std::size_t slash = name.rfind('/');
@@ -319,8 +320,8 @@ bool WritePartChunk(CommandContext& ctx, const v1::ExportData& data,
     part.file.open(part.partial, std::ios::binary | std::ios::trunc);
   }
   if (data.offset() != part.bytes || !part.file) {
-    ctx.err << "brdfctl export: part '" << data.part() << "': "
-            << (part.file ? "bytes out of order" : "cannot create " + part.partial)
+    ctx.err << "brdfctl export: part '" << data.part()
+            << "': " << (part.file ? "bytes out of order" : "cannot create " + part.partial)
             << "; try again\n";
     return false;
   }
@@ -405,7 +406,8 @@ bool KeepParts(std::ostream& err, const v1::ExportReport& report, const std::str
     if (part.partial.empty() && p.bytes() == 0) continue;
     part.file.close();
     const std::string to = PartPath(path, p);
-    if (part.bytes != p.bytes() || !part.file || std::rename(part.partial.c_str(), to.c_str()) != 0) {
+    if (part.bytes != p.bytes() || !part.file ||
+        std::rename(part.partial.c_str(), to.c_str()) != 0) {
       err << "brdfctl export: part '" << p.name() << "' (" << part.bytes << " of " << p.bytes()
           << " bytes) could not be kept as " << to << "; try again\n";
       return false;
