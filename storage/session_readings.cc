@@ -1,6 +1,7 @@
 #include "storage/session_readings.h"
 
 #include <cmath>
+#include <memory>
 
 #include "core/plan/plan_json.h"
 #include "core/plan/sample.h"
@@ -40,6 +41,7 @@ Reading ToReading(const ReadingRecord& r) {
   if (r.uncertainty.has_value()) {
     out.brdf_u = r.uncertainty->combined;
     out.brdf_u_of_ratio = RatioPartOf(*r.uncertainty);
+    out.budget = std::make_shared<const uncertainty::ReadingBudget>(*r.uncertainty);
   }
   return out;
 }

@@ -28,6 +28,15 @@ std::vector<double> UncertaintyOf(const Reading& r, Quantity quantity, const Sam
   return u;
 }
 
+// The reading's budget when it is of the BRDF and the samples are (else null).
+std::shared_ptr<const uncertainty::ReadingBudget> BrdfBudgetOf(const Reading& r,
+                                                               Quantity quantity) {
+  if (quantity != Quantity::kBrdf || !r.budget || r.budget->quantity != Quantity::kBrdf) {
+    return nullptr;
+  }
+  return r.budget;
+}
+
 }  // namespace
 
 Result<DerivedSamples> DeriveSamples(const Session& session, Quantity quantity,
@@ -61,7 +70,7 @@ Result<DerivedSamples> DeriveSamples(const Session& session, Quantity quantity,
     std::vector<double> u = UncertaintyOf(r, quantity, *derived);
     out.samples.push_back(DerivedSample{r.id, r.directions, ToIsotropic(r.directions),
                                         std::move(derived->values[static_cast<int>(quantity)]),
-                                        std::move(u)});
+                                        std::move(u), BrdfBudgetOf(r, quantity)});
   }
   if (sample_readings == 0) {
     return FailedPrecondition("session " + std::to_string(session.id) +

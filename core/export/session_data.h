@@ -20,6 +20,7 @@
 #include "core/readings/reading.h"
 #include "core/spectrum.h"
 #include "core/status.h"
+#include "core/uncertainty/budget.h"
 
 namespace brdf::exports {
 
@@ -46,6 +47,10 @@ struct DerivedSample {
   // (Reading::brdf_u), the reflectance's (Reading::brdf_u_of_ratio · R / f, NaN where f = 0);
   // empty when the reading has none (not estimated) and for radiance.
   std::vector<double> u;
+  // The reading's stored budget of the BRDF, for blending into an interpolated value's
+  // measurement part (core/uncertainty/interpolated.h); null for other quantities and readings
+  // without one.
+  std::shared_ptr<const uncertainty::ReadingBudget> budget;
 };
 
 struct SkippedReading {

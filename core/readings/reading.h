@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -14,6 +15,10 @@
 #include "core/spectrum.h"
 
 namespace brdf {
+
+namespace uncertainty {
+struct ReadingBudget;  // core/uncertainty/budget.h
+}  // namespace uncertainty
 
 // What a reading measured: the sample I, the white standard I0, or the dark (ambient) D.
 enum class ReadingKind { kSample, kReference, kDark };
@@ -41,6 +46,9 @@ struct Reading {
   // The part of brdf_u the reflectance R = (I − D) / (I0 − D) carries too: without the white
   // standard's and the reference pose's terms, which scale the BRDF only; u(R) = this · R / f.
   std::vector<double> brdf_u_of_ratio;
+  // The stored budget itself, components and all (null when not estimated): what an interpolated
+  // value's measurement part blends (core/uncertainty/interpolated.h), shared terms correlated.
+  std::shared_ptr<const uncertainty::ReadingBudget> budget;
 };
 
 // A session's readings, with what the derivation needs of the session itself.

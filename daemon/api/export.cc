@@ -19,6 +19,8 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <memory>
+#include <optional>
 #include <ostream>
 #include <streambuf>
 #include <string>
@@ -28,6 +30,8 @@
 #include "core/export/fill/chain.h"
 #include "core/export/fill/session_interpolant.h"
 #include "core/export/fill/spectrum_source.h"
+#include "core/export/fill/uncertain_chain.h"
+#include "core/export/fill/uncertainty_summary.h"
 #include "core/export/grid/npy_writer.h"
 #include "core/export/grid/regular_grid.h"
 #include "core/export/grid/text.h"
@@ -94,28 +98,34 @@ class ExportStream {
     Send(chunk);
   }
 
-  // Buffers `n` bytes of the file, sending full chunks. False once the stream is broken.
-  bool Append(const char* data, std::size_t n) {
+  // Buffers `n` bytes of the file (part "") or of a companion part (ExportData.part), sending
+  // full chunks. False once the stream is broken.
+  bool Append(const std::string& part, const char* data, std::size_t n) {
     CheckCancelled();
+    Part& p = parts_[part];
     while (n > 0 && !broken_) {
-      const std::size_t take = std::min(n, next_chunk_bytes_ - buffer_.size());
-      buffer_.append(data, take);
+      const std::size_t take = std::min(n, next_chunk_bytes_ - p.buffer.size());
+      p.buffer.append(data, take);
       data += take;
       n -= take;
-      if (buffer_.size() == next_chunk_bytes_) SendBuffer();
+      if (p.buffer.size() == next_chunk_bytes_) SendBuffer(part, p);
     }
     return !broken_;
   }
 
-  // Sends what is buffered. False once the stream is broken.
+  // Sends what is buffered, of every part. False once the stream is broken.
   bool Flush() {
-    if (!buffer_.empty() && !broken_) SendBuffer();
+    for (auto& [name, p] : parts_) {
+      if (!p.buffer.empty() && !broken_) SendBuffer(name, p);
+    }
     return !broken_;
   }
 
+  // Sends the report with the file's size and each of its parts' (report.parts by name).
   bool SendReport(v1::ExportReport report) {
     if (!Flush()) return false;
-    report.set_bytes(offset_);
+    report.set_bytes(parts_[""].offset);
+    for (v1::ExportPart& part : *report.mutable_parts()) part.set_bytes(parts_[part.name()].offset);
     v1::ExportChunk chunk;
     *chunk.mutable_report() = std::move(report);
     Send(chunk);
@@ -123,9 +133,13 @@ class ExportStream {
   }
 
   bool broken() const { return broken_; }
-  std::uint64_t bytes() const { return offset_ + buffer_.size(); }
 
  private:
+  struct Part {
+    std::string buffer;
+    std::uint64_t offset = 0;  // bytes sent
+  };
+
   void CheckCancelled() {
     if (cancel_.cancelled()) return;
     if (broken_ || context_.IsCancelled()) {
@@ -137,12 +151,13 @@ class ExportStream {
 
   // The buffer's bytes move into the message (no copy kept while the write waits), and the
   // next chunk may be twice as large once this one was taken.
-  void SendBuffer() {
+  void SendBuffer(const std::string& name, Part& p) {
     v1::ExportChunk chunk;
-    chunk.mutable_data()->set_offset(offset_);
-    offset_ += buffer_.size();
-    chunk.mutable_data()->set_content(std::move(buffer_));
-    buffer_ = std::string();
+    chunk.mutable_data()->set_offset(p.offset);
+    if (!name.empty()) chunk.mutable_data()->set_part(name);
+    p.offset += p.buffer.size();
+    chunk.mutable_data()->set_content(std::move(p.buffer));
+    p.buffer = std::string();
     Send(chunk);
     next_chunk_bytes_ = std::min(chunk_bytes_, 2 * next_chunk_bytes_);
   }
@@ -162,8 +177,7 @@ class ExportStream {
   const std::size_t chunk_bytes_;
   std::size_t next_chunk_bytes_;  // the next data message's size, ≤ chunk_bytes_
   CancelToken cancel_;
-  std::string buffer_;
-  std::uint64_t offset_ = 0;  // bytes sent
+  std::map<std::string, Part> parts_;  // "": the file
   bool broken_ = false;
   std::string last_stage_;
   double last_fraction_ = 0;
@@ -174,21 +188,24 @@ class ExportStream {
 // fail, which the writers report as kIoError.
 class ExportStreamBuf : public std::streambuf {
  public:
-  explicit ExportStreamBuf(ExportStream& stream) : stream_(stream) {}
+  // `part`: "" for the file, else the companion part it writes (ExportData.part).
+  explicit ExportStreamBuf(ExportStream& stream, std::string part = "")
+      : stream_(stream), part_(std::move(part)) {}
 
  protected:
   int_type overflow(int_type ch) override {
     if (traits_type::eq_int_type(ch, traits_type::eof())) return traits_type::not_eof(ch);
     const char c = traits_type::to_char_type(ch);
-    return stream_.Append(&c, 1) ? ch : traits_type::eof();
+    return stream_.Append(part_, &c, 1) ? ch : traits_type::eof();
   }
   std::streamsize xsputn(const char* s, std::streamsize n) override {
-    return stream_.Append(s, static_cast<std::size_t>(n)) ? n : 0;
+    return stream_.Append(part_, s, static_cast<std::size_t>(n)) ? n : 0;
   }
   int sync() override { return stream_.Flush() ? 0 : -1; }
 
  private:
   ExportStream& stream_;
+  std::string part_;
 };
 
 // What the request asks for, checked.
@@ -205,6 +222,7 @@ struct ExportSettings {
   exports::FillPolicy fill = exports::FillPolicy::kChain;
   bool rgb = false;                // RGL
   bool float32 = false;            // grid .npy: '<f4'
+  bool uncertainty = false;        // grid .npy, MERL, RGL: the cells' u as parts of the stream
   exports::SessionRglOptions rgl;  // RGL: θi slices and resolution (rgb weights added later)
 };
 
@@ -268,6 +286,18 @@ grpc::Status CheckGridSteps(const ExportSettings& s) {
   return grpc::Status::OK;
 }
 
+grpc::Status ParseUncertaintyField(const v1::ExportRequest& r, ExportSettings* out) {
+  out->uncertainty = r.include_uncertainty();
+  if (!r.include_uncertainty() || r.format() == v1::EXPORT_FORMAT_GRID_NPY ||
+      r.format() == v1::EXPORT_FORMAT_MERL_BINARY || r.format() == v1::EXPORT_FORMAT_RGL_BSDF) {
+    return grpc::Status::OK;
+  }
+  return InvalidField("include_uncertainty",
+                      "is for GRID_NPY, MERL_BINARY and RGL_BSDF; the readings CSV has its "
+                      "u_<λ> columns and the BiRD file its uBRDF always, and a grid as CSV has no "
+                      "room for it (export it as .npy); leave it unset");
+}
+
 grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
   Result<SessionId> id = ParseSessionId(r.session_id(), "session_id");
   if (!id.ok()) return ToGrpcStatus(id.status());
@@ -305,6 +335,7 @@ grpc::Status ParseRequest(const v1::ExportRequest& r, ExportSettings* out) {
                         "format, an RGL file float32 already, CSV text; leave it unset");
   }
   out->float32 = r.float32();
+  if (grpc::Status st = ParseUncertaintyField(r, out); !st.ok()) return st;
   if (grpc::Status st = ParseMethodField(r.method(), &out->method); !st.ok()) return st;
   const v1::InterpolationOptions& o = r.options();
   if (o.axis_scale_size() != 0 && o.axis_scale_size() != 3) {
@@ -370,6 +401,17 @@ std::string FileName(const ExportSettings& s) {
     default:
       return base + ".binary";
   }
+}
+
+// A companion part's file name: `file` with ".<part>" before its extension
+// ("session-3-grid-brdf.npy", "u" → "session-3-grid-brdf.u.npy"); `extension` replaces the
+// file's when given (".json").
+std::string PartFileName(const std::string& file, const std::string& part,
+                         const std::string& extension = "") {
+  const std::size_t dot = file.rfind('.');
+  const std::string stem = dot == std::string::npos ? file : file.substr(0, dot);
+  const std::string ext = dot == std::string::npos ? "" : file.substr(dot);
+  return stem + "." + part + (extension.empty() ? ext : extension);
 }
 
 void AddSkipped(const std::vector<exports::SkippedReading>& skipped, v1::ExportReport* report) {
@@ -439,6 +481,58 @@ Status ExportReadingsCsv(const std::shared_ptr<const exports::Session>& session,
   return Status();
 }
 
+// The grid's uncertainty arrays (include_uncertainty): one .npy writer per uncertainty plane,
+// each streamed as a part of its own (ExportData.part "u", "u_measurement", "u_interpolation").
+class GridUncertaintyParts {
+ public:
+  GridUncertaintyParts(ExportStream& stream, const std::string& file, exports::NpyType type) {
+    for (exports::UncertainPlane plane :
+         {exports::UncertainPlane::kCombined, exports::UncertainPlane::kMeasurement,
+          exports::UncertainPlane::kInterpolation}) {
+      const std::string name = exports::UncertainPlaneName(plane);
+      buffers_.push_back(std::make_unique<ExportStreamBuf>(stream, name));
+      outs_.push_back(std::make_unique<std::ostream>(buffers_.back().get()));
+      writers_.push_back(std::make_unique<exports::NpyGridWriter>(*outs_.back(), type));
+      files_.push_back({plane, PartFileName(file, name)});
+    }
+  }
+  // The value's sink first, then the planes' (kUncertainPlanes in all).
+  std::vector<exports::GridSink*> Sinks(exports::GridSink& values) const {
+    std::vector<exports::GridSink*> sinks = {&values};
+    for (const auto& w : writers_) sinks.push_back(w.get());
+    return sinks;
+  }
+  const std::vector<exports::UncertaintyFile>& files() const { return files_; }
+  // Each part in the report (its bytes are set as the report is sent).
+  void AddTo(v1::ExportReport* report) const {
+    for (const exports::UncertaintyFile& f : files_) {
+      v1::ExportPart* part = report->add_parts();
+      part->set_name(exports::UncertainPlaneName(f.plane));
+      part->set_file_name(f.file_name);
+    }
+  }
+
+ private:
+  std::vector<std::unique_ptr<ExportStreamBuf>> buffers_;
+  std::vector<std::unique_ptr<std::ostream>> outs_;
+  std::vector<std::unique_ptr<exports::NpyGridWriter>> writers_;
+  std::vector<exports::UncertaintyFile> files_;
+};
+
+void AddGridCounts(const exports::GridReport& r, v1::ExportReport* report) {
+  report->set_summary(r.Summary());
+  report->set_cells(r.cells);
+  report->set_filled_cells(r.filled);
+  report->set_unfilled_cells(r.nan_cells);
+  for (const auto& [status, count] : r.by_status) {
+    if (status != interp::InterpStatus::kOk) {
+      (*report->mutable_unfilled_by_status())[interp::InterpStatusName(status)] = count;
+    }
+  }
+}
+
+// A grid as .npy or CSV; with include_uncertainty (.npy only) the same pass through the
+// uncertain fill chain (fill/uncertain_chain.h) also streams the three uncertainty arrays.
 Status ExportGrid(const exports::Session& session, const ExportSettings& s, const CallContext& ctx,
                   ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
   BRDF_ASSIGN_OR_RETURN(exports::RegularGrid grid,
@@ -455,34 +549,70 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
                                      in.derived.samples.size(),
                                      in.derived.skipped.size(),
                                      s.float32 ? "float32" : "float64"};
-  exports::NpyGridWriter npy(out,
-                             s.float32 ? exports::NpyType::kFloat32 : exports::NpyType::kFloat64);
+  const exports::NpyType type = s.float32 ? exports::NpyType::kFloat32 : exports::NpyType::kFloat64;
+  exports::NpyGridWriter npy(out, type);
   exports::CsvGridWriter csv(out, info);
   const bool as_npy = s.format == v1::EXPORT_FORMAT_GRID_NPY;
-  exports::GridSink& sink = as_npy ? static_cast<exports::GridSink&>(npy) : csv;
+  exports::GridSink& values = as_npy ? static_cast<exports::GridSink&>(npy) : csv;
+  std::optional<exports::UncertainChain> uncertain;
+  std::optional<GridUncertaintyParts> parts;
+  if (s.uncertainty) {
+    uncertain = exports::MakeUncertainChain(in);
+    parts.emplace(stream, FileName(s), type);
+  }
+  exports::PlaneSplitSink split(parts ? parts->Sinks(values) : std::vector<exports::GridSink*>{});
+  const exports::FillChain& chain = uncertain ? *uncertain->chain : *in.chain;
   exports::RunControl control;
   control.threads = 0;  // every hardware thread: the executor waits on devices, not the CPU
   control.progress = [&stream](double f) { stream.Progress("resampling", 0.05 + 0.95 * f); };
-  BRDF_ASSIGN_OR_RETURN(exports::GridReport r, exports::ResampleOnGrid(in.chain->Source(), grid,
-                                                                       bands, control, ctx, sink));
-  report->set_summary(r.Summary());
-  report->set_cells(r.cells);
-  report->set_filled_cells(r.filled);
-  report->set_unfilled_cells(r.nan_cells);
-  for (const auto& [status, count] : r.by_status) {
-    if (status != interp::InterpStatus::kOk) {
-      (*report->mutable_unfilled_by_status())[interp::InterpStatusName(status)] = count;
-    }
-  }
+  BRDF_ASSIGN_OR_RETURN(
+      exports::GridReport r,
+      exports::ResampleOnGrid(chain.Source(), grid, bands, control, ctx,
+                              parts ? static_cast<exports::GridSink&>(split) : values,
+                              parts ? exports::kUncertainPlanes : 1));
+  AddGridCounts(r, report);
   AddSkipped(in.derived.skipped, report);
-  AddFill(in.chain->Tally(), report);
+  AddFill(chain.Tally(), report);
   if (as_npy) {
     for (std::size_t n : {grid.theta_i.count, grid.theta_o.count, grid.phi.count}) {
       report->add_shape(n);
     }
     report->add_shape(bands.count);
-    report->set_description_json(exports::GridDescriptionJson(grid, bands, info, r, in.Info()));
+    exports::InterpolantInfo how = in.Info();
+    how.fill_json = chain.Tally().Json();
+    std::string uncertainty_json;
+    if (parts) {
+      uncertainty_json = exports::UncertaintyJson(uncertain->coverage, s.quantity, parts->files());
+      parts->AddTo(report);
+      for (std::string& w : exports::UncertaintyWarnings(uncertain->coverage)) {
+        report->add_warnings(std::move(w));
+      }
+    }
+    report->set_description_json(
+        exports::GridDescriptionJson(grid, bands, info, r, how, uncertainty_json));
   }
+  return Status();
+}
+
+// MERL and RGL with include_uncertainty: the per-band summary of the cells' u as the part
+// "uncertainty" (fill/uncertainty_summary.h), since the formats cannot hold it.
+Status SendUncertaintySummary(const exports::SessionInterpolant& in, const ExportSettings& s,
+                              const char* format, const CallContext& ctx, ExportStream& stream,
+                              v1::ExportReport* report) {
+  if (!s.uncertainty) return Status();
+  stream.Progress("summarising the uncertainty", 0.92);
+  exports::RunControl control;
+  control.threads = 0;
+  BRDF_ASSIGN_OR_RETURN(std::string json,
+                        exports::UncertaintySummaryJson(in, format, control, ctx));
+  ExportStreamBuf buffer(stream, "uncertainty");
+  std::ostream part(&buffer);
+  part << json;
+  part.flush();
+  if (!part) return IoError("Export: sending the uncertainty summary failed");
+  v1::ExportPart* named = report->add_parts();
+  named->set_name("uncertainty");
+  named->set_file_name(PartFileName(FileName(s), "uncertainty", ".json"));
   return Status();
 }
 
@@ -503,6 +633,7 @@ Status ExportMerl(const exports::Session& session, const ExportSettings& s, cons
                         exports::BuildMerlTable(in.chain->Source(), bands, rgb, control, ctx));
   stream.Progress("sending", 0.9);
   if (Status st = exports::WriteMerl(table.table, out); !st.ok()) return st;
+  BRDF_RETURN_IF_ERROR(SendUncertaintySummary(in, s, "merl", ctx, stream, report));
   const exports::MerlReport& m = table.report;
   report->set_summary(m.Summary());
   AddTableCounts(m.cells, m.filled, m.unfilled, m.below_horizon, m.clamped, report);
@@ -531,6 +662,7 @@ Status ExportRgl(const exports::Session& session, const ExportSettings& s, const
                         exports::BuildSessionRgl(session, in, options, control, ctx));
   stream.Progress("sending", 0.9);
   if (Status st = exports::WriteRgl(table.fields, out); !st.ok()) return st;
+  BRDF_RETURN_IF_ERROR(SendUncertaintySummary(in, s, "rgl", ctx, stream, report));
   const exports::RglReport& g = table.report;
   report->set_summary(g.Summary());
   AddTableCounts(g.cells, g.interpolated + g.fallback, g.unfilled, g.below_horizon, g.clamped,

@@ -3,6 +3,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/uncertainty/budget.h"
 #include "storage/session_readings.h"
 
 namespace brdf::daemon {
@@ -70,6 +71,12 @@ std::uint64_t SharedSessionLoads::BytesOf(const SessionReadings& session) {
   std::uint64_t bytes = sizeof(SessionReadings);
   for (const Reading& r : session.readings) {
     bytes += sizeof(Reading) + r.spectrum.values.capacity() * sizeof(double);
+    if (r.budget) {
+      for (const uncertainty::Component& c : r.budget->components) {
+        bytes += sizeof(c) + c.name.capacity() + c.contribution.capacity() * sizeof(double);
+      }
+      bytes += sizeof(*r.budget) + 3 * r.budget->combined.capacity() * sizeof(double);
+    }
   }
   return bytes;
 }

@@ -1,96 +1,35 @@
 #include "daemon/api/interpolation_uncertainty.h"
 
-#include <algorithm>
-#include <array>
 #include <cmath>
-#include <span>
 #include <string>
-#include <vector>
+#include <utility>
 
-#include "core/uncertainty/blend.h"
-#include "core/uncertainty/interpolation_calibration.h"
+#include "core/uncertainty/interpolated.h"
 
 namespace brdf::daemon {
-namespace {
-
-// Room for an answer's vertices without allocating (octant: 4 or 5; Delaunay: dims + 1); a
-// larger answer goes to the heap.
-constexpr std::size_t kInline = 8;
-
-template <typename T>
-struct Scratch {
-  std::array<T, kInline> inline_items{};
-  std::vector<T> heap;
-  std::span<T> Take(std::size_t n) {
-    if (n <= kInline) return {inline_items.data(), n};
-    heap.resize(n);
-    return heap;
-  }
-};
-
-// The measurement part into `u`; false (with the reason in not_estimated) when there is none.
-bool AddMeasurement(const interp::Interpolation& answer, const IndexSnapshot& index,
-                    v1::InterpolationUncertainty* u) {
-  if (index.quantity != Quantity::kBrdf) {
-    u->add_not_estimated(std::string("measurement: the readings' budgets are of the BRDF, this "
-                                     "answer is ") +
-                         QuantityName(index.quantity) + "; ask for quantity BRDF");
-    return false;
-  }
-  Scratch<uncertainty::BlendVertex> scratch;
-  const std::span<uncertainty::BlendVertex> vertices = scratch.Take(answer.vertices.size());
-  for (std::size_t i = 0; i < vertices.size(); ++i) {
-    const interp::Vertex& v = answer.vertices[i];
-    vertices[i] = {v.id, v.weight, index.budgets.at(v.index)};
-  }
-  Result<uncertainty::BlendedUncertainty> blended =
-      uncertainty::BlendMeasurementUncertainty(vertices, index.grid.count);
-  if (!blended.ok()) {
-    u->add_not_estimated("measurement: " + blended.status().message());
-    return false;
-  }
-  u->mutable_measurement()->Add(blended->measurement.begin(), blended->measurement.end());
-  u->mutable_shared()->Add(blended->shared.begin(), blended->shared.end());
-  for (std::string& entry : blended->not_estimated) u->add_not_estimated(std::move(entry));
-  return true;
-}
-
-// The interpolation term into `u`; false (with the reason) when there is none.
-bool AddInterpolation(const interp::Interpolation& answer, const IndexSnapshot& index,
-                      v1::InterpolationUncertainty* u) {
-  if (answer.method == interp::Method::kNearest) {
-    u->add_not_estimated(
-        "interpolation: the nearest method blends one reading, so its spread says nothing; use "
-        "octant or delaunay for an estimate");
-    return false;
-  }
-  Scratch<double> weight_scratch;
-  Scratch<std::span<const double>> spectrum_scratch;
-  const std::span<double> weights = weight_scratch.Take(answer.vertices.size());
-  const std::span<std::span<const double>> spectra = spectrum_scratch.Take(weights.size());
-  for (std::size_t i = 0; i < weights.size(); ++i) {
-    weights[i] = answer.vertices[i].weight;
-    spectra[i] = index.samples->spectrum(answer.vertices[i].index);
-  }
-  std::vector<double> spread = uncertainty::InterpolationSpread(weights, spectra, answer.spectrum);
-  // Calibrated against the session's held-out readings (index/interpolation_calibration.h).
-  const uncertainty::InterpolationCalibration& calibration = index.calibration->Get(index);
-  if (!uncertainty::ApplyInterpolationCalibration(calibration, spread)) {
-    u->add_not_estimated("interpolation: not calibrated (" + calibration.detail +
-                         "); the vertices' spread as it is");
-  }
-  u->mutable_interpolation()->Add(spread.begin(), spread.end());
-  return true;
-}
-
-}  // namespace
 
 void AddInterpolationUncertainty(const interp::Interpolation& answer, const IndexSnapshot& index,
                                  v1::InterpolationResult* out) {
   if (answer.status != interp::InterpStatus::kOk) return;
+  uncertainty::InterpolatedInputs inputs;
+  inputs.samples = index.samples.get();
+  // Calibrated against the session's held-out readings (index/interpolation_calibration.h).
+  inputs.calibration = &index.calibration->Get(index);
+  if (index.quantity == Quantity::kBrdf) {
+    inputs.budget_of = [&index](std::size_t i) { return index.budgets.at(i); };
+  } else {
+    inputs.no_budgets = std::string("the readings' budgets are of the BRDF, this answer is ") +
+                        QuantityName(index.quantity) + "; ask for quantity BRDF";
+  }
+  uncertainty::InterpolatedUncertainty found =
+      uncertainty::EstimateInterpolatedUncertainty(answer, inputs);
   v1::InterpolationUncertainty* u = out->mutable_uncertainty();
-  const bool measured = AddMeasurement(answer, index, u);
-  const bool interpolated = AddInterpolation(answer, index, u);
+  u->mutable_measurement()->Add(found.measurement.begin(), found.measurement.end());
+  u->mutable_shared()->Add(found.shared.begin(), found.shared.end());
+  u->mutable_interpolation()->Add(found.interpolation.begin(), found.interpolation.end());
+  for (std::string& entry : found.not_estimated) u->add_not_estimated(std::move(entry));
+  const bool measured = !found.measurement.empty();
+  const bool interpolated = !found.interpolation.empty();
   const int bands = static_cast<int>(answer.spectrum.size());
   google::protobuf::RepeatedField<double>* combined = u->mutable_combined();
   combined->Resize(bands, 0.0);

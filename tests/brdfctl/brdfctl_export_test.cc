@@ -212,6 +212,42 @@ TEST_F(BrdfctlExportTest, AnAnalystExportsMerlGridAndCsvFilesThatTheirReadersLoa
 // rgl: the .bsdf reads back with tools/check/rgl_read.py, with a value where a renderer looks;
 // the fill line counts the chain's cells, none of them empty. --fill none leaves a grid's holes
 // and counts them; --rgb on a grid is the user's error.
+TEST_F(BrdfctlExportTest, UncertaintyArraysGoBesideTheGridAndItsSidecarNamesThem) {
+  // --uncertainty: three more .npy files named after -o, of the grid's shape and dtype, named in
+  // OUT.json as they are on disk; u is NaN exactly where the values are, and ≥ 0 elsewhere.
+  const std::string npy = Path("ugrid.npy");
+  const CommandResult g =
+      Ctl({"export", id_, "grid", "--steps", "10,10,20", "--float32", "--uncertainty", "-o", npy});
+  ASSERT_EQ(g.exit_code, 0) << Describe(g);
+  for (const char* part : {"u", "u_measurement", "u_interpolation"}) {
+    EXPECT_TRUE(std::filesystem::exists(Path(std::string("ugrid.") + part + ".npy"))) << part;
+    EXPECT_FALSE(std::filesystem::exists(npy + ".partial." + part)) << part;
+    EXPECT_NE(g.err.find(std::string(part) + " → " + Path(std::string("ugrid.") + part + ".npy")),
+              std::string::npos)
+        << g.err;
+  }
+  const std::string script = Path("load_u.py");
+  std::ofstream(script)
+      << "import json, sys, numpy as np\n"
+         "a = np.load(sys.argv[1])\n"
+         "d = json.load(open(sys.argv[1] + '.json'))['uncertainty']\n"
+         "u = np.load(sys.argv[1][:-4] + '.u.npy')\n"
+         "names = sorted(v['file'] for v in d['arrays'].values())\n"
+         "ok = np.isfinite(a)\n"
+         "assert np.isnan(u[~ok]).all() and (u[ok] >= 0).all() and np.isfinite(u[ok]).all()\n"
+         "print(u.dtype, *u.shape, d['k'], *names)\n";
+  const CommandResult numpy = RunShell("/usr/bin/python3 '" + script + "' '" + npy + "' 2>&1");
+  ASSERT_EQ(numpy.exit_code, 0) << Describe(numpy);
+  EXPECT_EQ(Lines(numpy.out).at(0),
+            "float32 9 9 9 101 1 ugrid.u.npy ugrid.u_interpolation.npy ugrid.u_measurement.npy")
+      << numpy.out;
+
+  const CommandResult refused = Ctl({"export", id_, "csv", "-o", Path("r.csv"), "--uncertainty"});
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.err.find("--uncertainty is for grid exports to .npy"), std::string::npos)
+      << refused.err;
+}
+
 TEST_F(BrdfctlExportTest, RglReadsBackAndTheFillIsReported) {
   const std::string bsdf = Path("session.bsdf");
   const CommandResult r =

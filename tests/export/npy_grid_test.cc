@@ -5,9 +5,11 @@
 
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <regex>
 #include <sstream>
 
+#include "core/export/fill/uncertain_chain.h"
 #include "core/export/grid/npy_writer.h"
 #include "core/export/grid/regular_grid.h"
 #include "core/export/grid/text.h"
@@ -366,6 +368,74 @@ TEST(GridCsv, RowsPerCellWithStatusAndDocumentedHeader) {
       GridDescriptionJson(*grid, bands, {3, "paint", Quantity::kBrdf, "octant", 100, 2}, *report);
   EXPECT_NE(json.find("\"shape\": [6, 3, 4, 2]"), std::string::npos) << json;
   EXPECT_NE(json.find("\"nan_cells\": " + std::to_string(report->nan_cells)), std::string::npos);
+}
+
+}  // namespace
+}  // namespace brdf::exports
+
+namespace brdf::exports {
+namespace {
+
+// PatternSource's value and three more planes derived from it (as the uncertain fill chain
+// answers: value, u, u_measurement, u_interpolation), NaN rows where it has none.
+interp::InterpStatus PlanesSource(const IsoDirection& at, std::span<double> row) {
+  const std::size_t bands = row.size() / kUncertainPlanes;
+  const interp::InterpStatus st = PatternSource(at, row.first(bands));
+  if (st != interp::InterpStatus::kOk) return st;
+  for (std::size_t p = 1; p < kUncertainPlanes; ++p) {
+    for (std::size_t b = 0; b < bands; ++b)
+      row[p * bands + b] = 0.001 * static_cast<double>(p) * row[b];
+  }
+  return st;
+}
+
+TEST(Npy, UncertaintyPlanesGoToFilesOfTheValuesShapeAndDtype) {
+  Result<RegularGrid> grid = MakeRegularGrid(10, 15, 30, GridPlacement::kCellCentres);
+  ASSERT_TRUE(grid.ok());
+  const WavelengthGrid bands{400, 100, 3};
+  std::ostringstream files[kUncertainPlanes];
+  std::vector<std::unique_ptr<NpyGridWriter>> writers;
+  std::vector<GridSink*> sinks;
+  for (std::ostringstream& f : files) {
+    writers.push_back(std::make_unique<NpyGridWriter>(f, NpyType::kFloat32));
+    sinks.push_back(writers.back().get());
+  }
+  PlaneSplitSink split(sinks);
+  Result<GridReport> report =
+      ResampleOnGrid(PlanesSource, *grid, bands, {}, LongContext(), split, kUncertainPlanes);
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  MemoryGrid plain;
+  ASSERT_TRUE(ResampleOnGrid(PatternSource, *grid, bands, {}, LongContext(), plain).ok());
+  EXPECT_EQ(report->filled, plain.report().filled);
+  for (std::size_t p = 0; p < kUncertainPlanes; ++p) {
+    PatternNpy f;
+    f.bytes = files[p].str();
+    f.parsed = ParseNpy(f.bytes);
+    ASSERT_TRUE(f.parsed.ok) << "plane " << p;
+    EXPECT_EQ(f.parsed.descr, "<f4");
+    EXPECT_EQ(f.parsed.shape, (std::vector<std::size_t>{9, 6, 6, 3}));
+    ASSERT_EQ(f.bytes.size(), f.parsed.data_offset + 9 * 6 * 6 * 3 * 4);
+    for (std::size_t i = 0; i < plain.values().size(); ++i) {
+      const double want = plain.values()[i] * (p == 0 ? 1.0 : 0.001 * static_cast<double>(p));
+      const float got = LittleEndianValue<float, std::uint32_t>(f, i);
+      if (std::isnan(want)) {
+        EXPECT_TRUE(std::isnan(got)) << "plane " << p << " value " << i;
+      } else {
+        EXPECT_EQ(got, static_cast<float>(want)) << "plane " << p << " value " << i;
+      }
+    }
+  }
+}
+
+TEST(Npy, PlaneSplitRefusesASliceWithoutItsPlanes) {
+  MemoryGrid a, b;
+  PlaneSplitSink split({&a, &b});
+  Result<RegularGrid> grid = MakeRegularGrid(30, 30, 60, GridPlacement::kCellCentres);
+  ASSERT_TRUE(grid.ok());
+  // One plane per cell where two are due: the same source without planes.
+  Result<GridReport> report =
+      ResampleOnGrid(PatternSource, *grid, {400, 100, 2}, {}, LongContext(), split);
+  EXPECT_FALSE(report.ok());
 }
 
 }  // namespace

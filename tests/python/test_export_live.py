@@ -287,6 +287,102 @@ class LiveExport(unittest.TestCase):
         self.assertEqual(r.fill["interpolated"] + r.fill["fallback"] + r.fill["model"],
                          r.filled_cells)
 
+    def stored_brdf_and_u(self, folder):
+        """(ids, BRDF, u) of the sample readings from the readings CSV (its u_<λ> columns)."""
+        csv_path = os.path.join(folder, "brdf.csv")
+        self.client.export(self.session_id, "csv", csv_path)
+        header, rows = self.read_csv(csv_path)
+        bands = [h for h in header if h.replace(".", "").isdigit()]
+        values = [header.index(h) for h in bands]
+        uncertain = [header.index(f"u_{h}") for h in bands]
+        ids = np.array([int(row[0]) for row in rows])
+        brdf = np.array([[float(row[i]) for i in values] for row in rows])
+        u = np.array([[float(row[i]) for i in uncertain] for row in rows])
+        return ids, brdf, u
+
+    def test_grid_npy_with_uncertainty(self):
+        """uncertainty=True: three more arrays of the grid's shape and dtype beside it, named in
+        the sidecar; u ≥ 0 wherever there is a value, NaN where there is none."""
+        path = self.path("grid.npy")
+        r = self.client.export(self.session_id, "grid", path, uncertainty=True, sidecar=True,
+                               float32=True, **GRID_STEPS)
+        folder = os.path.dirname(path)
+        self.assertEqual(sorted(os.listdir(folder)),
+                         ["grid.npy", "grid.npy.json", "grid.u.npy",
+                          "grid.u_interpolation.npy", "grid.u_measurement.npy"])
+        self.assertEqual(sorted(r.parts), ["u", "u_interpolation", "u_measurement"])
+        self.assertEqual(r.warnings, [])
+        with open(path + ".json", encoding="utf-8") as f:
+            sidecar = json.load(f)
+        arrays = sidecar["uncertainty"]["arrays"]
+        self.assertEqual(sidecar["uncertainty"]["k"], 1)
+        self.assertEqual(sidecar["uncertainty"]["unit"], sidecar["unit"])
+        self.assertEqual(sidecar["uncertainty"]["samples_without_budget"], 0)
+        for name, saved in r.parts.items():
+            self.assertEqual(arrays[name]["file"], os.path.basename(saved))
+            self.assertEqual(os.path.dirname(saved), folder)
+        values = np.load(path)
+        u, u_m, u_i = (np.load(r.parts[k]) for k in ("u", "u_measurement", "u_interpolation"))
+        for a in (u, u_m, u_i):
+            self.assertEqual((a.shape, a.dtype), (values.shape, np.float32))
+        finite = np.isfinite(values)
+        self.assertTrue(finite.any())
+        self.assertTrue(np.all(np.isnan(u[~finite])))
+        self.assertTrue(np.all(np.isfinite(u[finite])), "a cell with a value lacks its u")
+        self.assertTrue(np.all(u[finite] >= 0))
+        self.assertTrue(np.all(u_i[finite] >= 0))
+        # u = sqrt(u_measurement² + u_interpolation²), but model cells have no measurement part.
+        model = np.isnan(u_m) & finite
+        self.assertEqual(int(model.all(axis=-1).sum()), r.fill["model"])
+        np.testing.assert_allclose(u[finite & ~model], np.hypot(u_m, u_i)[finite & ~model],
+                                   rtol=1e-5)
+        np.testing.assert_array_equal(u[model], u_i[model])
+
+    def test_grid_cell_on_a_reading_has_its_stored_u(self):
+        """With the nearest method every cell is one reading's value: its measurement part is
+        that reading's stored u (the readings CSV's u_<λ>), and there is no interpolation term
+        (NaN, as the sidecar says)."""
+        path = self.path("nearest.npy")
+        r = self.client.export(self.session_id, "grid", path, uncertainty=True,
+                               method="nearest", **GRID_STEPS)
+        values = np.load(path)
+        u, u_m, u_i = (np.load(r.parts[k]) for k in ("u", "u_measurement", "u_interpolation"))
+        self.assertIn("nearest method", r.description["uncertainty"]["nan"])
+        ids, brdf, stored = self.stored_brdf_and_u(os.path.dirname(path))
+        cells = values.reshape(-1, values.shape[-1])
+        finite = np.all(np.isfinite(cells), axis=1)
+        self.assertEqual(int(finite.sum()), r.cells)
+        matched = set()
+        for cell, measured in zip(cells[finite], u_m.reshape(cells.shape)[finite]):
+            gap = np.max(np.abs(brdf - cell), axis=1)
+            k = int(np.argmin(gap))
+            self.assertLess(gap[k], 1e-9 * np.max(np.abs(cell)) + 1e-12, "no reading has it")
+            np.testing.assert_allclose(measured, stored[k], rtol=1e-9, atol=0)
+            matched.add(int(ids[k]))
+        self.assertGreater(len(matched), 5)
+        self.assertTrue(np.all(np.isnan(u_i)) and np.all(np.isnan(u)))
+
+    def test_merl_with_uncertainty_has_its_summary_beside_it(self):
+        path = self.path("paint.binary")
+        r = self.client.export(self.session_id, "merl", path, uncertainty=True)
+        self.assertEqual(os.path.getsize(path), MERL_BYTES)
+        self.assertEqual(sorted(os.listdir(os.path.dirname(path))),
+                         ["paint.binary", "paint.uncertainty.json"])
+        with open(r.parts["uncertainty"], encoding="utf-8") as f:
+            summary = json.load(f)
+        self.assertEqual((summary["format"], summary["k"]), ("merl", 1))
+        median = np.array(summary["relative_u"]["median"], dtype=float)
+        p95 = np.array(summary["relative_u"]["p95"], dtype=float)
+        white = np.array(summary["relative_white_standard"], dtype=float)
+        self.assertEqual(median.shape, (101,))
+        self.assertTrue(np.all(median > 0) and np.all(p95 >= median))
+        # The white standard's part is shared by every cell: no cell's u is below it.
+        self.assertTrue(np.all(white > 0), white)
+        measured = np.array(summary["relative_u_measurement"]["median"], dtype=float)
+        self.assertTrue(np.all(measured >= white * 0.999), (measured, white))
+        with self.assertRaisesRegex(ValueError, "uncertainty"):
+            self.client.export(self.session_id, "csv", self.path("x.csv"), uncertainty=True)
+
     def test_grid_fill_none_and_chain(self):
         none_path = self.path("none.npy")
         folder = os.path.dirname(none_path)

@@ -18,7 +18,8 @@ Units: degrees for angles, nm for wavelengths, sr⁻¹ for a BRDF, W·m⁻²·sr
 
 import os
 import time
-from typing import Any, Callable, Iterable, Iterator, List, Optional, Sequence, Tuple, Union
+from typing import (Any, Callable, Dict, Iterable, Iterator, List, Optional, Sequence, Tuple,
+                    Union)
 
 import grpc
 
@@ -27,7 +28,7 @@ from .appearance import Appearance, illuminant_enums
 from ._stubs import brdf_pb2, brdf_pb2_grpc
 from .errors import BrdfError
 from .events import Event
-from .export import ExportResult, export_request, format_name
+from .export import ExportResult, export_request, format_name, part_path
 from .interpolation import (InterpolationBatch, InterpolationResult, direction_query,
                             interpolation_options)
 from .plans import PlanLike, to_plan
@@ -53,13 +54,25 @@ def _read_pem(value: PemSource, what: str) -> Optional[bytes]:
 
 
 def _save_export_stream(call: Iterable[Any], partial: str,
-                        on_progress: Callable[[str, float], None]) -> Message:
+                        on_progress: Callable[[str, float], None],
+                        parts: Optional[Dict[str, List[Any]]] = None) -> Message:
     """Writes an Export stream's bytes to `partial`, checking that they come in order and add up
-    to the report's count; returns the report. BrdfError (the daemon's code, or DATA_LOSS)."""
+    to the report's count; returns the report. Companion parts (ExportData.part, with
+    include_uncertainty) go to `partial`.<part>, recorded in `parts` as {part: [path, bytes]}.
+    BrdfError (the daemon's code, or DATA_LOSS)."""
     rpc = "Data.Export"
+    received_parts: Dict[str, List[Any]] = {} if parts is None else parts
 
     def broken(message: str) -> BrdfError:
         return BrdfError(grpc.StatusCode.DATA_LOSS, f"{message}; export again", rpc)
+
+    def write_part(data: Any) -> None:
+        entry = received_parts.setdefault(data.part, [f"{partial}.{data.part}", 0])
+        if data.offset != entry[1]:
+            raise broken(f"part {data.part!r}: bytes at offset {data.offset} after {entry[1]}")
+        with open(entry[0], "ab" if entry[1] else "wb") as pf:
+            pf.write(data.content)
+        entry[1] += len(data.content)
 
     received, report = 0, None
     with open(partial, "wb") as f:
@@ -68,6 +81,8 @@ def _save_export_stream(call: Iterable[Any], partial: str,
                 kind = chunk.WhichOneof("payload")
                 if kind == "progress":
                     on_progress(chunk.progress.stage, chunk.progress.fraction)
+                elif kind == "data" and chunk.data.part:
+                    write_part(chunk.data)
                 elif kind == "data":
                     if chunk.data.offset != received:
                         raise broken(f"the daemon sent bytes at offset {chunk.data.offset} "
@@ -82,6 +97,11 @@ def _save_export_stream(call: Iterable[Any], partial: str,
         raise broken(f"the stream ended without a report after {received} bytes")
     if report.bytes != received:
         raise broken(f"the report counts {report.bytes} bytes but {received} came")
+    for part in report.parts:
+        got = received_parts.get(part.name, ["", 0])[1]
+        if got != part.bytes:
+            raise broken(f"the report counts {part.bytes} bytes of part {part.name!r} but {got} "
+                         "came")
     return report
 
 
@@ -441,7 +461,8 @@ class BrdfClient:
                on_progress: Optional[Callable[[str, float], Any]] = None,
                timeout: Optional[float] = None, coordinates: Union[str, int, None] = None,
                trend: Union[str, int, None] = None, progress: Optional[bool] = None,
-               sidecar: bool = False, float32: bool = False) -> ExportResult:
+               sidecar: bool = False, float32: bool = False,
+               uncertainty: bool = False) -> ExportResult:
         """Has the daemon export the session as a file and saves it at `path`; returns an
         ExportResult (file name, bytes, summary, rows, cells, filled_cells, shape, ...).
 
@@ -483,6 +504,12 @@ class BrdfClient:
             (brdf_client.open_grid reads the pair).
         float32: grid .npy: float32 instead of float64, half the bytes (the sidecar's "dtype"
             says which); ValueError for other formats.
+        uncertainty: grid .npy: also the cells' standard uncertainties (k = 1), three arrays of
+            the grid's shape and dtype saved beside `path` as STEM.u.npy (combined),
+            STEM.u_measurement.npy and STEM.u_interpolation.npy, named in the description's
+            "uncertainty" (docs/uncertainty.md, "Exports"); MERL and RGL: STEM.uncertainty.json,
+            the per-band summary of the cells' u. The result's `parts` maps each to its path.
+            ValueError for the readings CSV, a grid as CSV and BiRD.
 
         Raises BrdfError with the daemon's code and message (NOT_FOUND for an unknown session,
         INVALID_ARGUMENT for bad steps or options, FAILED_PRECONDITION for a session without
@@ -501,9 +528,11 @@ class BrdfClient:
                                  step_phi=step_phi, grid_nodes=grid_nodes,
                                  exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes,
                                  fill=fill, rgb=rgb, rgl_theta_i_count=rgl_theta_i_count,
-                                 rgl_resolution=rgl_resolution, float32=float32)
+                                 rgl_resolution=rgl_resolution, float32=float32,
+                                 uncertainty=uncertainty)
         partial = (os.path.join(path, f"brdf_client-export-{session_id}") if into_folder
                    else path) + ".partial"
+        parts: Dict[str, List[Any]] = {}
         call = self._data.Export(request, metadata=self._metadata, timeout=timeout)
         try:
             with Bar(progress, total=100, desc=f"export {format_name(request.format)}",
@@ -512,19 +541,24 @@ class BrdfClient:
                     bar.moveto(round(100 * fraction, 1), desc=stage)
                     if on_progress:
                         on_progress(stage, fraction)
-                report = _save_export_stream(call, partial, show)
+                report = _save_export_stream(call, partial, show, parts)
             # basename: the daemon names a file, never where it goes.
             final = (os.path.join(path, os.path.basename(report.file_name)) if into_folder
                      else path)
             os.replace(partial, final)
+            saved = {p.name: part_path(final, p.name, p.file_name) for p in report.parts}
+            for name, to in saved.items():
+                if name in parts:
+                    os.replace(parts[name][0], to)
         except BaseException:
             call.cancel()  # stops the daemon's work when we gave up early (Ctrl-C included)
-            try:
-                os.remove(partial)
-            except OSError:
-                pass  # never created (or already gone); the error that matters is re-raised
+            for leftover in [partial] + [entry[0] for entry in parts.values()]:
+                try:
+                    os.remove(leftover)
+                except OSError:
+                    pass  # never created (or already gone); the error that matters is re-raised
             raise
-        result = ExportResult.from_report(report, final, request.format)
+        result = ExportResult.from_report(report, final, request.format, saved)
         if sidecar and result.description is not None:
             result.write_sidecar()
         return result

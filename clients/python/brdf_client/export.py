@@ -39,6 +39,18 @@ FILLED_FORMATS = frozenset((brdf_pb2.EXPORT_FORMAT_GRID_NPY, brdf_pb2.EXPORT_FOR
                             brdf_pb2.EXPORT_FORMAT_MERL_BINARY, brdf_pb2.EXPORT_FORMAT_RGL_BSDF))
 FILLS = {"chain": brdf_pb2.EXPORT_FILL_CHAIN, "none": brdf_pb2.EXPORT_FILL_NONE}
 GRID_FORMATS = frozenset((brdf_pb2.EXPORT_FORMAT_GRID_NPY, brdf_pb2.EXPORT_FORMAT_GRID_CSV))
+# Formats that carry their cells' uncertainty on request (include_uncertainty).
+UNCERTAIN_FORMATS = frozenset((brdf_pb2.EXPORT_FORMAT_GRID_NPY, brdf_pb2.EXPORT_FORMAT_MERL_BINARY,
+                               brdf_pb2.EXPORT_FORMAT_RGL_BSDF))
+
+
+def part_path(path: str, name: str, daemon_file_name: str) -> str:
+    """Where companion part `name` of an export saved at `path` goes: path's stem, ".name", and
+    the extension of the daemon's name for the part ("x.npy", "u", "….u.npy" → "x.u.npy";
+    "x.binary", "uncertainty", "….uncertainty.json" → "x.uncertainty.json"), as brdfctl."""
+    stem, _ = os.path.splitext(path)
+    _, ext = os.path.splitext(daemon_file_name)
+    return f"{stem}.{name}{ext}"
 
 
 def format_name(value: int) -> str:
@@ -80,7 +92,8 @@ def export_request(session_id: str, fmt: Union[str, int], path: str = "", *,
                    exclude_flagged: bool = False, chunk_bytes: int = 0, fill: str = "chain",
                    rgb: bool = False, rgl_theta_i_count: int = 0, rgl_resolution: int = 0,
                    coordinates: Union[str, int, None] = None,
-                   trend: Union[str, int, None] = None, float32: bool = False) -> Any:
+                   trend: Union[str, int, None] = None, float32: bool = False,
+                   uncertainty: bool = False) -> Any:
     """The ExportRequest for BrdfClient.export's arguments (which document them).
 
     As brdfctl: reciprocity None means on for MERL and RGL (a cell stands for a pair of
@@ -95,6 +108,10 @@ def export_request(session_id: str, fmt: Union[str, int], path: str = "", *,
                          f"{format_name(value)}")
     if float32 and value != brdf_pb2.EXPORT_FORMAT_GRID_NPY:
         raise ValueError(f"float32 is for grids as .npy, not {format_name(value)}")
+    if uncertainty and value not in UNCERTAIN_FORMATS:
+        raise ValueError(f"uncertainty is for grids as .npy, MERL and RGL, not "
+                         f"{format_name(value)} (the readings CSV has u_<λ> columns and BiRD "
+                         "uBRDF always)")
     fill_key = str(fill).strip().lower()
     if fill_key not in FILLS:
         raise ValueError(f"unknown fill {fill!r}; use chain or none")
@@ -124,7 +141,8 @@ def export_request(session_id: str, fmt: Union[str, int], path: str = "", *,
         step_theta_i=step_theta_i, step_theta_o=step_theta_o, step_phi=step_phi,
         grid_nodes=grid_nodes, exclude_flagged=exclude_flagged, chunk_bytes=chunk_bytes,
         fill=FILLS[fill_key] if value in FILLED_FORMATS else 0, rgb=rgb,
-        rgl_theta_i_count=rgl_theta_i_count, rgl_resolution=rgl_resolution, float32=float32)
+        rgl_theta_i_count=rgl_theta_i_count, rgl_resolution=rgl_resolution, float32=float32,
+        include_uncertainty=uncertainty)
 
 
 @dataclasses.dataclass
@@ -157,6 +175,9 @@ class ExportResult:
       fill:        grids, MERL, RGL: where the cells' values came from, {"policy": "chain" or
                    "none", "interpolated": n, "fallback": n, "model": n, "empty": n,
                    "model_fraction": x}; None for the readings CSV.
+      parts:       with uncertainty=True: {part name: path} of the files saved beside `path`
+                   ("u", "u_measurement", "u_interpolation" for a grid; "uncertainty" for MERL
+                   and RGL); the description's "uncertainty" names the same files.
     """
 
     path: str
@@ -177,6 +198,7 @@ class ExportResult:
     description: Optional[Dict[str, Any]] = None
     warnings: List[str] = dataclasses.field(default_factory=list)
     fill: Optional[Dict[str, Any]] = None
+    parts: Dict[str, str] = dataclasses.field(default_factory=dict)
 
     def write_sidecar(self) -> str:
         """Writes `description` as JSON next to the file (`path`.json, as brdfctl does);
@@ -199,9 +221,16 @@ class ExportResult:
         return grid_dataset(np.load(self.path), self.description, provenance, source=self.path)
 
     @classmethod
-    def from_report(cls, report: Any, path: str, fmt: int) -> "ExportResult":
-        """From a brdf_pb2.ExportReport, the saved file's path and the ExportFormat number."""
-        return cls(path=path, format=format_name(fmt), file_name=report.file_name,
+    def from_report(cls, report: Any, path: str, fmt: int,
+                    parts: Optional[Dict[str, str]] = None) -> "ExportResult":
+        """From a brdf_pb2.ExportReport, the saved file's path and the ExportFormat number (and
+        where its companion parts were saved: the description then names those files)."""
+        description_json = report.description_json
+        for part in report.parts:
+            if parts and part.name in parts:
+                description_json = description_json.replace(
+                    json.dumps(part.file_name), json.dumps(os.path.basename(parts[part.name])))
+        return cls(path=path, parts=dict(parts or {}), format=format_name(fmt), file_name=report.file_name,
                    bytes=report.bytes, summary=report.summary, rows=report.rows,
                    cells=report.cells, filled_cells=report.filled_cells,
                    unfilled_cells=report.unfilled_cells,
@@ -210,8 +239,7 @@ class ExportResult:
                    clamped_cells=report.clamped_cells,
                    skipped_readings=report.skipped_readings,
                    first_skip_reason=report.first_skip_reason, shape=tuple(report.shape),
-                   description=(json.loads(report.description_json)
-                                if report.description_json else None),
+                   description=(json.loads(description_json) if description_json else None),
                    warnings=list(report.warnings),
                    fill=(_fill_counts(report.fill) if report.HasField("fill") else None))
 

@@ -92,11 +92,18 @@ std::string GridReport::Summary() const {
 Result<GridReport> ResampleOnGrid(const SpectrumSource& source, const RegularGrid& grid,
                                   const WavelengthGrid& bands, const RunControl& control,
                                   const CallContext& ctx, GridSink& sink) {
+  return ResampleOnGrid(source, grid, bands, control, ctx, sink, 1);
+}
+
+Result<GridReport> ResampleOnGrid(const SpectrumSource& source, const RegularGrid& grid,
+                                  const WavelengthGrid& bands, const RunControl& control,
+                                  const CallContext& ctx, GridSink& sink, std::size_t planes) {
   BRDF_RETURN_IF_ERROR(ValidateRegularGrid(grid));
   if (!bands.valid()) {
     return InvalidArgument("resampling onto a grid: the wavelength grid is invalid (no bands)");
   }
-  const std::size_t nb = bands.count;
+  if (planes < 1) return InvalidArgument("resampling onto a grid: planes must be at least 1");
+  const std::size_t nb = bands.count * planes;  // values per cell
   const std::size_t slice_cells = grid.theta_o.count * grid.phi.count;
   const unsigned threads = ResolveThreads(control.threads);
   BRDF_RETURN_IF_ERROR(sink.Begin(grid, bands));
@@ -107,7 +114,7 @@ Result<GridReport> ResampleOnGrid(const SpectrumSource& source, const RegularGri
   // Whole slices go through in windows of at least kWindowCells cells, each window in batches of
   // BatchCells (SpectrumSource::Spectra) spread over the threads, then slice by slice to the sink.
   const std::size_t window_slices =
-      std::min(grid.theta_i.count, std::max<std::size_t>(1, kWindowCells / slice_cells));
+      std::min(grid.theta_i.count, std::max<std::size_t>(1, kWindowCells / planes / slice_cells));
   std::vector<double> directions(3 * window_slices * slice_cells);
   std::vector<double> values(window_slices * slice_cells * nb);
   std::vector<interp::InterpStatus> statuses(window_slices * slice_cells);
@@ -142,6 +149,41 @@ Result<GridReport> ResampleOnGrid(const SpectrumSource& source, const RegularGri
   BRDF_RETURN_IF_ERROR(sink.Finish(report));
   progress.Finish();
   return report;
+}
+
+Status PlaneSplitSink::Begin(const RegularGrid& grid, const WavelengthGrid& bands) {
+  bands_ = bands.count;
+  plane_.resize(grid.theta_o.count * grid.phi.count * bands_);
+  for (GridSink* sink : sinks_) {
+    if (sink != nullptr) BRDF_RETURN_IF_ERROR(sink->Begin(grid, bands));
+  }
+  return Status::Ok();
+}
+
+Status PlaneSplitSink::WriteSlice(std::size_t theta_i_index, std::span<const double> values,
+                                  std::span<const interp::InterpStatus> statuses) {
+  const std::size_t planes = sinks_.size();
+  if (values.size() != statuses.size() * planes * bands_ ||
+      plane_.size() != statuses.size() * bands_) {
+    return Internal("PlaneSplitSink: slice " + std::to_string(theta_i_index) + " does not hold " +
+                    std::to_string(planes) + " planes per cell");
+  }
+  for (std::size_t p = 0; p < planes; ++p) {
+    if (sinks_[p] == nullptr) continue;
+    for (std::size_t c = 0; c < statuses.size(); ++c) {
+      std::copy_n(values.begin() + static_cast<std::ptrdiff_t>((c * planes + p) * bands_), bands_,
+                  plane_.begin() + static_cast<std::ptrdiff_t>(c * bands_));
+    }
+    BRDF_RETURN_IF_ERROR(sinks_[p]->WriteSlice(theta_i_index, plane_, statuses));
+  }
+  return Status::Ok();
+}
+
+Status PlaneSplitSink::Finish(const GridReport& report) {
+  for (GridSink* sink : sinks_) {
+    if (sink != nullptr) BRDF_RETURN_IF_ERROR(sink->Finish(report));
+  }
+  return Status::Ok();
 }
 
 Status MemoryGrid::Begin(const RegularGrid& grid, const WavelengthGrid& bands) {

@@ -13,6 +13,7 @@
 #include <map>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/call_context.h"
@@ -87,6 +88,31 @@ class GridSink {
 Result<GridReport> ResampleOnGrid(const SpectrumSource& source, const RegularGrid& grid,
                                   const WavelengthGrid& bands, const RunControl& control,
                                   const CallContext& ctx, GridSink& sink);
+
+// The same for a source whose rows hold `planes` planes of bands.count values each (a value and
+// its uncertainties: fill/uncertain_chain.h): the sink's slices then hold planes · bands values
+// per cell, plane after plane (PlaneSplitSink hands each plane to a sink of its own). The window
+// of slices shrinks by `planes` so the memory stays as without. planes ≥ 1.
+Result<GridReport> ResampleOnGrid(const SpectrumSource& source, const RegularGrid& grid,
+                                  const WavelengthGrid& bands, const RunControl& control,
+                                  const CallContext& ctx, GridSink& sink, std::size_t planes);
+
+// A GridSink taking slices of `sinks.size()` planes per cell and handing plane p of every cell
+// to sinks[p] (null: that plane is dropped), each as an ordinary slice of bands values per cell.
+// The sinks must outlive it. Errors: the sinks' own, kInternal for a slice of the wrong size.
+class PlaneSplitSink : public GridSink {
+ public:
+  explicit PlaneSplitSink(std::vector<GridSink*> sinks) : sinks_(std::move(sinks)) {}
+  Status Begin(const RegularGrid& grid, const WavelengthGrid& bands) override;
+  Status WriteSlice(std::size_t theta_i_index, std::span<const double> values,
+                    std::span<const interp::InterpStatus> statuses) override;
+  Status Finish(const GridReport& report) override;
+
+ private:
+  std::vector<GridSink*> sinks_;
+  std::size_t bands_ = 0;
+  std::vector<double> plane_;
+};
 
 // A sink that keeps the whole grid in memory: for small grids, tests and callers that post-process.
 class MemoryGrid : public GridSink {

@@ -103,7 +103,7 @@ Status CsvGridWriter::Finish(const GridReport& report) {
 
 std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& bands,
                                 const GridExportInfo& info, const GridReport& report,
-                                const InterpolantInfo& how) {
+                                const InterpolantInfo& how, const std::string& uncertainty_json) {
   std::string j = "{\n";
   j += "  \"format\": \"brdfd regular grid (.npy, " + info.dtype + ", C order)\",\n";
   j += "  \"dtype\": " + JsonString(info.dtype) + ",\n";
@@ -139,6 +139,7 @@ std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& b
   }
   j += "  \"axis_scale\": " + scale + ",\n";
   if (!how.fill_json.empty()) j += "  \"fill\": " + how.fill_json + ",\n";
+  if (!uncertainty_json.empty()) j += "  \"uncertainty\": " + uncertainty_json + ",\n";
   j += "  \"samples\": " + std::to_string(info.samples) + ",\n";
   j += "  \"samples_left_out\": " + std::to_string(info.skipped) + ",\n";
   j += "  \"cells\": " + std::to_string(report.cells) + ",\n";

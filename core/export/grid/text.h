@@ -61,10 +61,13 @@ class CsvGridWriter : public GridSink {
 // count, in degrees), the wavelengths, quantity, unit, method, symmetry options ("mirror_phi",
 // "reciprocity"), "coordinates" ("incidence" or "half_difference"), "trend" ("none" or
 // "bivariate"), "axis_scale" (null: all 1),
-// "fill" (policy and per-provenance counts), and the counts per status.
+// "fill" (policy and per-provenance counts), "uncertainty" (`uncertainty_json`, a JSON object
+// naming the uncertainty arrays beside the grid: fill/uncertain_chain.h UncertaintyJson; left
+// out when empty), and the counts per status.
 std::string GridDescriptionJson(const RegularGrid& grid, const WavelengthGrid& bands,
                                 const GridExportInfo& info, const GridReport& report,
-                                const InterpolantInfo& how = {});
+                                const InterpolantInfo& how = {},
+                                const std::string& uncertainty_json = "");
 
 // Comment lines (without the leading "# ") shared by the text exports: the angle convention.
 std::vector<std::string> AngleConventionLines();

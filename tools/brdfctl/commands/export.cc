@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -91,6 +92,14 @@ int SetQuantityAndFill(const ExportOptions& o, std::ostream& err, v1::ExportRequ
     return Invalid(err, "--float32 is for grid exports to .npy");
   }
   request->set_float32(o.float32);
+  if (o.uncertainty && request->format() != v1::EXPORT_FORMAT_GRID_NPY &&
+      request->format() != v1::EXPORT_FORMAT_MERL_BINARY &&
+      request->format() != v1::EXPORT_FORMAT_RGL_BSDF) {
+    return Invalid(err,
+                   "--uncertainty is for grid exports to .npy, merl and rgl (the readings CSV "
+                   "has u_<λ> columns and the BiRD file uBRDF always)");
+  }
+  request->set_include_uncertainty(o.uncertainty);
   request->set_rgb(o.rgb);
   request->set_rgl_theta_i_count(o.theta_i_count);
   request->set_rgl_resolution(o.resolution);
@@ -205,6 +214,26 @@ class ExportProgressLine {
   std::string last_stage_;
 };
 
+// Where part `p` of the report goes beside `path`: PATH's stem, ".<name>", and the extension of
+// the daemon's name for it ("x.npy", u → "x.u.npy"; "x.binary", uncertainty →
+// "x.uncertainty.json").
+std::string PartPath(const std::string& path, const v1::ExportPart& p) {
+  const auto extension_of = [](const std::string& name) {
+    const std::size_t slash = name.rfind('/');
+    const std::size_t dot = name.rfind('.');
+    return dot == std::string::npos || (slash != std::string::npos && dot < slash)
+               ? std::string()
+               : name.substr(dot);
+  };
+  const std::string ext = extension_of(path);
+  return path.substr(0, path.size() - ext.size()) + "." + p.name() + extension_of(p.file_name());
+}
+
+std::string BaseName(const std::string& path) {
+  const std::size_t slash = path.rfind('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
 void PrintReport(std::ostream& err, const v1::ExportReport& r, const std::string& path) {
   err << "brdfctl export: " << r.summary() << " → " << path << " (" << r.bytes() << " bytes)\n";
   if (r.skipped_readings() > 0) {
@@ -216,6 +245,10 @@ void PrintReport(std::ostream& err, const v1::ExportReport& r, const std::string
     for (int i = 0; i < r.shape_size(); ++i) err << (i > 0 ? ", " : "") << r.shape(i);
     err << ") float64, NaN cells: " << r.unfilled_cells() << "; axes, wavelengths, unit: " << path
         << ".json\n";
+  }
+  for (const v1::ExportPart& p : r.parts()) {
+    err << "brdfctl export: " << p.name() << " → " << PartPath(path, p) << " (" << p.bytes()
+        << " bytes)\n";
   }
   if (r.has_fill()) {
     const v1::ExportFillCounts& f = r.fill();
@@ -243,6 +276,7 @@ class ExportDestination {
   // For messages: "standard output" or the .partial file.
   std::string name() const { return to_stdout_ ? "standard output" : partial_; }
   const std::string& partial() const { return partial_; }
+  bool to_stdout() const { return to_stdout_; }
 
   void Discard() {
     if (to_stdout_) return;
@@ -262,10 +296,40 @@ class ExportDestination {
   std::ofstream file_;
 };
 
+// A companion part of the export (ExportData.part, with --uncertainty): PARTIAL.<part>, renamed
+// beside the file once the report has come.
+struct PartFile {
+  std::string partial;
+  std::ofstream file;
+  std::uint64_t bytes = 0;
+};
+
 struct Received {
   std::uint64_t bytes = 0;
   std::optional<v1::ExportReport> report;
+  std::map<std::string, PartFile> parts;
 };
+
+// Writes a chunk of a companion part at the offset expected; false (the message printed) when
+// the offset, the part's file or the write is wrong.
+bool WritePartChunk(CommandContext& ctx, const v1::ExportData& data,
+                    const ExportDestination& destination, Received* received) {
+  PartFile& part = received->parts[data.part()];
+  if (part.partial.empty()) {
+    part.partial = destination.partial() + "." + data.part();
+    part.file.open(part.partial, std::ios::binary | std::ios::trunc);
+  }
+  if (data.offset() != part.bytes || !part.file) {
+    ctx.err << "brdfctl export: part '" << data.part()
+            << "': " << (part.file ? "bytes out of order" : "cannot create " + part.partial)
+            << "; try again\n";
+    return false;
+  }
+  part.file.write(data.content().data(), static_cast<std::streamsize>(data.content().size()));
+  part.bytes += data.content().size();
+  if (!part.file) ctx.err << "brdfctl export: writing " << part.partial << " failed (disk full?)\n";
+  return static_cast<bool>(part.file);
+}
 
 // Writes a data chunk at the offset expected; false (the message printed) when the offset or
 // the write is wrong.
@@ -301,6 +365,12 @@ int ReceiveExport(CommandContext& ctx, const ExportOptions& o, const v1::ExportR
       stage = chunk.progress().stage();
       fraction = chunk.progress().fraction();
       line.Update(stage, fraction, received->bytes);
+    } else if (chunk.has_data() && !chunk.data().part().empty()) {
+      if (destination.to_stdout() || !WritePartChunk(ctx, chunk.data(), destination, received)) {
+        call->TryCancel();
+        line.Finish();
+        return kExitFailure;
+      }
     } else if (chunk.has_data()) {
       if (!WriteChunk(ctx, chunk.data(), destination, received->bytes)) {
         call->TryCancel();
@@ -327,11 +397,45 @@ int ReceiveExport(CommandContext& ctx, const ExportOptions& o, const v1::ExportR
   return kExitOk;
 }
 
+// Moves each companion part beside `path` (PartPath); false (the message printed) when one is
+// missing, its size does not match the report's, or it cannot be moved.
+bool KeepParts(std::ostream& err, const v1::ExportReport& report, const std::string& path,
+               Received* received) {
+  for (const v1::ExportPart& p : report.parts()) {
+    PartFile& part = received->parts[p.name()];
+    if (part.partial.empty() && p.bytes() == 0) continue;
+    part.file.close();
+    const std::string to = PartPath(path, p);
+    if (part.bytes != p.bytes() || !part.file ||
+        std::rename(part.partial.c_str(), to.c_str()) != 0) {
+      err << "brdfctl export: part '" << p.name() << "' (" << part.bytes << " of " << p.bytes()
+          << " bytes) could not be kept as " << to << "; try again\n";
+      return false;
+    }
+  }
+  return true;
+}
+
+// The description with the daemon's names of the parts replaced by the files' names beside
+// `path`, so that it names what is on disk.
+std::string DescriptionFor(const v1::ExportReport& report, const std::string& path) {
+  std::string text = report.description_json();
+  for (const v1::ExportPart& p : report.parts()) {
+    const std::string from = "\"" + p.file_name() + "\"";
+    const std::string to = "\"" + BaseName(PartPath(path, p)) + "\"";
+    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at)) {
+      text.replace(at, from.size(), to);
+      at += to.size();
+    }
+  }
+  return text;
+}
+
 // The grid's description next to it (PATH.json), when the daemon sent one.
 bool WriteDescription(std::ostream& err, const v1::ExportReport& report, const std::string& path) {
   if (report.description_json().empty()) return true;
   std::ofstream json(path + ".json", std::ios::trunc);
-  json << report.description_json();
+  json << DescriptionFor(report, path);
   if (!json) {
     err << "brdfctl export: cannot write " << path << ".json\n";
     return false;
@@ -360,6 +464,10 @@ int RunExport(CommandContext& ctx, const ExportOptions& o) {
   Received received;
   if (int rc = ReceiveExport(ctx, o, request, destination, &received); rc != kExitOk) {
     destination.Discard();
+    for (auto& [name, part] : received.parts) {
+      part.file.close();
+      std::remove(part.partial.c_str());
+    }
     return rc;
   }
   const v1::ExportReport& report = *received.report;
@@ -372,6 +480,7 @@ int RunExport(CommandContext& ctx, const ExportOptions& o) {
       destination.Discard();
       return kExitFailure;
     }
+    if (!KeepParts(ctx.err, report, path, &received)) return kExitFailure;
     if (!WriteDescription(ctx.err, report, path)) return kExitFailure;
   } else {
     ctx.out.flush();
@@ -434,6 +543,10 @@ void AddInterpolationFlags(CLI::App& cmd, ExportOptions& o) {
 
 void AddRglAndReadingFlags(CLI::App& cmd, ExportOptions& o, bool& no_progress) {
   cmd.add_flag("--rgb", o.rgb, "rgl: linear sRGB under D65 (field rgb) instead of spectra");
+  cmd.add_flag("--uncertainty", o.uncertainty,
+               "grid .npy: also FILE.u.npy, FILE.u_measurement.npy, FILE.u_interpolation.npy "
+               "(standard uncertainties, k = 1, named in FILE.json); merl, rgl: "
+               "FILE.uncertainty.json (the cells' u per band)");
   cmd.add_flag("--float32", o.float32,
                "grid .npy: float32 instead of float64, half the bytes (the .json says dtype)");
   cmd.add_option("--theta-i", o.theta_i_count, "rgl: θi slices (default 24)");

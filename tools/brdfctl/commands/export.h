@@ -43,6 +43,7 @@ struct ExportOptions {
   std::string fill = "chain";   // grid, merl, rgl: chain or none
   bool rgb = false;             // rgl: linear sRGB under D65 instead of spectra
   bool float32 = false;         // grid .npy: float32 instead of float64
+  bool uncertainty = false;     // grid .npy, merl, rgl: the cells' u beside the file
   unsigned theta_i_count = 0;   // rgl: θi slices; 0: the daemon's default (24)
   unsigned resolution = 0;      // rgl: nodes per side of the warped square; 0: 48
   bool exclude_flagged = false;

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# What asking for uncertainties costs the grid export (issue 37, deliverable 6: at most 2× the
+# time without): records examples/plans/demo.json on brdf-sim through brdfd (87 sample readings,
+# each with its stored budget), then times `brdfctl export SESSION grid` with and without
+# --uncertainty in the same run, alternating which goes first, and prints the medians and their
+# ratio. Both write float32 .npy files (with --uncertainty four of them).
+#
+# Usage: bench/uncertainty/grid_cost.sh [BUILD_DIR]   (default ./build; builds brdfd, brdf-sim
+#        and brdfctl unless BENCH_NO_BUILD=1)
+# Environment: COST_STEPS (grid steps, "2,2,2": 45 × 45 × 90 cells), COST_REPS (5),
+# COST_METHOD (octant), COST_FILL (chain), BENCH_KEEP=1 keeps the work directory.
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+build="${1:-$root/build}"
+case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
+
+if [[ "${BENCH_NO_BUILD:-0}" != 1 ]]; then
+  echo "== building brdfd, brdf-sim, brdfctl (-j2)" >&2
+  cmake --build "$build" -j2 --target brdfd brdf-sim brdfctl >&2
+fi
+brdfd="$build/daemon/brdfd"
+sim="$build/tools/brdf-sim/brdf-sim"
+ctl="$build/tools/brdfctl/brdfctl"
+
+# shellcheck source=bench/daemon/lib.sh
+source "$root/bench/daemon/lib.sh"
+bench_workdir_and_cleanup /tmp/brdfd-grid-cost.XXXXXX
+config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
+
+echo "grid export's uncertainty: cost — $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) CPUs"
+echo "load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
+start_rig_on_sim "$work" 8 warn
+session="$("$ctl" submit "$root/examples/plans/demo.json" --start --quiet)"
+on_prompt="$(printf '%q sim-mount from-prompt --modbus %q' "$ctl" "$modbus")"
+"$ctl" watch "$session" --auto-confirm --on-prompt "$on_prompt" --exit-on-pause \
+  >"$work/watch.out" 2>&1 </dev/null
+echo "session $session recorded (demo plan)"
+
+steps="${COST_STEPS:-2,2,2}"
+export_once() {  # $1: "" or --uncertainty; prints seconds
+  local t0 t1
+  rm -f "$work"/g.*
+  t0="$(date +%s.%N)"
+  "$ctl" export "$session" grid \
+    -o "$work/g.npy" --steps "$steps" --float32 --method "${COST_METHOD:-octant}" \
+    --fill "${COST_FILL:-chain}" $1 >/dev/null 2>"$work/export.err" || {
+    cat "$work/export.err" >&2
+    exit 1
+  }
+  t1="$(date +%s.%N)"
+  echo "$t1 - $t0" | bc
+}
+plain=()
+with=()
+for ((r = 0; r < ${COST_REPS:-5}; r++)); do
+  if ((r % 2 == 0)); then
+    plain+=("$(export_once "")")
+    with+=("$(export_once --uncertainty)")
+  else
+    with+=("$(export_once --uncertainty)")
+    plain+=("$(export_once "")")
+  fi
+done
+ls -l "$work"/g.* | awk '{print "  " $5 " bytes  " $NF}'
+python3 - "${plain[*]}" "${with[*]}" <<'PY'
+import statistics, sys
+plain = [float(x) for x in sys.argv[1].split()]
+with_u = [float(x) for x in sys.argv[2].split()]
+a, b = statistics.median(plain), statistics.median(with_u)
+print(f"grid export, without uncertainty: {' '.join(f'{x:.2f}' for x in plain)} s, median {a:.2f} s")
+print(f"grid export, with uncertainty:    {' '.join(f'{x:.2f}' for x in with_u)} s, median {b:.2f} s")
+print(f"ratio (medians): {b / a:.2f}")
+PY
+echo "load at end: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -1,0 +1,239 @@
+#include "core/export/fill/uncertain_chain.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <span>
+#include <utility>
+
+#include "core/export/json_text.h"
+#include "core/export/number_text.h"
+#include "core/fit/models.h"
+#include "core/uncertainty/interpolated.h"
+
+namespace brdf::exports {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr std::size_t kMostNotEstimated = 20;
+
+// Plane `p` of a row of kUncertainPlanes · bands values.
+std::span<double> Plane(std::span<double> row, UncertainPlane p, std::size_t bands) {
+  return row.subspan(static_cast<std::size_t>(p) * bands, bands);
+}
+
+// One answer's row: the value, then its uncertainty planes (NaN where a part is missing).
+void WriteAnswer(const interp::Interpolation& answer, const uncertainty::InterpolatedInputs& inputs,
+                 std::span<double> row) {
+  const std::size_t bands = answer.spectrum.size();
+  std::copy(answer.spectrum.begin(), answer.spectrum.end(), row.begin());
+  const uncertainty::InterpolatedUncertainty u =
+      uncertainty::EstimateInterpolatedUncertainty(answer, inputs);
+  // A vertex without a budget would leave the blend short: the whole part is NaN, never partial.
+  bool every_budget = !u.measurement.empty();
+  for (const interp::Vertex& v : answer.vertices) {
+    every_budget = every_budget && inputs.budget_of(v.index) != nullptr;
+  }
+  const std::span<double> m = Plane(row, UncertainPlane::kMeasurement, bands);
+  const std::span<double> i = Plane(row, UncertainPlane::kInterpolation, bands);
+  const std::span<double> c = Plane(row, UncertainPlane::kCombined, bands);
+  for (std::size_t b = 0; b < bands; ++b) {
+    m[b] = every_budget && b < u.measurement.size() ? u.measurement[b] : kNaN;
+    i[b] = b < u.interpolation.size() ? u.interpolation[b] : kNaN;
+    c[b] = std::sqrt(m[b] * m[b] + i[b] * i[b]);
+  }
+}
+
+// An interpolator as a stage answering rows with their uncertainties.
+SpectrumSource InterpolatorWithUncertainty(const interp::Interpolator& interpolator,
+                                           uncertainty::InterpolatedInputs inputs) {
+  auto one = [&interpolator, inputs](const IsoDirection& at, std::span<double> out) {
+    const double q[3] = {at.theta_i, at.theta_o, at.phi};
+    const interp::Interpolation answer = interpolator.Evaluate(q);
+    if (answer.status == interp::InterpStatus::kOk) WriteAnswer(answer, inputs, out);
+    return answer.status;
+  };
+  auto many = [&interpolator, inputs](std::span<const double> directions,
+                                      std::span<interp::InterpStatus> statuses,
+                                      std::span<double> rows) {
+    const std::size_t width = statuses.empty() ? 0 : rows.size() / statuses.size();
+    interpolator.EvaluateEach(directions, [&](std::size_t k, interp::Interpolation&& answer) {
+      statuses[k] = answer.status;
+      const std::span<double> row = rows.subspan(k * width, width);
+      if (answer.status == interp::InterpStatus::kOk) {
+        WriteAnswer(answer, inputs, row);
+      } else {
+        std::fill(row.begin(), row.end(), kNaN);
+      }
+      return true;
+    });
+  };
+  return SpectrumSource(std::move(one), std::move(many));
+}
+
+// The model as a stage: its value, its residual spread as the interpolation term and the
+// combined u, no measurement part.
+SpectrumSource ModelWithSpread(const fit::CookTorranceFit& model, std::vector<double> spread) {
+  return [params = model.band, spread = std::move(spread)](const IsoDirection& at,
+                                                           std::span<double> row) {
+    const std::size_t bands = params.size();
+    for (std::size_t b = 0; b < bands; ++b) {
+      const double u = b < spread.size() ? spread[b] : kNaN;
+      row[b] = fit::CookTorranceBrdf(at, params[b]);
+      Plane(row, UncertainPlane::kCombined, bands)[b] = u;
+      Plane(row, UncertainPlane::kMeasurement, bands)[b] = kNaN;
+      Plane(row, UncertainPlane::kInterpolation, bands)[b] = u;
+    }
+    return interp::InterpStatus::kOk;
+  };
+}
+
+UncertaintyCoverage CoverageOf(const SessionInterpolant& in) {
+  UncertaintyCoverage c;
+  c.samples = in.derived.samples.size();
+  if (in.derived.quantity != Quantity::kBrdf) {
+    c.no_budgets = std::string("the readings' budgets are of the BRDF, this export is of ") +
+                   QuantityName(in.derived.quantity) + "; export the BRDF for a measurement part";
+    c.without_budget = c.samples;
+  }
+  for (const DerivedSample& s : in.derived.samples) {
+    if (!c.no_budgets.empty()) break;
+    if (!s.budget) {
+      ++c.without_budget;
+      continue;
+    }
+    for (const std::string& entry : s.budget->not_estimated) {
+      if (c.not_estimated.size() < kMostNotEstimated &&
+          std::find(c.not_estimated.begin(), c.not_estimated.end(), entry) ==
+              c.not_estimated.end()) {
+        c.not_estimated.push_back(entry);
+      }
+    }
+  }
+  if (in.model) {
+    for (const fit::Residuals& r : in.model->band_residuals) c.model_spread.push_back(r.rms);
+  }
+  return c;
+}
+
+}  // namespace
+
+const char* UncertainPlaneName(UncertainPlane p) {
+  switch (p) {
+    case UncertainPlane::kValue:
+      return "value";
+    case UncertainPlane::kCombined:
+      return "u";
+    case UncertainPlane::kMeasurement:
+      return "u_measurement";
+    case UncertainPlane::kInterpolation:
+      return "u_interpolation";
+  }
+  return "?";
+}
+
+namespace {
+
+const char* PlaneMeaning(UncertainPlane p) {
+  switch (p) {
+    case UncertainPlane::kCombined:
+      return "combined standard uncertainty (k = 1), sqrt(u_measurement^2 + u_interpolation^2); "
+             "model cells: the model's residual RMS alone";
+    case UncertainPlane::kMeasurement:
+      return "measurement part: the blended vertices' reading budgets, shared terms (white "
+             "standard, references, darks, instrument) correlated, as Interpolate gives it";
+    case UncertainPlane::kInterpolation:
+      return "interpolation term: the vertices' weighted spread about the blend, not calibrated "
+             "against held-out readings as Interpolate's is (wider: docs/uncertainty.md); model "
+             "cells: "
+             "the fitted model's residual RMS per band over the readings it was fitted to";
+    case UncertainPlane::kValue:
+      break;
+  }
+  return "the value";
+}
+
+std::string JsonList(const std::vector<std::string>& items) {
+  std::string j = "[";
+  for (std::size_t k = 0; k < items.size(); ++k) j += (k ? ", " : "") + JsonString(items[k]);
+  return j + "]";
+}
+
+std::string JsonNumbers(const std::vector<double>& values) {
+  if (values.empty()) return "null";
+  std::string j = "[";
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    j += (k ? ", " : "") + (std::isfinite(values[k]) ? FormatNumber(values[k]) : "null");
+  }
+  return j + "]";
+}
+
+}  // namespace
+
+std::string UncertaintyJson(const UncertaintyCoverage& c, Quantity quantity,
+                            const std::vector<UncertaintyFile>& files) {
+  std::string j = "{\"k\": 1, \"kind\": \"standard uncertainty\", \"unit\": " +
+                  JsonString(QuantityUnit(quantity)) +
+                  ", \"shape\": \"the values' shape, the same cells and bands\", \"arrays\": {";
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    j += (k ? ", " : "") + JsonString(UncertainPlaneName(files[k].plane)) +
+         ": {\"file\": " + JsonString(files[k].file_name) +
+         ", \"what\": " + JsonString(PlaneMeaning(files[k].plane)) + "}";
+  }
+  j += "}, \"nan\": " +
+       JsonString(
+           "NaN in every array where the value is NaN (no stage of the fill chain had "
+           "one); u_measurement (and u) NaN where a blended reading has no uncertainty "
+           "budget or the quantity has none, and in model cells; u_interpolation (and u) "
+           "NaN for the nearest method (one vertex)");
+  j += ", \"samples\": " + std::to_string(c.samples) +
+       ", \"samples_without_budget\": " + std::to_string(c.without_budget);
+  j += ", \"measurement_not_estimated\": " +
+       (c.no_budgets.empty() ? "null" : JsonString(c.no_budgets));
+  j += ", \"budgets_not_estimated\": " + JsonList(c.not_estimated);
+  j += ", \"model_residual_rms\": " + JsonNumbers(c.model_spread);
+  j += ", \"docs\": \"docs/uncertainty.md, Exports\"}";
+  return j;
+}
+
+std::vector<std::string> UncertaintyWarnings(const UncertaintyCoverage& c) {
+  std::vector<std::string> w;
+  if (!c.no_budgets.empty()) {
+    w.push_back("uncertainty: no measurement part (" + c.no_budgets +
+                "); u_measurement and u are NaN, u_interpolation is given");
+  } else if (c.without_budget > 0) {
+    w.push_back("uncertainty: " + std::to_string(c.without_budget) + " of " +
+                std::to_string(c.samples) +
+                " sample readings have no uncertainty budget (recorded before budgets, or "
+                "[uncertainty] enabled = false): the cells blending them have u_measurement and "
+                "u NaN");
+  }
+  return w;
+}
+
+UncertainChain MakeUncertainChain(const SessionInterpolant& in) {
+  UncertainChain out;
+  out.coverage = CoverageOf(in);
+  uncertainty::InterpolatedInputs inputs;
+  inputs.samples = in.samples.get();
+  if (out.coverage.no_budgets.empty()) {
+    inputs.budget_of = [&in](std::size_t i) {
+      return i < in.derived.samples.size() ? in.derived.samples[i].budget.get() : nullptr;
+    };
+  } else {
+    inputs.no_budgets = out.coverage.no_budgets;
+  }
+  std::vector<FillChain::Stage> stages;
+  stages.push_back(
+      {Provenance::kInterpolated, InterpolatorWithUncertainty(*in.interpolator, inputs)});
+  if (in.fallback) {
+    stages.push_back({Provenance::kFallback, InterpolatorWithUncertainty(*in.fallback, inputs)});
+  }
+  if (in.model) {
+    stages.push_back({Provenance::kModel, ModelWithSpread(*in.model, out.coverage.model_spread)});
+  }
+  out.chain = std::make_unique<FillChain>(in.chain->Tally().policy, std::move(stages));
+  return out;
+}
+
+}  // namespace brdf::exports

@@ -1,0 +1,66 @@
+// The fill chain of a session's interpolant answering each direction with its uncertainty, for
+// exports that carry one (the grid's .npy with `include_uncertainty`; docs/uncertainty.md,
+// "Exports"). A cell's row holds kUncertainPlanes planes of `bands` values each:
+//   value          the interpolated (or modelled) quantity, as the plain chain gives it;
+//   u              the combined standard uncertainty (k = 1), sqrt(u_measurement² +
+//                  u_interpolation²); for a model cell its residual spread alone;
+//   u_measurement  the vertices' budgets blended (core/uncertainty/interpolated.h, the same as
+//                  the Interpolate API), NaN when a vertex has no budget or the quantity has none
+//                  (only the BRDF has budgets), and for model cells;
+//   u_interpolation the vertices' spread about the blend (InterpolationSpread); for model cells
+//                  the model's residual RMS per band over the readings it was fitted to; NaN for
+//                  the nearest method (one vertex).
+// NaN in every plane where no stage has a value. One pass: the values and their uncertainties
+// come from the same answers (Interpolator::EvaluateEach). Pure: no I/O.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/export/fill/chain.h"
+#include "core/export/fill/session_interpolant.h"
+
+namespace brdf::exports {
+
+inline constexpr std::size_t kUncertainPlanes = 4;
+enum class UncertainPlane { kValue = 0, kCombined = 1, kMeasurement = 2, kInterpolation = 3 };
+const char* UncertainPlaneName(UncertainPlane p);  // "value", "u", "u_measurement", …
+
+// What the session's samples give the uncertainty, for the sidecar and the report's warnings.
+struct UncertaintyCoverage {
+  std::size_t samples = 0;
+  std::size_t without_budget = 0;  // sample readings with no budget of this quantity
+  std::string no_budgets;          // non-empty: the quantity has no budgets at all, and why
+  // The union of the samples' budgets' not_estimated entries (each once, at most 20).
+  std::vector<std::string> not_estimated;
+  std::vector<double> model_spread;  // per band, the model's residual RMS; empty without a model
+};
+
+// A FillChain over `in`'s stages (the chosen method, its Delaunay fallback and its model, as
+// `in.chain` has them) whose sources answer rows of kUncertainPlanes · bands values. `in` must
+// outlive it. Its Tally() counts the cells as in.chain's would.
+struct UncertainChain {
+  std::unique_ptr<FillChain> chain;
+  UncertaintyCoverage coverage;
+};
+UncertainChain MakeUncertainChain(const SessionInterpolant& in);
+
+// The uncertainty arrays written beside an export, one per plane other than the value.
+struct UncertaintyFile {
+  UncertainPlane plane = UncertainPlane::kCombined;
+  std::string file_name;  // e.g. "session-3-grid-brdf.u.npy"
+};
+
+// The sidecar's "uncertainty" object (a JSON object, no trailing newline): k = 1, the unit of
+// `quantity`, each file and what it holds, which cells are NaN and why, the coverage (samples
+// without a budget, what the budgets leave out, the model's residual RMS per band).
+std::string UncertaintyJson(const UncertaintyCoverage& coverage, Quantity quantity,
+                            const std::vector<UncertaintyFile>& files);
+
+// The report's warnings for `coverage`: samples without a budget (their cells' u_measurement
+// and u NaN), a quantity without budgets. Empty when every sample has a budget.
+std::vector<std::string> UncertaintyWarnings(const UncertaintyCoverage& coverage);
+
+}  // namespace brdf::exports

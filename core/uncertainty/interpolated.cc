@@ -1,0 +1,89 @@
+#include "core/uncertainty/interpolated.h"
+
+#include <array>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/uncertainty/blend.h"
+
+namespace brdf::uncertainty {
+namespace {
+
+// Room for an answer's vertices without allocating (octant: 4 or 5; Delaunay: dims + 1); a
+// larger answer goes to the heap.
+constexpr std::size_t kInline = 8;
+
+template <typename T>
+struct Scratch {
+  std::array<T, kInline> inline_items{};
+  std::vector<T> heap;
+  std::span<T> Take(std::size_t n) {
+    if (n <= kInline) return {inline_items.data(), n};
+    heap.resize(n);
+    return heap;
+  }
+};
+
+// The measurement part into `out`, or the reason it has none.
+void AddMeasurement(const interp::Interpolation& answer, const InterpolatedInputs& inputs,
+                    InterpolatedUncertainty& out) {
+  if (!inputs.budget_of) {
+    out.not_estimated.push_back("measurement: " + inputs.no_budgets);
+    return;
+  }
+  Scratch<BlendVertex> scratch;
+  const std::span<BlendVertex> vertices = scratch.Take(answer.vertices.size());
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    const interp::Vertex& v = answer.vertices[i];
+    vertices[i] = {v.id, v.weight, inputs.budget_of(v.index)};
+  }
+  Result<BlendedUncertainty> blended =
+      BlendMeasurementUncertainty(vertices, static_cast<int>(answer.spectrum.size()));
+  if (!blended.ok()) {
+    out.not_estimated.push_back("measurement: " + blended.status().message());
+    return;
+  }
+  out.measurement = std::move(blended->measurement);
+  out.shared = std::move(blended->shared);
+  for (std::string& entry : blended->not_estimated) out.not_estimated.push_back(std::move(entry));
+}
+
+// The interpolation term into `out`, or the reason it has none.
+void AddInterpolation(const interp::Interpolation& answer, const InterpolatedInputs& inputs,
+                      InterpolatedUncertainty& out) {
+  if (answer.method == interp::Method::kNearest) {
+    out.not_estimated.push_back(
+        "interpolation: the nearest method blends one reading, so its spread says nothing; use "
+        "octant or delaunay for an estimate");
+    return;
+  }
+  Scratch<double> weight_scratch;
+  Scratch<std::span<const double>> spectrum_scratch;
+  const std::span<double> weights = weight_scratch.Take(answer.vertices.size());
+  const std::span<std::span<const double>> spectra = spectrum_scratch.Take(weights.size());
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    weights[i] = answer.vertices[i].weight;
+    spectra[i] = inputs.samples->spectrum(answer.vertices[i].index);
+  }
+  out.interpolation = InterpolationSpread(weights, spectra, answer.spectrum);
+  const InterpolationCalibration* calibration = inputs.calibration;
+  if (calibration != nullptr && !ApplyInterpolationCalibration(*calibration, out.interpolation)) {
+    out.not_estimated.push_back("interpolation: not calibrated (" + calibration->detail +
+                                "); the vertices' spread as it is");
+  }
+}
+
+}  // namespace
+
+InterpolatedUncertainty EstimateInterpolatedUncertainty(const interp::Interpolation& answer,
+                                                        const InterpolatedInputs& inputs) {
+  InterpolatedUncertainty out;
+  if (answer.status != interp::InterpStatus::kOk) return out;
+  AddMeasurement(answer, inputs, out);
+  AddInterpolation(answer, inputs, out);
+  return out;
+}
+
+}  // namespace brdf::uncertainty

@@ -1,0 +1,149 @@
+// fill/uncertain_chain: a session's fill chain answering each direction with its uncertainty —
+// at a reading's pose the measurement part is that reading's budget, NaN where a blended reading
+// has none, model cells carry the model's residual RMS; and the sidecar's "uncertainty" object.
+#include "core/export/fill/uncertain_chain.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "core/export/fill/session_interpolant.h"
+#include "export_test_util.h"
+
+namespace brdf::exports {
+namespace {
+
+CallContext LongContext() {
+  return CallContext::WithTimeout(std::chrono::hours(1));
+}
+
+// Each sample gets a budget of 1 % shared (the session's white standard) and 2 % independent.
+void AddBudgets(DerivedSamples& derived) {
+  for (DerivedSample& s : derived.samples) {
+    auto b = std::make_shared<uncertainty::ReadingBudget>();
+    uncertainty::Component white{"white_standard", {uncertainty::Sharing::kWhiteStandard, 1}, {}};
+    uncertainty::Component signal{"sample_signal", {uncertainty::Sharing::kIndependent, 0}, {}};
+    for (double f : s.values) {
+      white.contribution.push_back(0.01 * f);
+      signal.contribution.push_back(0.02 * f);
+      b->combined.push_back(std::hypot(0.01 * f, 0.02 * f));
+      b->independent.push_back(0.02 * f);
+    }
+    b->components = {white, signal};
+    s.budget = b;
+  }
+}
+
+struct Row {
+  interp::InterpStatus status;
+  std::vector<double> values;
+  std::span<const double> plane(UncertainPlane p) const {
+    const std::size_t bands = values.size() / kUncertainPlanes;
+    return std::span<const double>(values).subspan(static_cast<std::size_t>(p) * bands, bands);
+  }
+};
+
+Row Ask(const UncertainChain& chain, const IsoDirection& at, std::size_t bands) {
+  Row r{interp::InterpStatus::kOk, std::vector<double>(kUncertainPlanes * bands, 0.0)};
+  r.status = chain.chain->Source()(at, r.values);
+  return r;
+}
+
+// The first sample from the middle of the set on whose pose the chain has a value (the octant
+// method has none at the grid's edges), and that answer.
+std::pair<std::size_t, Row> AnsweredSample(const UncertainChain& chain,
+                                           const DerivedSamples& derived) {
+  const std::size_t n = derived.samples.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = (n / 2 + k) % n;
+    Row row = Ask(chain, derived.samples[i].iso, derived.grid.count);
+    if (row.status == interp::InterpStatus::kOk) return {i, std::move(row)};
+  }
+  ADD_FAILURE() << "no sample's pose has a value";
+  return {0, Row{interp::InterpStatus::kOutsideHull, {}}};
+}
+
+TEST(UncertainChain, AtAReadingsPoseTheMeasurementPartIsItsBudget) {
+  std::optional<testing::PaintGridSamples> paint = testing::PaintLikeGridSamples();
+  ASSERT_TRUE(paint.has_value());
+  AddBudgets(paint->derived);
+  Result<SessionInterpolant> in = BuildSessionInterpolant(paint->derived, interp::Method::kOctant,
+                                                          {}, FillPolicy::kNone, LongContext());
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  const UncertainChain chain = MakeUncertainChain(*in);
+  const auto [index, row] = AnsweredSample(chain, paint->derived);
+  ASSERT_EQ(row.status, interp::InterpStatus::kOk);
+  const DerivedSample& reading = paint->derived.samples[index];
+  const std::size_t bands = reading.values.size();
+  for (std::size_t b = 0; b < bands; ++b) {
+    EXPECT_NEAR(row.plane(UncertainPlane::kValue)[b], reading.values[b], 1e-12);
+    EXPECT_NEAR(row.plane(UncertainPlane::kMeasurement)[b], reading.budget->combined[b], 1e-12);
+    EXPECT_NEAR(row.plane(UncertainPlane::kInterpolation)[b], 0.0, 1e-9);
+    EXPECT_NEAR(row.plane(UncertainPlane::kCombined)[b], reading.budget->combined[b], 1e-9);
+  }
+  EXPECT_EQ(chain.coverage.without_budget, 0u);
+  EXPECT_GE(chain.chain->Tally().interpolated, 1u);
+}
+
+TEST(UncertainChain, ABlendedReadingWithoutBudgetMakesTheMeasurementPartNaN) {
+  std::optional<testing::PaintGridSamples> paint = testing::PaintLikeGridSamples();
+  ASSERT_TRUE(paint.has_value());
+  Result<SessionInterpolant> in = BuildSessionInterpolant(paint->derived, interp::Method::kOctant,
+                                                          {}, FillPolicy::kNone, LongContext());
+  ASSERT_TRUE(in.ok());
+  const UncertainChain chain = MakeUncertainChain(*in);
+  const Row row = AnsweredSample(chain, paint->derived).second;
+  ASSERT_EQ(row.status, interp::InterpStatus::kOk);
+  EXPECT_TRUE(std::isnan(row.plane(UncertainPlane::kMeasurement)[0]));
+  EXPECT_TRUE(std::isnan(row.plane(UncertainPlane::kCombined)[0]));
+  EXPECT_TRUE(std::isfinite(row.plane(UncertainPlane::kInterpolation)[0]));
+  EXPECT_EQ(chain.coverage.without_budget, paint->derived.samples.size());
+  ASSERT_EQ(UncertaintyWarnings(chain.coverage).size(), 1u);
+  EXPECT_NE(UncertaintyWarnings(chain.coverage)[0].find("have no uncertainty budget"),
+            std::string::npos);
+}
+
+TEST(UncertainChain, ModelCellsCarryTheModelsResidualRms) {
+  std::optional<testing::PaintGridSamples> paint = testing::PaintLikeGridSamples();
+  ASSERT_TRUE(paint.has_value());
+  AddBudgets(paint->derived);
+  Result<SessionInterpolant> in = BuildSessionInterpolant(paint->derived, interp::Method::kOctant,
+                                                          {}, FillPolicy::kChain, LongContext());
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  ASSERT_TRUE(in->model.has_value());
+  const UncertainChain chain = MakeUncertainChain(*in);
+  // Grazing on both sides: beyond every reading, so neither octant nor Delaunay has a value.
+  const std::size_t bands = paint->derived.grid.count;
+  const Row row = Ask(chain, IsoDirection{89.5, 89.5, 0.5}, bands);
+  ASSERT_EQ(row.status, interp::InterpStatus::kOk);
+  ASSERT_EQ(chain.chain->Tally().model, 1u) << chain.chain->Tally().Summary();
+  ASSERT_EQ(chain.coverage.model_spread.size(), bands);
+  for (std::size_t b = 0; b < bands; ++b) {
+    EXPECT_EQ(row.plane(UncertainPlane::kInterpolation)[b], in->model->band_residuals[b].rms);
+    EXPECT_EQ(row.plane(UncertainPlane::kCombined)[b], in->model->band_residuals[b].rms);
+    EXPECT_TRUE(std::isnan(row.plane(UncertainPlane::kMeasurement)[b]));
+    EXPECT_GT(in->model->band_residuals[b].rms, 0.0);
+  }
+}
+
+TEST(UncertainChain, SidecarNamesEachFileItsUnitAndK) {
+  UncertaintyCoverage c;
+  c.samples = 10;
+  c.without_budget = 2;
+  const std::string j =
+      UncertaintyJson(c, Quantity::kBrdf,
+                      {{UncertainPlane::kCombined, "s-grid-brdf.u.npy"},
+                       {UncertainPlane::kMeasurement, "s-grid-brdf.u_measurement.npy"}});
+  EXPECT_NE(j.find("\"k\": 1"), std::string::npos);
+  EXPECT_NE(j.find("\"u\": {\"file\": \"s-grid-brdf.u.npy\""), std::string::npos) << j;
+  EXPECT_NE(j.find("\"u_measurement\": {\"file\": \"s-grid-brdf.u_measurement.npy\""),
+            std::string::npos);
+  EXPECT_NE(j.find("\"samples_without_budget\": 2"), std::string::npos);
+  EXPECT_NE(j.find(QuantityUnit(Quantity::kBrdf)), std::string::npos);
+}
+
+}  // namespace
+}  // namespace brdf::exports
