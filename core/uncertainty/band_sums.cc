@@ -85,7 +85,32 @@ template <int W>
   }
 }
 
+template <int W>
+[[gnu::always_inline]] inline void AddSquaredSumLanes(double* __restrict acc,
+                                                      const double* const* x, const double* w,
+                                                      std::size_t m, std::size_t n) {
+  Lanes<W> s, v, t;
+  std::size_t k = 0;
+  for (; k + W <= n; k += W) {
+    std::memcpy(&v, x[0] + k, sizeof v);
+    t = w[0] * v;
+    for (std::size_t i = 1; i < m; ++i) {
+      std::memcpy(&v, x[i] + k, sizeof v);
+      t += w[i] * v;
+    }
+    std::memcpy(&s, acc + k, sizeof s);
+    s += t * t;
+    std::memcpy(acc + k, &s, sizeof s);
+  }
+  for (; k < n; ++k) {
+    double sum = w[0] * x[0][k];
+    for (std::size_t i = 1; i < m; ++i) sum += w[i] * x[i][k];
+    acc[k] += sum * sum;
+  }
+}
+
 using ScaledFn = void (*)(double*, const double*, double, std::size_t);
+using SumFn = void (*)(double*, const double* const*, const double*, std::size_t, std::size_t);
 using DifferenceFn = void (*)(double*, const double*, const double*, double, std::size_t);
 using SqrtFn = void (*)(double*, std::size_t);
 
@@ -93,6 +118,7 @@ struct Kernels {
   ScaledFn add_scaled;
   ScaledFn add_squared;
   DifferenceFn add_squared_difference;
+  SumFn add_squared_sum;
   SqrtFn sqrt;
 };
 
@@ -110,6 +136,10 @@ void AddSquared2(double* acc, const double* x, double a, std::size_t n) {
 }
 void AddSquaredDifference2(double* acc, const double* x, const double* y, double a, std::size_t n) {
   AddSquaredDifferenceLanes<2>(acc, x, y, a, n);
+}
+void AddSquaredSum2(double* acc, const double* const* x, const double* w, std::size_t m,
+                    std::size_t n) {
+  AddSquaredSumLanes<2>(acc, x, w, m, n);
 }
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 void Sqrt2(double* x, std::size_t n) {
@@ -137,6 +167,10 @@ __attribute__((target("avx2"))) void AddSquaredDifference4(double* acc, const do
                                                            std::size_t n) {
   AddSquaredDifferenceLanes<4>(acc, x, y, a, n);
 }
+__attribute__((target("avx2"))) void AddSquaredSum4(double* acc, const double* const* x,
+                                                    const double* w, std::size_t m, std::size_t n) {
+  AddSquaredSumLanes<4>(acc, x, w, m, n);
+}
 __attribute__((target("avx2"))) void Sqrt4(double* x, std::size_t n) {
   std::size_t k = 0;
   for (; k + 4 <= n; k += 4) _mm256_storeu_pd(x + k, _mm256_sqrt_pd(_mm256_loadu_pd(x + k)));
@@ -155,6 +189,11 @@ __attribute__((target("avx512f"))) void AddSquaredDifference8(double* acc, const
                                                               std::size_t n) {
   AddSquaredDifferenceLanes<8>(acc, x, y, a, n);
 }
+__attribute__((target("avx512f"))) void AddSquaredSum8(double* acc, const double* const* x,
+                                                       const double* w, std::size_t m,
+                                                       std::size_t n) {
+  AddSquaredSumLanes<8>(acc, x, w, m, n);
+}
 __attribute__((target("avx512f"))) void Sqrt8(double* x, std::size_t n) {
   std::size_t k = 0;
   for (; k + 8 <= n; k += 8) _mm512_storeu_pd(x + k, _mm512_sqrt_pd(_mm512_loadu_pd(x + k)));
@@ -165,11 +204,11 @@ __attribute__((target("avx512f"))) void Sqrt8(double* x, std::size_t n) {
 Kernels PickKernels() {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
   if (__builtin_cpu_supports("avx512f"))
-    return {&AddScaled8, &AddSquared8, &AddSquaredDifference8, &Sqrt8};
+    return {&AddScaled8, &AddSquared8, &AddSquaredDifference8, &AddSquaredSum8, &Sqrt8};
   if (__builtin_cpu_supports("avx2"))
-    return {&AddScaled4, &AddSquared4, &AddSquaredDifference4, &Sqrt4};
+    return {&AddScaled4, &AddSquared4, &AddSquaredDifference4, &AddSquaredSum4, &Sqrt4};
 #endif
-  return {&AddScaled2, &AddSquared2, &AddSquaredDifference2, &Sqrt2};
+  return {&AddScaled2, &AddSquared2, &AddSquaredDifference2, &AddSquaredSum2, &Sqrt2};
 }
 
 const Kernels& Picked() {
@@ -190,6 +229,12 @@ void AddSquaredBands(std::span<double> acc, std::span<const double> x, double a)
 void AddSquaredDifferenceBands(std::span<double> acc, std::span<const double> x,
                                std::span<const double> y, double a) {
   Picked().add_squared_difference(acc.data(), x.data(), y.data(), a, acc.size());
+}
+
+void AddSquaredSumBands(std::span<double> acc, std::span<const double* const> x,
+                        std::span<const double> w) {
+  if (w.empty()) return;
+  Picked().add_squared_sum(acc.data(), x.data(), w.data(), w.size(), acc.size());
 }
 
 void SqrtBands(std::span<double> x) {

@@ -20,6 +20,12 @@ void AddSquaredBands(std::span<double> acc, std::span<const double> x, double a)
 void AddSquaredDifferenceBands(std::span<double> acc, std::span<const double> x,
                                std::span<const double> y, double a);
 
+// acc[k] += (Σᵢ w[i] · x[i][k])², i < w.size() == x.size() ≥ 1, each x[i] of acc.size() values:
+// one shared input's blend (its contributions from several vertices, weighted) squared, in one
+// pass over the bands.
+void AddSquaredSumBands(std::span<double> acc, std::span<const double* const> x,
+                        std::span<const double> w);
+
 // x[k] = sqrt(x[k]) (correctly rounded, as std::sqrt; a negative x[k] gives NaN).
 void SqrtBands(std::span<double> x);
 

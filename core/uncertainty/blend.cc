@@ -18,19 +18,23 @@ struct Blended {
   const ReadingBudget* budget = nullptr;
 };
 
-// A shared input (name, sharing, id); its Σ wᵢ uⱼ,ᵢ per band is its row of the sums.
+// A shared input (name, sharing, id) and the vertices' contributions to it with their weights:
+// its Σ wᵢ uⱼ,ᵢ per band is formed in one pass when it is squared.
 struct SharedInput {
   const std::string* name = nullptr;
   SharedThrough through;
+  std::vector<const double*> contributions;
+  std::vector<double> weights;
 };
 
 // What one blend works in, kept by each thread from one blend to the next (a batch blends
-// thousands): after the first few, a blend allocates only its result.
+// thousands): after the first few, a blend allocates nothing here.
 struct Scratch {
   std::vector<Blended> readings;
   std::vector<double> independent;  // Σ wᵢ² u_ind,ᵢ² per band
-  std::vector<SharedInput> inputs;  // the shared inputs met so far
-  std::vector<double> sums;         // inputs.size() rows of `bands` values
+  // The first `used` are this blend's shared inputs; the rest are kept for their storage.
+  std::vector<SharedInput> inputs;
+  std::size_t used = 0;
 };
 
 Scratch& ThreadScratch() {
@@ -70,28 +74,30 @@ void AddNotEstimated(std::vector<std::string>& list, const std::string& entry) {
   if (std::find(list.begin(), list.end(), entry) == list.end()) list.push_back(entry);
 }
 
-// The row of `sums` that holds the shared input `c` is shared through, added (zeros) when it is
-// the first component met of that input.
-std::span<double> RowOf(const Component& c, Scratch& s, std::size_t bands) {
-  auto input = std::find_if(s.inputs.begin(), s.inputs.end(), [&](const SharedInput& in) {
-    return in.through == c.shared && *in.name == c.name;
-  });
-  if (input == s.inputs.end()) {
-    s.inputs.push_back(SharedInput{&c.name, c.shared});
-    s.sums.resize(s.sums.size() + bands, 0.0);
-    input = s.inputs.end() - 1;
+// The shared input `c` is shared through, added (with no contributions yet) when it is the first
+// component met of that input.
+SharedInput& InputOf(const Component& c, Scratch& s) {
+  for (std::size_t j = 0; j < s.used; ++j) {
+    if (s.inputs[j].through == c.shared && *s.inputs[j].name == c.name) return s.inputs[j];
   }
-  return {s.sums.data() + static_cast<std::size_t>(input - s.inputs.begin()) * bands, bands};
+  if (s.used == s.inputs.size()) s.inputs.emplace_back();
+  SharedInput& input = s.inputs[s.used++];
+  input.name = &c.name;
+  input.through = c.shared;
+  input.contributions.clear();
+  input.weights.clear();
+  return input;
 }
 
 // Adds one reading: its independent part (the budget's, sqrt(Σ independent uⱼ²)) squared and
-// weighted into `independent`, its shared components linearly into their input's row of `sums`.
+// weighted into `independent`, its shared components to their inputs, with its weight.
 void AddReading(const Blended& b, Scratch& s) {
-  const std::size_t bands = s.independent.size();
   AddSquaredBands(s.independent, b.budget->independent, b.weight * b.weight);
   for (const Component& c : b.budget->components) {
     if (c.shared.kind == Sharing::kIndependent) continue;
-    AddScaledBands(RowOf(c, s, bands), c.contribution, b.weight);
+    SharedInput& input = InputOf(c, s);
+    input.contributions.push_back(c.contribution.data());
+    input.weights.push_back(b.weight);
   }
 }
 
@@ -112,8 +118,7 @@ Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int ba
   const auto n = static_cast<std::size_t>(bands);
   out->not_estimated.clear();
   s.independent.assign(n, 0.0);
-  s.inputs.clear();
-  s.sums.clear();
+  s.used = 0;
   for (const Blended& b : s.readings) {
     if (b.budget == nullptr) {
       AddNotEstimated(out->not_estimated, "reading " + std::to_string(b.reading_id) +
@@ -126,11 +131,11 @@ Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int ba
     }
     AddReading(b, s);
   }
-  // shared² = Σ over inputs of their squared sums, row by row; measurement² = shared² +
+  // shared² = Σ over inputs of (Σ wᵢ uⱼ,ᵢ)², an input at a time; measurement² = shared² +
   // independent²; then both roots.
   out->shared.assign(n, 0.0);
-  for (std::size_t row = 0; row < s.inputs.size(); ++row) {
-    AddSquaredBands(out->shared, std::span<const double>(s.sums.data() + row * n, n), 1.0);
+  for (std::size_t j = 0; j < s.used; ++j) {
+    AddSquaredSumBands(out->shared, s.inputs[j].contributions, s.inputs[j].weights);
   }
   out->measurement.assign(out->shared.begin(), out->shared.end());
   AddScaledBands(out->measurement, s.independent, 1.0);
