@@ -27,9 +27,29 @@ struct Scratch {
   }
 };
 
-// The measurement part into `u`; false (with the reason in not_estimated) when there is none.
+// What one answer's uncertainty is computed in, kept by each thread from answer to answer: a
+// batch's thousands of answers allocate nothing for their spectra once it has grown.
+struct AnswerScratch {
+  uncertainty::BlendedUncertainty blended;
+  std::vector<double> spread;
+};
+
+AnswerScratch& ThreadScratch() {
+  thread_local AnswerScratch scratch;
+  return scratch;
+}
+
+// `values` as the API's single-precision spectrum `out` (its previous values replaced).
+void SetFloats(const std::vector<double>& values, google::protobuf::RepeatedField<float>* out) {
+  out->Resize(static_cast<int>(values.size()), 0.0f);
+  float* to = out->mutable_data();
+  for (std::size_t k = 0; k < values.size(); ++k) to[k] = static_cast<float>(values[k]);
+}
+
+// The measurement part into `u` (the shared part too with parts.shared); false (with the reason
+// in not_estimated) when there is none.
 bool AddMeasurement(const interp::Interpolation& answer, const IndexSnapshot& index,
-                    v1::InterpolationUncertainty* u) {
+                    UncertaintyParts parts, v1::InterpolationUncertainty* u) {
   if (index.quantity != Quantity::kBrdf) {
     u->add_not_estimated(std::string("measurement: the readings' budgets are of the BRDF, this "
                                      "answer is ") +
@@ -42,15 +62,15 @@ bool AddMeasurement(const interp::Interpolation& answer, const IndexSnapshot& in
     const interp::Vertex& v = answer.vertices[i];
     vertices[i] = {v.id, v.weight, index.budgets.at(v.index)};
   }
-  Result<uncertainty::BlendedUncertainty> blended =
-      uncertainty::BlendMeasurementUncertainty(vertices, index.grid.count);
-  if (!blended.ok()) {
-    u->add_not_estimated("measurement: " + blended.status().message());
+  uncertainty::BlendedUncertainty& blended = ThreadScratch().blended;
+  const Status st = uncertainty::BlendMeasurementUncertainty(vertices, index.grid.count, &blended);
+  if (!st.ok()) {
+    u->add_not_estimated("measurement: " + st.message());
     return false;
   }
-  u->mutable_measurement()->Add(blended->measurement.begin(), blended->measurement.end());
-  u->mutable_shared()->Add(blended->shared.begin(), blended->shared.end());
-  for (std::string& entry : blended->not_estimated) u->add_not_estimated(std::move(entry));
+  SetFloats(blended.measurement, u->mutable_measurement());
+  if (parts.shared) SetFloats(blended.shared, u->mutable_shared());
+  for (std::string& entry : blended.not_estimated) u->add_not_estimated(std::move(entry));
   return true;
 }
 
@@ -71,28 +91,33 @@ bool AddInterpolation(const interp::Interpolation& answer, const IndexSnapshot& 
     weights[i] = answer.vertices[i].weight;
     spectra[i] = index.samples->spectrum(answer.vertices[i].index);
   }
-  const std::vector<double> spread =
-      uncertainty::InterpolationSpread(weights, spectra, answer.spectrum);
-  u->mutable_interpolation()->Add(spread.begin(), spread.end());
+  std::vector<double>& spread = ThreadScratch().spread;
+  uncertainty::InterpolationSpread(weights, spectra, answer.spectrum, &spread);
+  SetFloats(spread, u->mutable_interpolation());
   return true;
+}
+
+// combined = sqrt(m² + i²) per band from the parts as sent (floats; a part not estimated is
+// empty and counts 0), in double, rounded to float: what a client computes from them.
+void AddCombined(int bands, v1::InterpolationUncertainty* u) {
+  google::protobuf::RepeatedField<float>* combined = u->mutable_combined();
+  combined->Resize(bands, 0.0f);
+  for (int k = 0; k < bands; ++k) {
+    const double m = k < u->measurement_size() ? u->measurement(k) : 0.0;
+    const double i = k < u->interpolation_size() ? u->interpolation(k) : 0.0;
+    combined->Set(k, static_cast<float>(std::sqrt(m * m + i * i)));
+  }
 }
 
 }  // namespace
 
 void AddInterpolationUncertainty(const interp::Interpolation& answer, const IndexSnapshot& index,
-                                 v1::InterpolationResult* out) {
+                                 UncertaintyParts parts, v1::InterpolationResult* out) {
   if (answer.status != interp::InterpStatus::kOk) return;
   v1::InterpolationUncertainty* u = out->mutable_uncertainty();
-  const bool measured = AddMeasurement(answer, index, u);
-  const bool interpolated = AddInterpolation(answer, index, u);
-  const int bands = static_cast<int>(answer.spectrum.size());
-  google::protobuf::RepeatedField<double>* combined = u->mutable_combined();
-  combined->Resize(bands, 0.0);
-  for (int k = 0; k < bands; ++k) {
-    const double m = measured && k < u->measurement_size() ? u->measurement(k) : 0.0;
-    const double i = interpolated && k < u->interpolation_size() ? u->interpolation(k) : 0.0;
-    combined->Set(k, std::sqrt(m * m + i * i));
-  }
+  AddMeasurement(answer, index, parts, u);
+  AddInterpolation(answer, index, u);
+  if (parts.combined) AddCombined(static_cast<int>(answer.spectrum.size()), u);
 }
 
 }  // namespace brdf::daemon
