@@ -9,8 +9,11 @@ in [0, --theta-max], φ in [0, 180]) while the rig is still up, and every OK ans
 by band, with `brdf-sim truth` at its direction. Prints per run and over all: the fraction of
 (direction, band) pairs whose interval y ± k·u holds the truth with u the combined uncertainty,
 the same with the measurement part alone and with the interpolation term scaled by 0.25, 0.5 and
-0.75 (what a calibrated estimator would give), the normalised errors' spread, and the median k·u
-against the median actual error (the goal: intervals at most 2× the error, coverage 93–97 %).
+0.75, the normalised errors' spread, and the median k·u against the median actual error (the
+goal: intervals at most 2× the error, coverage 93–97 %); then each material pooled over its seeds
+(with its lowest and highest session) and all sessions pooled. --expect-coverage and
+--expect-ratio make it a test (exit 1 when the pooled figures miss; 77 when nothing is built);
+--dump keeps each session's answers, uncertainties and truth as .npz.
 
     bench/uncertainty/coverage_interp.py --materials paint clay --seeds 1 2 --directions 2000
 
@@ -93,17 +96,25 @@ def main():
     p.add_argument("--theta-max", type=float, default=80.0)
     p.add_argument("--method", default="octant")
     p.add_argument("--k", type=float, default=2.0)
+    p.add_argument("--expect-coverage", nargs=2, type=float, metavar=("LO", "HI"),
+                   help="fail unless the pooled coverage lies in [LO, HI] (the test's short form)")
+    p.add_argument("--expect-ratio", type=float, metavar="MAX",
+                   help="fail unless the pooled median k·u / median |error| is at most MAX")
+    p.add_argument("--dump", help="a folder to write each run's directions, answers, "
+                                  "uncertainties and truth to (.npz)")
     args = p.parse_args()
     errors = dict(coverage.ERRORS)
     sim, daemon = live_rig.binaries()
     if not sim or not daemon:
-        sys.exit("build brdf-sim and brdfd first (BRDF_BUILD_DIR)")
+        print("build brdf-sim and brdfd first (BRDF_BUILD_DIR); skipped", file=sys.stderr)
+        sys.exit(77)
     with open(args.plan, encoding="utf-8") as fh:
         plan = json.load(fh)
     print(json.dumps({"errors": errors, "k": args.k, "plan": os.path.basename(args.plan),
                       "directions": args.directions, "method": args.method,
                       "theta_max": args.theta_max}))
     parts = []
+    by_material = {}
     for material in args.materials:
         path = os.path.join(coverage.ROOT, "deploy", "materials", material + ".toml")
         for seed in args.seeds:
@@ -116,14 +127,45 @@ def main():
             t = np.full_like(y, np.nan)
             for i in np.flatnonzero(ok):
                 t[i] = iso_truth(sim, path, dirs[i])
+            if args.dump:
+                os.makedirs(args.dump, exist_ok=True)
+                np.savez(os.path.join(args.dump, f"{material}-{seed}.npz"), directions=dirs[ok],
+                         y=y[ok], u=u[ok], u_measurement=u_meas[ok], truth=t[ok])
             parts.append(summarise(f"{material} seed {seed} ({int(ok.sum())} ok)",
                                    y[ok], u[ok], u_meas[ok], t[ok], args.k))
-    inside, z, ku, err = (np.concatenate([p[i] for p in parts]) for i in range(4))
-    print(json.dumps({"run": "all", "pairs": int(inside.size), "coverage": float(inside.mean()),
-                      "z_sd": float(np.std(z)), "median_kU": float(np.median(ku)),
-                      "median_error": float(np.median(err)),
-                      "kU_over_error": float(np.median(ku) / np.median(err))}))
+            by_material.setdefault(material, []).append(parts[-1])
+    for material, runs in by_material.items():
+        pooled(material, runs)
+    row = pooled("all", parts)
+    return check(args, row)
+
+
+def pooled(label, runs):
+    """One line over several runs: coverage pooled and per run (min, max), the interval ratio."""
+    inside, z, ku, err = (np.concatenate([r[i] for r in runs]) for i in range(4))
+    per_run = [float(r[0].mean()) for r in runs]
+    row = {"run": label, "sessions": len(runs), "pairs": int(inside.size),
+           "coverage": float(inside.mean()), "coverage_min": min(per_run),
+           "coverage_max": max(per_run), "z_sd": float(np.std(z)),
+           "median_kU": float(np.median(ku)), "median_error": float(np.median(err)),
+           "kU_over_error": float(np.median(ku) / np.median(err))}
+    print(json.dumps(row), flush=True)
+    return row
+
+
+def check(args, row):
+    """The failures of the --expect options, each printed; 1 when any."""
+    failures = []
+    if args.expect_coverage and not args.expect_coverage[0] <= row["coverage"] <= \
+            args.expect_coverage[1]:
+        failures.append(f"coverage {row['coverage']:.3f} outside {args.expect_coverage}")
+    if args.expect_ratio is not None and not row["kU_over_error"] <= args.expect_ratio:
+        failures.append(f"median k·u / median |error| {row['kU_over_error']:.2f} above "
+                        f"{args.expect_ratio}")
+    for failure in failures:
+        print("FAILED: " + failure, file=sys.stderr)
+    return 1 if failures else 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

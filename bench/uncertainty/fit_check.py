@@ -4,11 +4,14 @@
 For each material and seed: brdf-sim with the material and the error sources of coverage.py,
 brdfd with the matching [uncertainty] terms, a plan run to completion, the session exported by
 the daemon as a readings CSV of the BRDF (its u_<λ> columns from each reading's budget), and
-`brdf-export fit --readings` run on that file. Prints, per run, the Cook-Torrance (GGX) and
-Lambert χ²/dof and the fitted α ± u(α); and, for comparison, the χ²/dof when the same file's u
-columns are replaced by the budgets' independent parts (the shared terms left out of the weights). A material the model can represent should give χ²/dof near
-(or, since the weights are the combined u with the shared white-standard term, a little below) 1;
-one it cannot, well above.
+`brdf-export fit` run three ways on the same session: on brdfd's database (`--db`: generalised
+least squares with each reading's budget, its independent part and its shared components —
+white standard, reference reading, dark, instrument — correlated; the "gls" figures), on that CSV
+(`--readings`: weighted by the combined u as if independent), and on the CSV with its u columns
+replaced by the budgets' independent parts. Prints, per run, the Cook-Torrance (GGX) and Lambert
+χ²/dof of each, the fitted α and F0 ± u, and kd and ks at 550 nm ± u (GLS) with the material's
+truth where it is the fit's own model (ggx-plastic). A material the model can represent should
+give a GLS χ²/dof near 1; one it cannot, well above.
 
     bench/uncertainty/fit_check.py --materials bench/uncertainty/ggx-plastic.toml gold \
         retro-coating --seeds 1 2
@@ -25,6 +28,7 @@ import argparse
 import csv
 import io
 import json
+import math
 import os
 import re
 import subprocess
@@ -46,9 +50,10 @@ PLAN = {"name": "fit check", "sampleDescription": "in-plane specular crossings",
         "measurement": {"integrationMs": 0, "averages": 1}}
 
 
-def export_session(sim, daemon, material, seed, plan, errors, csv_path):
-    """Runs one session and has brdfd export its readings CSV of the BRDF to csv_path; returns
-    each sample reading's independent part of u (its budget's), by id."""
+def export_session(sim, daemon, material, seed, plan, errors, csv_path, on_database):
+    """Runs one session and has brdfd export its readings CSV of the BRDF to csv_path; calls
+    on_database(path, session id) once brdfd has stopped; returns each sample reading's
+    independent part of u (its budget's), by id, and what on_database returned."""
     rig = live_rig.LiveRig(sim, daemon, seed=seed, sim_args=coverage.sim_flags(material, errors),
                            extra_config=coverage.budget_config(errors))
     rig.sample_extra = f"white_reflectance_uncertainty = {0.99 * errors['white_error']}\n"
@@ -72,10 +77,12 @@ def export_session(sim, daemon, material, seed, plan, errors, csv_path):
         independent = {int(i): b.independent for i, b in zip(data.ids, data.budgets)
                        if b is not None}
         client.close()
+        rig.stop()
+        from_database = on_database(os.path.join(rig.dir, "brdfd.db"), s.session_id)
     finally:
         rig.stop()
         rig.cleanup()
-    return independent
+    return independent, from_database
 
 
 def with_independent_u(csv_path, independent, out_path):
@@ -100,17 +107,36 @@ def with_independent_u(csv_path, independent, out_path):
         f.write("\n".join(out) + "\n")
 
 
-def fit(export_tool, csv_path, out_path):
-    """χ²/dof of both models and α ± u(α), from brdf-export fit's standard error."""
-    err = subprocess.run([export_tool, "--quiet", "fit", "--readings", csv_path, "-o", out_path],
+def at_550(out_path):
+    """kd ± u and ks ± u at the band nearest 550 nm of a fit report CSV."""
+    with open(out_path, encoding="utf-8") as f:
+        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
+    row = min(rows, key=lambda r: abs(float(r["wavelength_nm"]) - 550))
+    return {"ct_kd_550": f'{float(row["ct_kd"]):.4f} ± {float(row["ct_kd_u"]):.4f}',
+            "ct_ks_550": f'{float(row["ct_ks"]):.4f} ± {float(row["ct_ks_u"]):.4f}'}
+
+
+def fit(export_tool, source_args, out_path):
+    """χ²/dof of both models, how the fit weighted, α ± u(α) and F0 ± u(F0), from brdf-export
+    fit's standard error; kd and ks at 550 nm from its report."""
+    err = subprocess.run([export_tool, "--quiet", "fit", *source_args, "-o", out_path],
                          check=True, capture_output=True, text=True).stderr
     chi = re.findall(r"χ²/dof = ([0-9.e+-]+)", err)
     alpha = re.search(r"α = ([0-9.e+-]+) ± ([0-9.e+-]+|nan)", err)
-    return {"weighted": "weighted by their uncertainties" in err,
+    f0 = re.search(r"F0 = ([0-9.e+-]+) ± ([0-9.e+-]+|nan)", err)
+    weighting = re.search(r"weighted by their uncertainties: ([^)]*)\)", err)
+    return {"weighting": weighting.group(1) if weighting else "unweighted",
             "lambert_chi2_dof": float(chi[0]) if len(chi) > 0 else None,
             "ct_chi2_dof": float(chi[1]) if len(chi) > 1 else None,
-            "ct_alpha": alpha.group(1) if alpha else None,
-            "ct_alpha_u": alpha.group(2) if alpha else None}
+            "ct_alpha": f"{alpha.group(1)} ± {alpha.group(2)}" if alpha else None,
+            "ct_f0": f"{f0.group(1)} ± {f0.group(2)}" if f0 else None,
+            **at_550(out_path)}
+
+
+# The truth where the material is the fit's own model: kd(550) from the albedo bump
+# 0.25 + 0.45 exp(−((λ − 610)/90)²), ks 1, α 0.2, F0 0.04 (ggx-plastic.toml).
+TRUTH = {"ggx-plastic": {"alpha": 0.2, "f0": 0.04, "ks": 1.0,
+                         "kd_550": 0.25 + 0.45 * math.exp(-((550 - 610) / 90) ** 2)}}
 
 
 def main():
@@ -137,13 +163,20 @@ def main():
             for seed in args.seeds:
                 label = os.path.basename(material).removesuffix(".toml")
                 csv_path = os.path.join(work, f"{label}-{seed}.csv")
-                independent = export_session(sim, daemon, path, seed, plan, errors, csv_path)
-                row = fit(export_tool, csv_path, os.path.join(work, f"{label}-{seed}-fit.csv"))
+                gls_out = os.path.join(work, f"{label}-{seed}-fit-gls.csv")
+                independent, gls = export_session(
+                    sim, daemon, path, seed, plan, errors, csv_path,
+                    lambda db, sid, out=gls_out: fit(
+                        export_tool, ["--db", db, "--session", str(sid)], out))
+                row = {"gls": gls,
+                       "combined_u": fit(export_tool, ["--readings", csv_path],
+                                         os.path.join(work, f"{label}-{seed}-fit.csv"))}
                 ind_path = os.path.join(work, f"{label}-{seed}-independent.csv")
                 with_independent_u(csv_path, independent, ind_path)
-                ind = fit(export_tool, ind_path, os.path.join(work, f"{label}-{seed}-fit-ind.csv"))
-                row["ct_chi2_dof_independent_u"] = ind["ct_chi2_dof"]
-                row["lambert_chi2_dof_independent_u"] = ind["lambert_chi2_dof"]
+                row["independent_u"] = fit(export_tool, ["--readings", ind_path],
+                                           os.path.join(work, f"{label}-{seed}-fit-ind.csv"))
+                if label in TRUTH:
+                    row["truth"] = TRUTH[label]
                 print(json.dumps({"material": label, "seed": seed, **row}), flush=True)
 
 

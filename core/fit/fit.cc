@@ -6,6 +6,7 @@
 #include <numbers>
 #include <string>
 
+#include "core/fit/band_covariance.h"
 #include "core/fit/nelder_mead.h"
 
 namespace brdf::fit {
@@ -26,14 +27,27 @@ double Logit(double p) {
   return std::log(p / (1 - p));
 }
 
-double Weight(const Observations& data, std::size_t i, std::size_t b) {
-  if (!data.weighted()) return 1.0;
-  const double u = data.uncertainty(i, b);
-  return 1.0 / (u * u);
+// Σ of the scale sources' fraction² in `band` (band_covariance.h's ScaleSource).
+double ScaleVariance(const std::vector<ScaleSource>& scales, std::size_t band) {
+  double v = 0;
+  for (const ScaleSource& s : scales) v += s.fraction[band] * s.fraction[band];
+  return v;
 }
 
-// One band's weighted sums for the linear part f ≈ kd·a + ks·s with a = 1/π:
-// Σw, Σw f, Σw f² (fixed) and Σw s, Σw s², Σw s f (for the lobe shape s being tried).
+// A linear parameter's u with the scale sources' share of its value added (NaN stays NaN).
+double WithScales(double u, double value, double fraction2) {
+  return std::sqrt(u * u + fraction2 * value * value);
+}
+
+// One band's values over all observations.
+std::vector<double> BandValues(const Observations& data, std::size_t band) {
+  std::vector<double> f(data.size());
+  for (std::size_t i = 0; i < data.size(); ++i) f[i] = data.value(i, band);
+  return f;
+}
+
+// One band's products under V⁻¹ for the linear part f ≈ kd·a + ks·s with a = 1/π: 1ᵀV⁻¹1,
+// 1ᵀV⁻¹f, fᵀV⁻¹f (fixed) and 1ᵀV⁻¹s, sᵀV⁻¹s, sᵀV⁻¹f (for the lobe shape s being tried).
 struct BandSums {
   double sw = 0, swf = 0, swff = 0;
   double sws = 0, swss = 0, swsf = 0;
@@ -67,21 +81,27 @@ LinearSolution SolveBand(const BandSums& s) {
 }
 
 // The variable-projection objective over bands [b0, b1): evaluates the lobe shape for (α, F0)
-// at every observation and solves each band's (kd, ks), weighted when the data are.
+// at every observation and solves each band's (kd, ks) under that band's V⁻¹ (V = I unweighted).
 class Projection {
  public:
-  Projection(const Observations& data, std::size_t b0, std::size_t b1)
-      : data_(data), b0_(b0), b1_(b1), sums_(b1 - b0), spec_(data.size()) {
+  Projection(const Observations& data, const std::vector<BandCovariance>& covariance,
+             std::size_t b0, std::size_t b1)
+      : data_(data), covariance_(covariance), b0_(b0), b1_(b1), sums_(b1 - b0), spec_(data.size()) {
     geometry_.reserve(data.size());
     for (std::size_t i = 0; i < data.size(); ++i) {
       geometry_.push_back(LobeGeometryOf(data.direction(i)));
-      for (std::size_t b = b0; b < b1; ++b) {
-        const double f = data.value(i, b), w = Weight(data, i, b);
-        BandSums& s = sums_[b - b0];
-        s.sw += w;
-        s.swf += w * f;
-        s.swff += w * f * f;
-      }
+    }
+    const std::vector<double> one(data.size(), 1.0);
+    for (std::size_t b = b0; b < b1; ++b) {
+      const BandCovariance& v = covariance[b];
+      const std::vector<double> f = BandValues(data, b);
+      std::vector<double> v_one = v.Solve(one), v_f = v.Solve(f);
+      BandSums& s = sums_[b - b0];
+      s.sw = Dot(one, v_one);
+      s.swf = Dot(f, v_one);
+      s.swff = Dot(f, v_f);
+      v_one_.push_back(std::move(v_one));
+      v_f_.push_back(std::move(v_f));
     }
   }
 
@@ -91,14 +111,13 @@ class Projection {
     for (std::size_t i = 0; i < data_.size(); ++i) {
       spec_[i] = CookTorranceSpecularAt(geometry_[i], alpha, f0);
     }
-    if (data_.weighted()) {
-      AccumulateWeighted();
-    } else {
-      AccumulateUnweighted();
-    }
     double total = 0;
     if (out != nullptr) out->clear();
-    for (BandSums& s : sums_) {
+    for (std::size_t b = b0_; b < b1_; ++b) {
+      BandSums& s = sums_[b - b0_];
+      s.sws = Dot(spec_, v_one_[b - b0_]);
+      s.swsf = Dot(spec_, v_f_[b - b0_]);
+      s.swss = covariance_[b].Product(spec_, spec_);
       const LinearSolution sol = SolveBand(s);
       total += sol.sse;
       if (out != nullptr) out->push_back(sol);
@@ -107,42 +126,17 @@ class Projection {
   }
 
  private:
-  // Σ s and Σ s² are the same for every band when all weights are 1.
-  void AccumulateUnweighted() {
-    double sb = 0, sbb = 0;
-    for (double s : spec_) {
-      sb += s;
-      sbb += s * s;
-    }
-    for (BandSums& s : sums_) {
-      s.sws = sb;
-      s.swss = sbb;
-      s.swsf = 0;
-    }
-    for (std::size_t i = 0; i < data_.size(); ++i) {
-      const double s = spec_[i];
-      const std::span<const double> f = data_.spectrum(i);
-      for (std::size_t b = b0_; b < b1_; ++b) sums_[b - b0_].swsf += s * f[b];
-    }
-  }
-  void AccumulateWeighted() {
-    for (BandSums& s : sums_) s.sws = s.swss = s.swsf = 0;
-    for (std::size_t i = 0; i < data_.size(); ++i) {
-      const double s = spec_[i];
-      const std::span<const double> f = data_.spectrum(i);
-      for (std::size_t b = b0_; b < b1_; ++b) {
-        const double u = data_.uncertainty(i, b), ws = s / (u * u);
-        BandSums& sum = sums_[b - b0_];
-        sum.sws += ws;
-        sum.swss += ws * s;
-        sum.swsf += ws * f[b];
-      }
-    }
+  static double Dot(std::span<const double> x, std::span<const double> y) {
+    double s = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) s += x[i] * y[i];
+    return s;
   }
 
   const Observations& data_;
+  const std::vector<BandCovariance>& covariance_;
   std::size_t b0_, b1_;
   std::vector<BandSums> sums_;
+  std::vector<std::vector<double>> v_one_, v_f_;  // V⁻¹1 and V⁻¹f per band
   std::vector<LobeGeometry> geometry_;
   std::vector<double> spec_;
 };
@@ -183,31 +177,41 @@ SearchResult Search(Projection& projection, const CookTorranceOptions& options,
   return best;
 }
 
-// JᵀWJ of bands [b0, b1) over (kd, ks of each band, then α, F0) at the fit in `band`: kd and ks
-// enter linearly (∂f/∂kd = 1/π, ∂f/∂ks = s); the lobe's ∂s/∂α and ∂s/∂F0 by central differences.
-std::vector<double> CookTorranceNormalMatrix(const Observations& data, std::size_t b0,
-                                             std::size_t b1,
+// JᵀV⁻¹J of bands [b0, b1) over (kd, ks of each band, then α, F0) at the fit in `band`: kd and
+// ks enter linearly (∂f/∂kd = 1/π, ∂f/∂ks = s); the lobe's ∂s/∂α and ∂s/∂F0 by central
+// differences. Bands do not covary, so each band adds its own 4 × 4 block of products.
+std::vector<double> CookTorranceNormalMatrix(const Observations& data,
+                                             const std::vector<BandCovariance>& covariance,
+                                             std::size_t b0, std::size_t b1,
                                              const std::vector<CookTorranceParams>& band) {
-  const std::size_t nb = b1 - b0, n = 2 * nb + 2;
+  const std::size_t nb = b1 - b0, n = 2 * nb + 2, count = data.size();
   const double alpha = band[b0].alpha, f0 = band[b0].f0;
   const double ha = 1e-4 * alpha, hf = 1e-3;
-  std::vector<double> m(n * n, 0.0);
-  for (std::size_t i = 0; i < data.size(); ++i) {
+  std::vector<double> s(count), dsa(count), dsf(count);
+  for (std::size_t i = 0; i < count; ++i) {
     const LobeGeometry g = LobeGeometryOf(data.direction(i));
-    const double s = CookTorranceSpecularAt(g, alpha, f0);
-    const double dsa =
+    s[i] = CookTorranceSpecularAt(g, alpha, f0);
+    dsa[i] =
         (CookTorranceSpecularAt(g, alpha + ha, f0) - CookTorranceSpecularAt(g, alpha - ha, f0)) /
         (2 * ha);
-    const double dsf =
+    dsf[i] =
         (CookTorranceSpecularAt(g, alpha, f0 + hf) - CookTorranceSpecularAt(g, alpha, f0 - hf)) /
         (2 * hf);
-    for (std::size_t b = b0; b < b1; ++b) {
-      const double w = Weight(data, i, b), ks = band[b].ks;
-      const std::size_t at[4] = {2 * (b - b0), 2 * (b - b0) + 1, n - 2, n - 1};
-      const double d[4] = {1.0 / kPi, s, ks * dsa, ks * dsf};
-      for (int p = 0; p < 4; ++p) {
-        for (int q = 0; q < 4; ++q) m[at[p] * n + at[q]] += w * d[p] * d[q];
-      }
+  }
+  std::vector<double> m(n * n, 0.0);
+  std::vector<std::vector<double>> columns(4, std::vector<double>(count));
+  for (std::size_t b = b0; b < b1; ++b) {
+    const double ks = band[b].ks;
+    for (std::size_t i = 0; i < count; ++i) {
+      columns[0][i] = 1.0 / kPi;
+      columns[1][i] = s[i];
+      columns[2][i] = ks * dsa[i];
+      columns[3][i] = ks * dsf[i];
+    }
+    const std::vector<double> g = covariance[b].Gram(columns);
+    const std::size_t at[4] = {2 * (b - b0), 2 * (b - b0) + 1, n - 2, n - 1};
+    for (int p = 0; p < 4; ++p) {
+      for (int q = 0; q < 4; ++q) m[at[p] * n + at[q]] += g[p * 4 + q];
     }
   }
   return m;
@@ -218,8 +222,10 @@ std::vector<double> CookTorranceNormalMatrix(const Observations& data, std::size
 // are inside their ranges.
 // `group`: the statistics of these bands alone (for the unweighted scaling); its note goes to
 // `note` when that is still empty.
-void CookTorranceUncertainties(const Observations& data, std::size_t b0, std::size_t b1,
-                               FitStatistics group, CookTorranceFit& fit, std::string& note) {
+void CookTorranceUncertainties(const Observations& data,
+                               const std::vector<BandCovariance>& covariance, std::size_t b0,
+                               std::size_t b1, FitStatistics group, CookTorranceFit& fit,
+                               std::string& note) {
   const std::size_t nb = b1 - b0, n = 2 * nb + 2;
   std::vector<bool> free(n, false);
   bool lobe = false;
@@ -232,8 +238,8 @@ void CookTorranceUncertainties(const Observations& data, std::size_t b0, std::si
   const double alpha = fit.band[b0].alpha, f0 = fit.band[b0].f0;
   free[n - 2] = lobe && alpha > kAlphaMin * (1 + 1e-9) && alpha < kAlphaMax * (1 - 1e-9);
   free[n - 1] = lobe && f0 > 1e-6 && f0 < 1 - 1e-6;
-  const std::vector<double> u =
-      ParameterUncertainties(CookTorranceNormalMatrix(data, b0, b1, fit.band), n, free, group);
+  const std::vector<double> u = ParameterUncertainties(
+      CookTorranceNormalMatrix(data, covariance, b0, b1, fit.band), n, free, group);
   for (std::size_t b = b0; b < b1; ++b) {
     fit.band_u[b] = CookTorranceParams{u[2 * (b - b0)], u[2 * (b - b0) + 1], u[n - 2], u[n - 1]};
   }
@@ -269,42 +275,45 @@ Result<LambertFit> FitLambert(const Observations& data) {
   if (data.size() == 0) {
     return FailedPrecondition("Lambert fit: no observations (no usable BRDF readings)");
   }
+  const std::vector<ScaleSource> scales = ScaleSourcesOf(data);
+  Result<std::vector<BandCovariance>> made = CovariancesOf(data, scales);
+  if (!made.ok()) return made.status().WithContext("Lambert fit");
+  const std::vector<BandCovariance>& covariance = *made;
   LambertFit fit;
   fit.grid = data.grid();
   const std::size_t nb = data.bands(), n = data.size();
-  std::vector<double> sw(nb, 0.0), swf(nb, 0.0);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t b = 0; b < nb; ++b) {
-      const double w = Weight(data, i, b);
-      sw[b] += w;
-      swf[b] += w * data.value(i, b);
-    }
-  }
+  // ρ/π = 1ᵀV⁻¹f / 1ᵀV⁻¹1 per band (generalised least squares of a constant), u(ρ) = π/√1ᵀV⁻¹1.
+  const std::vector<double> one(n, 1.0);
+  std::vector<double> sw(nb);
   fit.albedo.resize(nb);
-  for (std::size_t b = 0; b < nb; ++b) fit.albedo[b] = swf[b] / sw[b] * kPi;
+  for (std::size_t b = 0; b < nb; ++b) {
+    sw[b] = covariance[b].Product(one, one);
+    fit.albedo[b] = covariance[b].Product(one, BandValues(data, b)) / sw[b] * kPi;
+  }
   auto model = [&](std::size_t, std::size_t b) { return LambertBrdf(fit.albedo[b]); };
   for (std::size_t b = 0; b < nb; ++b) {
     fit.band_residuals.push_back(ResidualsOf(data, b, b + 1, model));
-    // u(ρ) = π / √Σw; unweighted, scaled by the band's residual variance Σ r² / (n − 1).
+    // Unweighted, scaled by the band's residual variance Σ r² / (n − 1).
     const double r2 = fit.band_residuals[b].rms * fit.band_residuals[b].rms;
     const double scale = data.weighted() ? 1.0
                          : n > 1         ? r2 * static_cast<double>(n) / static_cast<double>(n - 1)
                                          : std::numeric_limits<double>::quiet_NaN();
-    fit.albedo_u.push_back(kPi * std::sqrt(scale / sw[b]));
+    fit.albedo_u.push_back(
+        WithScales(kPi * std::sqrt(scale / sw[b]), fit.albedo[b], ScaleVariance(scales, b)));
   }
   fit.overall = ResidualsOf(data, 0, nb, model);
-  fit.statistics = StatisticsOf(data.weighted(), WeightedSumOfSquares(data, model), n * nb, nb);
+  fit.statistics = StatisticsOf(data, WeightedSumOfSquares(data, covariance, model), n * nb, nb);
+  fit.statistics.scale_terms = scales.size();
   return fit;
 }
 
-double WeightedSumOfSquares(const Observations& data,
+double WeightedSumOfSquares(const Observations& data, const std::vector<BandCovariance>& covariance,
                             const std::function<double(std::size_t, std::size_t)>& model) {
   double sum = 0;
-  for (std::size_t i = 0; i < data.size(); ++i) {
-    for (std::size_t b = 0; b < data.bands(); ++b) {
-      const double r = model(i, b) - data.value(i, b);
-      sum += Weight(data, i, b) * r * r;
-    }
+  std::vector<double> r(data.size());
+  for (std::size_t b = 0; b < data.bands(); ++b) {
+    for (std::size_t i = 0; i < data.size(); ++i) r[i] = model(i, b) - data.value(i, b);
+    sum += covariance[b].Product(r, r);
   }
   return sum;
 }
@@ -328,6 +337,10 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
   if (!(options.f0_start > 0 && options.f0_start < 1)) {
     return InvalidArgument("Cook-Torrance fit: f0_start must lie strictly between 0 and 1");
   }
+  const std::vector<ScaleSource> scales = ScaleSourcesOf(data);
+  Result<std::vector<BandCovariance>> made = CovariancesOf(data, scales);
+  if (!made.ok()) return made.status().WithContext("Cook-Torrance fit");
+  const std::vector<BandCovariance>& covariance = *made;
   const std::size_t nb = data.bands();
   CookTorranceFit fit;
   fit.grid = data.grid();
@@ -348,7 +361,7 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
   std::string note;
   for (std::size_t g = 0; g < groups; ++g) {
     const std::size_t b0 = groups == 1 ? 0 : g, b1 = groups == 1 ? nb : g + 1;
-    Projection projection(data, b0, b1);
+    Projection projection(data, covariance, b0, b1);
     const SearchResult s = Search(projection, options, ctx);
     if (ctx.cancelled()) return Cancelled("Cook-Torrance fit cancelled: " + ctx.cancel().reason());
     if (ctx.expired()) {
@@ -359,9 +372,9 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
     const double sse = projection.Evaluate(s.alpha, s.f0, &sol);
     record(b0, b1, s, sol);
     const std::size_t group_parameters = 2 * (b1 - b0) + 2;
-    CookTorranceUncertainties(
-        data, b0, b1, StatisticsOf(data.weighted(), sse, data.size() * (b1 - b0), group_parameters),
-        fit, note);
+    CookTorranceUncertainties(data, covariance, b0, b1,
+                              StatisticsOf(data, sse, data.size() * (b1 - b0), group_parameters),
+                              fit, note);
     if (options.progress)
       options.progress(static_cast<double>(g + 1) / static_cast<double>(groups));
   }
@@ -369,13 +382,19 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
   auto model = [&](std::size_t i, std::size_t b) {
     return CookTorranceBrdf(data.direction(i), fit.band[b]);
   };
-  for (std::size_t b = 0; b < nb; ++b)
+  for (std::size_t b = 0; b < nb; ++b) {
     fit.band_residuals.push_back(ResidualsOf(data, b, b + 1, model));
+    // A scale of the whole band moves kd and ks together (not α, F0).
+    const double f2 = ScaleVariance(scales, b);
+    fit.band_u[b].kd = WithScales(fit.band_u[b].kd, fit.band[b].kd, f2);
+    fit.band_u[b].ks = WithScales(fit.band_u[b].ks, fit.band[b].ks, f2);
+  }
   fit.overall = ResidualsOf(data, 0, nb, model);
   const std::size_t parameters = groups == 1 ? 2 * nb + 2 : 4 * nb;
-  fit.statistics = StatisticsOf(data.weighted(), WeightedSumOfSquares(data, model),
+  fit.statistics = StatisticsOf(data, WeightedSumOfSquares(data, covariance, model),
                                 data.size() * nb, parameters);
   fit.statistics.note = note;
+  fit.statistics.scale_terms = scales.size();
   return fit;
 }
 

@@ -1,9 +1,12 @@
 // Evaluation of analytic reflection models against measured BRDFs, wavelength by wavelength (the
 // paper's "evaluation of existing analytic models"): Lambert, and Cook-Torrance with a GGX
-// distribution (models.h). Least squares on the BRDF values themselves (sr⁻¹): weighted by 1/u²
-// when every observation carries its standard uncertainty u (Observations::weighted()), else every
-// value alike. Each fit reports its parameters' standard uncertainties and χ²/dof
-// (fit_statistics.h: unscaled (JᵀWJ)⁻¹ when weighted, scaled by the residual variance when not).
+// distribution (models.h). Least squares on the BRDF values themselves (sr⁻¹) when every
+// observation carries its standard uncertainty (Observations::weighted()): generalised least
+// squares, weighted by V⁻¹ with the shared sources' covariance (band_covariance.h), when the
+// observations name shared sources; by 1/u² when every u is independent; else every value alike.
+// Each fit reports how it weighted (FitStatistics::weighting), its parameters' standard
+// uncertainties and χ²/dof (fit_statistics.h: unscaled (JᵀV⁻¹J)⁻¹ when weighted, scaled by the
+// residual variance when not).
 //
 // Cook-Torrance's parameters: kd(λ) and ks(λ) per band; the roughness α and Schlick's F0 shared
 // by all bands (default: the microfacet geometry does not depend on wavelength, and a coloured
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "core/call_context.h"
+#include "core/fit/band_covariance.h"
 #include "core/fit/fit_statistics.h"
 #include "core/fit/models.h"
 #include "core/fit/observations.h"
@@ -35,14 +39,15 @@ struct Residuals {
 
 struct LambertFit {
   WavelengthGrid grid;
-  std::vector<double> albedo;             // ρ per band: π · (weighted) mean f, least squares
+  std::vector<double> albedo;             // ρ per band: π · (GLS-weighted) mean f
   std::vector<double> albedo_u;           // its standard uncertainty per band
   FitStatistics statistics;               // all bands: values N·B, parameters B
   std::vector<Residuals> band_residuals;  // per band
   Residuals overall;                      // all bands together
 };
 
-// Closed form. Errors: no observations (kFailedPrecondition).
+// Closed form. Errors: no observations, a covariance that cannot be factored
+// (kFailedPrecondition).
 Result<LambertFit> FitLambert(const Observations& data);
 
 enum class ParameterSharing { kSharedAcrossBands, kPerBand };
@@ -72,14 +77,16 @@ struct CookTorranceFit {
   bool converged = false;  // every search met its tolerances
 };
 
-// Errors: fewer than 3 observations (kFailedPrecondition: three unknowns per band at least),
+// Errors: fewer than 3 observations (kFailedPrecondition: three unknowns per band at least), a
+// covariance that cannot be factored (kFailedPrecondition),
 // options without a start or with a non-positive one (kInvalidArgument), kCancelled / kTimeout
 // from `ctx`.
 Result<CookTorranceFit> FitCookTorrance(const Observations& data,
                                         const CookTorranceOptions& options, const CallContext& ctx);
 
-// Σ w r² over `data` (w = 1/u² when data.weighted(), else 1) for a per-band model.
-double WeightedSumOfSquares(const Observations& data,
+// Σ over bands of rᵀV⁻¹r, r the residuals of a per-band model over `data` and V each band's
+// covariance (CovariancesOf(data): V = I when the data are unweighted).
+double WeightedSumOfSquares(const Observations& data, const std::vector<BandCovariance>& covariance,
                             const std::function<double(std::size_t obs, std::size_t band)>& model);
 
 // Residuals of any per-band model over `data`: model(i, band) is its value at observation i.

@@ -34,18 +34,35 @@ std::string CookTorranceShared(const CookTorranceFit& ct) {
 // "χ²/dof = 1.02 (χ² = …, dof = …)" when weighted, else why there is none.
 std::string ChiSquareText(const FitStatistics& s) {
   if (!s.weighted) return "χ²/dof: none (unweighted: not every reading carries an uncertainty)";
-  return "χ²/dof = " + Short(s.chi2_per_dof) + " (χ² = " + Short(s.chi2) +
-         ", dof = " + Short(s.dof) + " = " + std::to_string(s.values) + " values − " +
-         std::to_string(s.parameters) + " parameters)";
+  return "χ²/dof = " + Short(s.chi2_per_dof) + " (" + WeightingText(s.weighting, s.shared_terms) +
+         "; χ² = " + Short(s.chi2) + ", dof = " + Short(s.dof) + " = " + std::to_string(s.values) +
+         " values − " + std::to_string(s.parameters) + " parameters)";
 }
 
-std::string WeightingLine(const FitReportInfo& info, bool weighted) {
-  if (weighted) {
-    return "# weighting: every value by 1/u², u its reading's combined standard uncertainty "
-           "(docs/uncertainty.md); parameter uncertainties (_u, k = 1) from (JᵀWJ)⁻¹ at the "
-           "optimum, not scaled by χ²/dof: χ²/dof ≫ 1 says the model does not describe the data "
-           "within their uncertainty, and then the _u understate how uncertain the parameters "
-           "are\n";
+std::string WeightingLine(const FitReportInfo& info, const FitStatistics& s) {
+  const std::string covariance =
+      "; parameter uncertainties (_u, k = 1) from (JᵀV⁻¹J)⁻¹ at the optimum, not scaled by "
+      "χ²/dof: χ²/dof ≫ 1 says the model does not describe the data within their uncertainty, "
+      "and then the _u understate how uncertain the parameters are\n";
+  if (s.weighting == Weighting::kGeneralised) {
+    return "# weighting: " + WeightingText(s.weighting, s.shared_terms) +
+           " (generalised least squares): per band, the values' covariance V = D + Σ b bᵀ, D the "
+           "budgets' independent variances, one column b per shared source (white standard, "
+           "reference reading, dark, instrument) with each reading's contribution "
+           "(docs/uncertainty.md); χ² = Σ rᵀV⁻¹r" +
+           (s.scale_terms > 0
+                ? "; " + std::to_string(s.scale_terms) +
+                      " of them a scale of every reading (the white standard's): left out of V, "
+                      "where it cannot show in the residuals, and added to the _u of kd, ks and "
+                      "the albedo"
+                : std::string()) +
+           covariance;
+  }
+  if (s.weighting == Weighting::kIndependent) {
+    return "# weighting: " + WeightingText(s.weighting, s.shared_terms) +
+           ": every value by 1/u², u its reading's combined standard uncertainty taken as "
+           "independent of the others (docs/uncertainty.md)" +
+           covariance;
   }
   return "# weighting: none, every value alike (" + std::to_string(info.with_uncertainty) + " of " +
          std::to_string(info.observations) +
@@ -79,13 +96,14 @@ std::string FitReportCsv(const FitReportInfo& info, const LambertFit* lambert,
   h += "\n# data: BRDF f(λ) in sr⁻¹ of " + std::to_string(info.observations) +
        " sample readings (" + std::to_string(info.left_out) +
        " left out), fitted band by band by least squares on f\n";
-  const bool weighted = (lambert != nullptr && lambert->statistics.weighted) ||
-                        (ct != nullptr && ct->statistics.weighted);
-  h += WeightingLine(info, weighted);
+  const FitStatistics none;
+  h += WeightingLine(info, lambert != nullptr ? lambert->statistics
+                           : ct != nullptr    ? ct->statistics
+                                              : none);
   h += "# residuals: rms = √(Σ r² / n) in sr⁻¹; rel_rms = √(Σ r² / Σ f²) (0 = perfect, 1 = no "
        "better than f = 0)\n";
   if (lambert != nullptr) {
-    h += "# lambert: f = ρ(λ) / π, ρ = π · mean f, weighted when the fit is (closed form); "
+    h += "# lambert: f = ρ(λ) / π, ρ = π · mean f, weighted as the fit is (closed form); "
          "overall " +
          ResidualText(lambert->overall) + "; " + ChiSquareText(lambert->statistics) + "\n";
   }

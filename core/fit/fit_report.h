@@ -1,6 +1,7 @@
-// A model evaluation as text: a '#' comment block with the models, how they were fitted (weighted
-// by the readings' uncertainties or not), the overall residuals and χ²/dof, then one CSV row per
-// band with every model's parameters, their standard uncertainties (k = 1; _u) and residuals:
+// A model evaluation as text: a '#' comment block with the models, how they were fitted ("GLS with
+// N shared terms", "weighted, independent" or unweighted), the overall residuals and χ²/dof, then
+// one CSV row per band with every model's parameters, their standard uncertainties (k = 1; _u) and
+// residuals:
 //   wavelength_nm,lambert_albedo,lambert_albedo_u,lambert_rms,lambert_rel_rms,
 //   ct_kd,ct_kd_u,ct_ks,ct_ks_u,ct_alpha,ct_alpha_u,ct_f0,ct_f0_u,ct_rms,ct_rel_rms
 // (the columns of a model that was not fitted are left out; nan: not determined).

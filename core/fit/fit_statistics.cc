@@ -5,10 +5,13 @@
 
 namespace brdf::fit {
 
-FitStatistics StatisticsOf(bool weighted, double sum_of_squares, std::size_t values,
+FitStatistics StatisticsOf(const Observations& data, double sum_of_squares, std::size_t values,
                            std::size_t parameters) {
+  const bool weighted = data.weighted();
   FitStatistics s;
   s.weighted = weighted;
+  s.weighting = data.weighting();
+  s.shared_terms = s.weighting == Weighting::kGeneralised ? data.shared_sources().size() : 0;
   s.values = values;
   s.parameters = parameters;
   s.chi2 = sum_of_squares;
@@ -19,8 +22,7 @@ FitStatistics StatisticsOf(bool weighted, double sum_of_squares, std::size_t val
   return s;
 }
 
-std::vector<double> InvertSymmetric(std::vector<double> a, std::size_t n) {
-  // Cholesky a = L Lᵀ in place (lower triangle), then a⁻¹ = L⁻ᵀ L⁻¹.
+std::vector<double> CholeskyLower(std::vector<double> a, std::size_t n) {
   for (std::size_t j = 0; j < n; ++j) {
     double d = a[j * n + j];
     for (std::size_t k = 0; k < j; ++k) d -= a[j * n + k] * a[j * n + k];
@@ -32,7 +34,15 @@ std::vector<double> InvertSymmetric(std::vector<double> a, std::size_t n) {
       for (std::size_t k = 0; k < j; ++k) s -= a[i * n + k] * a[j * n + k];
       a[i * n + j] = s / l;
     }
+    for (std::size_t i = 0; i < j; ++i) a[i * n + j] = 0;
   }
+  return a;
+}
+
+std::vector<double> InvertSymmetric(std::vector<double> a, std::size_t n) {
+  // a = L Lᵀ, then a⁻¹ = L⁻ᵀ L⁻¹.
+  a = CholeskyLower(std::move(a), n);
+  if (a.empty() && n > 0) return {};
   std::vector<double> inv_l(n * n, 0.0);  // L⁻¹, lower triangular
   for (std::size_t j = 0; j < n; ++j) {
     inv_l[j * n + j] = 1.0 / a[j * n + j];

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/uncertainty/blend.h"
+#include "core/uncertainty/interpolation_calibration.h"
 
 namespace brdf::daemon {
 namespace {
@@ -93,6 +94,12 @@ bool AddInterpolation(const interp::Interpolation& answer, const IndexSnapshot& 
   }
   std::vector<double>& spread = ThreadScratch().spread;
   uncertainty::InterpolationSpread(weights, spectra, answer.spectrum, &spread);
+  // Calibrated against the session's held-out readings (index/interpolation_calibration.h).
+  const uncertainty::InterpolationCalibration& calibration = index.calibration->Get(index);
+  if (!uncertainty::ApplyInterpolationCalibration(calibration, spread)) {
+    u->add_not_estimated("interpolation: not calibrated (" + calibration.detail +
+                         "); the vertices' spread as it is");
+  }
   SetFloats(spread, u->mutable_interpolation());
   return true;
 }

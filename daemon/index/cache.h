@@ -60,6 +60,7 @@
 #include "core/status.h"
 #include "core/wavelength_grid.h"
 #include "daemon/index/budgets.h"
+#include "daemon/index/interpolation_calibration.h"
 #include "daemon/sessions/session_id.h"
 #include "daemon/sessions/session_plan.h"
 #include "storage/records.h"
@@ -89,6 +90,9 @@ struct IndexSnapshot {
   // BRDF snapshots: the samples' uncertainty budgets, position for position (null: not
   // estimated); empty for other quantities (the stored budgets are of the BRDF).
   BudgetList budgets;
+  // The interpolation term's calibration from held-out readings, computed on the first answer
+  // with uncertainty (interpolation_calibration.h); never null in a published snapshot.
+  std::shared_ptr<const CalibrationSlot> calibration = std::make_shared<CalibrationSlot>();
 };
 
 struct IndexKey;  // index_build.h

@@ -10,11 +10,13 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "core/export/merl/reader.h"
 #include "core/export/rgl/reader.h"
 #include "core/export/synthetic_session.h"
+#include "core/uncertainty/budget.h"
 #include "export_test_util.h"
 #include "storage/session_store.h"
 
@@ -240,6 +242,56 @@ TEST_F(BrdfExportTool, FitReportsParametersAndResiduals) {
   EXPECT_NE(r.err.find("Cook-Torrance GGX"), std::string::npos) << r.err;
 }
 
+// A stored session whose readings carry budgets with shared components (here a white standard
+// and the readings' reference) is fitted by generalised least squares, and says so.
+TEST_F(BrdfExportTool, FitOfAStoredSessionWithBudgetsIsGeneralisedLeastSquares) {
+  const std::string copy = File("budgets.sqlite");
+  std::filesystem::copy_file(*db_, copy, std::filesystem::copy_options::overwrite_existing);
+  std::size_t expected_terms = 0;
+  {
+    auto store = storage::SessionStore::Open(copy);
+    ASSERT_TRUE(store.ok()) << store.status().ToString();
+    Result<std::vector<storage::ReadingRecord>> records =
+        (*store)->GetReadings(session_, 0, 100000);
+    ASSERT_TRUE(records.ok());
+    std::vector<std::pair<std::int64_t, uncertainty::ReadingBudget>> budgets;
+    std::set<std::int64_t> references;
+    for (const storage::ReadingRecord& r : *records) {
+      if (r.kind != storage::ReadingKind::kSample) continue;
+      const std::size_t n = r.spectrum.size();
+      ASSERT_TRUE(r.reference_reading_id.has_value());
+      references.insert(*r.reference_reading_id);
+      uncertainty::ReadingBudget b;
+      b.value.assign(n, 0.1);
+      b.components = {{"sample_signal", {}, std::vector<double>(n, 0.002)},
+                      {"white_standard",
+                       {uncertainty::Sharing::kWhiteStandard, session_},
+                       std::vector<double>(n, 0.001)},
+                      {"reference_signal",
+                       {uncertainty::Sharing::kReferenceReading, *r.reference_reading_id},
+                       std::vector<double>(n, 0.0005)}};
+      b.independent.assign(n, 0.002);
+      b.combined.assign(n, std::sqrt(0.002 * 0.002 + 0.001 * 0.001 + 0.0005 * 0.0005));
+      budgets.emplace_back(r.id, std::move(b));
+    }
+    ASSERT_FALSE(budgets.empty());
+    const Status st = (*store)->ReplaceReadingUncertainties(session_, budgets);
+    ASSERT_TRUE(st.ok()) << st.ToString();
+    ASSERT_GE(references.size(), 1u);
+    expected_terms = 1 + references.size();
+  }
+  ToolRun r = Exec("--db " + copy + " --session " + std::to_string(session_) + " --quiet fit -o " +
+                   File("fit_gls.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string terms = "GLS with " + std::to_string(expected_terms) + " shared terms";
+  EXPECT_NE(r.err.find("weighted by their uncertainties: " + terms), std::string::npos) << r.err;
+  const std::string report = ReadFile(File("fit_gls.csv"));
+  EXPECT_NE(report.find("# weighting: " + terms + " (generalised least squares)"),
+            std::string::npos);
+  EXPECT_NE(report.find("χ²/dof = "), std::string::npos);
+  EXPECT_EQ(CsvRows(report).size(), 102u);
+}
+
 // The path from a session to a weighted fit: the readings CSV of the BRDF with its u_<λ> columns
 // filled (here 2 % of each value, standing in for the budgets) is fitted weighted and reports
 // χ²/dof; the same file without the u columns (an older export) is fitted unweighted.
@@ -286,7 +338,8 @@ TEST_F(BrdfExportTool, FitOfAReadingsCsvIsWeightedByItsUncertaintyColumns) {
   EXPECT_NE(r.err.find("weighted by their uncertainties"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("χ²/dof = "), std::string::npos) << r.err;
   const std::string report = ReadFile(File("fit_u.csv"));
-  EXPECT_NE(report.find("# weighting: every value by 1/u²"), std::string::npos);
+  EXPECT_NE(report.find("# weighting: weighted, independent: every value by 1/u²"),
+            std::string::npos);
   EXPECT_EQ(CsvRows(report).size(), 102u);
 
   r = Exec("fit --readings " + File("brdf_old.csv") + " -o " + File("fit_old.csv"));

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "core/call_context.h"
@@ -32,6 +33,15 @@ inline double KdAt(double nm) {
 }
 inline double KsAt(double nm) {
   return 0.8 + 0.4 * (nm - 380) / 400;
+}
+
+// A broad retro-reflective lobe (peak when the detector looks back along the lamp), which no
+// Cook-Torrance lobe has: kr · exp((cos γ − 1) / w), γ the angle between ωi and ωo.
+inline double Retro(const IsoDirection& d, double kr) {
+  const double r = std::numbers::pi / 180;
+  const double cos_g = std::sin(d.theta_i * r) * std::sin(d.theta_o * r) * std::cos(d.phi * r) +
+                       std::cos(d.theta_i * r) * std::cos(d.theta_o * r);
+  return kr * std::exp((cos_g - 1) / 0.05);
 }
 
 }  // namespace brdf::fit::testing

@@ -20,22 +20,13 @@
 namespace brdf::fit {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kAlpha = 0.25, kF0 = 0.2;
 
 using testing::KdAt;
 using testing::KsAt;
 using testing::LongContext;
 using testing::PaperDirections;
-
-// A broad retro-reflective lobe (peak when the detector looks back along the lamp), which no
-// Cook-Torrance lobe has: kr · exp((cos γ − 1) / w), γ the angle between ωi and ωo.
-double Retro(const IsoDirection& d, double kr) {
-  const double r = kPi / 180;
-  const double cos_g = std::sin(d.theta_i * r) * std::sin(d.theta_o * r) * std::cos(d.phi * r) +
-                       std::cos(d.theta_i * r) * std::cos(d.theta_o * r);
-  return kr * std::exp((cos_g - 1) / 0.05);
-}
+using testing::Retro;
 
 // The standard uncertainty the synthetic readings are drawn with: `relative` of the value (2 %
 // by default) and a floor.
@@ -171,7 +162,7 @@ TEST(WeightedFit, AModelTheFitCannotRepresentGivesChiSquarePerDofWellAboveOne) {
   EXPECT_GT(lambert->statistics.chi2_per_dof, ct->statistics.chi2_per_dof);
   // The report says so, with the parameters' uncertainties in their own columns.
   const std::string csv = FitReportCsv({1, "retro", data.size(), 0, data.size()}, &*lambert, &*ct);
-  EXPECT_NE(csv.find("# weighting: every value by 1/u²"), std::string::npos);
+  EXPECT_NE(csv.find("# weighting: weighted, independent: every value by 1/u²"), std::string::npos);
   EXPECT_NE(csv.find("χ²/dof = " + std::to_string(ct->statistics.chi2_per_dof).substr(0, 2)),
             std::string::npos);
   EXPECT_NE(csv.find("lambert_albedo,lambert_albedo_u,"), std::string::npos);

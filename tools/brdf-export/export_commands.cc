@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -27,6 +28,7 @@
 #include "core/fit/fit_report.h"
 #include "core/fit/models.h"
 #include "core/geometry.h"
+#include "core/uncertainty/budget.h"
 #include "data/cie_tables.h"
 #include "storage/session_readings.h"
 #include "storage/session_store.h"
@@ -362,7 +364,52 @@ struct FitInput {
   fit::FitReportInfo info;
 };
 
-// The BRDF of a stored (or the demo) session's sample readings, with their budgets' u.
+// A budget component's shared source for the fit: the component and what it is shared through
+// ("reference_signal via reference_reading 812"); the same name in two readings is one error.
+std::string SharedSourceName(const uncertainty::Component& c) {
+  return c.name + " via " + uncertainty::SharingName(c.shared.kind) + " " +
+         std::to_string(c.shared.id);
+}
+
+// The stored budgets of a session's sample readings (of the BRDF), by reading id; none for the
+// demo session.
+Result<std::map<std::int64_t, uncertainty::ReadingBudget>> SampleBudgets(const CommonOptions& c) {
+  std::map<std::int64_t, uncertainty::ReadingBudget> budgets;
+  if (c.demo) return budgets;
+  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<storage::SessionStore> store, OpenExistingStore(c.db_path));
+  constexpr int kPage = 1000;
+  for (std::int64_t after = 0;;) {
+    BRDF_ASSIGN_OR_RETURN(std::vector<storage::ReadingRecord> page,
+                          store->GetReadings(c.session_id, after, kPage));
+    for (storage::ReadingRecord& r : page) {
+      if (r.uncertainty.has_value() && r.uncertainty->quantity == Quantity::kBrdf) {
+        budgets.emplace(r.id, std::move(*r.uncertainty));
+      }
+    }
+    if (page.size() < static_cast<std::size_t>(kPage)) break;
+    after = page.back().id;
+  }
+  return budgets;
+}
+
+// One sample reading for the fit: with its budget's independent part and shared components
+// (generalised least squares) when its budget matches the derived BRDF's u, else with that u.
+Status AddFitReading(fit::Observations& data, const exports::DerivedSample& s,
+                     const uncertainty::ReadingBudget* budget) {
+  if (budget == nullptr || s.u.empty() || budget->combined.size() != s.u.size() ||
+      budget->independent.size() != s.u.size()) {
+    return data.Add(s.iso, s.values, s.u);
+  }
+  std::vector<fit::SharedContribution> shared;
+  for (const uncertainty::Component& c : budget->components) {
+    if (c.shared.kind == uncertainty::Sharing::kIndependent) continue;
+    shared.push_back({SharedSourceName(c), c.contribution});
+  }
+  return data.AddWithSharedTerms(s.iso, s.values, budget->independent, shared);
+}
+
+// The BRDF of a stored (or the demo) session's sample readings, with their budgets: the
+// independent part and the shared components of each (the fit's generalised least squares).
 Result<FitInput> FitInputFromSession(const CommonOptions& c, std::ostream& err) {
   BRDF_ASSIGN_OR_RETURN(const exports::Session session, LoadInput(c));
   if (exports::HasSeveralDialPositions(session)) {
@@ -372,10 +419,12 @@ Result<FitInput> FitInputFromSession(const CommonOptions& c, std::ostream& err) 
   BRDF_ASSIGN_OR_RETURN(
       const exports::DerivedSamples derived,
       exports::DeriveSamples(session, exports::Quantity::kBrdf, {c.exclude_flagged}));
+  BRDF_ASSIGN_OR_RETURN(const auto budgets, SampleBudgets(c));
   FitInput in{fit::Observations(derived.grid), {session.id, session.name, 0, 0, 0}};
   for (const exports::DerivedSample& s : derived.samples) {
-    BRDF_RETURN_IF_ERROR(
-        in.data.Add(s.iso, s.values, s.u).WithContext("reading " + std::to_string(s.reading_id)));
+    const auto b = budgets.find(s.reading_id);
+    BRDF_RETURN_IF_ERROR(AddFitReading(in.data, s, b == budgets.end() ? nullptr : &b->second)
+                             .WithContext("reading " + std::to_string(s.reading_id)));
   }
   in.info.left_out = derived.skipped.size();
   return in;
@@ -448,7 +497,8 @@ int RunFit(const CommonOptions& c, const FitCommandOptions& o, std::ostream& err
   err << "brdf-export fit: session " << input->info.session_id << ", " << data.size()
       << " BRDF readings (" << input->info.left_out << " left out; "
       << (data.weighted()
-              ? "weighted by their uncertainties"
+              ? "weighted by their uncertainties: " +
+                    fit::WeightingText(data.weighting(), data.shared_sources().size())
               : std::to_string(data.with_uncertainty()) + " with an uncertainty: unweighted")
       << ") → " << c.output << "\n"
       << fit::FitSummary(l, t);

@@ -3,6 +3,9 @@
 // spectrum at a chosen direction with its vertices and weights (Figure 8; method, coordinates
 // and trend switches), a polar plot in the plane of incidence with a wavelength slider, and
 // downloads of every export (Data.Export: readings CSV, grids at a chosen step, MERL, RGL).
+// Uncertainties (docs/uncertainty.md) are drawn expanded, ± k·u with k chosen (1 or 2): a
+// reading's stored budget as error bars on its BRDF, bands around Figure 8's spectrum (the
+// measurement part and the combined one with the interpolation term) and the polar curve.
 import { plotly } from './plotly.js';
 import { call, stream } from './api.js';
 import { el, clear, stateName } from './dom.js';
@@ -11,10 +14,58 @@ import { createAppearance } from './appearance.js';
 
 const PLOT = { displaylogo: false, responsive: true };
 const POINT_COLUMNS = ['ids', 'alpha', 'beta', 'delta', 'theta_i', 'theta_o', 'phi', 'flagged'];
+// The coverage factors offered, with the coverage each stands for (docs/uncertainty.md,
+// "Expanded uncertainty").
+const COVERAGE = { 2: 'k = 2 (≈95 %)', 1: 'k = 1 (≈68 %)' };
+// A reading's spectra: each quantity's legend name and y axis.
+const QUANTITY_AXES = { QUANTITY_RADIANCE: ['radiance (W·m⁻²·sr⁻¹·nm⁻¹)', 'y'], QUANTITY_REFLECTANCE: ['reflectance', 'y2'], QUANTITY_BRDF: ['BRDF (sr⁻¹)', 'y2'] };
+const BLUE = '#1f77b4'; // plotly's first colour, kept by the polar curve drawn after its band
+
+// The median of k·u / |y| over the bands, as a percentage ("1.3 %"); '' without u.
+function medianPercent(u, y, k) {
+  if (!u?.length || u.length !== y.length) return '';
+  const r = u.map((v, i) => (k * v) / Math.abs(y[i])).filter(Number.isFinite).sort((a, b) => a - b);
+  return r.length ? `${(100 * r[Math.floor(r.length / 2)]).toPrecision(2)} %` : '';
+}
 
 function wavelengths(grid, n) {
   const count = n ?? grid.count;
   return Array.from({ length: count }, (_, i) => grid.start_nm + i * grid.step_nm);
+}
+
+// A shaded band y ± k·u as two traces: the lower edge, then the upper one filled down to it.
+// None when u is not given (not estimated) or is not one value per band. `meta.band` names the
+// band (the tests read it).
+function band(x, y, u, k, { id, name, color }) {
+  if (!u?.length || u.length !== y.length) return [];
+  const edge = { x, mode: 'lines', line: { width: 0, color }, legendgroup: id, hoverinfo: 'skip' };
+  return [
+    { ...edge, y: y.map((v, i) => v - k * u[i]), showlegend: false, meta: { band: id, edge: 'lower', k } },
+    { ...edge, y: y.map((v, i) => v + k * u[i]), fill: 'tonexty', fillcolor: color, name, meta: { band: id, edge: 'upper', k } },
+  ];
+}
+
+// What the combined band of an interpolated spectrum holds: the interpolation term alone where
+// the answer has no measurement part (quantities other than the BRDF).
+function combinedName(u) {
+  return u.measurement?.length ? 'measurement and interpolation' : 'interpolation only';
+}
+
+// An answer's combined uncertainty in one band: its `combined`, or sqrt(measurement² +
+// interpolation²) where a batch answer leaves combined out; undefined where neither part was
+// estimated (combined is then 0, which is not an uncertainty of zero).
+function combinedAt(u, at) {
+  const m = u?.measurement?.[at];
+  const i = u?.interpolation?.[at];
+  if (m === undefined && i === undefined) return undefined;
+  return u.combined?.length ? u.combined[at] : Math.hypot(m ?? 0, i ?? 0);
+}
+
+// What an uncertainty leaves out ("interpolation: the nearest method blends one reading…"), as
+// a list under `id`; nothing when it leaves nothing out.
+function notEstimated(id, texts) {
+  if (!texts?.length) return [];
+  return [el('p', { class: 'muted' }, 'Not in the uncertainty:'), el('ul', { id, class: 'muted' }, texts.map((t) => el('li', {}, t)))];
 }
 
 function fromBase64(s) {
@@ -46,24 +97,29 @@ export function createExplorer(root, report) {
   const sliderLabel = el('span', { id: 'wavelength-label' });
   const downloads = el('div', { id: 'downloads', class: 'buttons' });
   const downloadInfo = el('p', { id: 'download-info' });
+  const coverage = el('select', { id: 'coverage-k' }, [2, 1].map((k) => el('option', { value: k }, COVERAGE[k])));
+  const readingNotes = el('div', { id: 'reading-notes' });
+  const bandSummary = el('p', { id: 'interp-bands', class: 'muted' });
 
   let Plotly = null; // once loaded (plotly.js)
   let points = null; // columns of ReadingPoints over the whole session
   let session = '';
   let polarData = null;
+  let shownReading = null; // the clicked reading's spectra and budget, redrawn when k changes
+  let shownInterpolation = null; // Figure 8's answer, likewise
   const measured = new Set(); // sessions the listing showed with sample readings
 
   root.append(
-    el('div', { class: 'buttons' }, el('label', {}, 'Session ', sessionSelect), el('button', { id: 'explorer-load', onclick: () => load(sessionSelect.value) }, 'Load'), loadInfo),
+    el('div', { class: 'buttons' }, el('label', {}, 'Session ', sessionSelect), el('button', { id: 'explorer-load', onclick: () => load(sessionSelect.value) }, 'Load'), el('label', {}, 'uncertainty ± k·u, ', coverage), loadInfo),
     el('h2', {}, 'Figure 7: the readings'),
     el('div', { class: 'row' }, fig7aBox, fig7bBox),
-    readingInfo, spectrum,
+    readingInfo, spectrum, readingNotes,
     el('h2', {}, 'Figure 8: a direction between the readings'),
     el('form', { id: 'direction-form', class: 'buttons', onsubmit: (e) => { e.preventDefault(); interpolate(); } },
       el('label', {}, 'θi ', ti), el('label', {}, 'θo ', to), el('label', {}, 'φ ', phi),
       el('label', {}, 'method ', method), el('label', {}, 'coordinates ', coordinates), el('label', {}, 'trend ', trend), el('label', {}, 'quantity ', quantity),
       el('button', { id: 'interpolate', type: 'submit' }, 'Interpolate')),
-    interpInfo, interp,
+    interpInfo, bandSummary, interp,
     el('h2', {}, 'Plane of incidence'),
     el('div', { class: 'buttons' }, el('label', {}, 'wavelength ', slider), sliderLabel),
     polar,
@@ -171,14 +227,42 @@ export function createExplorer(root, report) {
     for (const f of figure7()) f.mark(k);
     // The reading's own spectrum in each quantity: the nearest reading to its own direction is
     // itself (the daemon converts radiance to reflectance and BRDF with its reference).
-    const quantities = [['QUANTITY_RADIANCE', 'radiance (W·m⁻²·sr⁻¹·nm⁻¹)', 'y'], ['QUANTITY_REFLECTANCE', 'reflectance', 'y2'], ['QUANTITY_BRDF', 'BRDF (sr⁻¹)', 'y2']];
-    const answers = await Promise.all(quantities.map(([q]) => call('Interpolation/Interpolate', { session_id: session, method: 'INTERPOLATION_METHOD_NEAREST', quantity: q, direction: { iso } }).catch((e) => { report(e.message); return null; })));
-    const traces = [];
-    answers.forEach((a, i) => {
-      const res = a?.result;
-      if (res?.status === 'INTERPOLATION_STATUS_OK') traces.push({ x: wavelengths(res.grid, res.spectrum.length), y: res.spectrum, name: quantities[i][1], yaxis: quantities[i][2] });
+    const quantities = ['QUANTITY_RADIANCE', 'QUANTITY_REFLECTANCE', 'QUANTITY_BRDF'];
+    const [budget, ...answers] = await Promise.all([readingBudget(p.ids[k]), ...quantities.map((q) => call('Interpolation/Interpolate', { session_id: session, method: 'INTERPOLATION_METHOD_NEAREST', quantity: q, direction: { iso } }).catch((e) => { report(e.message); return null; }))]);
+    shownReading = { id: p.ids[k], budget, results: answers.map((a) => a?.result).filter((r) => r?.status === 'INTERPOLATION_STATUS_OK') };
+    drawReading();
+  }
+
+  // The reading's stored uncertainty budget (Reading.uncertainty), null when it has none (not
+  // estimated): the first sample reading after id − 1, without its radiance, the stream cancelled
+  // once it is here.
+  async function readingBudget(id) {
+    const stop = new AbortController();
+    let reading = null;
+    const request = { session_id: session, kinds: ['READING_KIND_SAMPLE'], after_id: String(BigInt(id) - 1n) };
+    try {
+      await stream('Data/StreamReadings', request, (r) => { reading ??= r; stop.abort(); }, stop.signal, ['radiance']);
+    } catch (e) {
+      if (!reading) report(e.message);
+    }
+    return reading?.id === String(id) ? reading.uncertainty ?? null : null;
+  }
+
+  // The clicked reading's spectra, the quantity its budget is of (the BRDF) with error bars
+  // ± k·u_c, and what its budget leaves out.
+  function drawReading() {
+    if (!shownReading) return;
+    const k = Number(coverage.value);
+    const { budget, results } = shownReading;
+    const traces = results.map((res) => {
+      const [name, yaxis] = QUANTITY_AXES[res.quantity];
+      const trace = { x: wavelengths(res.grid, res.spectrum.length), y: res.spectrum, name, yaxis };
+      const u = budget?.quantity === res.quantity ? budget.combined : null;
+      if (u?.length === res.spectrum.length) Object.assign(trace, { name: `${name} ± ${k}·u, ${COVERAGE[k]}`, error_y: { type: 'data', array: u.map((v) => k * v), visible: true, thickness: 1, width: 2 } });
+      return trace;
     });
     Plotly.react(spectrum, traces, { height: 320, margin: { t: 20 }, xaxis: { title: { text: 'wavelength nm' } }, yaxis: { title: { text: 'radiance' } }, yaxis2: { overlaying: 'y', side: 'right', title: { text: 'reflectance, BRDF' } } }, PLOT);
+    clear(readingNotes).append(...(budget ? notEstimated('reading-not-estimated', budget.not_estimated) : [el('p', { class: 'muted', id: 'reading-no-budget' }, `reading ${shownReading.id}: its uncertainty was not estimated (no budget stored with it)`)]));
   }
 
   // The choices of the Figure 8 form as InterpolationOptions (exports add reciprocity).
@@ -191,10 +275,13 @@ export function createExplorer(root, report) {
     Plotly = await plotly();
     const t0 = performance.now();
     try {
-      // One call: the vertices come with their own spectra (include_vertex_spectra).
-      const res = (await call('Interpolation/Interpolate', { session_id: session, method: method.value, quantity: quantity.value, options: options(), direction: { iso: { theta_i: Number(ti.value), theta_o: Number(to.value), phi: Number(phi.value) } }, include_vertex_spectra: true })).result;
+      // One call: the vertices come with their own spectra (include_vertex_spectra), the
+      // spectrum with its uncertainty (include_uncertainty).
+      const res = (await call('Interpolation/Interpolate', { session_id: session, method: method.value, quantity: quantity.value, options: options(), direction: { iso: { theta_i: Number(ti.value), theta_o: Number(to.value), phi: Number(phi.value) } }, include_vertex_spectra: true, include_uncertainty: true })).result;
       const ms = performance.now() - t0;
       clear(interpInfo);
+      bandSummary.textContent = '';
+      shownInterpolation = null;
       if (res.status !== 'INTERPOLATION_STATUS_OK') {
         interpInfo.append(el('p', { class: 'error', id: 'interp-status' }, `${res.status.replace('INTERPOLATION_STATUS_', '').toLowerCase()}: ${res.detail}`));
         Plotly.purge(interp);
@@ -204,14 +291,41 @@ export function createExplorer(root, report) {
       interpInfo.append(el('p', { id: 'interp-status' }, `${res.spectrum.length} wavelengths from ${res.vertices.length} readings in ${Math.round(ms)} ms` +
         (residuals ? ' (trend + the blend of the vertices\' residuals, so not Σ weight · vertex spectrum)' : '')),
         el('table', { id: 'vertices' }, el('tr', {}, el('th', {}, 'reading'), el('th', {}, '(θi, θo, φ)'), el('th', {}, 'weight')),
-          res.vertices.map((v) => el('tr', {}, el('td', {}, v.reading_id), el('td', {}, v.coords.map((c) => c.toFixed(1)).join(', ')), el('td', {}, v.weight.toFixed(3))))));
-      const x = wavelengths(res.grid, res.spectrum.length);
-      const traces = [{ x, y: res.spectrum, name: 'interpolated', line: { width: 3, color: 'black' } }];
-      for (const v of res.vertices) {
-        if (v.spectrum?.length) traces.push({ x, y: v.spectrum, name: `reading ${v.reading_id} (w ${v.weight.toFixed(2)})`, line: { dash: 'dot' } });
-      }
-      Plotly.react(interp, traces, { height: 340, margin: { t: 20 }, xaxis: { title: { text: 'wavelength nm' } }, yaxis: { title: { text: quantity.selectedOptions[0].textContent } } }, PLOT);
+          res.vertices.map((v) => el('tr', {}, el('td', {}, v.reading_id), el('td', {}, v.coords.map((c) => c.toFixed(1)).join(', ')), el('td', {}, v.weight.toFixed(3))))),
+        ...notEstimated('interp-not-estimated', res.uncertainty?.not_estimated));
+      shownInterpolation = { res, unit: quantity.selectedOptions[0].textContent };
+      drawInterpolation();
     } catch (e) { report(e.message); }
+  }
+
+  // Figure 8: the interpolated spectrum inside its bands ± k·u — the combined one (measurement
+  // and interpolation term) when the interpolation term is estimated, the measurement part
+  // inside it, darker — and each vertex's own spectrum.
+  function drawInterpolation() {
+    if (!shownInterpolation) return;
+    const { res, unit } = shownInterpolation;
+    const k = Number(coverage.value);
+    const x = wavelengths(res.grid, res.spectrum.length);
+    const u = res.uncertainty || {};
+    const traces = [
+      ...(u.interpolation?.length ? band(x, res.spectrum, u.combined, k, { id: 'combined', name: `± ${k}·u, ${combinedName(u)}, ${COVERAGE[k]}`, color: 'rgba(255, 127, 14, 0.25)' }) : []),
+      ...band(x, res.spectrum, u.measurement, k, { id: 'measurement', name: `± ${k}·u, measurement only, ${COVERAGE[k]}`, color: 'rgba(31, 119, 180, 0.3)' }),
+      { x, y: res.spectrum, name: 'interpolated', line: { width: 3, color: 'black' } },
+    ];
+    for (const v of res.vertices) {
+      if (v.spectrum?.length) traces.push({ x, y: v.spectrum, name: `reading ${v.reading_id} (w ${v.weight.toFixed(2)})`, line: { dash: 'dot' } });
+    }
+    summarizeBands(u, res.spectrum, k);
+    Plotly.react(interp, traces, { height: 340, margin: { t: 20 }, xaxis: { title: { text: 'wavelength nm' } }, yaxis: { title: { text: unit } } }, PLOT);
+  }
+
+  // One line above Figure 8: each band's median half-width relative to the spectrum (the bands
+  // of a matte sample are thin at the plot's scale).
+  function summarizeBands(u, y, k) {
+    const parts = [['measurement', u.measurement]];
+    if (u.interpolation?.length) parts.unshift([combinedName(u), u.combined]);
+    const shown = parts.map(([what, v]) => [what, medianPercent(v, y, k)]).filter(([, p]) => p);
+    bandSummary.textContent = shown.length ? `± ${k}·u, ${COVERAGE[k]}, median over the wavelengths: ${shown.map(([what, p]) => `${p} of the value (${what})`).join(', ')}` : 'no uncertainty estimated';
   }
 
   // BRDF along the plane of incidence at θi: θo from −85° (φ 0, the lamp's side) to 85° (φ 180,
@@ -228,7 +342,7 @@ export function createExplorer(root, report) {
     for (const m of ['INTERPOLATION_METHOD_OCTANT', 'INTERPOLATION_METHOD_NEAREST']) {
       results = new Array(angles.length);
       try {
-        await stream('Interpolation/InterpolateBatch', { session_id: id, method: m, quantity: 'QUANTITY_BRDF', directions }, (chunk) => {
+        await stream('Interpolation/InterpolateBatch', { session_id: id, method: m, quantity: 'QUANTITY_BRDF', directions, include_uncertainty: true }, (chunk) => {
           chunk.results.forEach((r, i) => { results[chunk.first_index + i] = r; });
         });
       } catch (e) { report(e.message); return null; }
@@ -242,14 +356,29 @@ export function createExplorer(root, report) {
 
   function drawPolar() {
     if (!polarData) return;
-    const k = Number(slider.value);
-    const nm = polarData.grid.start_nm + k * polarData.grid.step_nm;
+    const at = Number(slider.value); // the band (wavelength) shown
+    const nm = polarData.grid.start_nm + at * polarData.grid.step_nm;
     sliderLabel.textContent = `${nm} nm`;
     const ok = polarData.results.map((r) => r && r.status === 'INTERPOLATION_STATUS_OK');
-    Plotly.react(polar, [{ type: 'scatterpolar', mode: 'lines+markers', theta: polarData.angles.filter((_, i) => ok[i]).map((a) => a + 90), r: polarData.results.filter((_, i) => ok[i]).map((r) => r.spectrum[k]), name: `θi ${polarData.thetaI}°` }],
+    const theta = polarData.angles.filter((_, i) => ok[i]).map((a) => a + 90);
+    const results = polarData.results.filter((_, i) => ok[i]);
+    const r = results.map((res) => res.spectrum[at]);
+    Plotly.react(polar, [...polarBand(theta, r, results.map((res) => combinedAt(res.uncertainty, at))), { type: 'scatterpolar', mode: 'lines+markers', theta, r, name: `θi ${polarData.thetaI}°`, line: { color: BLUE }, marker: { color: BLUE } }],
       { height: 380, margin: { t: 30 }, title: { text: `BRDF (sr⁻¹) in the plane of incidence, θi ${polarData.thetaI}°, ${nm} nm (${polarData.used})` }, polar: { sector: [0, 180], angularaxis: { rotation: 180, direction: 'clockwise', tickvals: [0, 30, 60, 90, 120, 150, 180], ticktext: ['−90° lamp side', '−60°', '−30°', 'normal', '30°', '60°', '90° specular side'] } } }, PLOT);
   }
+
+  // The band r ± k·u (combined) around the polar curve as one closed outline: the upper edge
+  // out, the lower edge back, the lower at 0 at least (a BRDF is not negative, nor is a radius).
+  // None unless every point has its uncertainty.
+  function polarBand(theta, r, u) {
+    if (!r.length || u.some((v) => !Number.isFinite(v))) return [];
+    const k = Number(coverage.value);
+    const upper = r.map((v, i) => v + k * u[i]);
+    const lower = r.map((v, i) => Math.max(0, v - k * u[i])).reverse();
+    return [{ type: 'scatterpolar', mode: 'lines', theta: [...theta, ...[...theta].reverse()], r: [...upper, ...lower], fill: 'toself', fillcolor: 'rgba(31, 119, 180, 0.25)', line: { width: 0 }, hoverinfo: 'skip', name: `± ${k}·u, ${COVERAGE[k]}`, meta: { band: 'combined', k, points: r.length } }];
+  }
   slider.addEventListener('input', drawPolar);
+  coverage.addEventListener('change', () => { drawReading(); drawInterpolation(); drawPolar(); });
 
   const EXPORTS = [
     ['EXPORT_FORMAT_READINGS_CSV', 'readings CSV'],

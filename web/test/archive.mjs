@@ -3,7 +3,7 @@
 // brdf-archive with [web] listen and Debian's headless Chromium driven by puppeteer-core. The
 // archive's console is read-only for every token (no plan, no rig, no control; the session's rig
 // named; its history as the rig recorded it); the explorer draws Figure 7 from the archive,
-// interpolates a direction and downloads the readings CSV. No errors in the browser console.
+// interpolates a direction (with its uncertainty bands) and downloads the readings CSV. No errors in the browser console.
 // Screenshots go to $BRDF_TEST_OUTPUT_DIR/archive.
 import puppeteer from 'puppeteer-core';
 import { readFileSync, readdirSync, mkdirSync, mkdtempSync, writeFileSync } from 'node:fs';
@@ -117,6 +117,9 @@ try {
     await page.waitForSelector('#interp-status');
     const status = await page.$eval('#interp-status', (e) => e.textContent);
     check(/wavelengths from \d+ readings/.test(status), `explorer: a direction interpolated by the archive: ${status}`);
+    // With its uncertainty bands, from the budgets the rig shipped with the readings.
+    const bands = await page.evaluate(() => document.getElementById('interp-spectrum').data.filter((t) => t.meta?.band).map((t) => t.meta.band).join());
+    check(bands === 'combined,combined,measurement,measurement', `explorer: the archive's answer has its combined and measurement bands (${bands}; ${await page.$eval('#interp-bands', (e) => e.textContent)})`);
     await page.waitForSelector('#appearance-sphere-D65', { timeout: 60000 });
     const cdp = await page.createCDPSession();
     await cdp.send('Browser.setDownloadBehavior', { behavior: 'allow', downloadPath: out });

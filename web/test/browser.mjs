@@ -2,8 +2,10 @@
 // puppeteer-core against a real brdfd on brdf-sim. As an operator: sign in, submit the demo plan
 // from its file (validated, with the estimated time), watch progress move, answer the prompts
 // (doing on the simulator what the prompt asks), pause and resume, then the explorer: Figure 7,
-// a reading's spectrum, a direction's interpolated spectrum with its vertices (two methods), the
-// plane of incidence, the sample's colour and lit spheres (D65, A), an export downloaded. As an
+// a reading's spectrum (its BRDF with error bars from its stored budget), a direction's
+// interpolated spectrum with its vertices (two methods) and its uncertainty bands (the gateway's
+// numbers for the same direction; k = 1 and 2; nearest's not-estimated note), the plane of
+// incidence with its band, the sample's colour and lit spheres (D65, A), an export downloaded. As an
 // analyst: no control anywhere, and the server refuses one sent anyway. No errors in the browser
 // console. Screenshots of every view go to $BRDF_TEST_OUTPUT_DIR.
 import puppeteer from 'puppeteer-core';
@@ -59,6 +61,93 @@ async function checkNoPlaceholders(page, view) {
   check(!bad, `${view}: no "null", "undefined", "NaN" or "[object Object]" shown${bad ? ` (found "${bad[0]}" in …${shown.slice(Math.max(0, bad.index - 60), bad.index + 20)}…)` : ''}`);
 }
 const text = (page, sel) => page.$eval(sel, (e) => e.textContent).catch(() => null);
+// The gateway asked directly (as the analyst), for the numbers a plot must show: a unary call's
+// JSON, or a stream's messages.
+async function gateway(method, body, streamed = false) {
+  const r = await fetch(new URL(`/api/brdf.v1.${method}`, rig.url), { method: 'POST', headers: { 'Content-Type': 'application/json', Authorization: `Bearer ${rig.analystToken}` }, body: JSON.stringify(body) });
+  const answer = await r.text();
+  if (r.status !== 200) throw new Error(`${method}: ${r.status} ${answer}`);
+  return streamed ? answer.split('\n\n').filter((b) => b.startsWith('data: ')).map((b) => JSON.parse(b.slice(6))) : JSON.parse(answer);
+}
+// Equal to the last few digits (the page computes y ± k·u, the test k·u from the same doubles).
+const close = (a, b) => Math.abs(a - b) <= 1e-9 * Math.max(Math.abs(a), Math.abs(b), 1e-12);
+// Figure 8's bands as drawn: per band (meta.band), its coverage factor, legend name and
+// half-widths (upper − lower) / 2 per wavelength.
+const figure8Bands = (page) => page.evaluate(() => {
+  const out = {};
+  for (const t of document.getElementById('interp-spectrum').data.filter((d) => d.meta?.band)) {
+    const b = (out[t.meta.band] ??= { k: t.meta.k });
+    b[t.meta.edge] = t.y;
+    if (t.meta.edge === 'upper') b.name = t.name;
+  }
+  for (const b of Object.values(out)) b.half = b.upper.map((u, i) => (u - b.lower[i]) / 2);
+  return out;
+});
+const setCoverage = (page, k) => page.$eval('#coverage-k', (e, v) => { e.value = v; e.dispatchEvent(new Event('change')); }, String(k));
+
+// Figure 8 asked again with the form as it is.
+async function interpolateAgain(page) {
+  await page.evaluate(() => { document.getElementById('interp-status')?.remove(); });
+  await clickId(page, 'interpolate');
+  await page.waitForSelector('#interp-status');
+}
+
+// Figure 8 with the paper's method: bands ± k·u whose half-widths are k times the gateway's
+// combined and measurement uncertainties for the same direction, finite and non-negative; k = 1
+// halves them; the nearest method draws the measurement band alone and says why, a reflectance
+// answer the interpolation term's alone.
+async function checkFigure8Bands(page, sessionId) {
+  await page.select('#method', 'INTERPOLATION_METHOD_OCTANT');
+  await interpolateAgain(page);
+  const iso = await page.evaluate(() => ({ theta_i: Number(document.getElementById('q-theta-i').value), theta_o: Number(document.getElementById('q-theta-o').value), phi: Number(document.getElementById('q-phi').value) }));
+  const request = { session_id: sessionId, method: 'INTERPOLATION_METHOD_OCTANT', quantity: 'QUANTITY_BRDF', options: { coordinates: 'INTERPOLATION_COORDINATES_INCIDENCE', trend: 'INTERPOLATION_TREND_NONE' }, direction: { iso }, include_uncertainty: true };
+  const u = (await gateway('Interpolation/Interpolate', request)).result.uncertainty;
+  const k2 = await figure8Bands(page);
+  for (const part of ['combined', 'measurement']) {
+    const b = k2[part];
+    check(b && b.k === 2 && b.name.includes('k = 2 (≈95 %)') && b.half.length === u[part].length && b.half.every((h, i) => Number.isFinite(h) && h >= 0 && close(h, 2 * u[part][i])) && b.half.some((h) => h > 0),
+      `Figure 8's ${part} band: half-widths 2·u for every one of ${b?.half.length} bands, as the gateway answers (legend "${b?.name}")`);
+  }
+  check(k2.combined.half.every((h, i) => h >= k2.measurement.half[i] - 1e-15), 'the measurement band lies inside the combined one');
+  const summary = await text(page, '#interp-bands');
+  check(/^± 2·u, k = 2 \(≈95 %\), median over the wavelengths: [\d.]+ % of the value \(measurement and interpolation\), [\d.]+ % of the value \(measurement\)$/.test(summary), `the bands' median widths are stated: ${summary}`);
+  await shot(page, '07a-explorer-bands-k2');
+  await setCoverage(page, 1);
+  const k1 = await figure8Bands(page);
+  check(['combined', 'measurement'].every((p) => k1[p].k === 1 && k1[p].name.includes('k = 1 (≈68 %)') && k1[p].half.every((h, i) => close(2 * h, k2[p].half[i]))), 'k = 1 halves both bands\' half-widths');
+  await setCoverage(page, 2);
+  await page.select('#method', 'INTERPOLATION_METHOD_NEAREST');
+  await interpolateAgain(page);
+  const nearest = await figure8Bands(page);
+  const notes = await page.$$eval('#interp-not-estimated li', (l) => l.map((e) => e.textContent));
+  check(Object.keys(nearest).join() === 'measurement' && notes.some((t) => /^interpolation: the nearest method/.test(t)), `nearest: the measurement band alone, the interpolation term named as not estimated (${notes.length} notes)`);
+  await page.select('#method', 'INTERPOLATION_METHOD_OCTANT');
+  await page.select('#quantity', 'QUANTITY_REFLECTANCE');
+  await interpolateAgain(page);
+  const reflectance = await figure8Bands(page);
+  const why = await page.$$eval('#interp-not-estimated li', (l) => l.map((e) => e.textContent));
+  check(Object.keys(reflectance).join() === 'combined' && /interpolation only/.test(reflectance.combined.name) && reflectance.combined.half.some((h) => h > 0) && why.some((t) => /^measurement: the readings' budgets are of the BRDF/.test(t)),
+    `reflectance: the interpolation term's band alone, the measurement part named as not estimated (${reflectance.combined?.name})`);
+  await page.select('#quantity', 'QUANTITY_BRDF');
+}
+
+// The polar plot's band ± k·u (combined) around its curve: a closed outline around every point,
+// finite, its upper edge at or above the curve; k = 1 halves its distance from the curve.
+async function checkPolarBand(page) {
+  const polarBand = () => page.evaluate(() => {
+    const d = document.getElementById('polar').data;
+    const b = d.find((t) => t.meta?.band === 'combined');
+    const curve = d.find((t) => !t.meta?.band);
+    return b && { fill: b.fill, k: b.meta.k, name: b.name, above: curve.r.map((r, i) => b.r[i] - r), r: b.r, n: curve.r.length };
+  });
+  const k2 = await polarBand();
+  check(k2 && k2.fill === 'toself' && k2.r.length === 2 * k2.n && k2.r.every((r) => Number.isFinite(r) && r >= 0) && k2.above.every((a) => a >= 0) && k2.above.some((a) => a > 0) && k2.name.includes('k = 2 (≈95 %)'),
+    `the polar plot has its band around the ${k2?.n} points (${k2?.name})`);
+  await setCoverage(page, 1);
+  const k1 = await polarBand();
+  check(k1.k === 1 && k1.above.every((a, i) => close(2 * a, k2.above[i])), 'k = 1 halves the polar band\'s distance above the curve');
+  await setCoverage(page, 2);
+}
 
 let failed = false;
 try {
@@ -171,6 +260,14 @@ try {
   await page.mouse.click(at.x, at.y);
   await page.waitForFunction(() => document.querySelectorAll('#reading-spectrum .scatterlayer .trace').length >= 2, { timeout: 15000 });
   check(/^reading \d+: α/.test(await text(page, '#reading-info')), `a click on a point shows its reading's spectrum (${await text(page, '#reading-info')})`);
+  // Its BRDF with error bars ± k·u_c from the budget stored with the reading (Reading.uncertainty).
+  await page.waitForFunction(() => document.getElementById('reading-spectrum').data?.some((t) => t.error_y?.array?.length), { timeout: 15000 });
+  const clickedId = /^reading (\d+):/.exec(await text(page, '#reading-info'))[1];
+  const sessionId = await page.$eval('#explorer-session', (e) => e.value);
+  const stored = (await gateway('Data/StreamReadings', { session_id: sessionId, kinds: ['READING_KIND_SAMPLE'] }, true)).find((m) => m.id === clickedId)?.uncertainty;
+  const bars = await page.evaluate(() => document.getElementById('reading-spectrum').data.filter((t) => t.error_y?.array).map((t) => ({ name: t.name, array: t.error_y.array })));
+  check(stored?.combined?.length > 0 && bars.length === 1 && /^BRDF .* ± 2·u, k = 2 \(≈95 %\)$/.test(bars[0].name) && bars[0].array.length === stored.combined.length && bars[0].array.every((v, i) => Number.isFinite(v) && v >= 0 && close(v, 2 * stored.combined[i])),
+    `reading ${clickedId}'s BRDF has error bars 2·u_c from its stored budget (${bars[0]?.name}; ${bars[0]?.array.length} bands)`);
   await shot(page, '06-explorer-figure7');
 
   for (const method of ['INTERPOLATION_METHOD_OCTANT', 'INTERPOLATION_METHOD_DELAUNAY']) {
@@ -184,7 +281,7 @@ try {
     check(rows >= 1, `${method}: ${rows} vertices with weights`);
     await page.waitForFunction(() => document.querySelectorAll('#interp-spectrum .scatterlayer .trace').length >= 2, { timeout: 15000 });
     const traces = await page.$$eval('#interp-spectrum .scatterlayer .trace', (t) => t.length);
-    check(traces === rows + 1, `${method}: the interpolated spectrum and each vertex's own spectrum drawn (${traces} traces for ${rows} vertices)`);
+    check(traces === rows + 1 + 4, `${method}: the interpolated spectrum, each vertex's own spectrum and two bands of two edges each drawn (${traces} traces for ${rows} vertices)`);
   }
   // The bivariate trend: the same direction, the vertices' residuals blended on top of the trend.
   await page.select('#trend', 'INTERPOLATION_TREND_BIVARIATE');
@@ -194,10 +291,12 @@ try {
   const trended = await text(page, '#interp-status');
   check(/wavelengths from \d+ readings.*trend/.test(trended), `Delaunay with the bivariate trend: ${trended}`);
   await page.select('#trend', 'INTERPOLATION_TREND_NONE');
+  await checkFigure8Bands(page, sessionId);
   await page.waitForSelector('#polar .scatterlayer .trace, #polar .trace');
   const nm0 = await text(page, '#wavelength-label');
   await page.$eval('#wavelength', (e) => { e.value = '5'; e.dispatchEvent(new Event('input')); });
   check((await text(page, '#wavelength-label')) !== nm0, `the wavelength slider redraws the polar plot (${nm0} → ${await text(page, '#wavelength-label')})`);
+  await checkPolarBand(page);
   await shot(page, '07-explorer-direction-polar');
 
   // The sample's colour and lit spheres under D65 and A (Interpolation/RenderAppearance), drawn

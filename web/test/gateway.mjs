@@ -1,6 +1,7 @@
 // The web gateway probed like the gRPC API, over real HTTP against a real brdfd on brdf-sim: no
 // token, a wrong token, the wrong role, oversized and malformed requests, unknown methods, a
-// stream refused before its first event, security headers, no inline script, no CORS.
+// stream refused before its first event, security headers, no inline script, no CORS, and the
+// uncertainties (include_uncertainty, Reading.uncertainty) mapped to JSON and back.
 import { readFileSync } from 'node:fs';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -17,6 +18,61 @@ async function post(method, body, token, extra = {}) {
   let json = null;
   try { json = JSON.parse(text); } catch { /* not JSON */ }
   return { status: r.status, json, text, headers: r.headers };
+}
+// A stream's messages (a stream that ends by itself), read whole: each event's data as JSON.
+async function messages(method, body, token) {
+  const r = await post(method, body, token);
+  if (r.status !== 200) throw new Error(`${method}: ${r.status} ${r.text}`);
+  return r.text.split('\n\n').filter((b) => b.startsWith('data: ')).map((b) => JSON.parse(b.slice(6)));
+}
+const sleep = (ms) => new Promise((res) => setTimeout(res, ms));
+// A plan of three poses measured to its end on the simulator, its prompts answered; its id.
+async function measureSmallSession() {
+  const small = { name: 'uncertainty over JSON', poseList: { poses: [{ alpha: 0, beta: 10, delta: 40 }, { alpha: 10, beta: 20, delta: 40 }, { alpha: 20, beta: 40, delta: 40 }] }, measurement: { integrationMs: 100, averages: 1 } };
+  const id = (await post('Control/SubmitPlan', { plan: small, start_now: true }, rig.operatorToken)).json.session.session_id;
+  for (const deadline = Date.now() + 60000; Date.now() < deadline; await sleep(100)) {
+    const s = (await post('Control/GetSession', { session_id: id }, rig.operatorToken)).json;
+    if (s.state === 'SESSION_STATE_COMPLETED') return id;
+    if (['SESSION_STATE_FAILED', 'SESSION_STATE_ABORTED'].includes(s.state)) throw new Error(`the small session is ${s.state}: ${s.state_reason}`);
+    if (s.state === 'SESSION_STATE_AWAITING_OPERATOR' && s.pending_prompt) {
+      await rig.simMount(s.pending_prompt.kind);
+      await post('Control/AnswerPrompt', { session_id: id, step_index: s.pending_prompt.step_index ?? 0 }, rig.operatorToken);
+    }
+  }
+  throw new Error('the small session did not finish within a minute');
+}
+const finiteNonNegative = (a, n) => Array.isArray(a) && a.length === n && a.every((v) => typeof v === 'number' && Number.isFinite(v) && v >= 0);
+// include_uncertainty through the gateway, both ways (the JSON mapping is protobuf's, field names
+// as in brdf.proto): a reading's budget in Data.StreamReadings (and left out with ?omit=), an
+// interpolated spectrum's uncertainty in Interpolate and InterpolateBatch, none when not asked.
+async function checkUncertaintyOverJson() {
+  const id = await measureSmallSession();
+  const readings = await messages('Data/StreamReadings', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, rig.analystToken);
+  const budget = readings[0]?.uncertainty;
+  const bands = readings[0]?.radiance.length;
+  check(readings.length === 3 && budget?.quantity === 'QUANTITY_BRDF' && finiteNonNegative(budget.combined, bands) && budget.combined.some((v) => v > 0) && Array.isArray(budget.components) && Array.isArray(budget.not_estimated),
+    `a reading's budget comes through as Reading.uncertainty (${readings.length} readings, ${budget?.combined?.length} bands, ${budget?.components?.length} components)`);
+  const omitted = await messages('Data/StreamReadings?omit=uncertainty', { session_id: id, kinds: ['READING_KIND_SAMPLE'] }, rig.analystToken);
+  check(omitted.length === 3 && omitted.every((m) => !('uncertainty' in m)), '?omit=uncertainty leaves the budgets out');
+  const at = { session_id: id, method: 'INTERPOLATION_METHOD_NEAREST', direction: { iso: readings[0].iso } };
+  let r = await post('Interpolation/Interpolate', at, rig.analystToken);
+  check(r.status === 200 && r.json.result.status === 'INTERPOLATION_STATUS_OK' && !('uncertainty' in r.json.result), `Interpolate without include_uncertainty → no uncertainty (${r.status})`);
+  r = await post('Interpolation/Interpolate', { ...at, include_uncertainty: true }, rig.analystToken);
+  const u = r.json?.result?.uncertainty;
+  // Equal to float precision (an answer's uncertainty may travel as float, the budget as double).
+  const same = (a, b) => a.length === b.length && a.every((v, i) => Math.abs(v - b[i]) <= 1e-6 * Math.abs(b[i]) + 1e-30);
+  check(r.status === 200 && finiteNonNegative(u?.measurement, bands) && finiteNonNegative(u.combined, bands) && same(u.measurement, budget.combined) && same(u.combined, u.measurement),
+    `Interpolate with include_uncertainty: the nearest reading's measurement part is its stored budget, combined equals it (${u?.measurement?.length} bands)`);
+  check(Array.isArray(u?.interpolation) && u.interpolation.length === 0 && Array.isArray(u.shared) && u.not_estimated.some((t) => /^interpolation: the nearest method/.test(t)),
+    `…and its interpolation term is empty and named as not estimated (${u?.not_estimated?.join(' | ')})`);
+  const directions = readings.map((m) => ({ iso: m.iso }));
+  const chunks = await messages('Interpolation/InterpolateBatch', { session_id: id, method: 'INTERPOLATION_METHOD_NEAREST', directions, include_uncertainty: true }, rig.analystToken);
+  const results = chunks.flatMap((c) => c.results);
+  const byId = new Map(readings.map((m) => [m.id, m.uncertainty.combined]));
+  check(results.length === 3 && results.every((x) => x.status === 'INTERPOLATION_STATUS_OK' && finiteNonNegative(x.uncertainty?.measurement, bands) && same(x.uncertainty.measurement, byId.get(x.vertices[0].reading_id))),
+    `InterpolateBatch with include_uncertainty: each result's measurement part, per band, its reading's budget (${results.map((x) => x.uncertainty?.measurement?.length).join(', ')})`);
+  const plain = (await messages('Interpolation/InterpolateBatch', { session_id: id, method: 'INTERPOLATION_METHOD_NEAREST', directions }, rig.analystToken)).flatMap((c) => c.results);
+  check(plain.length === 3 && plain.every((x) => !('uncertainty' in x)), 'InterpolateBatch without it → no uncertainty');
 }
 
 let failed = false;
@@ -129,6 +185,7 @@ try {
   // refused naming the field, before anything is streamed.
   r = await post('Data/Export', { session_id: id, format: 'EXPORT_FORMAT_GRID_NPY', step_theta_i: 7 }, rig.analystToken);
   check(r.status === 400 && /step_theta_i/.test(r.json?.message), `an export grid step of 7° → 400 naming step_theta_i (${r.status} ${r.json?.message})`);
+  await checkUncertaintyOverJson();
 
   const page = await fetch(rig.url);
   const html = await page.text();

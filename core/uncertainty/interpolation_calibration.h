@@ -1,0 +1,60 @@
+// Calibrating an interpolated value's interpolation term against the session's own readings
+// (docs/uncertainty.md, "The interpolation term"). The vertices' spread s (blend.h,
+// InterpolationSpread) says how much the BRDF changes across a cell, not how far the blend is
+// from the truth: on the simulator's materials it is 1.5–4 times too wide, by a factor that
+// differs from material to material. The calibrated term is
+//
+//     u_int(λ) = c(λ) · s(λ),
+//
+// with c fitted per session from held-out readings: readings left out of the index, predicted
+// from the rest at their own poses, their residuals r compared with c · s there. (A held-out
+// reading sits in a wider cell than a random query; on the simulator's sessions |r| / s did not
+// change with the cell's size, so no correction for it is applied: docs.) A split-conformal rank
+// (the ⌈(n + 1) · coverage⌉-th smallest of n) keeps a small calibration set from claiming more
+// than it has. Pure: no I/O.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace brdf::uncertainty {
+
+// One held-out reading, predicted from the others at its own pose.
+struct HeldOutPoint {
+  std::vector<double> residual;  // prediction − the reading, per band
+  std::vector<double> spread;    // the prediction's vertices' spread s, per band
+  std::vector<double> noise;     // the residual's standard uncertainty from the readings' own
+                                 // independent noise, per band (empty: none known)
+};
+
+// The fitted scale c per band; empty `scale`: not calibrated (`detail` says why).
+struct InterpolationCalibration {
+  std::vector<double> scale;  // c(λ), per band
+  std::size_t held_out = 0;   // held-out readings it rests on
+  std::string detail;         // how it was fitted, or why it was not
+};
+
+// What the fit aims at.
+struct CalibrationTarget {
+  double k = 2;                // coverage factor of the intervals it calibrates
+  double coverage = 0.95;      // fraction of held-out (reading, band) pairs inside k · u
+  int band_groups = 4;         // contiguous groups of bands, one c each (at most one per band)
+  std::size_t min_points = 8;  // fewer held-out readings: not calibrated
+};
+
+// Per band group, the smallest c such that |r| ≤ k · sqrt(noise² + (c · s)²) holds for the
+// ⌈(n + 1) · coverage⌉-th smallest of the group's n held-out (reading, band) pairs' needs (all
+// of them when that rank passes n). A pair the noise alone covers needs c = 0; a pair with s = 0
+// that the noise does not cover needs more than any c: when the rank falls on such a pair, c is
+// the largest finite need. Points whose vectors do not have `bands` values are left out.
+InterpolationCalibration FitInterpolationCalibration(std::span<const HeldOutPoint> points,
+                                                     int bands, const CalibrationTarget& target);
+
+// Scales `spread` (s per band) in place into c(λ) · s(λ). False, leaving it unchanged, when
+// `calibration` has no scale for its bands (not calibrated).
+bool ApplyInterpolationCalibration(const InterpolationCalibration& calibration,
+                                   std::span<double> spread);
+
+}  // namespace brdf::uncertainty

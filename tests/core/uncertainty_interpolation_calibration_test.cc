@@ -1,0 +1,115 @@
+// core/uncertainty/interpolation_calibration: the fit of the interpolation term's scale to
+// held-out residuals, and its application.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include "core/uncertainty/interpolation_calibration.h"
+
+namespace brdf::uncertainty {
+namespace {
+
+HeldOutPoint Point(double residual, double spread, double noise, int bands) {
+  HeldOutPoint p;
+  p.residual.assign(bands, residual);
+  p.spread.assign(bands, spread);
+  p.noise.assign(bands, noise);
+  return p;
+}
+
+TEST(FitInterpolationCalibration, TheScaleIsTheConformalRankOfTheNeeds) {
+  // 39 points with residual i·0.01 (i = 1..39), s = 0.1, no noise: point i needs
+  // c = r / (k·s) = i·0.05; n = 39, rank ⌈0.95 · 40⌉ = 38.
+  std::vector<HeldOutPoint> points;
+  for (int i = 1; i <= 39; ++i) points.push_back(Point(i * 0.01, 0.1, 0.0, 1));
+  const InterpolationCalibration c = FitInterpolationCalibration(points, 1, CalibrationTarget{});
+  ASSERT_EQ(c.scale.size(), 1u);
+  EXPECT_NEAR(c.scale[0], 38 * 0.05, 1e-12);
+  EXPECT_EQ(c.held_out, 39u);
+  int inside = 0;
+  for (const HeldOutPoint& p : points)
+    inside += std::abs(p.residual[0]) <= 2 * c.scale[0] * 0.1 + 1e-15;
+  EXPECT_EQ(inside, 38);
+}
+
+TEST(FitInterpolationCalibration, ASmallSetTakesItsLargestNeed) {
+  // n = 10: rank ⌈0.95 · 11⌉ = 11 > n, so the largest need (point 10: c = 0.5).
+  std::vector<HeldOutPoint> points;
+  for (int i = 1; i <= 10; ++i) points.push_back(Point(i * 0.01, 0.1, 0.0, 2));
+  const InterpolationCalibration c = FitInterpolationCalibration(points, 2, CalibrationTarget{});
+  ASSERT_EQ(c.scale.size(), 2u);
+  EXPECT_NEAR(c.scale[0], 0.5, 1e-12);
+  EXPECT_NEAR(c.scale[1], 0.5, 1e-12);
+}
+
+TEST(FitInterpolationCalibration, NoiseThatCoversAResidualNeedsNoScale) {
+  std::vector<HeldOutPoint> points;
+  for (int i = 0; i < 10; ++i) points.push_back(Point(0.01, 0.1, 0.01, 2));
+  const InterpolationCalibration c = FitInterpolationCalibration(points, 2, CalibrationTarget{});
+  ASSERT_EQ(c.scale.size(), 2u);
+  EXPECT_EQ(c.scale[0], 0.0);
+  EXPECT_EQ(c.scale[1], 0.0);
+  // Noise that covers part of it: |r|/k = 0.05, noise 0.03, so c · s = 0.04.
+  std::vector<HeldOutPoint> partly;
+  for (int i = 0; i < 10; ++i) partly.push_back(Point(0.1, 0.2, 0.03, 1));
+  EXPECT_NEAR(FitInterpolationCalibration(partly, 1, CalibrationTarget{}).scale[0], 0.2, 1e-12);
+}
+
+TEST(FitInterpolationCalibration, BandGroupsAreFittedApart) {
+  // Bands 0–1 residual 0.1, bands 2–3 residual −0.4, s = 1: c = |r|/2 in each group.
+  std::vector<HeldOutPoint> points;
+  for (int i = 0; i < 10; ++i) {
+    HeldOutPoint p = Point(0.1, 1.0, 0.0, 4);
+    p.residual[2] = p.residual[3] = -0.4;
+    points.push_back(p);
+  }
+  CalibrationTarget target;
+  target.band_groups = 2;
+  const InterpolationCalibration c = FitInterpolationCalibration(points, 4, target);
+  ASSERT_EQ(c.scale.size(), 4u);
+  EXPECT_NEAR(c.scale[0], 0.05, 1e-12);
+  EXPECT_NEAR(c.scale[1], 0.05, 1e-12);
+  EXPECT_NEAR(c.scale[2], 0.2, 1e-12);
+  EXPECT_NEAR(c.scale[3], 0.2, 1e-12);
+}
+
+TEST(FitInterpolationCalibration, PairsNoScaleCanCoverFallBackToTheLargestFiniteNeed) {
+  // 11 points needing c = 0.5, then 9 with s = 0 and a residual beyond the noise (need ∞): the
+  // rank ⌈0.95 · 21⌉ = 20 falls on an infinite need.
+  std::vector<HeldOutPoint> points;
+  for (int i = 0; i < 11; ++i) points.push_back(Point(1.0, 1.0, 0.0, 1));
+  for (int i = 0; i < 9; ++i) points.push_back(Point(1.0, 0.0, 0.0, 1));
+  const InterpolationCalibration c = FitInterpolationCalibration(points, 1, CalibrationTarget{});
+  ASSERT_EQ(c.scale.size(), 1u);
+  EXPECT_NEAR(c.scale[0], 0.5, 1e-12);
+}
+
+TEST(FitInterpolationCalibration, TooFewOrMisshapenPointsAreNotCalibrated) {
+  std::vector<HeldOutPoint> points;
+  for (int i = 0; i < 5; ++i) points.push_back(Point(0.1, 1.0, 0.0, 2));
+  InterpolationCalibration c = FitInterpolationCalibration(points, 2, CalibrationTarget{});
+  EXPECT_TRUE(c.scale.empty());
+  EXPECT_NE(c.detail.find("5 held-out readings"), std::string::npos) << c.detail;
+  for (int i = 0; i < 10; ++i) points.push_back(Point(0.1, 1.0, 0.0, 3));  // wrong bands
+  c = FitInterpolationCalibration(points, 2, CalibrationTarget{});
+  EXPECT_TRUE(c.scale.empty());
+  EXPECT_EQ(c.held_out, 5u);
+}
+
+TEST(ApplyInterpolationCalibration, ScalesTheSpreadBandByBand) {
+  InterpolationCalibration c;
+  c.scale = {0.5, 2.0};
+  std::vector<double> spread = {1.0, 3.0};
+  EXPECT_TRUE(ApplyInterpolationCalibration(c, spread));
+  EXPECT_DOUBLE_EQ(spread[0], 0.5);
+  EXPECT_DOUBLE_EQ(spread[1], 6.0);
+  InterpolationCalibration none;
+  std::vector<double> kept = {1.0, 3.0};
+  EXPECT_FALSE(ApplyInterpolationCalibration(none, kept));
+  EXPECT_DOUBLE_EQ(kept[1], 3.0);
+}
+
+}  // namespace
+}  // namespace brdf::uncertainty

@@ -1,0 +1,101 @@
+// daemon/index/interpolation_calibration: readings held out of the index in hashed folds and
+// predicted from the others, and the snapshot's calibration from them.
+#include "daemon/index/interpolation_calibration.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "daemon/index/cache.h"
+
+namespace brdf::daemon {
+namespace {
+
+constexpr int kBands = 4;
+
+// Samples on a (θi, θo, φ) grid, every 10° in θ up to 80° and 20° in φ up to 180° (810), band b
+// of each the function's value plus 0.01·b.
+std::shared_ptr<interp::SampleSet> Grid(const std::function<double(double, double, double)>& f) {
+  auto set = std::make_shared<interp::SampleSet>(3, kBands);
+  std::int64_t id = 1;
+  for (double ti = 0; ti <= 80; ti += 10) {
+    for (double to = 0; to <= 80; to += 10) {
+      for (double phi = 0; phi <= 180; phi += 20) {
+        std::vector<double> spectrum(kBands);
+        for (int b = 0; b < kBands; ++b) spectrum[b] = f(ti, to, phi) + 0.01 * b;
+        const double c[3] = {ti, to, phi};
+        EXPECT_TRUE(set->Add(id++, c, spectrum).ok());
+      }
+    }
+  }
+  return set;
+}
+
+double Linear(double ti, double to, double phi) {
+  return 0.1 + 0.001 * ti + 0.002 * to + 0.0005 * phi;
+}
+double Curved(double ti, double to, double phi) {
+  return 0.1 + 1e-4 * (ti - 40) * (ti - 40) + 5e-5 * (to - phi / 3) * (to - phi / 3);
+}
+
+TEST(PredictHeldOut, ALinearBrdfIsPredictedExactlyAndTheScaleIsZero) {
+  const auto set = Grid(Linear);
+  const auto points =
+      PredictHeldOut(*set, BudgetList{}, interp::Method::kDelaunay, interp::Options{});
+  ASSERT_GE(points.size(), 100u);  // the interior readings, at least
+  EXPECT_LE(points.size(), kMaxHeldOut);
+  for (const uncertainty::HeldOutPoint& p : points) {
+    ASSERT_EQ(p.residual.size(), static_cast<std::size_t>(kBands));
+    for (double r : p.residual) EXPECT_NEAR(r, 0.0, 1e-12);
+    EXPECT_TRUE(p.noise.empty());  // no budgets
+  }
+  const auto fit = uncertainty::FitInterpolationCalibration(points, kBands, {});
+  ASSERT_EQ(fit.scale.size(), static_cast<std::size_t>(kBands));
+  EXPECT_LT(fit.scale[0], 1e-6);
+}
+
+TEST(PredictHeldOut, AHeldOutReadingIsNotItsOwnVertexAndTheFoldsAreFixed) {
+  // On a curved BRDF a reading predicted with itself in the index would have residual 0.
+  const auto set = Grid(Curved);
+  const auto first = PredictHeldOut(*set, BudgetList{}, interp::Method::kOctant, {});
+  const auto again = PredictHeldOut(*set, BudgetList{}, interp::Method::kOctant, {});
+  ASSERT_GE(first.size(), 50u);
+  ASSERT_EQ(first.size(), again.size());
+  std::size_t nonzero = 0;
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    EXPECT_EQ(first[i].residual, again[i].residual);
+    EXPECT_EQ(first[i].spread, again[i].spread);
+    nonzero += std::abs(first[i].residual[0]) > 1e-9;
+  }
+  EXPECT_GT(nonzero, first.size() * 9 / 10);
+  const auto fit = uncertainty::FitInterpolationCalibration(first, kBands, {});
+  ASSERT_EQ(fit.scale.size(), static_cast<std::size_t>(kBands));
+  EXPECT_GT(fit.scale[0], 0.0);
+}
+
+TEST(CalibrateInterpolation, TheNearestMethodIsNotCalibratedAndSaysWhy) {
+  IndexSnapshot snapshot;
+  snapshot.method = interp::Method::kNearest;
+  snapshot.samples = Grid(Linear);
+  snapshot.grid.count = kBands;
+  const uncertainty::InterpolationCalibration& c = snapshot.calibration->Get(snapshot);
+  EXPECT_TRUE(c.scale.empty());
+  EXPECT_NE(c.detail.find("nearest"), std::string::npos) << c.detail;
+}
+
+TEST(CalibrateInterpolation, IsComputedOnceForTheSnapshot) {
+  IndexSnapshot snapshot;
+  snapshot.method = interp::Method::kOctant;
+  snapshot.samples = Grid(Curved);
+  snapshot.grid.count = kBands;
+  const uncertainty::InterpolationCalibration& c = snapshot.calibration->Get(snapshot);
+  ASSERT_EQ(c.scale.size(), static_cast<std::size_t>(kBands));
+  EXPECT_GE(c.held_out, 50u);
+  EXPECT_EQ(&snapshot.calibration->Get(snapshot), &c);
+}
+
+}  // namespace
+}  // namespace brdf::daemon
