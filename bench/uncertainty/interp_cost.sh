@@ -3,12 +3,14 @@
 # at most 1.5× the time without): records examples/plans/demo.json on brdf-sim through brdfd (87
 # sample readings, each with its stored budget), then bench_interp_uncertainty times, in the same
 # run, Interpolate (sequential calls) and InterpolateBatch (one call) at random directions with
-# and without include_uncertainty, alternating which goes first, and prints medians and ratios.
+# and without include_uncertainty, alternating which goes first, and prints medians and ratios
+# (the batch's also split into the daemon's and the client's CPU time).
 #
 # Usage: bench/uncertainty/interp_cost.sh [BUILD_DIR]   (default ./build; builds brdfd, brdf-sim,
 #        brdfctl and bench_interp_uncertainty unless BENCH_NO_BUILD=1)
 # Environment: COST_CALLS (Interpolate calls per timing, 2000), COST_DIRECTIONS (batch size,
-# 20000), COST_REPS (5), COST_METHOD (octant), BENCH_KEEP=1 keeps the work directory.
+# 20000), COST_REPS (5), COST_METHOD (octant), COST_SHARED=1 (the batch's answers also carry the
+# shared part: include_uncertainty_shared), BENCH_KEEP=1 keeps the work directory.
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -44,5 +46,6 @@ echo "session $session recorded (demo plan); sample readings with a budget: $bud
 
 "$bench" --address "$BRDF_ADDRESS" --token "$analyst_token" --session "$session" \
   --calls "${COST_CALLS:-2000}" --directions "${COST_DIRECTIONS:-20000}" \
-  --reps "${COST_REPS:-5}" --method "${COST_METHOD:-octant}"
+  --reps "${COST_REPS:-5}" --method "${COST_METHOD:-octant}" --daemon-pid "$brdfd_pid" \
+  ${COST_SHARED:+--shared}
 echo "load at end: $(cut -d' ' -f1-3 /proc/loadavg)"

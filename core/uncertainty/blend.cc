@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/uncertainty/band_sums.h"
+
 namespace brdf::uncertainty {
 namespace {
 
@@ -16,14 +18,32 @@ struct Blended {
   const ReadingBudget* budget = nullptr;
 };
 
-// A shared input (name, sharing, id); its Σ wᵢ uⱼ,ᵢ per band is row `row` of the sums.
+// A shared input (name, sharing, id) and the vertices' contributions to it with their weights:
+// its Σ wᵢ uⱼ,ᵢ per band is formed in one pass when it is squared.
 struct SharedInput {
   const std::string* name = nullptr;
   SharedThrough through;
+  std::vector<const double*> contributions;
+  std::vector<double> weights;
 };
 
-Result<std::vector<Blended>> MergeByReading(std::span<const BlendVertex> vertices) {
-  std::vector<Blended> out;
+// What one blend works in, kept by each thread from one blend to the next (a batch blends
+// thousands): after the first few, a blend allocates nothing here.
+struct Scratch {
+  std::vector<Blended> readings;
+  std::vector<double> independent;  // Σ wᵢ² u_ind,ᵢ² per band
+  // The first `used` are this blend's shared inputs; the rest are kept for their storage.
+  std::vector<SharedInput> inputs;
+  std::size_t used = 0;
+};
+
+Scratch& ThreadScratch() {
+  thread_local Scratch scratch;
+  return scratch;
+}
+
+Status MergeByReading(std::span<const BlendVertex> vertices, std::vector<Blended>& out) {
+  out.clear();
   for (const BlendVertex& v : vertices) {
     if (!std::isfinite(v.weight)) {
       return InvalidArgument("reading " + std::to_string(v.reading_id) +
@@ -38,7 +58,7 @@ Result<std::vector<Blended>> MergeByReading(std::span<const BlendVertex> vertice
       if (same->budget == nullptr) same->budget = v.budget;
     }
   }
-  return out;
+  return Status::Ok();
 }
 
 Status CheckBands(const Blended& b, std::size_t bands) {
@@ -54,33 +74,30 @@ void AddNotEstimated(std::vector<std::string>& list, const std::string& entry) {
   if (std::find(list.begin(), list.end(), entry) == list.end()) list.push_back(entry);
 }
 
-// row[k] += w · u[k] for k < n (restrict: the compiler keeps w in a register).
-void AddScaled(double* __restrict row, const double* __restrict u, double w, std::size_t n) {
-  for (std::size_t k = 0; k < n; ++k) row[k] += w * u[k];
+// The shared input `c` is shared through, added (with no contributions yet) when it is the first
+// component met of that input.
+SharedInput& InputOf(const Component& c, Scratch& s) {
+  for (std::size_t j = 0; j < s.used; ++j) {
+    if (s.inputs[j].through == c.shared && *s.inputs[j].name == c.name) return s.inputs[j];
+  }
+  if (s.used == s.inputs.size()) s.inputs.emplace_back();
+  SharedInput& input = s.inputs[s.used++];
+  input.name = &c.name;
+  input.through = c.shared;
+  input.contributions.clear();
+  input.weights.clear();
+  return input;
 }
 
 // Adds one reading: its independent part (the budget's, sqrt(Σ independent uⱼ²)) squared and
-// weighted into `independent`, its shared components linearly into their input's row of `sums`
-// (inputs.size() rows of `bands` values).
-void AddReading(const Blended& b, std::vector<double>& independent,
-                std::vector<SharedInput>& inputs, std::vector<double>& sums) {
-  const std::size_t bands = independent.size();
-  const double w = b.weight;
-  const double w2 = w * w;
-  const double* ind = b.budget->independent.data();
-  for (std::size_t k = 0; k < bands; ++k) independent[k] += w2 * ind[k] * ind[k];
+// weighted into `independent`, its shared components to their inputs, with its weight.
+void AddReading(const Blended& b, Scratch& s) {
+  AddSquaredBands(s.independent, b.budget->independent, b.weight * b.weight);
   for (const Component& c : b.budget->components) {
     if (c.shared.kind == Sharing::kIndependent) continue;
-    auto input = std::find_if(inputs.begin(), inputs.end(), [&](const SharedInput& s) {
-      return s.through == c.shared && *s.name == c.name;
-    });
-    if (input == inputs.end()) {
-      inputs.push_back(SharedInput{&c.name, c.shared});
-      sums.resize(sums.size() + bands, 0.0);
-      input = inputs.end() - 1;
-    }
-    AddScaled(sums.data() + static_cast<std::size_t>(input - inputs.begin()) * bands,
-              c.contribution.data(), w, bands);
+    SharedInput& input = InputOf(c, s);
+    input.contributions.push_back(c.contribution.data());
+    input.weights.push_back(b.weight);
   }
 }
 
@@ -88,59 +105,66 @@ void AddReading(const Blended& b, std::vector<double>& independent,
 
 Result<BlendedUncertainty> BlendMeasurementUncertainty(std::span<const BlendVertex> vertices,
                                                        int bands) {
-  if (bands < 1) return InvalidArgument("a blend needs at least one band");
-  BRDF_ASSIGN_OR_RETURN(std::vector<Blended> readings, MergeByReading(vertices));
-  const auto n = static_cast<std::size_t>(bands);
   BlendedUncertainty out;
-  std::vector<double> independent(n, 0.0);
-  std::vector<SharedInput> inputs;
-  std::vector<double> sums;
-  inputs.reserve(16);
-  sums.reserve(16 * n);
-  for (const Blended& b : readings) {
+  BRDF_RETURN_IF_ERROR(BlendMeasurementUncertainty(vertices, bands, &out));
+  return out;
+}
+
+Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int bands,
+                                   BlendedUncertainty* out) {
+  if (bands < 1) return InvalidArgument("a blend needs at least one band");
+  Scratch& s = ThreadScratch();
+  BRDF_RETURN_IF_ERROR(MergeByReading(vertices, s.readings));
+  const auto n = static_cast<std::size_t>(bands);
+  out->not_estimated.clear();
+  s.independent.assign(n, 0.0);
+  s.used = 0;
+  for (const Blended& b : s.readings) {
     if (b.budget == nullptr) {
-      AddNotEstimated(out.not_estimated, "reading " + std::to_string(b.reading_id) +
-                                             ": no uncertainty budget (not estimated)");
+      AddNotEstimated(out->not_estimated, "reading " + std::to_string(b.reading_id) +
+                                              ": no uncertainty budget (not estimated)");
       continue;
     }
     BRDF_RETURN_IF_ERROR(CheckBands(b, n));
     for (const std::string& entry : b.budget->not_estimated) {
-      AddNotEstimated(out.not_estimated, entry);
+      AddNotEstimated(out->not_estimated, entry);
     }
-    AddReading(b, independent, inputs, sums);
+    AddReading(b, s);
   }
-  // Σ over inputs of their squared sums, accumulated row by row into `shared2`.
-  std::vector<double>& shared2 = out.shared;
-  shared2.assign(n, 0.0);
-  for (std::size_t row = 0; row < inputs.size(); ++row) {
-    const double* sum = sums.data() + row * n;
-    for (std::size_t k = 0; k < n; ++k) shared2[k] += sum[k] * sum[k];
+  // shared² = Σ over inputs of (Σ wᵢ uⱼ,ᵢ)², an input at a time; measurement² = shared² +
+  // independent²; then both roots.
+  out->shared.assign(n, 0.0);
+  for (std::size_t j = 0; j < s.used; ++j) {
+    AddSquaredSumBands(out->shared, s.inputs[j].contributions, s.inputs[j].weights);
   }
-  out.measurement.resize(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    out.measurement[k] = std::sqrt(shared2[k] + independent[k]);
-    shared2[k] = std::sqrt(shared2[k]);
-  }
-  return out;
+  out->measurement.assign(out->shared.begin(), out->shared.end());
+  AddScaledBands(out->measurement, s.independent, 1.0);
+  SqrtBands(out->measurement);
+  SqrtBands(out->shared);
+  return Status::Ok();
 }
 
 std::vector<double> InterpolationSpread(std::span<const double> weights,
                                         std::span<const std::span<const double>> spectra,
                                         std::span<const double> blend) {
-  std::vector<double> out(blend.size(), 0.0);
+  std::vector<double> out;
+  InterpolationSpread(weights, spectra, blend, &out);
+  return out;
+}
+
+void InterpolationSpread(std::span<const double> weights,
+                         std::span<const std::span<const double>> spectra,
+                         std::span<const double> blend, std::vector<double>* out) {
+  out->assign(blend.size(), 0.0);
   double total = 0;
   for (double w : weights) total += std::abs(w);
-  if (total <= 0) return out;
+  if (total <= 0) return;
   for (std::size_t i = 0; i < spectra.size() && i < weights.size(); ++i) {
-    const double w = std::abs(weights[i]) / total;
     const std::size_t bands = std::min(blend.size(), spectra[i].size());
-    for (std::size_t k = 0; k < bands; ++k) {
-      const double d = spectra[i][k] - blend[k];
-      out[k] += w * d * d;
-    }
+    AddSquaredDifferenceBands(std::span<double>(*out).first(bands), spectra[i].first(bands),
+                              blend.first(bands), std::abs(weights[i]) / total);
   }
-  for (double& v : out) v = std::sqrt(v);
-  return out;
+  SqrtBands(*out);
 }
 
 }  // namespace brdf::uncertainty

@@ -49,6 +49,11 @@ struct BlendedUncertainty {
 // named as not estimated.
 Result<BlendedUncertainty> BlendMeasurementUncertainty(std::span<const BlendVertex> vertices,
                                                        int bands);
+// The same into *out, its contents replaced and its storage reused: a caller blending many
+// answers (a batch) allocates nothing for the spectra once *out has grown. On an error *out is
+// left unspecified.
+Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int bands,
+                                   BlendedUncertainty* out);
 
 // The interpolation term per band: the vertices' weighted spread about the blend,
 //   u_int(λ) = sqrt( Σᵢ |wᵢ| (fᵢ(λ) − y(λ))² / Σᵢ |wᵢ| ),
@@ -59,5 +64,9 @@ Result<BlendedUncertainty> BlendMeasurementUncertainty(std::span<const BlendVert
 std::vector<double> InterpolationSpread(std::span<const double> weights,
                                         std::span<const std::span<const double>> spectra,
                                         std::span<const double> blend);
+// The same into *out (blend.size() values, its storage reused).
+void InterpolationSpread(std::span<const double> weights,
+                         std::span<const std::span<const double>> spectra,
+                         std::span<const double> blend, std::vector<double>* out);
 
 }  // namespace brdf::uncertainty

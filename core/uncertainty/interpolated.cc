@@ -39,15 +39,18 @@ void AddMeasurement(const interp::Interpolation& answer, const InterpolatedInput
     const interp::Vertex& v = answer.vertices[i];
     vertices[i] = {v.id, v.weight, inputs.budget_of(v.index)};
   }
-  Result<BlendedUncertainty> blended =
-      BlendMeasurementUncertainty(vertices, static_cast<int>(answer.spectrum.size()));
-  if (!blended.ok()) {
-    out.not_estimated.push_back("measurement: " + blended.status().message());
+  // The blend's working storage, kept by each thread: a batch's answers allocate nothing once it
+  // has grown (the vectors are swapped with `out`'s, so both keep their capacity).
+  thread_local BlendedUncertainty blended;
+  const Status st =
+      BlendMeasurementUncertainty(vertices, static_cast<int>(answer.spectrum.size()), &blended);
+  if (!st.ok()) {
+    out.not_estimated.push_back("measurement: " + st.message());
     return;
   }
-  out.measurement = std::move(blended->measurement);
-  out.shared = std::move(blended->shared);
-  for (std::string& entry : blended->not_estimated) out.not_estimated.push_back(std::move(entry));
+  std::swap(out.measurement, blended.measurement);
+  std::swap(out.shared, blended.shared);
+  for (std::string& entry : blended.not_estimated) out.not_estimated.push_back(std::move(entry));
 }
 
 // The interpolation term into `out`, or the reason it has none.
@@ -67,7 +70,7 @@ void AddInterpolation(const interp::Interpolation& answer, const InterpolatedInp
     weights[i] = answer.vertices[i].weight;
     spectra[i] = inputs.samples->spectrum(answer.vertices[i].index);
   }
-  out.interpolation = InterpolationSpread(weights, spectra, answer.spectrum);
+  InterpolationSpread(weights, spectra, answer.spectrum, &out.interpolation);
   const InterpolationCalibration* calibration = inputs.calibration;
   if (calibration != nullptr && !ApplyInterpolationCalibration(*calibration, out.interpolation)) {
     out.not_estimated.push_back("interpolation: not calibrated (" + calibration->detail +
@@ -77,12 +80,22 @@ void AddInterpolation(const interp::Interpolation& answer, const InterpolatedInp
 
 }  // namespace
 
+void EstimateInterpolatedUncertainty(const interp::Interpolation& answer,
+                                     const InterpolatedInputs& inputs,
+                                     InterpolatedUncertainty* out) {
+  out->measurement.clear();
+  out->shared.clear();
+  out->interpolation.clear();
+  out->not_estimated.clear();
+  if (answer.status != interp::InterpStatus::kOk) return;
+  AddMeasurement(answer, inputs, *out);
+  AddInterpolation(answer, inputs, *out);
+}
+
 InterpolatedUncertainty EstimateInterpolatedUncertainty(const interp::Interpolation& answer,
                                                         const InterpolatedInputs& inputs) {
   InterpolatedUncertainty out;
-  if (answer.status != interp::InterpStatus::kOk) return out;
-  AddMeasurement(answer, inputs, out);
-  AddInterpolation(answer, inputs, out);
+  EstimateInterpolatedUncertainty(answer, inputs, &out);
   return out;
 }
 

@@ -49,5 +49,10 @@ struct InterpolatedUncertainty {
 // answer's bands; a vertex without a budget is left out of the blend and named (blend.h).
 InterpolatedUncertainty EstimateInterpolatedUncertainty(const interp::Interpolation& answer,
                                                         const InterpolatedInputs& inputs);
+// The same into `out`, whose vectors are reused (cleared, their capacity kept): a batch's
+// thousands of answers allocate nothing for their spectra once they have grown.
+void EstimateInterpolatedUncertainty(const interp::Interpolation& answer,
+                                     const InterpolatedInputs& inputs,
+                                     InterpolatedUncertainty* out);
 
 }  // namespace brdf::uncertainty

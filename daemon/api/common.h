@@ -33,32 +33,42 @@ inline constexpr int kMaxBatchDirections = 100000;
 // 401 bands ~3.6 MB, near it: see MaxChunkResults).
 inline constexpr std::uint32_t kDefaultChunkSize = 256;
 inline constexpr std::uint32_t kMaxChunkSize = 1024;
-// With include_uncertainty a result carries four more spectra (~4.5 kB a result): at most 512
-// (~2.3 MB) per chunk.
+// With include_uncertainty a result carries two or three more spectra (of floats; ~2.5 kB a
+// result at 101 bands): at most 512 (~1.3 MB) per chunk.
 inline constexpr std::uint32_t kMaxUncertainChunkSize = 512;
 // A client's default receive limit (gRPC's 4 MiB), which an InterpolateBatch chunk must stay under.
 inline constexpr std::uint64_t kClientReceiveLimitBytes = 4 * 1024 * 1024;
+// The uncertainty an InterpolateBatch result carries (InterpolateBatchRequest.include_uncertainty
+// and include_uncertainty_shared): none; the measurement and interpolation parts; and the shared
+// part too. Never `combined`: clients compute it (brdf.proto, InterpolationUncertainty).
+enum class BatchUncertainty { kNone, kParts, kPartsAndShared };
 // Wire bytes of one InterpolateBatch result of `bands` bands, bounded above: 8 per band (packed
 // double), the result's fixed part (status, directions, grid, up to 5 vertices with ids, weights
 // and detail) within kResultOverheadBytes. 101 bands: 1,208 (the 1,200 B the batch budget took).
-// With its uncertainty (include_uncertainty): four more spectra and the not-estimated texts.
+// With its uncertainty: 4 per band (packed float) for each part it carries, and the not-estimated
+// texts (a vertex without a budget, the budgets' terms not estimated: a few lines of ~100 B).
 inline constexpr std::uint64_t kResultOverheadBytes = 400;
-inline constexpr std::uint64_t kUncertaintyTextBytes = 200;
-inline constexpr std::uint64_t ResultBytes(std::size_t bands, bool uncertainty = false) {
-  const auto spectrum = 8 * static_cast<std::uint64_t>(bands);
-  return kResultOverheadBytes + spectrum + (uncertainty ? 4 * spectrum + kUncertaintyTextBytes : 0);
+inline constexpr std::uint64_t kUncertaintyTextBytes = 512;
+inline constexpr std::uint64_t ResultBytes(std::size_t bands,
+                                           BatchUncertainty uncertainty = BatchUncertainty::kNone) {
+  const auto n = static_cast<std::uint64_t>(bands);
+  const std::uint64_t parts = uncertainty == BatchUncertainty::kNone    ? 0
+                              : uncertainty == BatchUncertainty::kParts ? 2
+                                                                        : 3;
+  return kResultOverheadBytes + 8 * n + (parts == 0 ? 0 : parts * 4 * n + kUncertaintyTextBytes);
 }
 // Wire bytes of a chunk of `results` results of `bands` bands.
 inline constexpr std::uint64_t ChunkBytes(std::uint64_t results, std::size_t bands,
-                                          bool uncertainty = false) {
+                                          BatchUncertainty uncertainty = BatchUncertainty::kNone) {
   return results * ResultBytes(bands, uncertainty);
 }
 // The most results a chunk of `bands` bands may hold: the client's request (0: the default),
 // capped at kMaxChunkSize and so that the chunk stays under half a client's default receive
-// limit (401 bands: 1,024 → 581; with uncertainty 101 bands: 512 → 451). The batch's answer is
-// the same, in more chunks.
-inline constexpr std::uint32_t MaxChunkResults(std::uint32_t requested, std::size_t bands,
-                                               bool uncertainty = false) {
+// limit (401 bands: 1,024 → 581; with the uncertainty's two parts 401 bands: 512 → 286, with the
+// shared part too 234). The batch's answer is the same, in more chunks.
+inline constexpr std::uint32_t MaxChunkResults(
+    std::uint32_t requested, std::size_t bands,
+    BatchUncertainty uncertainty = BatchUncertainty::kNone) {
   const std::uint64_t fit = kClientReceiveLimitBytes / 2 / ResultBytes(bands, uncertainty);
   const std::uint64_t asked = requested == 0 ? kDefaultChunkSize : requested;
   const std::uint64_t capped = asked < kMaxChunkSize ? asked : kMaxChunkSize;
@@ -66,6 +76,9 @@ inline constexpr std::uint32_t MaxChunkResults(std::uint32_t requested, std::siz
 }
 static_assert(MaxChunkResults(kMaxChunkSize, 101) == kMaxChunkSize);
 static_assert(ChunkBytes(kMaxChunkSize, 401) < kClientReceiveLimitBytes);
+static_assert(MaxChunkResults(kMaxUncertainChunkSize, 101, BatchUncertainty::kPartsAndShared) ==
+              kMaxUncertainChunkSize);
+static_assert(MaxChunkResults(kMaxUncertainChunkSize, 401, BatchUncertainty::kParts) == 286);
 // Free texts (abort reason, prompt note) are stored in the audit log; longer ones are refused.
 inline constexpr std::size_t kMaxNoteBytes = 4096;
 // A session id is a positive decimal number of at most 18 digits; ids and page tokens longer than

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -118,15 +119,15 @@ grpc::Status ToCoords(const v1::DirectionQuery& q, const IndexSnapshot& index,
 
 // Whether each vertex carries its sample's spectrum (InterpolateRequest.include_vertex_spectra).
 enum class VertexSpectra { kOmit, kInclude };
-// Whether the answer carries its uncertainty (include_uncertainty).
-enum class WithUncertainty { kOmit, kInclude };
+// Which parts of its uncertainty the answer carries; none: not asked (include_uncertainty).
+using WithUncertainty = std::optional<UncertaintyParts>;
 
 // One answer as the API gives it.
 void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const Settings& settings,
               const IndexSnapshot& index, VertexSpectra vertex_spectra,
               WithUncertainty with_uncertainty, v1::InterpolationResult* out) {
   *out->mutable_query() = query;
-  if (with_uncertainty == WithUncertainty::kInclude) AddInterpolationUncertainty(r, index, out);
+  if (with_uncertainty) AddInterpolationUncertainty(r, index, *with_uncertainty, out);
   out->set_status(ToProtoInterpStatus(r.status));
   out->set_method(ToProtoMethod(r.method));
   out->set_quantity(ToProtoQuantity(settings.quantity));
@@ -235,7 +236,7 @@ std::optional<grpc::Status> InterpolationService::Respond(const v1::InterpolateR
   }
   Evaluate(request.direction(), coords, settings, *index,
            request.include_vertex_spectra() ? VertexSpectra::kInclude : VertexSpectra::kOmit,
-           request.include_uncertainty() ? WithUncertainty::kInclude : WithUncertainty::kOmit,
+           request.include_uncertainty() ? WithUncertainty(UncertaintyParts{}) : std::nullopt,
            response->mutable_result());
   return grpc::Status::OK;
 }
@@ -274,7 +275,7 @@ grpc::Status CheckBatch(const v1::InterpolateBatchRequest& request, SessionId* i
     return InvalidField("chunk_size", std::to_string(request.chunk_size()) +
                                           " results per chunk with include_uncertainty; at most " +
                                           std::to_string(kMaxUncertainChunkSize) +
-                                          " (each result carries four more spectra)");
+                                          " (each result carries more spectra)");
   }
   *chunk = static_cast<int>(request.chunk_size() == 0 ? kDefaultChunkSize : request.chunk_size());
   for (int i = 0; i < n; ++i) {
@@ -326,14 +327,22 @@ grpc::Status CheckBatchDirections(const v1::InterpolateBatchRequest& request,
 // control), so a batch holds at most a slice's answers ahead of its client, however long it is.
 constexpr int kSliceChunks = 4;
 
+// The uncertainty a batch's results carry, for their size.
+BatchUncertainty UncertaintyOf(const v1::InterpolateBatchRequest& request) {
+  if (!request.include_uncertainty()) return BatchUncertainty::kNone;
+  return request.include_uncertainty_shared() ? BatchUncertainty::kPartsAndShared
+                                              : BatchUncertainty::kParts;
+}
+
 // What a batch holds while it streams, bytes (for the memory budget, rpc/memory_budget.h): its
 // request (as received and parsed), and per slice the coordinates, the octant method's sort and
 // blends (~200 bytes a query) and the chunks of full answers (ResultBytes: ~1.2 kB each with
-// provenance at 101 bands, ~3.6 kB at 401; four more spectra with the uncertainty).
+// provenance at 101 bands, ~3.6 kB at 401; two or three more spectra of floats with the
+// uncertainty).
 std::uint64_t BatchBytes(const v1::InterpolateBatchRequest& request, int chunk, std::size_t bands) {
   const auto n = static_cast<std::uint64_t>(request.directions_size());
   const std::uint64_t slice = std::min<std::uint64_t>(n, std::uint64_t{kSliceChunks} * chunk);
-  const std::uint64_t answer = ResultBytes(bands, request.include_uncertainty());
+  const std::uint64_t answer = ResultBytes(bands, UncertaintyOf(request));
   return 3 * request.ByteSizeLong() + slice * (200 + answer) + 2ULL * chunk * answer;
 }
 
@@ -344,7 +353,7 @@ grpc::Status FitChunkAndReserve(const v1::InterpolateBatchRequest& request,
                                 const IndexSnapshot& index, StreamRegistry::Slot& slot,
                                 int* chunk) {
   *chunk = static_cast<int>(MaxChunkResults(static_cast<std::uint32_t>(*chunk), index.grid.count,
-                                            request.include_uncertainty()));
+                                            UncertaintyOf(request)));
   return slot.Reserve(BatchBytes(request, *chunk, index.grid.count));
 }
 
@@ -398,8 +407,11 @@ grpc::Status InterpolationService::InterpolateBatch(
     out.set_first_index(static_cast<std::uint32_t>(first));
     return true;
   };
+  // A batch's answers leave `combined` to the client, and `shared` unless asked (brdf.proto).
   const WithUncertainty with_uncertainty =
-      request->include_uncertainty() ? WithUncertainty::kInclude : WithUncertainty::kOmit;
+      request->include_uncertainty()
+          ? WithUncertainty(UncertaintyParts{request->include_uncertainty_shared(), false})
+          : std::nullopt;
   auto take = [&](int i, interp::Interpolation&& answer) {
     if (i % chunk == 0 && !start_chunk(i)) return false;
     ToResult(request->directions(i), std::move(answer), settings, index, VertexSpectra::kOmit,

@@ -3,41 +3,61 @@
 #include <cmath>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/uncertainty/interpolated.h"
 
 namespace brdf::daemon {
+namespace {
 
-void AddInterpolationUncertainty(const interp::Interpolation& answer, const IndexSnapshot& index,
-                                 v1::InterpolationResult* out) {
-  if (answer.status != interp::InterpStatus::kOk) return;
+// `values` as the API's single-precision spectrum `out` (its previous values replaced).
+void SetFloats(const std::vector<double>& values, google::protobuf::RepeatedField<float>* out) {
+  out->Resize(static_cast<int>(values.size()), 0.0f);
+  float* to = out->mutable_data();
+  for (std::size_t k = 0; k < values.size(); ++k) to[k] = static_cast<float>(values[k]);
+}
+
+// combined = sqrt(m² + i²) per band from the parts as sent (floats; a part not estimated is
+// empty and counts 0), in double, rounded to float: what a client computes from them.
+void AddCombined(int bands, v1::InterpolationUncertainty* u) {
+  google::protobuf::RepeatedField<float>* combined = u->mutable_combined();
+  combined->Resize(bands, 0.0f);
+  for (int k = 0; k < bands; ++k) {
+    const double m = k < u->measurement_size() ? u->measurement(k) : 0.0;
+    const double i = k < u->interpolation_size() ? u->interpolation(k) : 0.0;
+    combined->Set(k, static_cast<float>(std::sqrt(m * m + i * i)));
+  }
+}
+
+// Where the answer's vertices' budgets and spectra are, and the snapshot's calibration.
+uncertainty::InterpolatedInputs InputsOf(const IndexSnapshot& index) {
   uncertainty::InterpolatedInputs inputs;
   inputs.samples = index.samples.get();
-  // Calibrated against the session's held-out readings (index/interpolation_calibration.h).
-  inputs.calibration = &index.calibration->Get(index);
   if (index.quantity == Quantity::kBrdf) {
     inputs.budget_of = [&index](std::size_t i) { return index.budgets.at(i); };
   } else {
     inputs.no_budgets = std::string("the readings' budgets are of the BRDF, this answer is ") +
                         QuantityName(index.quantity) + "; ask for quantity BRDF";
   }
-  uncertainty::InterpolatedUncertainty found =
-      uncertainty::EstimateInterpolatedUncertainty(answer, inputs);
+  // Calibrated against the session's held-out readings (index/interpolation_calibration.h).
+  inputs.calibration = &index.calibration->Get(index);
+  return inputs;
+}
+
+}  // namespace
+
+void AddInterpolationUncertainty(const interp::Interpolation& answer, const IndexSnapshot& index,
+                                 UncertaintyParts parts, v1::InterpolationResult* out) {
+  if (answer.status != interp::InterpStatus::kOk) return;
+  // Kept by each thread from answer to answer: a batch allocates nothing for its spectra.
+  thread_local uncertainty::InterpolatedUncertainty found;
+  uncertainty::EstimateInterpolatedUncertainty(answer, InputsOf(index), &found);
   v1::InterpolationUncertainty* u = out->mutable_uncertainty();
-  u->mutable_measurement()->Add(found.measurement.begin(), found.measurement.end());
-  u->mutable_shared()->Add(found.shared.begin(), found.shared.end());
-  u->mutable_interpolation()->Add(found.interpolation.begin(), found.interpolation.end());
+  SetFloats(found.measurement, u->mutable_measurement());
+  if (parts.shared) SetFloats(found.shared, u->mutable_shared());
+  SetFloats(found.interpolation, u->mutable_interpolation());
   for (std::string& entry : found.not_estimated) u->add_not_estimated(std::move(entry));
-  const bool measured = !found.measurement.empty();
-  const bool interpolated = !found.interpolation.empty();
-  const int bands = static_cast<int>(answer.spectrum.size());
-  google::protobuf::RepeatedField<double>* combined = u->mutable_combined();
-  combined->Resize(bands, 0.0);
-  for (int k = 0; k < bands; ++k) {
-    const double m = measured && k < u->measurement_size() ? u->measurement(k) : 0.0;
-    const double i = interpolated && k < u->interpolation_size() ? u->interpolation(k) : 0.0;
-    combined->Set(k, std::sqrt(m * m + i * i));
-  }
+  if (parts.combined) AddCombined(static_cast<int>(answer.spectrum.size()), u);
 }
 
 }  // namespace brdf::daemon

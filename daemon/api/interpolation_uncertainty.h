@@ -13,8 +13,19 @@
 
 namespace brdf::daemon {
 
-// Fills out->uncertainty for `answer`, evaluated on `index`; nothing when the answer is not OK.
+// The parts of an answer's uncertainty the API sends. Interpolate sends every part;
+// InterpolateBatch leaves out `combined` (clients add measurement and interpolation in quadrature,
+// brdf.proto) and, unless asked (include_uncertainty_shared), `shared`: its answers then grow by
+// two spectra of floats instead of four of doubles.
+struct UncertaintyParts {
+  bool shared = true;
+  bool combined = true;
+};
+
+// Fills out->uncertainty for `answer`, evaluated on `index`, with `parts`; nothing when the
+// answer is not OK. The spectra are floats; `combined` is evaluated from the two rounded parts
+// (sqrt(m² + i²) in double, rounded to float), as a client computes it from a batch's answer.
 void AddInterpolationUncertainty(const interp::Interpolation& answer, const IndexSnapshot& index,
-                                 v1::InterpolationResult* out);
+                                 UncertaintyParts parts, v1::InterpolationResult* out);
 
 }  // namespace brdf::daemon

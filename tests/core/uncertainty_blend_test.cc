@@ -150,6 +150,99 @@ TEST(BlendUncertainty, BadInputIsNamed) {
   EXPECT_FALSE(BlendMeasurementUncertainty(nan_weight, 0).ok());
 }
 
+// A reading's budget over `bands` bands: an independent term, the session's white standard, its
+// own reference (`reference`) and the instrument's wavelength scale, each a different spectrum.
+ReadingBudget ManyBands(std::size_t bands, std::int64_t reference, double scale) {
+  std::vector<double> signal(bands), white(bands), ref(bands), wavelength(bands);
+  for (std::size_t k = 0; k < bands; ++k) {
+    const double x = static_cast<double>(k);
+    signal[k] = scale * (0.01 + 0.0001 * x);
+    white[k] = scale * (0.02 + 0.00005 * x);
+    ref[k] = -scale * (0.005 + 0.00003 * x);
+    wavelength[k] = scale * 0.001 * std::sin(0.1 * x);
+  }
+  return Budget({Make("sample_signal", Sharing::kIndependent, 0, signal),
+                 Make("white_standard", Sharing::kWhiteStandard, 1, white),
+                 Make("reference_signal", Sharing::kReferenceReading, reference, ref),
+                 Make("wavelength_scale", Sharing::kInstrument, 1, wavelength)});
+}
+
+TEST(BlendUncertainty, EveryBandOfALongGridFollowsGum52AndBlendsDoNotLeakIntoTheNext) {
+  // 101 and 401 bands (the PR-650's and the CS-2000's grids): every band, the last ones after the
+  // vectors' full widths included, is the GUM §5.2 sum written out here; a blend of other
+  // vertices in between (the same thread's scratch) changes nothing.
+  for (std::size_t n : {std::size_t{101}, std::size_t{401}}) {
+    const ReadingBudget a = ManyBands(n, 10, 1.0), b = ManyBands(n, 10, 1.3),
+                        c = ManyBands(n, 11, 0.7);
+    const std::vector<BlendVertex> v = {{1, 0.2, &a}, {2, 0.5, &b}, {3, 0.3, &c}};
+    const int bands = static_cast<int>(n);
+    Result<BlendedUncertainty> first = BlendMeasurementUncertainty(v, bands);
+    ASSERT_TRUE(first.ok()) << first.status().message();
+    const std::vector<BlendVertex> other = {{4, 1.0, &c}};
+    ASSERT_TRUE(BlendMeasurementUncertainty(other, bands).ok());
+    Result<BlendedUncertainty> again = BlendMeasurementUncertainty(v, bands);
+    ASSERT_TRUE(again.ok());
+    EXPECT_EQ(again->measurement, first->measurement);
+    EXPECT_EQ(again->shared, first->shared);
+    for (std::size_t k = 0; k < n; ++k) {
+      auto u = [&](const ReadingBudget& r, int j) { return r.components[j].contribution[k]; };
+      const double white = 0.2 * u(a, 1) + 0.5 * u(b, 1) + 0.3 * u(c, 1);
+      const double ref10 = 0.2 * u(a, 2) + 0.5 * u(b, 2);
+      const double ref11 = 0.3 * u(c, 2);
+      const double wl = 0.2 * u(a, 3) + 0.5 * u(b, 3) + 0.3 * u(c, 3);
+      const double shared2 = white * white + ref10 * ref10 + ref11 * ref11 + wl * wl;
+      const double ind2 =
+          0.04 * u(a, 0) * u(a, 0) + 0.25 * u(b, 0) * u(b, 0) + 0.09 * u(c, 0) * u(c, 0);
+      EXPECT_NEAR(first->shared[k], std::sqrt(shared2), 1e-15) << "band " << k << " of " << n;
+      EXPECT_NEAR(first->measurement[k], std::sqrt(shared2 + ind2), 1e-15)
+          << "band " << k << " of " << n;
+    }
+  }
+}
+
+TEST(BlendUncertainty, IntoAReusedResultGivesTheSameAsAFreshOne) {
+  // A batch blends answer after answer into one BlendedUncertainty: whatever it held before (a
+  // longer grid, other not-estimated entries) is replaced.
+  const ReadingBudget a = ManyBands(401, 10, 1.0), b = ManyBands(101, 10, 1.0),
+                      c = ManyBands(101, 11, 0.5);
+  BlendedUncertainty reused;
+  const std::vector<BlendVertex> long_grid = {{1, 1.0, &a}, {2, 0.0, nullptr}};
+  ASSERT_TRUE(BlendMeasurementUncertainty(long_grid, 401, &reused).ok());
+  ASSERT_EQ(reused.measurement.size(), 401u);
+  ASSERT_EQ(reused.not_estimated.size(), 1u);  // reading 2
+  const std::vector<BlendVertex> v = {{3, 0.4, &b}, {4, 0.6, &c}};
+  ASSERT_TRUE(BlendMeasurementUncertainty(v, 101, &reused).ok());
+  Result<BlendedUncertainty> fresh = BlendMeasurementUncertainty(v, 101);
+  ASSERT_TRUE(fresh.ok());
+  EXPECT_EQ(reused.measurement, fresh->measurement);
+  EXPECT_EQ(reused.shared, fresh->shared);
+  EXPECT_EQ(reused.not_estimated, fresh->not_estimated);
+  EXPECT_TRUE(reused.not_estimated.empty());
+}
+
+TEST(InterpolationSpread, EveryBandOfALongGrid) {
+  const std::size_t n = 101;
+  std::vector<double> f1(n), f2(n), f3(n), blend(n);
+  const std::vector<double> w = {0.5, 0.3, 0.2};
+  for (std::size_t k = 0; k < n; ++k) {
+    f1[k] = 1.0 + 0.01 * static_cast<double>(k);
+    f2[k] = 2.0 - 0.005 * static_cast<double>(k);
+    f3[k] = 0.5 + 0.02 * static_cast<double>(k % 7);
+    blend[k] = w[0] * f1[k] + w[1] * f2[k] + w[2] * f3[k];
+  }
+  const std::vector<std::span<const double>> spectra = {f1, f2, f3};
+  const std::vector<double> u = InterpolationSpread(w, spectra, blend);
+  ASSERT_EQ(u.size(), n);
+  std::vector<double> reused(401, 7.0);  // a longer answer's spread before: replaced
+  InterpolationSpread(w, spectra, blend, &reused);
+  EXPECT_EQ(reused, u);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double d1 = f1[k] - blend[k], d2 = f2[k] - blend[k], d3 = f3[k] - blend[k];
+    EXPECT_NEAR(u[k], std::sqrt(0.5 * d1 * d1 + 0.3 * d2 * d2 + 0.2 * d3 * d3), 1e-14)
+        << "band " << k;
+  }
+}
+
 TEST(InterpolationSpread, ZeroAtAReadingAndTheWeightedSpreadElsewhere) {
   const std::vector<double> f1 = {1.0, 2.0};
   const std::vector<double> f2 = {3.0, 2.0};

@@ -42,6 +42,7 @@ GRID_SHAPE = (9, 9, 9)
 # A client's default receive limit (gRPC's 4 MiB), and the most results per chunk one may ask.
 CLIENT_RECEIVE_LIMIT = 4 * 1024 * 1024
 MAX_CHUNK = 1024
+MAX_UNCERTAIN_CHUNK = 512  # with include_uncertainty (daemon/api/common.h)
 # test_live.py's plan, coarser in β: fewer readings at the CS-2000's pace.
 PLAN = {
     "name": "401-band session",
@@ -278,6 +279,42 @@ class Live401Bands(unittest.TestCase):  # pylint: disable=too-many-public-method
         print(f"\nInterpolateBatch at 401 bands: chunk of {MAX_CHUNK} results {max(sizes):,} B "
               f"({per_result:,.0f} B a result)", file=sys.stderr)
         self.assertLessEqual(per_result, 400 + 8 * BANDS)
+
+    def test_interpolate_batch_with_uncertainty_stays_under_the_receive_limit(self):
+        """With include_uncertainty (and the shared part, the largest form) at 401 bands, the
+        daemon splits the most results a client may ask into chunks under half a client's
+        receive limit, each result within common.h's ResultBytes(401, kPartsAndShared); the
+        answers carry float parts of 401 values and no combined."""
+        rng = np.random.default_rng(6)
+        directions = np.column_stack([rng.uniform(0, 40, 1200), rng.uniform(0, 40, 1200),
+                                      rng.uniform(0, 180, 1200)])
+        request = brdf_pb2.InterpolateBatchRequest(
+            session_id=self.session_id, method=names.to_enum("delaunay", names.METHODS, "method"),
+            directions=[direction_query(d) for d in directions], chunk_size=MAX_UNCERTAIN_CHUNK,
+            include_uncertainty=True, include_uncertainty_shared=True)
+        sizes, counts, answered, with_parts, largest = [], [], 0, 0, 0
+        for chunk in self.client._interp.InterpolateBatch(  # pylint: disable=protected-access
+                request, metadata=self.client._metadata, timeout=60):  # pylint: disable=protected-access
+            sizes.append(chunk.ByteSize())
+            counts.append(len(chunk.results))
+            answered += len(chunk.results)
+            for result in chunk.results:
+                if result.status != brdf_pb2.INTERPOLATION_STATUS_OK:
+                    continue
+                largest = max(largest, result.ByteSize())
+                u = result.uncertainty
+                self.assertEqual(len(u.measurement), BANDS)
+                self.assertEqual(len(u.shared), BANDS)
+                self.assertEqual(len(u.combined), 0)
+                with_parts += len(u.interpolation) == BANDS
+        self.assertEqual(answered, 1200)
+        self.assertGreater(with_parts, 0, "no answer of both parts to size")
+        self.assertLess(max(sizes), CLIENT_RECEIVE_LIMIT // 2)
+        self.assertLess(max(counts), MAX_UNCERTAIN_CHUNK)  # split: 512 would pass the half
+        print(f"\nInterpolateBatch with uncertainty at 401 bands: chunks of {max(counts)} "
+              f"results, at most {max(sizes):,} B (the largest result {largest:,} B)",
+              file=sys.stderr)
+        self.assertLessEqual(largest, 400 + 8 * BANDS + 3 * 4 * BANDS + 512)
 
     def test_appearance_renders_from_401_bands(self):
         a = self.client.appearance(self.session_id, "D65", sphere_size=32)

@@ -281,34 +281,56 @@ class InterpolationUncertainties(unittest.TestCase):
         return r
 
     def test_result_batch_and_dataset(self):
+        # The wire's spectra are float32: the values read back are 0.003 etc. rounded to float.
+        f32 = np.float32
         with_u = InterpolationResult.from_proto(self.proto(True))
         without = InterpolationResult.from_proto(self.proto(False))
         self.assertIsNone(without.uncertainty)
         u = with_u.uncertainty
         self.assertIsInstance(u, brdf_client.InterpolationUncertainty)
-        np.testing.assert_array_equal(u.measurement, [0.003, 0.004, 0.005])
-        np.testing.assert_array_equal(u.shared, [0.002, 0.003, 0.004])
-        np.testing.assert_array_equal(u.interpolation, [0.004, 0.003, 0.0])
-        np.testing.assert_array_equal(u.combined, [0.005, 0.005, 0.005])
+        np.testing.assert_array_equal(u.measurement, f32([0.003, 0.004, 0.005]))
+        np.testing.assert_array_equal(u.shared, f32([0.002, 0.003, 0.004]))
+        np.testing.assert_array_equal(u.interpolation, f32([0.004, 0.003, 0.0]))
+        np.testing.assert_array_equal(u.combined, f32([0.005, 0.005, 0.005]))
         self.assertEqual(u.not_estimated, ["reading 9: no uncertainty budget (not estimated)"])
 
         nearest = InterpolationResult.from_proto(self.proto(True, interpolation=False))
         batch = InterpolationBatch([with_u, without, nearest])
-        np.testing.assert_array_equal(batch.u_combined[0], [0.005, 0.005, 0.005])
+        np.testing.assert_array_equal(batch.u_combined[0], f32([0.005, 0.005, 0.005]))
         self.assertTrue(np.isnan(batch.u_combined[1]).all())   # not asked: NaN, not 0
-        np.testing.assert_array_equal(batch.u_measurement[2], [0.003, 0.004, 0.005])
+        np.testing.assert_array_equal(batch.u_measurement[2], f32([0.003, 0.004, 0.005]))
         self.assertTrue(np.isnan(batch.u_interpolation[2]).all())  # not estimated
 
         ds = batch.to_dataset()
         name = uncertainty_name("brdf")
         self.assertEqual(ds[name].dims, ("direction", "wavelength"))
-        np.testing.assert_array_equal(ds[name].values[0], [0.005, 0.005, 0.005])
+        np.testing.assert_array_equal(ds[name].values[0], f32([0.005, 0.005, 0.005]))
         self.assertTrue(np.isnan(ds[name + "_interpolation"].values[2]).all())
         self.assertIn("k = 1", ds.attrs["uncertainty"])
         one = with_u.to_dataset()
-        np.testing.assert_array_equal(one[name + "_measurement"].values, [0.003, 0.004, 0.005])
+        np.testing.assert_array_equal(one[name + "_measurement"].values,
+                                      f32([0.003, 0.004, 0.005]))
         # Answers without uncertainty keep the old layout and its note.
         self.assertNotIn(name, without.to_dataset())
+
+    def test_a_batch_answers_combined_is_computed_from_its_parts(self):
+        """InterpolateBatch leaves combined out (brdf.proto): the client computes it as the
+        daemon computes Interpolate's, sqrt(m² + i²) in float64 from the float32 parts, rounded
+        to float32; a part not estimated counts 0."""
+        f32 = np.float32
+        both = self.proto(True)
+        both.uncertainty.ClearField("combined")
+        both.uncertainty.ClearField("shared")
+        u = InterpolationResult.from_proto(both).uncertainty
+        m, i = f32([0.003, 0.004, 0.005]).astype(float), f32([0.004, 0.003, 0.0]).astype(float)
+        np.testing.assert_array_equal(u.combined, np.sqrt(m * m + i * i).astype(f32))
+        np.testing.assert_allclose(u.combined, [0.005, 0.005, 0.005], rtol=1.2e-7)
+        self.assertEqual(u.shared.shape, (0,))  # not asked for: empty, not zeros
+        nearest = self.proto(True, interpolation=False)
+        nearest.uncertainty.ClearField("combined")
+        batch = InterpolationBatch([InterpolationResult.from_proto(nearest)])
+        np.testing.assert_array_equal(batch.u_combined[0], f32([0.003, 0.004, 0.005]))
+        self.assertTrue(np.isnan(batch.u_interpolation[0]).all())
 
 
 class Angles(unittest.TestCase):

@@ -677,21 +677,25 @@ class BrdfClient:
                           coordinates: Union[str, int, None] = None,
                           trend: Union[str, int, None] = None,
                           progress: Optional[bool] = None,
-                          uncertainty: bool = False) -> InterpolationBatch:
+                          uncertainty: bool = False,
+                          uncertainty_shared: bool = False) -> InterpolationBatch:
         """Spectra at many directions: `directions` is (N, 3) (θi, θo, φ) or (N, 4)
         (θi, φi, θo, φo), degrees. Returns an InterpolationBatch in the order asked (spectra
         (N, m) with NaN rows where the method could not fill the direction; .to_dataset():
         labelled, xarray). progress: a tqdm bar of the directions answered (None: when someone
         watches); Ctrl-C cancels the stream. uncertainty: also each spectrum's standard
         uncertainties (batch.u_measurement, .u_interpolation, .u_combined, (N, m); each
-        result's .uncertainty); chunk_size is then at most 512."""
+        result's .uncertainty, its combined computed here from the two parts as the daemon
+        computes Interpolate's); chunk_size is then at most 512. uncertainty_shared: also each
+        answer's shared part (result.uncertainty.shared; else empty, to keep the stream small)."""
         queries = [direction_query(d) for d in directions]
         request = brdf_pb2.InterpolateBatchRequest(
             session_id=session_id, method=names.to_enum(method, names.METHODS, "method"),
             quantity=names.to_enum(quantity, names.QUANTITIES, "quantity"), directions=queries,
             options=interpolation_options(axis_scale, mirror_phi, reciprocity, coordinates,
                                           trend),
-            chunk_size=chunk_size, include_uncertainty=uncertainty)
+            chunk_size=chunk_size, include_uncertainty=uncertainty,
+            include_uncertainty_shared=uncertainty_shared)
         results: List[Optional[InterpolationResult]] = [None] * len(queries)
         with Bar(progress, total=len(queries), desc=f"interpolating ({names.method_name(request.method)})",
                  unit="direction") as bar:

@@ -42,11 +42,18 @@ class InterpolationUncertainty:
     measurement:   (m,) from the blended readings' budgets, shared terms (white standard, the
                    same reference, dark, instrument) correlated; empty when not estimated (a
                    quantity other than the BRDF).
-    shared:        (m,) the part of `measurement` more readings would not reduce.
+    shared:        (m,) the part of `measurement` more readings would not reduce; empty in a
+                   batch's answers unless asked (interpolate_batch(uncertainty_shared=True)).
     interpolation: (m,) the interpolant's own error, estimated from the vertices' spread; empty
                    when not estimated (nearest).
-    combined:      (m,) sqrt(measurement² + interpolation²) of what was estimated.
+    combined:      (m,) sqrt(measurement² + interpolation²) of what was estimated. A batch's
+                   answers do not carry it (brdf.proto): it is computed here from the two parts
+                   as the daemon computes Interpolate's (in double from the float parts, rounded
+                   to float32), so both give the same values.
     not_estimated: what is left out, each "what: why" (never silently zero).
+
+    The daemon sends the parts as float32 (two significant digits mean something); they are
+    float64 arrays here.
     """
 
     measurement: np.ndarray
@@ -56,13 +63,25 @@ class InterpolationUncertainty:
     not_estimated: List[str]
 
     @classmethod
-    def from_proto(cls, u: Any) -> "InterpolationUncertainty":
-        """Converts a brdf.v1.InterpolationUncertainty."""
-        return cls(measurement=np.array(u.measurement, dtype=float),
-                   shared=np.array(u.shared, dtype=float),
-                   interpolation=np.array(u.interpolation, dtype=float),
-                   combined=np.array(u.combined, dtype=float),
+    def from_proto(cls, u: Any, bands: int) -> "InterpolationUncertainty":
+        """Converts a brdf.v1.InterpolationUncertainty of an answer of `bands` bands (its
+        combined computed from the parts when the answer leaves it out)."""
+        measurement = np.array(u.measurement, dtype=float)
+        interpolation = np.array(u.interpolation, dtype=float)
+        combined = (np.array(u.combined, dtype=float) if len(u.combined) > 0
+                    else quadrature_sum(measurement, interpolation, bands))
+        return cls(measurement=measurement, shared=np.array(u.shared, dtype=float),
+                   interpolation=interpolation, combined=combined,
                    not_estimated=list(u.not_estimated))
+
+
+def quadrature_sum(measurement: np.ndarray, interpolation: np.ndarray, bands: int) -> np.ndarray:
+    """sqrt(measurement² + interpolation²) over `bands` bands, a part not estimated (empty)
+    counting 0, in float64 and rounded to float32: brdf.proto's InterpolationUncertainty.combined,
+    the same bits as the daemon's."""
+    m = measurement if len(measurement) == bands else np.zeros(bands)
+    i = interpolation if len(interpolation) == bands else np.zeros(bands)
+    return np.sqrt(m * m + i * i).astype(np.float32).astype(float)
 
 
 @dataclasses.dataclass
@@ -158,7 +177,8 @@ class InterpolationResult:
             vertices=[Vertex(v.reading_id, np.array(v.coords, dtype=float), v.weight)
                       for v in result.vertices],
             detail=result.detail,
-            uncertainty=(InterpolationUncertainty.from_proto(result.uncertainty)
+            uncertainty=(InterpolationUncertainty.from_proto(result.uncertainty,
+                                                             len(result.spectrum))
                          if result.HasField("uncertainty") else None))
 
 

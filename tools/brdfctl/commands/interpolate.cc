@@ -181,7 +181,7 @@ void PrintVertices(std::ostream& out, const v1::InterpolationResult& result,
 }
 
 // "±" and k times band b of `values`, or "-" when it has no such band.
-std::string PlusMinus(const google::protobuf::RepeatedField<double>& values, int b, double k) {
+std::string PlusMinus(const google::protobuf::RepeatedField<float>& values, int b, double k) {
   return b < values.size() ? "±" + Num(k * values.Get(b), 3) : "-";
 }
 
