@@ -13,7 +13,8 @@ DataService::DataService(SessionCatalogue& catalogue, const Authenticator& auth,
       auth_(auth),
       stopping_(stopping),
       streams_(streams),
-      program_(std::move(program)) {}
+      program_(std::move(program)),
+      export_interpolants_(streams.budget()) {}
 
 grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
                                          const v1::StreamReadingsRequest* request,
@@ -61,7 +62,7 @@ grpc::Status DataService::Serve(grpc::ServerContext& context,
 grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportRequest* request,
                                  grpc::ServerWriter<v1::ExportChunk>* writer) {
   return ExportSession(*context, *request, *writer, auth_, streams_, stopping_, catalogue_.reader(),
-                       export_loads_);
+                       export_loads_, export_interpolants_);
 }
 
 }  // namespace brdf::daemon

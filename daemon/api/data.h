@@ -10,6 +10,7 @@
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/api/common.h"
+#include "daemon/api/export_cache.h"
 #include "daemon/api/export_loads.h"
 #include "daemon/api/session_catalogue.h"
 #include "daemon/api/stream_readings.h"
@@ -50,7 +51,8 @@ class DataService final : public v1::Data::Service {
   const StopSignal& stopping_;
   StreamRegistry& streams_;
   std::string program_;
-  SharedSessionLoads export_loads_;  // the sessions the exports in flight hold
+  SharedSessionLoads export_loads_;         // the sessions the exports in flight hold
+  ExportInterpolants export_interpolants_;  // their interpolants, kept per snapshot
 };
 
 }  // namespace brdf::daemon

@@ -42,6 +42,7 @@
 #include "core/export/session_data.h"
 #include "core/export/spectral_rgb.h"
 #include "daemon/api/export_bird.h"
+#include "daemon/api/export_cache.h"
 #include "daemon/api/export_loads.h"
 #include "daemon/api/export_session.h"
 #include "data/cie_tables.h"
@@ -54,6 +55,9 @@ namespace {
 // 4 MiB receive limit together with its framing).
 constexpr std::uint32_t kDefaultExportChunkBytes = 1024 * 1024;
 constexpr std::uint32_t kMaxExportChunkBytes = 4 * 1024 * 1024 - 1024;
+// The most bands a session holds: the CS-2000/3000's 380–780 nm every 1 nm
+// (docs/cs2000-protocol.md).
+constexpr std::size_t kMostBands = 401;
 // Exports have no deadline of their own beyond the client's; this caps a client without one.
 constexpr std::chrono::hours kLongestExport{24};
 // The first data message holds at most this much; each one the client takes doubles the next, up
@@ -150,16 +154,20 @@ class ExportStream {
   }
 
   // The buffer's bytes move into the message (no copy kept while the write waits), and the
-  // next chunk may be twice as large once this one was taken.
+  // next chunk may be twice as large once this one was taken. Once written (Write serialized the
+  // message), the buffer comes back and is reused at the next chunk's size: appends neither
+  // reallocate (and copy) it nor touch fresh pages.
   void SendBuffer(const std::string& name, Part& p) {
     v1::ExportChunk chunk;
     chunk.mutable_data()->set_offset(p.offset);
     if (!name.empty()) chunk.mutable_data()->set_part(name);
     p.offset += p.buffer.size();
     chunk.mutable_data()->set_content(std::move(p.buffer));
-    p.buffer = std::string();
     Send(chunk);
+    p.buffer = std::move(*chunk.mutable_data()->mutable_content());
+    p.buffer.clear();
     next_chunk_bytes_ = std::min(chunk_bytes_, 2 * next_chunk_bytes_);
+    p.buffer.reserve(next_chunk_bytes_);
   }
 
   void Send(const v1::ExportChunk& chunk) {
@@ -224,6 +232,12 @@ struct ExportSettings {
   bool float32 = false;            // grid .npy: '<f4'
   bool uncertainty = false;        // grid .npy, MERL, RGL: the cells' u as parts of the stream
   exports::SessionRglOptions rgl;  // RGL: θi slices and resolution (rgb weights added later)
+  // Where BuildInterpolator finds the session's interpolants (set once the session is loaded).
+  struct Interpolants {
+    std::shared_ptr<const exports::Session> session;  // the copy the export holds
+    SharedSessionLoads* loads = nullptr;              // its derived samples, shared
+    ExportInterpolants* kept = nullptr;               // kept per snapshot (export_cache.h)
+  } interpolants;
 };
 
 grpc::Status ParseFillField(v1::ExportFill fill, exports::FillPolicy* out) {
@@ -420,14 +434,26 @@ void AddSkipped(const std::vector<exports::SkippedReading>& skipped, v1::ExportR
 }
 
 // The session's interpolant over the derived quantity behind the fill chain (as brdf-export
-// builds it: core/export/fill/session_interpolant.h).
+// builds it: core/export/fill/session_interpolant.h), kept for the next export of this snapshot
+// of the session with the same settings (export_cache.h), its derived samples shared with the
+// exports of the same copy (export_loads.h).
 Result<exports::SessionInterpolant> BuildInterpolator(const exports::Session& session,
                                                       exports::Quantity quantity,
                                                       const ExportSettings& s,
                                                       const CallContext& ctx) {
-  BRDF_ASSIGN_OR_RETURN(exports::DerivedSamples derived,
-                        exports::DeriveSamples(session, quantity, {s.exclude_flagged}));
-  return exports::BuildSessionInterpolant(std::move(derived), s.method, s.options, s.fill, ctx);
+  const ExportSettings::Interpolants& from = s.interpolants;
+  if (from.kept == nullptr || from.session.get() != &session) {
+    BRDF_ASSIGN_OR_RETURN(exports::DerivedSamples derived,
+                          exports::DeriveSamples(session, quantity, {s.exclude_flagged}));
+    return exports::BuildSessionInterpolant(std::move(derived), s.method, s.options, s.fill, ctx);
+  }
+  const ExportInterpolants::Settings settings{quantity, s.method, s.options, s.fill,
+                                              s.exclude_flagged};
+  return from.kept->Get(from.session, settings, [&]() -> Result<exports::SessionInterpolant> {
+    BRDF_ASSIGN_OR_RETURN(std::shared_ptr<const exports::DerivedSamples> derived,
+                          from.loads->Derived(from.session, quantity, s.exclude_flagged));
+    return exports::BuildSessionInterpolant(std::move(derived), s.method, s.options, s.fill, ctx);
+  });
 }
 
 // The cell counts of a MERL or RGL table (unfilled: by the interpolation's why).
@@ -541,13 +567,13 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
                                                          : exports::GridPlacement::kCellCentres));
   BRDF_ASSIGN_OR_RETURN(exports::SessionInterpolant in,
                         BuildInterpolator(session, s.quantity, s, ctx));
-  const WavelengthGrid bands = in.derived.grid;
+  const WavelengthGrid bands = in.derived->grid;
   const exports::GridExportInfo info{session.id,
                                      session.name,
                                      s.quantity,
                                      interp::MethodName(s.method),
-                                     in.derived.samples.size(),
-                                     in.derived.skipped.size(),
+                                     in.derived->samples.size(),
+                                     in.derived->skipped.size(),
                                      s.float32 ? "float32" : "float64"};
   const exports::NpyType type = s.float32 ? exports::NpyType::kFloat32 : exports::NpyType::kFloat64;
   exports::NpyGridWriter npy(out, type);
@@ -571,7 +597,7 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
                               parts ? static_cast<exports::GridSink&>(split) : values,
                               parts ? exports::kUncertainPlanes : 1));
   AddGridCounts(r, report);
-  AddSkipped(in.derived.skipped, report);
+  AddSkipped(in.derived->skipped, report);
   AddFill(chain.Tally(), report);
   if (as_npy) {
     for (std::size_t n : {grid.theta_i.count, grid.theta_o.count, grid.phi.count}) {
@@ -621,7 +647,7 @@ Status ExportMerl(const exports::Session& session, const ExportSettings& s, cons
   BRDF_ASSIGN_OR_RETURN(data::CieTables cie, data::LoadCieTables(data::kDefaultColordDir));
   BRDF_ASSIGN_OR_RETURN(exports::SessionInterpolant in,
                         BuildInterpolator(session, exports::Quantity::kBrdf, s, ctx));
-  const WavelengthGrid bands = in.derived.grid;
+  const WavelengthGrid bands = in.derived->grid;
   BRDF_ASSIGN_OR_RETURN(exports::SpectralRgbWeights rgb,
                         exports::SpectralRgbWeights::Make(bands, cie.d65, cie.cmf));
   exports::RunControl control;
@@ -637,7 +663,7 @@ Status ExportMerl(const exports::Session& session, const ExportSettings& s, cons
   const exports::MerlReport& m = table.report;
   report->set_summary(m.Summary());
   AddTableCounts(m.cells, m.filled, m.unfilled, m.below_horizon, m.clamped, report);
-  AddSkipped(in.derived.skipped, report);
+  AddSkipped(in.derived->skipped, report);
   AddFill(in.chain->Tally(), report);
   return Status();
 }
@@ -650,7 +676,7 @@ Status ExportRgl(const exports::Session& session, const ExportSettings& s, const
   if (s.rgb) {
     BRDF_ASSIGN_OR_RETURN(data::CieTables cie, data::LoadCieTables(data::kDefaultColordDir));
     BRDF_ASSIGN_OR_RETURN(exports::SpectralRgbWeights rgb,
-                          exports::SpectralRgbWeights::Make(in.derived.grid, cie.d65, cie.cmf));
+                          exports::SpectralRgbWeights::Make(in.derived->grid, cie.d65, cie.cmf));
     options.rgb = rgb;
   }
   exports::RunControl control;
@@ -667,7 +693,7 @@ Status ExportRgl(const exports::Session& session, const ExportSettings& s, const
   report->set_summary(g.Summary());
   AddTableCounts(g.cells, g.interpolated + g.fallback, g.unfilled, g.below_horizon, g.clamped,
                  report);
-  AddSkipped(in.derived.skipped, report);
+  AddSkipped(in.derived->skipped, report);
   AddFill(in.chain->Tally(), report);
   return Status();
 }
@@ -712,8 +738,9 @@ grpc::Status LoadAndReserve(const ExportSettings& s, storage::SessionReader& rea
   Result<std::shared_ptr<const exports::Session>> got = loads.Load(reader, s.session_id, &loaded);
   if (!got.ok()) return ToGrpcStatus(got.status());
   const std::uint64_t readings = SharedSessionLoads::BytesOf(**got);
+  // A session without readings has no grid yet: reserved as for the finest one brdfd records.
   const std::size_t bands =
-      (*got)->readings.empty() ? 101 : (*got)->readings.front().spectrum.values.size();
+      (*got)->readings.empty() ? kMostBands : (*got)->readings.front().spectrum.values.size();
   if (grpc::Status st = slot.Reserve((loaded ? readings : 0) + WorkingBytes(s, bands, readings));
       !st.ok()) {
     return st;
@@ -727,7 +754,8 @@ grpc::Status LoadAndReserve(const ExportSettings& s, storage::SessionReader& rea
 grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest& request,
                            grpc::ServerWriter<v1::ExportChunk>& writer, const Authenticator& auth,
                            StreamRegistry& streams, const StopSignal& stopping,
-                           storage::SessionReader& reader, SharedSessionLoads& loads) {
+                           storage::SessionReader& reader, SharedSessionLoads& loads,
+                           ExportInterpolants& kept) {
   Caller caller;
   if (grpc::Status st = auth.CallerOf(context, &caller); !st.ok()) return st;
   std::unique_ptr<StreamRegistry::Slot> slot;
@@ -752,6 +780,7 @@ grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest
     return st;
   }
   stream.Progress("loading readings", 0.05);
+  settings.interpolants = {session, &loads, &kept};
 
   v1::ExportReport report;
   report.set_file_name(FileName(settings));

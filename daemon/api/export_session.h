@@ -8,6 +8,7 @@
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/api/common.h"
+#include "daemon/api/export_cache.h"
 #include "daemon/api/export_loads.h"
 #include "daemon/rpc/auth.h"
 #include "daemon/rpc/stream_registry.h"
@@ -18,6 +19,7 @@ namespace brdf::daemon {
 grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest& request,
                            grpc::ServerWriter<v1::ExportChunk>& writer, const Authenticator& auth,
                            StreamRegistry& streams, const StopSignal& stopping,
-                           storage::SessionReader& reader, SharedSessionLoads& loads);
+                           storage::SessionReader& reader, SharedSessionLoads& loads,
+                           ExportInterpolants& kept);
 
 }  // namespace brdf::daemon

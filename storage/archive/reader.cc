@@ -16,7 +16,14 @@ constexpr std::size_t kMaxIdleConnections = 8;
 constexpr std::string_view kSessionColumns =
     "archive_id, name, plan_kind, plan_json, state, state_reason, created_at, started_at, "
     "finished_at, created_by_role, total_steps, done_steps, white_reflectance, meter_serial, "
-    "config_json, uuid, rig";
+    "config_json, uuid, rig, "
+    // The session's grid: its first reading's (as the rig's store says it, session_rows.cc).
+    "(SELECT wl_start_nm FROM readings WHERE readings.session_uuid = sessions.uuid "
+    "ORDER BY rig_reading_id LIMIT 1), "
+    "(SELECT wl_step_nm FROM readings WHERE readings.session_uuid = sessions.uuid "
+    "ORDER BY rig_reading_id LIMIT 1), "
+    "(SELECT wl_count FROM readings WHERE readings.session_uuid = sessions.uuid "
+    "ORDER BY rig_reading_id LIMIT 1)";
 
 constexpr std::string_view kStepsOfSession = R"sql(
 SELECT step_index, kind, alpha, beta, gamma, delta, prompt, prompt_kind, expected_action,
@@ -80,6 +87,10 @@ Result<SessionRecord> SessionAt(const PgResult& r, int row) {
   s.config_json = std::string(r.Text(row, 14));
   s.uuid = std::string(r.Text(row, 15));
   s.rig = std::string(r.Text(row, 16));
+  if (!r.IsNull(row, 19)) {
+    s.grid = WavelengthGrid{r.Double(row, 17), r.Double(row, 18),
+                            static_cast<std::size_t>(r.Int64(row, 19))};
+  }
   return s;
 }
 

@@ -349,6 +349,11 @@ TEST_F(ArchiveServerTest, TwoReplicasAnswerBitForBitWhatTheRigAnswers) {
   EXPECT_TRUE(MessageDifferencer::Equals(archived.sample(), on_rig.sample()));
   EXPECT_TRUE(MessageDifferencer::Equals(archived.progress(), on_rig.progress()));
   EXPECT_TRUE(MessageDifferencer::Equals(archived.created_at(), on_rig.created_at()));
+  // The session's wavelength grid (its first reading's), as the rig says it.
+  ASSERT_TRUE(on_rig.has_grid());
+  EXPECT_EQ(on_rig.grid().count(), 101U);
+  EXPECT_TRUE(MessageDifferencer::Equals(archived.grid(), on_rig.grid()))
+      << archived.grid().ShortDebugString() << " vs " << on_rig.grid().ShortDebugString();
   // The session's history of states: the rig's, byte for byte (the same ids and times), on both
   // replicas, for the analyst too; an unknown archive id is NOT_FOUND.
   {

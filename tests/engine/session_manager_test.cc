@@ -423,6 +423,38 @@ TEST_F(EngineTest, DeviceFaultThatSurvivesRetriesPausesWithTheFaultThenResumeCom
   EXPECT_EQ(will_retry, (std::vector<bool>{true, false}));
 }
 
+TEST_F(EngineTest, AReadingOnAnotherGridMidSessionIsRefusedAndPausesTheSessionNamingBothGrids) {
+  // The first measurement on the meter's 101 bands, every later one on a CS-2000's 401 (a meter
+  // of another model put in mid-session): the store refuses the reading at commit, and the
+  // session pauses with the fault rather than mixing grids.
+  FakeFaults faults;
+  faults.grid = WavelengthGrid{380, 1, 401};
+  faults.grid_after_calls = 1;
+  fake_.meter_faults->Set(faults);
+  const SessionId id = Submit(kTinyPlan);
+  Operator& op = Watch(id);
+  v1::Session s = WaitForSession(*manager_, id, [](const v1::Session& x) {
+    return x.state() == v1::SESSION_STATE_PAUSED || Terminal(x);
+  });
+  ASSERT_EQ(s.state(), v1::SESSION_STATE_PAUSED);
+  ASSERT_TRUE(s.has_last_fault());
+  const std::string& why = s.last_fault().reason();
+  EXPECT_NE(why.find("380–780 nm every 1 nm (401 bands)"), std::string::npos) << why;
+  EXPECT_NE(why.find("380–780 nm every 4 nm (101 bands)"), std::string::npos) << why;
+  auto record = store_->GetSession(id);
+  ASSERT_TRUE(record.ok());
+  EXPECT_NE(record->state_reason.find("401 bands"), std::string::npos) << record->state_reason;
+  EXPECT_NE(record->state_reason.find("101 bands"), std::string::npos) << record->state_reason;
+  // Only the first reading was kept, and on its own grid.
+  const std::vector<storage::ReadingRecord> kept = Readings(id);
+  ASSERT_EQ(kept.size(), 1U);
+  EXPECT_EQ(kept.front().grid.count, 101U);
+  ASSERT_TRUE(record->grid.has_value());
+  EXPECT_EQ(record->grid->count, 101U);
+  ExpectIntact(id);
+  op.Stop();
+}
+
 TEST_F(EngineTest, SecondSessionQueuesAndStartsWhenTheRigFrees) {
   const SessionId first = Submit(kTinyPlan);
   const SessionId second = Submit(kTinyPlan, /*start_now=*/false);

@@ -113,7 +113,7 @@ TEST(UncertainChain, ModelCellsCarryTheModelsResidualRms) {
   Result<SessionInterpolant> in = BuildSessionInterpolant(paint->derived, interp::Method::kOctant,
                                                           {}, FillPolicy::kChain, LongContext());
   ASSERT_TRUE(in.ok()) << in.status().ToString();
-  ASSERT_TRUE(in->model.has_value());
+  ASSERT_NE(in->model, nullptr);
   const UncertainChain chain = MakeUncertainChain(*in);
   // Grazing on both sides: beyond every reading, so neither octant nor Delaunay has a value.
   const std::size_t bands = paint->derived.grid.count;

@@ -107,7 +107,7 @@ void DescribeFillChain(const Interpolation& in, std::ostream& err) {
   if (!in.model) return;
   err << "brdf-export: fill chain: " << interp::MethodName(in.method)
       << (in.fallback ? ", then delaunay" : "") << ", then Cook-Torrance (relative RMS "
-      << in.model->overall.relative_rms << " over " << in.derived.samples.size() << " readings)\n";
+      << in.model->overall.relative_rms << " over " << in.derived->samples.size() << " readings)\n";
 }
 
 Result<Interpolation> BuildInterpolator(const exports::Session& session, exports::Quantity q,
@@ -212,7 +212,7 @@ int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
   Result<Interpolation> in = BuildInterpolator(*session, *q, c, o.interp, err);
   if (!in.ok()) return Fail(err, "grid", in.status());
 
-  const WavelengthGrid bands = in->derived.grid;
+  const WavelengthGrid bands = in->derived->grid;
   const double bytes =
       static_cast<double>(grid->cells()) * static_cast<double>(bands.count) * (o.float32 ? 4 : 8);
   err << "brdf-export grid: " << grid->theta_i.count << " × " << grid->theta_o.count << " × "
@@ -226,8 +226,8 @@ int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
                                      session->name,
                                      *q,
                                      o.interp.method,
-                                     in->derived.samples.size(),
-                                     in->derived.skipped.size(),
+                                     in->derived->samples.size(),
+                                     in->derived->skipped.size(),
                                      o.float32 ? "float32" : "float64"};
   exports::NpyGridWriter npy((*file)->stream(),
                              o.float32 ? exports::NpyType::kFloat32 : exports::NpyType::kFloat64);
@@ -271,7 +271,7 @@ int RunMerl(const CommonOptions& c, const MerlOptions& o, std::ostream& out, std
   Result<Interpolation> in =
       BuildInterpolator(*session, exports::Quantity::kBrdf, c, o.interp, err);
   if (!in.ok()) return Fail(err, "merl", in.status());
-  const WavelengthGrid bands = in->derived.grid;
+  const WavelengthGrid bands = in->derived->grid;
   Result<exports::SpectralRgbWeights> rgb =
       exports::SpectralRgbWeights::Make(bands, cie->d65, cie->cmf);
   if (!rgb.ok()) return Fail(err, "merl", rgb.status());
@@ -334,7 +334,7 @@ int RunRgl(const CommonOptions& c, const RglCommandOptions& o, std::ostream& err
     Result<data::CieTables> cie = data::LoadCieTables(o.colord_dir);
     if (!cie.ok()) return Fail(err, "rgl", cie.status());
     Result<exports::SpectralRgbWeights> rgb =
-        exports::SpectralRgbWeights::Make(in->derived.grid, cie->d65, cie->cmf);
+        exports::SpectralRgbWeights::Make(in->derived->grid, cie->d65, cie->cmf);
     if (!rgb.ok()) return Fail(err, "rgl", rgb.status());
     options.rgb = *rgb;
   }

@@ -75,35 +75,55 @@ InterpolantInfo SessionInterpolant::Info() const {
           interp::TrendName(options.trend)};
 }
 
-Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, interp::Method method,
+namespace {
+
+// The chain over the parts `in` has: the chosen method, then (kChain) the fallback and the model.
+std::unique_ptr<FillChain> MakeChain(const SessionInterpolant& in) {
+  std::vector<FillChain::Stage> stages;
+  stages.push_back({Provenance::kInterpolated, InterpolatorSource(*in.interpolator)});
+  if (in.policy == FillPolicy::kChain) {
+    if (in.fallback) stages.push_back({Provenance::kFallback, InterpolatorSource(*in.fallback)});
+    stages.push_back({Provenance::kModel, ModelSource(*in.model)});
+  }
+  return std::make_unique<FillChain>(in.policy, std::move(stages));
+}
+
+}  // namespace
+
+Result<SessionInterpolant> BuildSessionInterpolant(std::shared_ptr<const DerivedSamples> derived,
+                                                   interp::Method method,
                                                    const interp::Options& options,
                                                    FillPolicy policy, const CallContext& ctx) {
   SessionInterpolant in;
   in.derived = std::move(derived);
   in.method = method;
   in.options = options;
-  BRDF_ASSIGN_OR_RETURN(std::shared_ptr<const interp::SampleSet> set, ToSampleSet(in.derived));
-  in.samples = set;
-  BRDF_ASSIGN_OR_RETURN(std::unique_ptr<interp::Interpolator> chosen,
-                        interp::MakeInterpolator(method, in.samples, options));
-  in.interpolator = std::move(chosen);
-
-  std::vector<FillChain::Stage> stages;
-  stages.push_back({Provenance::kInterpolated, InterpolatorSource(*in.interpolator)});
+  in.policy = policy;
+  BRDF_ASSIGN_OR_RETURN(in.samples, ToSampleSet(*in.derived));
+  Result<std::unique_ptr<interp::Interpolator>> chosen =
+      interp::MakeInterpolator(method, in.samples, options);
+  if (!chosen.ok()) return chosen.status();
+  in.interpolator = std::move(*chosen);
   if (policy == FillPolicy::kChain) {
     if (method != interp::Method::kDelaunay) {
       Result<std::unique_ptr<interp::Interpolator>> d =
           interp::MakeInterpolator(interp::Method::kDelaunay, in.samples, options);
       if (!d.ok()) return d.status().WithContext("the fill chain's Delaunay fallback");
       in.fallback = std::move(*d);
-      stages.push_back({Provenance::kFallback, InterpolatorSource(*in.fallback)});
     }
-    Result<fit::CookTorranceFit> model = FitSampleModel(*in.samples, in.derived.grid, ctx);
+    Result<fit::CookTorranceFit> model = FitSampleModel(*in.samples, in.derived->grid, ctx);
     if (!model.ok()) return model.status().WithContext("the fill chain's model");
-    in.model = std::move(*model);
-    stages.push_back({Provenance::kModel, ModelSource(*in.model)});
+    in.model = std::make_shared<const fit::CookTorranceFit>(*std::move(model));
   }
-  in.chain = std::make_unique<FillChain>(policy, std::move(stages));
+  in.chain = MakeChain(in);
+  return in;
+}
+
+SessionInterpolant ShareSessionInterpolant(const SessionInterpolant& built) {
+  SessionInterpolant in{built.derived,  built.samples, built.method,
+                        built.options,  built.policy,  built.interpolator,
+                        built.fallback, built.model,   nullptr};
+  in.chain = MakeChain(in);
   return in;
 }
 
@@ -114,7 +134,7 @@ Result<RglExport> BuildSessionRgl(const Session& session, const SessionInterpola
   options.theta_i_count = o.theta_i_count;
   options.sample_res = o.sample_res;
   options.theta_i_max_deg = 0;
-  for (const DerivedSample& s : in.derived.samples) {
+  for (const DerivedSample& s : in.derived->samples) {
     options.theta_i_max_deg = std::max({options.theta_i_max_deg, s.iso.theta_i, s.iso.theta_o});
   }
   options.theta_i_max_deg = std::min(options.theta_i_max_deg, 89.0);
@@ -123,12 +143,12 @@ Result<RglExport> BuildSessionRgl(const Session& session, const SessionInterpola
                         (o.rgb ? ", linear sRGB (D65)" : "");
   options.rgb = o.rgb;
 
-  Result<RetroProfile> retro = RetroReflectionFromSamples(in.derived);
+  Result<RetroProfile> retro = RetroReflectionFromSamples(*in.derived);
   if (!retro.ok()) {
     if (in.model) {
       retro = RetroFromModel(*in.model);
     } else {
-      Result<fit::CookTorranceFit> model = FitSampleModel(*in.samples, in.derived.grid, ctx);
+      Result<fit::CookTorranceFit> model = FitSampleModel(*in.samples, in.derived->grid, ctx);
       if (!model.ok()) {
         return model.status().WithContext(retro.status().message() +
                                           "; fitting Cook-Torrance (GGX) instead");
@@ -139,7 +159,7 @@ Result<RglExport> BuildSessionRgl(const Session& session, const SessionInterpola
   // Where the chain has no value (fill policy none), the nearest reading's.
   BRDF_ASSIGN_OR_RETURN(std::unique_ptr<interp::Interpolator> nearest,
                         interp::MakeInterpolator(interp::Method::kNearest, in.samples, {}));
-  return BuildRgl(in.chain->Source(), InterpolatorSource(*nearest), in.derived.grid, *retro,
+  return BuildRgl(in.chain->Source(), InterpolatorSource(*nearest), in.derived->grid, *retro,
                   options, control, ctx);
 }
 

@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/call_context.h"
@@ -28,15 +29,20 @@
 
 namespace brdf::exports {
 
+// The parts are shared: ShareSessionInterpolant hands another export the same derived samples,
+// indexes and model (the daemon keeps them per session snapshot, daemon/api/export_cache.h), each
+// with a chain of its own, so that each export counts its own cells. The parts are immutable and
+// their queries thread-safe.
 struct SessionInterpolant {
-  DerivedSamples derived;
+  std::shared_ptr<const DerivedSamples> derived;
   std::shared_ptr<const interp::SampleSet> samples;
   interp::Method method = interp::Method::kOctant;
   interp::Options options;
-  std::unique_ptr<interp::Interpolator> interpolator;  // the chosen method
-  std::unique_ptr<interp::Interpolator> fallback;      // kChain: Delaunay, unless the method is
-  std::optional<fit::CookTorranceFit> model;           // kChain: the fitted model
-  std::unique_ptr<FillChain> chain;                    // ask chain->Source(), read its Tally()
+  FillPolicy policy = FillPolicy::kNone;
+  std::shared_ptr<const interp::Interpolator> interpolator;  // the chosen method
+  std::shared_ptr<const interp::Interpolator> fallback;  // kChain: Delaunay, unless the method is
+  std::shared_ptr<const fit::CookTorranceFit> model;     // kChain: the fitted model
+  std::unique_ptr<FillChain> chain;                      // ask chain->Source(), read its Tally()
 
   // The symmetry options, axis scales and fill counts so far, for a grid's sidecar.
   InterpolantInfo Info() const;
@@ -44,9 +50,22 @@ struct SessionInterpolant {
 
 // Errors: no usable sample (from the interpolator), a sample the fit refuses or a failed fit
 // (with context naming the fill chain's stage), kCancelled / kTimeout from `ctx` (the fit).
-Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived, interp::Method method,
+Result<SessionInterpolant> BuildSessionInterpolant(std::shared_ptr<const DerivedSamples> derived,
+                                                   interp::Method method,
                                                    const interp::Options& options,
                                                    FillPolicy policy, const CallContext& ctx);
+inline Result<SessionInterpolant> BuildSessionInterpolant(DerivedSamples derived,
+                                                          interp::Method method,
+                                                          const interp::Options& options,
+                                                          FillPolicy policy,
+                                                          const CallContext& ctx) {
+  return BuildSessionInterpolant(std::make_shared<const DerivedSamples>(std::move(derived)), method,
+                                 options, policy, ctx);
+}
+
+// The same parts as `built` (shared, not copied) behind a chain of its own, whose tally starts at
+// zero: what another export of the same samples and settings asks.
+SessionInterpolant ShareSessionInterpolant(const SessionInterpolant& built);
 
 // The most samples the fill chain's model is fitted to. A model of four parameters per band is
 // determined long before this many; a 50,000-reading session took 7 s to fit in full against

@@ -90,13 +90,13 @@ SpectrumSource ModelWithSpread(const fit::CookTorranceFit& model, std::vector<do
 
 UncertaintyCoverage CoverageOf(const SessionInterpolant& in) {
   UncertaintyCoverage c;
-  c.samples = in.derived.samples.size();
-  if (in.derived.quantity != Quantity::kBrdf) {
+  c.samples = in.derived->samples.size();
+  if (in.derived->quantity != Quantity::kBrdf) {
     c.no_budgets = std::string("the readings' budgets are of the BRDF, this export is of ") +
-                   QuantityName(in.derived.quantity) + "; export the BRDF for a measurement part";
+                   QuantityName(in.derived->quantity) + "; export the BRDF for a measurement part";
     c.without_budget = c.samples;
   }
-  for (const DerivedSample& s : in.derived.samples) {
+  for (const DerivedSample& s : in.derived->samples) {
     if (!c.no_budgets.empty()) break;
     if (!s.budget) {
       ++c.without_budget;
@@ -218,7 +218,7 @@ UncertainChain MakeUncertainChain(const SessionInterpolant& in) {
   inputs.samples = in.samples.get();
   if (out.coverage.no_budgets.empty()) {
     inputs.budget_of = [&in](std::size_t i) {
-      return i < in.derived.samples.size() ? in.derived.samples[i].budget.get() : nullptr;
+      return i < in.derived->samples.size() ? in.derived->samples[i].budget.get() : nullptr;
     };
   } else {
     inputs.no_budgets = out.coverage.no_budgets;

@@ -78,9 +78,9 @@ Result<std::string> UncertaintySummaryJson(const SessionInterpolant& in, const s
   MemoryGrid planes[kUncertainPlanes];
   PlaneSplitSink split({&planes[0], &planes[1], &planes[2], &planes[3]});
   BRDF_ASSIGN_OR_RETURN(GridReport report,
-                        ResampleOnGrid(uncertain.chain->Source(), grid, in.derived.grid, control,
+                        ResampleOnGrid(uncertain.chain->Source(), grid, in.derived->grid, control,
                                        ctx, split, kUncertainPlanes));
-  const WavelengthGrid& bands = in.derived.grid;
+  const WavelengthGrid& bands = in.derived->grid;
   std::string j =
       "{\n  \"format\": " + JsonString(format) +
       ",\n  \"what\": \"the uncertainty of the export's cells, which the format "
@@ -95,8 +95,8 @@ Result<std::string> UncertaintySummaryJson(const SessionInterpolant& in, const s
   j += "  \"relative_u\": " + RelativeSummary(planes[0], planes[1]) + ",\n";
   j += "  \"relative_u_measurement\": " + RelativeSummary(planes[0], planes[2]) + ",\n";
   j += "  \"relative_u_interpolation\": " + RelativeSummary(planes[0], planes[3]) + ",\n";
-  j += "  \"relative_white_standard\": " + Numbers(WhiteStandardPart(in.derived)) + ",\n";
-  j += "  \"coverage\": " + UncertaintyJson(uncertain.coverage, in.derived.quantity, {}) + "\n}\n";
+  j += "  \"relative_white_standard\": " + Numbers(WhiteStandardPart(*in.derived)) + ",\n";
+  j += "  \"coverage\": " + UncertaintyJson(uncertain.coverage, in.derived->quantity, {}) + "\n}\n";
   return j;
 }
 

@@ -87,13 +87,19 @@ Status NpyGridWriter::WriteSlice(std::size_t theta_i_index, std::span<const doub
                     " arrived, expected " + std::to_string(next_slice_));
   }
   ++next_slice_;
-  buffer_.clear();
-  if (type_ == NpyType::kFloat32) {
-    AppendLittleEndianFloat32(values, buffer_);
+  if (type_ == NpyType::kFloat64 && std::endian::native == std::endian::little) {
+    // The values are the file's bytes already: no copy.
+    out_.write(reinterpret_cast<const char*>(values.data()),
+               static_cast<std::streamsize>(values.size_bytes()));
   } else {
-    AppendLittleEndian(values, buffer_);
+    buffer_.clear();
+    if (type_ == NpyType::kFloat32) {
+      AppendLittleEndianFloat32(values, buffer_);
+    } else {
+      AppendLittleEndian(values, buffer_);
+    }
+    out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
   }
-  out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
   if (!out_) {
     return IoError("writing the .npy data failed at θi slice " + std::to_string(theta_i_index) +
                    ": is the disk full?");

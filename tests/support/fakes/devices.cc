@@ -145,13 +145,16 @@ Result<drivers::MeasurementOutcome> FakeMeter::Measure(const CallContext& ctx) {
 
   const FakeTarget target = bench_->mounted();
   const Directions d = PoseToDirections(bench_->pose(), options_.convention);
+  const WavelengthGrid grid = faults.grid && faults_->counts().calls > faults.grid_after_calls
+                                  ? *faults.grid
+                                  : options_.grid;
   last_ = drivers::SpectrumReport();
-  last_.grid = options_.grid;
-  last_.radiance.resize(options_.grid.count);
+  last_.grid = grid;
+  last_.radiance.resize(grid.count);
   double integrated = 0;
-  for (std::size_t i = 0; i < options_.grid.count; ++i) {
-    last_.radiance[i] = Radiance(target, d, options_.grid.at(i));
-    integrated += last_.radiance[i] * options_.grid.step_nm;
+  for (std::size_t i = 0; i < grid.count; ++i) {
+    last_.radiance[i] = Radiance(target, d, grid.at(i));
+    integrated += last_.radiance[i] * grid.step_nm;
   }
   drivers::MeasurementOutcome outcome;
   // A dark reads weak light (the PR-650 reports 10 and the dark policy accepts it flagged).

@@ -19,6 +19,7 @@
 #include <chrono>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 
 #include "core/call_context.h"
@@ -53,6 +54,11 @@ struct FakeFaults {
   Status failure = DeviceError(14, "fake device: injected failure");
   std::chrono::milliseconds delay{0};  // added to every measurement or move
   bool unreachable = false;            // Connect fails; a connected device drops on its next call
+  // Meter: from measurement number `grid_after_calls` + 1 on (counted as FakeCounts::calls), the
+  // spectra are on this grid instead of the meter's own: a meter of another model put in
+  // mid-session.
+  std::optional<WavelengthGrid> grid;
+  int grid_after_calls = 0;
 };
 
 // Counts of what a fake was asked to do (for assertions on the traffic).

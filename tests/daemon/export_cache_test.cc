@@ -1,0 +1,200 @@
+// ExportInterpolants (daemon/api/export_cache.h): the exports' interpolants kept per session
+// snapshot and settings, one builder at a time, within the memory budget.
+#include "daemon/api/export_cache.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "core/call_context.h"
+
+namespace brdf::daemon {
+namespace {
+
+// A session copy with `readings` readings (ids 1…n): only its identity and size matter here.
+std::shared_ptr<const SessionReadings> SessionCopy(std::int64_t id, int readings) {
+  auto s = std::make_shared<SessionReadings>();
+  s->id = id;
+  s->name = "s" + std::to_string(id);
+  for (int i = 1; i <= readings; ++i) {
+    Reading r;
+    r.id = i;
+    r.spectrum.values.assign(101, 0.5);
+    s->readings.push_back(std::move(r));
+  }
+  return s;
+}
+
+// A real interpolant over a few samples (nearest neighbour, no fill chain), counting its builds.
+ExportInterpolants::Build Builder(std::atomic<int>* builds,
+                                  std::chrono::milliseconds take = std::chrono::milliseconds(0)) {
+  return [builds, take]() -> Result<exports::SessionInterpolant> {
+    builds->fetch_add(1);
+    std::this_thread::sleep_for(take);
+    exports::DerivedSamples derived;
+    derived.grid = WavelengthGrid::Pr650();
+    for (int k = 0; k < 8; ++k) {
+      exports::DerivedSample s;
+      s.reading_id = k + 1;
+      s.iso = {5.0 * k, 10.0 + 3 * k, 20.0 * k};
+      s.values.assign(101, 0.1 * (k + 1));
+      derived.samples.push_back(std::move(s));
+    }
+    return exports::BuildSessionInterpolant(std::move(derived), interp::Method::kNearest, {},
+                                            exports::FillPolicy::kNone,
+                                            CallContext::WithTimeout(std::chrono::minutes(1)));
+  };
+}
+
+TEST(ExportInterpolantsTest, TheSecondExportOfASnapshotReusesTheFirstsInterpolant) {
+  MemoryBudget budget(1024);
+  ExportInterpolants cache(budget);
+  const auto session = SessionCopy(1, 10);
+  std::atomic<int> builds{0};
+  bool built = false;
+  Result<exports::SessionInterpolant> first = cache.Get(session, {}, Builder(&builds), &built);
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  EXPECT_TRUE(built);
+  Result<exports::SessionInterpolant> second = cache.Get(session, {}, Builder(&builds), &built);
+  ASSERT_TRUE(second.ok());
+  EXPECT_FALSE(built);
+  EXPECT_EQ(builds.load(), 1);
+  // The same parts, a chain of its own: the second export's tally starts at zero.
+  EXPECT_EQ(second->interpolator, first->interpolator);
+  EXPECT_EQ(second->derived, first->derived);
+  EXPECT_NE(second->chain.get(), first->chain.get());
+  std::vector<double> out(101);
+  ASSERT_EQ(first->chain->Source()({5, 10, 0}, out), interp::InterpStatus::kOk);
+  EXPECT_EQ(first->chain->Tally().asked(), 1U);
+  EXPECT_EQ(second->chain->Tally().asked(), 0U);
+  const ExportInterpolants::Stats stats = cache.stats();
+  EXPECT_EQ(stats.hits, 1U);
+  EXPECT_EQ(stats.entries, 1U);
+  EXPECT_GT(stats.bytes, 0U);
+  EXPECT_EQ(budget.reserved_bytes(), stats.bytes) << "the kept entry is reserved from the budget";
+
+  // Another setting on the same copy: the session and (here) nothing else shared is reserved
+  // once, not per entry.
+  ExportInterpolants::Settings mirrored;
+  mirrored.options.mirror_phi = true;
+  ASSERT_TRUE(cache.Get(session, mirrored, Builder(&builds)).ok());
+  const ExportInterpolants::Stats two = cache.stats();
+  EXPECT_EQ(two.entries, 2U);
+  EXPECT_LT(two.bytes, 2 * stats.bytes);
+  EXPECT_GT(two.bytes, stats.bytes);
+  EXPECT_EQ(budget.reserved_bytes(), two.bytes);
+}
+
+TEST(ExportInterpolantsTest, EachSettingIsItsOwnKey) {
+  MemoryBudget budget(1024);
+  ExportInterpolants cache(budget);
+  const auto session = SessionCopy(1, 10);
+  std::atomic<int> builds{0};
+  ExportInterpolants::Settings base;
+  std::vector<ExportInterpolants::Settings> all(7, base);
+  all[1].method = interp::Method::kDelaunay;
+  all[2].options.mirror_phi = true;
+  all[3].options.reciprocity = true;
+  all[4].options.axis_scale = {1, 1, 0.5};
+  all[5].fill = exports::FillPolicy::kNone;
+  all[6].quantity = exports::Quantity::kReflectance;
+  for (std::size_t k = 1; k < all.size(); ++k) {
+    EXPECT_NE(ExportInterpolants::KeyOf(all[k]), ExportInterpolants::KeyOf(base))
+        << ExportInterpolants::KeyOf(all[k]);
+  }
+  ExportInterpolants::Settings scaled = base;
+  scaled.options.axis_scale = {1, 1, 0.5000001};
+  EXPECT_NE(ExportInterpolants::KeyOf(scaled), ExportInterpolants::KeyOf(all[4]));
+  ASSERT_TRUE(cache.Get(session, all[0], Builder(&builds)).ok());
+  ASSERT_TRUE(cache.Get(session, all[2], Builder(&builds)).ok());
+  ASSERT_TRUE(cache.Get(session, all[0], Builder(&builds)).ok());
+  EXPECT_EQ(builds.load(), 2);
+}
+
+TEST(ExportInterpolantsTest, ASessionThatGainedReadingsIsBuiltAgainAndItsOlderCopyDropped) {
+  MemoryBudget budget(1024);
+  ExportInterpolants cache(budget);
+  std::atomic<int> builds{0};
+  const auto before = SessionCopy(1, 10);
+  ASSERT_TRUE(cache.Get(before, {}, Builder(&builds)).ok());
+  const auto other = SessionCopy(2, 10);
+  ASSERT_TRUE(cache.Get(other, {}, Builder(&builds)).ok());
+  const auto after = SessionCopy(1, 11);  // a new copy: the store had a reading past the old one
+  bool built = false;
+  ASSERT_TRUE(cache.Get(after, {}, Builder(&builds), &built).ok());
+  EXPECT_TRUE(built);
+  EXPECT_EQ(builds.load(), 3);
+  const ExportInterpolants::Stats stats = cache.stats();
+  EXPECT_EQ(stats.entries, 2U) << "the older copy of session 1 is dropped, session 2 kept";
+  EXPECT_EQ(stats.evictions, 1U);
+  ASSERT_TRUE(cache.Get(other, {}, Builder(&builds), &built).ok());
+  EXPECT_FALSE(built);
+}
+
+TEST(ExportInterpolantsTest, OneBuilderOthersWaitAndShareIt) {
+  MemoryBudget budget(1024);
+  ExportInterpolants cache(budget);
+  const auto session = SessionCopy(1, 10);
+  std::atomic<int> builds{0};
+  std::atomic<int> ok{0};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 6; ++t) {
+    threads.emplace_back([&] {
+      if (cache.Get(session, {}, Builder(&builds, std::chrono::milliseconds(200))).ok()) ++ok;
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(ok.load(), 6);
+  EXPECT_EQ(builds.load(), 1);
+}
+
+TEST(ExportInterpolantsTest, AFailedBuildIsNotKeptAndTheNextCallerBuildsAgain) {
+  MemoryBudget budget(1024);
+  ExportInterpolants cache(budget);
+  const auto session = SessionCopy(1, 10);
+  int calls = 0;
+  const ExportInterpolants::Build failing = [&calls]() -> Result<exports::SessionInterpolant> {
+    ++calls;
+    return Cancelled("the client went away");
+  };
+  Result<exports::SessionInterpolant> got = cache.Get(session, {}, failing);
+  ASSERT_FALSE(got.ok());
+  EXPECT_EQ(got.status().code(), StatusCode::kCancelled);
+  std::atomic<int> builds{0};
+  ASSERT_TRUE(cache.Get(session, {}, Builder(&builds)).ok());
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(builds.load(), 1);
+}
+
+TEST(ExportInterpolantsTest, WhatDoesNotFitIsHandedOverButNotKept) {
+  MemoryBudget budget(1024);
+  ExportInterpolants tiny(budget, {4, 1024});  // 1 kB: no interpolant fits
+  const auto session = SessionCopy(1, 10);
+  std::atomic<int> builds{0};
+  ASSERT_TRUE(tiny.Get(session, {}, Builder(&builds)).ok());
+  ASSERT_TRUE(tiny.Get(session, {}, Builder(&builds)).ok());
+  EXPECT_EQ(builds.load(), 2);
+  EXPECT_EQ(tiny.stats().entries, 0U);
+  EXPECT_EQ(budget.reserved_bytes(), 0U);
+
+  // At most max_entries: the least recently used goes first.
+  ExportInterpolants two(budget, {2, 0});
+  const auto a = SessionCopy(1, 10), b = SessionCopy(2, 10), c = SessionCopy(3, 10);
+  ASSERT_TRUE(two.Get(a, {}, Builder(&builds)).ok());
+  ASSERT_TRUE(two.Get(b, {}, Builder(&builds)).ok());
+  ASSERT_TRUE(two.Get(a, {}, Builder(&builds)).ok());  // a used last
+  ASSERT_TRUE(two.Get(c, {}, Builder(&builds)).ok());  // b out
+  EXPECT_EQ(two.stats().entries, 2U);
+  bool built = false;
+  ASSERT_TRUE(two.Get(a, {}, Builder(&builds), &built).ok());
+  EXPECT_FALSE(built);
+  ASSERT_TRUE(two.Get(b, {}, Builder(&builds), &built).ok());
+  EXPECT_TRUE(built);
+}
+
+}  // namespace
+}  // namespace brdf::daemon
