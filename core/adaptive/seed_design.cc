@@ -45,8 +45,9 @@ std::vector<Pose> SpaceFilling(const AdaptiveSpec& spec, const plan::RigDescript
   return poses;
 }
 
-// α in 10° bands, β ascending in even bands and descending in odd ones.
-void SerpentineOrder(std::vector<Pose>& poses) {
+}  // namespace
+
+void OrderForTravel(std::vector<Pose>& poses) {
   auto band = [](const Pose& p) { return static_cast<int>(std::floor(p.alpha / 10)); };
   std::sort(poses.begin(), poses.end(), [&](const Pose& a, const Pose& b) {
     if (band(a) != band(b)) return band(a) < band(b);
@@ -54,8 +55,6 @@ void SerpentineOrder(std::vector<Pose>& poses) {
     return a.alpha < b.alpha;
   });
 }
-
-}  // namespace
 
 double RadicalInverse(unsigned index, unsigned base) {
   double result = 0;
@@ -81,7 +80,7 @@ std::vector<SeedGroup> MakeSeedDesign(const AdaptiveSpec& spec, const plan::RigD
     for (double delta : spec.delta_deg) {
       SeedGroup group{spec.gamma_deg[g], delta, 0, spec.readings_per_delta, {}};
       group.poses = SpaceFilling(spec, rig, group.gamma_deg, delta, spec.readings_per_delta);
-      SerpentineOrder(group.poses);
+      OrderForTravel(group.poses);
       groups.push_back(std::move(group));
     }
   }

@@ -41,6 +41,10 @@ std::vector<Pose> SeedPoses(const std::vector<SeedGroup>& groups);
 // motorized axis, through the rig's convention) and both its directions lie in `region`.
 bool Reachable(const Pose& model, const Region& region, const plan::RigDescription& rig);
 
+// Orders poses of one (γ, δ) for short holder moves: α in 10° bands, β ascending in even bands
+// and descending in odd ones (ties: α ascending). Deterministic.
+void OrderForTravel(std::vector<Pose>& poses);
+
 // The radical inverse of `index` in `base` (the Halton sequence's coordinate), in [0, 1).
 double RadicalInverse(unsigned index, unsigned base);
 
