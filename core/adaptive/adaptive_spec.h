@@ -16,6 +16,10 @@ inline constexpr double kDefaultThetaMaxDeg = 80;
 inline constexpr int kDefaultRetroReadings = 8;
 inline constexpr int kDefaultReadingsPerDelta = 12;
 inline constexpr int kDefaultRoundReadings = 24;
+// Caps that keep validation quick: (δ, γ) settings of one plan, and space-filling seed readings
+// asked for in all.
+inline constexpr int kMaxSeedSettings = 400;
+inline constexpr int kMaxSeedReadings = 20000;
 // Spacing of the candidate poses a round chooses from (candidates.h), degrees.
 inline constexpr double kCandidateStepDeg = 5;
 

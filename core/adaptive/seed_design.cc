@@ -9,7 +9,7 @@
 namespace brdf::adaptive {
 namespace {
 
-constexpr unsigned kDrawsPerPose = 4096;
+constexpr unsigned kDrawsPerPose = 512;
 
 double Round2(double deg) {
   return std::round(deg * 100) / 100;

@@ -7,7 +7,7 @@
 // The space-filling set is deterministic: the Halton sequence in bases 2 and 3 maps to holder
 // normals spread evenly over the upper hemisphere (sin α and β uniform, α ≥ 0 as geometry.md's
 // rig reaches every isotropic point that way); each is kept when the pose is within the rig's
-// travel and both directions lie in the plan's region, until the set is full or 4,096 draws per
+// travel and both directions lie in the plan's region, until the set is full or 512 draws per
 // wanted pose have been tried. Angles are rounded to 0.01°. Pure.
 #pragma once
 

@@ -1,5 +1,6 @@
 #include "core/plan/check_fields.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -337,10 +338,30 @@ class FieldChecker {
     ok &= AdaptiveBudget(base + ".budget", a.budget());
     ok &= AdaptiveRegion(base + ".region", a.region());
     const GridSpec paper;
-    ok &= Sweep(base + ".delta", a.delta(), paper.delta_start_deg, paper.delta_stop_deg,
-                paper.delta_step_deg, 0, 180, Axis::kDelta)
-              .has_value();
+    const std::optional<double> n_delta =
+        Sweep(base + ".delta", a.delta(), paper.delta_start_deg, paper.delta_stop_deg,
+              paper.delta_step_deg, 0, 180, Axis::kDelta);
+    ok &= n_delta.has_value();
     ok &= DialPositions(base + ".gamma", a.gamma());
+    const double settings = n_delta.value_or(0) * std::max(a.gamma_size(), 1);
+    if (settings > adaptive::kMaxSeedSettings) {
+      sink_.Add(base + ".delta", Num(settings) +
+                                     " detector and dial settings (δ × γ) is more than " +
+                                     std::to_string(adaptive::kMaxSeedSettings) +
+                                     "; give a coarser δ step or fewer dial positions");
+      ok = false;
+    }
+    const double per_delta = a.seed().readings_per_delta() != 0
+                                 ? a.seed().readings_per_delta()
+                                 : adaptive::kDefaultReadingsPerDelta;
+    if (ok && settings * per_delta > adaptive::kMaxSeedReadings) {
+      sink_.Add(base + ".seed.readingsPerDelta",
+                Num(settings * per_delta) + " seed readings (" + Num(per_delta) + " at each of " +
+                    Num(settings) + " settings) is more than " +
+                    std::to_string(adaptive::kMaxSeedReadings) +
+                    "; give fewer per δ or fewer detector positions");
+      ok = false;
+    }
     const v1::AdaptiveSeed& seed = a.seed();
     if (seed.has_retro_readings() && seed.retro_readings() > 100) {
       sink_.Add(base + ".seed.retroReadings", std::to_string(seed.retro_readings()) +

@@ -150,6 +150,20 @@ TEST(AdaptivePlanTest, UnreachableDetectorPositionIsNamed) {
   EXPECT_THAT(p->message, HasSubstr("δ = 90°"));
 }
 
+TEST(AdaptivePlanTest, SeedSizeIsCapped) {
+  std::vector<Problem> problems = ValidatePlan(
+      PlanFromJson(Adaptive(std::string(kGood) + R"(, "delta": {"step": 0.1})")), RigDescription{});
+  const Problem* settings = Find(problems, "adaptive.delta");
+  ASSERT_NE(settings, nullptr) << FormatProblems(problems);
+  EXPECT_THAT(settings->message, HasSubstr("δ × γ"));
+  problems = ValidatePlan(PlanFromJson(Adaptive(std::string(kGood) + R"(,
+      "gamma": [0, 45, 90], "seed": {"readingsPerDelta": 500})")),
+                          RigDescription{});
+  const Problem* readings = Find(problems, "adaptive.seed.readingsPerDelta");
+  ASSERT_NE(readings, nullptr) << FormatProblems(problems);
+  EXPECT_THAT(readings->message, HasSubstr("21000 seed readings"));
+}
+
 TEST(AdaptivePlanTest, RoundTripsThroughJson) {
   const v1::Plan plan = PlanFromJson(Adaptive(std::string(kGood) + R"(,
     "method": "ADAPTIVE_JUDGE_DELAUNAY", "gamma": [0, 45], "seed": {"retroReadings": 0})"));
