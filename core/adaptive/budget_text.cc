@@ -17,7 +17,7 @@ std::string AdaptiveBoundsText(const v1::Adaptive& adaptive) {
     limits.push_back(std::to_string(spec.budget.max_readings) + " readings");
   }
   if (spec.budget.max_rig_s > 0) {
-    limits.push_back(plan::Num(spec.budget.max_rig_s / 60) + " min of rig time");
+    limits.push_back(plan::Num(spec.budget.max_rig_s / 60) + " min of rig time (prompts included)");
   }
   if (spec.budget.max_prompts > 0) {
     limits.push_back(std::to_string(spec.budget.max_prompts) + " prompts");

@@ -10,8 +10,9 @@
 
 namespace brdf::adaptive {
 
-// "then rounds until U (k = 2) ≤ 5 % over the region, or at most 464 readings, 40 min of rig
-// time, 60 prompts (seed included)".
+// "then rounds of up to 24 readings until the expanded uncertainty (k = 2) is at most 5 % over the
+// region, or at most 464 readings, 38 min of rig time (prompts included) and 60 prompts in all
+// (seed included)".
 std::string AdaptiveBoundsText(const v1::Adaptive& adaptive);
 
 }  // namespace brdf::adaptive

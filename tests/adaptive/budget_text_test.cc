@@ -23,7 +23,7 @@ TEST(AdaptiveBoundsTextTest, StatesEveryLimitAndTheTarget) {
     "target": {"expandedUncertainty": 0.05},
     "budget": {"maxReadings": 464, "maxRigMinutes": 40, "maxPrompts": 60}})"));
   EXPECT_THAT(text, HasSubstr("expanded uncertainty (k = 2) is at most 5 %"));
-  EXPECT_THAT(text, HasSubstr("at most 464 readings, 40 min of rig time and 60 prompts"));
+  EXPECT_THAT(text, HasSubstr("at most 464 readings, 40 min of rig time (prompts included) and 60 prompts"));
   EXPECT_THAT(text, HasSubstr("rounds of up to 24 readings"));
   EXPECT_THAT(text, Not(HasSubstr("unset")));
 }
@@ -32,7 +32,7 @@ TEST(AdaptiveBoundsTextTest, SaysWhatIsLeftUnbounded) {
   const std::string text = AdaptiveBoundsText(FromJson(R"({
     "target": {"expectedError": 0.1}, "budget": {"maxRigMinutes": 30}, "roundReadings": 10})"));
   EXPECT_THAT(text, HasSubstr("expected error is at most 10 %"));
-  EXPECT_THAT(text, HasSubstr("at most 30 min of rig time in all"));
+  EXPECT_THAT(text, HasSubstr("at most 30 min of rig time (prompts included) in all"));
   EXPECT_THAT(text, HasSubstr("unset is bounded only by the rest"));
 }
 
