@@ -3,6 +3,7 @@
 #include <string>
 #include <utility>
 
+#include "core/adaptive/check_seed.h"
 #include "core/plan/check_fields.h"
 #include "core/plan/expand_steps.h"
 #include "core/plan/plan_settings.h"
@@ -31,6 +32,18 @@ PlanAnalysis AnalyzePlan(const v1::Plan& plan, const RigDescription& rig, double
   RigDescription timed = rig;
   timed.time_scale = time_scale;
   out.summary = SummarizeSteps(steps, timed, ResolveSettings(plan).measurement);
+  if (plan.has_adaptive()) {
+    // A budget's rig time is a real rig's (time scale 1), whatever a simulated rig runs at.
+    RigDescription real_rig = rig;
+    real_rig.time_scale = 1;
+    const PlanSummary real = SummarizeSteps(steps, real_rig, ResolveSettings(plan).measurement);
+    adaptive::CheckSeedWithinBudget(plan.adaptive(), real, sink);
+    out.problems = sink.Take();
+    if (!out.problems.empty()) {
+      out.summary = {};
+      return out;
+    }
+  }
   out.steps = std::move(steps);
   return out;
 }

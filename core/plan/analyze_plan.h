@@ -20,6 +20,9 @@
 //     kinematics.
 //   pose list: for each pose: a dial prompt when a manual γ changes, a detector relocation when
 //     δ changes (and before the first pose), MOVE, SAMPLE.
+//   adaptive: the seed design (core/adaptive/seed_design.h) expanded as the pose list it is; the
+//     rounds are chosen from the readings as the session goes (docs/adaptive.md), so they are not
+//     among these steps, and the summary is the seed's cost. The seed must fit the plan's budget.
 #pragma once
 
 #include <vector>

@@ -1,9 +1,12 @@
 #include "core/plan/check_fields.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
 
+#include "core/adaptive/adaptive_spec.h"
+#include "core/adaptive/check_seed.h"
 #include "core/geometry.h"
 #include "core/plan/angle_text.h"
 #include "core/plan/plan_settings.h"
@@ -151,6 +154,29 @@ class FieldChecker {
     return count;
   }
 
+  // Dial positions γ: finite, each once, within the travel of a motorized γ axis.
+  bool DialPositions(const std::string& base,
+                     const google::protobuf::RepeatedField<double>& gamma) {
+    bool ok = true;
+    for (int i = 0; i < gamma.size(); ++i) {
+      const std::string path = Index(base, i);
+      if (!Finite(path, gamma[i])) {
+        ok = false;
+        continue;
+      }
+      for (int j = 0; j < i; ++j) {
+        if (gamma[j] == gamma[i]) {
+          sink_.Add(path, "γ = " + Deg(gamma[i]) + " repeats " + Index("gamma", j) +
+                              "; give each dial position once");
+          ok = false;
+          break;
+        }
+      }
+      if (rig_.has_gamma_axis) ok &= WithinTravel(path, Axis::kGamma, gamma[i]);
+    }
+    return ok;
+  }
+
   void SampleRotation(const v1::SampleRotation& r) {
     const GridSpec defaults;
     const std::string base = "sampleRotation";
@@ -184,23 +210,7 @@ class FieldChecker {
                     "for lamp and detector, e.g. 89.999");
       theta_ok = false;
     }
-    bool gamma_ok = true;
-    for (int i = 0; i < r.gamma_size(); ++i) {
-      const std::string path = Index(base + ".gamma", i);
-      if (!Finite(path, r.gamma(i))) {
-        gamma_ok = false;
-        continue;
-      }
-      for (int j = 0; j < i; ++j) {
-        if (r.gamma(j) == r.gamma(i)) {
-          sink_.Add(path, "γ = " + Deg(r.gamma(i)) + " repeats " + Index("gamma", j) +
-                              "; give each dial position once");
-          gamma_ok = false;
-          break;
-        }
-      }
-      if (rig_.has_gamma_axis) gamma_ok &= WithinTravel(path, Axis::kGamma, r.gamma(i));
-    }
+    const bool gamma_ok = DialPositions(base + ".gamma", r.gamma());
     if (n_delta && n_alpha && n_beta && theta_ok && gamma_ok) {
       const double n_gamma = r.gamma_size() > 0 ? r.gamma_size() : 1;
       const double candidates = *n_delta * *n_alpha * *n_beta * n_gamma;
@@ -321,6 +331,122 @@ class FieldChecker {
     }
   }
 
+  // An adaptive plan's fields (plan.proto: Adaptive); true when all are usable for the seed.
+  bool Adaptive(const v1::Adaptive& a) {
+    const std::string base = "adaptive";
+    bool ok = AdaptiveTarget(base + ".target", a);
+    ok &= AdaptiveBudget(base + ".budget", a.budget());
+    ok &= AdaptiveRegion(base + ".region", a.region());
+    const GridSpec paper;
+    const std::optional<double> n_delta =
+        Sweep(base + ".delta", a.delta(), paper.delta_start_deg, paper.delta_stop_deg,
+              paper.delta_step_deg, 0, 180, Axis::kDelta);
+    ok &= n_delta.has_value();
+    ok &= DialPositions(base + ".gamma", a.gamma());
+    const double settings = n_delta.value_or(0) * std::max(a.gamma_size(), 1);
+    if (settings > adaptive::kMaxSeedSettings) {
+      sink_.Add(base + ".delta", Num(settings) +
+                                     " detector and dial settings (δ × γ) is more than " +
+                                     std::to_string(adaptive::kMaxSeedSettings) +
+                                     "; give a coarser δ step or fewer dial positions");
+      ok = false;
+    }
+    const double per_delta = a.seed().readings_per_delta() != 0
+                                 ? a.seed().readings_per_delta()
+                                 : adaptive::kDefaultReadingsPerDelta;
+    if (ok && settings * per_delta > adaptive::kMaxSeedReadings) {
+      sink_.Add(base + ".seed.readingsPerDelta",
+                Num(settings * per_delta) + " seed readings (" + Num(per_delta) + " at each of " +
+                    Num(settings) + " settings) is more than " +
+                    std::to_string(adaptive::kMaxSeedReadings) +
+                    "; give fewer per δ or fewer detector positions");
+      ok = false;
+    }
+    const v1::AdaptiveSeed& seed = a.seed();
+    if (seed.has_retro_readings() && seed.retro_readings() > 100) {
+      sink_.Add(base + ".seed.retroReadings", std::to_string(seed.retro_readings()) +
+                                                  " is more than 100; give 0 … 100 (0: no scan)");
+      ok = false;
+    }
+    if (seed.readings_per_delta() > 500) {
+      sink_.Add(base + ".seed.readingsPerDelta",
+                std::to_string(seed.readings_per_delta()) + " is more than 500; give 1 … 500");
+      ok = false;
+    }
+    if (a.round_readings() > 1000) {
+      sink_.Add(base + ".roundReadings",
+                std::to_string(a.round_readings()) + " is more than 1000; give 1 … 1000");
+      ok = false;
+    }
+    return ok;
+  }
+
+  bool AdaptiveTarget(const std::string& path, const v1::Adaptive& a) {
+    if (!a.has_target()) {
+      sink_.Add(path,
+                "missing; give expandedUncertainty (k = 2) or expectedError, relative "
+                "(e.g. {\"expandedUncertainty\": 0.05} for 5 %)");
+      return false;
+    }
+    const v1::AdaptiveTarget& t = a.target();
+    if (t.has_expanded_uncertainty() == t.has_expected_error()) {
+      sink_.Add(path, t.has_expected_error()
+                          ? "give either expandedUncertainty or expectedError, not both"
+                          : "no level; give expandedUncertainty (k = 2) or expectedError, "
+                            "relative (e.g. 0.05 for 5 %)");
+      return false;
+    }
+    const bool expanded = t.has_expanded_uncertainty();
+    const double level = expanded ? t.expanded_uncertainty() : t.expected_error();
+    const std::string field = path + (expanded ? ".expandedUncertainty" : ".expectedError");
+    if (!Finite(field, level)) return false;
+    if (level > 0 && level <= 1) return true;
+    sink_.Add(field, Num(level) + " is outside (0, 1]; give a relative level, e.g. 0.05 for 5 %");
+    return false;
+  }
+
+  bool AdaptiveBudget(const std::string& path, const v1::AdaptiveBudget& b) {
+    const double minutes = b.max_rig_minutes();
+    if (!Finite(path + ".maxRigMinutes", minutes)) return false;
+    if (minutes < 0) {
+      sink_.Add(path + ".maxRigMinutes",
+                Num(minutes) + " is negative; give minutes > 0 (0: no limit of its own)");
+      return false;
+    }
+    if (b.max_readings() == 0 && minutes == 0 && b.max_prompts() == 0) {
+      sink_.Add(path,
+                "no limit; give at least one of maxReadings, maxRigMinutes, maxPrompts "
+                "(the session stops at the first reached, or at the target)");
+      return false;
+    }
+    return true;
+  }
+
+  // One polar-angle limit pair of the region: min in [0, 90), max in (min, 90).
+  bool ThetaLimits(const std::string& path, const char* name, bool has_min, double min,
+                   bool has_max, double max) {
+    const double lo = has_min ? min : 0;
+    const double hi = has_max ? max : adaptive::kDefaultThetaMaxDeg;
+    const std::string what = std::string("a polar angle ") + name + " in degrees";
+    bool ok = InRange(path + "Min" + "Deg", lo, 0, 90, "°", what + " [0°, 90°)");
+    ok &= InRange(path + "Max" + "Deg", hi, 0, 90, "°", what + " (0°, 90°)");
+    if (!ok) return false;
+    if (hi >= 90 || hi <= lo) {
+      sink_.Add(path + "MaxDeg", Deg(hi) + " is not between " + name + " min (" + Deg(lo) +
+                                     ") and 90°; give a larger limit below grazing, e.g. 80");
+      return false;
+    }
+    return true;
+  }
+
+  bool AdaptiveRegion(const std::string& path, const v1::AdaptiveRegion& r) {
+    bool ok = ThetaLimits(path + ".thetaI", "θi", r.has_theta_i_min_deg(), r.theta_i_min_deg(),
+                          r.has_theta_i_max_deg(), r.theta_i_max_deg());
+    ok &= ThetaLimits(path + ".thetaO", "θo", r.has_theta_o_min_deg(), r.theta_o_min_deg(),
+                      r.has_theta_o_max_deg(), r.theta_o_max_deg());
+    return ok;
+  }
+
   void Reference(const v1::ReferencePolicy& r) {
     if (Finite("reference.everyMinutes", r.every_minutes()) && r.every_minutes() < 0) {
       sink_.Add("reference.everyMinutes",
@@ -420,8 +546,12 @@ void CheckPlanFields(const v1::Plan& plan, const RigDescription& rig, ProblemSin
     case v1::Plan::kPoseList:
       check.PoseList(plan.pose_list());
       break;
+    case v1::Plan::kAdaptive:
+      if (check.Adaptive(plan.adaptive())) adaptive::CheckSeedDesign(plan.adaptive(), rig, sink);
+      break;
     case v1::Plan::METHOD_NOT_SET:
-      sink.Add("method", "no measurement method; set one of sampleRotation, sampleFixed, poseList");
+      sink.Add("method",
+               "no measurement method; set one of sampleRotation, sampleFixed, poseList, adaptive");
       break;
   }
   check.Reference(plan.reference());

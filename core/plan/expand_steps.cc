@@ -5,6 +5,8 @@
 #include <string>
 #include <utility>
 
+#include "core/adaptive/adaptive_spec.h"
+#include "core/adaptive/seed_design.h"
 #include "core/geometry.h"
 #include "core/plan/angle_text.h"
 #include "core/plan/check_fields.h"
@@ -306,6 +308,26 @@ void ExpandPoseList(const v1::PoseList& list, const RigDescription& rig, Builder
   }
 }
 
+// The seed design of an adaptive plan, as the pose list it is (seed_design.h); the rounds come
+// later, chosen from the readings.
+void ExpandAdaptiveSeed(const v1::Adaptive& adaptive, const RigDescription& rig, Builder& b) {
+  const adaptive::AdaptiveSpec spec = adaptive::ResolveAdaptive(adaptive);
+  v1::PoseList list;
+  for (const adaptive::SeedGroup& group : adaptive::MakeSeedDesign(spec, rig)) {
+    for (std::size_t i = 0; i < group.poses.size(); ++i) {
+      const Pose& p = group.poses[i];
+      v1::PoseEntry* e = list.add_poses();
+      e->set_alpha(p.alpha);
+      e->set_beta(p.beta);
+      e->set_gamma(p.gamma);
+      e->set_delta(p.delta);
+      const bool retro = static_cast<int>(i) < group.retro_poses;
+      e->set_label((retro ? "seed retro-reflection " : "seed ") + PoseText(p));
+    }
+  }
+  ExpandPoseList(list, rig, b);
+}
+
 }  // namespace
 
 std::vector<Step> ExpandCheckedPlan(const v1::Plan& plan, const RigDescription& rig,
@@ -320,6 +342,9 @@ std::vector<Step> ExpandCheckedPlan(const v1::Plan& plan, const RigDescription& 
       break;
     case v1::Plan::kPoseList:
       ExpandPoseList(plan.pose_list(), rig, b);
+      break;
+    case v1::Plan::kAdaptive:
+      ExpandAdaptiveSeed(plan.adaptive(), rig, b);
       break;
     case v1::Plan::METHOD_NOT_SET:
       break;

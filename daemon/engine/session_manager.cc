@@ -23,6 +23,10 @@
 namespace brdf::daemon {
 namespace {
 
+// Adaptive plans validate and estimate (core/adaptive), but no executor chooses their rounds yet.
+constexpr const char* kAdaptiveNotRunnable =
+    "adaptive plans validate and estimate; this daemon cannot run them yet (issue 38)";
+
 std::string Who(const Actor& actor) {
   std::string who = actor.name.empty() ? std::string("anonymous") : actor.name;
   if (!actor.role.empty()) who += " (" + actor.role + ")";
@@ -489,6 +493,11 @@ Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor
     return InvalidArgument("the plan has " + std::to_string(analysis.problems.size()) +
                            " problem(s); fix them and submit again:\n" + listing);
   }
+  if (plan.has_adaptive()) {
+    impl_->Audit(actor, "session.submit", std::nullopt,
+                 "refused: plan \"" + plan.name() + "\" is adaptive");
+    return FailedPrecondition(kAdaptiveNotRunnable);
+  }
   BRDF_ASSIGN_OR_RETURN(std::string json, plan::PlanToJson(plan));
 
   storage::NewSession session;
@@ -526,6 +535,12 @@ Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor
 Result<v1::Session> SessionManager::Start(SessionId session, const Actor& actor) {
   return impl_->Verb(session, actor, "session.start", "started by " + Who(actor),
                      [&]() REQUIRES(impl_->mu) -> Status {
+                       if (impl_->StateLocked(session).ok()) {
+                         auto kept = impl_->PlanLocked(session, nullptr);
+                         if (kept.ok() && (*kept)->plan.has_adaptive()) {
+                           return FailedPrecondition(kAdaptiveNotRunnable);
+                         }
+                       }
                        BRDF_ASSIGN_OR_RETURN(SessionState to,
                                              impl_->TransitionLocked(session, SessionEvent::kStart,
                                                                      "started by " + Who(actor)));

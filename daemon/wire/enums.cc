@@ -230,6 +230,8 @@ std::string PlanKindWord(const v1::Plan& plan) {
       return "sample_fixed";
     case v1::Plan::kPoseList:
       return "pose_list";
+    case v1::Plan::kAdaptive:
+      return "adaptive";
     default:
       return "";
   }

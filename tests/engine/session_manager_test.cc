@@ -15,6 +15,8 @@
 #include <thread>
 
 #include "core/geometry.h"
+#include "core/plan/plan_json.h"
+#include "daemon/wire/plan.h"
 #include "drivers/pr650/spectroradiometer.h"
 #include "drivers/stage/modbus_stage.h"
 #include "storage/session_store.h"
@@ -538,6 +540,43 @@ TEST_F(EngineTest, InvalidPlanIsRefusedWithEveryProblemAndItsFieldPath) {
   EXPECT_EQ(manager_->GetSession(12345).status().code(), StatusCode::kNotFound);
   EXPECT_EQ(manager_->Pause(12345, PauseMode::kDeferred, kTestOperator).status().code(),
             StatusCode::kNotFound);
+}
+
+TEST_F(EngineTest, AdaptivePlanValidatesButIsRefusedUntilTheEngineRunsIt) {
+  const v1::Plan plan = PlanFromJson(R"({
+    "name": "adaptive",
+    "adaptive": {"target": {"expandedUncertainty": 0.05}, "budget": {"maxReadings": 300},
+                 "delta": {"start": 0, "stop": 22.5, "step": 11.25}}
+  })");
+  const plan::PlanAnalysis analysis = manager_->ValidatePlan(plan);
+  EXPECT_TRUE(analysis.valid()) << plan::FormatProblems(analysis.problems);
+  EXPECT_GT(analysis.summary.sample_readings, 0);  // the seed design's cost
+  for (bool start_now : {true, false}) {
+    auto refused = manager_->SubmitPlan(plan, kTestOperator, start_now);
+    EXPECT_EQ(refused.status().code(), StatusCode::kFailedPrecondition);
+    EXPECT_EQ(refused.status().message(),
+              "adaptive plans validate and estimate; this daemon cannot run them yet (issue 38)");
+  }
+  auto listed = manager_->ListSessions();
+  ASSERT_TRUE(listed.ok());
+  EXPECT_TRUE(listed->empty());  // nothing stored, nothing queued
+  // A stored adaptive session (another daemon's, say) is not started either.
+  storage::NewSession stored;
+  stored.name = "adaptive";
+  stored.plan_kind = "adaptive";
+  Result<std::string> json = plan::PlanToJson(plan);
+  ASSERT_TRUE(json.ok());
+  stored.plan_json = *json;
+  std::vector<storage::StepRecord> seed;
+  for (const plan::Step& step : analysis.steps) seed.push_back(daemon::ToStepRecord(step));
+  Result<std::int64_t> id = store_->CreateSession(stored, seed);
+  ASSERT_TRUE(id.ok()) << id.status().ToString();
+  auto start = manager_->Start(*id, kTestOperator);
+  EXPECT_EQ(start.status().code(), StatusCode::kFailedPrecondition);
+  EXPECT_NE(start.status().message().find("cannot run them yet (issue 38)"), std::string::npos);
+  auto session = manager_->GetSession(*id);
+  ASSERT_TRUE(session.ok());
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_QUEUED);
 }
 
 TEST_F(EngineTest, RigReportsBothDevicesTheMeterSerialAndTheLivePose) {

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <memory>
 
+#include "core/adaptive/budget_text.h"
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/output/json.h"
 #include "tools/brdfctl/output/session_text.h"
@@ -63,7 +64,11 @@ int RunValidate(CommandContext& ctx, const std::string& plan_path, double time_s
   if (reply.valid()) {
     ctx.out << plan_path << ": valid\n";
     if (reply.has_summary()) {
+      if (plan->has_adaptive()) ctx.out << "  adaptive: the seed design,\n";
       ctx.out << "  " << PlanSummaryText(reply.summary(), time_scale, real_rig_s) << "\n";
+      if (plan->has_adaptive()) {
+        ctx.out << "  " << adaptive::AdaptiveBoundsText(plan->adaptive()) << "\n";
+      }
     } else {
       ctx.out << "  " << reply.step_count() << " steps, " << reply.operator_interventions()
               << " operator actions, about " << Duration(reply.estimated_duration_s()) << "\n";

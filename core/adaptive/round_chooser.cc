@@ -1,0 +1,138 @@
+#include "core/adaptive/round_chooser.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <limits>
+#include <memory>
+#include <tuple>
+
+#include "core/adaptive/seed_design.h"
+#include "core/geometry.h"
+
+namespace brdf::adaptive {
+namespace {
+
+auto Key(const Pose& p) {
+  return std::tie(p.delta, p.gamma, p.alpha, p.beta);
+}
+
+bool SameSetting(const Pose& a, const Pose& b) {
+  return a.delta == b.delta && a.gamma == b.gamma;
+}
+
+// Candidates already measured (a reading's pose) start out taken.
+std::vector<bool> MeasuredAlready(const RoundInput& input) {
+  std::vector<Pose> measured;
+  for (const ReadingSoFar& r : input.readings) measured.push_back(r.pose);
+  std::sort(measured.begin(), measured.end(),
+            [](const Pose& a, const Pose& b) { return Key(a) < Key(b); });
+  std::vector<bool> taken(input.candidates.size());
+  for (std::size_t i = 0; i < taken.size(); ++i) {
+    taken[i] = std::binary_search(measured.begin(), measured.end(), input.candidates[i],
+                                  [](const Pose& a, const Pose& b) { return Key(a) < Key(b); });
+  }
+  return taken;
+}
+
+// The greedy picks, in pick order.
+std::vector<ChosenPose> PickGreedy(const RoundInput& input, UncertaintyMap& map,
+                                   const RoundCost& cost, const RoundOptions& options) {
+  std::vector<Directions> directions;
+  directions.reserve(input.candidates.size());
+  for (const Pose& c : input.candidates) directions.push_back(PoseToDirections(c));
+  std::vector<bool> taken = MeasuredAlready(input);
+  std::vector<ChosenPose> picks;
+  Pose at = input.rig_at;
+  Spend spent = input.spent;
+  while (static_cast<int>(picks.size()) < options.max_readings) {
+    std::size_t best = input.candidates.size();
+    double best_score = -std::numeric_limits<double>::infinity();
+    double best_gain = 0;
+    PoseCost best_cost;
+    for (std::size_t i = 0; i < input.candidates.size(); ++i) {
+      if (taken[i]) continue;
+      const Pose& c = input.candidates[i];
+      const double gain = map.PredictedGain(directions[i]);
+      if (!(gain > 0)) continue;
+      const PoseCost step = cost.Step(at, c);
+      if (!WithinBudget(input.budget, spent, step, 1)) continue;
+      const double charged = options.group_by_delta ? step.seconds : cost.MoveAndReadSeconds(at, c);
+      const double score = gain / std::max(charged, 1e-6);
+      if (score > best_score || (score == best_score && Key(c) < Key(input.candidates[best]))) {
+        best = i;
+        best_score = score;
+        best_gain = gain;
+        best_cost = step;
+      }
+    }
+    if (best == input.candidates.size()) break;
+    taken[best] = true;
+    map.Assume(directions[best]);
+    at = input.candidates[best];
+    spent.readings += 1;
+    spent.seconds += best_cost.seconds;
+    spent.prompts += best_cost.prompts;
+    picks.push_back({at, best_gain});
+  }
+  return picks;
+}
+
+// The picks grouped by (δ, γ): the rig's present setting first, then in order of first pick;
+// each group ordered for short moves.
+std::vector<ChosenPose> GroupBySetting(const std::vector<ChosenPose>& picks, const Pose& rig_at) {
+  std::vector<Pose> settings;
+  for (const ChosenPose& p : picks) {
+    if (std::none_of(settings.begin(), settings.end(),
+                     [&](const Pose& s) { return SameSetting(s, p.pose); })) {
+      settings.push_back(p.pose);
+    }
+  }
+  std::stable_partition(settings.begin(), settings.end(),
+                        [&](const Pose& s) { return SameSetting(s, rig_at); });
+  std::vector<ChosenPose> out;
+  for (const Pose& setting : settings) {
+    std::vector<Pose> group;
+    for (const ChosenPose& p : picks) {
+      if (SameSetting(p.pose, setting)) group.push_back(p.pose);
+    }
+    OrderForTravel(group);
+    for (const Pose& pose : group) {
+      for (const ChosenPose& p : picks) {
+        if (p.pose == pose) out.push_back(p);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+bool WithinBudget(const Budget& budget, const Spend& spent, const PoseCost& more, int readings) {
+  if (budget.max_readings > 0 && spent.readings + readings > budget.max_readings) return false;
+  if (budget.max_rig_s > 0 && spent.seconds + more.seconds > budget.max_rig_s + 1e-9) return false;
+  if (budget.max_prompts > 0 && spent.prompts + more.prompts > budget.max_prompts) return false;
+  return true;
+}
+
+Round ChooseRound(const RoundInput& input, const UncertaintyModel& model, const RoundCost& cost,
+                  const RoundOptions& options) {
+  std::unique_ptr<UncertaintyMap> map = model.Map(input.readings);
+  std::vector<ChosenPose> picks = PickGreedy(input, *map, cost, options);
+  if (options.group_by_delta) picks = GroupBySetting(picks, input.rig_at);
+  Round round;
+  std::vector<Pose> poses;
+  for (const ChosenPose& p : picks) poses.push_back(p.pose);
+  // Costed in measurement order; cut from the end until it fits.
+  while (!poses.empty()) {
+    round.cost = cost.Sequence(input.rig_at, poses);
+    if (WithinBudget(input.budget, input.spent, round.cost, static_cast<int>(poses.size()))) break;
+    poses.pop_back();
+    picks.pop_back();
+    round.cost = {};
+  }
+  round.poses = std::move(picks);
+  for (const ChosenPose& p : round.poses) round.predicted_gain += p.predicted_gain;
+  return round;
+}
+
+}  // namespace brdf::adaptive

@@ -1,0 +1,66 @@
+// One round of an adaptive session: which poses to measure next. Greedy: from the candidate
+// poses, repeatedly take the one with the largest predicted gain per second — the fall of the
+// integrated, cosine-weighted uncertainty (uncertainty_model.h) over what the reading costs from
+// where the rig then is (round_cost.h: move, reading, and a δ change costed as its prompt and
+// reference block) — and count it as measured (UncertaintyMap::Assume) before the next pick;
+// stop at the round's size, when nothing affordable gains anything, or at the budget. Then the
+// batch is grouped by detector position (the rig's present δ first, then in order of first
+// pick), each group ordered for short moves, so the operator relocates the detector once per δ
+// per round; the batch is costed again in that order and cut from the end to fit the budget.
+//
+// Deterministic: the same readings, candidates (in any order), rig position, spend and budget
+// give the same poses in the same order; equal scores go to the smaller (δ, γ, α, β).
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "core/adaptive/adaptive_spec.h"
+#include "core/adaptive/round_cost.h"
+#include "core/adaptive/uncertainty_model.h"
+#include "core/pose.h"
+
+namespace brdf::adaptive {
+
+// What a session has used so far (the seed design's included).
+struct Spend {
+  int readings = 0;
+  double seconds = 0;
+  int prompts = 0;
+};
+
+// True when `spent` plus `more` stays within every limit of `budget` (1e-9 s of slack).
+bool WithinBudget(const Budget& budget, const Spend& spent, const PoseCost& more, int readings);
+
+struct ChosenPose {
+  Pose pose;                  // model angles
+  double predicted_gain = 0;  // when it was picked, with the earlier picks assumed
+};
+
+struct Round {
+  std::vector<ChosenPose> poses;  // in measurement order
+  double predicted_gain = 0;      // sum of the picks' gains
+  PoseCost cost;                  // of the poses in measurement order, from the rig's pose
+};
+
+struct RoundInput {
+  std::span<const ReadingSoFar> readings;  // every sample reading so far
+  std::span<const Pose> candidates;        // model angles (candidates.h)
+  Pose rig_at;                             // where the rig is (model angles): the last reading
+  Spend spent;
+  Budget budget;
+};
+
+struct RoundOptions {
+  int max_readings = kDefaultRoundReadings;
+  // false, for comparison only: δ changes are not charged when picking and the batch is measured
+  // in pick order (it is still costed, prompts included, for the budget).
+  bool group_by_delta = true;
+};
+
+// The next round; empty when nothing affordable is predicted to gain anything (the caller
+// stops: stop_rule.h). A candidate equal to a reading's pose or to an earlier pick is skipped.
+Round ChooseRound(const RoundInput& input, const UncertaintyModel& model, const RoundCost& cost,
+                  const RoundOptions& options = {});
+
+}  // namespace brdf::adaptive

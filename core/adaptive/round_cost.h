@@ -1,0 +1,53 @@
+// What one more sample reading costs a round, in rig time and operator prompts, by the plan's
+// own timing model (core/plan/timing.h) and its own policies: the move and the reading (StepTimer
+// over a move and a sample step, the move overlapping the previous reading's transfer); a change
+// of δ adds what the plan expander puts between two readings at different δ (the relocation
+// prompt, or the arm's move, and under reference.perDetectorPosition the reference block with
+// its prompts and, with dark.withEachReference, the dark), measured once by expanding a two-pose
+// pose list with the plan's policies; a change of γ on a manual dial adds its prompt. The
+// reference rules by count or by minutes are not charged per pose (the round's steps, expanded
+// as a pose list, carry them exactly).
+#pragma once
+
+#include <span>
+
+#include "brdf/v1/plan.pb.h"
+#include "core/plan/plan_settings.h"
+#include "core/plan/rig_description.h"
+#include "core/pose.h"
+
+namespace brdf::adaptive {
+
+struct PoseCost {
+  double seconds = 0;
+  int prompts = 0;
+  PoseCost& operator+=(const PoseCost& other) {
+    seconds += other.seconds;
+    prompts += other.prompts;
+    return *this;
+  }
+};
+
+class RoundCost {
+ public:
+  // `plan` gives the reference, dark and measurement policies (its method is not used); `rig`
+  // the timing and which axes are manual. Times are for real devices (time scale 1): budgets
+  // are in a real rig's time.
+  RoundCost(const v1::Plan& plan, const plan::RigDescription& rig);
+
+  // From a reading at `from` to a reading at `to` (model angles).
+  PoseCost Step(const Pose& from, const Pose& to) const;
+  // Step() without what a change of δ or of a manual γ adds: the move and the reading alone.
+  double MoveAndReadSeconds(const Pose& from, const Pose& to) const;
+  // The readings `poses` in order, the rig starting after a reading at `from`.
+  PoseCost Sequence(const Pose& from, std::span<const Pose> poses) const;
+  // What a change of δ adds to a reading (see above).
+  const PoseCost& delta_change() const { return delta_change_; }
+
+ private:
+  plan::RigDescription rig_;
+  plan::MeasurementChoice measurement_;
+  PoseCost delta_change_;
+};
+
+}  // namespace brdf::adaptive

@@ -1,0 +1,30 @@
+// When an adaptive session stops: at the target, or when a budget is spent, checked before each
+// round; a round that finds nothing affordable worth measuring (ChooseRound's empty round) also
+// ends it. The first reason that holds is the one given, in the order of the enum.
+#pragma once
+
+#include "core/adaptive/adaptive_spec.h"
+#include "core/adaptive/round_chooser.h"
+
+namespace brdf::adaptive {
+
+enum class StopReason {
+  kContinue,
+  kTargetReached,  // the uncertainty left is at or below the target's level
+  kReadingBudget,  // budget.maxReadings reached
+  kTimeBudget,     // budget.maxRigMinutes reached
+  kPromptBudget,   // budget.maxPrompts reached
+  kNothingToGain,  // no affordable candidate is predicted to lower the uncertainty
+};
+
+// "target reached", "reading budget spent", …; "continue".
+const char* StopReasonText(StopReason reason);
+
+// Before a round: `remaining` is UncertaintyMap::Remaining() for the readings so far.
+StopReason ShouldStop(double remaining, const Target& target, const Budget& budget,
+                      const Spend& spent);
+
+// After choosing: kNothingToGain for an empty round, else kContinue.
+StopReason AfterChoosing(const Round& round);
+
+}  // namespace brdf::adaptive
