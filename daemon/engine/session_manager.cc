@@ -189,7 +189,10 @@ struct SessionManager::Impl final : public ExecutorHost {
       queue.erase(std::remove(queue.begin(), queue.end(), id), queue.end());
     }
     if (IsTerminal(*to) && holder == id) holder.reset();
-    if (IsTerminal(*to)) l.prompt.reset();
+    if (IsTerminal(*to)) {
+      l.prompt.reset();
+      owner.endings_.fetch_add(1);
+    }
 
     v1::SessionEvent change;
     change.mutable_state_changed()->set_from(ToProtoState(from));

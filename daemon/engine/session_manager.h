@@ -37,6 +37,7 @@
 //     back into the manager's verbs.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -167,9 +168,13 @@ class SessionManager {
   Result<std::vector<v1::Session>> ListSessions(const std::vector<SessionState>& states = {}) const;
   // The rig's devices, live pose and meter serial, plus which session holds the rig.
   v1::RigStatus GetRigStatus() const;
-  // The session's state as the manager knows it (no store read once the session is known; a
-  // following stream asks it before each page). kNotFound when there is no such session.
+  // The session's state as the manager knows it (no store read once the session is known).
+  // kNotFound when there is no such session.
   Result<SessionState> State(SessionId session) const;
+  // How many times a session reached a terminal state (any session), without the manager's lock:
+  // a following stream asks State (which takes the lock the verbs take) only when this moved
+  // since it last asked, so analysts' streams never hold up the operator's verbs.
+  std::uint64_t endings() const { return endings_.load(); }
   // The session's plan, parsed once (at submission, or when the session is first loaded) and
   // kept with the session (session_plan.h). kNotFound when there is no such session; kInternal
   // "session N: its stored plan does not parse: …" (logged once) when its stored plan is
@@ -198,6 +203,7 @@ class SessionManager {
   std::shared_ptr<storage::SessionStore> store_;
   std::shared_ptr<Rig> rig_;
   Options options_;
+  std::atomic<std::uint64_t> endings_{0};
   std::unique_ptr<Impl> impl_;
 };
 

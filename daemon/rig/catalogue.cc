@@ -79,8 +79,14 @@ SessionFollow RigCatalogue::Follow(SessionId session) {
   fanout_.Join(session);
   std::shared_ptr<void> joined(nullptr, [this, session](void*) { fanout_.Leave(session); });
   SessionFollow follow;
-  follow.ended = [this, session, joined]() -> Result<bool> {
+  // The manager's lock only when a session ended since the last look (endings() is read first:
+  // an ending after the look moves it again).
+  auto looked = std::make_shared<std::optional<std::uint64_t>>();
+  follow.ended = [this, session, joined, looked]() -> Result<bool> {
+    const std::uint64_t endings = manager_.endings();
+    if (looked->has_value() && **looked == endings) return false;
     BRDF_ASSIGN_OR_RETURN(SessionState now, manager_.State(session));
+    *looked = endings;
     return IsTerminal(now);
   };
   follow.wait = [this, session, joined](const StopSignal& stopping, std::int64_t last_id) {
