@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -57,6 +58,12 @@ grpc::Status ControlService::NoRig(const char* method, const std::string& sessio
 }
 
 namespace {
+
+// How long a WatchSession stream with no event waits before it looks at its client's
+// cancellation and the server's stop again (an event wakes it at once). 1 s, not 200 ms: 400
+// watchers then wake 400 times a second, not 2,000 (issue 40), and a cancelled watch frees its
+// thread within a second.
+constexpr std::chrono::milliseconds kWatchIdleWait{1000};
 
 // The session id of a request, or INVALID_ARGUMENT naming the field.
 grpc::Status ParseId(const std::string& text, SessionId* id) {
@@ -136,11 +143,12 @@ grpc::Status ControlService::PauseSession(grpc::ServerContext* context,
     return InvalidField("mode", "unknown pause mode " + std::to_string(request->mode()) +
                                     "; use PAUSE_MODE_DEFERRED or PAUSE_MODE_IMMEDIATE");
   }
-  Result<v1::Session> before = catalogue_.GetSession(id);
-  Result<v1::Session> session = rig_->Pause(id, *mode, caller.ToActor());
+  // Whether it was paused before comes from the rig's own state as the verb ran: no read of the
+  // session before the verb (1.5 ms of 3.4 idle, more under the analysts' reads).
+  bool was_paused = false;
+  Result<v1::Session> session = rig_->Pause(id, *mode, caller.ToActor(), &was_paused);
   if (!session.ok()) return ToGrpcStatus(session.status());
-  response->set_already_paused(before.ok() && before->state() == v1::SESSION_STATE_PAUSED &&
-                               session->state() == v1::SESSION_STATE_PAUSED);
+  response->set_already_paused(was_paused && session->state() == v1::SESSION_STATE_PAUSED);
   *response->mutable_session() = std::move(*session);
   return grpc::Status::OK;
 }
@@ -220,7 +228,7 @@ grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
     // At shutdown, send what is queued (the pause the shutdown made, typically), then end.
     const bool stopping = stopping_.stopped();
     std::optional<v1::SessionEvent> event =
-        watch.Next(stopping ? std::chrono::milliseconds(0) : kStreamPollInterval);
+        watch.Next(stopping ? std::chrono::milliseconds(0) : kWatchIdleWait);
     if (event.has_value()) {
       if (!slot->Write(writer, *event)) {
         watch.Close();

@@ -50,7 +50,8 @@ grpc::Status DataService::Serve(grpc::ServerContext& context,
   ReadingSource source;
   source.reader = &reader;
   source.ended = follow.ended;
-  source.wait = [&] { return follow.wait(stopping_); };
+  source.wait = [&](std::int64_t last_id) { return follow.wait(stopping_, last_id); };
+  source.recent = follow.recent;
   source.server = program_;
   // Labels and averaging are fixed at submission.
   source.extras = [&] {

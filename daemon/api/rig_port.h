@@ -42,7 +42,10 @@ class RigPort {
   // faster (0: the rig's own, its [rig] time_scale); nothing stored.
   virtual plan::PlanAnalysis ValidatePlan(const v1::Plan& plan, double time_scale) const = 0;
   virtual Result<v1::Session> Start(SessionId session, const Actor& actor) = 0;
-  virtual Result<v1::Session> Pause(SessionId session, PauseMode mode, const Actor& actor) = 0;
+  // `already_paused` (not null): whether the session was PAUSED before this call, as the rig
+  // knew it when the verb ran (no second read of the session).
+  virtual Result<v1::Session> Pause(SessionId session, PauseMode mode, const Actor& actor,
+                                    bool* already_paused) = 0;
   virtual Result<v1::Session> Resume(SessionId session, const Actor& actor) = 0;
   virtual Result<v1::Session> Abort(SessionId session, const std::string& reason,
                                     const Actor& actor) = 0;

@@ -50,9 +50,15 @@ struct SessionFollow {
   // Asked BEFORE each page: true when the session will get no reading after what the next page
   // reads (so a short page then ends the stream).
   std::function<Result<bool>()> ended;
-  // After a short page of a session not ended: waits a while for more readings, or until
-  // `stopping`. True when stopping.
-  std::function<bool(const StopSignal& stopping)> wait;
+  // After a short page of a session not ended (the stream's last reading id `last_id`): waits
+  // until a newer reading may be there, or a while, or until `stopping`. True when stopping.
+  std::function<bool(const StopSignal& stopping, std::int64_t last_id)> wait;
+  // After a wait: the readings after `after_id` (at most `limit`, in id order) when the catalogue
+  // holds them for all its followers (api/stream_readings_fanout.h), nullopt when the stream must
+  // read the store itself. Empty: always the store.
+  std::function<Result<std::optional<std::vector<storage::ReadingRecord>>>(std::int64_t after_id,
+                                                                           int limit)>
+      recent;
 };
 
 class SessionCatalogue {

@@ -1,7 +1,9 @@
 #include "daemon/api/stream_readings.h"
 
 #include <functional>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace brdf::daemon {
@@ -86,7 +88,7 @@ grpc::Status ForEachReadingPage(
     }
     if (more_stored) continue;  // next page now
     if (ended) return grpc::Status::OK;
-    if (source.wait()) {
+    if (source.wait(last)) {
       return grpc::Status(grpc::StatusCode::UNAVAILABLE,
                           std::string(call.rpc) + ": " + source.server +
                               " is shutting down; resume with after_id = " + std::to_string(last) +
@@ -102,9 +104,22 @@ grpc::Status StreamSessionReadings(grpc::ServerContext& context,
                                    StreamReadingsCall& call, const ReadingSource& source,
                                    grpc::ServerWriter<v1::Reading>* writer) {
   const ReadingExtras extras = source.extras();
+  // The page after a wait comes from the catalogue's fan-out when it holds it (one store read per
+  // commit for all followers); the pages before (catching up) from the store.
+  ReadingSource waiting = source;
+  bool waited = false;
+  waiting.wait = [&](std::int64_t last_id) {
+    waited = true;
+    return source.wait(last_id);
+  };
   return ForEachReadingPage<storage::ReadingRecord>(
-      context, request, call, source, kPageSize,
-      [&](std::int64_t after_id, int limit) {
+      context, request, call, waiting, kPageSize,
+      [&](std::int64_t after_id, int limit) -> Result<std::vector<storage::ReadingRecord>> {
+        if (std::exchange(waited, false) && source.recent) {
+          BRDF_ASSIGN_OR_RETURN(std::optional<std::vector<storage::ReadingRecord>> held,
+                                source.recent(after_id, limit));
+          if (held.has_value()) return std::move(*held);
+        }
         return source.reader->GetReadings(call.session, after_id, limit);
       },
       [&](const std::vector<const storage::ReadingRecord*>& page, bool) {

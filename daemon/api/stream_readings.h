@@ -41,9 +41,15 @@ struct ReadingSource {
   // With follow, asked BEFORE each page: true when the session will get no reading after what
   // the next page reads (so a short page then ends the stream).
   std::function<Result<bool>()> ended;
-  // With follow, after a short page of a session not ended: waits a while for more; true when
-  // the server is stopping (the stream then ends with UNAVAILABLE).
-  std::function<bool()> wait;
+  // With follow, after a short page of a session not ended (its last reading id given): waits
+  // until more may be there, or a while; true when the server is stopping (the stream then ends
+  // with UNAVAILABLE).
+  std::function<bool(std::int64_t last_id)> wait;
+  // With follow, the page after a wait, when the catalogue holds it for all its followers
+  // (SessionFollow::recent; nullopt or empty: read `reader`).
+  std::function<Result<std::optional<std::vector<storage::ReadingRecord>>>(std::int64_t after_id,
+                                                                           int limit)>
+      recent;
   std::string server = "the server";  // in the stopping message ("brdfd is shutting down; …")
   // The session's step labels and averaging (ReadingExtrasOf), for the readings that carry them:
   // StreamReadings asks once, before its first page; StreamReadingPoints never (a session of

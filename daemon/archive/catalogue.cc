@@ -96,7 +96,9 @@ Result<SessionPage> ArchiveCatalogue::ListSessions(const CatalogueFilter& filter
 SessionFollow ArchiveCatalogue::Follow(SessionId session) {
   SessionFollow follow;
   follow.ended = [this, session] { return archive_->Finished(session); };
-  follow.wait = [](const StopSignal& stopping) { return stopping.WaitFor(kArchivePollInterval); };
+  follow.wait = [](const StopSignal& stopping, std::int64_t) {
+    return stopping.WaitFor(kArchivePollInterval);
+  };
   return follow;
 }
 

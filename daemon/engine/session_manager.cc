@@ -15,6 +15,7 @@
 #include "core/plan/plan_summary.h"
 #include "core/plan/sample.h"
 #include "core/plan/timing.h"
+#include "daemon/engine/audit_writer.h"
 #include "daemon/engine/executor.h"
 #include "daemon/wire/enums.h"
 #include "daemon/wire/plan.h"
@@ -192,7 +193,10 @@ struct SessionManager::Impl final : public ExecutorHost {
       queue.erase(std::remove(queue.begin(), queue.end(), id), queue.end());
     }
     if (IsTerminal(*to) && holder == id) holder.reset();
-    if (IsTerminal(*to)) l.prompt.reset();
+    if (IsTerminal(*to)) {
+      l.prompt.reset();
+      owner.endings_.fetch_add(1);
+    }
 
     v1::SessionEvent change;
     change.mutable_state_changed()->set_from(ToProtoState(from));
@@ -276,26 +280,24 @@ struct SessionManager::Impl final : public ExecutorHost {
 
   // --- Audit --------------------------------------------------------------------------------
 
+  // The record, durable when this returns (`later`: written by the audit writer's thread right
+  // after; audit_writer.h says which verbs).
   void Audit(const Actor& actor, const std::string& action, std::optional<SessionId> session,
-             const std::string& detail) {
+             const std::string& detail, bool later = false) {
     storage::AuditRecord record;
     record.role = actor.role;
     record.actor = actor.name;
     record.action = action;
     record.session_id = session;
     record.detail = detail;
-    Status st = store.AppendAudit(record);
-    if (!st.ok() && session.has_value()) {  // e.g. no such session: keep the record without it
-      record.session_id.reset();
-      record.detail = SessionName(*session) + ": " + detail;
-      st = store.AppendAudit(record);
-    }
-    if (!st.ok()) spdlog::warn("audit record {} not stored: {}", action, st.ToString());
+    later ? audit.WriteLater(std::move(record)) : audit.Write(std::move(record));
   }
 
-  // Runs a verb under the lock and audits it, successful or refused.
+  // Runs a verb under the lock and audits it, successful or refused. A refused verb, or one whose
+  // body set `*changed_nothing` (when given), is answered before its record is written.
   Result<v1::Session> Verb(SessionId id, const Actor& actor, const std::string& action,
-                           const std::string& detail, const std::function<Status()>& body) {
+                           const std::string& detail, const std::function<Status()>& body,
+                           const bool* changed_nothing = nullptr) {
     Status st;
     Result<v1::Session> out = Internal("unset");
     {
@@ -307,7 +309,8 @@ struct SessionManager::Impl final : public ExecutorHost {
       }
       if (st.ok()) out = BuildLocked(id, /*with_plan=*/true);
     }
-    Audit(actor, action, id, st.ok() ? detail : "refused: " + st.ToString());
+    const bool later = !st.ok() || (changed_nothing != nullptr && *changed_nothing);
+    Audit(actor, action, id, st.ok() ? detail : "refused: " + st.ToString(), later);
     if (!st.ok()) return st;
     return out;
   }
@@ -382,6 +385,11 @@ struct SessionManager::Impl final : public ExecutorHost {
   storage::SessionStore& store;
   Rig& rig;
   EventBus bus;
+  AuditWriter audit{
+      store, [] {
+        return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+            .count();
+      }};
 
   Mutex mu;
   CondVar scheduler_cv;
@@ -471,6 +479,7 @@ void SessionManager::Shutdown(std::chrono::milliseconds timeout) {
   lock.Unlock();
   if (m.scheduler.joinable()) m.scheduler.join();
   if (m.running_thread.joinable()) m.running_thread.join();
+  m.audit.Drain();  // the records of verbs answered before their record was written
   rig_->Stop();
 }
 
@@ -549,26 +558,34 @@ Result<v1::Session> SessionManager::Start(SessionId session, const Actor& actor)
                      });
 }
 
-Result<v1::Session> SessionManager::Pause(SessionId session, PauseMode mode, const Actor& actor) {
+Result<v1::Session> SessionManager::Pause(SessionId session, PauseMode mode, const Actor& actor,
+                                          bool* already_paused) {
+  if (already_paused != nullptr) *already_paused = false;
+  bool was_paused = false;
   const bool immediate = mode == PauseMode::kImmediate;
   const std::string reason =
       std::string("paused (") + (immediate ? "immediate" : "deferred") + ") by " + Who(actor);
-  return impl_->Verb(session, actor, "session.pause", reason, [&]() REQUIRES(impl_->mu) -> Status {
-    Impl& m = *impl_;
-    m.mu.AssertHeld();  // the same mutex, under another name
-    BRDF_RETURN_IF_ERROR(m.StateLocked(session).status());
-    if (!immediate) m.live[session].pause_reason = reason;
-    BRDF_ASSIGN_OR_RETURN(
-        SessionState to,
-        m.TransitionLocked(session,
-                           immediate ? SessionEvent::kPauseImmediate : SessionEvent::kPauseDeferred,
-                           reason));
-    // Paused now (immediate, or while awaiting the operator): stop the run where it is.
-    if (to == SessionState::kPaused && m.current && m.current->session() == session) {
-      m.current->Cancel(reason);
-    }
-    return Status::Ok();
-  });
+  return impl_->Verb(
+      session, actor, "session.pause", reason,
+      [&]() REQUIRES(impl_->mu) -> Status {
+        Impl& m = *impl_;
+        m.mu.AssertHeld();  // the same mutex, under another name
+        BRDF_ASSIGN_OR_RETURN(SessionState from, m.StateLocked(session));
+        was_paused = from == SessionState::kPaused;
+        if (already_paused != nullptr) *already_paused = was_paused;
+        if (!immediate) m.live[session].pause_reason = reason;
+        BRDF_ASSIGN_OR_RETURN(
+            SessionState to,
+            m.TransitionLocked(
+                session, immediate ? SessionEvent::kPauseImmediate : SessionEvent::kPauseDeferred,
+                reason));
+        // Paused now (immediate, or while awaiting the operator): stop the run where it is.
+        if (to == SessionState::kPaused && m.current && m.current->session() == session) {
+          m.current->Cancel(reason);
+        }
+        return Status::Ok();
+      },
+      &was_paused);
 }
 
 Result<v1::Session> SessionManager::Resume(SessionId session, const Actor& actor) {
@@ -642,6 +659,11 @@ Result<v1::Session> SessionManager::AnswerPrompt(SessionId session, int step_ind
 Result<v1::Session> SessionManager::GetSession(SessionId session) const {
   MutexLock lock(impl_->mu);
   return impl_->BuildLocked(session, /*with_plan=*/true);
+}
+
+Result<SessionState> SessionManager::State(SessionId session) const {
+  MutexLock lock(impl_->mu);
+  return impl_->StateLocked(session);
 }
 
 Result<std::vector<v1::Session>> SessionManager::ListSessions(

@@ -37,6 +37,7 @@
 //     back into the manager's verbs.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -139,8 +140,11 @@ class SessionManager {
   // a no-op that returns it.
   Result<v1::Session> Start(SessionId session, const Actor& actor);
   // RUNNING → PAUSING (deferred) or PAUSED (immediate); AWAITING_OPERATOR → PAUSED. Pausing a
-  // paused session is a no-op; immediate upgrades a pausing one.
-  Result<v1::Session> Pause(SessionId session, PauseMode mode, const Actor& actor);
+  // paused session is a no-op; immediate upgrades a pausing one. `already_paused` (when given)
+  // says whether the session was PAUSED before the call, from the manager's state under the
+  // same lock as the verb (no store read).
+  Result<v1::Session> Pause(SessionId session, PauseMode mode, const Actor& actor,
+                            bool* already_paused = nullptr);
   // PAUSED (or PAUSING: cancels the pending pause) → RUNNING, or QUEUED when another session
   // holds the rig. The step cancelled by an immediate pause, or that faulted, is run again, after
   // moving the stage to the pose of the first unfinished step.
@@ -164,6 +168,13 @@ class SessionManager {
   Result<std::vector<v1::Session>> ListSessions(const std::vector<SessionState>& states = {}) const;
   // The rig's devices, live pose and meter serial, plus which session holds the rig.
   v1::RigStatus GetRigStatus() const;
+  // The session's state as the manager knows it (no store read once the session is known).
+  // kNotFound when there is no such session.
+  Result<SessionState> State(SessionId session) const;
+  // How many times a session reached a terminal state (any session), without the manager's lock:
+  // a following stream asks State (which takes the lock the verbs take) only when this moved
+  // since it last asked, so analysts' streams never hold up the operator's verbs.
+  std::uint64_t endings() const { return endings_.load(); }
   // The session's plan, parsed once (at submission, or when the session is first loaded) and
   // kept with the session (session_plan.h). kNotFound when there is no such session; kInternal
   // "session N: its stored plan does not parse: …" (logged once) when its stored plan is
@@ -192,6 +203,7 @@ class SessionManager {
   std::shared_ptr<storage::SessionStore> store_;
   std::shared_ptr<Rig> rig_;
   Options options_;
+  std::atomic<std::uint64_t> endings_{0};
   std::unique_ptr<Impl> impl_;
 };
 

@@ -10,14 +10,15 @@
 
 namespace brdf::daemon {
 
-RigCatalogue::RigCatalogue(SessionManager& manager) : manager_(manager) {
-  listener_ = manager_.AddReadingListener([this](SessionId, const storage::ReadingRecord&) {
-    {
-      MutexLock lock(mu_);
-      ++generation_;
-    }
-    cv_.NotifyAll();
-  });
+RigCatalogue::RigCatalogue(SessionManager& manager)
+    : manager_(manager),
+      fanout_([&manager](std::int64_t session, std::int64_t after_id, int limit) {
+        return manager.store()->GetReadings(session, after_id, limit);
+      }) {
+  listener_ =
+      manager_.AddReadingListener([this](SessionId session, const storage::ReadingRecord& reading) {
+        fanout_.Committed(session, reading.id);
+      });
 }
 
 RigCatalogue::~RigCatalogue() {
@@ -73,29 +74,28 @@ storage::SessionReader& RigCatalogue::reader() {
   return *manager_.store();
 }
 
-std::uint64_t RigCatalogue::Generation() const {
-  MutexLock lock(mu_);
-  return generation_;
-}
-
-void RigCatalogue::WaitForReading(std::uint64_t seen, std::chrono::steady_clock::duration d,
-                                  const StopSignal& stopping) const {
-  MutexLock lock(mu_);
-  cv_.WaitFor(mu_, d, [&]() REQUIRES(mu_) { return generation_ != seen || stopping.stopped(); });
-}
-
 SessionFollow RigCatalogue::Follow(SessionId session) {
-  auto seen = std::make_shared<std::uint64_t>(0);
+  // The stream follows from now: joined before its first page is read from the store.
+  fanout_.Join(session);
+  std::shared_ptr<void> joined(nullptr, [this, session](void*) { fanout_.Leave(session); });
   SessionFollow follow;
-  follow.ended = [this, session, seen]() -> Result<bool> {
-    BRDF_ASSIGN_OR_RETURN(storage::SessionRecord now, manager_.store()->GetSession(session));
-    *seen = Generation();
-    return IsTerminal(now.state);
+  // The manager's lock only when a session ended since the last look (endings() is read first:
+  // an ending after the look moves it again).
+  auto looked = std::make_shared<std::optional<std::uint64_t>>();
+  follow.ended = [this, session, joined, looked]() -> Result<bool> {
+    const std::uint64_t endings = manager_.endings();
+    if (looked->has_value() && **looked == endings) return false;
+    BRDF_ASSIGN_OR_RETURN(SessionState now, manager_.State(session));
+    *looked = endings;
+    return IsTerminal(now);
   };
-  follow.wait = [this, seen](const StopSignal& stopping) {
+  follow.wait = [this, session, joined](const StopSignal& stopping, std::int64_t last_id) {
     if (stopping.stopped()) return true;
-    WaitForReading(*seen, kStreamPollInterval, stopping);
-    return false;
+    fanout_.Wait(session, last_id, kFollowIdleWait);
+    return stopping.stopped();
+  };
+  follow.recent = [this, session, joined](std::int64_t after_id, int limit) {
+    return fanout_.After(session, after_id, limit);
   };
   return follow;
 }

@@ -36,8 +36,9 @@ Result<v1::Session> ManagerRigPort::Start(SessionId session, const Actor& actor)
   return manager_.Start(session, actor);
 }
 
-Result<v1::Session> ManagerRigPort::Pause(SessionId session, PauseMode mode, const Actor& actor) {
-  return manager_.Pause(session, mode, actor);
+Result<v1::Session> ManagerRigPort::Pause(SessionId session, PauseMode mode, const Actor& actor,
+                                          bool* already_paused) {
+  return manager_.Pause(session, mode, actor, already_paused);
 }
 
 Result<v1::Session> ManagerRigPort::Resume(SessionId session, const Actor& actor) {

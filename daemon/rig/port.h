@@ -17,7 +17,8 @@ class ManagerRigPort final : public RigPort {
   Result<v1::Session> SubmitPlan(const v1::Plan& plan, const Actor& actor, bool start_now) override;
   plan::PlanAnalysis ValidatePlan(const v1::Plan& plan, double time_scale) const override;
   Result<v1::Session> Start(SessionId session, const Actor& actor) override;
-  Result<v1::Session> Pause(SessionId session, PauseMode mode, const Actor& actor) override;
+  Result<v1::Session> Pause(SessionId session, PauseMode mode, const Actor& actor,
+                            bool* already_paused) override;
   Result<v1::Session> Resume(SessionId session, const Actor& actor) override;
   Result<v1::Session> Abort(SessionId session, const std::string& reason,
                             const Actor& actor) override;

@@ -140,7 +140,9 @@ void StreamRegistry::Watchdog() {
   MutexLock lock(mu_);
   while (!stop_) {
     stop_cv_.WaitFor(mu_, period);
+    lock.Unlock();  // a trim takes milliseconds: streams open and close meanwhile
     budget_.TrimIfDue();
+    lock.Lock();
     const std::int64_t now = NowNs();
     const std::int64_t limit =
         std::chrono::duration_cast<std::chrono::nanoseconds>(stall_timeout_).count();

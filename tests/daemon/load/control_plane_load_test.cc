@@ -110,6 +110,32 @@ TEST(ControlPlaneLoadTest, OperatorCallsAnswerWhile400AnalystStreamsAreOpen) {
   (void)MedianRigStatusMs(rig, 20);  // warm-up
   const double idle_ms = MedianRigStatusMs(rig, 40);
 
+  // Two followers that read: under the load they get every reading of the session, in order, as
+  // the fan-out hands them out (api/stream_readings_fanout.h), until the session ends.
+  std::vector<std::vector<std::int64_t>> followed(2);
+  std::vector<std::thread> followers;
+  struct JoinFollowers {
+    std::vector<std::thread>& threads;
+    ~JoinFollowers() {
+      for (std::thread& t : threads) {
+        if (t.joinable()) t.join();
+      }
+    }
+  } join_followers{followers};
+  for (std::vector<std::int64_t>& ids : followed) {
+    followers.emplace_back([&rig, &id, &ids] {
+      v1::StreamReadingsRequest r;
+      r.set_session_id(id);
+      r.set_follow(true);
+      auto context = DaemonRig::Context(kAnalystToken, 120s);
+      auto stream = rig.data().StreamReadings(context.get(), r);
+      v1::Reading reading;
+      while (stream->Read(&reading)) ids.push_back(reading.id());
+      const grpc::Status ended = stream->Finish();
+      EXPECT_TRUE(ended.ok()) << ended.error_code() << " " << ended.error_message();
+    });
+  }
+
   // The analysts' streams, over 8 connections of their own.
   std::vector<std::shared_ptr<grpc::Channel>> channels;
   for (int c = 0; c < 8; ++c) {
@@ -279,6 +305,21 @@ TEST(ControlPlaneLoadTest, OperatorCallsAnswerWhile400AnalystStreamsAreOpen) {
   abort.set_reason("test done");
   v1::AbortSessionResponse aborted;
   (void)rig.control().AbortSession(DaemonRig::Context().get(), abort, &aborted);
+
+  // The session ended: the followers' streams end, each with every reading the store holds.
+  for (std::thread& t : followers) t.join();
+  std::vector<std::int64_t> stored;
+  {
+    v1::StreamReadingsRequest r;
+    r.set_session_id(id);
+    auto context = DaemonRig::Context(kAnalystToken, 30s);
+    auto stream = rig.data().StreamReadings(context.get(), r);
+    v1::Reading reading;
+    while (stream->Read(&reading)) stored.push_back(reading.id());
+    ASSERT_TRUE(stream->Finish().ok());
+  }
+  EXPECT_GT(stored.size(), 2u);
+  for (const std::vector<std::int64_t>& ids : followed) EXPECT_EQ(ids, stored);
 }
 
 }  // namespace
