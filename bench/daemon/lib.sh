@@ -83,6 +83,17 @@ start_rig_on_sim() {
   wait_for_rig_connected "$ctl"
 }
 
+# Records the plan $1 on the rig start_rig_on_sim started (its prompts answered by mounting on the
+# simulator, its log in $2): submits, starts and watches it until it ends or pauses; sets
+# `session` to its id. Uses the script's `ctl` and start_rig_on_sim's `modbus`.
+record_session_on_sim() {
+  local plan="$1" log="$2" on_prompt
+  session="$("$ctl" submit "$plan" --start --quiet)"
+  on_prompt="$(printf '%q sim-mount from-prompt --modbus %q' "$ctl" "$modbus")"
+  "$ctl" watch "$session" --auto-confirm --on-prompt "$on_prompt" --exit-on-pause \
+    >"$log" 2>&1 </dev/null
+}
+
 # brdfd's configuration on stdout, with both tokens: $1 database, $2 meter port, $3 Modbus
 # host:port, $4 more [server] lines. A script may set config_axis_speed (deg/s of α, β and δ;
 # unset: the defaults) and config_extra (TOML appended at the end, in tables of its own).

@@ -32,10 +32,7 @@ config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
 echo "grid export's uncertainty: cost — $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) CPUs"
 echo "load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
 start_rig_on_sim "$work" 8 warn
-session="$("$ctl" submit "$root/examples/plans/demo.json" --start --quiet)"
-on_prompt="$(printf '%q sim-mount from-prompt --modbus %q' "$ctl" "$modbus")"
-"$ctl" watch "$session" --auto-confirm --on-prompt "$on_prompt" --exit-on-pause \
-  >"$work/watch.out" 2>&1 </dev/null
+record_session_on_sim "$root/examples/plans/demo.json" "$work/watch.out"
 echo "session $session recorded (demo plan)"
 
 steps="${COST_STEPS:-2,2,2}"
@@ -45,7 +42,7 @@ export_once() {  # $1: "" or --uncertainty; prints seconds
   t0="$(date +%s.%N)"
   "$ctl" export "$session" grid \
     -o "$work/g.npy" --steps "$steps" --float32 --method "${COST_METHOD:-octant}" \
-    --fill "${COST_FILL:-chain}" $1 >/dev/null 2>"$work/export.err" || {
+    --fill "${COST_FILL:-chain}" ${1:+"$1"} >/dev/null 2>"$work/export.err" || {
     cat "$work/export.err" >&2
     exit 1
   }
@@ -63,7 +60,7 @@ for ((r = 0; r < ${COST_REPS:-5}; r++)); do
     plain+=("$(export_once "")")
   fi
 done
-ls -l "$work"/g.* | awk '{print "  " $5 " bytes  " $NF}'
+find "$work" -maxdepth 1 -name 'g.*' -printf '  %s bytes  %p\n' | sort -k3
 python3 - "${plain[*]}" "${with[*]}" <<'PY'
 import statistics, sys
 plain = [float(x) for x in sys.argv[1].split()]

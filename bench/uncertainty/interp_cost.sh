@@ -35,10 +35,7 @@ config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
 echo "interpolated values' uncertainty: cost — $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) CPUs"
 echo "load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
 start_rig_on_sim "$work" 8 warn
-session="$("$ctl" submit "$root/examples/plans/demo.json" --start --quiet)"
-on_prompt="$(printf '%q sim-mount from-prompt --modbus %q' "$ctl" "$modbus")"
-"$ctl" watch "$session" --auto-confirm --on-prompt "$on_prompt" --exit-on-pause \
-  >"$work/watch.out" 2>&1 </dev/null
+record_session_on_sim "$root/examples/plans/demo.json" "$work/watch.out"
 budgets="$(sqlite3 -readonly "$work/brdfd.db" \
   "SELECT count(*) FROM reading_uncertainty u JOIN readings r ON r.id = u.reading_id
    WHERE r.session_id = $session")"
