@@ -184,6 +184,8 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
                                        published.skipped_detail[qi], session));
   BRDF_ASSIGN_OR_RETURN(MadeIndex made,
                         MakeIndex(published.sets[qi], method, options, stale.get(), session));
+  std::shared_ptr<const CalibrationSlot> calibration =
+      CarriedCalibration(stale.get(), published.sets[qi]->size());
   stale.reset();
 
   auto snapshot = std::make_shared<IndexSnapshot>();
@@ -199,6 +201,7 @@ Result<std::shared_ptr<const IndexSnapshot>> IndexCache::Get(SessionId session, 
   snapshot->skipped_detail = published.skipped_detail[qi];
   snapshot->samples = published.sets[qi];
   if (quantity == Quantity::kBrdf) snapshot->budgets = published.brdf_budgets;
+  snapshot->calibration = std::move(calibration);
   snapshot->interpolator =
       std::shared_ptr<const interp::Interpolator>(std::move(made.interpolator));
   Keep(*entry, key, snapshot);

@@ -146,4 +146,13 @@ uncertainty::InterpolationCalibration CalibrateInterpolation(const IndexSnapshot
                                                   uncertainty::CalibrationTarget{});
 }
 
+std::shared_ptr<const CalibrationSlot> CarriedCalibration(const IndexSnapshot* previous,
+                                                          std::size_t samples) {
+  if (previous != nullptr && previous->calibration != nullptr) {
+    const std::size_t base = previous->calibration->samples();
+    if (samples <= base + base / 4) return previous->calibration;
+  }
+  return std::make_shared<CalibrationSlot>(samples);
+}
+
 }  // namespace brdf::daemon

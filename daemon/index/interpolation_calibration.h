@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <mutex>
 #include <vector>
 
@@ -43,17 +44,31 @@ std::vector<uncertainty::HeldOutPoint> PredictHeldOut(const interp::SampleSet& s
 // no interpolation term, and when too few held-out readings could be predicted.
 uncertainty::InterpolationCalibration CalibrateInterpolation(const IndexSnapshot& snapshot);
 
-// Holds a snapshot's calibration, computed once on first use; thread-safe.
+// Holds a snapshot's calibration, computed once on first use; thread-safe. A recording session's
+// next snapshots share their predecessor's slot until the session has grown by a quarter
+// (CarriedCalibration): the calibration is a property of the sample and the grid's density, which
+// a few more readings barely change, and each calibration builds up to kMaxFolds indexes.
 class CalibrationSlot {
  public:
+  CalibrationSlot() = default;
+  // `samples`: how many samples the snapshot it was made for holds.
+  explicit CalibrationSlot(std::size_t samples) : samples_(samples) {}
+  std::size_t samples() const { return samples_; }
   const uncertainty::InterpolationCalibration& Get(const IndexSnapshot& snapshot) const {
     std::call_once(once_, [&] { value_ = CalibrateInterpolation(snapshot); });
     return value_;
   }
 
  private:
+  std::size_t samples_ = 0;
   mutable std::once_flag once_;
   mutable uncertainty::InterpolationCalibration value_;
 };
+
+// The calibration slot of a new snapshot over `samples` samples: `previous`'s (this key's
+// snapshot over fewer readings, may be null) while samples ≤ 1.25 × the samples its slot was made
+// for, else a new one.
+std::shared_ptr<const CalibrationSlot> CarriedCalibration(const IndexSnapshot* previous,
+                                                          std::size_t samples);
 
 }  // namespace brdf::daemon
