@@ -11,6 +11,7 @@
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "core/client_text.h"
+#include "core/json_text.h"
 
 namespace brdf::daemon {
 namespace {
@@ -40,38 +41,6 @@ std::map<std::string, WebMethod, std::less<>> BuildMethods() {
 std::unique_ptr<pb::Message> NewMessage(const pb::Descriptor* type) {
   return std::unique_ptr<pb::Message>(
       pb::MessageFactory::generated_factory()->GetPrototype(type)->New());
-}
-
-std::string JsonEscape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out;
 }
 
 const char* CodeName(grpc::StatusCode code) {
@@ -167,8 +136,8 @@ std::string ToJson(const pb::Message& message) {
 }
 
 std::string StatusJson(const grpc::Status& status) {
-  return std::string("{\"code\":\"") + CodeName(status.error_code()) + "\",\"message\":\"" +
-         JsonEscape(status.error_message()) + "\"}";
+  return std::string("{\"code\":\"") + CodeName(status.error_code()) +
+         "\",\"message\":" + JsonString(status.error_message()) + "}";
 }
 
 int HttpStatusFor(grpc::StatusCode code) {

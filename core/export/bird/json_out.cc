@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "core/export/json_text.h"
+#include "core/json_text.h"
 #include "core/export/number_text.h"
 
 namespace brdf::exports {

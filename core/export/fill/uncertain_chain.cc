@@ -6,7 +6,7 @@
 #include <span>
 #include <utility>
 
-#include "core/export/json_text.h"
+#include "core/json_text.h"
 #include "core/export/number_text.h"
 #include "core/fit/models.h"
 #include "core/uncertainty/interpolated.h"

@@ -6,7 +6,7 @@
 
 #include "core/export/fill/uncertain_chain.h"
 #include "core/export/grid/regular_grid.h"
-#include "core/export/json_text.h"
+#include "core/json_text.h"
 #include "core/export/number_text.h"
 
 namespace brdf::exports {

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <string>
 
+#include "core/json_text.h"
 #include "tools/brdf-sim/optics/material.h"
 #include "tools/brdf-sim/optics/optics.h"
 
@@ -14,24 +15,6 @@ std::string Number(double x) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.17g", x);
   return buf;
-}
-
-// A JSON string literal: quotes, backslashes and control characters escaped.
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
-#include "core/export/json_text.h"
+#include "core/json_text.h"
 
 #include <cstdio>
 
-namespace brdf::exports {
+namespace brdf {
 
 void AppendJsonString(std::string& out, std::string_view text) {
   out += '"';
@@ -42,4 +42,4 @@ std::string JsonString(std::string_view text) {
   return out;
 }
 
-}  // namespace brdf::exports
+}  // namespace brdf
