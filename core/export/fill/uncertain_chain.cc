@@ -27,8 +27,9 @@ void WriteAnswer(const interp::Interpolation& answer, const uncertainty::Interpo
                  std::span<double> row) {
   const std::size_t bands = answer.spectrum.size();
   std::copy(answer.spectrum.begin(), answer.spectrum.end(), row.begin());
-  const uncertainty::InterpolatedUncertainty u =
-      uncertainty::EstimateInterpolatedUncertainty(answer, inputs);
+  // Kept by each resampling thread from cell to cell: a grid's cells allocate nothing for it.
+  thread_local uncertainty::InterpolatedUncertainty u;
+  uncertainty::EstimateInterpolatedUncertainty(answer, inputs, &u);
   // A vertex without a budget would leave the blend short: the whole part is NaN, never partial.
   bool every_budget = !u.measurement.empty();
   for (const interp::Vertex& v : answer.vertices) {
