@@ -180,4 +180,22 @@ struct SessionEventRecord {
   std::string reason;
 };
 
+// One round of an adaptive session (schema v6's adaptive_rounds; docs/adaptive.md): the poses the
+// engine chose, stored with the round's steps in one transaction before any of them is measured.
+struct RoundPick {
+  Pose pose;                  // model angles (α, β, γ, δ), as the chooser gave them
+  double predicted_gain = 0;  // the fall of the integrated uncertainty it was predicted to bring
+};
+struct RoundRecord {
+  std::int64_t session_id = 0;
+  int round = 0;                 // 1, 2, 3, … (the seed is round 0 and has no record)
+  int first_step = 0;            // the index of the round's first step
+  int step_count = 0;            // its steps: first_step … first_step + step_count − 1
+  std::vector<RoundPick> picks;  // in measurement order
+  double predicted_gain = 0;     // sum of the picks' gains
+  double uncertainty_left = 0;   // the integrated uncertainty before the round (the target's unit)
+  int readings_used = 0;         // sample readings it was chosen from
+  UnixSeconds created_at = 0;    // filled by the store
+};
+
 }  // namespace brdf::storage

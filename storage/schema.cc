@@ -208,12 +208,39 @@ CREATE TABLE reading_uncertainty (
 );
 )sql";
 
-constexpr std::array<Migration, 5> kMigrations{{
+// Version 6: the rounds of adaptive sessions (docs/adaptive.md), each stored with its steps in one
+// transaction before it is measured: the poses chosen (one line "alpha beta gamma delta gain" per
+// pick, model angles in degrees), the predicted gain, the uncertainty left when it was chosen and
+// the number of sample readings it was chosen from. Steps appended to a session after it was
+// created are noted in the archive's outbox (only steps beyond the session's total at the time,
+// so that a new session's steps are not noted twice).
+constexpr std::string_view kV6 = R"sql(
+CREATE TABLE adaptive_rounds (
+  session_id       INTEGER NOT NULL REFERENCES sessions (id),
+  round            INTEGER NOT NULL CHECK (round >= 1),
+  first_step       INTEGER NOT NULL CHECK (first_step >= 0),
+  step_count       INTEGER NOT NULL CHECK (step_count >= 1),
+  picks            TEXT    NOT NULL,
+  predicted_gain   REAL    NOT NULL,
+  uncertainty_left REAL    NOT NULL,
+  readings_used    INTEGER NOT NULL CHECK (readings_used >= 0),
+  created_at       REAL    NOT NULL,
+  PRIMARY KEY (session_id, round)
+) WITHOUT ROWID;
+CREATE TRIGGER archive_step_appended AFTER INSERT ON steps
+  WHEN (SELECT value FROM archive_marks WHERE name = 'enabled') = 1 AND
+       NEW.step_index >= (SELECT total_steps FROM sessions WHERE id = NEW.session_id)
+  BEGIN INSERT INTO archive_outbox (session_id, step_index) VALUES (NEW.session_id, NEW.step_index);
+  END;
+)sql";
+
+constexpr std::array<Migration, 6> kMigrations{{
     {1, "create sessions, steps, readings, devices and audit", kV1},
     {2, "give every session a UUID and its rig's name", kV2},
     {3, "keep an outbox and marks for shipping to the lab archive", kV3},
     {4, "keep every session's history of states (session_events)", kV4},
     {5, "keep each reading's uncertainty budget (reading_uncertainty)", kV5},
+    {6, "keep the rounds of adaptive sessions (adaptive_rounds)", kV6},
 }};
 
 std::string Hex(std::int64_t v) {

@@ -1,5 +1,5 @@
 // The database schema and its migrations. The full description is in storage/schema.md; in short
-// (schema version 5):
+// (schema version 6):
 //
 //   sessions  id, name, plan_kind, plan_json (the plan as submitted), state, state_reason,
 //             created_at, started_at, finished_at, created_by_role, total_steps, done_steps
@@ -29,6 +29,9 @@
 //             "name sharing id"), contributions (BLOB), not_estimated: a sample reading's
 //             uncertainty budget, written with the reading; no row: not estimated
 //             (uncertainty_columns.h)
+//   adaptive_rounds (v6)  (session_id, round) primary key; first_step, step_count, picks (text
+//             lines "alpha beta gamma delta gain"), predicted_gain, uncertainty_left,
+//             readings_used, created_at: a round of an adaptive session, stored with its steps
 //
 // Timestamps are Unix seconds (REAL, UTC). Angles are degrees. Enumerations are lower-case words
 // guarded by CHECK constraints.

@@ -6,6 +6,7 @@
 
 #include "core/spectrum.h"
 #include "core/status.h"
+#include "storage/round_picks.h"
 #include "storage/schema.h"
 #include "storage/session_rows.h"
 #include "storage/spectrum_blob.h"
@@ -277,6 +278,56 @@ Status MarkStepDone(Database& db, std::int64_t session, int step_index, UnixSeco
   return st.Run().WithContext(what + ": counting the step done");
 }
 
+// Steps to store: at least one, numbered first, first + 1, … in order, every angle finite.
+Status CheckNewSteps(const std::vector<StepRecord>& steps, int first, const std::string& what) {
+  if (steps.empty()) return InvalidArgument(what + ": the plan has no steps");
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const int want = first + static_cast<int>(i);
+    if (steps[i].step_index != want) {
+      return InvalidArgument(what + ": step " + std::to_string(want) + " has step_index " +
+                             std::to_string(steps[i].step_index) + "; steps must be numbered " +
+                             std::to_string(first) + ", " + std::to_string(first + 1) +
+                             ", … in order");
+    }
+    if (!Finite(steps[i].pose) || (steps[i].target && !Finite(*steps[i].target))) {
+      return InvalidArgument(what + ": step " + std::to_string(want) + " has a non-finite angle");
+    }
+  }
+  return Status::Ok();
+}
+
+// Inserts `steps` of `session` (inside the caller's transaction).
+Status InsertSteps(Database& db, std::int64_t id, const std::vector<StepRecord>& steps,
+                   const std::string& what) {
+  BRDF_ASSIGN_OR_RETURN(
+      Statement st,
+      db.Prepare("INSERT INTO steps (session_id, step_index, kind, alpha, beta, gamma, delta, "
+                 "prompt, prompt_kind, expected_action, target_theta_i, target_phi_i, "
+                 "target_theta_o, target_phi_o, label) "
+                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
+  for (const StepRecord& step : steps) {
+    const std::optional<Directions>& t = step.target;
+    st.Bind(1, id)
+        .Bind(2, step.step_index)
+        .Bind(3, ToString(step.kind))
+        .Bind(4, step.pose.alpha)
+        .Bind(5, step.pose.beta)
+        .Bind(6, step.pose.gamma)
+        .Bind(7, step.pose.delta)
+        .Bind(8, step.prompt)
+        .Bind(9, step.prompt_kind)
+        .Bind(10, step.expected_action)
+        .Bind(11, t ? std::optional<double>(t->theta_i) : std::nullopt)
+        .Bind(12, t ? std::optional<double>(t->phi_i) : std::nullopt)
+        .Bind(13, t ? std::optional<double>(t->theta_o) : std::nullopt)
+        .Bind(14, t ? std::optional<double>(t->phi_o) : std::nullopt)
+        .Bind(15, step.label);
+    BRDF_RETURN_IF_ERROR(st.Run().WithContext(what + ", step " + std::to_string(step.step_index)));
+    st.Reset();
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 // --- Opening
@@ -315,17 +366,7 @@ UnixSeconds SessionStore::Now() const {
 Result<std::int64_t> SessionStore::CreateSession(const NewSession& session,
                                                  const std::vector<StepRecord>& steps) {
   const std::string what = "creating session \"" + session.name + "\"";
-  if (steps.empty()) return InvalidArgument(what + ": the plan has no steps");
-  for (std::size_t i = 0; i < steps.size(); ++i) {
-    if (steps[i].step_index != static_cast<int>(i)) {
-      return InvalidArgument(what + ": step " + std::to_string(i) + " has step_index " +
-                             std::to_string(steps[i].step_index) +
-                             "; steps must be numbered 0, 1, 2, … in order");
-    }
-    if (!Finite(steps[i].pose) || (steps[i].target && !Finite(*steps[i].target))) {
-      return InvalidArgument(what + ": step " + std::to_string(i) + " has a non-finite angle");
-    }
-  }
+  BRDF_RETURN_IF_ERROR(CheckNewSteps(steps, 0, what));
   const UnixSeconds now = Now();
 
   MutexLock lock(write_mu_);
@@ -351,34 +392,85 @@ Result<std::int64_t> SessionStore::CreateSession(const NewSession& session,
     BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
   }
   const std::int64_t id = db.last_insert_rowid();
-  BRDF_ASSIGN_OR_RETURN(
-      Statement st,
-      db.Prepare("INSERT INTO steps (session_id, step_index, kind, alpha, beta, gamma, delta, "
-                 "prompt, prompt_kind, expected_action, target_theta_i, target_phi_i, "
-                 "target_theta_o, target_phi_o, label) "
-                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
-  for (const StepRecord& step : steps) {
-    const std::optional<Directions>& t = step.target;
-    st.Bind(1, id)
-        .Bind(2, step.step_index)
-        .Bind(3, ToString(step.kind))
-        .Bind(4, step.pose.alpha)
-        .Bind(5, step.pose.beta)
-        .Bind(6, step.pose.gamma)
-        .Bind(7, step.pose.delta)
-        .Bind(8, step.prompt)
-        .Bind(9, step.prompt_kind)
-        .Bind(10, step.expected_action)
-        .Bind(11, t ? std::optional<double>(t->theta_i) : std::nullopt)
-        .Bind(12, t ? std::optional<double>(t->phi_i) : std::nullopt)
-        .Bind(13, t ? std::optional<double>(t->theta_o) : std::nullopt)
-        .Bind(14, t ? std::optional<double>(t->phi_o) : std::nullopt)
-        .Bind(15, step.label);
-    BRDF_RETURN_IF_ERROR(st.Run().WithContext(what + ", step " + std::to_string(step.step_index)));
-    st.Reset();
-  }
+  BRDF_RETURN_IF_ERROR(InsertSteps(db, id, steps, what));
   BRDF_RETURN_IF_ERROR(tx.Commit().WithContext(what));
   return id;
+}
+
+Status SessionStore::AppendRound(const RoundRecord& round, const std::vector<StepRecord>& steps) {
+  const std::int64_t id = round.session_id;
+  const std::string what =
+      "storing round " + std::to_string(round.round) + " of " + SessionName(id);
+  BRDF_RETURN_IF_ERROR(CheckNewSteps(steps, round.first_step, what));
+  const UnixSeconds now = Now();
+  MutexLock lock(write_mu_);
+  Database& db = *writer_;
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
+  BRDF_ASSIGN_OR_RETURN(SessionState state, SessionStateOf(db, id));
+  if (IsTerminal(state)) {
+    return FailedPrecondition(what + ": the session has ended (" +
+                              std::string(SessionStateName(state)) + ")");
+  }
+  BRDF_ASSIGN_OR_RETURN(std::int64_t total,
+                        db.QueryInt64("SELECT total_steps FROM sessions WHERE id = " + S(id)));
+  BRDF_ASSIGN_OR_RETURN(
+      std::int64_t rounds,
+      db.QueryInt64("SELECT count(*) FROM adaptive_rounds WHERE session_id = " + S(id)));
+  if (round.round != rounds + 1 || round.first_step != total) {
+    return FailedPrecondition(what + ": the session has " + S(rounds) + " round(s) and " +
+                              S(total) + " steps; the next round is " + S(rounds + 1) +
+                              " from step " + S(total) + " (not stored twice)");
+  }
+  BRDF_RETURN_IF_ERROR(InsertSteps(db, id, steps, what));
+  BRDF_ASSIGN_OR_RETURN(Statement up,
+                        db.Prepare("UPDATE sessions SET total_steps = ? WHERE id = ?"));
+  up.Bind(1, total + static_cast<std::int64_t>(steps.size())).Bind(2, id);
+  BRDF_RETURN_IF_ERROR(up.Run().WithContext(what));
+  BRDF_ASSIGN_OR_RETURN(
+      Statement st,
+      db.Prepare("INSERT INTO adaptive_rounds (session_id, round, first_step, step_count, picks, "
+                 "predicted_gain, uncertainty_left, readings_used, created_at) "
+                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)"));
+  st.Bind(1, id)
+      .Bind(2, round.round)
+      .Bind(3, round.first_step)
+      .Bind(4, static_cast<int>(steps.size()))
+      .Bind(5, EncodePicks(round.picks))
+      .Bind(6, round.predicted_gain)
+      .Bind(7, round.uncertainty_left)
+      .Bind(8, round.readings_used)
+      .Bind(9, now);
+  BRDF_RETURN_IF_ERROR(st.Run().WithContext(what));
+  return tx.Commit().WithContext(what);
+}
+
+Result<std::vector<RoundRecord>> SessionStore::GetRounds(std::int64_t session) {
+  BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
+  BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
+  BRDF_RETURN_IF_ERROR(RequireSession(*db, session));
+  BRDF_ASSIGN_OR_RETURN(
+      Statement st,
+      db->Prepare("SELECT round, first_step, step_count, picks, predicted_gain, uncertainty_left, "
+                  "readings_used, created_at FROM adaptive_rounds WHERE session_id = ? "
+                  "ORDER BY round"));
+  st.Bind(1, session);
+  std::vector<RoundRecord> out;
+  while (true) {
+    BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
+    if (!row) break;
+    RoundRecord r;
+    r.session_id = session;
+    r.round = st.Int(0);
+    r.first_step = st.Int(1);
+    r.step_count = st.Int(2);
+    BRDF_ASSIGN_OR_RETURN(r.picks, DecodePicks(st.Text(3)));
+    r.predicted_gain = st.Double(4);
+    r.uncertainty_left = st.Double(5);
+    r.readings_used = st.Int(6);
+    r.created_at = st.Double(7);
+    out.push_back(std::move(r));
+  }
+  return out;
 }
 
 Status SessionStore::SetSessionState(std::int64_t session, SessionState state, std::string reason) {

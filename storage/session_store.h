@@ -90,6 +90,18 @@ class SessionStore final : public SessionReader {
   Result<std::int64_t> CreateSession(const NewSession& session,
                                      const std::vector<StepRecord>& steps);
 
+  // Appends a round of an adaptive session: its steps (numbered total_steps, total_steps + 1, …,
+  // as round.first_step says), the session's total_steps raised by their number, and the round's
+  // record (adaptive_rounds), in ONE transaction: a crash leaves the whole round or none of it.
+  //   kNotFound            no such session;
+  //   kFailedPrecondition  the session has ended, or round.round is not the next round number
+  //                        (a round chosen twice is refused, nothing is written), or
+  //                        round.first_step is not the session's total_steps;
+  //   kInvalidArgument     no steps, misnumbered steps, a non-finite angle.
+  Status AppendRound(const RoundRecord& round, const std::vector<StepRecord>& steps);
+  // The session's rounds, in order (empty for a session that has none).
+  Result<std::vector<RoundRecord>> GetRounds(std::int64_t session);
+
   // Moves a session to `state`, recording why. Sets started_at the first time it becomes running
   // and finished_at when it becomes completed, aborted or failed. kFailedPrecondition when the
   // session is already in a terminal state, or when it is to be completed with steps pending.

@@ -44,6 +44,15 @@ class Builder {
         timer_(rig, settings_.measurement),
         sample_fixed_(plan.method_case() == v1::Plan::kSampleFixed) {}
 
+  // Continues after steps stored before (ExpandPosesFrom).
+  void StartFrom(const ExpansionStart& start) {
+    model_ = start.model;
+    have_reference_ = start.have_reference;
+    relocated_since_reference_ = start.relocated_since_reference;
+    samples_since_reference_ = start.samples_since_reference;
+    last_reference_s_ = -start.seconds_since_reference;
+  }
+
   bool full() const { return steps_.size() > static_cast<std::size_t>(kMaxSteps); }
   const Pose& model() const { return model_; }
   std::vector<Step> Take() { return std::move(steps_); }
@@ -291,12 +300,16 @@ void ExpandSampleFixed(const v1::SampleFixed& fixed, Builder& b, ProblemSink& si
   }
 }
 
-void ExpandPoseList(const v1::PoseList& list, const RigDescription& rig, Builder& b) {
+// `continued`: the rig is where b.model() says (ExpandPosesFrom), so the first pose relocates the
+// detector or turns the dial only when it differs.
+void ExpandPoseList(const v1::PoseList& list, const RigDescription& rig, Builder& b,
+                    bool continued = false) {
   bool dial_in_use = false;
   if (!rig.has_gamma_axis) {
     for (const v1::PoseEntry& e : list.poses()) dial_in_use |= e.gamma() != 0;
+    dial_in_use |= continued && b.model().gamma != 0;
   }
-  bool first = true;
+  bool first = !continued;
   for (int i = 0; i < list.poses_size() && !b.full(); ++i) {
     const v1::PoseEntry& e = list.poses(i);
     const Pose pose{e.alpha(), e.beta(), e.gamma(), e.delta()};
@@ -350,6 +363,51 @@ std::vector<Step> ExpandCheckedPlan(const v1::Plan& plan, const RigDescription& 
       break;
   }
   return b.Take();
+}
+
+ExpansionStart StartAfter(std::span<const Step> steps, const v1::Plan& plan,
+                          const RigDescription& rig) {
+  ExpansionStart start;
+  StepTimer timer(rig, ResolveSettings(plan).measurement);
+  double reference_at = 0;
+  for (const Step& step : steps) {
+    timer.Advance(step);
+    const double delta_before = start.model.delta;
+    start.model = ToModelAngles(step.pose, rig.convention);
+    if (step.kind == v1::STEP_KIND_REFERENCE) {
+      start.have_reference = true;
+      start.relocated_since_reference = false;
+      start.samples_since_reference = 0;
+      reference_at = timer.elapsed_estimate_s();
+    } else if (step.kind == v1::STEP_KIND_SAMPLE) {
+      ++start.samples_since_reference;
+    } else if (step.prompt == v1::PROMPT_KIND_RELOCATE_DETECTOR ||
+               (step.kind == v1::STEP_KIND_MOVE && start.model.delta != delta_before)) {
+      start.relocated_since_reference = true;
+    }
+  }
+  start.seconds_since_reference = timer.elapsed_estimate_s() - reference_at;
+  return start;
+}
+
+std::vector<Step> ExpandPosesFrom(const v1::Plan& plan, const RigDescription& rig,
+                                  const ExpansionStart& start, std::span<const Pose> poses,
+                                  int first_index) {
+  v1::PoseList list;
+  for (const Pose& p : poses) {
+    v1::PoseEntry* e = list.add_poses();
+    e->set_alpha(p.alpha);
+    e->set_beta(p.beta);
+    e->set_gamma(p.gamma);
+    e->set_delta(p.delta);
+  }
+  ProblemSink ignored;  // the caller's poses are within travel (the candidates are)
+  Builder b(plan, rig, ignored);
+  b.StartFrom(start);
+  ExpandPoseList(list, rig, b, /*continued=*/true);
+  std::vector<Step> steps = b.Take();
+  for (Step& s : steps) s.index += first_index;
+  return steps;
 }
 
 }  // namespace brdf::plan

@@ -94,20 +94,48 @@ void Executor::Run() {
   if (!Load(c, where)) return;
   spdlog::info("{}: running from step {} ({} of {} steps left)", where,
                c.steps.size() - static_cast<std::size_t>(c.pending), c.pending, c.steps.size());
-  RunSteps(c);
-  if (cancel_.cancelled()) {
-    // Pause immediate, abort or shutdown: the canceller has set the state. Make sure nothing
-    // keeps turning.
-    (void)rig_.StopStage();
-    spdlog::info("{}: run cancelled ({})", where, cancel_.reason());
-    return;
+  std::string finish_reason;
+  do {
+    RunSteps(c);
+    if (cancel_.cancelled()) {
+      // Pause immediate, abort or shutdown: the canceller has set the state. Make sure nothing
+      // keeps turning.
+      (void)rig_.StopStage();
+      spdlog::info("{}: run cancelled ({})", where, cancel_.reason());
+      return;
+    }
+    if (c.pending != 0) return;  // stopped (paused, faulted)
+  } while (MoreSteps(c, where, finish_reason));
+  if (c.pending != 0 || finish_reason.empty()) return;
+  EstimateBudgetsAgain(c, where);
+  Result<SessionState> done = host_.ApplyEvent(session_, SessionEvent::kFinish, finish_reason);
+  if (done.ok()) spdlog::info("{}: completed ({})", where, finish_reason);
+}
+
+bool Executor::MoreSteps(Context& c, const std::string& where, std::string& finish_reason) {
+  Result<ExecutorHost::LastStepOutcome> outcome = host_.AfterLastStep(session_);
+  if (!outcome.ok()) {
+    Stop(c, -1, outcome.status(), "choosing what follows the last step of " + where, false);
+    return false;
   }
-  if (c.pending == 0) {
-    EstimateBudgetsAgain(c, where);
-    Result<SessionState> done =
-        host_.ApplyEvent(session_, SessionEvent::kFinish, "every step done");
-    if (done.ok()) spdlog::info("{}: completed", where);
+  if (!outcome->more_steps) {
+    finish_reason = outcome->finish_reason;
+    return false;
   }
+  Result<std::vector<storage::StepRecord>> steps = store_->GetSteps(session_);
+  if (!steps.ok()) {
+    Stop(c, -1, steps.status(), "reading the steps of " + where, false);
+    return false;
+  }
+  c.steps = std::move(*steps);
+  c.estimate_s.clear();
+  c.move_before.clear();
+  c.pending = c.done_steps = c.total_samples = c.done_samples = 0;
+  c.remaining_s = 0;
+  TallySteps(c);
+  // A deferred pause asked while the round was chosen takes effect here, as after any step.
+  Result<SessionState> next = host_.ApplyEvent(session_, SessionEvent::kStepDone, "");
+  return next.ok() && *next == SessionState::kRunning;
 }
 
 void Executor::EstimateBudgetsAgain(Context& c, const std::string& where) {

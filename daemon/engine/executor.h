@@ -62,7 +62,19 @@ class PipelinedMove;
 // thread.
 class ExecutorHost {
  public:
+  // Every stored step is done: the session goes on with steps the host has just stored (an
+  // adaptive session's next round, adaptive_rounds.h), or it finishes with `finish_reason`.
+  struct LastStepOutcome {
+    bool more_steps = false;
+    std::string finish_reason = "every step done";
+  };
+
   virtual ~ExecutorHost() = default;
+  // Asked each time every stored step is done, before the session finishes. An error stops the
+  // run as a fault (the session pauses; resume asks again). Default: finish.
+  virtual Result<LastStepOutcome> AfterLastStep(std::int64_t /*session*/) {
+    return LastStepOutcome{};
+  }
   // Applies an executor event (kStepDone, kFault, kFinish, kError) to the session: the state after
   // it, or the refusal (the session is no longer running: stop).
   virtual Result<SessionState> ApplyEvent(std::int64_t session, SessionEvent event,
@@ -128,6 +140,10 @@ class Executor {
   // estimate and the progress so far; the pending steps run in order until one stops the run.
   bool Load(Context& c, const std::string& where);
   void TallySteps(Context& c);
+  // Every stored step done: asks the host whether more were stored (then reads the steps again
+  // and returns true, unless a pending pause or a refusal stops the run) or the session ends
+  // (false, with the reason in `finish_reason`).
+  bool MoreSteps(Context& c, const std::string& where, std::string& finish_reason);
   void RunSteps(Context& c);
 
   Outcome RunMove(Context& c, int index, std::uint32_t first_attempt);

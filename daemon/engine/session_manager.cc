@@ -24,9 +24,10 @@
 namespace brdf::daemon {
 namespace {
 
-// Adaptive plans validate and estimate (core/adaptive), but no executor chooses their rounds yet.
-constexpr const char* kAdaptiveNotRunnable =
-    "adaptive plans validate and estimate; this daemon cannot run them yet (issue 38)";
+// Adaptive sessions choose their rounds by an uncertainty model (Options::uncertainty_model).
+constexpr const char* kNoUncertaintyModel =
+    "no uncertainty model is configured in this daemon, so it cannot choose the rounds of an "
+    "adaptive plan (it validates and estimates); run the plan on a daemon that has one";
 
 std::string Who(const Actor& actor) {
   std::string who = actor.name.empty() ? std::string("anonymous") : actor.name;
@@ -106,6 +107,40 @@ struct SessionManager::Impl final : public ExecutorHost {
   Result<std::shared_ptr<const SessionPlan>> Plan(std::int64_t session) override {
     MutexLock lock(mu);
     return PlanLocked(session, nullptr);
+  }
+
+  Result<LastStepOutcome> AfterLastStep(std::int64_t session) override {
+    BRDF_ASSIGN_OR_RETURN(std::shared_ptr<const SessionPlan> kept, Plan(session));
+    if (!kept->plan.has_adaptive()) return LastStepOutcome{};
+    return NextAdaptiveRound(session, kept->plan);
+  }
+
+  // An adaptive session's next round stored (more steps) or its stop (the finish reason); either
+  // is published to the watchers.
+  Result<LastStepOutcome> NextAdaptiveRound(SessionId id, const v1::Plan& plan) {
+    if (!owner.options_.uncertainty_model) return FailedPrecondition(kNoUncertaintyModel);
+    const adaptive::AdaptiveSpec spec = adaptive::ResolveAdaptive(plan.adaptive());
+    std::unique_ptr<adaptive::UncertaintyModel> model = owner.options_.uncertainty_model(spec);
+    if (model == nullptr) return Internal("the uncertainty model factory made no model");
+    BRDF_ASSIGN_OR_RETURN(RoundDecision decision,
+                          NextRound(store, id, plan, owner.options_.rig_description, *model));
+    LastStepOutcome out;
+    v1::SessionEvent event;
+    if (decision.round.has_value()) {
+      *event.mutable_adaptive_round() = ToProtoRound(*decision.round);
+      out.more_steps = true;
+      spdlog::info(
+          "{}: round {} stored: {} poses, {} steps, predicted gain {:.4g}, uncertainty "
+          "left {:.4g}",
+          SessionName(id), decision.round->round, decision.round->picks.size(),
+          decision.round->step_count, decision.round->predicted_gain, decision.uncertainty_left);
+    } else {
+      *event.mutable_adaptive_stop() = ToProtoStop(decision);
+      out.finish_reason = StopText(decision, spec);
+    }
+    MutexLock lock(mu);
+    bus.Publish(id, std::move(event));
+    return out;
   }
 
   void Fault(std::int64_t session, const v1::Fault& fault) override {
@@ -502,10 +537,12 @@ Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor
     return InvalidArgument("the plan has " + std::to_string(analysis.problems.size()) +
                            " problem(s); fix them and submit again:\n" + listing);
   }
-  if (plan.has_adaptive()) {
+  if (plan.has_adaptive() && !options_.uncertainty_model) {
     impl_->Audit(actor, "session.submit", std::nullopt,
-                 "refused: plan \"" + plan.name() + "\" is adaptive");
-    return FailedPrecondition(kAdaptiveNotRunnable);
+                 "refused: plan \"" + plan.name() +
+                     "\" is adaptive and no uncertainty model is "
+                     "configured");
+    return FailedPrecondition(kNoUncertaintyModel);
   }
   BRDF_ASSIGN_OR_RETURN(std::string json, plan::PlanToJson(plan));
 
@@ -542,20 +579,21 @@ Result<v1::Session> SessionManager::SubmitPlan(const v1::Plan& plan, const Actor
 }
 
 Result<v1::Session> SessionManager::Start(SessionId session, const Actor& actor) {
-  return impl_->Verb(session, actor, "session.start", "started by " + Who(actor),
-                     [&]() REQUIRES(impl_->mu) -> Status {
-                       if (impl_->StateLocked(session).ok()) {
-                         auto kept = impl_->PlanLocked(session, nullptr);
-                         if (kept.ok() && (*kept)->plan.has_adaptive()) {
-                           return FailedPrecondition(kAdaptiveNotRunnable);
-                         }
-                       }
-                       BRDF_ASSIGN_OR_RETURN(SessionState to,
-                                             impl_->TransitionLocked(session, SessionEvent::kStart,
-                                                                     "started by " + Who(actor)));
-                       if (to == SessionState::kRunning) impl_->EnsureRunLocked(session);
-                       return Status::Ok();
-                     });
+  return impl_->Verb(
+      session, actor, "session.start", "started by " + Who(actor),
+      [&]() REQUIRES(impl_->mu) -> Status {
+        if (impl_->StateLocked(session).ok()) {
+          auto kept = impl_->PlanLocked(session, nullptr);
+          if (kept.ok() && (*kept)->plan.has_adaptive() && !options_.uncertainty_model) {
+            return FailedPrecondition(kNoUncertaintyModel);
+          }
+        }
+        BRDF_ASSIGN_OR_RETURN(
+            SessionState to,
+            impl_->TransitionLocked(session, SessionEvent::kStart, "started by " + Who(actor)));
+        if (to == SessionState::kRunning) impl_->EnsureRunLocked(session);
+        return Status::Ok();
+      });
 }
 
 Result<v1::Session> SessionManager::Pause(SessionId session, PauseMode mode, const Actor& actor,

@@ -54,6 +54,7 @@
 #include "core/plan/rig_description.h"
 #include "core/session_state.h"
 #include "core/status.h"
+#include "daemon/engine/adaptive_rounds.h"
 #include "daemon/engine/event_bus.h"
 #include "daemon/engine/reading_budget.h"
 #include "daemon/engine/rig.h"
@@ -93,6 +94,9 @@ class SessionManager {
     const Clock* clock = &Clock::Real();
     // Each sample reading's uncertainty budget (reading_budget.h); nullopt: not estimated.
     std::optional<ReadingBudgetSettings> uncertainty;
+    // The uncertainty model adaptive sessions choose their rounds by (adaptive_rounds.h); unset:
+    // adaptive plans are refused (SubmitPlan, Start: kFailedPrecondition).
+    UncertaintyModelFactory uncertainty_model;
   };
 
   // Takes a shared store (the Data service and the index cache read it too) and the rig. Starts

@@ -542,7 +542,10 @@ TEST_F(EngineTest, InvalidPlanIsRefusedWithEveryProblemAndItsFieldPath) {
             StatusCode::kNotFound);
 }
 
-TEST_F(EngineTest, AdaptivePlanValidatesButIsRefusedUntilTheEngineRunsIt) {
+// Without an uncertainty model (Options::uncertainty_model unset) the daemon cannot choose rounds:
+// adaptive plans validate, but are neither stored nor started. (With one:
+// adaptive_session_test.cc.)
+TEST_F(EngineTest, AdaptivePlanValidatesButIsRefusedWithoutAnUncertaintyModel) {
   const v1::Plan plan = PlanFromJson(R"({
     "name": "adaptive",
     "adaptive": {"target": {"expandedUncertainty": 0.05}, "budget": {"maxReadings": 300},
@@ -555,7 +558,9 @@ TEST_F(EngineTest, AdaptivePlanValidatesButIsRefusedUntilTheEngineRunsIt) {
     auto refused = manager_->SubmitPlan(plan, kTestOperator, start_now);
     EXPECT_EQ(refused.status().code(), StatusCode::kFailedPrecondition);
     EXPECT_EQ(refused.status().message(),
-              "adaptive plans validate and estimate; this daemon cannot run them yet (issue 38)");
+              "no uncertainty model is configured in this daemon, so it cannot choose the rounds "
+              "of an adaptive plan (it validates and estimates); run the plan on a daemon that "
+              "has one");
   }
   auto listed = manager_->ListSessions();
   ASSERT_TRUE(listed.ok());
@@ -573,7 +578,7 @@ TEST_F(EngineTest, AdaptivePlanValidatesButIsRefusedUntilTheEngineRunsIt) {
   ASSERT_TRUE(id.ok()) << id.status().ToString();
   auto start = manager_->Start(*id, kTestOperator);
   EXPECT_EQ(start.status().code(), StatusCode::kFailedPrecondition);
-  EXPECT_NE(start.status().message().find("cannot run them yet (issue 38)"), std::string::npos);
+  EXPECT_NE(start.status().message().find("no uncertainty model is configured"), std::string::npos);
   auto session = manager_->GetSession(*id);
   ASSERT_TRUE(session.ok());
   EXPECT_EQ(session->state(), v1::SESSION_STATE_QUEUED);

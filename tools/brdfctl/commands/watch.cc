@@ -141,6 +141,12 @@ class Watcher {
       case v1::SessionEvent::kFault:
         Note(FaultText(event.fault()));
         break;
+      case v1::SessionEvent::kAdaptiveRound:
+        Note(AdaptiveRoundText(event.adaptive_round()));
+        break;
+      case v1::SessionEvent::kAdaptiveStop:
+        Note(AdaptiveStopText(event.adaptive_stop()));
+        break;
       default:
         break;
     }

@@ -1,0 +1,187 @@
+#include "daemon/engine/adaptive_rounds.h"
+
+#include <cstdio>
+#include <span>
+#include <string>
+#include <utility>
+
+#include "core/adaptive/candidates.h"
+#include "core/adaptive/round_cost.h"
+#include "core/geometry.h"
+#include "core/plan/expand_steps.h"
+#include "core/plan/plan_settings.h"
+#include "core/plan/plan_summary.h"
+#include "core/plan/sample.h"
+#include "core/readings/derive.h"
+#include "daemon/wire/plan.h"
+#include "storage/session_readings.h"
+
+namespace brdf::daemon {
+namespace {
+
+// Mean of `values` over the bands of `grid` within the summary range; nullopt when none is.
+std::optional<double> SummaryMean(const std::vector<double>& values, const WavelengthGrid& grid) {
+  double sum = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < values.size() && i < grid.count; ++i) {
+    const double nm = grid.at(i);
+    if (nm < kSummaryBandsMinNm - 1e-9 || nm > kSummaryBandsMaxNm + 1e-9) continue;
+    sum += values[i];
+    ++n;
+  }
+  if (n == 0) return std::nullopt;
+  return sum / n;
+}
+
+// The relative standard uncertainty of a sample from its stored budget (combined u over the
+// budget's quantity, both averaged over the summary bands), or the fallback.
+double RelativeUncertainty(const storage::ReadingRecord& r, const SampleQuantities& q) {
+  if (!r.uncertainty.has_value() || !q.has(r.uncertainty->quantity)) {
+    return kFallbackRelativeUncertainty;
+  }
+  const std::optional<double> u = SummaryMean(r.uncertainty->combined, r.grid);
+  const std::optional<double> v = SummaryMean(q.of(r.uncertainty->quantity), r.grid);
+  if (!u.has_value() || !v.has_value() || *v <= 0 || !(*u >= 0)) {
+    return kFallbackRelativeUncertainty;
+  }
+  return *u / *v;
+}
+
+// What the session has used: its stored steps, by the timing model for real devices.
+adaptive::Spend SpendOf(std::span<const plan::Step> steps, const v1::Plan& plan,
+                        const plan::RigDescription& rig) {
+  plan::RigDescription real = rig;
+  real.time_scale = 1;
+  const plan::PlanSummary s =
+      plan::SummarizeSteps(steps, real, plan::ResolveSettings(plan).measurement);
+  return {s.sample_readings, s.estimated_duration_s, s.operator_interventions};
+}
+
+storage::RoundRecord MakeRecord(std::int64_t session, int number, int first_step,
+                                const adaptive::Round& round, double left, int readings) {
+  storage::RoundRecord r;
+  r.session_id = session;
+  r.round = number;
+  r.first_step = first_step;
+  for (const adaptive::ChosenPose& c : round.poses) r.picks.push_back({c.pose, c.predicted_gain});
+  r.predicted_gain = round.predicted_gain;
+  r.uncertainty_left = left;
+  r.readings_used = readings;
+  return r;
+}
+
+}  // namespace
+
+Result<std::vector<adaptive::ReadingSoFar>> ReadingsSoFar(storage::SessionStore& store,
+                                                          std::int64_t session,
+                                                          const v1::Plan& plan,
+                                                          const plan::RigDescription& rig) {
+  BRDF_ASSIGN_OR_RETURN(storage::SessionRecord record, store.GetSession(session));
+  BRDF_ASSIGN_OR_RETURN(std::vector<storage::StepRecord> steps, store.GetSteps(session));
+  ReadingDeriver deriver(record.white_reflectance.value_or(kWhiteStandardReflectance),
+                         plan::WhiteReflectanceSpectrumOf(plan));
+  std::vector<adaptive::ReadingSoFar> out;
+  BRDF_RETURN_IF_ERROR(store.ForEachReading(session, [&](const storage::ReadingRecord& r) {
+    const std::optional<SampleQuantities> q = deriver.Fold(storage::ToReading(r));
+    if (!q.has_value() || r.kind != ReadingKind::kSample) return Status::Ok();
+    adaptive::ReadingSoFar so_far;
+    // The pose the step asked for (the one the chooser compares candidates with).
+    const std::size_t step = static_cast<std::size_t>(r.step_index);
+    so_far.pose = ToModelAngles(step < steps.size() ? steps[step].pose : r.pose, rig.convention);
+    so_far.directions = r.directions;
+    const bool has_brdf = q->has(Quantity::kBrdf);
+    so_far.brdf = has_brdf ? SummaryMean(q->of(Quantity::kBrdf), r.grid).value_or(0) : 0;
+    so_far.relative_uncertainty =
+        has_brdf ? RelativeUncertainty(r, *q) : kFallbackRelativeUncertainty;
+    out.push_back(so_far);
+    return Status::Ok();
+  }));
+  return out;
+}
+
+Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t session,
+                                const v1::Plan& plan, const plan::RigDescription& rig,
+                                const adaptive::UncertaintyModel& model) {
+  const adaptive::AdaptiveSpec spec = adaptive::ResolveAdaptive(plan.adaptive());
+  BRDF_ASSIGN_OR_RETURN(std::vector<adaptive::ReadingSoFar> readings,
+                        ReadingsSoFar(store, session, plan, rig));
+  BRDF_ASSIGN_OR_RETURN(std::vector<storage::StepRecord> stored, store.GetSteps(session));
+  BRDF_ASSIGN_OR_RETURN(std::vector<storage::RoundRecord> rounds, store.GetRounds(session));
+  const std::vector<plan::Step> steps = ToPlanSteps(stored);
+
+  RoundDecision decision;
+  decision.rounds = static_cast<int>(rounds.size());
+  decision.spent = SpendOf(steps, plan, rig);
+  decision.uncertainty_left = model.Map(readings)->Remaining();
+  decision.stop =
+      adaptive::ShouldStop(decision.uncertainty_left, spec.target, spec.budget, decision.spent);
+  if (decision.stop != adaptive::StopReason::kContinue) return decision;
+
+  const plan::ExpansionStart start = plan::StartAfter(steps, plan, rig);
+  const std::vector<Pose> candidates = adaptive::CandidatePoses(spec, rig);
+  const adaptive::RoundInput input{readings, candidates, start.model, decision.spent, spec.budget};
+  const adaptive::RoundCost cost(plan, rig);
+  const adaptive::Round round =
+      adaptive::ChooseRound(input, model, cost, {.max_readings = spec.round_readings});
+  decision.stop = adaptive::AfterChoosing(round);
+  if (decision.stop != adaptive::StopReason::kContinue) return decision;
+
+  std::vector<Pose> poses;
+  for (const adaptive::ChosenPose& c : round.poses) poses.push_back(c.pose);
+  const int first = static_cast<int>(stored.size());
+  std::vector<storage::StepRecord> added;
+  for (const plan::Step& s : plan::ExpandPosesFrom(plan, rig, start, poses, first)) {
+    added.push_back(ToStepRecord(s));
+  }
+  storage::RoundRecord record =
+      MakeRecord(session, decision.rounds + 1, first, round, decision.uncertainty_left,
+                 static_cast<int>(readings.size()));
+  record.step_count = static_cast<int>(added.size());
+  BRDF_RETURN_IF_ERROR(store.AppendRound(record, added));
+  decision.round = std::move(record);
+  decision.rounds += 1;
+  return decision;
+}
+
+v1::AdaptiveRound ToProtoRound(const storage::RoundRecord& round) {
+  v1::AdaptiveRound out;
+  out.set_round(static_cast<std::uint32_t>(round.round));
+  for (const storage::RoundPick& p : round.picks) {
+    v1::Pose* pose = out.add_poses();
+    pose->set_alpha(p.pose.alpha);
+    pose->set_beta(p.pose.beta);
+    pose->set_gamma(p.pose.gamma);
+    pose->set_delta(p.pose.delta);
+    out.add_pose_gains(p.predicted_gain);
+  }
+  out.set_predicted_gain(round.predicted_gain);
+  out.set_uncertainty_left(round.uncertainty_left);
+  out.set_readings_used(static_cast<std::uint32_t>(round.readings_used));
+  out.set_first_step(static_cast<std::uint32_t>(round.first_step));
+  out.set_step_count(static_cast<std::uint32_t>(round.step_count));
+  return out;
+}
+
+v1::AdaptiveStop ToProtoStop(const RoundDecision& decision) {
+  v1::AdaptiveStop out;
+  out.set_reason(adaptive::StopReasonText(decision.stop));
+  out.set_uncertainty_left(decision.uncertainty_left);
+  out.set_readings(static_cast<std::uint32_t>(decision.spent.readings));
+  out.set_rig_s(decision.spent.seconds);
+  out.set_prompts(static_cast<std::uint32_t>(decision.spent.prompts));
+  out.set_rounds(static_cast<std::uint32_t>(decision.rounds));
+  return out;
+}
+
+std::string StopText(const RoundDecision& decision, const adaptive::AdaptiveSpec& spec) {
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "adaptive: %s; uncertainty left %.4g (target %.4g); %d round(s), %d readings, "
+                "%.1f min of rig time, %d prompts",
+                adaptive::StopReasonText(decision.stop), decision.uncertainty_left,
+                spec.target.level, decision.rounds, decision.spent.readings,
+                decision.spent.seconds / 60, decision.spent.prompts);
+  return text;
+}
+
+}  // namespace brdf::daemon
