@@ -12,6 +12,7 @@
 #include "tests/support/test_env.h"
 #include "tools/brdfctl/commands/sim_mount.h"
 #include "tools/brdfctl/exit_codes.h"
+#include "tools/brdfctl/output/session_text.h"
 #include "tools/brdfctl/output/text_format.h"
 #include "tools/brdfctl/output/uncertainty_text.h"
 #include "tools/brdfctl/plan_file.h"
@@ -88,6 +89,31 @@ TEST(TextFormat, PosesPrintToTheStagesResolutionNotTheFloatingPointNoise) {
   EXPECT_EQ(StageAngle(123.4567), "123.457");
   EXPECT_EQ(StageAngle(-30.0014), "-30.001");
   EXPECT_EQ(StageAngle(45), "45");
+}
+
+TEST(SessionText, AnAdaptiveRoundAndTheStopOnALineEach) {
+  v1::AdaptiveRound round;
+  round.set_round(2);
+  for (double delta : {11.25, 0.0, 22.5}) round.add_poses()->set_delta(delta);
+  round.set_predicted_gain(0.01234);
+  round.set_uncertainty_left(0.07123);
+  round.set_readings_used(188);
+  round.set_first_step(422);
+  round.set_step_count(96);
+  EXPECT_EQ(AdaptiveRoundText(round),
+            "round 2: 3 poses (δ 0°–22.5°), predicted gain 0.0123, uncertainty left 0.0712, "
+            "chosen from 188 readings; steps 422–517");
+  v1::AdaptiveStop stop;
+  stop.set_reason("reading budget spent");
+  stop.set_uncertainty_left(0.04123);
+  stop.set_rounds(3);
+  stop.set_readings(212);
+  stop.set_rig_s(1890);
+  stop.set_prompts(40);
+  EXPECT_EQ(AdaptiveStopText(stop),
+            "adaptive stop: reading budget spent; uncertainty left 0.0412 after 3 round(s), 212 "
+            "readings, " +
+                Duration(1890) + " of rig time, 40 prompts");
 }
 
 TEST(ProgressLine, ShowsCountsPercentEtaPoseAndQuality) {

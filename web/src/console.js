@@ -162,6 +162,8 @@ export function createConsole(root, role, report, server = 'brdfd') {
     else if (ev.prompt) text = `prompt: ${ev.prompt.text}`;
     else if (ev.step_completed) text = `step ${ev.step_completed.step_index} done (${String(ev.step_completed.kind).replace('STEP_KIND_', '').toLowerCase()})${ev.step_completed.flagged ? ', flagged' : ''}`;
     else if (ev.fault) text = `fault: ${ev.fault.code} ${ev.fault.reason}`;
+    else if (ev.adaptive_round) text = `round ${ev.adaptive_round.round}: ${(ev.adaptive_round.poses || []).length} poses, predicted gain ${Number(ev.adaptive_round.predicted_gain || 0).toPrecision(3)}, uncertainty left ${Number(ev.adaptive_round.uncertainty_left || 0).toPrecision(3)}`;
+    else if (ev.adaptive_stop) text = `adaptive stop: ${ev.adaptive_stop.reason}; uncertainty left ${Number(ev.adaptive_stop.uncertainty_left || 0).toPrecision(3)}`;
     events.unshift(`${(ev.time || '').slice(11, 19)} #${ev.sequence} ${text}`);
     events = events.slice(0, 200);
     clear(eventList).append(...events.map((t) => el('li', {}, t)));

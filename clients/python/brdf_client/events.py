@@ -16,12 +16,13 @@ class Event:
     """One event of a session.
 
     Attributes:
-      kind:       "snapshot", "state_changed", "prompt", "step_completed" or "fault".
+      kind:       "snapshot", "state_changed", "prompt", "step_completed", "fault", and for
+                  adaptive sessions "adaptive_round" and "adaptive_stop".
       session_id: the session it belongs to.
       sequence:   increases by one per event.
       time:       when it happened (datetime, UTC), or None when unset.
-      data:       the event's message: Session, StateChange, Prompt, StepCompletion or Fault
-                  (brdf.proto documents their fields).
+      data:       the event's message: Session, StateChange, Prompt, StepCompletion, Fault,
+                  AdaptiveRound or AdaptiveStop (brdf.proto documents their fields).
       raw:        the brdf.v1.SessionEvent as received.
     """
 
@@ -62,4 +63,11 @@ class Event:
         if self.kind == "fault":
             retry = "will retry" if d.will_retry else "session paused"
             return f"fault at step {d.step_index} ({d.code}, attempt {d.attempt}, {retry}): {d.reason}"
+        if self.kind == "adaptive_round":
+            return (f"round {d.round}: {len(d.poses)} poses, predicted gain {d.predicted_gain:.3g}, "
+                    f"uncertainty left {d.uncertainty_left:.3g}, chosen from {d.readings_used} "
+                    f"readings")
+        if self.kind == "adaptive_stop":
+            return (f"adaptive stop: {d.reason}; uncertainty left {d.uncertainty_left:.3g} after "
+                    f"{d.rounds} round(s), {d.readings} readings")
         return self.kind
