@@ -1,5 +1,5 @@
-// bench_interp_calibration: what the interpolation term's calibration (daemon/index/
-// interpolation_calibration.h) costs beside the index build it follows, on a session of N
+// bench_interp_calibration: what the interpolation term's calibration (core/uncertainty/
+// held_out.h) costs beside the index build it follows, on a session of N
 // readings (default 50,000, 101 bands) at random isotropic directions (θi, θo in [0°, 80°],
 // φ in [0°, 180°]) with a smooth lobe's spectra. Times, in one run, the index build
 // (MakeInterpolator) and the calibration (PredictHeldOut and the fit), --repeat times each, and
@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "core/interp/interpolator.h"
+#include "core/uncertainty/held_out.h"
 #include "core/uncertainty/interpolation_calibration.h"
-#include "daemon/index/interpolation_calibration.h"
 
 namespace {
 
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     t0 = Clock::now();
-    const auto points = daemon::PredictHeldOut(*samples, daemon::BudgetList{}, *method, {});
+    const auto points = uncertainty::PredictHeldOut(*samples, uncertainty::BudgetOf{}, *method, {});
     const auto fit = uncertainty::FitInterpolationCalibration(points, bands, {});
     calibrate.push_back(Seconds(t0));
     held_out = fit.held_out;

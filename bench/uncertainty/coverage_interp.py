@@ -13,7 +13,10 @@ the same with the measurement part alone and with the interpolation term scaled 
 goal: intervals at most 2× the error, coverage 93–97 %); then each material pooled over its seeds
 (with its lowest and highest session) and all sessions pooled. --expect-coverage and
 --expect-ratio make it a test (exit 1 when the pooled figures miss; 77 when nothing is built);
---dump keeps each session's answers, uncertainties and truth as .npz.
+--dump keeps each session's answers, uncertainties and truth as .npz. --export-grid STEPS
+counts the same for a grid export with uncertainty (Data.Export, include_uncertainty) instead of
+the batch: its cells' centres (θi, θo ≤ --theta-max) are the directions, each cell's value and u
+(the .npy and its u and u_measurement arrays) the answer, with --fill's chain behind them.
 
     bench/uncertainty/coverage_interp.py --materials paint clay --seeds 1 2 --directions 2000
 
@@ -24,6 +27,7 @@ import argparse
 import json
 import os
 import sys
+import tempfile
 
 import numpy as np
 
@@ -39,8 +43,27 @@ def iso_truth(sim, material, d):
     return coverage.truth(sim, material, (d[0], 0.0, d[1], d[2]))
 
 
-def interpolate_session(sim, daemon, material, seed, plan, errors, directions, method):
-    """The batch's answers at `directions` once the plan completed: (ok, y, u, u_meas, wl)."""
+def grid_answers(client, session_id, steps, method, fill, theta_max):
+    """A grid export with uncertainty as answers: (directions, ok, y, u, u_meas) over the cells
+    whose θi and θo are at most theta_max."""
+    with tempfile.TemporaryDirectory() as work:
+        path = os.path.join(work, "g.npy")
+        client.export(session_id, "grid", path, method=method, fill=fill, step_theta_i=steps[0],
+                      step_theta_o=steps[1], step_phi=steps[2], uncertainty=True, progress=False)
+        y, u, u_meas = (np.load(os.path.join(work, name))
+                        for name in ("g.npy", "g.u.npy", "g.u_measurement.npy"))
+    ti, to, ph = (s / 2 + s * np.arange(n) for s, n in zip(steps, y.shape[:3]))
+    dirs = np.stack(np.meshgrid(ti, to, ph, indexing="ij"), axis=-1).reshape(-1, 3)
+    y, u, u_meas = (a.reshape(-1, a.shape[-1]) for a in (y, u, u_meas))
+    keep = (dirs[:, 0] <= theta_max) & (dirs[:, 1] <= theta_max)
+    ok = np.isfinite(y[:, 0]) & keep
+    return dirs, ok, y, u, u_meas
+
+
+def interpolate_session(sim, daemon, material, seed, plan, errors, directions, method,
+                        grid=None):
+    """The batch's answers at `directions` once the plan completed: (ok, y, u, u_meas, wl);
+    with `grid` (steps, fill, theta_max) the grid export's instead: (dirs, ok, y, u, u_meas)."""
     rig = live_rig.LiveRig(sim, daemon, seed=seed, sim_args=coverage.sim_flags(material, errors),
                            extra_config=coverage.budget_config(errors))
     rig.sample_extra = f"white_reflectance_uncertainty = {0.99 * errors['white_error']}\n"
@@ -58,6 +81,10 @@ def interpolate_session(sim, daemon, material, seed, plan, errors, directions, m
         final = client.wait(s.session_id, on_prompt=act, timeout=600, stop_states=("paused",))
         if names.state_name(final.state) != "completed":
             raise RuntimeError(f"session ended {names.state_name(final.state)}")
+        if grid is not None:
+            answers = grid_answers(client, s.session_id, grid[0], method, grid[1], grid[2])
+            client.close()
+            return answers
         batch = client.interpolate_batch(s.session_id, directions, method=method,
                                          uncertainty=True, progress=False)
         client.close()
@@ -95,6 +122,9 @@ def main():
     p.add_argument("--directions", type=int, default=2000)
     p.add_argument("--theta-max", type=float, default=80.0)
     p.add_argument("--method", default="octant")
+    p.add_argument("--export-grid", metavar="STEPS",
+                   help="count a grid export's cells instead: its steps θi,θo,φ (e.g. 10,10,20)")
+    p.add_argument("--fill", default="chain", help="--export-grid's fill: chain or none")
     p.add_argument("--k", type=float, default=2.0)
     p.add_argument("--expect-coverage", nargs=2, type=float, metavar=("LO", "HI"),
                    help="fail unless the pooled coverage lies in [LO, HI] (the test's short form)")
@@ -122,8 +152,14 @@ def main():
             dirs = np.column_stack([rng.uniform(0, args.theta_max, args.directions),
                                     rng.uniform(0, args.theta_max, args.directions),
                                     rng.uniform(0, 180, args.directions)])
-            ok, y, u, u_meas, _ = interpolate_session(sim, daemon, path, seed, plan, errors,
-                                                      dirs, args.method)
+            if args.export_grid:
+                steps = [float(x) for x in args.export_grid.split(",")]
+                dirs, ok, y, u, u_meas = interpolate_session(
+                    sim, daemon, path, seed, plan, errors, None, args.method,
+                    grid=(steps, args.fill, args.theta_max))
+            else:
+                ok, y, u, u_meas, _ = interpolate_session(sim, daemon, path, seed, plan, errors,
+                                                          dirs, args.method)
             t = np.full_like(y, np.nan)
             for i in np.flatnonzero(ok):
                 t[i] = iso_truth(sim, path, dirs[i])

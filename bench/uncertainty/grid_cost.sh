@@ -3,7 +3,9 @@
 # time without): records examples/plans/demo.json on brdf-sim through brdfd (87 sample readings,
 # each with its stored budget), then times `brdfctl export SESSION grid` with and without
 # --uncertainty in the same run, alternating which goes first, and prints the medians and their
-# ratio. Both write float32 .npy files (with --uncertainty four of them).
+# ratio, and the same for brdfd's CPU time (all its threads, /proc/PID/stat), which a machine
+# shared with other work disturbs less than the wall time. Both write float32 .npy files (with
+# --uncertainty four of them).
 #
 # Usage: bench/uncertainty/grid_cost.sh [BUILD_DIR]   (default ./build; builds brdfd, brdf-sim
 #        and brdfctl unless BENCH_NO_BUILD=1)
@@ -36,9 +38,13 @@ record_session_on_sim "$root/examples/plans/demo.json" "$work/watch.out"
 echo "session $session recorded (demo plan)"
 
 steps="${COST_STEPS:-2,2,2}"
-export_once() {  # $1: "" or --uncertainty; prints seconds
-  local t0 t1
+cpu_ticks() {  # brdfd's user + system time so far, clock ticks
+  awk '{print $14 + $15}' "/proc/$brdfd_pid/stat"
+}
+export_once() {  # $1: "" or --uncertainty; prints "wall_seconds cpu_seconds"
+  local t0 t1 c0 c1
   rm -f "$work"/g.*
+  c0="$(cpu_ticks)"
   t0="$(date +%s.%N)"
   "$ctl" export "$session" grid \
     -o "$work/g.npy" --steps "$steps" --float32 --method "${COST_METHOD:-octant}" \
@@ -47,7 +53,8 @@ export_once() {  # $1: "" or --uncertainty; prints seconds
     exit 1
   }
   t1="$(date +%s.%N)"
-  echo "$t1 - $t0" | bc
+  c1="$(cpu_ticks)"
+  echo "$(echo "$t1 - $t0" | bc) $(echo "scale=3; ($c1 - $c0) / $(getconf CLK_TCK)" | bc)"
 }
 plain=()
 with=()
@@ -63,11 +70,12 @@ done
 find "$work" -maxdepth 1 -name 'g.*' -printf '  %s bytes  %p\n' | sort -k3
 python3 - "${plain[*]}" "${with[*]}" <<'PY'
 import statistics, sys
-plain = [float(x) for x in sys.argv[1].split()]
-with_u = [float(x) for x in sys.argv[2].split()]
-a, b = statistics.median(plain), statistics.median(with_u)
-print(f"grid export, without uncertainty: {' '.join(f'{x:.2f}' for x in plain)} s, median {a:.2f} s")
-print(f"grid export, with uncertainty:    {' '.join(f'{x:.2f}' for x in with_u)} s, median {b:.2f} s")
-print(f"ratio (medians): {b / a:.2f}")
+pairs = [[float(x) for x in arg.split()] for arg in sys.argv[1:3]]
+for col, what in ((0, "wall"), (1, "brdfd's CPU")):
+    plain, with_u = pairs[0][col::2], pairs[1][col::2]
+    a, b = statistics.median(plain), statistics.median(with_u)
+    print(f"grid export ({what}), without uncertainty: {' '.join(f'{x:.2f}' for x in plain)} s, median {a:.2f} s")
+    print(f"grid export ({what}), with uncertainty:    {' '.join(f'{x:.2f}' for x in with_u)} s, median {b:.2f} s")
+    print(f"ratio (medians, {what}): {b / a:.2f}")
 PY
 echo "load at end: $(cut -d' ' -f1-3 /proc/loadavg)"

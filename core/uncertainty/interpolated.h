@@ -32,7 +32,7 @@ struct InterpolatedInputs {
   // The session's calibration of the interpolation term (interpolation_calibration.h): the
   // spread s becomes c(λ)·s(λ). A calibration without a scale: the spread as it is and
   // "interpolation: not calibrated (…)" in not_estimated. Null: the spread as it is, with no note
-  // per answer (the grid export's sidecar says it once).
+  // per answer.
   const InterpolationCalibration* calibration = nullptr;
 };
 

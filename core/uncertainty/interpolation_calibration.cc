@@ -56,10 +56,11 @@ InterpolationCalibration FitInterpolationCalibration(std::span<const HeldOutPoin
   const std::size_t groups =
       std::clamp<std::size_t>(static_cast<std::size_t>(std::max(1, target.band_groups)), 1, nb);
   out.scale.assign(nb, 0.0);
+  out.band_groups = groups;
   std::vector<double> needed;
   for (std::size_t g = 0; g < groups; ++g) {
-    const std::size_t first = g * nb / groups;
-    const std::size_t last = (g + 1) * nb / groups;
+    const std::size_t first = BandGroupFirst(g, groups, nb);
+    const std::size_t last = BandGroupFirst(g + 1, groups, nb);
     needed.clear();
     for (const HeldOutPoint* p : usable) {
       for (std::size_t b = first; b < last; ++b) {

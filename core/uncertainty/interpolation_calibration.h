@@ -33,7 +33,10 @@ struct HeldOutPoint {
 struct InterpolationCalibration {
   std::vector<double> scale;  // c(λ), per band
   std::size_t held_out = 0;   // held-out readings it rests on
-  std::string detail;         // how it was fitted, or why it was not
+  // Contiguous groups of bands with one c each: group g holds bands [g·n/groups, (g+1)·n/groups)
+  // of n (BandGroupFirst); 0 when not calibrated.
+  std::size_t band_groups = 0;
+  std::string detail;  // how it was fitted, or why it was not
 };
 
 // What the fit aims at.
@@ -51,6 +54,11 @@ struct CalibrationTarget {
 // the largest finite need. Points whose vectors do not have `bands` values are left out.
 InterpolationCalibration FitInterpolationCalibration(std::span<const HeldOutPoint> points,
                                                      int bands, const CalibrationTarget& target);
+
+// The first band of group `g` of `groups` over `bands` bands (g = groups: one past the last band).
+inline std::size_t BandGroupFirst(std::size_t g, std::size_t groups, std::size_t bands) {
+  return groups == 0 ? 0 : g * bands / groups;
+}
 
 // Scales `spread` (s per band) in place into c(λ) · s(λ). False, leaving it unchanged, when
 // `calibration` has no scale for its bands (not calibrated).

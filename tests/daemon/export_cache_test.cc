@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/call_context.h"
+#include "core/export/fill/uncertain_chain.h"
 
 namespace brdf::daemon {
 namespace {
@@ -87,6 +88,30 @@ TEST(ExportInterpolantsTest, TheSecondExportOfASnapshotReusesTheFirstsInterpolan
   EXPECT_LT(two.bytes, 2 * stats.bytes);
   EXPECT_GT(two.bytes, stats.bytes);
   EXPECT_EQ(budget.reserved_bytes(), two.bytes);
+}
+
+// The interpolation term's calibration is kept with the interpolant: the first export with
+// uncertainty computes it, the next export of the snapshot finds it computed and uses the same.
+TEST(ExportInterpolantsTest, AKeptInterpolantIsCalibratedOnceForEveryExport) {
+  MemoryBudget budget(1024);
+  ExportInterpolants cache(budget);
+  const auto session = SessionCopy(1, 10);
+  std::atomic<int> builds{0};
+  Result<exports::SessionInterpolant> first = cache.Get(session, {}, Builder(&builds));
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  EXPECT_FALSE(first->calibrations->chosen.computed()) << "a build alone does not calibrate";
+  const exports::UncertainChain one = exports::MakeUncertainChain(*first);
+  EXPECT_TRUE(first->calibrations->chosen.computed());
+  ASSERT_EQ(one.coverage.calibrations.size(), 1u);
+
+  Result<exports::SessionInterpolant> second = cache.Get(session, {}, Builder(&builds));
+  ASSERT_TRUE(second.ok());
+  EXPECT_EQ(builds.load(), 1);
+  EXPECT_EQ(second->calibrations, first->calibrations);
+  EXPECT_TRUE(second->calibrations->chosen.computed()) << "computed before the second asks";
+  const exports::UncertainChain two = exports::MakeUncertainChain(*second);
+  EXPECT_EQ(&exports::ChosenCalibration(*second), &exports::ChosenCalibration(*first));
+  EXPECT_EQ(two.coverage.calibrations[0].fit.detail, one.coverage.calibrations[0].fit.detail);
 }
 
 TEST(ExportInterpolantsTest, EachSettingIsItsOwnKey) {

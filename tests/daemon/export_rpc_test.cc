@@ -13,9 +13,11 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <memory>
 #include <optional>
 #include <random>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -41,6 +43,7 @@ struct ExportResult {
   grpc::Status status;
   std::vector<v1::ExportProgress> progress;
   std::string file;
+  std::map<std::string, std::string> parts;  // ExportData.part's bytes by name
   std::size_t chunks = 0;
   std::size_t largest_chunk = 0;
   std::optional<v1::ExportReport> report;
@@ -120,11 +123,14 @@ class ExportRpcTest : public ::testing::Test {
         last_fraction = chunk.progress().fraction();
         out.progress.push_back(chunk.progress());
       } else if (chunk.has_data()) {
-        if (chunk.data().offset() != out.file.size()) {
+        const std::string& part = chunk.data().part();
+        std::string& into = part.empty() ? out.file : out.parts[part];
+        if (chunk.data().offset() != into.size()) {
           out.contract_errors.push_back("chunk at offset " + std::to_string(chunk.data().offset()) +
-                                        " after " + std::to_string(out.file.size()) + " bytes");
+                                        " after " + std::to_string(into.size()) + " bytes" +
+                                        (part.empty() ? "" : " of part " + part));
         }
-        out.file += chunk.data().content();
+        into += chunk.data().content();
         ++out.chunks;
         out.largest_chunk = std::max(out.largest_chunk, chunk.data().content().size());
       } else if (chunk.has_report()) {
@@ -280,6 +286,171 @@ TEST_F(ExportRpcTest, GridNpyAndCsvHoldTheReportedShapeAndNanCells) {
   }
   EXPECT_EQ(rows, 729u);
   EXPECT_EQ(nan_rows, report.unfilled_cells());
+}
+
+// The doubles of a .npy file (NPY 1.0, '<f8'), after its header.
+std::vector<double> NpyDoubles(const std::string& npy) {
+  if (npy.size() < 10 || npy.compare(0, 6, "\x93NUMPY") != 0) {
+    ADD_FAILURE() << "not a .npy file";
+    return {};
+  }
+  const std::size_t header_len =
+      static_cast<unsigned char>(npy[8]) + 256u * static_cast<unsigned char>(npy[9]);
+  std::vector<double> values((npy.size() - 10 - header_len) / 8);
+  std::memcpy(values.data(), npy.data() + 10 + header_len, values.size() * 8);
+  return values;
+}
+
+// A grid export with include_uncertainty by `method` (the fill chain behind it), its cells'
+// u_interpolation compared with the Interpolate API's interpolation term at the same directions
+// of the same (ended) session: the chain's chosen-method cells with `method`'s, its fallback
+// cells with Delaunay's, to the API's float rounding. Counts the cells compared per method.
+class GridUncertaintyCheck {
+ public:
+  static constexpr std::size_t kBands = 101, kCells = 9 * 9 * 9;
+
+  GridUncertaintyCheck(DaemonRig& rig, const std::string& session, v1::ExportRequest request,
+                       v1::InterpolationMethod method)
+      : rig_(rig), session_(session), method_(method) {
+    request.set_method(method);
+    request.set_step_theta_i(10);
+    request.set_step_theta_o(10);
+    request.set_step_phi(20);
+    request.set_include_uncertainty(true);
+    request_ = request;
+  }
+  const v1::ExportRequest& request() const { return request_; }
+
+  void Compare(const std::vector<double>& values, const std::vector<double>& u_int) {
+    ASSERT_EQ(values.size(), kCells * kBands);
+    ASSERT_EQ(u_int.size(), kCells * kBands);
+    for (std::size_t cell = 0; cell < kCells; cell += 3) {
+      if (std::isnan(values[cell * kBands])) continue;
+      const v1::InterpolateResponse answer = Ask(cell);
+      if (answer.result().status() != v1::INTERPOLATION_STATUS_OK) continue;  // a model cell
+      const v1::InterpolationUncertainty& u = answer.result().uncertainty();
+      ASSERT_EQ(u.interpolation_size(), static_cast<int>(kBands));
+      ++compared[answer.result().method()];
+      for (std::size_t b = 0; b < kBands; ++b) {
+        const double want = u.interpolation(static_cast<int>(b));
+        EXPECT_NEAR(u_int[cell * kBands + b], want, 0x1p-23 * std::abs(want))
+            << "cell " << cell << ", band " << b << ", method " << answer.result().method();
+        nonzero += want > 0;
+      }
+      for (const std::string& n : u.not_estimated()) not_estimated.insert(n);
+    }
+  }
+
+  std::map<v1::InterpolationMethod, std::size_t> compared;
+  std::size_t nonzero = 0;
+  std::set<std::string> not_estimated;  // the API's, over the answers compared
+
+ private:
+  // Interpolate at cell's centre (θ 5°, 15°, …, 85°; φ 10°, 30°, …, 170°) in the chain's order:
+  // the chosen method, then its Delaunay fallback.
+  v1::InterpolateResponse Ask(std::size_t cell) {
+    v1::InterpolateRequest ask;
+    ask.set_session_id(session_);
+    ask.set_include_uncertainty(true);
+    v1::IsoDirection* at = ask.mutable_direction()->mutable_iso();
+    at->set_theta_i(5.0 + 10.0 * static_cast<double>(cell / 81));
+    at->set_theta_o(5.0 + 10.0 * static_cast<double>(cell / 9 % 9));
+    at->set_phi(10.0 + 20.0 * static_cast<double>(cell % 9));
+    v1::InterpolateResponse answer;
+    for (v1::InterpolationMethod m : {method_, v1::INTERPOLATION_METHOD_DELAUNAY}) {
+      ask.set_method(m);
+      const grpc::Status st =
+          rig_.interpolation().Interpolate(DaemonRig::Context(kAnalystToken).get(), ask, &answer);
+      EXPECT_TRUE(st.ok()) << st.error_message();
+      if (answer.result().status() == v1::INTERPOLATION_STATUS_OK) break;
+    }
+    return answer;
+  }
+
+  DaemonRig& rig_;
+  std::string session_;
+  v1::InterpolationMethod method_;
+  v1::ExportRequest request_;
+};
+
+// With include_uncertainty a grid's u_interpolation is the Interpolate API's calibrated
+// interpolation term at the same direction of the same (ended) session, to the API's float
+// rounding, and the sidecar says the term is calibrated and how; a second export of the snapshot
+// (its kept interpolant and calibration) gives the same arrays. Delaunay: the suite's 24 readings
+// give it held-out readings to calibrate on.
+TEST_F(ExportRpcTest, GridUncertaintyIsInterpolatesCalibratedInterpolationTerm) {
+  GridUncertaintyCheck check(*rig_, *session_id_, Request(v1::EXPORT_FORMAT_GRID_NPY),
+                             v1::INTERPOLATION_METHOD_DELAUNAY);
+  const ExportResult grid = Export(check.request());
+  ExpectCompleteStream(grid);
+  ASSERT_TRUE(grid.parts.contains("u_interpolation"));
+  const std::string& sidecar = grid.report->description_json();
+  EXPECT_NE(sidecar.find("\"interpolation_calibration\": {\"calibrated\": true"), std::string::npos)
+      << sidecar;
+  EXPECT_NE(sidecar.find("\"band_groups\": [{\"bands\": [0, 24], \"nm\": [380, 476], "
+                         "\"scale\": "),
+            std::string::npos)
+      << sidecar;
+  check.Compare(NpyDoubles(grid.file), NpyDoubles(grid.parts.at("u_interpolation")));
+  EXPECT_GE(check.compared[v1::INTERPOLATION_METHOD_DELAUNAY], 20u);
+  EXPECT_GT(check.nonzero, 0u);
+  for (const std::string& n : check.not_estimated) {
+    EXPECT_EQ(n.find("interpolation:"), std::string::npos) << "the API's term is calibrated: " << n;
+  }
+
+  const ExportResult again = Export(check.request());
+  ExpectCompleteStream(again);
+  EXPECT_EQ(again.parts, grid.parts);
+}
+
+// Where the term cannot be calibrated (the octant method predicts none of the suite's readings
+// held out: each lies on the data's edge once left out), the grid's u_interpolation is the
+// spread as it is, as the API's is (its not_estimated says so), and the sidecar says why; the
+// chain's Delaunay fallback cells are calibrated, as Delaunay's answers are.
+TEST_F(ExportRpcTest, GridUncertaintyNotCalibratedSaysWhyAndIsTheApisToo) {
+  GridUncertaintyCheck check(*rig_, *session_id_, Request(v1::EXPORT_FORMAT_GRID_NPY),
+                             v1::INTERPOLATION_METHOD_OCTANT);
+  const ExportResult grid = Export(check.request());
+  ExpectCompleteStream(grid);
+  const std::string& sidecar = grid.report->description_json();
+  EXPECT_NE(sidecar.find("\"interpolation_calibration\": {\"calibrated\": false"),
+            std::string::npos)
+      << sidecar;
+  EXPECT_NE(sidecar.find("{\"stage\": \"interpolated\", \"method\": \"octant\", "
+                         "\"calibrated\": false, \"held_out_readings\": 0, \"why\": \"0 "
+                         "held-out readings predicted, fewer than 8\""),
+            std::string::npos)
+      << sidecar;
+  EXPECT_NE(sidecar.find("{\"stage\": \"fallback\", \"method\": \"delaunay\", "
+                         "\"calibrated\": true"),
+            std::string::npos)
+      << sidecar;
+  bool warned = false;
+  for (const std::string& w : grid.report->warnings()) {
+    warned = warned || w.find("(octant) is not calibrated") != std::string::npos;
+  }
+  EXPECT_TRUE(warned);
+  check.Compare(NpyDoubles(grid.file), NpyDoubles(grid.parts.at("u_interpolation")));
+  EXPECT_GE(check.compared[v1::INTERPOLATION_METHOD_OCTANT], 3u);
+  EXPECT_GE(check.compared[v1::INTERPOLATION_METHOD_DELAUNAY], 3u);
+  EXPECT_TRUE(check.not_estimated.contains(
+      "interpolation: not calibrated (0 held-out readings predicted, fewer than 8); the "
+      "vertices' spread as it is"));
+}
+
+// MERL's uncertainty summary (include_uncertainty) rests on the same calibrated term
+// (Delaunay, as above).
+TEST_F(ExportRpcTest, MerlUncertaintySummarySaysTheInterpolationTermIsCalibrated) {
+  v1::ExportRequest request = Request(v1::EXPORT_FORMAT_MERL_BINARY);
+  request.set_method(v1::INTERPOLATION_METHOD_DELAUNAY);
+  request.set_include_uncertainty(true);
+  const ExportResult merl = Export(request);
+  ExpectCompleteStream(merl);
+  ASSERT_TRUE(merl.parts.contains("uncertainty"));
+  const std::string& summary = merl.parts.at("uncertainty");
+  EXPECT_NE(summary.find("\"interpolation_calibration\": {\"calibrated\": true"), std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("\"held_out_readings\": "), std::string::npos) << summary;
 }
 
 // The MERL file has MERL's size and dims, reads back with the reference reader's layout, and its

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/export/fill/session_interpolant.h"
+#include "core/uncertainty/interpolated.h"
 #include "export_test_util.h"
 
 namespace brdf::exports {
@@ -35,6 +36,20 @@ void AddBudgets(DerivedSamples& derived) {
     b->components = {white, signal};
     s.budget = b;
   }
+}
+
+// The paint-like session's octant interpolant without a fill chain, over its first `keep`
+// samples (0: all), each with a budget when `budgets`.
+std::optional<SessionInterpolant> PaintOctant(bool budgets, std::size_t keep = 0) {
+  std::optional<testing::PaintGridSamples> paint = testing::PaintLikeGridSamples();
+  if (!paint) return std::nullopt;
+  if (budgets) AddBudgets(paint->derived);
+  if (keep > 0) paint->derived.samples.resize(keep);
+  Result<SessionInterpolant> in = BuildSessionInterpolant(
+      std::move(paint->derived), interp::Method::kOctant, {}, FillPolicy::kNone, LongContext());
+  EXPECT_TRUE(in.ok()) << in.status().ToString();
+  if (!in.ok()) return std::nullopt;
+  return std::move(*in);
 }
 
 struct Row {
@@ -127,6 +142,64 @@ TEST(UncertainChain, ModelCellsCarryTheModelsResidualRms) {
     EXPECT_TRUE(std::isnan(row.plane(UncertainPlane::kMeasurement)[b]));
     EXPECT_GT(in->model->band_residuals[b].rms, 0.0);
   }
+}
+
+// The interpolation term is c(λ)·s(λ): the vertices' spread scaled by the stage's calibration
+// from held-out readings (the one the Interpolate API computes for the same samples), and the
+// sidecar says it is calibrated, on how many held-out readings.
+TEST(UncertainChain, TheInterpolationTermIsTheSpreadScaledByTheCalibration) {
+  const std::optional<SessionInterpolant> in = PaintOctant(true);
+  ASSERT_TRUE(in.has_value());
+  const UncertainChain chain = MakeUncertainChain(*in);
+  const uncertainty::InterpolationCalibration& c = ChosenCalibration(*in);
+  ASSERT_FALSE(c.scale.empty()) << c.detail;
+  const std::size_t bands = in->derived->grid.count;
+  uncertainty::InterpolatedInputs unscaled;
+  unscaled.samples = in->samples.get();
+  std::size_t compared = 0;
+  for (const DerivedSample& s : in->derived->samples) {
+    // Between readings: off each reading's pose by a few degrees.
+    const IsoDirection at{s.iso.theta_i + 2.5, s.iso.theta_o + 3.5, s.iso.phi + 7};
+    const double q[3] = {at.theta_i, at.theta_o, at.phi};
+    const interp::Interpolation answer = in->interpolator->Evaluate(q);
+    if (answer.status != interp::InterpStatus::kOk) continue;
+    const std::vector<double> spread =
+        uncertainty::EstimateInterpolatedUncertainty(answer, unscaled).interpolation;
+    const Row row = Ask(chain, at, bands);
+    ASSERT_EQ(row.status, interp::InterpStatus::kOk);
+    for (std::size_t b = 0; b < bands; ++b) {
+      EXPECT_NEAR(row.plane(UncertainPlane::kInterpolation)[b], c.scale[b] * spread[b],
+                  1e-12 * spread[b]);
+    }
+    if (++compared == 10) break;
+  }
+  EXPECT_EQ(compared, 10u);
+  ASSERT_EQ(chain.coverage.calibrations.size(), 1u);
+  const std::string j = UncertaintyJson(chain.coverage, Quantity::kBrdf, {});
+  EXPECT_NE(j.find("\"interpolation_calibration\": {\"calibrated\": true"), std::string::npos) << j;
+  EXPECT_NE(j.find("\"held_out_readings\": " + std::to_string(c.held_out)), std::string::npos);
+  EXPECT_TRUE(UncertaintyWarnings(chain.coverage).empty());
+}
+
+// Too few readings to hold out: the term is the spread as it is, and the sidecar and the
+// report's warnings say why, as the API's not_estimated does.
+TEST(UncertainChain, ATermThatCannotBeCalibratedIsTheSpreadAndSaysWhy) {
+  const std::optional<SessionInterpolant> in = PaintOctant(false, 10);
+  ASSERT_TRUE(in.has_value());
+  const UncertainChain chain = MakeUncertainChain(*in);
+  ASSERT_EQ(chain.coverage.calibrations.size(), 1u);
+  const uncertainty::InterpolationCalibration& c = chain.coverage.calibrations[0].fit;
+  EXPECT_TRUE(c.scale.empty());
+  EXPECT_NE(c.detail.find("fewer than 8"), std::string::npos) << c.detail;
+  const std::string j = UncertaintyJson(chain.coverage, Quantity::kBrdf, {});
+  EXPECT_NE(j.find("\"interpolation_calibration\": {\"calibrated\": false"), std::string::npos)
+      << j;
+  EXPECT_NE(j.find("\"why\": \"" + c.detail + "\""), std::string::npos) << j;
+  bool warned = false;
+  for (const std::string& w : UncertaintyWarnings(chain.coverage)) {
+    warned = warned || w.find("is not calibrated") != std::string::npos;
+  }
+  EXPECT_TRUE(warned);
 }
 
 TEST(UncertainChain, SidecarNamesEachFileItsUnitAndK) {

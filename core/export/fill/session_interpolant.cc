@@ -120,9 +120,9 @@ Result<SessionInterpolant> BuildSessionInterpolant(std::shared_ptr<const Derived
 }
 
 SessionInterpolant ShareSessionInterpolant(const SessionInterpolant& built) {
-  SessionInterpolant in{built.derived,  built.samples, built.method,
-                        built.options,  built.policy,  built.interpolator,
-                        built.fallback, built.model,   nullptr};
+  SessionInterpolant in{built.derived, built.samples,      built.method,   built.options,
+                        built.policy,  built.interpolator, built.fallback, built.model,
+                        nullptr,       built.calibrations};
   in.chain = MakeChain(in);
   return in;
 }

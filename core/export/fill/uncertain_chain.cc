@@ -6,9 +6,10 @@
 #include <span>
 #include <utility>
 
-#include "core/json_text.h"
 #include "core/export/number_text.h"
 #include "core/fit/models.h"
+#include "core/json_text.h"
+#include "core/uncertainty/held_out.h"
 #include "core/uncertainty/interpolated.h"
 
 namespace brdf::exports {
@@ -89,9 +90,24 @@ SpectrumSource ModelWithSpread(const fit::CookTorranceFit& model, std::vector<do
   };
 }
 
+// Sample i's budget; unset for a quantity other than the BRDF (the budgets are of the BRDF).
+uncertainty::BudgetOf BudgetsOf(const SessionInterpolant& in) {
+  if (in.derived->quantity != Quantity::kBrdf) return {};
+  return [&samples = in.derived->samples](std::size_t i) {
+    return i < samples.size() ? samples[i].budget.get() : nullptr;
+  };
+}
+
+uncertainty::InterpolationCalibration Calibrate(const SessionInterpolant& in,
+                                                interp::Method method) {
+  return uncertainty::CalibrateInterpolation(*in.samples, BudgetsOf(in), method, in.options,
+                                             static_cast<int>(in.derived->grid.count));
+}
+
 UncertaintyCoverage CoverageOf(const SessionInterpolant& in) {
   UncertaintyCoverage c;
   c.samples = in.derived->samples.size();
+  c.grid = in.derived->grid;
   if (in.derived->quantity != Quantity::kBrdf) {
     c.no_budgets = std::string("the readings' budgets are of the BRDF, this export is of ") +
                    QuantityName(in.derived->quantity) + "; export the BRDF for a measurement part";
@@ -144,10 +160,11 @@ const char* PlaneMeaning(UncertainPlane p) {
       return "measurement part: the blended vertices' reading budgets, shared terms (white "
              "standard, references, darks, instrument) correlated, as Interpolate gives it";
     case UncertainPlane::kInterpolation:
-      return "interpolation term: the vertices' weighted spread about the blend, not calibrated "
-             "against held-out readings as Interpolate's is (wider: docs/uncertainty.md); model "
-             "cells: "
-             "the fitted model's residual RMS per band over the readings it was fitted to";
+      return "interpolation term c(lambda) s(lambda): the vertices' weighted spread about the "
+             "blend scaled by the session's calibration from held-out readings "
+             "(interpolation_calibration), as Interpolate gives it; a stage not calibrated: the "
+             "spread as it is; model cells: the fitted model's residual RMS per band over the "
+             "readings it was fitted to";
     case UncertainPlane::kValue:
       break;
   }
@@ -167,6 +184,47 @@ std::string JsonNumbers(const std::vector<double>& values) {
     j += (k ? ", " : "") + (std::isfinite(values[k]) ? FormatNumber(values[k]) : "null");
   }
   return j + "]";
+}
+
+// A stage's calibration: its method, and its scale per band group or why it has none.
+std::string StageCalibrationJson(const StageCalibration& s, const WavelengthGrid& grid) {
+  const uncertainty::InterpolationCalibration& fit = s.fit;
+  std::string j = std::string("{\"stage\": ") + JsonString(ProvenanceName(s.stage)) +
+                  ", \"method\": " + JsonString(interp::MethodName(s.method)) +
+                  ", \"calibrated\": " + (fit.scale.empty() ? "false" : "true") +
+                  ", \"held_out_readings\": " + std::to_string(fit.held_out);
+  if (fit.scale.empty()) {
+    return j + ", \"why\": " + JsonString(fit.detail) +
+           ", \"instead\": \"the vertices' spread as it is (wider: docs/uncertainty.md)\"}";
+  }
+  j += ", \"band_groups\": [";
+  for (std::size_t g = 0; g < fit.band_groups; ++g) {
+    const std::size_t first = uncertainty::BandGroupFirst(g, fit.band_groups, fit.scale.size());
+    const std::size_t last = uncertainty::BandGroupFirst(g + 1, fit.band_groups, fit.scale.size());
+    if (last <= first) continue;
+    j += (g ? ", " : "") + std::string("{\"bands\": [") + std::to_string(first) + ", " +
+         std::to_string(last - 1) + "], \"nm\": [" + FormatNumber(grid.at(first)) + ", " +
+         FormatNumber(grid.at(last - 1)) + "], \"scale\": " + FormatNumber(fit.scale[first]) + "}";
+  }
+  return j + "], \"detail\": " + JsonString(fit.detail) + "}";
+}
+
+// "interpolation_calibration": calibrated when every interpolating stage is.
+std::string CalibrationJson(const UncertaintyCoverage& c) {
+  bool calibrated = !c.calibrations.empty();
+  std::string stages;
+  for (const StageCalibration& s : c.calibrations) {
+    calibrated = calibrated && !s.fit.scale.empty();
+    stages += (stages.empty() ? "" : ", ") + StageCalibrationJson(s, c.grid);
+  }
+  const uncertainty::CalibrationTarget target;
+  return std::string("{\"calibrated\": ") + (calibrated ? "true" : "false") +
+         ", \"what\": \"u_interpolation = c(lambda) s(lambda), c per band group the smallest "
+         "scale whose k = " +
+         FormatNumber(target.k) + " intervals hold " + FormatNumber(target.coverage) +
+         " of the held-out readings' residuals (split-conformal rank), fitted on this session "
+         "as Interpolate's is (docs/uncertainty.md, The interpolation term)\", \"stages\": [" +
+         stages + "]}";
 }
 
 }  // namespace
@@ -193,6 +251,7 @@ std::string UncertaintyJson(const UncertaintyCoverage& c, Quantity quantity,
        (c.no_budgets.empty() ? "null" : JsonString(c.no_budgets));
   j += ", \"budgets_not_estimated\": " + JsonList(c.not_estimated);
   j += ", \"model_residual_rms\": " + JsonNumbers(c.model_spread);
+  j += ", \"interpolation_calibration\": " + CalibrationJson(c);
   j += ", \"docs\": \"docs/uncertainty.md, Exports\"}";
   return j;
 }
@@ -209,7 +268,23 @@ std::vector<std::string> UncertaintyWarnings(const UncertaintyCoverage& c) {
                 "[uncertainty] enabled = false): the cells blending them have u_measurement and "
                 "u NaN");
   }
+  for (const StageCalibration& s : c.calibrations) {
+    if (!s.fit.scale.empty() || s.method == interp::Method::kNearest) continue;
+    w.push_back(std::string("uncertainty: the interpolation term of the ") +
+                ProvenanceName(s.stage) + " cells (" + interp::MethodName(s.method) +
+                ") is not calibrated (" + s.fit.detail +
+                "): their u_interpolation is the vertices' spread as it is, wider than a "
+                "calibrated term (docs/uncertainty.md)");
+  }
   return w;
+}
+
+const uncertainty::InterpolationCalibration& ChosenCalibration(const SessionInterpolant& in) {
+  return in.calibrations->chosen.Get([&in] { return Calibrate(in, in.method); });
+}
+
+const uncertainty::InterpolationCalibration& FallbackCalibration(const SessionInterpolant& in) {
+  return in.calibrations->fallback.Get([&in] { return Calibrate(in, interp::Method::kDelaunay); });
 }
 
 UncertainChain MakeUncertainChain(const SessionInterpolant& in) {
@@ -217,17 +292,18 @@ UncertainChain MakeUncertainChain(const SessionInterpolant& in) {
   out.coverage = CoverageOf(in);
   uncertainty::InterpolatedInputs inputs;
   inputs.samples = in.samples.get();
-  if (out.coverage.no_budgets.empty()) {
-    inputs.budget_of = [&in](std::size_t i) {
-      return i < in.derived->samples.size() ? in.derived->samples[i].budget.get() : nullptr;
-    };
-  } else {
-    inputs.no_budgets = out.coverage.no_budgets;
-  }
+  inputs.budget_of = BudgetsOf(in);
+  inputs.no_budgets = out.coverage.no_budgets;
+  // Each interpolating stage's term scaled by its own calibration, as Interpolate's is.
+  inputs.calibration = &ChosenCalibration(in);
+  out.coverage.calibrations.push_back({Provenance::kInterpolated, in.method, *inputs.calibration});
   std::vector<FillChain::Stage> stages;
   stages.push_back(
       {Provenance::kInterpolated, InterpolatorWithUncertainty(*in.interpolator, inputs)});
   if (in.fallback) {
+    inputs.calibration = &FallbackCalibration(in);
+    out.coverage.calibrations.push_back(
+        {Provenance::kFallback, interp::Method::kDelaunay, *inputs.calibration});
     stages.push_back({Provenance::kFallback, InterpolatorWithUncertainty(*in.fallback, inputs)});
   }
   if (in.model) {

@@ -1,11 +1,9 @@
-// daemon/index/interpolation_calibration: readings held out of the index in hashed folds and
-// predicted from the others, and the snapshot's calibration from them.
+// daemon/index/interpolation_calibration: a snapshot's calibration (core/uncertainty/held_out.h
+// over its samples), computed once for the snapshot.
 #include "daemon/index/interpolation_calibration.h"
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <functional>
 #include <memory>
 #include <vector>
 
@@ -16,70 +14,21 @@ namespace {
 
 constexpr int kBands = 4;
 
-// Samples on a (θi, θo, φ) grid, every 10° in θ up to 80° and 20° in φ up to 180° (810), band b
-// of each the function's value plus 0.01·b.
-std::shared_ptr<interp::SampleSet> Grid(const std::function<double(double, double, double)>& f) {
+// 512 samples of a curved BRDF on an 8 × 8 × 8 grid of (θi, θo, φ), every band alike.
+std::shared_ptr<interp::SampleSet> CurvedSamples() {
   auto set = std::make_shared<interp::SampleSet>(3, kBands);
-  std::int64_t id = 1;
-  for (double ti = 0; ti <= 80; ti += 10) {
-    for (double to = 0; to <= 80; to += 10) {
-      for (double phi = 0; phi <= 180; phi += 20) {
-        std::vector<double> spectrum(kBands);
-        for (int b = 0; b < kBands; ++b) spectrum[b] = f(ti, to, phi) + 0.01 * b;
-        const double c[3] = {ti, to, phi};
-        EXPECT_TRUE(set->Add(id++, c, spectrum).ok());
-      }
-    }
+  for (int k = 0; k < 512; ++k) {
+    const double c[3] = {10.0 * (k / 64), 10.0 * (k / 8 % 8), 20.0 * (k % 8)};
+    const double f = 0.1 + 1e-4 * (c[0] - 40) * (c[0] - 40) + 5e-6 * c[1] * c[2];
+    EXPECT_TRUE(set->Add(k + 1, c, std::vector<double>(kBands, f)).ok());
   }
   return set;
-}
-
-double Linear(double ti, double to, double phi) {
-  return 0.1 + 0.001 * ti + 0.002 * to + 0.0005 * phi;
-}
-double Curved(double ti, double to, double phi) {
-  return 0.1 + 1e-4 * (ti - 40) * (ti - 40) + 5e-5 * (to - phi / 3) * (to - phi / 3);
-}
-
-TEST(PredictHeldOut, ALinearBrdfIsPredictedExactlyAndTheScaleIsZero) {
-  const auto set = Grid(Linear);
-  const auto points =
-      PredictHeldOut(*set, BudgetList{}, interp::Method::kDelaunay, interp::Options{});
-  ASSERT_GE(points.size(), 100u);  // the interior readings, at least
-  EXPECT_LE(points.size(), kMaxHeldOut);
-  for (const uncertainty::HeldOutPoint& p : points) {
-    ASSERT_EQ(p.residual.size(), static_cast<std::size_t>(kBands));
-    for (double r : p.residual) EXPECT_NEAR(r, 0.0, 1e-12);
-    EXPECT_TRUE(p.noise.empty());  // no budgets
-  }
-  const auto fit = uncertainty::FitInterpolationCalibration(points, kBands, {});
-  ASSERT_EQ(fit.scale.size(), static_cast<std::size_t>(kBands));
-  EXPECT_LT(fit.scale[0], 1e-6);
-}
-
-TEST(PredictHeldOut, AHeldOutReadingIsNotItsOwnVertexAndTheFoldsAreFixed) {
-  // On a curved BRDF a reading predicted with itself in the index would have residual 0.
-  const auto set = Grid(Curved);
-  const auto first = PredictHeldOut(*set, BudgetList{}, interp::Method::kOctant, {});
-  const auto again = PredictHeldOut(*set, BudgetList{}, interp::Method::kOctant, {});
-  ASSERT_GE(first.size(), 50u);
-  ASSERT_EQ(first.size(), again.size());
-  std::size_t nonzero = 0;
-  for (std::size_t i = 0; i < first.size(); ++i) {
-    EXPECT_EQ(first[i].residual, again[i].residual);
-    EXPECT_EQ(first[i].spread, again[i].spread);
-    nonzero += std::abs(first[i].residual[0]) > 1e-9;
-  }
-  EXPECT_GT(nonzero, first.size() * 9 / 10);
-  const auto fit = uncertainty::FitInterpolationCalibration(first, kBands, {});
-  ASSERT_EQ(fit.scale.size(), static_cast<std::size_t>(kBands));
-  EXPECT_GT(fit.scale[0], 0.0);
 }
 
 TEST(CalibrateInterpolation, TheNearestMethodIsNotCalibratedAndSaysWhy) {
   IndexSnapshot snapshot;
   snapshot.method = interp::Method::kNearest;
-  snapshot.samples = Grid(Linear);
+  snapshot.samples = CurvedSamples();
   snapshot.grid.count = kBands;
   const uncertainty::InterpolationCalibration& c = snapshot.calibration->Get(snapshot);
   EXPECT_TRUE(c.scale.empty());
@@ -89,11 +38,13 @@ TEST(CalibrateInterpolation, TheNearestMethodIsNotCalibratedAndSaysWhy) {
 TEST(CalibrateInterpolation, IsComputedOnceForTheSnapshot) {
   IndexSnapshot snapshot;
   snapshot.method = interp::Method::kOctant;
-  snapshot.samples = Grid(Curved);
+  snapshot.samples = CurvedSamples();
   snapshot.grid.count = kBands;
+  EXPECT_FALSE(snapshot.calibration->computed());
   const uncertainty::InterpolationCalibration& c = snapshot.calibration->Get(snapshot);
   ASSERT_EQ(c.scale.size(), static_cast<std::size_t>(kBands));
   EXPECT_GE(c.held_out, 50u);
+  EXPECT_TRUE(snapshot.calibration->computed());
   EXPECT_EQ(&snapshot.calibration->Get(snapshot), &c);
 }
 
