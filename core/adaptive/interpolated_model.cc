@@ -76,7 +76,9 @@ struct Cell {
   int vertex_count = 0;
   std::array<std::array<double, 3>, 4> vertex{};  // answered: the simplex's vertices
   double radius = 0;                              // answered: the largest vertex distance
-  std::array<double, 8> nearest{};  // per orthant, the nearest reading's distance (+∞: empty)
+  // Per orthant, the nearest reading's squared distance (+∞: empty; squared, so that a reading
+  // at the very point compares equal, not by a rounding of the root).
+  std::array<double, 8> nearest2{};
 };
 
 // What a reading at p would do to one cell.
@@ -84,6 +86,7 @@ struct CellEffect {
   double factor = 1;  // the interpolation variance's new share
   int orthant = 0;    // p's orthant about the cell's direction
   double distance = 0;
+  double squared = 0;
   int replaced = -1;  // answered: the vertex p takes the place of
 };
 
@@ -111,24 +114,29 @@ bool AnsweredEffect(const Cell& cell, const std::array<double, 3>& e, CellEffect
 // An unknown cell: p helps when it fills one of its E empty orthants, by a share 1/E, more the
 // nearer it is (all of it only when it fills the last one at distance 0).
 bool UnknownEffect(const Cell& cell, CellEffect* out) {
-  if (!(out->distance < kUnknownReachDeg)) return false;
+  if (!(out->distance < kReachDeg)) return false;
   int empty = 0;
-  for (double n : cell.nearest) empty += std::isinf(n) ? 1 : 0;
-  const double near = (out->distance / kUnknownReachDeg) * (out->distance / kUnknownReachDeg);
+  for (double n : cell.nearest2) empty += std::isinf(n) ? 1 : 0;
+  const double near = (out->distance / kReachDeg) * (out->distance / kReachDeg);
   if (empty == 0) {  // every orthant holds a reading, yet no simplex encloses the direction
     out->factor = near;
     return true;
   }
-  if (!std::isinf(cell.nearest[out->orthant])) return false;
+  if (!std::isinf(cell.nearest2[out->orthant])) return false;
   out->factor = (empty - 1 + near) / empty;
   return true;
 }
 
 bool Effect(const Cell& cell, const std::array<double, 3>& e, const std::array<double, 3>& p,
             CellEffect* out) {
-  out->distance = Distance(p, e);
+  const double d0 = p[0] - e[0], d1 = p[1] - e[1], d2 = p[2] - e[2];
+  const double squared = d0 * d0 + d1 * d1 + d2 * d2;
+  const double reach = cell.answered ? std::min(cell.radius, kReachDeg) : kReachDeg;
+  if (!(squared < reach * reach)) return false;
   out->orthant = OrthantAbout(p, e);
-  if (!(out->distance < cell.nearest[out->orthant])) return false;
+  if (!(squared < cell.nearest2[out->orthant])) return false;
+  out->squared = squared;
+  out->distance = std::sqrt(squared);
   return cell.answered ? AnsweredEffect(cell, e, out) : UnknownEffect(cell, out);
 }
 
@@ -162,7 +170,7 @@ class InterpolatedMap final : public UncertaintyMap {
     Visit(p, [&](std::size_t i, const CellEffect& effect) {
       Cell& cell = cells_[i];
       cell.v_interpolation *= effect.factor;
-      cell.nearest[effect.orthant] = effect.distance;
+      cell.nearest2[effect.orthant] = effect.squared;
       if (effect.replaced >= 0) {
         cell.vertex[effect.replaced] = p;
         cell.radius *= std::sqrt(effect.factor);
@@ -183,13 +191,28 @@ class InterpolatedMap final : public UncertaintyMap {
 
   void IndexBuckets() {
     buckets_.assign(kBuckets[0] * kBuckets[1] * kBuckets[2], {});
+    bucket_reach_.assign(buckets_.size(), 0);
     for (std::size_t i = 0; i < points_.size(); ++i) {
       const auto& x = points_[i].x;
-      buckets_[(BucketOf(x[0], 0) * kBuckets[1] + BucketOf(x[1], 1)) * kBuckets[2] +
-               BucketOf(x[2], 2)]
-          .push_back(i);
-      reach_ = std::max(reach_, cells_[i].answered ? cells_[i].radius : kUnknownReachDeg);
+      const int b =
+          (BucketOf(x[0], 0) * kBuckets[1] + BucketOf(x[1], 1)) * kBuckets[2] + BucketOf(x[2], 2);
+      const double reach = cells_[i].answered ? std::min(cells_[i].radius, kReachDeg) : kReachDeg;
+      buckets_[b].push_back(i);
+      bucket_reach_[b] = std::max(bucket_reach_[b], reach);
+      reach_ = std::max(reach_, reach);
     }
+  }
+
+  // The squared distance from p to bucket (b0, b1, b2)'s box (the outermost ones open outwards).
+  static double BoxDistanceSquared(const std::array<double, 3>& p, const int (&b)[3]) {
+    double sum = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = b[a] == 0 ? -INFINITY : b[a] * kBucketDeg;
+      const double hi = b[a] == kBuckets[a] - 1 ? INFINITY : (b[a] + 1) * kBucketDeg;
+      const double gap = p[a] < lo ? lo - p[a] : (p[a] > hi ? p[a] - hi : 0);
+      sum += gap * gap;
+    }
+    return sum;
   }
 
   // Calls f(point, effect) for every evaluation direction a reading at p would enter,
@@ -205,7 +228,10 @@ class InterpolatedMap final : public UncertaintyMap {
     for (int b0 = lo[0]; b0 <= hi[0]; ++b0) {
       for (int b1 = lo[1]; b1 <= hi[1]; ++b1) {
         for (int b2 = lo[2]; b2 <= hi[2]; ++b2) {
-          for (std::size_t i : buckets_[(b0 * kBuckets[1] + b1) * kBuckets[2] + b2]) {
+          const int b = (b0 * kBuckets[1] + b1) * kBuckets[2] + b2;
+          const double reach = bucket_reach_[b];
+          if (!(BoxDistanceSquared(p, {b0, b1, b2}) < reach * reach)) continue;
+          for (std::size_t i : buckets_[b]) {
             CellEffect effect;
             if (Effect(cells_[i], points_[i].x, p, &effect)) f(i, effect);
           }
@@ -237,6 +263,7 @@ class InterpolatedMap final : public UncertaintyMap {
   double sum_ = 0;
   double reach_ = 0;  // the largest radius when built (radii only shrink)
   std::vector<std::vector<std::size_t>> buckets_;
+  std::vector<double> bucket_reach_;  // per bucket, the largest reach of its cells when built
 };
 
 // The cells from the judged interpolant's answers; unknown cells get `unknown_v` per unit cos².
@@ -246,7 +273,7 @@ std::vector<Cell> AnswerCells(const std::vector<EvalPoint>& points, const Judged
   double m_all = 0, m_answered = 0, y2 = 0, cy2 = 0;
   for (std::size_t i = 0; i < points.size(); ++i) {
     m_all += points[i].measure;
-    cells[i].nearest = judged.OrthantNearest(points[i].x);
+    cells[i].nearest2 = judged.OrthantNearest2(points[i].x);
     const std::optional<JudgedAnswer> a = judged.Answer(points[i].x);
     if (!a.has_value()) continue;
     Cell& cell = cells[i];

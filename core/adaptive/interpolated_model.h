@@ -36,19 +36,19 @@
 //
 // PredictedGain(candidate): a reading at the candidate's isotropic point p enters the cell of an
 // evaluation direction e when it is nearer to e than the nearest reading (or mirror image) in
-// p's orthant about e — the octant method's own test. In an answered cell it takes the place of
-// the simplex's vertex in that orthant (or, when the simplex has none there, of its farthest
-// vertex); the cell's size h (its largest vertex distance) becomes h', and e's interpolation
-// term falls in proportion, u_int · h' / h (the vertices' spread follows the cell's size where
-// the BRDF is smooth). The measurement part stays. An unknown direction with E empty orthants
-// loses a share (1 − (d / kUnknownReachDeg)²) / E of its unknown term to a reading at distance d
-// < kUnknownReachDeg that fills one of them. The gain is the fall of Remaining() (≥ 0); Assume()
-// applies it. Distances are in the interpolator's degrees (θi, θo, φ).
+// p's orthant about e — the octant method's own test — and within kReachDeg of e. In an answered
+// cell it takes the place of the simplex's vertex in that orthant (or, when the simplex has none
+// there, of its farthest vertex); the cell's size h (its largest vertex distance) becomes h', and
+// e's interpolation term falls in proportion, u_int · h' / h (the vertices' spread follows the
+// cell's size where the BRDF is smooth). The measurement part stays. An unknown direction with E
+// empty orthants loses a share (1 − (d / kReachDeg)²) / E of its unknown term to a reading at
+// distance d < kReachDeg that fills one of them. The gain is the fall of Remaining() (≥ 0);
+// Assume() applies it. Distances are in the interpolator's degrees (θi, θo, φ).
 //
 // Deterministic: the same readings in the same order give the same map and the same gains.
 // Readings with a non-finite direction or BRDF, or a negative or non-finite u, are left out.
 // No usable readings: every direction is unknown, Remaining() = k · kUnknownRelative, and a
-// reading anywhere gains near it (within kUnknownReachDeg). If the judged method cannot be built
+// reading anywhere gains near it (within kReachDeg). If the judged method cannot be built
 // over the readings (Delaunay over fewer than 4 readings, or all of them in one plane), the
 // octant method stands in; if that fails too, every direction is unknown. Pure: no I/O.
 //
@@ -66,8 +66,10 @@ namespace brdf::adaptive {
 
 // The relative uncertainty given to a direction the method cannot answer.
 inline constexpr double kUnknownRelative = 1.0;
-// How near a reading must come to an unknown direction to count for it (degrees).
-inline constexpr double kUnknownReachDeg = 45;
+// How near a reading must come to an evaluation direction to count for it (degrees, in
+// (θi, θo, φ)): a cheap round (interpolated_model.h, "Cost"); a reading farther away than this
+// is predicted to gain nothing there, even when it would enter a larger cell.
+inline constexpr double kReachDeg = 30;
 
 // The interpolation options the model judges with, and the adaptive benchmark interpolates with:
 // the isotropic mirror images of φ (exact for an isotropic sample, interpolation.md), which let

@@ -174,7 +174,7 @@ std::optional<JudgedAnswer> JudgedReadings::Answer(const std::array<double, 3>& 
   return out;
 }
 
-std::array<double, 8> JudgedReadings::OrthantNearest(const std::array<double, 3>& point) const {
+std::array<double, 8> JudgedReadings::OrthantNearest2(const std::array<double, 3>& point) const {
   std::array<double, 8> best;
   best.fill(std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < samples_->size(); ++i) {
@@ -187,7 +187,6 @@ std::array<double, 8> JudgedReadings::OrthantNearest(const std::array<double, 3>
       best[o] = std::min(best[o], d0 * d0 + d1 * d1 + d2 * d2);
     }
   }
-  for (double& b : best) b = std::sqrt(b);
   return best;
 }
 

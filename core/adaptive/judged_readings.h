@@ -47,10 +47,10 @@ class JudgedReadings {
   // The answer at (θi, θo, φ); empty where the method has none (an empty octant, outside the
   // hull, no index).
   std::optional<JudgedAnswer> Answer(const std::array<double, 3>& point) const;
-  // Per orthant about `point` (bit 0: θi ≥, bit 1: θo ≥, bit 2: φ ≥ the point's), the distance
-  // (degrees, in (θi, θo, φ)) to the nearest usable reading or its mirror image in φ (−φ,
-  // 360° − φ, as JudgeOptions() adds them); +∞ for an empty orthant.
-  std::array<double, 8> OrthantNearest(const std::array<double, 3>& point) const;
+  // Per orthant about `point` (bit 0: θi ≥, bit 1: θo ≥, bit 2: φ ≥ the point's), the squared
+  // distance (degrees², in (θi, θo, φ)) to the nearest usable reading or its mirror image in φ
+  // (−φ, 360° − φ, as JudgeOptions() adds them); +∞ for an empty orthant.
+  std::array<double, 8> OrthantNearest2(const std::array<double, 3>& point) const;
   // The mean of the usable readings' squared BRDF; 0 without any.
   double MeanSquareValue() const;
 
