@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/adaptive/interpolated_model.h"
+
 namespace brdf::daemon {
 
 Result<std::unique_ptr<RigBackEnd>> RigBackEnd::Open(const Config& config,
@@ -66,6 +68,9 @@ Status RigBackEnd::StartManager(const Config& config, std::unique_ptr<Rig> rig) 
   options.rig_description = ToRigDescription(config);
   options.white_reflectance = config.sample.white_reflectance;
   options.uncertainty = ReadingBudgetSettingsFrom(config);
+  options.uncertainty_model = [](const adaptive::AdaptiveSpec& spec) {
+    return adaptive::MakeInterpolatedModel(spec);
+  };
   options.rig_name = RigName(config);
   if (Status adopted = store_->AdoptUnnamedSessions(options.rig_name); !adopted.ok()) {
     spdlog::critical("naming the rig of older sessions failed: {}", adopted.ToString());

@@ -1,0 +1,20 @@
+#!/bin/sh
+# The adaptive planner's offline study (docs/adaptive.md, "The offline study"): the planner's loop
+# on brdf-sim's materials without a rig, at 10, 20, 30 and 50 % of the paper grid's readings,
+# against the paper grid itself. Runs from the repository root; BUILD names the build directory.
+#
+#   bench/adaptive/study.sh                       paint, glossy, gold, retro-coating, seeds 1 2 3
+#   MATERIALS="blue-plastic" SEEDS="1" bench/adaptive/study.sh
+#   EXTRA="--candidate-step 2.5" bench/adaptive/study.sh
+set -eu
+BUILD=${BUILD:-build}
+MATERIALS=${MATERIALS:-"paint glossy gold retro-coating"}
+SEEDS=${SEEDS:-"1 2 3"}
+EXTRA=${EXTRA:-}
+study="$BUILD/bench/adaptive/bench_adaptive_study"
+[ -x "$study" ] || { echo "study.sh: build it first: cmake --build $BUILD --target bench_adaptive_study" >&2; exit 2; }
+echo "# $(date -u '+%Y-%m-%d %H:%M UTC'), load $(cut -d' ' -f1-3 /proc/loadavg), commit $(git rev-parse --short HEAD)"
+for m in $MATERIALS; do
+  # shellcheck disable=SC2086  # SEEDS and EXTRA are lists of words
+  "$study" --material "deploy/materials/$m.toml" --seeds $SEEDS $EXTRA
+done
