@@ -1,6 +1,7 @@
 #include "core/fit/fit.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -109,7 +110,7 @@ class Projection {
       v_one_.push_back(std::move(v_one));
       v_f_.push_back(std::move(v_f));
     }
-    if (shared_) TransposeBands();
+    if (shared_) swsf_.resize(b1 - b0);
   }
 
   // Solves for (α, F0) and returns the total (weighted) SSE; fills `out` (b1 − b0 solutions)
@@ -147,17 +148,6 @@ class Projection {
     return b1 > b0;
   }
 
-  // v_f_ observation by observation (f_by_observation_[i · bands + b]), for SharedLobeSums.
-  void TransposeBands() {
-    const std::size_t bands = b1_ - b0_, count = data_.size();
-    f_by_observation_.resize(bands * count);
-    for (std::size_t b = 0; b < bands; ++b) {
-      for (std::size_t i = 0; i < count; ++i) f_by_observation_[i * bands + b] = v_f_[b][i];
-    }
-    v_f_.clear();
-    swsf_.resize(bands);
-  }
-
   // Each band's products with the lobe shape s: 1ᵀV⁻¹s, sᵀV⁻¹f, sᵀV⁻¹s.
   void BandLobeSums() {
     for (std::size_t b = b0_; b < b1_; ++b) {
@@ -169,20 +159,17 @@ class Projection {
   }
 
   // The same products when every band has the same diagonal V (unweighted data): 1ᵀV⁻¹s and
-  // sᵀV⁻¹s are then one value for all bands, taken once, and every band's sᵀV⁻¹f comes from one
-  // pass over the observations. Each band's sum still adds the observations in their order from
-  // 0, so every value is BandLobeSums' to the bit; the bands' independent sums pipeline where
-  // BandLobeSums waits on one sum at a time.
+  // sᵀV⁻¹s are then one value for all bands, taken once, and the bands' sᵀV⁻¹f are summed eight
+  // at a time. Each band's sum still adds the observations in their order from 0, so every value
+  // is BandLobeSums' to the bit; the eight independent sums pipeline where BandLobeSums waits on
+  // one sum at a time.
   void SharedLobeSums() {
     const double sws = Dot(spec_, v_one_[0]);
     const double swss = covariance_[b0_].Product(spec_, spec_);
     const std::size_t bands = b1_ - b0_;
-    std::fill(swsf_.begin(), swsf_.end(), 0.0);
-    for (std::size_t i = 0; i < data_.size(); ++i) {
-      const double x = spec_[i];
-      const double* row = &f_by_observation_[i * bands];
-      for (std::size_t b = 0; b < bands; ++b) swsf_[b] += x * row[b];
-    }
+    std::size_t first = 0;
+    for (; first + 8 <= bands; first += 8) SumBands<8>(first);
+    for (; first < bands; ++first) SumBands<1>(first);
     for (std::size_t b = 0; b < bands; ++b) {
       sums_[b].sws = sws;
       sums_[b].swss = swss;
@@ -190,13 +177,27 @@ class Projection {
     }
   }
 
+  // sᵀV⁻¹f of bands [first, first + N) into swsf_: N sums side by side, each over the
+  // observations in order (N streams of V⁻¹f read once each).
+  template <std::size_t N>
+  void SumBands(std::size_t first) {
+    std::array<const double*, N> f;
+    for (std::size_t k = 0; k < N; ++k) f[k] = v_f_[first + k].data();
+    std::array<double, N> sum{};
+    for (std::size_t i = 0; i < data_.size(); ++i) {
+      const double x = spec_[i];
+#pragma GCC unroll 8
+      for (std::size_t k = 0; k < N; ++k) sum[k] += x * f[k][i];
+    }
+    std::copy(sum.begin(), sum.end(), swsf_.begin() + static_cast<std::ptrdiff_t>(first));
+  }
+
   const Observations& data_;
   const std::vector<BandCovariance>& covariance_;
   std::size_t b0_, b1_;
   const bool shared_;  // every band's V the same diagonal one
   std::vector<BandSums> sums_;
-  std::vector<std::vector<double>> v_one_, v_f_;  // V⁻¹1 and V⁻¹f per band (V⁻¹f: not shared_)
-  std::vector<double> f_by_observation_;          // shared_: V⁻¹f observation by observation
+  std::vector<std::vector<double>> v_one_, v_f_;  // V⁻¹1 and V⁻¹f per band
   std::vector<double> swsf_;                      // shared_: sᵀV⁻¹f per band
   std::vector<LobeGeometry> geometry_;
   std::vector<double> spec_;
