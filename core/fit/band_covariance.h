@@ -40,6 +40,11 @@ class BandCovariance {
 
   std::size_t size() const { return inv_d_.size(); }  // observations
   std::size_t shared_sources() const { return k_; }   // sources with a contribution in the band
+  // Both diagonal (no shared source) with the same D, as every band of unweighted data (V = I):
+  // then Solve and Product answer the same for the same inputs, to the bit.
+  bool SameDiagonal(const BandCovariance& other) const {
+    return k_ == 0 && other.k_ == 0 && inv_d_ == other.inv_d_;
+  }
 
   // V⁻¹ y for y one value per observation.
   std::vector<double> Solve(std::span<const double> y) const;

@@ -1,6 +1,7 @@
 #include "core/fit/fit.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -86,7 +87,13 @@ class Projection {
  public:
   Projection(const Observations& data, const std::vector<BandCovariance>& covariance,
              std::size_t b0, std::size_t b1)
-      : data_(data), covariance_(covariance), b0_(b0), b1_(b1), sums_(b1 - b0), spec_(data.size()) {
+      : data_(data),
+        covariance_(covariance),
+        b0_(b0),
+        b1_(b1),
+        shared_(SharedDiagonal(covariance, b0, b1)),
+        sums_(b1 - b0),
+        spec_(data.size()) {
     geometry_.reserve(data.size());
     for (std::size_t i = 0; i < data.size(); ++i) {
       geometry_.push_back(LobeGeometryOf(data.direction(i)));
@@ -103,6 +110,7 @@ class Projection {
       v_one_.push_back(std::move(v_one));
       v_f_.push_back(std::move(v_f));
     }
+    if (shared_) swsf_.resize(b1 - b0);
   }
 
   // Solves for (α, F0) and returns the total (weighted) SSE; fills `out` (b1 − b0 solutions)
@@ -111,13 +119,14 @@ class Projection {
     for (std::size_t i = 0; i < data_.size(); ++i) {
       spec_[i] = CookTorranceSpecularAt(geometry_[i], alpha, f0);
     }
+    if (shared_) {
+      SharedLobeSums();
+    } else {
+      BandLobeSums();
+    }
     double total = 0;
     if (out != nullptr) out->clear();
-    for (std::size_t b = b0_; b < b1_; ++b) {
-      BandSums& s = sums_[b - b0_];
-      s.sws = Dot(spec_, v_one_[b - b0_]);
-      s.swsf = Dot(spec_, v_f_[b - b0_]);
-      s.swss = covariance_[b].Product(spec_, spec_);
+    for (const BandSums& s : sums_) {
       const LinearSolution sol = SolveBand(s);
       total += sol.sse;
       if (out != nullptr) out->push_back(sol);
@@ -131,12 +140,65 @@ class Projection {
     for (std::size_t i = 0; i < x.size(); ++i) s += x[i] * y[i];
     return s;
   }
+  static bool SharedDiagonal(const std::vector<BandCovariance>& covariance, std::size_t b0,
+                             std::size_t b1) {
+    for (std::size_t b = b0 + 1; b < b1; ++b) {
+      if (!covariance[b].SameDiagonal(covariance[b0])) return false;
+    }
+    return b1 > b0;
+  }
+
+  // Each band's products with the lobe shape s: 1ᵀV⁻¹s, sᵀV⁻¹f, sᵀV⁻¹s.
+  void BandLobeSums() {
+    for (std::size_t b = b0_; b < b1_; ++b) {
+      BandSums& s = sums_[b - b0_];
+      s.sws = Dot(spec_, v_one_[b - b0_]);
+      s.swsf = Dot(spec_, v_f_[b - b0_]);
+      s.swss = covariance_[b].Product(spec_, spec_);
+    }
+  }
+
+  // The same products when every band has the same diagonal V (unweighted data): 1ᵀV⁻¹s and
+  // sᵀV⁻¹s are then one value for all bands, taken once, and the bands' sᵀV⁻¹f are summed eight
+  // at a time. Each band's sum still adds the observations in their order from 0, so every value
+  // is BandLobeSums' to the bit; the eight independent sums pipeline where BandLobeSums waits on
+  // one sum at a time.
+  void SharedLobeSums() {
+    const double sws = Dot(spec_, v_one_[0]);
+    const double swss = covariance_[b0_].Product(spec_, spec_);
+    const std::size_t bands = b1_ - b0_;
+    std::size_t first = 0;
+    for (; first + 8 <= bands; first += 8) SumBands<8>(first);
+    for (; first < bands; ++first) SumBands<1>(first);
+    for (std::size_t b = 0; b < bands; ++b) {
+      sums_[b].sws = sws;
+      sums_[b].swss = swss;
+      sums_[b].swsf = swsf_[b];
+    }
+  }
+
+  // sᵀV⁻¹f of bands [first, first + N) into swsf_: N sums side by side, each over the
+  // observations in order (N streams of V⁻¹f read once each).
+  template <std::size_t N>
+  void SumBands(std::size_t first) {
+    std::array<const double*, N> f;
+    for (std::size_t k = 0; k < N; ++k) f[k] = v_f_[first + k].data();
+    std::array<double, N> sum{};
+    for (std::size_t i = 0; i < data_.size(); ++i) {
+      const double x = spec_[i];
+#pragma GCC unroll 8
+      for (std::size_t k = 0; k < N; ++k) sum[k] += x * f[k][i];
+    }
+    std::copy(sum.begin(), sum.end(), swsf_.begin() + static_cast<std::ptrdiff_t>(first));
+  }
 
   const Observations& data_;
   const std::vector<BandCovariance>& covariance_;
   std::size_t b0_, b1_;
+  const bool shared_;  // every band's V the same diagonal one
   std::vector<BandSums> sums_;
   std::vector<std::vector<double>> v_one_, v_f_;  // V⁻¹1 and V⁻¹f per band
+  std::vector<double> swsf_;                      // shared_: sᵀV⁻¹f per band
   std::vector<LobeGeometry> geometry_;
   std::vector<double> spec_;
 };

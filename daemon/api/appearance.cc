@@ -20,6 +20,7 @@
 #include "core/export/fill/session_interpolant.h"
 #include "core/export/fill/spectrum_source.h"
 #include "core/fit/fit.h"
+#include "daemon/api/appearance_stage.h"
 #include "daemon/api/interpolation.h"
 #include "daemon/wire/values.h"
 #include "data/cie_tables.h"
@@ -97,51 +98,13 @@ grpc::Status ParseAppearance(const v1::AppearanceRequest& r, AppearanceSettings*
   return grpc::Status::OK;
 }
 
-// A stage of the fill chain that is only made when a direction first needs it (the Delaunay
-// index, the fitted model): most sessions' spheres never ask. A stage that cannot be made answers
-// no value, and says why in `error`.
-class LazyStage {
- public:
-  using Make = std::function<Result<exports::SpectrumSource>()>;
-  explicit LazyStage(Make make) : make_(std::move(make)) {}
-
-  exports::SpectrumSource Source() {
-    return [this](const IsoDirection& at, std::span<double> out) {
-      std::call_once(once_, [this] {
-        Result<exports::SpectrumSource> made = make_();
-        if (made.ok()) {
-          source_.emplace(*std::move(made));
-        } else {
-          error_ = made.status().message();
-          code_ = made.status().code();
-        }
-      });
-      return source_ ? (*source_)(at, out) : interp::InterpStatus::kOutsideHull;
-    };
-  }
-  const std::string& error() const { return error_; }
-  // Made, not needed, or failed for a reason of the readings (the same for every call on this
-  // snapshot), not of this call (its deadline, a cancellation, the store).
-  bool Lasting() const {
-    return error_.empty() || code_ == StatusCode::kFailedPrecondition ||
-           code_ == StatusCode::kInvalidArgument || code_ == StatusCode::kNotFound;
-  }
-
- private:
-  Make make_;
-  std::once_flag once_;
-  std::optional<exports::SpectrumSource> source_;
-  std::string error_;
-  StatusCode code_ = StatusCode::kOk;
-};
-
-CallContext FitContext(const grpc::ServerContext& context) {
+CallContext FitContext(const grpc::ServerContext& context, const CancelToken& cancel) {
   const auto remaining = context.deadline() - std::chrono::system_clock::now();
   const auto timeout = std::min<std::chrono::steady_clock::duration>(
       std::chrono::duration_cast<std::chrono::steady_clock::duration>(
           std::max(remaining, std::chrono::system_clock::duration::zero())),
       kLongestFit);
-  return CallContext::WithTimeout(timeout);
+  return CallContext::WithTimeout(timeout, cancel);
 }
 
 void SetColour(const SampleColour& c, v1::AppearanceColour* out) {
@@ -175,16 +138,20 @@ class AppearanceChain {
  public:
   AppearanceChain(IndexCache& cache, grpc::ServerContext& context, const AppearanceSettings& s,
                   const std::shared_ptr<const IndexSnapshot>& index)
-      : fallback_([this, &cache, &s]() -> Result<exports::SpectrumSource> {
+      : fallback_([this, &cache, &s](const CancelToken&) -> Result<exports::SpectrumSource> {
+          // A direction the index has no value for: the model is likely needed too (a direction
+          // outside the readings' hull), so it is fitted beside the Delaunay build.
+          model_.Start();
           Result<std::shared_ptr<const IndexSnapshot>> d =
               cache.Get(s.session, Quantity::kBrdf, interp::Method::kDelaunay, s.options);
           if (!d.ok()) return d.status().WithContext("the fill chain's Delaunay fallback");
           delaunay_ = std::move(*d);
           return exports::InterpolatorSource(*delaunay_->interpolator);
         }),
-        model_([this, &context, &index]() -> Result<exports::SpectrumSource> {
+        model_([this, &context,
+                &index](const CancelToken& cancel) -> Result<exports::SpectrumSource> {
           Result<fit::CookTorranceFit> fitted =
-              exports::FitSampleModel(*index->samples, index->grid, FitContext(context));
+              exports::FitSampleModel(*index->samples, index->grid, FitContext(context, cancel));
           if (!fitted.ok()) return fitted.status().WithContext("the fill chain's model");
           model_fit_ = std::move(*fitted);
           return exports::ModelSource(*model_fit_);

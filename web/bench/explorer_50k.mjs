@@ -39,6 +39,12 @@
 //   1087 ms (ratios to the small session 1.30, 1.37, 1.26; before, in the same hour, 1718 ms and
 //   1.92), with the polar plot 1288, 1621, 1358 ms (before 2044 ms); new direction 58.4, 73.2,
 //   81.7 ms (before 55.3 ms). bench/README.md has the table.
+//   2026-12-06 (issue 41: the fill chain's model fitted in one pass over the bands and beside the
+//   Delaunay build), the lit spheres' first render, BRDF_BENCH_VIEWS=1, 3 repetitions, main's
+//   brdfd interleaved, load 11–17: 101 bands median 18.33 s (main 31.23 s), 401 bands 28.38 s
+//   (main 74.17 s, once); again 0.05 s for both. With the fit's sums eight bands at a time
+//   (85e5df8; load 7–13): 101 bands 8.98 s (main 11.36 s), 401 bands 9.30 s. bench/README.md,
+//   "The explorer's first lit spheres", has brdfd's CPU time beside it.
 import puppeteer from 'puppeteer-core';
 import { spawn, execFileSync } from 'node:child_process';
 import { mkdtempSync, writeFileSync, openSync, readFileSync, copyFileSync, existsSync } from 'node:fs';

@@ -86,13 +86,14 @@ export function createAppearance(root, report) {
   return {
     // A session of `readings` sample readings was loaded in the explorer: rendered at once, but
     // for a large session only on request. Its first render builds the fill chain's indexes over
-    // every reading (mirrored and swapped: 4×), which on 50,000 readings takes the daemon close to
-    // a minute and its one work permit; the plots must stay interactive meanwhile.
+    // every reading (mirrored and swapped: 4×), which on 50,000 readings takes the daemon several
+    // seconds (tens on a busy machine) and its one work permit; the plots must stay interactive
+    // meanwhile.
     load(id, readings) {
       session = id;
       if (readings > AUTO_RENDER_READINGS) {
         clear(images);
-        info.textContent = `${readings} sample readings: press Render for the colour and lit spheres (on a session this large the daemon needs a minute or more the first time; the answer is then kept).`;
+        info.textContent = `${readings} sample readings: press Render for the colour and lit spheres (on a session this large the daemon needs several seconds the first time, more when busy; the answer is then kept).`;
         return Promise.resolve();
       }
       return render();
