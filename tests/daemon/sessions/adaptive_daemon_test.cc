@@ -77,20 +77,6 @@ void ExpectSameRound(const storage::RoundRecord& after, const storage::RoundReco
 
 class AdaptiveDaemonTest : public SessionRigTest {
  protected:
-  void ExpectIntact(std::int64_t id) {
-    Result<DbSessionCounts> c = CountSession(rig_.database(), id);
-    ASSERT_TRUE(c.ok()) << c.status().ToString();
-    EXPECT_EQ(c->steps, c->total_steps);
-    EXPECT_EQ(c->step_index_gaps, 0);
-    EXPECT_EQ(c->duplicate_readings, 0);
-    EXPECT_EQ(c->orphan_readings, 0);
-    EXPECT_EQ(c->readings, c->measuring_steps_done);
-    EXPECT_EQ(c->done_steps_recorded, c->steps_done);
-    Result<std::string> problems = StorageProblems(rig_.database(), id);
-    ASSERT_TRUE(problems.ok()) << problems.status().ToString();
-    EXPECT_EQ(*problems, "");
-  }
-
   std::set<std::int64_t> ReadingIds(const std::string& id) {
     Result<std::vector<v1::Reading>> r = rig_.Readings(id);
     EXPECT_TRUE(r.ok()) << r.status().ToString();
