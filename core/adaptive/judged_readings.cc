@@ -10,15 +10,12 @@
 #include "core/geometry.h"
 #include "core/interp/octant/octant.h"
 #include "core/uncertainty/blend.h"
+#include "core/uncertainty/budget.h"
+#include "core/uncertainty/held_out.h"
 #include "core/uncertainty/interpolation_calibration.h"
 
 namespace brdf::adaptive {
 namespace {
-
-constexpr std::size_t kMaxHeldOut = 300;
-constexpr std::size_t kMaxFolds = 32;
-constexpr std::size_t kMaxFoldSamplesOctant = 60000;
-constexpr std::size_t kMaxFoldSamplesDelaunay = 10000;
 
 interp::Method MethodOf(Judge judge) {
   return judge == Judge::kDelaunay ? interp::Method::kDelaunay : interp::Method::kOctant;
@@ -45,14 +42,6 @@ std::unique_ptr<interp::Interpolator> BuildIndex(std::shared_ptr<const interp::S
   return index.ok() ? std::move(*index) : nullptr;
 }
 
-// splitmix64 of a reading's position: the folds do not follow the plan's order.
-std::uint64_t Mix(std::uint64_t z) {
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 // The answer's vertices' weights and values, and its blend's measurement part (absolute).
 double MeasurementPart(const interp::Interpolation& answer, const interp::SampleSet& set,
                        std::span<const double> relative_u, std::vector<double>* weights,
@@ -69,58 +58,15 @@ double MeasurementPart(const interp::Interpolation& answer, const interp::Sample
   return std::sqrt(u2);
 }
 
-// One fold held out: an index over the rest predicts each held reading at its own point.
-void PredictFold(const interp::SampleSet& all, std::span<const double> relative_u,
-                 std::span<const std::size_t> held, interp::Method method,
-                 std::vector<uncertainty::HeldOutPoint>* out) {
-  std::vector<bool> is_held(all.size(), false);
-  for (std::size_t j : held) is_held[j] = true;
-  auto rest = std::make_shared<interp::SampleSet>(all.dims(), all.bands());
-  std::vector<double> rest_u;
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    if (is_held[i] || !rest->Add(all.id(i), all.coords(i), all.spectrum(i)).ok()) continue;
-    rest_u.push_back(relative_u[i]);
+// Each reading's measurement noise as held_out.h reads it: a one-band budget whose independent
+// part is the reading's relative u times its BRDF (absolute).
+std::vector<uncertainty::ReadingBudget> ScalarBudgets(const interp::SampleSet& samples,
+                                                      std::span<const double> relative_u) {
+  std::vector<uncertainty::ReadingBudget> budgets(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    budgets[i].independent = {relative_u[i] * samples.spectrum(i)[0]};
   }
-  const std::unique_ptr<interp::Interpolator> index = BuildIndex(rest, method);
-  if (index == nullptr) return;
-  std::vector<double> weights;
-  std::vector<std::span<const double>> values;
-  for (std::size_t j : held) {
-    const interp::Interpolation answer = index->Evaluate(all.coords(j));
-    if (answer.status != interp::InterpStatus::kOk || answer.spectrum.size() != 1) continue;
-    const double truth = all.spectrum(j)[0];
-    const double noise_vertices = MeasurementPart(answer, *rest, rest_u, &weights, &values);
-    const double noise_own = relative_u[j] * truth;
-    uncertainty::HeldOutPoint point;
-    point.residual = {answer.spectrum[0] - truth};
-    point.spread = uncertainty::InterpolationSpread(weights, values, answer.spectrum);
-    point.noise = {std::hypot(noise_own, noise_vertices)};
-    out->push_back(std::move(point));
-  }
-}
-
-// The held-out predictions, in folds bounded as the daemon's (judged_readings.h).
-std::vector<uncertainty::HeldOutPoint> PredictHeldOut(const interp::SampleSet& all,
-                                                      std::span<const double> relative_u,
-                                                      interp::Method method) {
-  std::vector<uncertainty::HeldOutPoint> out;
-  const std::size_t n = all.size();
-  if (n < 2) return out;
-  const std::size_t cap =
-      method == interp::Method::kOctant ? kMaxFoldSamplesOctant : kMaxFoldSamplesDelaunay;
-  const std::size_t folds = std::clamp<std::size_t>(cap / n, 1, std::min(kMaxFolds, n));
-  const std::size_t fold =
-      std::max<std::size_t>(1, std::min((n + folds - 1) / folds, kMaxHeldOut / folds));
-  std::vector<std::pair<std::uint64_t, std::size_t>> keyed(n);
-  for (std::size_t i = 0; i < n; ++i) keyed[i] = {Mix(i), i};
-  std::sort(keyed.begin(), keyed.end());
-  std::vector<std::size_t> order(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
-  for (std::size_t f = 0; f < folds && f * fold < n; ++f) {
-    const std::size_t end = std::min(n, (f + 1) * fold);
-    PredictFold(all, relative_u, std::span(order).subspan(f * fold, end - f * fold), method, &out);
-  }
-  return out;
+  return budgets;
 }
 
 }  // namespace
@@ -142,8 +88,11 @@ JudgedReadings::JudgedReadings(std::span<const ReadingSoFar> readings, Judge jud
     index_ = BuildIndex(samples_, method);
   }
   if (index_ == nullptr) return;
-  const std::vector<uncertainty::HeldOutPoint> points =
-      PredictHeldOut(*samples_, relative_u_, method);
+  // Held out as the daemon's calibration is (held_out.h): folds by a hash of the sample ids,
+  // which are the readings' positions here.
+  const std::vector<uncertainty::ReadingBudget> budgets = ScalarBudgets(*samples_, relative_u_);
+  const std::vector<uncertainty::HeldOutPoint> points = uncertainty::PredictHeldOut(
+      *samples_, [&budgets](std::size_t i) { return &budgets[i]; }, method, JudgeOptions());
   held_out_ = points.size();
   const uncertainty::InterpolationCalibration fit =
       uncertainty::FitInterpolationCalibration(points, 1, uncertainty::CalibrationTarget{});

@@ -7,10 +7,11 @@
 // same method over the rest predicts each of its readings at its own point, and each answer gives
 // a residual r, the spread s of its vertices and the noise n of the residual (the reading's own u
 // and its vertices', weighted, in quadrature); c is uncertainty::FitInterpolationCalibration's
-// (k = 2, 95 %, split-conformal rank). Bounded as the daemon's calibration is
-// (daemon/index/interpolation_calibration.h): at most 300 readings predicted in at most 32 folds,
-// the folds' indexes holding together at most about 60,000 readings (octant) or 10,000
-// (Delaunay). Fewer than 8 predicted: c = 1, `calibrated()` false.
+// (k = 2, 95 %, split-conformal rank). The folds and predictions are the daemon's own
+// (core/uncertainty/held_out.h, PredictHeldOut, over a one-band sample set with each reading's
+// u · BRDF as its independent noise): at most 300 readings predicted in at most 32 folds, the
+// folds' indexes holding together at most about 60,000 readings (octant) or 10,000 (Delaunay).
+// Fewer than 8 predicted: c = 1, `calibrated()` false.
 #pragma once
 
 #include <array>

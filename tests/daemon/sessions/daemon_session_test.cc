@@ -60,22 +60,6 @@ class DaemonSessionTest : public SessionRigTest {
     return r.ok() ? *r : std::vector<v1::Reading>();
   }
 
-  // The database holds every planned step once, one reading per done measuring step, nothing
-  // else; and storage's own check agrees.
-  void ExpectIntact(std::int64_t id) {
-    Result<DbSessionCounts> c = CountSession(rig_.database(), id);
-    ASSERT_TRUE(c.ok()) << c.status().ToString();
-    EXPECT_EQ(c->steps, c->total_steps);
-    EXPECT_EQ(c->step_index_gaps, 0);
-    EXPECT_EQ(c->duplicate_readings, 0);
-    EXPECT_EQ(c->orphan_readings, 0);
-    EXPECT_EQ(c->readings, c->measuring_steps_done);
-    EXPECT_EQ(c->done_steps_recorded, c->steps_done);
-    Result<std::string> problems = StorageProblems(rig_.database(), id);
-    ASSERT_TRUE(problems.ok()) << problems.status().ToString();
-    EXPECT_EQ(*problems, "");
-  }
-
   static int PlannedReadings(const v1::Session& s) {
     return static_cast<int>(s.summary().sample_readings() + s.summary().reference_readings() +
                             s.summary().dark_readings());

@@ -6,12 +6,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "tests/support/daemon/rig_teardown.h"
 #include "tests/support/daemon/test_rig.h"
+#include "tests/support/daemon/test_util.h"
 
 namespace brdf::testing {
 
@@ -38,6 +40,22 @@ class SessionRigTest : public ::testing::Test {
   GrpcOperator& Watch(const std::string& session_id, bool answering = true) {
     operators_.push_back(std::make_unique<GrpcOperator>(rig_, session_id, answering));
     return *operators_.back();
+  }
+
+  // The database holds every planned step once, one reading per done measuring step, nothing
+  // else; and storage's own check agrees.
+  void ExpectIntact(std::int64_t id) {
+    Result<DbSessionCounts> c = CountSession(rig_.database(), id);
+    ASSERT_TRUE(c.ok()) << c.status().ToString();
+    EXPECT_EQ(c->steps, c->total_steps);
+    EXPECT_EQ(c->step_index_gaps, 0);
+    EXPECT_EQ(c->duplicate_readings, 0);
+    EXPECT_EQ(c->orphan_readings, 0);
+    EXPECT_EQ(c->readings, c->measuring_steps_done);
+    EXPECT_EQ(c->done_steps_recorded, c->steps_done);
+    Result<std::string> problems = StorageProblems(rig_.database(), id);
+    ASSERT_TRUE(problems.ok()) << problems.status().ToString();
+    EXPECT_EQ(*problems, "");
   }
 
   DaemonRig rig_;

@@ -1,0 +1,188 @@
+// An adaptive session through the real binaries (docs/adaptive.md, "Rounds as steps"; issue 38's
+// check): brdfd with its interpolated uncertainty model (daemon/rig/back_end.cc) on brdf-sim,
+// driven over gRPC. brdfd is killed with SIGKILL in the middle of a round, restarted on the same
+// database, and the session resumed: the rounds stored before the kill are kept as they were,
+// later ones follow, the session completes with an adaptive stop, and every reading step holds
+// exactly one reading, within the reading budget.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "storage/session_store.h"
+#include "tests/daemon/sessions/rig_test.h"
+#include "tests/support/daemon/test_util.h"
+
+namespace brdf::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr int kRoundReadings = 6;
+constexpr int kMaxReadings = 33;  // the seed's 15 (if all fit) and three rounds of 6
+
+// examples/plans/adaptive.json made small: three detector positions, a seed of 3 + 3 × 4, rounds
+// of 6; the target is out of reach, so the reading budget (or an empty round) stops it.
+const std::string kAdaptivePlan = R"({
+  "name": "adaptive, killed mid-round",
+  "adaptive": {
+    "target": {"expandedUncertainty": 0.001},
+    "budget": {"maxReadings": )" + std::to_string(kMaxReadings) +
+                                  R"(},
+    "region": {"thetaIMaxDeg": 80, "thetaOMaxDeg": 80},
+    "method": "ADAPTIVE_JUDGE_OCTANT",
+    "delta": {"start": 0, "stop": 22.5, "step": 11.25},
+    "seed": {"retroReadings": 3, "readingsPerDelta": 4},
+    "roundReadings": )" + std::to_string(kRoundReadings) +
+                                  R"(
+  },
+  "reference": {"perDetectorPosition": true},
+  "measurement": {"integrationMs": 100, "averages": 1}
+})";
+
+std::vector<storage::RoundRecord> StoredRounds(const std::string& database, std::int64_t id) {
+  auto store = storage::SessionStore::Open(database);
+  EXPECT_TRUE(store.ok()) << store.status().ToString();
+  if (!store.ok()) return {};
+  auto rounds = (*store)->GetRounds(id);
+  EXPECT_TRUE(rounds.ok()) << rounds.status().ToString();
+  return rounds.ok() ? *rounds : std::vector<storage::RoundRecord>{};
+}
+
+std::optional<int> FirstUnfinished(const std::string& database, std::int64_t id) {
+  auto store = storage::SessionStore::Open(database);
+  EXPECT_TRUE(store.ok()) << store.status().ToString();
+  if (!store.ok()) return std::nullopt;
+  auto first = (*store)->FirstUnfinishedStep(id);
+  EXPECT_TRUE(first.ok()) << first.status().ToString();
+  return first.ok() ? *first : std::nullopt;
+}
+
+void ExpectSameRound(const storage::RoundRecord& after, const storage::RoundRecord& before) {
+  EXPECT_EQ(after.round, before.round);
+  EXPECT_EQ(after.first_step, before.first_step) << "round " << before.round;
+  EXPECT_EQ(after.step_count, before.step_count) << "round " << before.round;
+  EXPECT_EQ(after.readings_used, before.readings_used) << "round " << before.round;
+  EXPECT_EQ(after.predicted_gain, before.predicted_gain) << "round " << before.round;
+  ASSERT_EQ(after.picks.size(), before.picks.size()) << "round " << before.round;
+  for (std::size_t k = 0; k < before.picks.size(); ++k) {
+    EXPECT_EQ(after.picks[k].pose, before.picks[k].pose) << "round " << before.round;
+    EXPECT_EQ(after.picks[k].predicted_gain, before.picks[k].predicted_gain);
+  }
+}
+
+class AdaptiveDaemonTest : public SessionRigTest {
+ protected:
+  std::set<std::int64_t> ReadingIds(const std::string& id) {
+    Result<std::vector<v1::Reading>> r = rig_.Readings(id);
+    EXPECT_TRUE(r.ok()) << r.status().ToString();
+    std::set<std::int64_t> ids;
+    if (r.ok()) {
+      for (const v1::Reading& x : *r) EXPECT_TRUE(ids.insert(x.id()).second) << x.id();
+    }
+    return ids;
+  }
+};
+
+TEST_F(AdaptiveDaemonTest, KillNineMidRoundRestartResumeContinuesTheDesign) {
+  Result<v1::Session> submitted = rig_.Submit(kAdaptivePlan);
+  ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
+  const std::string id = submitted->session_id();
+  const std::int64_t sid = std::stoll(id);
+  const int seed_samples = static_cast<int>(submitted->summary().sample_readings());
+  ASSERT_GT(seed_samples, 0);
+  ASSERT_LE(seed_samples, kMaxReadings - kRoundReadings);
+  GrpcOperator& op = Watch(id);
+
+  // One sample reading into the first round (6 readings, a few seconds of real time: a slow poll
+  // still lands before the round's end).
+  const v1::Session running = rig_.WaitFor(
+      id,
+      [&](const v1::Session& x) {
+        return IsTerminal(x.state()) ||
+               (x.state() == v1::SESSION_STATE_RUNNING &&
+                static_cast<int>(x.progress().done_samples()) >= seed_samples + 1);
+      },
+      90s);
+  ASSERT_EQ(running.state(), v1::SESSION_STATE_RUNNING) << running.DebugString() << rig_.log();
+  op.Stop();
+  rig_.KillDaemon();  // SIGKILL: no shutdown code runs
+
+  // Killed mid-round: a round is stored and its steps are partly done.
+  const std::vector<storage::RoundRecord> before = StoredRounds(rig_.database(), sid);
+  ASSERT_GE(before.size(), 1u);
+  const storage::RoundRecord& current = before.back();
+  const std::optional<int> first_unfinished = FirstUnfinished(rig_.database(), sid);
+  ASSERT_TRUE(first_unfinished.has_value());
+  EXPECT_GT(*first_unfinished, current.first_step);
+  EXPECT_LT(*first_unfinished, current.first_step + current.step_count);
+  Result<DbSessionCounts> killed = CountSession(rig_.database(), sid);
+  ASSERT_TRUE(killed.ok()) << killed.status().ToString();
+  EXPECT_NE(killed->state, "completed");
+  ExpectIntact(sid);
+
+  Status restarted = rig_.StartDaemon();
+  ASSERT_TRUE(restarted.ok()) << restarted.ToString();
+  EXPECT_EQ(rig_.Get(id)->state(), v1::SESSION_STATE_PAUSED);
+  const std::set<std::int64_t> readings_before = ReadingIds(id);
+  EXPECT_EQ(static_cast<int>(readings_before.size()), killed->readings);
+
+  GrpcOperator& resumed_op = Watch(id);
+  v1::ResumeSessionRequest resume;
+  resume.set_session_id(id);
+  v1::ResumeSessionResponse resumed;
+  grpc::Status st = rig_.control().ResumeSession(DaemonRig::Context().get(), resume, &resumed);
+  ASSERT_TRUE(st.ok()) << st.error_message();
+  const v1::Session done = rig_.WaitForState(id, v1::SESSION_STATE_COMPLETED, 90s);
+  ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED) << done.DebugString() << rig_.log();
+  EXPECT_EQ(done.state_reason().rfind("adaptive: ", 0), 0u) << done.state_reason();
+
+  // The watcher after the restart saw the later rounds and the stop.
+  std::vector<v1::AdaptiveRound> seen_rounds;
+  std::vector<v1::AdaptiveStop> stops;
+  for (const v1::SessionEvent& e : resumed_op.events()) {
+    if (e.has_adaptive_round()) seen_rounds.push_back(e.adaptive_round());
+    if (e.has_adaptive_stop()) stops.push_back(e.adaptive_stop());
+  }
+  ASSERT_EQ(stops.size(), 1u);
+  EXPECT_FALSE(stops[0].reason().empty());
+  EXPECT_NE(done.state_reason().find(stops[0].reason()), std::string::npos)
+      << done.state_reason() << " / " << stops[0].reason();
+
+  // The design continued: the rounds before the kill as they were, then later ones.
+  const std::vector<storage::RoundRecord> after = StoredRounds(rig_.database(), sid);
+  ASSERT_GT(after.size(), before.size());
+  for (std::size_t i = 0; i < before.size(); ++i) ExpectSameRound(after[i], before[i]);
+  int next_step = before.front().first_step;
+  int samples_before_round = seed_samples;
+  for (const storage::RoundRecord& r : after) {
+    EXPECT_EQ(r.round, static_cast<int>(&r - after.data()) + 1);
+    EXPECT_EQ(r.first_step, next_step) << "round " << r.round;
+    EXPECT_EQ(r.readings_used, samples_before_round) << "round " << r.round;
+    next_step = r.first_step + r.step_count;
+    samples_before_round += static_cast<int>(r.picks.size());
+  }
+  EXPECT_EQ(stops[0].rounds(), after.size());
+  EXPECT_EQ(static_cast<int>(stops[0].readings()), samples_before_round);
+
+  // No reading lost or taken twice; within the budget.
+  Result<DbSessionCounts> c = CountSession(rig_.database(), sid);
+  ASSERT_TRUE(c.ok()) << c.status().ToString();
+  EXPECT_EQ(c->steps_pending, 0);
+  EXPECT_EQ(c->steps_done, c->total_steps);
+  EXPECT_EQ(c->total_steps, next_step);
+  EXPECT_EQ(c->duplicate_readings, 0);
+  ExpectIntact(sid);
+  const std::set<std::int64_t> readings_after = ReadingIds(id);
+  for (std::int64_t r : readings_before) EXPECT_EQ(readings_after.count(r), 1u) << r;
+  EXPECT_EQ(static_cast<int>(readings_after.size()), c->readings);
+  EXPECT_EQ(static_cast<int>(done.progress().done_samples()), samples_before_round);
+  EXPECT_LE(samples_before_round, kMaxReadings);
+}
+
+}  // namespace
+}  // namespace brdf::testing
