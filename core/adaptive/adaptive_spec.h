@@ -51,6 +51,16 @@ struct Budget {
 
 enum class Judge { kOctant, kDelaunay };
 
+// Why an adaptive session stops (stop_rule.h); kContinue while it goes on.
+enum class StopReason {
+  kContinue,
+  kTargetReached,  // the uncertainty left is at or below the target's level
+  kReadingBudget,  // budget.maxReadings reached, or no reading fits in what is left of it
+  kTimeBudget,     // budget.maxRigMinutes reached, or no reading fits in what is left of it
+  kPromptBudget,   // budget.maxPrompts reached, or no reading fits in what is left of it
+  kNothingToGain,  // no candidate within the budget is predicted to lower the uncertainty
+};
+
 struct AdaptiveSpec {
   Target target;
   Budget budget;

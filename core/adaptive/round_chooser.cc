@@ -36,7 +36,8 @@ std::vector<bool> MeasuredAlready(const RoundInput& input) {
 
 // The greedy picks, in pick order.
 std::vector<ChosenPose> PickGreedy(const RoundInput& input, UncertaintyMap& map,
-                                   const RoundCost& cost, const RoundOptions& options) {
+                                   const RoundCost& cost, const RoundOptions& options,
+                                   StopReason* limited_by) {
   std::vector<Directions> directions;
   directions.reserve(input.candidates.size());
   for (const Pose& c : input.candidates) directions.push_back(PoseToDirections(c));
@@ -55,7 +56,11 @@ std::vector<ChosenPose> PickGreedy(const RoundInput& input, UncertaintyMap& map,
       const double gain = map.PredictedGain(directions[i]);
       if (!(gain > 0)) continue;
       const PoseCost step = cost.Step(at, c);
-      if (!WithinBudget(input.budget, spent, step, 1)) continue;
+      if (const StopReason limit = LimitPassed(input.budget, spent, step, 1);
+          limit != StopReason::kContinue) {
+        if (*limited_by == StopReason::kContinue) *limited_by = limit;
+        continue;
+      }
       const double charged = options.group_by_delta ? step.seconds : cost.MoveAndReadSeconds(at, c);
       const double score = gain / std::max(charged, 1e-6);
       if (score > best_score || (score == best_score && Key(c) < Key(input.candidates[best]))) {
@@ -107,25 +112,39 @@ std::vector<ChosenPose> GroupBySetting(const std::vector<ChosenPose>& picks, con
 
 }  // namespace
 
+StopReason LimitPassed(const Budget& budget, const Spend& spent, const PoseCost& more,
+                       int readings) {
+  if (budget.max_readings > 0 && spent.readings + readings > budget.max_readings) {
+    return StopReason::kReadingBudget;
+  }
+  if (budget.max_rig_s > 0 && spent.seconds + more.seconds > budget.max_rig_s + 1e-9) {
+    return StopReason::kTimeBudget;
+  }
+  if (budget.max_prompts > 0 && spent.prompts + more.prompts > budget.max_prompts) {
+    return StopReason::kPromptBudget;
+  }
+  return StopReason::kContinue;
+}
+
 bool WithinBudget(const Budget& budget, const Spend& spent, const PoseCost& more, int readings) {
-  if (budget.max_readings > 0 && spent.readings + readings > budget.max_readings) return false;
-  if (budget.max_rig_s > 0 && spent.seconds + more.seconds > budget.max_rig_s + 1e-9) return false;
-  if (budget.max_prompts > 0 && spent.prompts + more.prompts > budget.max_prompts) return false;
-  return true;
+  return LimitPassed(budget, spent, more, readings) == StopReason::kContinue;
 }
 
 Round ChooseRound(const RoundInput& input, const UncertaintyModel& model, const RoundCost& cost,
                   const RoundOptions& options) {
   std::unique_ptr<UncertaintyMap> map = model.Map(input.readings);
-  std::vector<ChosenPose> picks = PickGreedy(input, *map, cost, options);
-  if (options.group_by_delta) picks = GroupBySetting(picks, input.rig_at);
   Round round;
+  std::vector<ChosenPose> picks = PickGreedy(input, *map, cost, options, &round.limited_by);
+  if (options.group_by_delta) picks = GroupBySetting(picks, input.rig_at);
   std::vector<Pose> poses;
   for (const ChosenPose& p : picks) poses.push_back(p.pose);
   // Costed in measurement order; cut from the end until it fits.
   while (!poses.empty()) {
     round.cost = cost.Sequence(input.rig_at, poses);
-    if (WithinBudget(input.budget, input.spent, round.cost, static_cast<int>(poses.size()))) break;
+    const StopReason limit =
+        LimitPassed(input.budget, input.spent, round.cost, static_cast<int>(poses.size()));
+    if (limit == StopReason::kContinue) break;
+    if (round.limited_by == StopReason::kContinue) round.limited_by = limit;
     poses.pop_back();
     picks.pop_back();
     round.cost = {};

@@ -29,7 +29,11 @@ struct Spend {
   int prompts = 0;
 };
 
-// True when `spent` plus `more` stays within every limit of `budget` (1e-9 s of slack).
+// The first limit of `budget` (readings, rig time, prompts) that `spent` plus `more` would pass
+// (1e-9 s of slack), or kContinue when it stays within every one.
+StopReason LimitPassed(const Budget& budget, const Spend& spent, const PoseCost& more,
+                       int readings);
+// True when `spent` plus `more` stays within every limit of `budget`.
 bool WithinBudget(const Budget& budget, const Spend& spent, const PoseCost& more, int readings);
 
 struct ChosenPose {
@@ -41,6 +45,9 @@ struct Round {
   std::vector<ChosenPose> poses;  // in measurement order
   double predicted_gain = 0;      // sum of the picks' gains
   PoseCost cost;                  // of the poses in measurement order, from the rig's pose
+  // The first budget limit that left out a pose predicted to gain (kContinue: none did). For an
+  // empty round this says why it is empty: the budget, not the uncertainty (stop_rule.h).
+  StopReason limited_by = StopReason::kContinue;
 };
 
 struct RoundInput {

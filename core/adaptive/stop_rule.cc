@@ -15,7 +15,7 @@ const char* StopReasonText(StopReason reason) {
     case StopReason::kPromptBudget:
       return "prompt budget spent";
     case StopReason::kNothingToGain:
-      return "no affordable pose is predicted to lower the uncertainty";
+      return "no pose within the budget is predicted to lower the uncertainty";
   }
   return "?";
 }
@@ -34,7 +34,8 @@ StopReason ShouldStop(double remaining, const Target& target, const Budget& budg
 }
 
 StopReason AfterChoosing(const Round& round) {
-  return round.poses.empty() ? StopReason::kNothingToGain : StopReason::kContinue;
+  if (!round.poses.empty()) return StopReason::kContinue;
+  return round.limited_by != StopReason::kContinue ? round.limited_by : StopReason::kNothingToGain;
 }
 
 }  // namespace brdf::adaptive

@@ -8,15 +8,6 @@
 
 namespace brdf::adaptive {
 
-enum class StopReason {
-  kContinue,
-  kTargetReached,  // the uncertainty left is at or below the target's level
-  kReadingBudget,  // budget.maxReadings reached
-  kTimeBudget,     // budget.maxRigMinutes reached
-  kPromptBudget,   // budget.maxPrompts reached
-  kNothingToGain,  // no affordable candidate is predicted to lower the uncertainty
-};
-
 // "target reached", "reading budget spent", …; "continue".
 const char* StopReasonText(StopReason reason);
 
@@ -24,7 +15,9 @@ const char* StopReasonText(StopReason reason);
 StopReason ShouldStop(double remaining, const Target& target, const Budget& budget,
                       const Spend& spent);
 
-// After choosing: kNothingToGain for an empty round, else kContinue.
+// After choosing: kContinue for a round with poses. For an empty round, the budget that left out
+// a pose predicted to gain (Round::limited_by: one more reading would pass it, though it is not
+// yet reached), else kNothingToGain.
 StopReason AfterChoosing(const Round& round);
 
 }  // namespace brdf::adaptive

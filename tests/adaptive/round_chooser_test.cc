@@ -120,8 +120,16 @@ TEST(RoundChooserTest, RespectsEveryBudget) {
   ASSERT_FALSE(r.poses.empty());
   EXPECT_EQ(r.cost.prompts, 0);
   for (const ChosenPose& p : r.poses) EXPECT_EQ(p.pose.delta, at.delta);
-  // Nothing affordable: an empty round, and the stop rule says why.
+  // Nothing affordable: an empty round, and the stop rule names the budget that is spent, though
+  // 0.1 s of it is left.
   r = ChooseRound({{}, candidates, at, {10, 599.9, 0}, {0, 600, 0}}, model, cost);
+  EXPECT_TRUE(r.poses.empty());
+  EXPECT_EQ(AfterChoosing(r), StopReason::kTimeBudget);
+  r = ChooseRound({{}, candidates, at, {10, 0, 8}, {0, 0, 8}}, model, cost);
+  EXPECT_EQ(r.limited_by, StopReason::kPromptBudget);  // other detector positions were left out
+  // Nothing predicted to gain, whatever the budget: the uncertainty, not the budget, stops it.
+  const KernelModel settled([](const IsoDirection&) { return 0.0; });
+  r = ChooseRound({{}, candidates, at, {10, 0, 0}, {1000, 0, 0}}, settled, cost);
   EXPECT_TRUE(r.poses.empty());
   EXPECT_EQ(AfterChoosing(r), StopReason::kNothingToGain);
 }
