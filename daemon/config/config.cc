@@ -383,11 +383,15 @@ void ReadUncertainty(TableReader& root, Config& c) {
   t.Finish();
 }
 
-// The small tables: [storage], [sample], [rig], [log].
+// The small tables: [storage], [index], [sample], [rig], [log].
 void ReadOthers(TableReader& root, Config& c) {
   TableReader storage = root.Sub("storage");
   storage.String("database", c.storage.database);
   storage.Finish();
+  TableReader index = root.Sub("index");
+  index.Int("max_sessions", c.index.max_sessions, 1, 1024);
+  index.Int("max_mb", c.index.max_mb, 16, 1048576);
+  index.Finish();
   TableReader sample = root.Sub("sample");
   sample.Double("white_reflectance", c.sample.white_reflectance, 0, 1, /*lo_open=*/true);
   sample.Double("white_reflectance_uncertainty", c.sample.white_reflectance_uncertainty, 0, 0.5);

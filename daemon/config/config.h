@@ -156,6 +156,14 @@ struct StorageConfig {
   std::string database = "/var/lib/brdfd/brdfd.db";
 };
 
+// [index]: the interpolation index cache (daemon/index/cache.h), least recently queried session
+// out first. A cached paper-grid session (2,112 sample readings of 101 bands with their
+// uncertainty budgets, one octant BRDF index) holds roughly 25 MB.
+struct IndexConfig {
+  int max_sessions = 8;  // sessions kept, 1–1024
+  int max_mb = 512;      // memory of their samples, budgets and indexes, MB, 16–1048576
+};
+
 // The meters brdfd drives, by [meter] model.
 enum class MeterModel { kPr650, kPr655, kPr670, kCs2000, kCs2000A, kCs3000 };
 // "pr650" … "cs3000" (the configuration's names) and "PR-650" … "CS-3000" (the meters' own).
@@ -282,6 +290,7 @@ struct WebConfig {
 struct Config {
   ServerConfig server;
   StorageConfig storage;
+  IndexConfig index;
   MeterConfig meter;
   StageConfig stage;
   SampleConfig sample;

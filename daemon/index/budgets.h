@@ -7,6 +7,9 @@
 // on a copy writes into a chunk of its own (the last, partly filled one is copied first when
 // another list holds it too), so a snapshot's list never changes while later readings are added.
 // Not thread-safe for Add; a published list is read-only and may be read by many threads.
+//
+// The index holds what the blend needs of each budget (BudgetForBlend): a paper-grid session's
+// 2,112 whole budgets would be most of its cached memory.
 #pragma once
 
 #include <cstddef>
@@ -16,6 +19,12 @@
 #include "core/uncertainty/budget.h"
 
 namespace brdf::daemon {
+
+// The part of a reading's budget an interpolated value's uncertainty reads (core/uncertainty's
+// blend.h and held_out.h): its quantity, shared components, combined, independent and
+// not_estimated. The value and the independent components are left out (their sum is
+// `independent`), so a blend of it equals the blend of the whole budget, bit for bit.
+uncertainty::ReadingBudget BudgetForBlend(const uncertainty::ReadingBudget& budget);
 
 class BudgetList {
  public:
@@ -29,7 +38,8 @@ class BudgetList {
   const uncertainty::ReadingBudget* at(std::size_t i) const {
     return i < size_ ? (*chunks_[i / kChunk])[i % kChunk].get() : nullptr;
   }
-  // Memory held by the budgets, roughly (for the cache's bound).
+  // Heap held by the list and its budgets (for the cache's bound): each budget's allocation, its
+  // vectors' and strings' storage with glibc's overhead per allocation, the list's slots.
   std::size_t bytes() const { return bytes_; }
 
  private:

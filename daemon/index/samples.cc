@@ -53,12 +53,13 @@ void IndexSamples::Add(Quantity q, const storage::ReadingRecord& record,
     return;
   }
   if (q == Quantity::kBrdf) {
-    // Only a budget of the BRDF blends with the BRDF; any other counts as not estimated.
+    // Only a budget of the BRDF blends with the BRDF; any other counts as not estimated. Kept
+    // as the blend needs it (budgets.h: the whole budgets would be most of the session's memory).
     const bool of_brdf =
         record.uncertainty.has_value() && record.uncertainty->quantity == Quantity::kBrdf;
-    working_.brdf_budgets.Add(
-        of_brdf ? std::make_shared<const uncertainty::ReadingBudget>(*record.uncertainty)
-                : nullptr);
+    working_.brdf_budgets.Add(of_brdf ? std::make_shared<const uncertainty::ReadingBudget>(
+                                            BudgetForBlend(*record.uncertainty))
+                                      : nullptr);
   }
 }
 

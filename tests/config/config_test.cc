@@ -58,6 +58,21 @@ TEST(ConfigTest, EmptyFileGivesTheDefaults) {
   EXPECT_NEAR(rig.adaptive_integration.sample_s, 2.0, 1e-12);
 }
 
+// [index] bounds the interpolation index cache: sessions kept and their memory, MB.
+TEST(ConfigTest, IndexCacheBounds) {
+  const Result<Config> none = ParseConfig("", "empty.toml");
+  ASSERT_TRUE(none.ok());
+  EXPECT_EQ(none->index.max_sessions, 8);
+  EXPECT_EQ(none->index.max_mb, 512);
+  const Result<Config> r = ParseConfig("[index]\nmax_sessions = 2\nmax_mb = 64\n", "lab.toml");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->index.max_sessions, 2);
+  EXPECT_EQ(r->index.max_mb, 64);
+  EXPECT_THAT(Refusal("[index]\nmax_sessions = 0\n"), HasSubstr("index.max_sessions"));
+  EXPECT_THAT(Refusal("[index]\nmax_mb = 8\n"), HasSubstr("index.max_mb"));
+  EXPECT_THAT(Refusal("[index]\nmax_entries = 3\n"), HasSubstr("index.max_entries"));
+}
+
 // [rig] names the sessions (default: the host name); [archive] ships them to the lab's PostgreSQL
 // and needs a credentials file, never a conninfo in the configuration itself.
 TEST(ConfigTest, RigNameAndArchive) {
