@@ -124,7 +124,8 @@ Result<std::shared_ptr<storage::ArchiveReader>> OpenArchive(const Config& config
 // The archive served until a stop signal.
 int Run(const Config& config, std::shared_ptr<storage::ArchiveReader> archive,
         const sigset_t& stop_signals) {
-  ArchiveBackEnd back_end(std::move(archive));
+  ArchiveBackEnd back_end(std::move(archive), std::chrono::seconds(1),
+                          IndexCacheOptionsFrom(config));
   Authenticator auth(config.tokens);
   if (!auth.enabled()) {
     spdlog::warn(

@@ -369,4 +369,11 @@ void IndexCache::Evict(SessionId keep) {
   }
 }
 
+IndexCache::Options IndexCacheOptionsFrom(const Config& config) {
+  IndexCache::Options options;
+  options.max_sessions = static_cast<std::size_t>(config.index.max_sessions);
+  options.max_bytes = static_cast<std::size_t>(config.index.max_mb) << 20;
+  return options;
+}
+
 }  // namespace brdf::daemon

@@ -59,6 +59,7 @@
 #include "core/readings/quantity.h"
 #include "core/status.h"
 #include "core/wavelength_grid.h"
+#include "daemon/config/config.h"
 #include "daemon/index/budgets.h"
 #include "daemon/index/interpolation_calibration.h"
 #include "daemon/sessions/session_id.h"
@@ -208,5 +209,9 @@ class IndexCache {
   std::atomic<std::uint64_t> hits_{0};  // Stats::hits (counted without mu_)
   std::atomic<std::uint64_t> tick_{0};  // recency clock of entries and indexes
 };
+
+// The cache's bounds from the configuration's [index] table (max_sessions, max_mb), the same in
+// brdfd and brdf-archive.
+IndexCache::Options IndexCacheOptionsFrom(const Config& config);
 
 }  // namespace brdf::daemon

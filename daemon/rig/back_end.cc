@@ -24,11 +24,8 @@ Result<std::unique_ptr<RigBackEnd>> RigBackEnd::Open(const Config& config,
   if (Status st = back_end->StartManager(config, std::move(rig)); !st.ok()) return st;
 
   SessionManager& manager = *back_end->manager_;
-  IndexCache::Options index_options;
-  index_options.max_sessions = static_cast<std::size_t>(config.index.max_sessions);
-  index_options.max_bytes = static_cast<std::size_t>(config.index.max_mb) << 20;
   back_end->cache_ =
-      std::make_unique<IndexCache>(back_end->store_, index_options,
+      std::make_unique<IndexCache>(back_end->store_, IndexCacheOptionsFrom(config),
                                    [&manager](SessionId session) { return manager.Plan(session); });
   IndexCache& cache = *back_end->cache_;
   back_end->cache_listener_ = manager.AddReadingListener(

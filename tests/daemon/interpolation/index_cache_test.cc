@@ -327,6 +327,23 @@ TEST_F(IndexCacheTest, KeepsAtMostMaxSessionsEvictingTheLeastRecentlyUsed) {
   EXPECT_EQ(cache.stats().evictions, 2u);
 }
 
+// brdfd and brdf-archive both take the cache's bounds from [index] (IndexCacheOptionsFrom).
+TEST_F(IndexCacheTest, TheConfigurationsIndexTableBoundsTheCache) {
+  const Result<Config> config = ParseConfig("[index]\nmax_sessions = 1\nmax_mb = 64\n", "lab.toml");
+  ASSERT_TRUE(config.ok()) << config.status().ToString();
+  const IndexCache::Options options = IndexCacheOptionsFrom(*config);
+  EXPECT_EQ(options.max_bytes, std::size_t{64} << 20);
+  SessionFixture a(*store_, 8);
+  FillGrid(a);
+  SessionFixture b(*store_, 8);
+  FillGrid(b);
+  IndexCache cache(store_, options);
+  ASSERT_TRUE(cache.Get(a.id(), Quantity::kBrdf, interp::Method::kNearest, {}).ok());
+  ASSERT_TRUE(cache.Get(b.id(), Quantity::kBrdf, interp::Method::kNearest, {}).ok());
+  EXPECT_EQ(cache.stats().sessions, 1u);
+  EXPECT_EQ(IndexCacheOptionsFrom(Config()).max_sessions, 8u);  // the defaults without [index]
+}
+
 // Queries of a current index take shared locks only (IndexCache::FreshHit); they must still see
 // every reading announced before they began, while other threads query and readings land.
 TEST_F(IndexCacheTest, ConcurrentQueriesSeeEveryReadingAnnouncedBeforeThemWhileReadingsLand) {
