@@ -14,6 +14,7 @@
 #include "core/plan/sample.h"
 #include "core/readings/derive.h"
 #include "daemon/wire/plan.h"
+#include "daemon/wire/values.h"
 #include "storage/session_readings.h"
 
 namespace brdf::daemon {
@@ -147,11 +148,7 @@ v1::AdaptiveRound ToProtoRound(const storage::RoundRecord& round) {
   v1::AdaptiveRound out;
   out.set_round(static_cast<std::uint32_t>(round.round));
   for (const storage::RoundPick& p : round.picks) {
-    v1::Pose* pose = out.add_poses();
-    pose->set_alpha(p.pose.alpha);
-    pose->set_beta(p.pose.beta);
-    pose->set_gamma(p.pose.gamma);
-    pose->set_delta(p.pose.delta);
+    *out.add_poses() = ToProtoPose(p.pose);
     out.add_pose_gains(p.predicted_gain);
   }
   out.set_predicted_gain(round.predicted_gain);
