@@ -132,9 +132,14 @@ bool WithinBudget(const Budget& budget, const Spend& spent, const PoseCost& more
 
 Round ChooseRound(const RoundInput& input, const UncertaintyModel& model, const RoundCost& cost,
                   const RoundOptions& options) {
-  std::unique_ptr<UncertaintyMap> map = model.Map(input.readings);
+  const std::unique_ptr<UncertaintyMap> map = model.Map(input.readings);
+  return ChooseRound(input, *map, cost, options);
+}
+
+Round ChooseRound(const RoundInput& input, UncertaintyMap& map, const RoundCost& cost,
+                  const RoundOptions& options) {
   Round round;
-  std::vector<ChosenPose> picks = PickGreedy(input, *map, cost, options, &round.limited_by);
+  std::vector<ChosenPose> picks = PickGreedy(input, map, cost, options, &round.limited_by);
   if (options.group_by_delta) picks = GroupBySetting(picks, input.rig_at);
   std::vector<Pose> poses;
   for (const ChosenPose& p : picks) poses.push_back(p.pose);

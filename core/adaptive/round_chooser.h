@@ -69,5 +69,9 @@ struct RoundOptions {
 // stops: stop_rule.h). A candidate equal to a reading's pose or to an earlier pick is skipped.
 Round ChooseRound(const RoundInput& input, const UncertaintyModel& model, const RoundCost& cost,
                   const RoundOptions& options = {});
+// The same from a map already built from input.readings (model.Map(input.readings)), for a
+// caller that read its Remaining() first; the map takes the round's picks (Assume).
+Round ChooseRound(const RoundInput& input, UncertaintyMap& map, const RoundCost& cost,
+                  const RoundOptions& options = {});
 
 }  // namespace brdf::adaptive

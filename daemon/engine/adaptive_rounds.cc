@@ -113,7 +113,9 @@ Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t sessi
   RoundDecision decision;
   decision.rounds = static_cast<int>(rounds.size());
   decision.spent = SpendOf(steps, plan, rig);
-  decision.uncertainty_left = model.Map(readings)->Remaining();
+  // One map for the stop rule and the chooser: building it is the round's main cost.
+  const std::unique_ptr<adaptive::UncertaintyMap> map = model.Map(readings);
+  decision.uncertainty_left = map->Remaining();
   decision.stop =
       adaptive::ShouldStop(decision.uncertainty_left, spec.target, spec.budget, decision.spent);
   if (decision.stop != adaptive::StopReason::kContinue) return decision;
@@ -123,7 +125,7 @@ Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t sessi
   const adaptive::RoundInput input{readings, candidates, start.model, decision.spent, spec.budget};
   const adaptive::RoundCost cost(plan, rig);
   const adaptive::Round round =
-      adaptive::ChooseRound(input, model, cost, {.max_readings = spec.round_readings});
+      adaptive::ChooseRound(input, *map, cost, {.max_readings = spec.round_readings});
   decision.stop = adaptive::AfterChoosing(round);
   if (decision.stop != adaptive::StopReason::kContinue) return decision;
 
