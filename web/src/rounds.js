@@ -51,7 +51,7 @@ export function createRoundsView() {
   const stopLine = el('p', { id: 'adaptive-stop' });
   const element = el('div', { id: 'rounds', hidden: true },
     el('h3', {}, 'Adaptive rounds (each chosen before it was measured)'), goal, table, chart,
-    el('h4', {}, 'The last round: what the rig measures'), next, stopLine);
+    el('h4', {}, 'The latest round (what the rig measures while the session runs)'), next, stopLine);
 
   let adaptive = null;
   let session = '';

@@ -96,7 +96,7 @@ export function createUncertaintyMap(report) {
     const Plotly = await plotly();
     Plotly.react(plot, [
       { type: 'scatterpolar', mode: 'markers', r: known.map(([, i]) => iso(i).theta_o), theta: known.map(([, i]) => iso(i).phi), name: `k·u / BRDF, k = ${k}`,
-        marker: { size: 11, color: known.map(([v]) => v), colorscale: 'YlOrRd', cmin: 0, showscale: true, colorbar: { title: { text: `k·u / f (k = ${k})` } } },
+        marker: { size: 11, color: known.map(([v]) => v), colorscale: 'YlOrRd', reversescale: true, cmin: 0, showscale: true, colorbar: { title: { text: `k·u / f (k = ${k})` } } },
         meta: { map: 'u', k, theta_i: at, mirror_phi: mirrored }, hovertemplate: 'θo %{r}°, φ %{theta}°: %{marker.color:.3f}<extra></extra>' },
       { type: 'scatterpolar', mode: 'markers', r: unknown.map(([, i]) => iso(i).theta_o), theta: unknown.map(([, i]) => iso(i).phi), name: 'unknown', marker: { size: 8, symbol: 'x', color: '#999' }, meta: { map: 'unknown' } },
       { type: 'scatterpolar', mode: 'markers', r: near.map((i) => points.theta_o[i]), theta: near.map((i) => points.phi[i]), name: `readings, θi ${at} ± 2.5°`, marker: { size: 5, color: 'black' }, meta: { map: 'readings', ids: near.map((i) => points.ids[i]) } },
