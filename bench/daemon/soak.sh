@@ -12,15 +12,21 @@
 # BRDF index) holds ~25 MB, and an hour records only ~8 sessions, so with brdfd's 8 the cache
 # would still be filling at the end (+30 MB a session: RSS 29 → 305 MB, "+86 MB" over the last
 # half) and the check would measure the cache, not a leak; with 2 it is full after the first
-# quarter and the last half is steady state. RSS is fitted through each minute's smallest
-# sample (the floor between the analysts' calls in flight: a leak raises it, a burst of exports
+# quarter and the last half is steady state. The exports' kept interpolants likewise, to
+# SOAK_EXPORT_ENTRIES ([export] max_entries, default 1 here, 4 in brdfd): a kept paper-grid
+# interpolant (the session copy, its index, Delaunay fallback and fitted model) holds ~45 MB and
+# the analysts export the current session over and over, so brdfd's 4 keep one more each session
+# for the first four (+57 MB over the last half of an hour with 4); with 1 the entry of the
+# session before is dropped when the next is exported (50 minutes, 5 sessions, load average 6–20:
+# floor fit −0.2 MB, RSS 29 MB first, 302 max, 187 last). RSS is fitted through each minute's
+# smallest sample (the floor between the analysts' calls in flight: a leak raises it, a burst of exports
 # does not); the fit through every sample is printed beside it. Then, from the database, that every reading
 # step done holds exactly one reading and no reading is stored twice.
 #
 # Usage: bench/daemon/soak.sh [BUILD_DIR] (default: build-bench; builds what it needs unless
 # BENCH_NO_BUILD=1). SOAK_DURATION_S (default 3600), SOAK_SAMPLE_S (10), SOAK_TIME_SCALE (32),
-# SOAK_INDEX_SESSIONS (2), BENCH_KEEP=1 keeps the work directory (samples in soak.samples:
-# seconds, RSS kB, threads, fds).
+# SOAK_INDEX_SESSIONS (2), SOAK_EXPORT_ENTRIES (1), BENCH_KEEP=1 keeps the work directory
+# (samples in soak.samples: seconds, RSS kB, threads, fds).
 # Prints one line of key=value figures; exits 1 when a check fails.
 set -euo pipefail
 
@@ -46,8 +52,9 @@ source "$here/lib.sh"
 bench_workdir_and_cleanup /tmp/brdfd-soak.XXXXXX
 load_start="$(cut -d' ' -f1-3 /proc/loadavg | tr ' ' /)"
 
-# The index cache full early (see above): the last half then measures leaks, not the cache filling.
-config_extra="$(printf '[index]\nmax_sessions = %s\n' "${SOAK_INDEX_SESSIONS:-2}")"
+# The caches full early (see above): the last half then measures leaks, not the caches filling.
+config_extra="$(printf '[index]\nmax_sessions = %s\n[export]\nmax_entries = %s\n' \
+  "${SOAK_INDEX_SESSIONS:-2}" "${SOAK_EXPORT_ENTRIES:-1}")"
 start_rig_on_sim "$work" "$scale" warn
 deadline=$((SECONDS + duration))
 running() { ((SECONDS < deadline)); }

@@ -8,13 +8,14 @@
 namespace brdf::daemon {
 
 DataService::DataService(SessionCatalogue& catalogue, const Authenticator& auth,
-                         const StopSignal& stopping, StreamRegistry& streams, std::string program)
+                         const StopSignal& stopping, StreamRegistry& streams, std::string program,
+                         ExportInterpolants::Options kept)
     : catalogue_(catalogue),
       auth_(auth),
       stopping_(stopping),
       streams_(streams),
       program_(std::move(program)),
-      export_interpolants_(streams.budget()) {}
+      export_interpolants_(streams.budget(), kept) {}
 
 grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
                                          const v1::StreamReadingsRequest* request,

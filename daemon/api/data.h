@@ -22,9 +22,11 @@ namespace brdf::daemon {
 class DataService final : public v1::Data::Service {
  public:
   // All must outlive the service. `program` ("brdfd", "brdf-archive") names the server in the
-  // message that ends a following stream at shutdown.
+  // message that ends a following stream at shutdown; `kept` bounds the exports' kept
+  // interpolants ([export]).
   DataService(SessionCatalogue& catalogue, const Authenticator& auth, const StopSignal& stopping,
-              StreamRegistry& streams, std::string program);
+              StreamRegistry& streams, std::string program,
+              ExportInterpolants::Options kept = ExportInterpolants::Options());
 
   grpc::Status StreamReadings(grpc::ServerContext* context,
                               const v1::StreamReadingsRequest* request,

@@ -1,5 +1,7 @@
 #include "daemon/api/export_cache.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <iterator>
 #include <utility>
@@ -113,6 +115,11 @@ void ExportInterpolants::Keep(Entries::iterator at,
   at->reservation = std::move(reservation);
   ++stats_.kept;
   Evict(at);
+  std::size_t kept = 0;
+  for (const Entry& e : entries_) kept += e.built ? 1 : 0;
+  spdlog::debug("export cache: kept session {}'s interpolant ({:.1f} MB); {} kept of {}, {:.1f} MB",
+                at->session->id, static_cast<double>(needed) / (1 << 20), kept, max_entries_,
+                static_cast<double>(KeptBytes()) / (1 << 20));
 }
 
 bool ExportInterpolants::ReservePart(const std::shared_ptr<const void>& part, std::uint64_t bytes) {
@@ -167,6 +174,13 @@ void ExportInterpolants::Evict(Entries::iterator keep) {
     entries_.erase(oldest);
     ++stats_.evictions;
   }
+}
+
+ExportInterpolants::Options ExportInterpolantsOptionsFrom(const Config& config) {
+  ExportInterpolants::Options options;
+  options.max_entries = static_cast<std::size_t>(config.exports.max_entries);
+  options.max_bytes = static_cast<std::uint64_t>(config.exports.max_mb) << 20;
+  return options;
 }
 
 ExportInterpolants::Stats ExportInterpolants::stats() const {

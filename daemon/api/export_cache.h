@@ -20,7 +20,9 @@
 // Memory: what the kept entries hold (estimated: each session copy and each set of derived
 // samples once, however many entries share them; each entry's sample set and indexes) is reserved
 // from the heavy calls' memory budget (memory_budget.h) for as long as it is held; at most
-// Options::max_entries entries and max_bytes in all, least recently used first out. An interpolant
+// Options::max_entries entries and max_bytes in all ([export] max_entries, max_mb), least
+// recently used first out. The estimate is below resident memory: a paper-grid entry (2,112
+// readings of 101 bands) counts 30.5 MB and holds 37–57 MB (daemon/DESIGN.md). An interpolant
 // that does not fit, or whose reservation the budget refuses, is handed to its caller and not
 // kept. Thread-safe.
 #pragma once
@@ -36,12 +38,14 @@
 #include "core/mutex.h"
 #include "core/readings/reading.h"
 #include "core/status.h"
+#include "daemon/config/config.h"
 #include "daemon/rpc/memory_budget.h"
 
 namespace brdf::daemon {
 
 class ExportInterpolants {
  public:
+  // The configuration's [export] table maps here (ExportInterpolantsOptionsFrom).
   struct Options {
     std::size_t max_entries = 4;
     // 0: half the memory budget.
@@ -122,5 +126,8 @@ class ExportInterpolants {
   std::uint64_t tick_ GUARDED_BY(mu_) = 0;
   Stats stats_ GUARDED_BY(mu_);
 };
+
+// The cache's bounds from the configuration's [export] table (brdfd and brdf-archive alike).
+ExportInterpolants::Options ExportInterpolantsOptionsFrom(const Config& config);
 
 }  // namespace brdf::daemon

@@ -181,7 +181,7 @@ Server::Server(const ServerConfig& config, const BackEnd& back_end, const Authen
       control_loop_(kControlThreads),
       health_(stopping_, streams_),
       control_(*back_end.catalogue, back_end.rig, auth, stopping_, streams_, back_end.program),
-      data_(*back_end.catalogue, auth, stopping_, streams_, back_end.program),
+      data_(*back_end.catalogue, auth, stopping_, streams_, back_end.program, back_end.exports),
       interpolation_(*back_end.cache, auth, stopping_, streams_),
       interpolate_loop_(interpolation_,
                         config.interpolate_threads > 0

@@ -52,6 +52,7 @@ struct BackEnd {
   SessionCatalogue* catalogue = nullptr;  // the sessions (required)
   IndexCache* cache = nullptr;            // Interpolation's indexes over them (required)
   RigPort* rig = nullptr;                 // the rig; null: none (its verbs are refused)
+  ExportInterpolants::Options exports;    // the exports' kept interpolants ([export])
 };
 
 class Server {

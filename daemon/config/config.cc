@@ -383,7 +383,7 @@ void ReadUncertainty(TableReader& root, Config& c) {
   t.Finish();
 }
 
-// The small tables: [storage], [index], [sample], [rig], [log].
+// The small tables: [storage], [index], [export], [sample], [rig], [log].
 void ReadOthers(TableReader& root, Config& c) {
   TableReader storage = root.Sub("storage");
   storage.String("database", c.storage.database);
@@ -392,6 +392,10 @@ void ReadOthers(TableReader& root, Config& c) {
   index.Int("max_sessions", c.index.max_sessions, 1, 1024);
   index.Int("max_mb", c.index.max_mb, 16, 1048576);
   index.Finish();
+  TableReader exports = root.Sub("export");
+  exports.Int("max_entries", c.exports.max_entries, 1, 1024);
+  exports.Int("max_mb", c.exports.max_mb, 0, 1048576);
+  exports.Finish();
   TableReader sample = root.Sub("sample");
   sample.Double("white_reflectance", c.sample.white_reflectance, 0, 1, /*lo_open=*/true);
   sample.Double("white_reflectance_uncertainty", c.sample.white_reflectance_uncertainty, 0, 0.5);

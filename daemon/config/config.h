@@ -164,6 +164,17 @@ struct IndexConfig {
   int max_mb = 512;      // memory of their samples, budgets and indexes, MB, 16–1048576
 };
 
+// [export]: the interpolants Data.Export keeps for grid, MERL and RGL exports (the session copy,
+// its chosen index, the Delaunay fallback and the fitted model; daemon/api/export_cache.h), least
+// recently used out first, so that the next export of the same session and settings starts at
+// once. A kept paper-grid session (2,112 readings of 101 bands) holds roughly 45 MB of resident
+// memory; the analysts' repeated exports of the current session keep about one entry per session.
+struct ExportConfig {
+  int max_entries = 4;  // interpolants kept, 1–1024
+  // Their estimated memory, MB, 1–1048576; 0 (the default): half of [server] memory_budget_mb.
+  int max_mb = 0;
+};
+
 // The meters brdfd drives, by [meter] model.
 enum class MeterModel { kPr650, kPr655, kPr670, kCs2000, kCs2000A, kCs3000 };
 // "pr650" … "cs3000" (the configuration's names) and "PR-650" … "CS-3000" (the meters' own).
@@ -291,6 +302,7 @@ struct Config {
   ServerConfig server;
   StorageConfig storage;
   IndexConfig index;
+  ExportConfig exports;  // [export]
   MeterConfig meter;
   StageConfig stage;
   SampleConfig sample;

@@ -31,7 +31,9 @@ Result<std::unique_ptr<Serving>> Serving::Start(const Program& program, const Co
                                                 const Authenticator& auth) {
   std::unique_ptr<Serving> serving(new Serving());
   serving->program_ = program;
-  Result<std::unique_ptr<Server>> server = Server::Start(config.server, back_end, auth);
+  BackEnd served = back_end;
+  served.exports = ExportInterpolantsOptionsFrom(config);
+  Result<std::unique_ptr<Server>> server = Server::Start(config.server, served, auth);
   if (!server.ok()) {
     spdlog::critical("{}", server.status().ToString());
     return server.status();

@@ -30,7 +30,8 @@ struct Program {
 
 class Serving {
  public:
-  // Starts the server on config.server over `back_end`, then, with [web] listen, the web gateway
+  // Starts the server on config.server over `back_end` (its exports' kept interpolants bounded by
+  // config's [export]), then, with [web] listen, the web gateway
   // (printing "<name> <web_name> on <url>"); then prints "<name> listening on <address>" and
   // tells systemd READY=1. A failure is logged and returned, with nothing left running. `auth`
   // and the back end's parts must outlive the Serving.

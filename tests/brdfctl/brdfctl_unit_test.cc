@@ -423,6 +423,9 @@ TEST(ExampleConfig, LoadsAndHoldsTheDefaults) {
   EXPECT_DOUBLE_EQ(config->stage.beta.speed_deg_s, defaults.stage.beta.speed_deg_s);
   EXPECT_EQ(config->stage.gamma.present, defaults.stage.gamma.present);
   EXPECT_DOUBLE_EQ(config->sample.white_reflectance, defaults.sample.white_reflectance);
+  EXPECT_EQ(config->index.max_sessions, defaults.index.max_sessions);
+  EXPECT_EQ(config->exports.max_entries, defaults.exports.max_entries);
+  EXPECT_EQ(config->exports.max_mb, defaults.exports.max_mb);
   EXPECT_TRUE(config->tokens.empty());
   EXPECT_EQ(config->log.level, defaults.log.level);
 }

@@ -73,6 +73,25 @@ TEST(ConfigTest, IndexCacheBounds) {
   EXPECT_THAT(Refusal("[index]\nmax_entries = 3\n"), HasSubstr("index.max_entries"));
 }
 
+// [export] bounds the exports' kept interpolants: entries and their estimated memory, MB (0: half
+// of [server] memory_budget_mb).
+TEST(ConfigTest, ExportCacheBounds) {
+  const Result<Config> none = ParseConfig("", "empty.toml");
+  ASSERT_TRUE(none.ok());
+  EXPECT_EQ(none->exports.max_entries, 4);
+  EXPECT_EQ(none->exports.max_mb, 0);
+  const Result<Config> r = ParseConfig("[export]\nmax_entries = 1\nmax_mb = 128\n", "lab.toml");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->exports.max_entries, 1);
+  EXPECT_EQ(r->exports.max_mb, 128);
+  EXPECT_THAT(Refusal("[export]\nmax_entries = 0\n"), HasSubstr("export.max_entries"));
+  EXPECT_THAT(Refusal("[export]\nmax_entries = 0\n"), HasSubstr("0 is outside 1"));
+  EXPECT_THAT(Refusal("[export]\nmax_entries = 2000\n"), HasSubstr("export.max_entries"));
+  EXPECT_THAT(Refusal("[export]\nmax_mb = -1\n"), HasSubstr("export.max_mb"));
+  EXPECT_THAT(Refusal("[export]\nmax_sessions = 3\n"), HasSubstr("export.max_sessions"));
+  EXPECT_THAT(Refusal("[export]\nmax_entries = \"one\"\n"), HasSubstr("export.max_entries"));
+}
+
 // [rig] names the sessions (default: the host name); [archive] ships them to the lab's PostgreSQL
 // and needs a credentials file, never a conninfo in the configuration itself.
 TEST(ConfigTest, RigNameAndArchive) {

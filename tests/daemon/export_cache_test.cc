@@ -12,6 +12,7 @@
 
 #include "core/call_context.h"
 #include "core/export/fill/uncertain_chain.h"
+#include "daemon/config/config.h"
 
 namespace brdf::daemon {
 namespace {
@@ -219,6 +220,35 @@ TEST(ExportInterpolantsTest, WhatDoesNotFitIsHandedOverButNotKept) {
   EXPECT_FALSE(built);
   ASSERT_TRUE(two.Get(b, {}, Builder(&builds), &built).ok());
   EXPECT_TRUE(built);
+}
+
+// The configuration's [export] table bounds the cache (brdfd and brdf-archive both map it with
+// ExportInterpolantsOptionsFrom): with max_entries = 1, exporting the next session drops the kept
+// interpolant of the one before, whose next export builds again.
+TEST(ExportInterpolantsTest, TheConfigurationsExportTableBoundsTheCache) {
+  const Result<Config> config = ParseConfig("[export]\nmax_entries = 1\nmax_mb = 64\n", "t");
+  ASSERT_TRUE(config.ok()) << config.status().ToString();
+  const ExportInterpolants::Options options = ExportInterpolantsOptionsFrom(*config);
+  EXPECT_EQ(options.max_entries, 1U);
+  EXPECT_EQ(options.max_bytes, 64U << 20);
+  const ExportInterpolants::Options defaults = ExportInterpolantsOptionsFrom(Config());
+  EXPECT_EQ(defaults.max_entries, 4U);  // without [export]: today's bounds
+  EXPECT_EQ(defaults.max_bytes, 0U);    // half the memory budget
+
+  MemoryBudget budget(1024);
+  ExportInterpolants one(budget, options);
+  const auto first = SessionCopy(1, 10), second = SessionCopy(2, 10);
+  std::atomic<int> builds{0};
+  bool built = false;
+  ASSERT_TRUE(one.Get(first, {}, Builder(&builds)).ok());
+  ASSERT_TRUE(one.Get(first, {}, Builder(&builds), &built).ok());
+  EXPECT_FALSE(built);  // kept
+  ASSERT_TRUE(one.Get(second, {}, Builder(&builds)).ok());
+  EXPECT_EQ(one.stats().entries, 1U);
+  EXPECT_EQ(one.stats().evictions, 1U);
+  ASSERT_TRUE(one.Get(first, {}, Builder(&builds), &built).ok());
+  EXPECT_TRUE(built);  // dropped for the second session: built again
+  EXPECT_EQ(builds.load(), 3);
 }
 
 }  // namespace
