@@ -9,7 +9,7 @@ ArchiveBackEnd::ArchiveBackEnd(std::shared_ptr<storage::ArchiveReader> archive,
     : catalogue_(archive), cache_(archive, cache), refresher_(archive, cache_, refresh) {}
 
 BackEnd ArchiveBackEnd::Served() {
-  return BackEnd{"brdf-archive", &catalogue_, &cache_, nullptr};
+  return BackEnd{"brdf-archive", &catalogue_, &cache_, nullptr, {}};  // exports: Serving
 }
 
 }  // namespace brdf::daemon

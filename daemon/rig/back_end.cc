@@ -96,7 +96,7 @@ RigBackEnd::~RigBackEnd() {
 }
 
 BackEnd RigBackEnd::Served() {
-  return BackEnd{"brdfd", catalogue_.get(), cache_.get(), port_.get()};
+  return BackEnd{"brdfd", catalogue_.get(), cache_.get(), port_.get(), {}};  // exports: Serving
 }
 
 void RigBackEnd::Shutdown(std::chrono::milliseconds timeout) {
