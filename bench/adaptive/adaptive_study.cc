@@ -34,6 +34,7 @@
 #include "core/adaptive/interpolated_model.h"
 #include "core/adaptive/round_chooser.h"
 #include "core/adaptive/round_cost.h"
+#include "core/adaptive/seed_design.h"
 #include "core/geometry.h"
 #include "core/interp/interpolator.h"
 #include "core/plan/analyze_plan.h"
@@ -234,6 +235,7 @@ struct Setup {
   double u = 0.015;
   bool verbose = false;
   double candidate_step_deg = adaptive::kCandidateStepDeg;
+  adaptive::RoundOptions round;  // its max_readings from the plan
   Judging judging;
 };
 
@@ -261,10 +263,26 @@ void PrintRound(const adaptive::Spend& spent, const adaptive::Round& round, doub
   std::printf("\n");
 }
 
+// The seed design of `setup.spec` (which may differ from the plan's: --seed-delta-every,
+// --seed-per-delta) expanded as the plan expands its seed: a pose list with the plan's policies.
+Expanded ExpandSeed(const Setup& setup) {
+  v1::Plan seed = setup.adaptive_plan;
+  seed.clear_method();
+  v1::PoseList* list = seed.mutable_pose_list();
+  for (const Pose& p : adaptive::SeedPoses(adaptive::MakeSeedDesign(setup.spec, setup.rig))) {
+    v1::PoseEntry* e = list->add_poses();
+    e->set_alpha(p.alpha);
+    e->set_beta(p.beta);
+    e->set_gamma(p.gamma);
+    e->set_delta(p.delta);
+  }
+  return Expand(seed, setup.rig);
+}
+
 // The adaptive session: the seed, then rounds until each level of readings; one stage per level.
 std::vector<Stage> AdaptiveStages(const Setup& setup, const Truth& truth, std::mt19937_64& rng,
                                   const std::vector<int>& levels) {
-  const Expanded seed = Expand(setup.adaptive_plan, setup.rig);
+  const Expanded seed = ExpandSeed(setup);
   std::vector<ReadingSoFar> readings;
   for (std::size_t i = 0; i < seed.poses.size(); ++i) {
     readings.push_back(Measure(truth, seed.poses[i], seed.directions[i], setup.u, rng));
@@ -278,9 +296,8 @@ std::vector<Stage> AdaptiveStages(const Setup& setup, const Truth& truth, std::m
   std::vector<Stage> stages;
   for (int level : levels) {
     while (spent.readings < level) {
-      const adaptive::Round round =
-          adaptive::ChooseRound({readings, candidates, at, spent, {level, 0, 0}}, *model, cost,
-                                {.max_readings = setup.spec.round_readings});
+      const adaptive::Round round = adaptive::ChooseRound(
+          {readings, candidates, at, spent, {level, 0, 0}}, *model, cost, setup.round);
       if (round.poses.empty()) break;
       if (setup.verbose) PrintRound(spent, round, model->Map(readings)->Remaining());
       for (const adaptive::ChosenPose& p : round.poses) {
@@ -347,6 +364,8 @@ void Timing(const Setup& setup, int repeat) {
   }
   const adaptive::RoundCost cost(setup.adaptive_plan, setup.rig);
   const auto model = adaptive::MakeInterpolatedModel(setup.spec);
+  adaptive::RoundOptions round_options = setup.round;
+  round_options.max_readings = 24;
   std::vector<double> map_s, round_s, map_cpu, round_cpu;
   for (int r = 0; r < repeat; ++r) {
     auto t0 = std::chrono::steady_clock::now();
@@ -356,9 +375,8 @@ void Timing(const Setup& setup, int repeat) {
     map_cpu.push_back(static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);
     t0 = std::chrono::steady_clock::now();
     c0 = std::clock();
-    const adaptive::Round round =
-        adaptive::ChooseRound({readings, some, readings.back().pose, {}, {100000, 0, 0}}, *model,
-                              cost, {.max_readings = 24});
+    const adaptive::Round round = adaptive::ChooseRound(
+        {readings, some, readings.back().pose, {}, {100000, 0, 0}}, *model, cost, round_options);
     round_s.push_back(Seconds(t0));
     round_cpu.push_back(static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);
     if (round.poses.size() != 24) Fail("round of " + std::to_string(round.poses.size()));
@@ -396,12 +414,25 @@ int main(int argc, char** argv) {
   app.add_option("--candidate-step", setup.candidate_step_deg,
                  "the candidates' lattice step, degrees (the planner's: 5)");
   app.add_option("--repeat", repeat, "timing repetitions");
+  app.add_option("--refine-levels", setup.round.refine.levels,
+                 "levels of finer candidates a round adds (refine_candidates.h; 0: none)");
+  int seed_every = 0, seed_per_delta = 0;
+  app.add_option("--seed-delta-every", seed_every,
+                 "the seed's space-filling set at every n-th δ only (default: the plan's)");
+  app.add_option("--seed-per-delta", seed_per_delta,
+                 "the seed's space-filling readings per δ (default: the plan's)");
+  app.add_option("--refine-keep", setup.round.refine.keep, "finer candidates kept per level");
+
   CLI11_PARSE(app, argc, argv);
   setup.adaptive_plan = LoadPlan(adaptive_path);
   setup.grid_plan = LoadPlan(grid_path);
   if (!setup.adaptive_plan.has_adaptive()) Fail(adaptive_path + " is not an adaptive plan");
   setup.spec = adaptive::ResolveAdaptive(setup.adaptive_plan.adaptive());
   setup.u = u;
+  if (seed_every > 0) setup.spec.seed_delta_every = seed_every;
+  if (seed_per_delta > 0) setup.spec.readings_per_delta = seed_per_delta;
+  setup.round.max_readings = setup.spec.round_readings;
+  setup.round.refine.step_deg = setup.candidate_step_deg;
   if (timing) {
     Timing(setup, repeat);
     return 0;
@@ -410,8 +441,10 @@ int main(int argc, char** argv) {
   std::printf(
       "readings' u %.3f; judged by the octant method (φ mirrored) at %d random pairs, "
       "θ ≤ region; rig time by the plan timing model (prompts %.0f s); candidates every "
-      "%g°\n",
-      u, directions, setup.rig.operator_action_s, setup.candidate_step_deg);
+      "%g° (refined %d levels, %d kept each); seed at every %d-th δ, %d readings each\n",
+      u, directions, setup.rig.operator_action_s, setup.candidate_step_deg,
+      setup.round.refine.levels, setup.round.refine.keep, setup.spec.seed_delta_every,
+      setup.spec.readings_per_delta);
   for (const std::string& path : materials) RunMaterial(setup, path, seeds);
   return 0;
 }

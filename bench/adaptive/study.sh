@@ -6,6 +6,8 @@
 #   bench/adaptive/study.sh                       paint, glossy, gold, retro-coating, seeds 1 2 3
 #   MATERIALS="blue-plastic" SEEDS="1" bench/adaptive/study.sh
 #   EXTRA="--candidate-step 2.5" bench/adaptive/study.sh
+#   EXTRA="--plan bench/adaptive/adaptive-cheap-seed.json" bench/adaptive/study.sh   (seed.deltaEvery 4)
+#   EXTRA="--refine-levels 0" bench/adaptive/study.sh          (the 5° lattice alone, as before)
 set -eu
 BUILD=${BUILD:-build}
 MATERIALS=${MATERIALS:-"paint glossy gold retro-coating"}

@@ -60,6 +60,9 @@ AdaptiveSpec ResolveAdaptive(const v1::Adaptive& adaptive) {
   if (adaptive.seed().readings_per_delta() != 0) {
     spec.readings_per_delta = static_cast<int>(adaptive.seed().readings_per_delta());
   }
+  if (adaptive.seed().delta_every() != 0) {
+    spec.seed_delta_every = static_cast<int>(adaptive.seed().delta_every());
+  }
   if (adaptive.round_readings() != 0) {
     spec.round_readings = static_cast<int>(adaptive.round_readings());
   }

@@ -70,6 +70,7 @@ struct AdaptiveSpec {
   std::vector<double> gamma_deg = {0};  // dial positions
   int retro_readings = kDefaultRetroReadings;
   int readings_per_delta = kDefaultReadingsPerDelta;
+  int seed_delta_every = 1;  // the seed's space-filling set at every n-th δ of delta_deg
   int round_readings = kDefaultRoundReadings;
 };
 

@@ -139,7 +139,14 @@ Round ChooseRound(const RoundInput& input, const UncertaintyModel& model, const 
 Round ChooseRound(const RoundInput& input, UncertaintyMap& map, const RoundCost& cost,
                   const RoundOptions& options) {
   Round round;
-  std::vector<ChosenPose> picks = PickGreedy(input, map, cost, options, &round.limited_by);
+  // The caller's candidates and the finer ones, refined from the map before any pick.
+  std::vector<Pose> candidates(input.candidates.begin(), input.candidates.end());
+  const std::vector<Pose> finer =
+      RefinedCandidates(input.readings, input.candidates, map, cost, options.refine);
+  candidates.insert(candidates.end(), finer.begin(), finer.end());
+  RoundInput all = input;
+  all.candidates = candidates;
+  std::vector<ChosenPose> picks = PickGreedy(all, map, cost, options, &round.limited_by);
   if (options.group_by_delta) picks = GroupBySetting(picks, input.rig_at);
   std::vector<Pose> poses;
   for (const ChosenPose& p : picks) poses.push_back(p.pose);

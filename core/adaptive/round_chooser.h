@@ -3,7 +3,10 @@
 // integrated, cosine-weighted uncertainty (uncertainty_model.h) over what the reading costs from
 // where the rig then is (round_cost.h: move, reading, and a δ change costed as its prompt and
 // reference block) — and count it as measured (UncertaintyMap::Assume) before the next pick;
-// stop at the round's size, when nothing affordable gains anything, or at the budget. Then the
+// stop at the round's size, when nothing affordable gains anything, or at the budget. The
+// candidates are the caller's plus finer ones near the readings and near the coarse candidates
+// that gain most (refine_candidates.h), so that a narrow peak between lattice poses can still be
+// reached. Then the
 // batch is grouped by detector position (the rig's present δ first, then in order of first
 // pick), each group ordered for short moves, so the operator relocates the detector once per δ
 // per round; the batch is costed again in that order and cut from the end to fit the budget.
@@ -16,6 +19,7 @@
 #include <vector>
 
 #include "core/adaptive/adaptive_spec.h"
+#include "core/adaptive/refine_candidates.h"
 #include "core/adaptive/round_cost.h"
 #include "core/adaptive/uncertainty_model.h"
 #include "core/pose.h"
@@ -63,10 +67,13 @@ struct RoundOptions {
   // false, for comparison only: δ changes are not charged when picking and the batch is measured
   // in pick order (it is still costed, prompts included, for the budget).
   bool group_by_delta = true;
+  // The finer candidates added to the caller's (refine_candidates.h); levels 0: none.
+  RefineOptions refine = {};
 };
 
 // The next round; empty when nothing affordable is predicted to gain anything (the caller
-// stops: stop_rule.h). A candidate equal to a reading's pose or to an earlier pick is skipped.
+// stops: stop_rule.h). A candidate equal to a reading's pose or to an earlier pick is skipped;
+// a pick may be a finer candidate, not one of input.candidates.
 Round ChooseRound(const RoundInput& input, const UncertaintyModel& model, const RoundCost& cost,
                   const RoundOptions& options = {});
 // The same from a map already built from input.readings (model.Map(input.readings)), for a

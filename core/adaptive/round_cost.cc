@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "core/adaptive/seed_design.h"
 #include "core/geometry.h"
 #include "core/plan/expand_steps.h"
 #include "core/plan/problem.h"
@@ -54,7 +55,9 @@ PoseCost MeasureDeltaChange(const v1::Plan& plan, const plan::RigDescription& ri
 }  // namespace
 
 RoundCost::RoundCost(const v1::Plan& plan, const plan::RigDescription& rig)
-    : rig_(rig), measurement_(plan::ResolveSettings(plan).measurement) {
+    : rig_(rig),
+      region_(ResolveAdaptive(plan.adaptive()).region),
+      measurement_(plan::ResolveSettings(plan).measurement) {
   rig_.time_scale = 1;
   delta_change_ = MeasureDeltaChange(plan, rig_);
 }
@@ -74,6 +77,10 @@ PoseCost RoundCost::Step(const Pose& from, const Pose& to) const {
   if (to.delta != from.delta) cost += delta_change_;
   if (to.gamma != from.gamma && !rig_.has_gamma_axis) cost += PoseCost{rig_.operator_action_s, 1};
   return cost;
+}
+
+bool RoundCost::CanReach(const Pose& pose) const {
+  return Reachable(pose, region_, rig_);
 }
 
 PoseCost RoundCost::Sequence(const Pose& from, std::span<const Pose> poses) const {

@@ -6,12 +6,14 @@
 // its prompts and, with dark.withEachReference, the dark), measured once by expanding a two-pose
 // pose list with the plan's policies; a change of γ on a manual dial adds its prompt. The
 // reference rules by count or by minutes are not charged per pose (the round's steps, expanded
-// as a pose list, carry them exactly).
+// as a pose list, carry them exactly). It also says which poses the rig can take at all
+// (CanReach: the rig's travel and the adaptive plan's region), for candidates a round makes up.
 #pragma once
 
 #include <span>
 
 #include "brdf/v1/plan.pb.h"
+#include "core/adaptive/adaptive_spec.h"
 #include "core/plan/plan_settings.h"
 #include "core/plan/rig_description.h"
 #include "core/pose.h"
@@ -43,9 +45,14 @@ class RoundCost {
   PoseCost Sequence(const Pose& from, std::span<const Pose> poses) const;
   // What a change of δ adds to a reading (see above).
   const PoseCost& delta_change() const { return delta_change_; }
+  // True when the pose (model angles) is within the rig's travel and both its directions lie in
+  // the plan's adaptive region (the default region for a plan of another method):
+  // seed_design.h's Reachable, as for the candidates.
+  bool CanReach(const Pose& pose) const;
 
  private:
   plan::RigDescription rig_;
+  Region region_;
   plan::MeasurementChoice measurement_;
   PoseCost delta_change_;
 };

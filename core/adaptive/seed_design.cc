@@ -77,7 +77,9 @@ bool Reachable(const Pose& model, const Region& region, const plan::RigDescripti
 std::vector<SeedGroup> MakeSeedDesign(const AdaptiveSpec& spec, const plan::RigDescription& rig) {
   std::vector<SeedGroup> groups;
   for (std::size_t g = 0; g < spec.gamma_deg.size(); ++g) {
-    for (double delta : spec.delta_deg) {
+    const std::size_t every = static_cast<std::size_t>(std::max(spec.seed_delta_every, 1));
+    for (std::size_t d = 0; d < spec.delta_deg.size(); d += every) {
+      const double delta = spec.delta_deg[d];
       SeedGroup group{spec.gamma_deg[g], delta, 0, spec.readings_per_delta, {}};
       group.poses = SpaceFilling(spec, rig, group.gamma_deg, delta, spec.readings_per_delta);
       OrderForTravel(group.poses);

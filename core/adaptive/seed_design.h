@@ -2,7 +2,8 @@
 // round has something to judge. A retro-reflection scan at δ = 0 (lamp and detector together,
 // θi = θo across the region: where retro-reflective coatings have their peak and where a
 // warped parameterisation such as Dupuy & Jakob's starts), then at every detector position δ
-// (and every dial position γ) a coarse space-filling set of holder poses.
+// (and every dial position γ) a coarse space-filling set of holder poses — or at every n-th δ only
+// (seed.deltaEvery), a cheaper seed: each δ left out spares a relocation and its reference.
 //
 // The space-filling set is deterministic: the Halton sequence in bases 2 and 3 maps to holder
 // normals spread evenly over the upper hemisphere (sin α and β uniform, α ≥ 0 as geometry.md's

@@ -368,6 +368,11 @@ class FieldChecker {
                                                   " is more than 100; give 0 … 100 (0: no scan)");
       ok = false;
     }
+    if (seed.delta_every() > 100) {
+      sink_.Add(base + ".seed.deltaEvery", std::to_string(seed.delta_every()) +
+                                               " is more than 100; give 1 … 100 (1: every δ)");
+      ok = false;
+    }
     if (seed.readings_per_delta() > 500) {
       sink_.Add(base + ".seed.readingsPerDelta",
                 std::to_string(seed.readings_per_delta()) + " is more than 500; give 1 … 500");

@@ -47,6 +47,39 @@ TEST(AdaptivePlanTest, ExampleIsValidAndExpandsToItsSeed) {
   EXPECT_EQ(Prompts(a.steps, v1::PROMPT_KIND_RELOCATE_DETECTOR).size(), 14u);
 }
 
+TEST(AdaptivePlanTest, ACheaperSeedAtEveryNthDeltaPassesItsChecksWithFewerPrompts) {
+  const std::string fields = std::string(kGood) + R"(,
+    "delta": {"start": 0, "stop": 146.25, "step": 11.25},
+    "seed": {"readingsPerDelta": 24)";
+  const PlanAnalysis every = AnalyzePlan(PlanFromJson(Adaptive(fields + "}")), RigDescription{});
+  const PlanAnalysis cheap =
+      AnalyzePlan(PlanFromJson(Adaptive(fields + R"(, "deltaEvery": 4})")), RigDescription{});
+  ASSERT_TRUE(every.valid()) << FormatProblems(every.problems);
+  ASSERT_TRUE(cheap.valid()) << FormatProblems(cheap.problems);
+  // δ = 0, 45, 90 and 135: four relocations, not 14, and a quarter of the rig time or so.
+  std::vector<double> deltas;
+  for (const Step& s : OfKind(cheap.steps, v1::STEP_KIND_SAMPLE)) {
+    if (deltas.empty() || deltas.back() != s.pose.delta) deltas.push_back(s.pose.delta);
+  }
+  EXPECT_EQ(deltas.size(), 4u);
+  EXPECT_EQ(Prompts(cheap.steps, v1::PROMPT_KIND_RELOCATE_DETECTOR).size(), 4u);
+  EXPECT_EQ(Prompts(every.steps, v1::PROMPT_KIND_RELOCATE_DETECTOR).size(), 14u);
+  EXPECT_LT(cheap.summary.operator_interventions * 3, every.summary.operator_interventions);
+  EXPECT_LT(cheap.summary.estimated_duration_s * 2, every.summary.estimated_duration_s);
+  // The budget checks see the cheaper seed: a budget between the two passes.
+  const std::string budget = R"("target": {"expandedUncertainty": 0.05},
+    "budget": {"maxPrompts": )" +
+                             std::to_string(every.summary.operator_interventions - 1) + "}";
+  const std::string rest = R"(,
+    "delta": {"start": 0, "stop": 146.25, "step": 11.25}, "seed": {"readingsPerDelta": 24)";
+  EXPECT_NE(Find(ValidatePlan(PlanFromJson(Adaptive(budget + rest + "}")), RigDescription{}),
+                 "adaptive.budget.maxPrompts"),
+            nullptr);
+  EXPECT_TRUE(ValidatePlan(PlanFromJson(Adaptive(budget + rest + R"(, "deltaEvery": 4})")),
+                           RigDescription{})
+                  .empty());
+}
+
 TEST(AdaptivePlanTest, SeedStaysInTheRegionAndTravel) {
   const v1::Plan plan = PlanFromJson(Adaptive(std::string(kGood) + R"(,
     "region": {"thetaIMinDeg": 10, "thetaIMaxDeg": 60, "thetaOMaxDeg": 70},
@@ -97,13 +130,13 @@ TEST(AdaptivePlanTest, BadValuesAreNamedWithTheirPaths) {
         "region": {"thetaIMinDeg": 50, "thetaIMaxDeg": 40, "thetaOMaxDeg": 95},
         "delta": {"step": 0},
         "gamma": [0, 0],
-        "seed": {"retroReadings": 101, "readingsPerDelta": 501},
+        "seed": {"retroReadings": 101, "readingsPerDelta": 501, "deltaEvery": 101},
         "roundReadings": 1001)")),
                                                      RigDescription{});
   for (const char* path :
        {"adaptive.target", "adaptive.budget.maxRigMinutes", "adaptive.region.thetaIMaxDeg",
         "adaptive.region.thetaOMaxDeg", "adaptive.delta.step", "adaptive.gamma[1]",
-        "adaptive.seed.retroReadings", "adaptive.seed.readingsPerDelta",
+        "adaptive.seed.retroReadings", "adaptive.seed.readingsPerDelta", "adaptive.seed.deltaEvery",
         "adaptive.roundReadings"}) {
     EXPECT_NE(Find(problems, path), nullptr) << path << "\n" << FormatProblems(problems);
   }
