@@ -24,10 +24,16 @@
 #   --out PREFIX         write PREFIX.csv and PREFIX.txt (default ./adaptive-daemon-bench; with
 #                        --smoke, in the work directory)
 #   --keep DIR           keep the work (databases, plans, logs, watch output) in DIR
+#   --gamma "0 90"       the anisotropic (4D) form: both plans anisotropic over these dial
+#                        positions (a motorized γ), the error judged at the four angles
+#                        (θi, φi, θo, φo) without mirroring φ; rows name the material NAME-4d
 #   --smoke              a check in well under a minute: paint, examples/plans/demo.json as the
 #                        grid, a small adaptive plan (3 detector positions), budget 50 %, 1,000
-#                        directions; fails unless the table has both rows and the grid's error
-#                        is finite and below 0.5
+#                        directions; fails unless the table has both rows, both errors finite
+#                        and below 0.5 (the paint is smooth: 0.25 in both, 2026-12-06), rig
+#                        times above 0 and the adaptive readings within their budget
+# Two runs' work directories (--keep) make one table with
+#   bench/adaptive/daemon_bench_table.py --work DIR1 --work DIR2 --out PREFIX
 # Environment: BENCH_NO_BUILD=1 (do not build brdfd, brdf-sim, brdfctl, the Python stubs).
 # Exit 1 when a session does not complete or a measurement fails (the message names the log).
 set -euo pipefail
@@ -44,6 +50,7 @@ adaptive_plan="$root/examples/plans/adaptive.json"
 out=""
 keep=""
 smoke=0
+gamma=""
 build=""
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -56,6 +63,7 @@ while [[ $# -gt 0 ]]; do
     --adaptive-plan) adaptive_plan="$2"; shift ;;
     --out) out="$2"; shift ;;
     --keep) keep="$2"; shift ;;
+    --gamma) gamma="$2"; shift ;;
     --smoke) smoke=1 ;;
     -h | --help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     -*) echo "daemon_bench: unknown option $1 (see --help)" >&2; exit 2 ;;
@@ -97,6 +105,15 @@ fi
 [[ -n "$out" ]] || out="$([[ $smoke == 1 ]] && echo "$work/table" || echo "$PWD/adaptive-daemon-bench")"
 config_real_meter=1  # estimates at a real PR-650's speed (brdfd's defaults)
 config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
+four_angles=()
+if [[ -n "$gamma" ]]; then
+  config_extra+=$'\n[stage.axes.gamma]\npresent = true'  # brdf-sim's dial is motorized (unit 3)
+  four_angles=(--four-angles)
+  gamma_json="[$(tr -s ' ' ',' <<<"$gamma" | sed 's/^,//; s/,$//')]"
+  jq --argjson g "$gamma_json" '.anisotropic = true | .sampleRotation.gamma = $g' "$grid_plan" \
+    >"$work/grid-4d.json" || fail "cannot make the anisotropic form of $grid_plan"
+  grid_plan="$work/grid-4d.json"
+fi
 sim_seed="$seed"
 
 say() { echo "daemon_bench: $*" >&2; }
@@ -110,7 +127,8 @@ adaptive_plan_for() {
     filter+=' | .adaptive.delta = {start: 0, stop: 45, step: 22.5}
       | .adaptive.seed = {retroReadings: 4, readingsPerDelta: 8} | .adaptive.roundReadings = 8'
   fi
-  jq --argjson n "$1" "$filter" "$adaptive_plan" >"$2"
+  [[ -z "$gamma" ]] || filter+=' | .anisotropic = true | .adaptive.gamma = $g'
+  jq --argjson n "$1" --argjson g "${gamma_json:-[0]}" "$filter" "$adaptive_plan" >"$2"
 }
 
 # Prints a progress line every 20 s from the watch output $1 (JSON lines) until killed.
@@ -157,12 +175,14 @@ count_of() {
 
 rows="$work/rows.tsv"  # material label budget_readings readings rig_s prompts wall_s session stop
 : >"$rows"
-load_start="$(cut -d' ' -f1-3 /proc/loadavg)"
-started="$(date -u '+%Y-%m-%d %H:%M UTC')"
+: >"$work/errors.tsv"  # material label err peak retro fallback
+echo "$(date -u '+%Y-%m-%d %H:%M UTC'), commit $(git -C "$root" rev-parse --short HEAD)," \
+  "brdf-sim seed $seed, time scale $scale, $directions directions${gamma:+, γ $gamma}," \
+  "load at the start $(cut -d' ' -f1-3 /proc/loadavg)" >"$work/meta.txt"
 for m in $materials; do
   file="$(material_file "$m")"
   [[ -f "$file" ]] || fail "no material file $file (give a name in deploy/materials/ or a path)"
-  material_name="$(basename "$file" .toml)"
+  material_name="$(basename "$file" .toml)${gamma:+-4d}"
   dir="$work/$material_name"
   mkdir -p "$dir"
   say "== $material_name: brdf-sim (time scale $scale, seed $seed) and brdfd on a fresh database in $dir"
@@ -198,6 +218,7 @@ for m in $materials; do
   "$python" "$here/daemon_bench_error.py" --address "$BRDF_ADDRESS" --token "$operator_token" \
     --sim "$sim" --material "$file" --directions "$directions" \
     --truth-cache "$work/truth-$material_name-$directions.npz" "${judged[@]}" \
+    ${four_angles[@]+"${four_angles[@]}"} \
     >"$dir/errors.jsonl" 2>"$dir/errors.log" ||
     fail "$material_name: measuring the errors failed: $(tail -n 3 "$dir/errors.log"); log $dir/errors.log"
   sed 's/^/  /' "$dir/errors.log" >&2
@@ -207,74 +228,7 @@ for m in $materials; do
   stop_pid "$sim_pid"
 done
 
-# The table: joins the rows and the errors, ratios to the material's grid, the goal.
-"$python" - "$rows" "$work/errors.tsv" "$out" "$started" "$load_start" \
-  "$(cut -d' ' -f1-3 /proc/loadavg)" "$(git -C "$root" rev-parse --short HEAD)" "$seed" \
-  "$scale" "$directions" "$smoke" <<'EOF'
-import csv, math, sys
-rows_path, err_path, out, started, load0, load1, commit, seed, scale, n, smoke = sys.argv[1:]
-errs = {}
-for line in open(err_path):
-    m, label, err, peak, retro, fb = line.rstrip("\n").split("\t")
-    errs[(m, label)] = (float(err), float(peak), float(retro), float(fb))
-rows = [line.rstrip("\n").split("\t") for line in open(rows_path)]
-grid = {r[0]: r for r in rows if r[1] == "grid"}
-def hms(s):
-    s = round(float(s)); return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
-table, verdicts = [], {}
-for r in rows:
-    m, label, budget, readings, rig, prompts, wall, session, stop = r
-    g = grid[m]
-    err, peak, retro, fb = errs[(m, label)]
-    gerr = errs[(m, "grid")][0]
-    e_ratio, t_ratio = err / gerr, float(rig) / float(g[4])
-    r_ratio = int(readings) / int(g[3])
-    goal = ""
-    if label != "grid":
-        a = e_ratio <= 1 and r_ratio <= 0.20 and t_ratio <= 0.25
-        b = e_ratio <= 0.5
-        why = [w for w, bad in (("error", e_ratio > 1), ("readings", r_ratio > 0.20),
-                                ("rig time", t_ratio > 0.25)) if bad]
-        goal = ("grid error at <=20% readings and <=25% time: " + ("yes" if a else "no (" + ", ".join(why) + ")")
-                + "; half the grid's error: " + ("yes" if b else "no"))
-        v = verdicts.setdefault(m, [False, False, math.inf])
-        v[0] |= a; v[1] |= b; v[2] = min(v[2], e_ratio)
-    table.append({"material": m, "plan": label, "budget_readings": budget, "readings": readings,
-                  "rig_time_s": f"{float(rig):.0f}", "rig_time": hms(rig), "prompts": prompts,
-                  "error": f"{err:.4f}", "peak_error": f"{peak:.4f}", "retro_error": f"{retro:.4f}",
-                  "fallback_pct": f"{100 * fb:.1f}", "error_over_grid": f"{e_ratio:.3f}",
-                  "readings_over_grid": f"{r_ratio:.3f}", "rig_time_over_grid": f"{t_ratio:.3f}",
-                  "goal": goal, "session": session, "wall_s": wall, "stop": stop})
-with open(out + ".csv", "w", newline="") as f:
-    w = csv.DictWriter(f, fieldnames=list(table[0]))
-    w.writeheader(); w.writerows(table)
-head = (f"# adaptive through brdfd on brdf-sim: {started}, commit {commit}, brdf-sim seed {seed}, "
-        f"time scale {scale}, {n} directions; load {load0} -> {load1}")
-lines = [head, "",
-         "| material | plan | readings | rig time (÷ grid) | prompts | error (÷ grid) | peak error | retro | fb % | wall s |",
-         "|---|---|---|---|---|---|---|---|---|---|"]
-for t in table:
-    lines.append(f"| {t['material']} | {t['plan']} | {t['readings']} ({t['readings_over_grid']}) | "
-                 f"{t['rig_time']} ({t['rig_time_over_grid']}) | {t['prompts']} | {t['error']} "
-                 f"({t['error_over_grid']}) | {t['peak_error']} | {t['retro_error']} | "
-                 f"{t['fallback_pct']} | {t['wall_s']} |")
-lines.append("")
-for t in table:
-    if t["goal"]:
-        lines.append(f"{t['material']} {t['plan']}: {t['goal']}; stop: {t['stop']}")
-lines.append("")
-for m, (a, b, best) in verdicts.items():
-    lines.append(f"{m}: goal (grid's error at <= 20 % readings and <= 25 % rig time) "
-                 f"{'REACHED' if a else 'not reached'}; half the grid's error "
-                 f"{'REACHED' if b else 'not reached'} (best error ÷ grid {best:.3f})")
-text = "\n".join(lines) + "\n"
-open(out + ".txt", "w").write(text)
-print(text, end="")
-print(f"written: {out}.csv, {out}.txt")
-if smoke == "1":
-    ok = (len(table) == 2 and {t["plan"] for t in table} == {"grid", "adapt50"}
-          and all(math.isfinite(float(t["error"])) for t in table)
-          and float(table[0]["error"]) < 0.5)
-    print("smoke:", "ok" if ok else "FAILED (want a grid and an adapt50 row, finite errors, grid error < 0.5)")
-    sys.exit(0 if ok else 1)
-EOF
+# The table: the rows and errors joined, ratios to each material's grid, the goal.
+table_args=()
+[[ $smoke == 1 ]] && table_args+=(--smoke)
+"$python" "$here/daemon_bench_table.py" --work "$work" --out "$out" ${table_args[@]+"${table_args[@]}"}

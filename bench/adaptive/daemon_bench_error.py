@@ -21,7 +21,9 @@ adaptive::JudgeOptions mirrors φ), asked at the isotropic direction (θi, θo, 
 (method nearest) stands in, and the share of such directions is reported (fb). The truth is
 `brdf-sim --material FILE truth` at the four angles (θi, φi, θo, φo): for an anisotropic material
 the isotropic interpolant's loss of the azimuth φi is part of the error. The truth is computed once
-per material and cached (--truth-cache).
+per material and cached (--truth-cache). --four-angles (sessions of an anisotropic plan): the
+daemon is asked at the four angles themselves, φ not mirrored (mirror_phi is for isotropic
+sessions).
 
 Prints one JSON object per session on stdout: label, session, err, peak, retro, fallback (share
 of the random directions), n (directions), and progress on stderr.
@@ -115,16 +117,14 @@ def truth_all(sim, material, d4, cache):
     return values
 
 
-def interpolated(client, session, d3):
-    """(scalar values, fallback mask): octant with φ mirrored, the nearest reading where it has
-    no answer."""
-    batch = client.interpolate_batch(session, d3, method="octant", mirror_phi=True,
+def interpolated(client, session, d3, mirror_phi=True):
+    """(scalar values, fallback mask): octant (φ mirrored unless told not to), the nearest
+    reading where it has no answer. d3: (N, 3) isotropic or (N, 4) four-angle directions."""
+    batch = client.interpolate_batch(session, d3, method="octant", mirror_phi=mirror_phi,
                                      progress=False, timeout=900)
-    if not batch.ok.any():
-        raise RuntimeError(f"session {session}: the octant method answered no direction "
-                           f"(statuses {sorted(set(batch.statuses))[:4]})")
     values = np.full(len(d3), np.nan)
-    values[batch.ok] = scalar(batch.wavelengths, batch.spectra[batch.ok])
+    if batch.ok.any():  # none (an empty octant everywhere, a sparse 4D session): all nearest
+        values[batch.ok] = scalar(batch.wavelengths, batch.spectra[batch.ok])
     missing = ~batch.ok
     if missing.any():
         near = client.interpolate_batch(session, d3[missing], method="nearest", progress=False,
@@ -154,6 +154,8 @@ def parse_args():
     p.add_argument("--seed", type=int, default=20261206, help="the random directions' seed")
     p.add_argument("--theta-max", type=float, default=80.0, help="θi, θo at most, degrees")
     p.add_argument("--truth-cache", default="", help="an .npz file caching the truth")
+    p.add_argument("--four-angles", action="store_true",
+                   help="anisotropic sessions: ask at (θi, φi, θo, φo), φ not mirrored")
     return p.parse_args()
 
 
@@ -175,7 +177,10 @@ def main():
     with BrdfClient(a.address, a.token) as client:
         for label, sid in sessions:
             start = time.monotonic()
-            values, missing = interpolated(client, sid, isotropic(every))
+            if a.four_angles:
+                values, missing = interpolated(client, sid, every, mirror_phi=False)
+            else:
+                values, missing = interpolated(client, sid, isotropic(every))
             row = {"label": label, "session": sid, "n": len(rand),
                    "fallback": float(missing[parts["err"]].mean())}
             for name, part in parts.items():
