@@ -27,6 +27,10 @@
 #   --gamma "0 90"       the anisotropic (4D) form: both plans anisotropic over these dial
 #                        positions (a motorized γ), the error judged at the four angles
 #                        (θi, φi, θo, φo) without mirroring φ; rows name the material NAME-4d
+#   --accept-overload    keep a reading the meter reports overloaded (quality 19), flagged,
+#                        instead of pausing the session: the brushed aluminium's grazing
+#                        highlight saturates the simulated PR-650 at δ 146.25° (its value is
+#                        then the clipped reading, an under-read the error counts)
 #   --smoke              a check in well under a minute: paint, examples/plans/demo.json as the
 #                        grid, a small adaptive plan (3 detector positions), budget 50 %, 1,000
 #                        directions; fails unless the table has both rows, both errors finite
@@ -50,6 +54,7 @@ adaptive_plan="$root/examples/plans/adaptive.json"
 out=""
 keep=""
 smoke=0
+accept_overload=0
 gamma=""
 build=""
 while [[ $# -gt 0 ]]; do
@@ -64,6 +69,7 @@ while [[ $# -gt 0 ]]; do
     --out) out="$2"; shift ;;
     --keep) keep="$2"; shift ;;
     --gamma) gamma="$2"; shift ;;
+    --accept-overload) accept_overload=1 ;;
     --smoke) smoke=1 ;;
     -h | --help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     -*) echo "daemon_bench: unknown option $1 (see --help)" >&2; exit 2 ;;
@@ -105,6 +111,7 @@ fi
 [[ -n "$out" ]] || out="$([[ $smoke == 1 ]] && echo "$work/table" || echo "$PWD/adaptive-daemon-bench")"
 config_real_meter=1  # estimates at a real PR-650's speed (brdfd's defaults)
 config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
+[[ $accept_overload == 0 ]] || config_extra+=$'\n"19" = "accept_and_flag"'
 four_angles=()
 if [[ -n "$gamma" ]]; then
   config_extra+=$'\n[stage.axes.gamma]\npresent = true'  # brdf-sim's dial is motorized (unit 3)
@@ -177,7 +184,8 @@ rows="$work/rows.tsv"  # material label budget_readings readings rig_s prompts w
 : >"$rows"
 : >"$work/errors.tsv"  # material label err peak retro fallback
 echo "$(date -u '+%Y-%m-%d %H:%M UTC'), commit $(git -C "$root" rev-parse --short HEAD)," \
-  "brdf-sim seed $seed, time scale $scale, $directions directions${gamma:+, γ $gamma}," \
+  "brdf-sim seed $seed, time scale $scale, $directions directions${gamma:+, γ $gamma}" \
+  "$([[ $accept_overload == 0 ]] || echo ", overloaded readings kept (flagged)"),"  \
   "load at the start $(cut -d' ' -f1-3 /proc/loadavg)" >"$work/meta.txt"
 for m in $materials; do
   file="$(material_file "$m")"
