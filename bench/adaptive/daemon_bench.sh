@@ -129,11 +129,13 @@ material_file() { if [[ -f "$1" ]]; then echo "$1"; else echo "$root/deploy/mate
 
 # The adaptive plan with its reading budget set to $1 (other budgets dropped), written to $2.
 adaptive_plan_for() {
+  # shellcheck disable=SC2016  # $n and $g are jq's
   local filter='.name = "adaptive, \($n) readings" | .adaptive.budget = {maxReadings: $n}'
   if [[ $smoke == 1 ]]; then
     filter+=' | .adaptive.delta = {start: 0, stop: 45, step: 22.5}
       | .adaptive.seed = {retroReadings: 4, readingsPerDelta: 8} | .adaptive.roundReadings = 8'
   fi
+  # shellcheck disable=SC2016
   [[ -z "$gamma" ]] || filter+=' | .anisotropic = true | .adaptive.gamma = $g'
   jq --argjson n "$1" --argjson g "${gamma_json:-[0]}" "$filter" "$adaptive_plan" >"$2"
 }
@@ -184,8 +186,8 @@ rows="$work/rows.tsv"  # material label budget_readings readings rig_s prompts w
 : >"$rows"
 : >"$work/errors.tsv"  # material label err peak retro fallback
 echo "$(date -u '+%Y-%m-%d %H:%M UTC'), commit $(git -C "$root" rev-parse --short HEAD)," \
-  "brdf-sim seed $seed, time scale $scale, $directions directions${gamma:+, γ $gamma}" \
-  "$([[ $accept_overload == 0 ]] || echo ", overloaded readings kept (flagged)"),"  \
+  "brdf-sim seed $seed, time scale $scale, $directions directions${gamma:+, γ $gamma}$(
+    [[ $accept_overload == 0 ]] || echo ", overloaded readings kept (flagged)")," \
   "load at the start $(cut -d' ' -f1-3 /proc/loadavg)" >"$work/meta.txt"
 for m in $materials; do
   file="$(material_file "$m")"
