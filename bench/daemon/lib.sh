@@ -61,12 +61,14 @@ wait_for_rig_connected() {
 # the configuration write_config writes to $1/brdfd.toml (database $1/brdfd.db), their output in
 # $1/{sim,brdfd}.{out,log}; waits until the rig is connected. Uses the script's `sim`, `brdfd` and
 # `ctl`; sets sim_pid, brdfd_pid (both added to `pids`) and modbus (the simulator's host:port), and
-# exports BRDF_ADDRESS and BRDF_TOKEN (the operator's).
+# exports BRDF_ADDRESS and BRDF_TOKEN (the operator's). A script may set sim_seed (brdf-sim's
+# --seed; default 1) and the array sim_extra_args (more brdf-sim flags, e.g. --material FILE).
 # shellcheck disable=SC2154  # sim, brdfd and ctl are the sourcing script's
 start_rig_on_sim() {
   local dir="$1" scale="$2" level="$3"
-  "$sim" --time-scale "$scale" --seed 1 --modbus-port 0 --pr650-link "$dir/pr650" --wake-window 0 \
-    --log-level "$level" >"$dir/sim.out" 2>"$dir/sim.log" </dev/null &
+  "$sim" --time-scale "$scale" --seed "${sim_seed:-1}" --modbus-port 0 --pr650-link "$dir/pr650" \
+    --wake-window 0 --log-level "$level" ${sim_extra_args[@]+"${sim_extra_args[@]}"} \
+    >"$dir/sim.out" 2>"$dir/sim.log" </dev/null &
   sim_pid=$!
   pids+=("$sim_pid")
   wait_line "$dir/sim.out" '^ready' 20
@@ -96,7 +98,9 @@ record_session_on_sim() {
 
 # brdfd's configuration on stdout, with both tokens: $1 database, $2 meter port, $3 Modbus
 # host:port, $4 more [server] lines. A script may set config_axis_speed (deg/s of α, β and δ;
-# unset: the defaults) and config_extra (TOML appended at the end, in tables of its own).
+# unset: the defaults), config_extra (TOML appended at the end, in tables of its own) and
+# config_real_meter=1 (the [meter] timing for the estimates left at brdfd's defaults, a real
+# PR-650's, instead of brdf-sim's meter: estimates then say what the plan takes on a real rig).
 write_config() {
   cat <<EOT
 [server]
@@ -108,11 +112,17 @@ database = "$1"
 port = "$2"
 pacing_ms = 5
 quiet_gap_ms = 10
+EOT
+  if [[ "${config_real_meter:-0}" != 1 ]]; then
+    cat <<EOT
 # brdf-sim's meter, for the estimates (docs/pr650.md, "How long a reading takes")
 overhead_ms = 1000
 adaptive_reference_ms = 150
 adaptive_dark_ms = 6000
 adaptive_sample_ms = 650
+EOT
+  fi
+  cat <<EOT
 [stage]
 transport = "tcp"
 address = "$3"
