@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/adaptive/prompt_order.h"
 #include "core/geometry.h"
 #include "core/plan/analyze_plan.h"
 #include "core/plan/plan_json.h"
@@ -269,6 +270,66 @@ TEST_F(AdaptiveSessionTest, WithoutAnUncertaintyModelAdaptivePlansAreRefused) {
   EXPECT_NE(refused.status().message().find("no uncertainty model is configured"),
             std::string::npos)
       << refused.status().message();
+}
+
+// The sample-fixed form (docs/adaptive.md): every pose a RELOCATE_LAMP_AND_DETECTOR prompt with
+// its target, the holder never moved, each reading recorded at its target's directions, each round
+// stored in prompt order, and the prompt budget what ends the session: the seed's 6 poses and its
+// reference are 8 prompts, then two rounds of 4 reach the 16.
+TEST_F(AdaptiveSessionTest, SampleFixedFormStopsAtThePromptBudgetWithAPromptPerPose) {
+  const std::string json = R"({
+  "name": "adaptive sample-fixed on the fake rig",
+  "adaptive": {
+    "target": {"expandedUncertainty": 0.001},
+    "budget": {"maxPrompts": 16},
+    "seed": {"retroReadings": 2},
+    "sampleFixed": {"seedReadings": 4},
+    "roundReadings": 4
+  },
+  "reference": {"perDetectorPosition": false},
+  "measurement": {"integrationMs": 100, "averages": 1},
+  "retry": {"maxAttempts": 2, "backoffMs": 0}
+})";
+  Open("brdfd.db", AdaptiveOptions());
+  SessionId id = 0;
+  const v1::Session done = RunToEnd(json, id);
+  ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED)
+      << done.state_reason() << (done.has_last_fault() ? done.last_fault().reason() : "");
+  EXPECT_NE(done.state_reason().find("adaptive: prompt budget spent"), std::string::npos)
+      << done.state_reason();
+  const std::vector<storage::RoundRecord> rounds = Rounds(*store_, id);
+  ASSERT_EQ(rounds.size(), 2u);
+  ExpectWholeAndDone(*store_, id);
+  ExpectRoundsAreTheirSteps(*store_, id, SeedSteps(json));
+
+  auto stored = store_->GetSteps(id);
+  ASSERT_TRUE(stored.ok());
+  const std::vector<plan::Step> steps = daemon::ToPlanSteps(*stored);
+  int prompts = 0;
+  int relocations = 0;
+  for (const plan::Step& s : steps) {
+    EXPECT_NE(s.kind, v1::STEP_KIND_MOVE) << s.label;
+    prompts += s.kind == v1::STEP_KIND_PROMPT;
+    relocations += s.prompt == v1::PROMPT_KIND_RELOCATE_LAMP_AND_DETECTOR;
+  }
+  EXPECT_EQ(prompts, 16);
+  EXPECT_EQ(relocations, 14);
+  EXPECT_EQ(SampleReadings(*store_, id), 14);
+  auto readings = store_->GetReadings(id, 0, 100000);
+  ASSERT_TRUE(readings.ok());
+  for (const storage::ReadingRecord& r : *readings) {
+    const plan::Step& step = steps[static_cast<std::size_t>(r.step_index)];
+    ASSERT_TRUE(step.target.has_value()) << step.label;
+    EXPECT_EQ(r.directions, *step.target) << step.label;
+  }
+  // Each round as stored is already in prompt order from where lamp and detector stood.
+  const plan::RigDescription rig = SimRigDescription();
+  for (const storage::RoundRecord& round : rounds) {
+    const Pose from =
+        ToModelAngles(steps[static_cast<std::size_t>(round.first_step - 1)].pose, rig.convention);
+    const std::vector<Pose> picks = EncodedPoses(round);
+    EXPECT_EQ(adaptive::OrderForPrompts(from, picks), picks) << "round " << round.round;
+  }
 }
 
 // --- kill -9 --------------------------------------------------------------------------------
