@@ -59,6 +59,22 @@ std::string AdaptivePlan(const std::string& budget) {
 const std::string kReadingBudgetPlan =
     AdaptivePlan(R"({"maxReadings": )" + std::to_string(kMaxReadings) + "}");
 
+// The sample-fixed form: a seed of 2 retro-reflection and 4 space-filling poses (8 prompts with
+// the first reference), rounds of 4, at most 16 prompts.
+const std::string kSampleFixedPlan = R"({
+  "name": "adaptive sample-fixed on the fake rig",
+  "adaptive": {
+    "target": {"expandedUncertainty": 0.001},
+    "budget": {"maxPrompts": 16},
+    "seed": {"retroReadings": 2},
+    "sampleFixed": {"seedReadings": 4},
+    "roundReadings": 4
+  },
+  "reference": {"perDetectorPosition": false},
+  "measurement": {"integrationMs": 100, "averages": 1},
+  "retry": {"maxAttempts": 2, "backoffMs": 0}
+})";
+
 daemon::UncertaintyModelFactory KernelFactory() {
   return [](const adaptive::AdaptiveSpec&) -> std::unique_ptr<adaptive::UncertaintyModel> {
     return std::make_unique<adaptive::testing::KernelModel>(
@@ -169,6 +185,13 @@ class AdaptiveSessionTest : public ::testing::Test {
     return WaitForSession(*manager_, id, Ended, 60s);
   }
 
+  // Runs `json` in a child killed right after the seed's last reading, before the first round is
+  // stored; a new manager on its database resumes it, and the rounds it stores are those of the
+  // same plan run uninterrupted (`rounds_wanted` of them), pose for pose, with `readings` sample
+  // readings. Defined with the kill -9 helpers below.
+  void ExpectTheSameRoundsAfterAKillAtTheSeedsEnd(const std::string& json,
+                                                  std::size_t rounds_wanted, int readings);
+
   TempDir dir_{"brdf-engine-adaptive"};
   FakeRig fake_;
   std::shared_ptr<storage::SessionStore> store_;
@@ -277,19 +300,7 @@ TEST_F(AdaptiveSessionTest, WithoutAnUncertaintyModelAdaptivePlansAreRefused) {
 // stored in prompt order, and the prompt budget what ends the session: the seed's 6 poses and its
 // reference are 8 prompts, then two rounds of 4 reach the 16.
 TEST_F(AdaptiveSessionTest, SampleFixedFormStopsAtThePromptBudgetWithAPromptPerPose) {
-  const std::string json = R"({
-  "name": "adaptive sample-fixed on the fake rig",
-  "adaptive": {
-    "target": {"expandedUncertainty": 0.001},
-    "budget": {"maxPrompts": 16},
-    "seed": {"retroReadings": 2},
-    "sampleFixed": {"seedReadings": 4},
-    "roundReadings": 4
-  },
-  "reference": {"perDetectorPosition": false},
-  "measurement": {"integrationMs": 100, "averages": 1},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
+  const std::string& json = kSampleFixedPlan;
   Open("brdfd.db", AdaptiveOptions());
   SessionId id = 0;
   const v1::Session done = RunToEnd(json, id);
@@ -392,21 +403,22 @@ v1::Session RecoverAndFinish(daemon::SessionManager& manager, FakeRig& fake, Ses
   return done;
 }
 
-TEST_F(AdaptiveSessionTest, KilledAfterTheSeedChoosesTheSameRoundOnRestart) {
+void AdaptiveSessionTest::ExpectTheSameRoundsAfterAKillAtTheSeedsEnd(const std::string& json,
+                                                                     std::size_t rounds_wanted,
+                                                                     int readings) {
   const std::string db = dir_.file("killed.db").string();
-  const int seed_steps = SeedSteps(kReadingBudgetPlan);
-  // Killed right after the seed's last reading, before the first round is stored.
-  const SessionId id = RunChildUntilKilled(
-      db, kReadingBudgetPlan, [=](const auto& r) { return r.step_index == seed_steps - 1; });
+  const int seed_steps = SeedSteps(json);
+  const SessionId id =
+      RunChildUntilKilled(db, json, [=](const auto& r) { return r.step_index == seed_steps - 1; });
   ASSERT_GT(id, 0);
 
   // The same plan uninterrupted, on a database of its own: the rounds to expect.
   Open("uninterrupted.db", AdaptiveOptions());
   SessionId reference_id = 0;
-  ASSERT_EQ(RunToEnd(kReadingBudgetPlan, reference_id).state(), v1::SESSION_STATE_COMPLETED);
+  ASSERT_EQ(RunToEnd(json, reference_id).state(), v1::SESSION_STATE_COMPLETED);
   const std::vector<storage::RoundRecord> expected = Rounds(*store_, reference_id);
   Close();
-  ASSERT_EQ(expected.size(), 3u);
+  ASSERT_EQ(expected.size(), rounds_wanted);
 
   auto opened = storage::SessionStore::Open(db);
   ASSERT_TRUE(opened.ok()) << opened.status().ToString();
@@ -432,8 +444,17 @@ TEST_F(AdaptiveSessionTest, KilledAfterTheSeedChoosesTheSameRoundOnRestart) {
     EXPECT_EQ(rounds[i].first_step, expected[i].first_step);
     EXPECT_EQ(rounds[i].step_count, expected[i].step_count);
   }
-  EXPECT_EQ(SampleReadings(*store, id), kMaxReadings);
+  EXPECT_EQ(SampleReadings(*store, id), readings);
   ExpectWholeAndDone(*store, id);
+}
+
+TEST_F(AdaptiveSessionTest, KilledAfterTheSeedChoosesTheSameRoundOnRestart) {
+  ExpectTheSameRoundsAfterAKillAtTheSeedsEnd(kReadingBudgetPlan, 3, kMaxReadings);
+}
+
+// The sample-fixed form: the same rounds in the same prompt order.
+TEST_F(AdaptiveSessionTest, SampleFixedFormKilledAfterTheSeedChoosesTheSameRoundsOnRestart) {
+  ExpectTheSameRoundsAfterAKillAtTheSeedsEnd(kSampleFixedPlan, 2, 14);
 }
 
 TEST_F(AdaptiveSessionTest, KilledMidRoundContinuesTheStoredRoundWithoutRepeats) {
