@@ -30,19 +30,39 @@ auto IsoKey(const Pose& p) {
   return std::make_tuple(d.theta_i, d.theta_o, d.phi);
 }
 
-// Nearest neighbour from `from`; ties to the smaller (θi, θo, φ).
-std::vector<Pose> NearestNeighbour(const Pose& from, std::span<const Pose> poses) {
-  std::vector<Pose> left(poses.begin(), poses.end());
-  std::vector<Pose> out;
-  Pose at = from;
+// The travels between `from` (index 0) and the poses (1 … n), computed once.
+class Travels {
+ public:
+  Travels(const Pose& from, std::span<const Pose> poses) : n_(poses.size() + 1), d_(n_ * n_) {
+    std::vector<Pose> all = {from};
+    all.insert(all.end(), poses.begin(), poses.end());
+    for (std::size_t i = 0; i < n_; ++i) {
+      for (std::size_t j = i + 1; j < n_; ++j) {
+        d_[i * n_ + j] = d_[j * n_ + i] = SettingTravel(all[i], all[j]);
+      }
+    }
+  }
+  double operator()(std::size_t a, std::size_t b) const { return d_[a * n_ + b]; }
+
+ private:
+  std::size_t n_;
+  std::vector<double> d_;
+};
+
+// Nearest neighbour from index 0 over indexes 1 … n; ties to the smaller (θi, θo, φ).
+std::vector<std::size_t> NearestNeighbour(const Travels& travel, std::span<const Pose> poses) {
+  std::vector<std::size_t> left;
+  for (std::size_t i = 1; i <= poses.size(); ++i) left.push_back(i);
+  std::vector<std::size_t> out;
+  std::size_t at = 0;
   while (!left.empty()) {
     std::size_t best = 0;
-    double best_d = SettingTravel(at, left[0]);
-    for (std::size_t i = 1; i < left.size(); ++i) {
-      const double d = SettingTravel(at, left[i]);
-      if (d < best_d || (d == best_d && IsoKey(left[i]) < IsoKey(left[best]))) {
-        best = i;
-        best_d = d;
+    for (std::size_t k = 1; k < left.size(); ++k) {
+      const double d = travel(at, left[k]);
+      const double best_d = travel(at, left[best]);
+      if (d < best_d ||
+          (d == best_d && IsoKey(poses[left[k] - 1]) < IsoKey(poses[left[best] - 1]))) {
+        best = k;
       }
     }
     at = left[best];
@@ -52,18 +72,18 @@ std::vector<Pose> NearestNeighbour(const Pose& from, std::span<const Pose> poses
   return out;
 }
 
-// 2-opt on the open path from `from`: reverses order[i..j] while that shortens the travel.
-void TwoOpt(const Pose& from, std::vector<Pose>& order) {
+// 2-opt on the open path from index 0: reverses order[i..j] while that shortens the travel.
+void TwoOpt(const Travels& travel, std::vector<std::size_t>& order) {
   const std::size_t n = order.size();
-  auto before = [&](std::size_t i) -> const Pose& { return i == 0 ? from : order[i - 1]; };
+  auto before = [&](std::size_t i) { return i == 0 ? std::size_t{0} : order[i - 1]; };
   for (int pass = 0; pass < kMaxOrderPasses; ++pass) {
     bool improved = false;
     for (std::size_t i = 0; i + 1 < n; ++i) {
       for (std::size_t j = i + 1; j < n; ++j) {
-        const double now = SettingTravel(before(i), order[i]) +
-                           (j + 1 < n ? SettingTravel(order[j], order[j + 1]) : 0);
-        const double then = SettingTravel(before(i), order[j]) +
-                            (j + 1 < n ? SettingTravel(order[i], order[j + 1]) : 0);
+        const double tail_now = j + 1 < n ? travel(order[j], order[j + 1]) : 0;
+        const double tail_then = j + 1 < n ? travel(order[i], order[j + 1]) : 0;
+        const double now = travel(before(i), order[i]) + tail_now;
+        const double then = travel(before(i), order[j]) + tail_then;
         if (then < now - 1e-9) {
           std::reverse(order.begin() + static_cast<std::ptrdiff_t>(i),
                        order.begin() + static_cast<std::ptrdiff_t>(j) + 1);
@@ -95,9 +115,12 @@ double PromptTravel(const Pose& from, std::span<const Pose> poses) {
 }
 
 std::vector<Pose> OrderForPrompts(const Pose& from, std::span<const Pose> poses) {
-  std::vector<Pose> order = NearestNeighbour(from, poses);
-  TwoOpt(from, order);
-  if (PromptTravel(from, order) < PromptTravel(from, poses)) return order;
+  const Travels travel(from, poses);
+  std::vector<std::size_t> order = NearestNeighbour(travel, poses);
+  TwoOpt(travel, order);
+  std::vector<Pose> out;
+  for (std::size_t i : order) out.push_back(poses[i - 1]);
+  if (PromptTravel(from, out) < PromptTravel(from, poses)) return out;
   return {poses.begin(), poses.end()};
 }
 
