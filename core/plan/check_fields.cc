@@ -393,7 +393,7 @@ class FieldChecker {
   // each pose's directions, so the rig's detector positions and dial do not apply.
   bool AdaptiveSampleFixed(const std::string& base, const v1::Adaptive& a, bool anisotropic) {
     const std::string why =
-        " does not apply to the sample-fixed form (sampleFixed: lamp and detector are placed by "
+        " do not apply to the sample-fixed form (sampleFixed: lamp and detector are placed by "
         "hand at each pose's directions); ";
     bool ok = true;
     if (a.has_delta()) {
