@@ -203,6 +203,21 @@ grpc::Status ControlService::GetRigStatus(grpc::ServerContext* /*context*/,
   return grpc::Status::OK;
 }
 
+grpc::Status ControlService::ListAdaptiveRounds(grpc::ServerContext* /*context*/,
+                                                const v1::ListAdaptiveRoundsRequest* request,
+                                                v1::ListAdaptiveRoundsResponse* response) {
+  if (rig_ == nullptr) return NoRig("ListAdaptiveRounds", request->session_id());
+  SessionId id = 0;
+  if (grpc::Status st = ParseSessionIdField(request->session_id(), "session_id", &id); !st.ok()) {
+    return st;
+  }
+  Result<std::vector<v1::AdaptiveRound>> rounds = rig_->AdaptiveRounds(id);
+  if (!rounds.ok()) return ToGrpcStatus(rounds.status());
+  response->mutable_rounds()->Reserve(static_cast<int>(rounds->size()));
+  for (v1::AdaptiveRound& r : *rounds) *response->add_rounds() = std::move(r);
+  return grpc::Status::OK;
+}
+
 grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
                                           const v1::WatchSessionRequest* request,
                                           grpc::ServerWriter<v1::SessionEvent>* writer) {

@@ -58,6 +58,10 @@ class ControlService final : public ControlServiceBase {
   // (then UNAVAILABLE, after the events already queued were sent).
   grpc::Status WatchSession(grpc::ServerContext* context, const v1::WatchSessionRequest* request,
                             grpc::ServerWriter<v1::SessionEvent>* writer) override;
+  // An adaptive session's stored rounds (the rig's store; brdf-archive has none).
+  grpc::Status ListAdaptiveRounds(grpc::ServerContext* context,
+                                  const v1::ListAdaptiveRoundsRequest* request,
+                                  v1::ListAdaptiveRoundsResponse* response) override;
 
   // The catalogue's (control_read.cc).
   grpc::Status GetSession(grpc::ServerContext* context, const v1::GetSessionRequest* request,

@@ -1,7 +1,8 @@
 // RigPort: the rig behind a server, when it has one (brdfd; brdf-archive has none). The Control
 // service's rig verbs (SubmitPlan, ValidatePlan, Start/Pause/Resume/Abort, AnswerPrompt),
-// GetRigStatus and WatchSession go through it; without one they answer FAILED_PRECONDITION naming
-// the session's rig (api/control.cc). brdfd plugs in its session manager (rig/port.h).
+// GetRigStatus, WatchSession and ListAdaptiveRounds go through it; without one they answer
+// FAILED_PRECONDITION naming the session's rig (api/control.cc). brdfd plugs in its session manager
+// (rig/port.h).
 //
 // Every verb returns the session as the API shows it after the call, or a Status whose code maps
 // onto a gRPC code (api/common.h: ToGrpcStatus); each is audited by the rig with `actor`.
@@ -11,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "brdf/v1/brdf.pb.h"
 #include "core/plan/analyze_plan.h"
@@ -56,6 +58,11 @@ class RigPort {
 
   // A watch of one session (kNotFound when there is no such session).
   virtual Result<std::unique_ptr<SessionWatch>> Watch(SessionId session) = 0;
+
+  // An adaptive session's stored rounds, oldest first, with what each was predicted to gain and
+  // cost (ListAdaptiveRounds); empty for a session of another kind. kNotFound when there is no
+  // such session.
+  virtual Result<std::vector<v1::AdaptiveRound>> AdaptiveRounds(SessionId session) = 0;
 };
 
 }  // namespace brdf::daemon

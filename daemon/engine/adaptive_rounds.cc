@@ -1,5 +1,6 @@
 #include "daemon/engine/adaptive_rounds.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <span>
 #include <string>
@@ -47,6 +48,12 @@ double RelativeUncertainty(const storage::ReadingRecord& r, const SampleQuantiti
     return kFallbackRelativeUncertainty;
   }
   return *u / *v;
+}
+
+// What `after` spent beyond `before`.
+adaptive::Spend Difference(const adaptive::Spend& after, const adaptive::Spend& before) {
+  return {after.readings - before.readings, after.seconds - before.seconds,
+          after.prompts - before.prompts};
 }
 
 storage::RoundRecord MakeRecord(std::int64_t session, int number, int first_step,
@@ -132,12 +139,35 @@ Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t sessi
                  static_cast<int>(readings.size()));
   record.step_count = static_cast<int>(added.size());
   BRDF_RETURN_IF_ERROR(store.AppendRound(record, added));
+  std::vector<plan::Step> after = steps;
+  for (const storage::StepRecord& r : added) after.push_back(ToPlanStep(r));
+  decision.round_cost = Difference(adaptive::SpendOfSteps(after, plan, rig), decision.spent);
   decision.round = std::move(record);
   decision.rounds += 1;
   return decision;
 }
 
-v1::AdaptiveRound ToProtoRound(const storage::RoundRecord& round) {
+Result<std::vector<v1::AdaptiveRound>> StoredRounds(storage::SessionStore& store,
+                                                    std::int64_t session, const v1::Plan& plan,
+                                                    const plan::RigDescription& rig) {
+  BRDF_ASSIGN_OR_RETURN(std::vector<storage::RoundRecord> rounds, store.GetRounds(session));
+  std::vector<v1::AdaptiveRound> out;
+  if (rounds.empty()) return out;
+  BRDF_ASSIGN_OR_RETURN(std::vector<storage::StepRecord> stored, store.GetSteps(session));
+  const std::vector<plan::Step> steps = ToPlanSteps(stored);
+  const std::span<const plan::Step> all(steps);
+  for (const storage::RoundRecord& r : rounds) {
+    const std::size_t first = std::min(static_cast<std::size_t>(r.first_step), all.size());
+    const std::size_t end = std::min(first + static_cast<std::size_t>(r.step_count), all.size());
+    RoundSpend spend;
+    spend.before = adaptive::SpendOfSteps(all.first(first), plan, rig);
+    spend.cost = Difference(adaptive::SpendOfSteps(all.first(end), plan, rig), spend.before);
+    out.push_back(ToProtoRound(r, spend));
+  }
+  return out;
+}
+
+v1::AdaptiveRound ToProtoRound(const storage::RoundRecord& round, const RoundSpend& spend) {
   v1::AdaptiveRound out;
   out.set_round(static_cast<std::uint32_t>(round.round));
   for (const storage::RoundPick& p : round.picks) {
@@ -149,6 +179,10 @@ v1::AdaptiveRound ToProtoRound(const storage::RoundRecord& round) {
   out.set_readings_used(static_cast<std::uint32_t>(round.readings_used));
   out.set_first_step(static_cast<std::uint32_t>(round.first_step));
   out.set_step_count(static_cast<std::uint32_t>(round.step_count));
+  out.set_spent_rig_s(spend.before.seconds);
+  out.set_spent_prompts(static_cast<std::uint32_t>(spend.before.prompts));
+  out.set_rig_s(spend.cost.seconds);
+  out.set_prompts(static_cast<std::uint32_t>(spend.cost.prompts));
   return out;
 }
 

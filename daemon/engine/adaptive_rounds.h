@@ -60,8 +60,16 @@ struct RoundDecision {
   std::optional<storage::RoundRecord> round;                    // stored with its steps: run them
   adaptive::StopReason stop = adaptive::StopReason::kContinue;  // no round: why it stops
   double uncertainty_left = 0;
-  adaptive::Spend spent;  // before the round (the seed included)
-  int rounds = 0;         // rounds stored, this one included
+  adaptive::Spend spent;       // before the round (the seed included)
+  adaptive::Spend round_cost;  // the stored round's own steps (zero when none is stored)
+  int rounds = 0;              // rounds stored, this one included
+};
+
+// What a round meant for the budget: the session's spend when it was chosen and its own steps'
+// cost, both by the timing model for real devices.
+struct RoundSpend {
+  adaptive::Spend before;
+  adaptive::Spend cost;
 };
 
 // Chooses the next round of adaptive session `session` (every stored step done) and stores it
@@ -77,8 +85,14 @@ Result<std::vector<adaptive::ReadingSoFar>> ReadingsSoFar(storage::SessionStore&
                                                           const v1::Plan& plan,
                                                           const plan::RigDescription& rig);
 
+// The session's stored rounds as ListAdaptiveRounds gives them, oldest first, each with its
+// RoundSpend from the stored steps (empty for a session without rounds).
+Result<std::vector<v1::AdaptiveRound>> StoredRounds(storage::SessionStore& store,
+                                                    std::int64_t session, const v1::Plan& plan,
+                                                    const plan::RigDescription& rig);
+
 // The events WatchSession carries (brdf.v1.AdaptiveRound, AdaptiveStop).
-v1::AdaptiveRound ToProtoRound(const storage::RoundRecord& round);
+v1::AdaptiveRound ToProtoRound(const storage::RoundRecord& round, const RoundSpend& spend);
 v1::AdaptiveStop ToProtoStop(const RoundDecision& decision);
 // The reason a stopped session completes with: "adaptive: target reached; uncertainty left
 // 0.0412 (target 0.05); 3 rounds, 212 readings, 31.5 min of rig time, 40 prompts".

@@ -127,7 +127,8 @@ struct SessionManager::Impl final : public ExecutorHost {
     LastStepOutcome out;
     v1::SessionEvent event;
     if (decision.round.has_value()) {
-      *event.mutable_adaptive_round() = ToProtoRound(*decision.round);
+      *event.mutable_adaptive_round() =
+          ToProtoRound(*decision.round, {decision.spent, decision.round_cost});
       out.more_steps = true;
       spdlog::info(
           "{}: round {} stored: {} poses, {} steps, predicted gain {:.4g}, uncertainty "

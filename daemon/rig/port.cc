@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "daemon/engine/adaptive_rounds.h"
+
 namespace brdf::daemon {
 namespace {
 
@@ -62,6 +64,12 @@ v1::RigStatus ManagerRigPort::GetRigStatus() const {
 Result<std::unique_ptr<SessionWatch>> ManagerRigPort::Watch(SessionId session) {
   BRDF_ASSIGN_OR_RETURN(std::shared_ptr<EventSubscription> subscribed, manager_.Subscribe(session));
   return std::unique_ptr<SessionWatch>(std::make_unique<EventWatch>(std::move(subscribed)));
+}
+
+Result<std::vector<v1::AdaptiveRound>> ManagerRigPort::AdaptiveRounds(SessionId session) {
+  BRDF_ASSIGN_OR_RETURN(std::shared_ptr<const SessionPlan> kept, manager_.Plan(session));
+  if (!kept->plan.has_adaptive()) return std::vector<v1::AdaptiveRound>{};
+  return StoredRounds(*manager_.store(), session, kept->plan, manager_.options().rig_description);
 }
 
 }  // namespace brdf::daemon

@@ -26,6 +26,7 @@ class ManagerRigPort final : public RigPort {
                                    const Actor& actor) override;
   v1::RigStatus GetRigStatus() const override;
   Result<std::unique_ptr<SessionWatch>> Watch(SessionId session) override;
+  Result<std::vector<v1::AdaptiveRound>> AdaptiveRounds(SessionId session) override;
 
  private:
   SessionManager& manager_;

@@ -1,8 +1,8 @@
 // Who is calling: bearer tokens from the configuration ([[auth.tokens]]) mapped to a role
 // (operator, analyst) and the token's name. A call carries the metadata
 // "authorization: Bearer <token>". Mutating Control calls need an operator; read-only calls
-// (ValidatePlan, GetSession, ListSessions, ListSessionEvents, GetRigStatus, WatchSession, Data.*,
-// Interpolation.*) accept either role (brdf.proto's header). The health service and reflection
+// (ValidatePlan, GetSession, ListSessions, ListSessionEvents, ListAdaptiveRounds, GetRigStatus,
+// WatchSession, Data.*, Interpolation.*) accept either role (brdf.proto's header). The health service and reflection
 // need no token.
 //
 // Tokens are secrets: they are never logged and never stored (the audit log gets the token's

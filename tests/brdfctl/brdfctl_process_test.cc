@@ -245,6 +245,12 @@ void BrdfctlProcessTest::CheckSubmitAndWatch() {
               (text_lines.front()[20] == '+' || text_lines.front()[20] == '-'))
       << "a local time first: " << text_lines.front();
 
+  // A fixed plan has no rounds: `rounds` says so and exits 2 (web/test/adaptive.mjs runs it on an
+  // adaptive session).
+  const CommandResult rounds = Ctl({"rounds", w.id}, kCtlAnalystToken);
+  EXPECT_EQ(rounds.exit_code, 2) << Describe(rounds);
+  EXPECT_NE(rounds.err.find("is not adaptive"), std::string::npos) << Describe(rounds);
+
   // Watching a finished session: the snapshot, then the stream ends; plain lines off a terminal.
   const CommandResult again = Ctl({"watch", w.id}, kCtlAnalystToken);
   EXPECT_EQ(again.exit_code, 0) << Describe(again);
@@ -462,6 +468,9 @@ TEST_F(BrdfctlProcessTest, VerbsOnAnUnknownSessionExitOneWithNotFound) {
   EXPECT_EQ(events.exit_code, 1) << Describe(events);
   EXPECT_NE(events.err.find("NOT_FOUND"), std::string::npos) << Describe(events);
   EXPECT_NE(events.err.find("ListSessionEvents"), std::string::npos) << Describe(events);
+  const CommandResult rounds = Ctl({"rounds", "999999"});
+  EXPECT_EQ(rounds.exit_code, 1) << Describe(rounds);
+  EXPECT_NE(rounds.err.find("NOT_FOUND"), std::string::npos) << Describe(rounds);
 }
 
 TEST_F(BrdfctlProcessTest, UnreachableDaemonExitsOneWithAHint) {

@@ -7,11 +7,14 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "daemon/config/config.h"
 #include "tests/support/test_env.h"
 #include "tools/brdfctl/commands/sim_mount.h"
 #include "tools/brdfctl/exit_codes.h"
+#include "tools/brdfctl/output/rounds_text.h"
 #include "tools/brdfctl/output/session_text.h"
 #include "tools/brdfctl/output/text_format.h"
 #include "tools/brdfctl/output/uncertainty_text.h"
@@ -91,18 +94,68 @@ TEST(TextFormat, PosesPrintToTheStagesResolutionNotTheFloatingPointNoise) {
   EXPECT_EQ(StageAngle(45), "45");
 }
 
-TEST(SessionText, AnAdaptiveRoundAndTheStopOnALineEach) {
+// The display columns of UTF-8 text (α, δ, →, – and ° are one column each).
+std::size_t Columns(const std::string& text) {
+  return static_cast<std::size_t>(
+      std::count_if(text.begin(), text.end(), [](char c) { return (c & 0xC0) != 0x80; }));
+}
+
+v1::Adaptive PaperGoal() {
+  v1::Adaptive a;
+  a.mutable_target()->set_expanded_uncertainty(0.05);
+  a.mutable_budget()->set_max_readings(464);
+  a.mutable_budget()->set_max_rig_minutes(38);
+  a.mutable_budget()->set_max_prompts(60);
+  return a;
+}
+
+v1::AdaptiveRound RoundOf(int number, double left, std::vector<double> deltas) {
   v1::AdaptiveRound round;
-  round.set_round(2);
-  for (double delta : {11.25, 0.0, 22.5}) round.add_poses()->set_delta(delta);
+  round.set_round(number);
+  for (double delta : deltas) {
+    v1::Pose* p = round.add_poses();
+    p->set_alpha(12.5);
+    p->set_beta(-32.5);
+    p->set_delta(delta);
+  }
   round.set_predicted_gain(0.01234);
-  round.set_uncertainty_left(0.07123);
+  round.set_uncertainty_left(left);
   round.set_readings_used(188);
   round.set_first_step(422);
   round.set_step_count(96);
-  EXPECT_EQ(AdaptiveRoundText(round),
-            "round 2: 3 poses (δ 0°–22.5°), predicted gain 0.0123, uncertainty left 0.0712, "
-            "chosen from 188 readings; steps 422–517");
+  round.set_spent_rig_s(1034);
+  round.set_spent_prompts(31);
+  round.set_rig_s(242);
+  round.set_prompts(6);
+  return round;
+}
+
+TEST(RoundsText, ARoundAgainstTheTargetAndBudgetsAndWhatItMeasuresNext) {
+  const v1::AdaptiveRound round = RoundOf(2, 0.07123, {45, 45, 146.25, 11.25});
+  const std::vector<std::string> lines = AdaptiveRoundLines(round, PaperGoal());
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_EQ(lines[0], "round 2 (from 188 of 464 readings): uncertainty left 0.0712, target 0.05");
+  EXPECT_EQ(lines[1], "  spent " + Duration(1034) + " of " + Duration(38 * 60) +
+                          " rig time, 31 of 60 prompts; predicted gain 0.0123");
+  EXPECT_EQ(lines[2],
+            "  next: 4 poses, steps 422–517, +" + Duration(242) + " rig time, +6 prompts");
+  EXPECT_EQ(lines[3], "  δ 45° → 146.25° → 11.25°");
+  // As many poses as fit in 80 columns: two of these.
+  EXPECT_EQ(lines[4], "  first poses: α 12.5° β -32.5° γ 0° δ 45°; α 12.5° β -32.5° γ 0° δ 45°");
+  for (const std::string& line : lines) EXPECT_LE(Columns(line), 80u) << line;
+
+  // A budget left unset is not named; an expected-error target says so.
+  v1::Adaptive readings_only;
+  readings_only.mutable_target()->set_expected_error(0.1);
+  readings_only.mutable_budget()->set_max_readings(300);
+  const std::vector<std::string> plain = AdaptiveRoundLines(round, readings_only);
+  EXPECT_EQ(plain[1], "  spent " + Duration(1034) + " rig time, 31 prompts; predicted gain 0.0123");
+  EXPECT_EQ(AdaptiveGoalText(readings_only), "target expected error ≤ 0.1; budget 300 readings");
+  EXPECT_EQ(AdaptiveGoalText(PaperGoal()), "target U (k = 2) ≤ 0.05; budget 464 readings, " +
+                                               Duration(38 * 60) + " rig time, 60 prompts");
+}
+
+TEST(RoundsText, TheStopAgainstTheBudgetsWithinEightyColumns) {
   v1::AdaptiveStop stop;
   stop.set_reason("reading budget spent");
   stop.set_uncertainty_left(0.04123);
@@ -110,10 +163,77 @@ TEST(SessionText, AnAdaptiveRoundAndTheStopOnALineEach) {
   stop.set_readings(212);
   stop.set_rig_s(1890);
   stop.set_prompts(40);
-  EXPECT_EQ(AdaptiveStopText(stop),
-            "adaptive stop: reading budget spent; uncertainty left 0.0412 after 3 round(s), 212 "
-            "readings, " +
-                Duration(1890) + " of rig time, 40 prompts");
+  const std::vector<std::string> lines = AdaptiveStopLines(stop, PaperGoal());
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0], "adaptive stop: reading budget spent; uncertainty left 0.0412 (target 0.05)");
+  EXPECT_EQ(lines[1], "  after 3 round(s): 212 of 464 readings, " + Duration(1890) + " of " +
+                          Duration(38 * 60) + " rig time,");
+  EXPECT_EQ(lines[2], "  40 of 60 prompts");
+  for (const std::string& line : lines) EXPECT_LE(Columns(line), 80u) << line;
+  // Without budgets of rig time and prompts it fits on two.
+  v1::Adaptive readings_only = PaperGoal();
+  readings_only.mutable_budget()->clear_max_rig_minutes();
+  readings_only.mutable_budget()->clear_max_prompts();
+  const std::vector<std::string> two = AdaptiveStopLines(stop, readings_only);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[1],
+            "  after 3 round(s): 212 of 464 readings, " + Duration(1890) + " rig time, 40 prompts");
+}
+
+TEST(RoundsText, LongTextWrapsAtSpacesWithinEightyColumns) {
+  const std::string reason =
+      "stopped: adaptive: reading budget spent; uncertainty left 0.0412 (target 0.001); 3 "
+      "round(s), 33 readings, 1.3 min of rig time, 6 prompts";
+  const std::vector<std::string> lines = WrapText(reason);
+  ASSERT_EQ(lines.size(), 2u);
+  std::string joined;
+  for (const std::string& line : lines) {
+    EXPECT_LE(Columns(line), 80u) << line;
+    joined += joined.empty() ? line : " " + line.substr(2);
+  }
+  EXPECT_EQ(joined, reason);
+  EXPECT_EQ(lines[1].rfind("  3 round(s)", 0), 0u) << lines[1];
+  EXPECT_EQ(WrapText("short"), std::vector<std::string>{"short"});
+}
+
+TEST(RoundsText, TheTableHasARowAndABarPerRoundWithinEightyColumns) {
+  std::vector<v1::AdaptiveRound> rounds;
+  const double left[] = {0.739, 0.461, 0.277, 0.027};
+  for (int i = 0; i < 4; ++i) rounds.push_back(RoundOf(i + 1, left[i], {11.25, 146.25}));
+  std::ostringstream out;
+  PrintRoundsTable(out, rounds, PaperGoal());
+  std::vector<std::string> lines;
+  std::istringstream in(out.str());
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  int rows = 0;
+  int bars = 0;
+  for (const std::string& line : lines) {
+    EXPECT_LE(Columns(line), 80u) << line;
+    if (line.find("11.25°–146.25°") != std::string::npos) ++rows;
+    if (line.find('#') != std::string::npos) ++bars;
+  }
+  EXPECT_EQ(rows, 4);
+  EXPECT_EQ(bars, 4);
+  EXPECT_NE(out.str().find("    1       188  0.739"), std::string::npos) << out.str();
+  // The bars fall with the uncertainty; the target's mark is where 0.05 is on the scale (50
+  // columns for the highest, 0.739); the last round is below it.
+  const auto bar_of = [&](const std::string& value) {
+    for (const std::string& line : lines) {
+      if (line.find(" " + value + " ") != std::string::npos &&
+          line.find('|') != std::string::npos) {
+        return line;
+      }
+    }
+    return std::string();
+  };
+  const std::string first = bar_of("0.739");
+  const std::string last = bar_of("0.027");
+  EXPECT_EQ(std::count(first.begin(), first.end(), '#'), 49);  // 50 columns, the target's '|'
+  EXPECT_EQ(std::count(last.begin(), last.end(), '#'), 2);
+  EXPECT_EQ(last.find('|') - last.find('#'), 3u) << last;  // mark at column 3 (0.05 / 0.01478)
+  EXPECT_NE(out.str().find("round 4 (from 188 of 464 readings)"), std::string::npos);
+  EXPECT_EQ(RoundsSoFarText(rounds),
+            "4 round(s) so far; uncertainty left 0.739 → 0.461 → 0.277 → 0.027");
 }
 
 TEST(ProgressLine, ShowsCountsPercentEtaPoseAndQuality) {

@@ -162,6 +162,14 @@ class LiveSession(unittest.TestCase):
         self.assertCode(grpc.StatusCode.INVALID_ARGUMENT, self.client.list_session_events,
                         "not-a-session")
 
+    def test_adaptive_rounds_of_a_fixed_plan(self):
+        """list_adaptive_rounds: none for a session of a fixed plan (an analyst may ask); an
+        unknown id is refused naming the call."""
+        with BrdfClient(self.rig.address, self.rig.analyst_token) as analyst:
+            self.assertEqual(analyst.list_adaptive_rounds(self.session.session_id), [])
+        e = self.assertCode(grpc.StatusCode.NOT_FOUND, self.client.list_adaptive_rounds, "987654")
+        self.assertEqual(e.method, "Control.ListAdaptiveRounds")
+
     # --- readings --------------------------------------------------------------------------------
 
     def test_readings_arrays(self):

@@ -249,6 +249,27 @@ class Conversions(unittest.TestCase):
         self.assertTrue(np.isnan(batch.at(550)[1]))
 
 
+
+class AdaptiveEventText(unittest.TestCase):
+    def test_a_round_says_its_spend_and_cost(self):
+        from brdf_client.events import Event
+        event = brdf_pb2.SessionEvent(session_id="7", sequence=3)
+        r = event.adaptive_round
+        r.round = 2
+        r.poses.add(alpha=10, beta=-35, delta=45)
+        r.predicted_gain = 0.104
+        r.uncertainty_left = 0.461
+        r.readings_used = 200
+        r.spent_rig_s = 1034
+        r.spent_prompts = 31
+        r.rig_s = 242
+        r.prompts = 2
+        text = Event.from_proto(event).describe()
+        self.assertEqual(text, "round 2: 1 poses, predicted gain 0.104, uncertainty left 0.461, "
+                               "chosen from 200 readings; spent 17.2 min of rig time and 31 "
+                               "prompts, the round 4.0 min and 2 prompts more")
+
+
 class Errors(unittest.TestCase):
     def test_rpc_error_becomes_brdf_error(self):
         class Failed(grpc.RpcError):

@@ -6,6 +6,7 @@
 #include "tools/brdfctl/commands/export.h"
 #include "tools/brdfctl/commands/interpolate.h"
 #include "tools/brdfctl/commands/readings.h"
+#include "tools/brdfctl/commands/rounds.h"
 #include "tools/brdfctl/commands/sim_mount.h"
 #include "tools/brdfctl/commands/watch.h"
 
@@ -17,6 +18,7 @@ CommandRegistry BrdfctlCommands() {
   RegisterOperatorCommands(registry);  // start, pause, resume, abort, answer
   RegisterViewCommands(registry);      // get, events, list, rig
   RegisterWatchCommand(registry);
+  RegisterRoundsCommand(registry);
   RegisterReadingsCommand(registry);
   RegisterInterpolateCommand(registry);
   RegisterAppearanceCommand(registry);

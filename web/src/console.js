@@ -1,6 +1,7 @@
 // The operator console: the queue and history, submitting a plan (validated first: problems at
 // their field paths, the estimated time), the operator verbs, live progress with ETA and the
-// coverage of the hemisphere (WatchSession), prompts, the rig and the session's events.
+// coverage of the hemisphere (WatchSession), prompts, the rig and the session's events; an adaptive
+// session's rounds, uncertainty left against the target and next poses (rounds.js).
 // Analysts see the same pages without any control (and the server refuses control anyway).
 // Served by brdf-archive, it is the archive's read-only console: every rig's sessions (with the
 // rig's name), their history, progress and coverage, refreshed as the rigs ship; no plan, no rig,
@@ -8,6 +9,7 @@
 import { plotly } from './plotly.js';
 import { call, stream } from './api.js';
 import { el, clear, stateName, duration } from './dom.js';
+import { createRoundsView } from './rounds.js';
 
 const ACTIVE = ['SESSION_STATE_QUEUED', 'SESSION_STATE_RUNNING', 'SESSION_STATE_PAUSING', 'SESSION_STATE_PAUSED', 'SESSION_STATE_AWAITING_OPERATOR'];
 
@@ -33,6 +35,7 @@ export function createConsole(root, role, report, server = 'brdfd') {
   const eventList = el('ol', { id: 'events' });
   const integrationNotes = el('ul', { id: 'integration-notes' });
   const history = el('div', { id: 'history' });
+  const rounds = createRoundsView(); // an adaptive session's rounds (rounds.js)
   let plan = null;
 
   const rigSide = archive
@@ -49,7 +52,7 @@ export function createConsole(root, role, report, server = 'brdfd') {
         el('table', { id: 'sessions' }, el('thead', {}, el('tr', {}, el('th', {}, 'name'), archive ? el('th', {}, 'rig') : null, el('th', {}, 'state'), el('th', {}, 'progress'), el('th', {}, 'created'))), sessionsBody),
         ...rigSide),
       el('div', { class: 'col wide' },
-        el('h2', {}, 'Session'), detail,
+        el('h2', {}, 'Session'), detail, rounds.element,
         el('h3', {}, 'Hemisphere coverage (measured outgoing directions)'), coverage,
         el('h3', {}, 'Readings whose integration time the meter changed'), integrationNotes,
         el('h3', {}, 'History (the states the session went through, as the rig recorded them)'), history,
@@ -232,6 +235,7 @@ export function createConsole(root, role, report, server = 'brdfd') {
     lastReadingId = 0;
     clear(eventList);
     clear(history);
+    rounds.show(null);
     refreshHistory(id);
     for (const tr of sessionsBody.children) tr.classList.toggle('selected', tr.dataset.id === id);
     updateCoverage(id);
@@ -241,7 +245,11 @@ export function createConsole(root, role, report, server = 'brdfd') {
     let session = null;
     stream('Control/WatchSession', { session_id: id }, async (ev) => {
       addEvent(ev);
-      if (ev.snapshot) session = ev.snapshot;
+      rounds.event(ev);
+      if (ev.snapshot) {
+        session = ev.snapshot;
+        rounds.show(session).catch((e) => { if (selected === id) report(e.message); });
+      }
       else if (session) {
         if (ev.step_completed) {
           session.progress = ev.step_completed.progress;

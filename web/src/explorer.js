@@ -5,12 +5,14 @@
 // downloads of every export (Data.Export: readings CSV, grids at a chosen step, MERL, RGL).
 // Uncertainties (docs/uncertainty.md) are drawn expanded, ± k·u with k chosen (1 or 2): a
 // reading's stored budget as error bars on its BRDF, bands around Figure 8's spectrum (the
-// measurement part and the combined one with the interpolation term) and the polar curve.
+// measurement part and the combined one with the interpolation term) and the polar curve; the
+// uncertainty map colours the outgoing hemisphere at one θi by k·u / BRDF (uncertainty_map.js).
 import { plotly } from './plotly.js';
 import { call, stream } from './api.js';
 import { el, clear, stateName } from './dom.js';
 import { createPoints3d } from './points3d.js';
 import { createAppearance } from './appearance.js';
+import { createUncertaintyMap } from './uncertainty_map.js';
 
 const PLOT = { displaylogo: false, responsive: true };
 const POINT_COLUMNS = ['ids', 'alpha', 'beta', 'delta', 'theta_i', 'theta_o', 'phi', 'flagged'];
@@ -100,6 +102,7 @@ export function createExplorer(root, report) {
   const coverage = el('select', { id: 'coverage-k' }, [2, 1].map((k) => el('option', { value: k }, COVERAGE[k])));
   const readingNotes = el('div', { id: 'reading-notes' });
   const bandSummary = el('p', { id: 'interp-bands', class: 'muted' });
+  const uncertaintyMap = createUncertaintyMap(report);
 
   let Plotly = null; // once loaded (plotly.js)
   let points = null; // columns of ReadingPoints over the whole session
@@ -120,6 +123,7 @@ export function createExplorer(root, report) {
       el('label', {}, 'method ', method), el('label', {}, 'coordinates ', coordinates), el('label', {}, 'trend ', trend), el('label', {}, 'quantity ', quantity),
       el('button', { id: 'interpolate', type: 'submit' }, 'Interpolate')),
     interpInfo, bandSummary, interp,
+    uncertaintyMap.element,
     el('h2', {}, 'Plane of incidence'),
     el('div', { class: 'buttons' }, el('label', {}, 'wavelength ', slider), sliderLabel),
     polar,
@@ -173,6 +177,7 @@ export function createExplorer(root, report) {
     if (!id) return;
     session = id;
     polarData = null;
+    uncertaintyMap.clear();
     const t0 = performance.now();
     const chunks = [];
     const thetaI = Number(ti.value);
@@ -211,6 +216,7 @@ export function createExplorer(root, report) {
     }
     // After the first view: the server renders it with the same work permits as the plots.
     await appearance.load(id, points.ids.length);
+    if (session === id) await uncertaintyMap.draw();
   }
 
   function joinColumns(chunks) {
@@ -378,7 +384,8 @@ export function createExplorer(root, report) {
     return [{ type: 'scatterpolar', mode: 'lines', theta: [...theta, ...[...theta].reverse()], r: [...upper, ...lower], fill: 'toself', fillcolor: 'rgba(31, 119, 180, 0.25)', line: { width: 0 }, hoverinfo: 'skip', name: `± ${k}·u, ${COVERAGE[k]}`, meta: { band: 'combined', k, points: r.length } }];
   }
   slider.addEventListener('input', drawPolar);
-  coverage.addEventListener('change', () => { drawReading(); drawInterpolation(); drawPolar(); });
+  coverage.addEventListener('change', () => { drawReading(); drawInterpolation(); drawPolar(); uncertaintyMap.redraw(Number(coverage.value)); });
+  uncertaintyMap.bind(() => ({ session, method: method.value, options: options(), points, k: Number(coverage.value) }));
 
   const EXPORTS = [
     ['EXPORT_FORMAT_READINGS_CSV', 'readings CSV'],

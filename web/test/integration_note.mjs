@@ -3,12 +3,10 @@
 // again, and the console's readings view lists that reading with the 50 ms it used and the
 // meter's note; the other readings are not listed. Headless Chromium (puppeteer-core) against a
 // real brdfd on brdf-sim, as an analyst.
-import puppeteer from 'puppeteer-core';
 import { join } from 'node:path';
-import { startRig, outputDir, check } from './rig.mjs';
+import { startRig, outputDir, check, launchBrowser, pageCollectingErrors } from './rig.mjs';
 
 const out = outputDir();
-const chromium = process.env.BRDF_CHROMIUM || '/usr/bin/chromium';
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 const rig = await startRig({ timeScale: 40, simArgs: ['--serial-quality-code', '19', '--serial-quality-count', '1'] });
@@ -42,15 +40,9 @@ try {
   }
   check(true, `session ${id} completed`);
 
-  browser = await puppeteer.launch({
-    executablePath: chromium, headless: true,
-    args: ['--no-sandbox', '--disable-dev-shm-usage', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--window-size=1400,1000'],
-    defaultViewport: { width: 1400, height: 1000 },
-  });
+  browser = await launchBrowser();
   const errors = [];
-  const page = await browser.newPage();
-  page.on('pageerror', (e) => errors.push(`page error: ${e.message}`));
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()}`); });
+  const page = await pageCollectingErrors(browser, errors);
   await page.goto(rig.url, { waitUntil: 'load' });
   await page.waitForSelector('#login-view:not([hidden])');
   await page.type('#token', rig.analystToken);

@@ -133,6 +133,25 @@ ${tokensWebAndLog(operatorToken, analystToken)}`, { mode: 0o600 });
   };
 }
 
+// Debian's Chromium ($BRDF_CHROMIUM), headless, driven by puppeteer-core, at 1400 × 1000.
+export async function launchBrowser() {
+  const { default: puppeteer } = await import('puppeteer-core');
+  return puppeteer.launch({
+    executablePath: process.env.BRDF_CHROMIUM || '/usr/bin/chromium',
+    headless: true,
+    args: ['--no-sandbox', '--disable-dev-shm-usage', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--window-size=1400,1000'],
+    defaultViewport: { width: 1400, height: 1000 },
+  });
+}
+
+// A new page of `browser` whose uncaught errors and console errors go to `errors`.
+export async function pageCollectingErrors(browser, errors) {
+  const page = await browser.newPage();
+  page.on('pageerror', (e) => errors.push(`page error: ${e.message}`));
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()}`); });
+  return page;
+}
+
 export function outputDir() {
   const d = process.env.BRDF_TEST_OUTPUT_DIR || join(process.cwd(), 'web-test-output');
   if (!existsSync(d)) mkdirSync(d, { recursive: true });

@@ -273,6 +273,16 @@ class BrdfClient:
                             "Control.ListSessionEvents")
         return list(reply.events)
 
+    def list_adaptive_rounds(self, session_id: str) -> List[Message]:
+        """An adaptive session's rounds as stored on the rig, oldest first: AdaptiveRound messages
+        (poses and their predicted gains, the uncertainty left before the round, the readings it
+        was chosen from, its steps, the rig time and prompts spent before it and its own cost);
+        empty for a session of another kind (docs/adaptive.md, "Every choice explained")."""
+        reply = self._unary(self._control.ListAdaptiveRounds,
+                            brdf_pb2.ListAdaptiveRoundsRequest(session_id=session_id),
+                            "Control.ListAdaptiveRounds")
+        return list(reply.rounds)
+
     def list_sessions(self, states: Union[str, int, Iterable[Union[str, int]], None] = None,
                       page_size: int = 0, limit: Optional[int] = None, *,
                       rig: Optional[str] = None, sample: Optional[str] = None,

@@ -66,7 +66,9 @@ class Event:
         if self.kind == "adaptive_round":
             return (f"round {d.round}: {len(d.poses)} poses, predicted gain {d.predicted_gain:.3g}, "
                     f"uncertainty left {d.uncertainty_left:.3g}, chosen from {d.readings_used} "
-                    f"readings")
+                    f"readings; spent {d.spent_rig_s / 60:.1f} min of rig time and "
+                    f"{d.spent_prompts} prompts, the round {d.rig_s / 60:.1f} min and "
+                    f"{d.prompts} prompts more")
         if self.kind == "adaptive_stop":
             return (f"adaptive stop: {d.reason}; uncertainty left {d.uncertainty_left:.3g} after "
                     f"{d.rounds} round(s), {d.readings} readings")

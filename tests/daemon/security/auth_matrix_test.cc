@@ -42,6 +42,7 @@ const std::map<std::string, Needs>& Classification() {
       {"brdf.v1.Control.GetSession", Needs::kRead},
       {"brdf.v1.Control.ListSessions", Needs::kRead},
       {"brdf.v1.Control.ListSessionEvents", Needs::kRead},
+      {"brdf.v1.Control.ListAdaptiveRounds", Needs::kRead},
       {"brdf.v1.Control.GetRigStatus", Needs::kRead},
       {"brdf.v1.Control.WatchSession", Needs::kRead},
       {"brdf.v1.Control.WhoAmI", Needs::kRead},

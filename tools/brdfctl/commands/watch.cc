@@ -19,6 +19,7 @@
 
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/output/json.h"
+#include "tools/brdfctl/output/rounds_text.h"
 #include "tools/brdfctl/output/session_text.h"
 #include "tools/brdfctl/output/text_format.h"
 #include "tools/brdfctl/rpc_error.h"
@@ -104,6 +105,7 @@ class Watcher {
         Note("watching session " + s.session_id() + " \"" + s.name() + "\": " + view_.state +
              (s.state_reason().empty() ? "" : " (" + s.state_reason() + ")") + ", " +
              ProgressText(s.progress()));
+        if (s.plan().has_adaptive()) OnAdaptive(s);
         if (s.has_pending_prompt()) return OnPrompt(s.pending_prompt());
         if (s.state() == v1::SESSION_STATE_PAUSED) {
           const int paused = OnPaused(s.state_reason());
@@ -142,16 +144,43 @@ class Watcher {
         Note(FaultText(event.fault()));
         break;
       case v1::SessionEvent::kAdaptiveRound:
-        Note(AdaptiveRoundText(event.adaptive_round()));
+        for (const std::string& line : AdaptiveRoundLines(event.adaptive_round(), adaptive_)) {
+          Note(line);
+        }
         break;
       case v1::SessionEvent::kAdaptiveStop:
-        Note(AdaptiveStopText(event.adaptive_stop()));
+        for (const std::string& line : AdaptiveStopLines(event.adaptive_stop(), adaptive_)) {
+          Note(line);
+        }
         break;
       default:
         break;
     }
     DrawBar();
     return kExitOk;
+  }
+
+  // An adaptive session watched: its target and budgets, and the rounds stored before the watch
+  // began (the uncertainty left falling, then the round being measured). Best effort: a daemon
+  // that cannot list them leaves the rounds to the events.
+  void OnAdaptive(const v1::Session& s) {
+    adaptive_ = s.plan().adaptive();
+    if (ctx_.json) return;
+    Note(AdaptiveGoalText(adaptive_));
+    v1::ListAdaptiveRoundsRequest request;
+    request.set_session_id(s.session_id());
+    v1::ListAdaptiveRoundsResponse reply;
+    if (!ctx_.client.control()
+             .ListAdaptiveRounds(ctx_.client.UnaryContext().get(), request, &reply)
+             .ok() ||
+        reply.rounds().empty()) {
+      return;
+    }
+    const std::vector<v1::AdaptiveRound> rounds(reply.rounds().begin(), reply.rounds().end());
+    Note(RoundsSoFarText(rounds));
+    for (const std::string& line : AdaptiveRoundLines(rounds.back(), adaptive_)) {
+      Note(line);
+    }
   }
 
   void OnStep(const v1::StepCompletion& step) {
@@ -366,6 +395,7 @@ class Watcher {
   std::string integration_note_;  // of the reading of the step being shown
   v1::SessionState state_ = v1::SESSION_STATE_UNSPECIFIED;
   std::string end_reason_;
+  v1::Adaptive adaptive_;  // an adaptive session's plan (its target and budgets)
   std::set<int> answered_;
   std::set<int> declined_;
   std::optional<int> open_prompt_;      // the prompt shown and not answered by us

@@ -83,34 +83,6 @@ std::string FaultText(const v1::Fault& f) {
   return out;
 }
 
-std::string AdaptiveRoundText(const v1::AdaptiveRound& r) {
-  char text[320];
-  double lo = 0, hi = 0;
-  for (int i = 0; i < r.poses_size(); ++i) {
-    const double d = r.poses(i).delta();
-    lo = i == 0 ? d : std::min(lo, d);
-    hi = i == 0 ? d : std::max(hi, d);
-  }
-  const std::string deltas =
-      lo == hi ? "δ " + Num(lo) + "°" : "δ " + Num(lo) + "°–" + Num(hi) + "°";
-  std::snprintf(text, sizeof text,
-                "round %u: %d poses (%s), predicted gain %.3g, uncertainty left %.3g, chosen "
-                "from %u readings; steps %u–%u",
-                r.round(), r.poses_size(), deltas.c_str(), r.predicted_gain(), r.uncertainty_left(),
-                r.readings_used(), r.first_step(), r.first_step() + r.step_count() - 1);
-  return text;
-}
-
-std::string AdaptiveStopText(const v1::AdaptiveStop& s) {
-  char text[320];
-  std::snprintf(text, sizeof text,
-                "adaptive stop: %s; uncertainty left %.3g after %u round(s), %u readings, %s of "
-                "rig time, %u prompts",
-                s.reason().c_str(), s.uncertainty_left(), s.rounds(), s.readings(),
-                Duration(s.rig_s()).c_str(), s.prompts());
-  return text;
-}
-
 void PrintSessionDetail(std::ostream& out, const v1::Session& s) {
   out << "session " << s.session_id() << "  \"" << s.name() << "\"\n";
   out << "  state        " << StateName(s.state()) << "\n";

@@ -30,13 +30,6 @@ void PrintPrompt(std::ostream& out, const v1::Prompt& prompt);
 // "fault at step 12 (attempt 3): timeout: <reason> — will retry" (or "— session paused").
 std::string FaultText(const v1::Fault& fault);
 
-// An adaptive session's round and stop (docs/adaptive.md), one line each:
-// "round 2: 24 poses (δ 11.25°–33.75°), predicted gain 0.0123, uncertainty left 0.0712, chosen
-// from 188 readings; steps 422–517" and "adaptive stop: reading budget spent; uncertainty left
-// 0.0412 after 3 rounds, 212 readings, 31:30 of rig time, 40 prompts".
-std::string AdaptiveRoundText(const v1::AdaptiveRound& round);
-std::string AdaptiveStopText(const v1::AdaptiveStop& stop);
-
 // "120 steps: 90 sample, 12 reference, 6 dark readings; 12 operator actions; rig time about 5:00
 // (at least 3:10); plus the operator's 12 prompts, not counted (about 30 s each by hand)".
 // The estimate is split in two: the rig's time (readings, moves and the daemon's own waits, as
