@@ -51,7 +51,11 @@ AdaptiveSpec ResolveAdaptive(const v1::Adaptive& adaptive) {
   spec.budget.max_prompts = static_cast<int>(adaptive.budget().max_prompts());
   spec.region = ResolveRegion(adaptive.region());
   spec.judge = adaptive.method() == v1::ADAPTIVE_JUDGE_DELAUNAY ? Judge::kDelaunay : Judge::kOctant;
-  spec.delta_deg = ResolveDeltas(adaptive.delta());
+  spec.sample_fixed = adaptive.has_sample_fixed();
+  if (adaptive.sample_fixed().seed_readings() != 0) {
+    spec.fixed_seed_readings = static_cast<int>(adaptive.sample_fixed().seed_readings());
+  }
+  if (!spec.sample_fixed) spec.delta_deg = ResolveDeltas(adaptive.delta());
   if (adaptive.gamma_size() > 0)
     spec.gamma_deg.assign(adaptive.gamma().begin(), adaptive.gamma().end());
   if (adaptive.seed().has_retro_readings()) {

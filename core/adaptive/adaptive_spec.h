@@ -22,6 +22,11 @@ inline constexpr int kMaxSeedSettings = 400;
 inline constexpr int kMaxSeedReadings = 20000;
 // Spacing of the candidate poses a round chooses from (candidates.h), degrees.
 inline constexpr double kCandidateStepDeg = 5;
+// The sample-fixed form's seed size (brdf.v1.AdaptiveSampleFixed.seed_readings) and its
+// candidate direction pairs' spacing in the relative azimuth φ, degrees (θi and θo:
+// kCandidateStepDeg; sample_fixed_design.h).
+inline constexpr int kDefaultFixedSeedReadings = 12;
+inline constexpr double kFixedCandidatePhiStepDeg = 10;
 
 // Where readings may go: both polar angles within their limits (degrees).
 struct Region {
@@ -62,11 +67,16 @@ enum class StopReason {
 };
 
 struct AdaptiveSpec {
+  // The sample-fixed method's form (plan.proto: AdaptiveSampleFixed): lamp and detector placed by
+  // hand at each pose's directions, a prompt per pose; delta_deg is then empty and gamma_deg {0}.
+  bool sample_fixed = false;
+  int fixed_seed_readings = kDefaultFixedSeedReadings;  // sample-fixed: space-filling seed poses
   Target target;
   Budget budget;
   Region region;
   Judge judge = Judge::kOctant;
   std::vector<double> delta_deg;        // the detector positions the design may use, ascending
+                                        // (empty for the sample-fixed form)
   std::vector<double> gamma_deg = {0};  // dial positions
   int retro_readings = kDefaultRetroReadings;
   int readings_per_delta = kDefaultReadingsPerDelta;

@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "core/adaptive/adaptive_spec.h"
+#include "core/adaptive/sample_fixed_design.h"
 #include "core/plan/angle_text.h"
 
 namespace brdf::adaptive {
@@ -31,6 +32,17 @@ std::string AdaptiveBoundsText(const v1::Adaptive& adaptive) {
   }
   text += " in all (seed included)";
   if (limits.size() < 3) text += "; what the budget leaves unset is bounded only by the rest";
+  return text;
+}
+
+std::string AdaptiveBoundsText(const v1::Plan& plan) {
+  std::string text = AdaptiveBoundsText(plan.adaptive());
+  if (!plan.adaptive().has_sample_fixed()) return text;
+  // Prompts do not depend on the rig's devices (the default rig's timing is not used here).
+  const int prompts = FixedPoseCost(plan, plan::RigDescription{}).prompts;
+  text += "; sample-fixed: each pose is " + std::to_string(prompts) +
+          (prompts == 1 ? " prompt (lamp and detector set by hand)"
+                        : " prompts (lamp and detector set by hand, then a reference's mounting)");
   return text;
 }
 

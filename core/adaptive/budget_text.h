@@ -15,4 +15,9 @@ namespace brdf::adaptive {
 // (seed included)".
 std::string AdaptiveBoundsText(const v1::Adaptive& adaptive);
 
+// The same for a whole plan; in the sample-fixed form (Adaptive.sample_fixed) followed by what
+// every pose costs in prompts under the plan's policies: "; sample-fixed: each pose is 3 prompts
+// (lamp and detector set by hand, then a reference's white and sample mounting)".
+std::string AdaptiveBoundsText(const v1::Plan& plan);
+
 }  // namespace brdf::adaptive

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/adaptive/adaptive_spec.h"
+#include "core/adaptive/sample_fixed_design.h"
 #include "core/adaptive/seed_design.h"
 #include "core/plan/angle_text.h"
 
@@ -15,15 +16,24 @@ using plan::Num;
 void CheckSeedDesign(const v1::Adaptive& adaptive, const plan::RigDescription& rig,
                      plan::ProblemSink& sink) {
   const AdaptiveSpec spec = ResolveAdaptive(adaptive);
-  const std::vector<SeedGroup> groups = MakeSeedDesign(spec, rig);
+  const std::vector<SeedGroup> groups =
+      spec.sample_fixed ? std::vector<SeedGroup>{FixedSeedDesign(spec)} : MakeSeedDesign(spec, rig);
   std::vector<std::string> empty;
   std::size_t readings = 0;
   for (const SeedGroup& g : groups) {
     readings += g.poses.size();
-    if (g.wanted > 0 && g.poses.size() == static_cast<std::size_t>(g.retro_poses)) {
+    if (g.wanted > 0 && g.poses.size() == static_cast<std::size_t>(g.retro_poses) &&
+        !spec.sample_fixed) {
       empty.push_back("δ = " + Deg(g.delta_deg) +
                       (spec.gamma_deg.size() > 1 ? " (γ = " + Deg(g.gamma_deg) + ")" : ""));
     }
+  }
+  if (spec.sample_fixed &&
+      groups.front().poses.size() == static_cast<std::size_t>(groups.front().retro_poses)) {
+    sink.Add("adaptive.region",
+             "no direction pair in whole degrees lies within this region for the sample-fixed "
+             "seed; widen the region's θ limits");
+    return;
   }
   if (readings == 0) {
     sink.Add("adaptive.region",

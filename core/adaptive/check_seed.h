@@ -12,7 +12,8 @@ namespace brdf::adaptive {
 
 // Precondition: the adaptive fields passed CheckPlanFields' own checks. Adds a problem for each
 // (γ, δ) at which no pose within the rig's travel puts both directions in the region (path
-// "adaptive.delta", or "adaptive.region" when no δ reaches it), and one when the seed alone
+// "adaptive.delta", or "adaptive.region" when no δ reaches it; in the sample-fixed form,
+// "adaptive.region" when no whole-degree direction pair lies in it), and one when the seed alone
 // has more readings than budget.maxReadings.
 void CheckSeedDesign(const v1::Adaptive& adaptive, const plan::RigDescription& rig,
                      plan::ProblemSink& sink);

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "core/adaptive/sample_fixed_design.h"
 #include "core/adaptive/seed_design.h"
 #include "core/geometry.h"
 #include "core/plan/expand_steps.h"
@@ -60,9 +61,11 @@ RoundCost::RoundCost(const v1::Plan& plan, const plan::RigDescription& rig)
       measurement_(plan::ResolveSettings(plan).measurement) {
   rig_.time_scale = 1;
   delta_change_ = MeasureDeltaChange(plan, rig_);
+  if (plan::SampleFixedMethod(plan)) fixed_pose_ = FixedPoseCost(plan, rig_);
 }
 
 double RoundCost::MoveAndReadSeconds(const Pose& from, const Pose& to) const {
+  if (fixed_pose_.has_value()) return fixed_pose_->seconds;
   plan::StepTimer timer(rig_, measurement_);
   timer.Advance(StepAt(v1::STEP_KIND_MOVE, from, rig_));
   timer.Advance(StepAt(v1::STEP_KIND_SAMPLE, from, rig_));
@@ -73,6 +76,7 @@ double RoundCost::MoveAndReadSeconds(const Pose& from, const Pose& to) const {
 }
 
 PoseCost RoundCost::Step(const Pose& from, const Pose& to) const {
+  if (fixed_pose_.has_value()) return *fixed_pose_;
   PoseCost cost{MoveAndReadSeconds(from, to), 0};
   if (to.delta != from.delta) cost += delta_change_;
   if (to.gamma != from.gamma && !rig_.has_gamma_axis) cost += PoseCost{rig_.operator_action_s, 1};

@@ -6,10 +6,13 @@
 // its prompts and, with dark.withEachReference, the dark), measured once by expanding a two-pose
 // pose list with the plan's policies; a change of γ on a manual dial adds its prompt. The
 // reference rules by count or by minutes are not charged per pose (the round's steps, expanded
-// as a pose list, carry them exactly). It also says which poses the rig can take at all
-// (CanReach: the rig's travel and the adaptive plan's region), for candidates a round makes up.
+// as a pose list, carry them exactly). In a sample-fixed plan every pose is a prompt: each costs
+// the same, the relocation prompt and what follows it (FixedPoseCost), wherever it goes. It also
+// says which poses the rig can take at all (CanReach: the rig's travel and the adaptive plan's
+// region), for candidates a round makes up.
 #pragma once
 
+#include <optional>
 #include <span>
 
 #include "brdf/v1/plan.pb.h"
@@ -32,7 +35,8 @@ struct PoseCost {
 
 class RoundCost {
  public:
-  // `plan` gives the reference, dark and measurement policies (its method is not used); `rig`
+  // `plan` gives the reference, dark and measurement policies (of its method only whether it is
+  // sample-fixed, plan::SampleFixedMethod); `rig`
   // the timing and which axes are manual. Times are for real devices (time scale 1): budgets
   // are in a real rig's time.
   RoundCost(const v1::Plan& plan, const plan::RigDescription& rig);
@@ -55,6 +59,9 @@ class RoundCost {
   Region region_;
   plan::MeasurementChoice measurement_;
   PoseCost delta_change_;
+  // A sample-fixed plan (plan::SampleFixedMethod): every pose costs this, wherever it goes
+  // (sample_fixed_design.h: FixedPoseCost).
+  std::optional<PoseCost> fixed_pose_;
 };
 
 }  // namespace brdf::adaptive

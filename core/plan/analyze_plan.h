@@ -23,6 +23,9 @@
 //   adaptive: the seed design (core/adaptive/seed_design.h) expanded as the pose list it is; the
 //     rounds are chosen from the readings as the session goes (docs/adaptive.md), so they are not
 //     among these steps, and the summary is the seed's cost. The seed must fit the plan's budget.
+//     In the sample-fixed form (Adaptive.sample_fixed, core/adaptive/sample_fixed_design.h) each
+//     seed pose is expanded as a sample-fixed target is: prompt RELOCATE_LAMP_AND_DETECTOR (its
+//     text gives θi, θo and φ), SAMPLE; no moves, references where lamp and detector stand.
 #pragma once
 
 #include <vector>

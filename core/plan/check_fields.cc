@@ -332,11 +332,13 @@ class FieldChecker {
   }
 
   // An adaptive plan's fields (plan.proto: Adaptive); true when all are usable for the seed.
-  bool Adaptive(const v1::Adaptive& a) {
+  bool Adaptive(const v1::Adaptive& a, bool anisotropic) {
     const std::string base = "adaptive";
     bool ok = AdaptiveTarget(base + ".target", a);
     ok &= AdaptiveBudget(base + ".budget", a.budget());
     ok &= AdaptiveRegion(base + ".region", a.region());
+    ok &= AdaptiveSizes(base, a);
+    if (a.has_sample_fixed()) return AdaptiveSampleFixed(base, a, anisotropic) && ok;
     const GridSpec paper;
     const std::optional<double> n_delta =
         Sweep(base + ".delta", a.delta(), paper.delta_start_deg, paper.delta_stop_deg,
@@ -362,25 +364,74 @@ class FieldChecker {
                     "; give fewer per δ or fewer detector positions");
       ok = false;
     }
+    if (a.seed().readings_per_delta() > 500) {
+      sink_.Add(base + ".seed.readingsPerDelta",
+                std::to_string(a.seed().readings_per_delta()) + " is more than 500; give 1 … 500");
+      ok = false;
+    }
+    if (a.seed().delta_every() > 100) {
+      sink_.Add(base + ".seed.deltaEvery", std::to_string(a.seed().delta_every()) +
+                                               " is more than 100; give 1 … 100 (1: every δ)");
+      ok = false;
+    }
+    return ok;
+  }
+
+  // The sizes both forms share: the retro-reflection scan and the round.
+  bool AdaptiveSizes(const std::string& base, const v1::Adaptive& a) {
+    bool ok = true;
     const v1::AdaptiveSeed& seed = a.seed();
     if (seed.has_retro_readings() && seed.retro_readings() > 100) {
       sink_.Add(base + ".seed.retroReadings", std::to_string(seed.retro_readings()) +
                                                   " is more than 100; give 0 … 100 (0: no scan)");
       ok = false;
     }
-    if (seed.delta_every() > 100) {
-      sink_.Add(base + ".seed.deltaEvery", std::to_string(seed.delta_every()) +
-                                               " is more than 100; give 1 … 100 (1: every δ)");
-      ok = false;
-    }
-    if (seed.readings_per_delta() > 500) {
-      sink_.Add(base + ".seed.readingsPerDelta",
-                std::to_string(seed.readings_per_delta()) + " is more than 500; give 1 … 500");
-      ok = false;
-    }
     if (a.round_readings() > 1000) {
       sink_.Add(base + ".roundReadings",
                 std::to_string(a.round_readings()) + " is more than 1000; give 1 … 1000");
+      ok = false;
+    }
+    return ok;
+  }
+
+  // The sample-fixed form (plan.proto: AdaptiveSampleFixed): lamp and detector set by hand at
+  // each pose's directions, so the rig's detector positions and dial do not apply.
+  bool AdaptiveSampleFixed(const std::string& base, const v1::Adaptive& a, bool anisotropic) {
+    const std::string why =
+        " do not apply to the sample-fixed form (sampleFixed: lamp and detector are placed by "
+        "hand at each pose's directions); ";
+    bool ok = true;
+    if (a.has_delta()) {
+      sink_.Add(base + ".delta", "detector positions" + why + "leave delta out");
+      ok = false;
+    }
+    if (a.gamma_size() > 0) {
+      sink_.Add(base + ".gamma", "dial positions" + why +
+                                     "leave gamma out (the sample-fixed form is isotropic only)");
+      ok = false;
+    }
+    if (a.seed().readings_per_delta() != 0) {
+      sink_.Add(base + ".seed.readingsPerDelta",
+                "readings per detector position" + why +
+                    "give the seed's size as sampleFixed.seedReadings");
+      ok = false;
+    }
+    if (a.seed().delta_every() != 0) {
+      sink_.Add(base + ".seed.deltaEvery", "a seed's detector positions" + why + "leave it out");
+      ok = false;
+    }
+    if (anisotropic) {
+      sink_.Add(base + ".sampleFixed",
+                "the sample-fixed form is for isotropic samples only (it sets θi, θo and the "
+                "relative azimuth φ); set anisotropic to false, or use the sample-rotation "
+                "form with gamma");
+      ok = false;
+    }
+    const std::uint32_t seed = a.sample_fixed().seed_readings();
+    if (seed > 500) {
+      sink_.Add(base + ".sampleFixed.seedReadings",
+                std::to_string(seed) + " is more than 500; give 1 … 500 (0: the default, " +
+                    std::to_string(adaptive::kDefaultFixedSeedReadings) + ")");
       ok = false;
     }
     return ok;
@@ -552,7 +603,9 @@ void CheckPlanFields(const v1::Plan& plan, const RigDescription& rig, ProblemSin
       check.PoseList(plan.pose_list());
       break;
     case v1::Plan::kAdaptive:
-      if (check.Adaptive(plan.adaptive())) adaptive::CheckSeedDesign(plan.adaptive(), rig, sink);
+      if (check.Adaptive(plan.adaptive(), plan.anisotropic())) {
+        adaptive::CheckSeedDesign(plan.adaptive(), rig, sink);
+      }
       break;
     case v1::Plan::METHOD_NOT_SET:
       sink.Add("method",

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "core/adaptive/adaptive_spec.h"
+#include "core/adaptive/sample_fixed_design.h"
 #include "core/adaptive/seed_design.h"
 #include "core/geometry.h"
 #include "core/plan/angle_text.h"
@@ -42,7 +43,7 @@ class Builder {
         settings_(ResolveSettings(plan)),
         sink_(sink),
         timer_(rig, settings_.measurement),
-        sample_fixed_(plan.method_case() == v1::Plan::kSampleFixed) {}
+        sample_fixed_(SampleFixedMethod(plan)) {}
 
   // Continues after steps stored before (ExpandPosesFrom).
   void StartFrom(const ExpansionStart& start) {
@@ -321,10 +322,38 @@ void ExpandPoseList(const v1::PoseList& list, const RigDescription& rig, Builder
   }
 }
 
-// The seed design of an adaptive plan, as the pose list it is (seed_design.h); the rounds come
-// later, chosen from the readings.
+// Poses of an adaptive plan in the sample-fixed method's form (sample_fixed_design.h), each a
+// target: the RELOCATE_LAMP_AND_DETECTOR prompt giving its θi, θo and φ, then the reading, as
+// ExpandSampleFixed does. `labels[i]` names pose i ("seed", "round").
+void ExpandFixedPoses(std::span<const Pose> poses, const std::vector<std::string>& labels,
+                      Builder& b) {
+  for (std::size_t i = 0; i < poses.size() && !b.full(); ++i) {
+    const IsoDirection d = adaptive::FixedTarget(poses[i]);
+    const Directions target = CanonicalDirections(d);
+    const std::string what =
+        labels[i] + " pose " + std::to_string(i + 1) + " of " + std::to_string(poses.size());
+    b.RelocateLampAndDetector(poses[i], target, what, /*isotropic_form=*/true);
+    b.Sample(poses[i], target,
+             "sample " + labels[i] + " θi " + Deg(d.theta_i) + " θo " + Deg(d.theta_o) + " φ " +
+                 Deg(d.phi),
+             {});
+  }
+}
+
+void ExpandFixedSeed(const adaptive::AdaptiveSpec& spec, Builder& b) {
+  const adaptive::SeedGroup seed = adaptive::FixedSeedDesign(spec);
+  std::vector<std::string> labels;
+  for (std::size_t i = 0; i < seed.poses.size(); ++i) {
+    labels.push_back(static_cast<int>(i) < seed.retro_poses ? "seed retro-reflection" : "seed");
+  }
+  ExpandFixedPoses(seed.poses, labels, b);
+}
+
+// The seed design of an adaptive plan, as the pose list it is (seed_design.h), or as targets in
+// the sample-fixed form; the rounds come later, chosen from the readings.
 void ExpandAdaptiveSeed(const v1::Adaptive& adaptive, const RigDescription& rig, Builder& b) {
   const adaptive::AdaptiveSpec spec = adaptive::ResolveAdaptive(adaptive);
+  if (spec.sample_fixed) return ExpandFixedSeed(spec, b);
   v1::PoseList list;
   for (const adaptive::SeedGroup& group : adaptive::MakeSeedDesign(spec, rig)) {
     for (std::size_t i = 0; i < group.poses.size(); ++i) {
@@ -339,6 +368,18 @@ void ExpandAdaptiveSeed(const v1::Adaptive& adaptive, const RigDescription& rig,
     }
   }
   ExpandPoseList(list, rig, b);
+}
+
+v1::PoseList PoseListOf(std::span<const Pose> poses) {
+  v1::PoseList list;
+  for (const Pose& p : poses) {
+    v1::PoseEntry* e = list.add_poses();
+    e->set_alpha(p.alpha);
+    e->set_beta(p.beta);
+    e->set_gamma(p.gamma);
+    e->set_delta(p.delta);
+  }
+  return list;
 }
 
 }  // namespace
@@ -382,6 +423,7 @@ ExpansionStart StartAfter(std::span<const Step> steps, const v1::Plan& plan,
     } else if (step.kind == v1::STEP_KIND_SAMPLE) {
       ++start.samples_since_reference;
     } else if (step.prompt == v1::PROMPT_KIND_RELOCATE_DETECTOR ||
+               step.prompt == v1::PROMPT_KIND_RELOCATE_LAMP_AND_DETECTOR ||
                (step.kind == v1::STEP_KIND_MOVE && start.model.delta != delta_before)) {
       start.relocated_since_reference = true;
     }
@@ -393,18 +435,14 @@ ExpansionStart StartAfter(std::span<const Step> steps, const v1::Plan& plan,
 std::vector<Step> ExpandPosesFrom(const v1::Plan& plan, const RigDescription& rig,
                                   const ExpansionStart& start, std::span<const Pose> poses,
                                   int first_index) {
-  v1::PoseList list;
-  for (const Pose& p : poses) {
-    v1::PoseEntry* e = list.add_poses();
-    e->set_alpha(p.alpha);
-    e->set_beta(p.beta);
-    e->set_gamma(p.gamma);
-    e->set_delta(p.delta);
-  }
   ProblemSink ignored;  // the caller's poses are within travel (the candidates are)
   Builder b(plan, rig, ignored);
   b.StartFrom(start);
-  ExpandPoseList(list, rig, b, /*continued=*/true);
+  if (SampleFixedMethod(plan)) {
+    ExpandFixedPoses(poses, std::vector<std::string>(poses.size(), "round"), b);
+  } else {
+    ExpandPoseList(PoseListOf(poses), rig, b, /*continued=*/true);
+  }
   std::vector<Step> steps = b.Take();
   for (Step& s : steps) s.index += first_index;
   return steps;

@@ -73,4 +73,8 @@ Directions TargetDirections(const v1::DirectionTarget& target) {
   return Directions{target.theta_i(), 0, target.theta_o(), target.phi()};
 }
 
+bool SampleFixedMethod(const v1::Plan& plan) {
+  return plan.has_sample_fixed() || (plan.has_adaptive() && plan.adaptive().has_sample_fixed());
+}
+
 }  // namespace brdf::plan

@@ -67,6 +67,10 @@ Pose ReferencePose(const ReferenceSettings& reference, double gamma_deg, double 
 // multiplier^(next_attempt − 2), capped at max_backoff_ms. 0 for next_attempt ≤ 1.
 std::uint32_t BackoffBeforeAttemptMs(const RetrySettings& retry, std::uint32_t next_attempt);
 
+// True when lamp and detector are placed by hand at each target and the holder stays still: a
+// sample-fixed plan, or an adaptive plan in the sample-fixed method's form (Adaptive.sample_fixed).
+bool SampleFixedMethod(const v1::Plan& plan);
+
 // A sample-fixed target as four angles: the isotropic form becomes (θi, 0, θo, φ); unset
 // fields count as 0 (ValidatePlan reports them as missing).
 Directions TargetDirections(const v1::DirectionTarget& target);

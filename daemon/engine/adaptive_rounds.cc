@@ -8,10 +8,11 @@
 
 #include "core/adaptive/candidates.h"
 #include "core/adaptive/round_cost.h"
+#include "core/adaptive/round_steps.h"
+#include "core/adaptive/sample_fixed_design.h"
 #include "core/geometry.h"
 #include "core/plan/expand_steps.h"
 #include "core/plan/plan_settings.h"
-#include "core/plan/plan_summary.h"
 #include "core/plan/sample.h"
 #include "core/readings/derive.h"
 #include "daemon/wire/plan.h"
@@ -47,16 +48,6 @@ double RelativeUncertainty(const storage::ReadingRecord& r, const SampleQuantiti
     return kFallbackRelativeUncertainty;
   }
   return *u / *v;
-}
-
-// What the session has used: its stored steps, by the timing model for real devices.
-adaptive::Spend SpendOf(std::span<const plan::Step> steps, const v1::Plan& plan,
-                        const plan::RigDescription& rig) {
-  plan::RigDescription real = rig;
-  real.time_scale = 1;
-  const plan::PlanSummary s =
-      plan::SummarizeSteps(steps, real, plan::ResolveSettings(plan).measurement);
-  return {s.sample_readings, s.estimated_duration_s, s.operator_interventions};
 }
 
 // What `after` spent beyond `before`.
@@ -119,7 +110,7 @@ Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t sessi
 
   RoundDecision decision;
   decision.rounds = static_cast<int>(rounds.size());
-  decision.spent = SpendOf(steps, plan, rig);
+  decision.spent = adaptive::SpendOfSteps(steps, plan, rig);
   // One map for the stop rule and the chooser: building it is the round's main cost.
   const std::unique_ptr<adaptive::UncertaintyMap> map = model.Map(readings);
   decision.uncertainty_left = map->Remaining();
@@ -128,21 +119,23 @@ Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t sessi
   if (decision.stop != adaptive::StopReason::kContinue) return decision;
 
   const plan::ExpansionStart start = plan::StartAfter(steps, plan, rig);
-  const std::vector<Pose> candidates = adaptive::CandidatePoses(spec, rig);
+  const std::vector<Pose> candidates =
+      spec.sample_fixed ? adaptive::FixedCandidates(spec) : adaptive::CandidatePoses(spec, rig);
   const adaptive::RoundInput input{readings, candidates, start.model, decision.spent, spec.budget};
   const adaptive::RoundCost cost(plan, rig);
-  const adaptive::Round round =
-      adaptive::ChooseRound(input, *map, cost, {.max_readings = spec.round_readings});
+  // A sample-fixed pose is set by hand in whole degrees: no finer candidates between them.
+  adaptive::RoundOptions options{.max_readings = spec.round_readings};
+  if (spec.sample_fixed) options.refine.levels = 0;
+  adaptive::Round round = adaptive::ChooseRound(input, *map, cost, options);
+  // In measurement order (a sample-fixed round in prompt order), within the budget step by step.
+  const std::vector<plan::Step> round_steps =
+      adaptive::RoundSteps(plan, rig, steps, start, spec.budget, round);
   decision.stop = adaptive::AfterChoosing(round);
   if (decision.stop != adaptive::StopReason::kContinue) return decision;
 
-  std::vector<Pose> poses;
-  for (const adaptive::ChosenPose& c : round.poses) poses.push_back(c.pose);
   const int first = static_cast<int>(stored.size());
   std::vector<storage::StepRecord> added;
-  for (const plan::Step& s : plan::ExpandPosesFrom(plan, rig, start, poses, first)) {
-    added.push_back(ToStepRecord(s));
-  }
+  for (const plan::Step& s : round_steps) added.push_back(ToStepRecord(s));
   storage::RoundRecord record =
       MakeRecord(session, decision.rounds + 1, first, round, decision.uncertainty_left,
                  static_cast<int>(readings.size()));
@@ -150,7 +143,7 @@ Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t sessi
   BRDF_RETURN_IF_ERROR(store.AppendRound(record, added));
   std::vector<plan::Step> after = steps;
   for (const storage::StepRecord& r : added) after.push_back(ToPlanStep(r));
-  decision.round_cost = Difference(SpendOf(after, plan, rig), decision.spent);
+  decision.round_cost = Difference(adaptive::SpendOfSteps(after, plan, rig), decision.spent);
   decision.round = std::move(record);
   decision.rounds += 1;
   return decision;
@@ -169,8 +162,8 @@ Result<std::vector<v1::AdaptiveRound>> StoredRounds(storage::SessionStore& store
     const std::size_t first = std::min(static_cast<std::size_t>(r.first_step), all.size());
     const std::size_t end = std::min(first + static_cast<std::size_t>(r.step_count), all.size());
     RoundSpend spend;
-    spend.before = SpendOf(all.first(first), plan, rig);
-    spend.cost = Difference(SpendOf(all.first(end), plan, rig), spend.before);
+    spend.before = adaptive::SpendOfSteps(all.first(first), plan, rig);
+    spend.cost = Difference(adaptive::SpendOfSteps(all.first(end), plan, rig), spend.before);
     out.push_back(ToProtoRound(r, spend));
   }
   return out;

@@ -18,6 +18,11 @@
 //   - the rig's state: where the last stored step left it, and the spend so far by the plan's
 //     timing model for real devices (time scale 1): sample readings, rig seconds (prompts at the
 //     operator's time), prompts.
+//   - the candidates: adaptive::CandidatePoses, or in the sample-fixed form FixedCandidates
+//     (core/adaptive/sample_fixed_design.h).
+// The chosen round becomes steps by adaptive::RoundSteps (core/adaptive/round_steps.h): a
+// sample-fixed round in prompt order, and poses cut from the end while the steps would pass the
+// budget.
 #pragma once
 
 #include <cstdint>

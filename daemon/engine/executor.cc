@@ -6,6 +6,7 @@
 #include <chrono>
 #include <utility>
 
+#include "core/plan/plan_settings.h"
 #include "core/plan/sample.h"
 #include "core/plan/timing.h"
 #include "daemon/engine/reading_step.h"
@@ -34,7 +35,7 @@ struct Executor::Context {
   storage::SessionRecord session;
   std::vector<storage::StepRecord> steps;
   plan::PlanSettings settings;
-  bool sample_fixed = false;
+  bool sample_fixed = false;       // lamp and detector set by hand (plan::SampleFixedMethod)
   std::vector<double> estimate_s;  // per step, by the timing model
   double remaining_s = 0;          // estimate of the pending steps
   std::vector<int> move_before;    // index of the last move step before each step, or -1
@@ -175,7 +176,7 @@ bool Executor::Load(Context& c, const std::string& where) {
     return false;
   }
   c.settings = (*plan)->settings;
-  c.sample_fixed = c.session.plan_kind == "sample_fixed";
+  c.sample_fixed = plan::SampleFixedMethod((*plan)->plan);
   if (options_.uncertainty.has_value()) {
     c.budgeter.emplace(*options_.uncertainty, session_,
                        c.session.white_reflectance.value_or(kWhiteStandardReflectance),

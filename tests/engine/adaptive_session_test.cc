@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/adaptive/prompt_order.h"
 #include "core/geometry.h"
 #include "core/plan/analyze_plan.h"
 #include "core/plan/plan_json.h"
@@ -57,6 +58,22 @@ std::string AdaptivePlan(const std::string& budget) {
 
 const std::string kReadingBudgetPlan =
     AdaptivePlan(R"({"maxReadings": )" + std::to_string(kMaxReadings) + "}");
+
+// The sample-fixed form: a seed of 2 retro-reflection and 4 space-filling poses (8 prompts with
+// the first reference), rounds of 4, at most 16 prompts.
+const std::string kSampleFixedPlan = R"({
+  "name": "adaptive sample-fixed on the fake rig",
+  "adaptive": {
+    "target": {"expandedUncertainty": 0.001},
+    "budget": {"maxPrompts": 16},
+    "seed": {"retroReadings": 2},
+    "sampleFixed": {"seedReadings": 4},
+    "roundReadings": 4
+  },
+  "reference": {"perDetectorPosition": false},
+  "measurement": {"integrationMs": 100, "averages": 1},
+  "retry": {"maxAttempts": 2, "backoffMs": 0}
+})";
 
 daemon::UncertaintyModelFactory KernelFactory() {
   return [](const adaptive::AdaptiveSpec&) -> std::unique_ptr<adaptive::UncertaintyModel> {
@@ -168,6 +185,13 @@ class AdaptiveSessionTest : public ::testing::Test {
     return WaitForSession(*manager_, id, Ended, 60s);
   }
 
+  // Runs `json` in a child killed right after the seed's last reading, before the first round is
+  // stored; a new manager on its database resumes it, and the rounds it stores are those of the
+  // same plan run uninterrupted (`rounds_wanted` of them), pose for pose, with `readings` sample
+  // readings. Defined with the kill -9 helpers below.
+  void ExpectTheSameRoundsAfterAKillAtTheSeedsEnd(const std::string& json,
+                                                  std::size_t rounds_wanted, int readings);
+
   TempDir dir_{"brdf-engine-adaptive"};
   FakeRig fake_;
   std::shared_ptr<storage::SessionStore> store_;
@@ -271,6 +295,54 @@ TEST_F(AdaptiveSessionTest, WithoutAnUncertaintyModelAdaptivePlansAreRefused) {
       << refused.status().message();
 }
 
+// The sample-fixed form (docs/adaptive.md): every pose a RELOCATE_LAMP_AND_DETECTOR prompt with
+// its target, the holder never moved, each reading recorded at its target's directions, each round
+// stored in prompt order, and the prompt budget what ends the session: the seed's 6 poses and its
+// reference are 8 prompts, then two rounds of 4 reach the 16.
+TEST_F(AdaptiveSessionTest, SampleFixedFormStopsAtThePromptBudgetWithAPromptPerPose) {
+  const std::string& json = kSampleFixedPlan;
+  Open("brdfd.db", AdaptiveOptions());
+  SessionId id = 0;
+  const v1::Session done = RunToEnd(json, id);
+  ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED)
+      << done.state_reason() << (done.has_last_fault() ? done.last_fault().reason() : "");
+  EXPECT_NE(done.state_reason().find("adaptive: prompt budget spent"), std::string::npos)
+      << done.state_reason();
+  const std::vector<storage::RoundRecord> rounds = Rounds(*store_, id);
+  ASSERT_EQ(rounds.size(), 2u);
+  ExpectWholeAndDone(*store_, id);
+  ExpectRoundsAreTheirSteps(*store_, id, SeedSteps(json));
+
+  auto stored = store_->GetSteps(id);
+  ASSERT_TRUE(stored.ok());
+  const std::vector<plan::Step> steps = daemon::ToPlanSteps(*stored);
+  int prompts = 0;
+  int relocations = 0;
+  for (const plan::Step& s : steps) {
+    EXPECT_NE(s.kind, v1::STEP_KIND_MOVE) << s.label;
+    prompts += s.kind == v1::STEP_KIND_PROMPT;
+    relocations += s.prompt == v1::PROMPT_KIND_RELOCATE_LAMP_AND_DETECTOR;
+  }
+  EXPECT_EQ(prompts, 16);
+  EXPECT_EQ(relocations, 14);
+  EXPECT_EQ(SampleReadings(*store_, id), 14);
+  auto readings = store_->GetReadings(id, 0, 100000);
+  ASSERT_TRUE(readings.ok());
+  for (const storage::ReadingRecord& r : *readings) {
+    const plan::Step& step = steps[static_cast<std::size_t>(r.step_index)];
+    ASSERT_TRUE(step.target.has_value()) << step.label;
+    EXPECT_EQ(r.directions, *step.target) << step.label;
+  }
+  // Each round as stored is already in prompt order from where lamp and detector stood.
+  const plan::RigDescription rig = SimRigDescription();
+  for (const storage::RoundRecord& round : rounds) {
+    const Pose from =
+        ToModelAngles(steps[static_cast<std::size_t>(round.first_step - 1)].pose, rig.convention);
+    const std::vector<Pose> picks = EncodedPoses(round);
+    EXPECT_EQ(adaptive::OrderForPrompts(from, picks), picks) << "round " << round.round;
+  }
+}
+
 // --- kill -9 --------------------------------------------------------------------------------
 
 // The child: runs `json` on the engine and is killed (SIGKILL, from the reading listener) right
@@ -331,21 +403,22 @@ v1::Session RecoverAndFinish(daemon::SessionManager& manager, FakeRig& fake, Ses
   return done;
 }
 
-TEST_F(AdaptiveSessionTest, KilledAfterTheSeedChoosesTheSameRoundOnRestart) {
+void AdaptiveSessionTest::ExpectTheSameRoundsAfterAKillAtTheSeedsEnd(const std::string& json,
+                                                                     std::size_t rounds_wanted,
+                                                                     int readings) {
   const std::string db = dir_.file("killed.db").string();
-  const int seed_steps = SeedSteps(kReadingBudgetPlan);
-  // Killed right after the seed's last reading, before the first round is stored.
-  const SessionId id = RunChildUntilKilled(
-      db, kReadingBudgetPlan, [=](const auto& r) { return r.step_index == seed_steps - 1; });
+  const int seed_steps = SeedSteps(json);
+  const SessionId id =
+      RunChildUntilKilled(db, json, [=](const auto& r) { return r.step_index == seed_steps - 1; });
   ASSERT_GT(id, 0);
 
   // The same plan uninterrupted, on a database of its own: the rounds to expect.
   Open("uninterrupted.db", AdaptiveOptions());
   SessionId reference_id = 0;
-  ASSERT_EQ(RunToEnd(kReadingBudgetPlan, reference_id).state(), v1::SESSION_STATE_COMPLETED);
+  ASSERT_EQ(RunToEnd(json, reference_id).state(), v1::SESSION_STATE_COMPLETED);
   const std::vector<storage::RoundRecord> expected = Rounds(*store_, reference_id);
   Close();
-  ASSERT_EQ(expected.size(), 3u);
+  ASSERT_EQ(expected.size(), rounds_wanted);
 
   auto opened = storage::SessionStore::Open(db);
   ASSERT_TRUE(opened.ok()) << opened.status().ToString();
@@ -371,8 +444,17 @@ TEST_F(AdaptiveSessionTest, KilledAfterTheSeedChoosesTheSameRoundOnRestart) {
     EXPECT_EQ(rounds[i].first_step, expected[i].first_step);
     EXPECT_EQ(rounds[i].step_count, expected[i].step_count);
   }
-  EXPECT_EQ(SampleReadings(*store, id), kMaxReadings);
+  EXPECT_EQ(SampleReadings(*store, id), readings);
   ExpectWholeAndDone(*store, id);
+}
+
+TEST_F(AdaptiveSessionTest, KilledAfterTheSeedChoosesTheSameRoundOnRestart) {
+  ExpectTheSameRoundsAfterAKillAtTheSeedsEnd(kReadingBudgetPlan, 3, kMaxReadings);
+}
+
+// The sample-fixed form: the same rounds in the same prompt order.
+TEST_F(AdaptiveSessionTest, SampleFixedFormKilledAfterTheSeedChoosesTheSameRoundsOnRestart) {
+  ExpectTheSameRoundsAfterAKillAtTheSeedsEnd(kSampleFixedPlan, 2, 14);
 }
 
 TEST_F(AdaptiveSessionTest, KilledMidRoundContinuesTheStoredRoundWithoutRepeats) {

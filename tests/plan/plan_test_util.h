@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,28 @@ inline std::vector<Step> Prompts(const std::vector<Step>& steps, PromptKind kind
   }
   return out;
 }
+
+// The problem with field path `path`, or nullptr.
+inline const Problem* FindProblem(const std::vector<Problem>& problems, const std::string& path) {
+  for (const Problem& p : problems) {
+    if (p.field_path == path) return &p;
+  }
+  return nullptr;
+}
+
+#ifdef BRDF_EXAMPLES_DIR
+// The text of examples/plans/`name` ("" when it cannot be read, with a failure).
+inline std::string ReadExamplePlan(const std::string& name) {
+  std::FILE* f = std::fopen((std::string(BRDF_EXAMPLES_DIR) + "/" + name).c_str(), "rb");
+  EXPECT_NE(f, nullptr) << name;
+  std::string text;
+  if (f == nullptr) return text;
+  char buf[4096];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
+  std::fclose(f);
+  return text;
+}
+#endif
 
 // A step of `kind` at pose 0 (a reading or a prompt), and a move of α and β to (alpha, beta).
 inline Step StepOfKind(StepKind kind) {

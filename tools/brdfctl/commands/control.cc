@@ -67,7 +67,7 @@ int RunValidate(CommandContext& ctx, const std::string& plan_path, double time_s
       if (plan->has_adaptive()) ctx.out << "  adaptive: the seed design,\n";
       ctx.out << "  " << PlanSummaryText(reply.summary(), time_scale, real_rig_s) << "\n";
       if (plan->has_adaptive()) {
-        ctx.out << "  " << adaptive::AdaptiveBoundsText(plan->adaptive()) << "\n";
+        ctx.out << "  " << adaptive::AdaptiveBoundsText(*plan) << "\n";
       }
     } else {
       ctx.out << "  " << reply.step_count() << " steps, " << reply.operator_interventions()
