@@ -116,11 +116,12 @@ TEST(AdaptiveSampleFixedTest, SeedIsDeterministic) {
 TEST(AdaptiveSampleFixedTest, FieldsOfTheRotationRigAreRefusedWithTheirPaths) {
   const v1::Plan plan = PlanFromJson(R"({"name": "f", "anisotropic": true, "adaptive": {
     "target": {"expandedUncertainty": 0.05}, "budget": {"maxPrompts": 200},
-    "delta": {"step": 22.5}, "gamma": [0, 90], "seed": {"readingsPerDelta": 6},
+    "delta": {"step": 22.5}, "gamma": [0, 90], "seed": {"readingsPerDelta": 6, "deltaEvery": 4},
     "sampleFixed": {"seedReadings": 501}}})");
   const std::vector<Problem> problems = ValidatePlan(plan, RigDescription{});
-  for (const char* path : {"adaptive.delta", "adaptive.gamma", "adaptive.seed.readingsPerDelta",
-                           "adaptive.sampleFixed", "adaptive.sampleFixed.seedReadings"}) {
+  for (const char* path :
+       {"adaptive.delta", "adaptive.gamma", "adaptive.seed.readingsPerDelta",
+        "adaptive.seed.deltaEvery", "adaptive.sampleFixed", "adaptive.sampleFixed.seedReadings"}) {
     EXPECT_NE(FindProblem(problems, path), nullptr) << path << "\n" << FormatProblems(problems);
   }
   EXPECT_THAT(FindProblem(problems, "adaptive.delta")->message, HasSubstr("sample-fixed"));
