@@ -10,13 +10,17 @@ namespace {
 
 constexpr double kInfinite = std::numeric_limits<double>::infinity();
 
-// The c a pair needs: 0 when the noise covers it, ∞ when s = 0 and it does not.
+// The c a pair needs: 0 when the noise covers it, ∞ when s = 0 and it does not. A spread so
+// small beside the residual that c would pass kMaxNeededScale is rounding, not a spread (a
+// held-out reading on another reading's coordinates, as several γ make in the isotropic
+// reduction: one vertex weighs 1 − 1e-16), and counts as s = 0.
 double NeededScale(double residual, double spread, double noise, double k) {
   const double half_width = std::abs(residual) / k;
   const double excess = half_width * half_width - noise * noise;
   if (excess <= 0) return 0;
-  if (spread <= 0) return kInfinite;
-  return std::sqrt(excess) / spread;
+  const double needed = std::sqrt(excess) / spread;
+  if (!(spread > 0) || !(needed <= kMaxNeededScale)) return kInfinite;
+  return needed;
 }
 
 bool Fits(const HeldOutPoint& p, std::size_t bands) {

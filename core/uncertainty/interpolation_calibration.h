@@ -47,11 +47,16 @@ struct CalibrationTarget {
   std::size_t min_points = 8;  // fewer held-out readings: not calibrated
 };
 
+// A pair needing a larger c than this has a spread that is rounding beside its residual: it counts
+// as s = 0 (the vertices' spread explains nothing of it). On the simulator's sessions c is 0.5–4.
+inline constexpr double kMaxNeededScale = 1e6;
+
 // Per band group, the smallest c such that |r| ≤ k · sqrt(noise² + (c · s)²) holds for the
 // ⌈(n + 1) · coverage⌉-th smallest of the group's n held-out (reading, band) pairs' needs (all
 // of them when that rank passes n). A pair the noise alone covers needs c = 0; a pair with s = 0
-// that the noise does not cover needs more than any c: when the rank falls on such a pair, c is
-// the largest finite need. Points whose vectors do not have `bands` values are left out.
+// (or a need above kMaxNeededScale) that the noise does not cover needs more than any c: when the
+// rank falls on such a pair, c is the largest finite need. Points whose vectors do not have `bands`
+// values are left out.
 InterpolationCalibration FitInterpolationCalibration(std::span<const HeldOutPoint> points,
                                                      int bands, const CalibrationTarget& target);
 

@@ -86,6 +86,22 @@ TEST(FitInterpolationCalibration, PairsNoScaleCanCoverFallBackToTheLargestFinite
   EXPECT_NEAR(c.scale[0], 0.5, 1e-12);
 }
 
+TEST(FitInterpolationCalibration, ASpreadThatIsRoundingCountsAsNone) {
+  // As PairsNoScaleCanCoverFallBackToTheLargestFiniteNeed, but the 9 pairs' spread is rounding
+  // (1e-16 beside a residual of 1: a held-out reading on another's coordinates). Taken as a
+  // spread, the largest finite need would be 5e15; it counts as s = 0 and c stays 0.5.
+  std::vector<HeldOutPoint> points;
+  for (int i = 0; i < 11; ++i) points.push_back(Point(1.0, 1.0, 0.0, 1));
+  for (int i = 0; i < 9; ++i) points.push_back(Point(1.0, 1e-16, 0.0, 1));
+  const InterpolationCalibration c = FitInterpolationCalibration(points, 1, CalibrationTarget{});
+  ASSERT_EQ(c.scale.size(), 1u);
+  EXPECT_NEAR(c.scale[0], 0.5, 1e-12);
+  // A need just under the bound is still a need: c = 1e6 · 0.999.
+  std::vector<HeldOutPoint> large;
+  for (int i = 0; i < 10; ++i) large.push_back(Point(2.0, 1.0 / 0.999e6, 0.0, 1));
+  EXPECT_NEAR(FitInterpolationCalibration(large, 1, CalibrationTarget{}).scale[0], 0.999e6, 1e-3);
+}
+
 TEST(FitInterpolationCalibration, TooFewOrMisshapenPointsAreNotCalibrated) {
   std::vector<HeldOutPoint> points;
   for (int i = 0; i < 5; ++i) points.push_back(Point(0.1, 1.0, 0.0, 2));
