@@ -141,9 +141,9 @@ Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t sessi
                  static_cast<int>(readings.size()));
   record.step_count = static_cast<int>(added.size());
   BRDF_RETURN_IF_ERROR(store.AppendRound(record, added));
-  std::vector<plan::Step> after = steps;
-  for (const storage::StepRecord& r : added) after.push_back(ToPlanStep(r));
-  decision.round_cost = Difference(adaptive::SpendOfSteps(after, plan, rig), decision.spent);
+  // RoundSteps costed the stored steps with the round's (round.cost): one sample reading a pose.
+  decision.round_cost = {static_cast<int>(round.poses.size()), round.cost.seconds,
+                         round.cost.prompts};
   decision.round = std::move(record);
   decision.rounds += 1;
   return decision;
