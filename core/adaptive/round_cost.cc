@@ -35,6 +35,14 @@ PoseCost MeasureDeltaChange(const v1::Plan& plan, const plan::RigDescription& ri
   const double delta = GridSpec{}.delta_step_deg;
   AddPose(*list, 30, 0);
   AddPose(*list, 30, delta);
+  // Between the first reading and the move to the second pose (that move is Step()'s).
+  return CostAfterFirstReading(probe, plan, rig, false);
+}
+
+}  // namespace
+
+PoseCost CostAfterFirstReading(const v1::Plan& probe, const v1::Plan& plan,
+                               const plan::RigDescription& rig, bool through_second) {
   plan::ProblemSink ignored;
   const std::vector<plan::Step> steps = plan::ExpandCheckedPlan(probe, rig, ignored);
   const std::vector<plan::StepTime> times =
@@ -45,15 +53,13 @@ PoseCost MeasureDeltaChange(const v1::Plan& plan, const plan::RigDescription& ri
   }
   PoseCost cost;
   if (samples.size() != 2) return cost;
-  // Between the first reading and the move to the second pose (that move is Step()'s).
-  for (std::size_t i = samples[0] + 1; i + 1 < samples[1]; ++i) {
+  const std::size_t end = through_second ? samples[1] + 1 : samples[1] - 1;
+  for (std::size_t i = samples[0] + 1; i < end; ++i) {
     cost.seconds += times[i].estimate_s;
     if (steps[i].kind == v1::STEP_KIND_PROMPT) ++cost.prompts;
   }
   return cost;
 }
-
-}  // namespace
 
 RoundCost::RoundCost(const v1::Plan& plan, const plan::RigDescription& rig)
     : rig_(rig),

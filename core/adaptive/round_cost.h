@@ -33,6 +33,14 @@ struct PoseCost {
   }
 };
 
+// What the plan expander puts after the first of `probe`'s two sample readings (a two-pose plan
+// made from `plan` to measure a cost): the steps up to and including the second reading
+// (`through_second`), or else those before the step that precedes it (the move to the second
+// pose), by the timing model for `rig` and `plan`'s measurement. Zero when `probe` does not expand
+// to two sample readings.
+PoseCost CostAfterFirstReading(const v1::Plan& probe, const v1::Plan& plan,
+                               const plan::RigDescription& rig, bool through_second);
+
 class RoundCost {
  public:
   // `plan` gives the reference, dark and measurement policies (of its method only whether it is

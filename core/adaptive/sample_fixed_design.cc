@@ -10,8 +10,6 @@
 #include "core/geometry.h"
 #include "core/plan/expand_steps.h"
 #include "core/plan/plan_settings.h"
-#include "core/plan/problem.h"
-#include "core/plan/timing.h"
 
 namespace brdf::adaptive {
 namespace {
@@ -139,22 +137,8 @@ PoseCost FixedPoseCost(const v1::Plan& plan, const plan::RigDescription& rig) {
   }
   plan::RigDescription real = rig;
   real.time_scale = 1;
-  plan::ProblemSink ignored;
-  const std::vector<plan::Step> steps = plan::ExpandCheckedPlan(probe, real, ignored);
-  const std::vector<plan::StepTime> times =
-      plan::EstimateSteps(steps, real, plan::ResolveSettings(plan).measurement);
-  std::vector<std::size_t> samples;
-  for (std::size_t i = 0; i < steps.size(); ++i) {
-    if (steps[i].kind == v1::STEP_KIND_SAMPLE) samples.push_back(i);
-  }
-  PoseCost cost;
-  if (samples.size() != 2) return cost;
   // After the first reading, up to and including the second.
-  for (std::size_t i = samples[0] + 1; i <= samples[1]; ++i) {
-    cost.seconds += times[i].estimate_s;
-    if (steps[i].kind == v1::STEP_KIND_PROMPT) ++cost.prompts;
-  }
-  return cost;
+  return CostAfterFirstReading(probe, plan, real, true);
 }
 
 }  // namespace brdf::adaptive
