@@ -10,9 +10,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <functional>
+#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -341,6 +344,77 @@ TEST_F(AdaptiveSessionTest, SampleFixedFormStopsAtThePromptBudgetWithAPromptPerP
     const std::vector<Pose> picks = EncodedPoses(round);
     EXPECT_EQ(adaptive::OrderForPrompts(from, picks), picks) << "round " << round.round;
   }
+}
+
+// Paused at each round boundary (deferred, from the reading listener, right after the seed's last
+// reading and the first round's last reading) and resumed: the session chooses the same rounds,
+// pose for pose, as the same plan run uninterrupted, with each reading once. A pause between
+// rounds must not lose, repeat or change the design.
+TEST_F(AdaptiveSessionTest, PausedBetweenRoundsResumesTheSameDesign) {
+  Open("uninterrupted.db", AdaptiveOptions());
+  SessionId reference_id = 0;
+  ASSERT_EQ(RunToEnd(kReadingBudgetPlan, reference_id).state(), v1::SESSION_STATE_COMPLETED);
+  const std::vector<storage::RoundRecord> expected = Rounds(*store_, reference_id);
+  Close();
+  ASSERT_EQ(expected.size(), 3u);
+  const int seed_steps = SeedSteps(kReadingBudgetPlan);
+  const std::vector<int> boundaries = {seed_steps - 1,
+                                       expected[0].first_step + expected[0].step_count - 1};
+
+  Open("paused.db", AdaptiveOptions());
+  std::atomic<int> pauses{0};
+  manager_->AddReadingListener([&](SessionId session, const storage::ReadingRecord& r) {
+    if (std::find(boundaries.begin(), boundaries.end(), r.step_index) == boundaries.end()) return;
+    // Another thread asks, as an operator's client would; the listener waits for the answer.
+    auto paused = std::async(std::launch::async, [&, session] {
+      return manager_->Pause(session, daemon::PauseMode::kDeferred, kTestOperator);
+    });
+    EXPECT_TRUE(paused.get().ok());
+    pauses.fetch_add(1);
+  });
+  auto submitted = manager_->SubmitPlan(PlanFromJson(kReadingBudgetPlan), kTestOperator, true);
+  ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
+  const SessionId id = IdOf(*submitted);
+  op_ = std::make_unique<Operator>(*manager_, *fake_.bench, id);
+
+  for (int k = 1; k <= 2; ++k) {
+    const v1::Session paused = WaitForSession(*manager_, id, Ended, 60s);
+    ASSERT_EQ(paused.state(), v1::SESSION_STATE_PAUSED)
+        << "pause " << k << ": " << paused.state_reason();
+    EXPECT_EQ(pauses.load(), k);
+    // Paused at the boundary: every stored step done, the rounds stored so far the expected ones.
+    // The next round may already be stored (chosen before it is measured), none of it measured.
+    const std::vector<storage::RoundRecord> so_far = Rounds(*store_, id);
+    ASSERT_LE(so_far.size(), expected.size());
+    auto first = store_->FirstUnfinishedStep(id);
+    ASSERT_TRUE(first.ok());
+    const int next_step = boundaries[static_cast<std::size_t>(k - 1)] + 1;
+    if (first->has_value()) {
+      EXPECT_EQ(**first, next_step) << "pause " << k;
+      ASSERT_EQ(so_far.size(), static_cast<std::size_t>(k)) << "pause " << k;
+      EXPECT_EQ(so_far.back().first_step, next_step) << "pause " << k;
+    } else {
+      EXPECT_EQ(so_far.size(), static_cast<std::size_t>(k - 1)) << "pause " << k;
+    }
+    for (std::size_t i = 0; i < so_far.size(); ++i) {
+      EXPECT_EQ(EncodedPoses(so_far[i]), EncodedPoses(expected[i])) << "pause " << k;
+    }
+    auto resumed = manager_->Resume(id, kTestOperator);
+    ASSERT_TRUE(resumed.ok()) << resumed.status().ToString();
+  }
+  const v1::Session done = WaitForSession(*manager_, id, Ended, 60s);
+  ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED) << done.state_reason();
+
+  const std::vector<storage::RoundRecord> rounds = Rounds(*store_, id);
+  ASSERT_EQ(rounds.size(), expected.size());
+  for (std::size_t i = 0; i < rounds.size(); ++i) {
+    EXPECT_EQ(EncodedPoses(rounds[i]), EncodedPoses(expected[i])) << "round " << i + 1;
+    EXPECT_EQ(rounds[i].first_step, expected[i].first_step) << "round " << i + 1;
+    EXPECT_EQ(rounds[i].step_count, expected[i].step_count) << "round " << i + 1;
+  }
+  EXPECT_EQ(SampleReadings(*store_, id), kMaxReadings);
+  ExpectWholeAndDone(*store_, id);
+  ExpectRoundsAreTheirSteps(*store_, id, seed_steps);
 }
 
 // --- kill -9 --------------------------------------------------------------------------------
