@@ -15,6 +15,7 @@
 #include "brdf/v1/brdf.pb.h"
 #include "tests/brdfctl/ctl_test_rig.h"
 #include "tests/support/test_env.h"
+#include "tools/brdf-sim/optics/optics.h"
 
 namespace brdf::testing {
 namespace {
@@ -393,8 +394,8 @@ void BrdfctlProcessTest::CheckInterpolateOutside() {
   EXPECT_EQ(retro.exit_code, 4) << Describe(retro);
   EXPECT_NE(retro.err.find("empty_octant"), std::string::npos) << Describe(retro);
   EXPECT_NE(retro.err.find("--mirror-phi fills it"), std::string::npos) << Describe(retro);
-  const CommandResult filled = Ctl({"interpolate", w.id, "--theta-i", "30", "--theta-o", "30",
-                                    "--phi", "180", "--mirror-phi"});
+  const CommandResult filled = Ctl(
+      {"interpolate", w.id, "--theta-i", "30", "--theta-o", "30", "--phi", "180", "--mirror-phi"});
   EXPECT_EQ(filled.exit_code, 0) << Describe(filled);
   // Where no symmetry helps, the hint says what else to try.
   const CommandResult corner =
@@ -423,6 +424,60 @@ TEST_F(BrdfctlProcessTest, DemoPlanSubmitWatchAutoConfirmAndInterpolate) {
     SCOPED_TRACE("interpolate outside the data");
     CheckInterpolateOutside();
   }
+}
+
+// The adaptive plan in the sample-fixed method's form (the panel stays put; each pose a
+// relocate_lamp_and_detector prompt) on brdf-sim: `sim-mount from-prompt` places lamp and detector
+// at each prompt's target, so every sample reading is the virtual sample's BRDF at its recorded
+// directions (without the placement the simulator would read at the holder's rest pose: errors of
+// 100 % and more).
+TEST_F(BrdfctlProcessTest, AdaptiveSampleFixedOnTheSimulatorReadsTheTargetsDirections) {
+  TempDir dir("brdfctl-sample-fixed");
+  const std::string plan = WriteFile(dir, "plan.json", R"({
+  "name": "adaptive sample-fixed on brdf-sim",
+  "adaptive": {
+    "target": {"expandedUncertainty": 0.001},
+    "budget": {"maxPrompts": 18},
+    "region": {"thetaIMaxDeg": 70, "thetaOMaxDeg": 70},
+    "seed": {"retroReadings": 2},
+    "sampleFixed": {"seedReadings": 6},
+    "roundReadings": 4
+  },
+  "reference": {"perDetectorPosition": false, "everyMinutes": 15},
+  "measurement": {"integrationMs": 100, "averages": 1}
+})");
+  const CommandResult submit = Ctl({"submit", plan, "--start", "--quiet"});
+  ASSERT_EQ(submit.exit_code, 0) << Describe(submit);
+  const std::string id = Lines(submit.out).at(0);
+  const std::string ctl = *BrdfctlBinary();
+  const CommandResult watch =
+      Ctl({"watch", id, "--auto-confirm", "--on-prompt",
+           "'" + ctl + "' sim-mount from-prompt --modbus " + rig_->modbus()},
+          kCtlOperatorToken, 100s);
+  ASSERT_EQ(watch.exit_code, 0) << Describe(watch) << rig_->log();
+  EXPECT_NE(watch.err.find("placed by hand"), std::string::npos) << Describe(watch);
+
+  const CommandResult r = Ctl({"readings", id, "--kind", "sample", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << Describe(r);
+  int samples = 0;
+  for (const std::string& line : Lines(r.out)) {
+    const auto reading = ParseJson<v1::Reading>(line);
+    ASSERT_TRUE(reading.has_value()) << line;
+    ASSERT_TRUE(reading->has_uncertainty()) << line;
+    const v1::Directions& d = reading->directions();
+    const std::vector<double> truth = sim::TrueBrdf(
+        Directions{d.theta_i(), d.phi_i(), d.theta_o(), d.phi_o()}, /*anisotropic=*/false);
+    const auto& f = reading->uncertainty().value();
+    ASSERT_EQ(f.size(), static_cast<int>(truth.size())) << line;
+    for (int k : {20, 42, 70}) {  // 460, 548 and 660 nm
+      EXPECT_NEAR(f[k], truth[static_cast<std::size_t>(k)],
+                  0.05 * truth[static_cast<std::size_t>(k)])
+          << "reading " << reading->id() << " at θi " << d.theta_i() << " θo " << d.theta_o()
+          << " φo " << d.phi_o() << ", band " << k;
+    }
+    ++samples;
+  }
+  EXPECT_GE(samples, 8) << Describe(r);
 }
 
 TEST_F(BrdfctlProcessTest, WrongTokenExitsThreeWithAClearMessage) {

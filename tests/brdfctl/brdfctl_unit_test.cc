@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -373,6 +374,42 @@ TEST(SimMount, MapsTargetsAndPromptKinds) {
   EXPECT_EQ(TargetForPromptKind("close_shutter"), "dark");
   EXPECT_EQ(TargetForPromptKind("relocate_detector"), "");
   EXPECT_EQ(SimMount("no-port", 100, 1).code(), StatusCode::kInvalidArgument);
+}
+
+// The sample-fixed method on brdf-sim: a relocate_lamp_and_detector prompt's target reaches the
+// hook's environment, and from there the placed-by-hand registers (1, then signed centidegrees).
+TEST(SimMount, PlacesLampAndDetectorAtThePromptsTarget) {
+  v1::Prompt prompt;
+  prompt.set_kind(v1::PROMPT_KIND_RELOCATE_LAMP_AND_DETECTOR);
+  v1::Directions* t = prompt.mutable_target();
+  t->set_theta_i(60);
+  t->set_theta_o(30);
+  t->set_phi_o(-150.25);
+  std::vector<std::pair<std::string, std::string>> env = PromptEnvironment("7", prompt);
+  for (const auto& [name, value] : env) ASSERT_EQ(::setenv(name.c_str(), value.c_str(), 1), 0);
+  auto placed = PlacedFromPromptEnvironment();
+  ASSERT_TRUE(placed.ok()) << placed.status().ToString();
+  EXPECT_EQ(*placed, (Directions{60, 0, 30, -150.25}));
+  auto regs = PlacedRegisters(*placed);
+  ASSERT_TRUE(regs.ok()) << regs.status().ToString();
+  EXPECT_EQ(*regs, (std::vector<std::uint16_t>{1, 6000, 0, 3000,
+                                               static_cast<std::uint16_t>(std::int16_t{-15025})}));
+
+  auto behind = PlacedRegisters(Directions{60, 0, 95, 0});
+  EXPECT_EQ(behind.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(behind.status().message().find("θo"), std::string::npos) << behind.status().message();
+
+  // A prompt without a target (a sample-rotation rig's) sets none of them.
+  v1::Prompt relocate;
+  relocate.set_kind(v1::PROMPT_KIND_RELOCATE_DETECTOR);
+  for (const auto& [name, value] : PromptEnvironment("7", relocate)) {
+    EXPECT_EQ(name.find("BRDF_PROMPT_THETA"), std::string::npos) << name;
+  }
+  ASSERT_EQ(::unsetenv("BRDF_PROMPT_PHI_O"), 0);
+  auto missing = PlacedFromPromptEnvironment();
+  EXPECT_EQ(missing.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(missing.status().message().find("BRDF_PROMPT_PHI_O"), std::string::npos);
+  for (const auto& [name, value] : env) ::unsetenv(name.c_str());
 }
 
 }  // namespace

@@ -238,6 +238,57 @@ TEST(SimProcessTest, MeasuresTheWhiteStandardThroughThePty) {
   }
 }
 
+// The sample-fixed method: once lamp and detector are placed by hand (control registers 29–33), the
+// sample reads at those directions, not at the holder's pose; register 29 = 0 returns to the pose.
+// Out-of-range directions are refused whole (exception 03), leaving the placement as it was.
+TEST(SimProcessTest, LampAndDetectorPlacedByHandSetTheDirections) {
+  auto sim = StartSim({"--mounted", "sample"});
+  ASSERT_NE(sim, nullptr);
+  auto control =
+      ModbusControl::Connect(sim->modbus_host(), sim->modbus_port(), sim->control_unit());
+  ASSERT_TRUE(control.ok()) << control.status().ToString();
+  auto& c = **control;
+  // θi 60°, φi 0°, θo 30°, φo −150°, in signed centidegrees.
+  const std::vector<std::uint16_t> placed = {1, 6000, 0, 3000,
+                                             static_cast<std::uint16_t>(std::int16_t{-15000})};
+  ASSERT_TRUE(c.WriteRegisters(29, placed).ok());
+  auto back = c.ReadRegisters(29, 5);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(*back, placed);
+  const std::vector<std::uint16_t> too_far = {9100};  // θi 91°
+  EXPECT_FALSE(c.WriteRegisters(30, too_far).ok());
+  EXPECT_EQ(*c.ReadRegisters(29, 5), placed);
+
+  MeterPort meter(sim->pr650_path());
+  ASSERT_TRUE(meter.is_open());
+  ASSERT_EQ(meter.Ask("B0", 1), std::vector<std::string>{"000"});
+  ASSERT_EQ(meter.Ask("S01,,,,,0,01,1", 1), std::vector<std::string>{"00"});
+  auto measure = [&] {
+    EXPECT_EQ(meter.Ask("M0", 1), std::vector<std::string>{"000"});
+    return SpectrumOf(meter.Ask("D5", 103));
+  };
+  const std::vector<double> by_hand = measure();
+
+  class RestPose final : public StagePoseSource {
+   public:
+    Pose LivePose() const override { return Pose{}; }
+  } rest;
+  SimControl sim_control;
+  RigOptics optics(rest, sim_control, OpticsConfig{});
+  const auto at_placed =
+      optics.ExpectedRadianceAt(MountedTarget::kSample, Directions{60, 0, 30, -150});
+  const auto at_rest = optics.ExpectedRadiance(MountedTarget::kSample, Pose{});
+  ASSERT_EQ(by_hand.size(), at_placed.size());
+  const std::size_t k550 = 42;
+  EXPECT_NEAR(by_hand[k550], at_placed[k550], 0.02 * at_placed[k550]);
+  // The holder at rest is normal incidence, a different reading by far.
+  EXPECT_GT(std::abs(at_rest[k550] - at_placed[k550]), 0.2 * at_placed[k550]);
+
+  ASSERT_TRUE(c.WriteRegisters(29, std::vector<std::uint16_t>{0}).ok());
+  const std::vector<double> from_pose = measure();
+  EXPECT_NEAR(from_pose[k550], at_rest[k550], 0.02 * at_rest[k550]);
+}
+
 // An injected quality code shows in exactly the next N measurements' status.
 TEST(SimProcessTest, InjectedQualityCodeReachesTheMeterForTheNextMeasurementsOnly) {
   auto sim = StartSim({"--mounted", "white"});

@@ -120,6 +120,21 @@ class SimControl {
     std::lock_guard l(mu_);
     modbus_ = f;
   }
+  // The sample-fixed method: lamp and detector placed by hand at `placed()`, the holder's pose
+  // ignored by the optics while by_hand() (the control unit's registers 29–33).
+  bool by_hand() const {
+    std::lock_guard l(mu_);
+    return by_hand_;
+  }
+  Directions placed() const {
+    std::lock_guard l(mu_);
+    return placed_;
+  }
+  void set_placed(bool by_hand, const Directions& d) {
+    std::lock_guard l(mu_);
+    by_hand_ = by_hand;
+    placed_ = d;
+  }
   // Atomically applies `fn` to the faults (to count down "next N" faults).
   template <typename Fn>
   auto UpdateSerial(Fn fn) {
@@ -137,6 +152,8 @@ class SimControl {
   MountedTarget mounted_ = MountedTarget::kSample;
   SerialFaults serial_;
   ModbusFaults modbus_;
+  bool by_hand_ = false;
+  Directions placed_;
 };
 
 }  // namespace brdf::sim

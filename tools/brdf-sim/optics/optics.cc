@@ -65,6 +65,10 @@ std::vector<double> RigOptics::TrueBrdf(const Directions& directions) const {
 }
 
 std::vector<double> RigOptics::ExpectedRadiance(MountedTarget target, const Pose& pose) const {
+  return ExpectedRadianceAt(target, PoseToDirections(pose));
+}
+
+std::vector<double> RigOptics::ExpectedRadianceAt(MountedTarget target, const Directions& d) const {
   const WavelengthGrid& grid = measured_grid_;
   std::vector<double> out(grid.count, config_.ambient_radiance);
   if (target == MountedTarget::kDark) return out;
@@ -76,7 +80,6 @@ std::vector<double> RigOptics::ExpectedRadiance(MountedTarget target, const Pose
       out[k] += stray * lamp_spectrum_[k] / std::numbers::pi * lamp;
     }
   }
-  const Directions d = PoseToDirections(pose);
   const double cos_i = CosAbove(d.theta_i);
   // The detector behind the surface sees only the holder's back: ambient (and stray) light.
   if (cos_i <= 0.0 || CosAbove(d.theta_o) <= 0.0) return out;
@@ -95,8 +98,11 @@ std::vector<double> RigOptics::ExpectedRadiance(MountedTarget target, const Pose
 
 SimMeasurement RigOptics::Measure(const MeterSetup& setup) {
   const MountedTarget target = control_.mounted();
-  const Pose pose = errors_.TruePose(stage_.LivePose());
-  std::vector<double> expected = ExpectedRadiance(target, pose);
+  // Placed by hand (the sample-fixed method): where the operator put lamp and detector, as is.
+  const Directions directions = control_.by_hand()
+                                    ? control_.placed()
+                                    : PoseToDirections(errors_.TruePose(stage_.LivePose()));
+  std::vector<double> expected = ExpectedRadianceAt(target, directions);
   if (const double gain = errors_.NextGain(); gain != 1.0) {
     for (double& e : expected) e = std::max(0.0, e * gain);
   }

@@ -1,6 +1,8 @@
 // The rig's optics as brdf-sim models them: what the PR-650 reads right now. A tungsten lamp lights
 // whatever is mounted on the holder (the virtual sample, the white standard, or the dark shutter);
-// the holder's live pose (from the stage simulator) sets the incident and viewing directions; the
+// the holder's live pose (from the stage simulator) sets the incident and viewing directions (or,
+// for the sample-fixed method, the directions where the operator placed lamp and detector, set on
+// the control unit: registers 29–33 of stage/control_map.h); the
 // detector adds noise and picks an integration time. This is the MeterBackend behind the PR-650
 // endpoint, and TrueBrdf is the ground truth that tests compare the daemon's results against.
 // The sample is a material (core/material): a file named by --material, or a built-in one.
@@ -86,6 +88,9 @@ class RigOptics final : public MeterBackend {
   // the lamp's present drift, the white error, the wavelength shift and stray light; without
   // pose jitter and gain, which are drawn per measurement).
   std::vector<double> ExpectedRadiance(MountedTarget target, const Pose& pose) const;
+  // The same for lamp and detector at `directions` (placed by hand: the sample-fixed method, where
+  // SimControl::by_hand() makes Measure use SimControl::placed() instead of the holder's pose).
+  std::vector<double> ExpectedRadianceAt(MountedTarget target, const Directions& directions) const;
 
   // The virtual sample's BRDF (sr⁻¹) for directions in the sample frame.
   std::vector<double> TrueBrdf(const Directions& directions) const;

@@ -37,8 +37,13 @@
 //                                   are refused), axis requests meanwhile are dropped (RTU: left
 //                                   unanswered); then the same port listens again. Reads N until
 //                                   the outage starts, then 0
+//     29  placed.by_hand            1: the operator has placed lamp and detector by hand (the
+//                                   sample-fixed method): the optics use the directions below,
+//                                   not the holder's pose; 0: the holder's pose again
+//  30-33  placed.theta_i, phi_i,    the directions placed by hand, signed centidegrees (θ 0–9000,
+//         theta_o, phi_o            φ −18000–18000); written before or with register 29
 //
-// Registers 2–9 read 0 and refuse writes (exception 02), as do addresses past 28.
+// Registers 2–9 read 0 and refuse writes (exception 02), as do addresses past 33.
 // A value out of range (mounted 3, a flag of 2, exception code 12) is refused with exception 03
 // and nothing of that write is applied. Faults apply to the axis unit ids only, never to the
 // control unit itself, so setting a fault cannot consume it.
@@ -74,6 +79,10 @@ inline constexpr std::uint16_t kModbusStall = 26;
 inline constexpr std::uint16_t kModbusSwapWordOrder = 27;
 inline constexpr std::uint16_t kModbusOutageMs = 28;
 
-inline constexpr std::uint16_t kRegisterCount = 29;  // addresses 0–28
+inline constexpr std::uint16_t kPlacedByHand = 29;
+inline constexpr std::uint16_t kPlacedThetaI = 30;  // then phi_i, theta_o, phi_o
+inline constexpr std::uint16_t kPlacedPhiO = 33;
+
+inline constexpr std::uint16_t kRegisterCount = 34;  // addresses 0–33
 
 }  // namespace brdf::sim::control_map

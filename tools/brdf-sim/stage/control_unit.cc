@@ -15,12 +15,30 @@ namespace cm = control_map;
 bool Defined(std::uint16_t a) {
   return a == cm::kMountedTarget || a == cm::kPowerCycleMeter ||
          (a >= cm::kSerialSilent && a <= cm::kSerialLeaveRemote) ||
-         (a >= cm::kModbusExceptionCode && a <= cm::kModbusOutageMs);
+         (a >= cm::kModbusExceptionCode && a <= cm::kModbusOutageMs) ||
+         (a >= cm::kPlacedByHand && a <= cm::kPlacedPhiO);
 }
 
 bool IsFlag(std::uint16_t a) {
   return a == cm::kSerialSilent || a == cm::kSerialLeaveRemote || a == cm::kModbusDropConnection ||
-         a == cm::kModbusAlarmMidMove || a == cm::kModbusStall || a == cm::kModbusSwapWordOrder;
+         a == cm::kModbusAlarmMidMove || a == cm::kModbusStall || a == cm::kModbusSwapWordOrder ||
+         a == cm::kPlacedByHand;
+}
+
+// Signed centidegrees in a register (two's complement) and back.
+std::uint16_t Centidegrees(double deg) {
+  return static_cast<std::uint16_t>(
+      static_cast<std::int16_t>(std::clamp<long>(std::lround(deg * 100), -32768, 32767)));
+}
+double Degrees(std::uint16_t reg) {
+  return static_cast<std::int16_t>(reg) / 100.0;
+}
+
+// A placed direction register holds θ in 0–90° or φ in −180–180°.
+bool PlacedValueInRange(std::uint16_t a, std::uint16_t v) {
+  const int c = static_cast<std::int16_t>(v);
+  const bool theta = (a - cm::kPlacedThetaI) % 2 == 0;
+  return theta ? c >= 0 && c <= 9000 : c >= -18000 && c <= 18000;
 }
 
 std::uint16_t Clamp16(long v) {
@@ -56,6 +74,12 @@ std::vector<std::uint16_t> Snapshot(const SimControl& control) {
   r[cm::kModbusStall] = m.stall ? 1 : 0;
   r[cm::kModbusSwapWordOrder] = m.swap_word_order ? 1 : 0;
   r[cm::kModbusOutageMs] = Clamp16(m.outage_ms);
+  const Directions d = control.placed();
+  r[cm::kPlacedByHand] = control.by_hand() ? 1 : 0;
+  r[cm::kPlacedThetaI] = Centidegrees(d.theta_i);
+  r[cm::kPlacedThetaI + 1] = Centidegrees(d.phi_i);
+  r[cm::kPlacedThetaI + 2] = Centidegrees(d.theta_o);
+  r[cm::kPlacedPhiO] = Centidegrees(d.phi_o);
   return r;
 }
 
@@ -85,6 +109,9 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
     if (IsFlag(a) && v > 1) return modbus::kIllegalDataValue;
     if (a == cm::kModbusExceptionCode && v > 0x0B) return modbus::kIllegalDataValue;
     if (a == cm::kSerialUnitsCode && v > 2) return modbus::kIllegalDataValue;
+    if (a >= cm::kPlacedThetaI && a <= cm::kPlacedPhiO && !PlacedValueInRange(a, v)) {
+      return modbus::kIllegalDataValue;
+    }
   }
   auto image = Snapshot(control_);
   for (std::size_t i = 0; i < values.size(); ++i) image[address + i] = values[i];
@@ -128,6 +155,12 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
       }
       if (written(cm::kModbusOutageMs)) m.outage_ms = image[cm::kModbusOutageMs];
     });
+  }
+  if (address + values.size() > cm::kPlacedByHand) {
+    control_.set_placed(
+        image[cm::kPlacedByHand] != 0,
+        Directions{Degrees(image[cm::kPlacedThetaI]), Degrees(image[cm::kPlacedThetaI + 1]),
+                   Degrees(image[cm::kPlacedThetaI + 2]), Degrees(image[cm::kPlacedPhiO])});
   }
   if (written(cm::kPowerCycleMeter) && image[cm::kPowerCycleMeter] == 1 && power_cycle_meter_) {
     power_cycle_meter_();

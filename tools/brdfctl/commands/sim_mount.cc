@@ -4,9 +4,12 @@
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
+#include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <vector>
 
 #include "tools/brdf-sim/stage/control_map.h"
 #include "tools/brdfctl/exit_codes.h"
@@ -21,6 +24,10 @@ std::optional<int> MountedTargetValue(const std::string& target) {
   return std::nullopt;
 }
 
+namespace {
+const char* const kPlacedNames[] = {"θi", "φi", "θo", "φo"};
+}  // namespace
+
 std::string TargetForPromptKind(const std::string& kind) {
   if (kind == "mount_white") return "white";
   if (kind == "mount_sample") return "sample";
@@ -28,7 +35,8 @@ std::string TargetForPromptKind(const std::string& kind) {
   return "";
 }
 
-Status SimMount(const std::string& modbus, int unit, int value) {
+Status WriteSimControl(const std::string& modbus, int unit, int address,
+                       const std::vector<std::uint16_t>& values) {
   const std::size_t colon = modbus.rfind(':');
   if (colon == std::string::npos || colon == 0 || colon + 1 == modbus.size() ||
       modbus.find_first_not_of("0123456789", colon + 1) != std::string::npos) {
@@ -46,12 +54,12 @@ Status SimMount(const std::string& modbus, int unit, int value) {
   }
   modbus_set_response_timeout(ctx, 2, 0);
   Status result = Status::Ok();
+  const int n = static_cast<int>(values.size());
   if (modbus_set_slave(ctx, unit) != 0 || modbus_connect(ctx) != 0) {
     result = Disconnected("cannot connect to brdf-sim's Modbus server at " + where + ": " +
                           modbus_strerror(errno) + "; is brdf-sim running on that port?");
-  } else if (modbus_write_register(ctx, sim::control_map::kMountedTarget,
-                                   static_cast<std::uint16_t>(value)) != 1) {
-    result = DeviceError(0, "writing the mounted target on " + where +
+  } else if (modbus_write_registers(ctx, address, n, values.data()) != n) {
+    result = DeviceError(0, "writing register " + std::to_string(address) + " on " + where +
                                 " failed: " + modbus_strerror(errno) +
                                 "; is this brdf-sim's control unit (it printed control-unit N)?");
   }
@@ -59,6 +67,62 @@ Status SimMount(const std::string& modbus, int unit, int value) {
   modbus_free(ctx);
   return result;
 }
+
+Status SimMount(const std::string& modbus, int unit, int value) {
+  return WriteSimControl(modbus, unit, sim::control_map::kMountedTarget,
+                         {static_cast<std::uint16_t>(value)});
+}
+
+Result<std::vector<std::uint16_t>> PlacedRegisters(const Directions& d) {
+  const double values[] = {d.theta_i, d.phi_i, d.theta_o, d.phi_o};
+  std::vector<std::uint16_t> regs = {1};  // placed by hand
+  for (int k = 0; k < 4; ++k) {
+    const bool theta = k % 2 == 0;
+    const double v = values[k];
+    if (!std::isfinite(v) || (theta && (v < 0 || v > 90)) || (!theta && (v < -180 || v > 180))) {
+      return InvalidArgument(std::string("the placed direction ") + kPlacedNames[k] + " = " +
+                             std::to_string(v) + "° is outside " + (theta ? "0–90°" : "−180–180°"));
+    }
+    regs.push_back(static_cast<std::uint16_t>(static_cast<std::int16_t>(std::lround(v * 100))));
+  }
+  return regs;
+}
+
+Result<Directions> PlacedFromPromptEnvironment() {
+  const char* names[] = {"BRDF_PROMPT_THETA_I", "BRDF_PROMPT_PHI_I", "BRDF_PROMPT_THETA_O",
+                         "BRDF_PROMPT_PHI_O"};
+  double v[4];
+  for (int k = 0; k < 4; ++k) {
+    const char* text = std::getenv(names[k]);
+    char* end = nullptr;
+    v[k] = text == nullptr ? 0 : std::strtod(text, &end);
+    if (text == nullptr || end == text || *end != '\0') {
+      return InvalidArgument(std::string(names[k]) + " is " +
+                             (text ? "\"" + std::string(text) + "\"" : "not set") +
+                             ": a relocate_lamp_and_detector prompt carries its target directions "
+                             "(run sim-mount from-prompt from `brdfctl watch --on-prompt`)");
+    }
+  }
+  return Directions{v[0], v[1], v[2], v[3]};
+}
+
+namespace {
+
+// relocate_lamp_and_detector: lamp and detector placed by hand where the prompt's target says.
+int PlaceByHand(std::ostream& out, std::ostream& err, const std::string& modbus, int unit) {
+  const Result<Directions> placed = PlacedFromPromptEnvironment();
+  if (!placed.ok()) return ReportLocalError(err, placed.status());
+  const Result<std::vector<std::uint16_t>> regs = PlacedRegisters(*placed);
+  if (!regs.ok()) return ReportLocalError(err, regs.status());
+  const Status status = WriteSimControl(modbus, unit, sim::control_map::kPlacedByHand, *regs);
+  if (!status.ok()) return ReportLocalError(err, status);
+  out << "sim-mount: lamp and detector placed by hand at θi " << placed->theta_i << "° φi "
+      << placed->phi_i << "° θo " << placed->theta_o << "° φo " << placed->phi_o
+      << "° on brdf-sim at " << modbus << "\n";
+  return kExitOk;
+}
+
+}  // namespace
 
 int RunSimMount(std::ostream& out, std::ostream& err, const std::string& target,
                 const std::string& modbus, int unit) {
@@ -71,6 +135,13 @@ int RunSimMount(std::ostream& out, std::ostream& err, const std::string& target,
       return kExitInvalid;
     }
     resolved = TargetForPromptKind(kind);
+    if (std::string(kind) == "relocate_lamp_and_detector")
+      return PlaceByHand(out, err, modbus, unit);
+    if (std::string(kind) == "relocate_detector") {
+      // A sample-rotation rig's prompt: the optics follow the holder's pose again.
+      const Status status = WriteSimControl(modbus, unit, sim::control_map::kPlacedByHand, {0});
+      if (!status.ok()) return ReportLocalError(err, status);
+    }
     if (resolved.empty()) {
       out << "sim-mount: prompt " << kind << " needs nothing mounted on the simulator\n";
       return kExitOk;

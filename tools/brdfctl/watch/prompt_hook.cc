@@ -14,7 +14,7 @@ namespace brdf::ctl {
 
 std::vector<std::pair<std::string, std::string>> PromptEnvironment(const std::string& session_id,
                                                                    const v1::Prompt& prompt) {
-  return {
+  std::vector<std::pair<std::string, std::string>> env = {
       {"BRDF_SESSION_ID", session_id},
       {"BRDF_PROMPT_STEP", std::to_string(prompt.step_index())},
       {"BRDF_PROMPT_KIND", PromptKindName(prompt.kind())},
@@ -24,6 +24,14 @@ std::vector<std::pair<std::string, std::string>> PromptEnvironment(const std::st
       {"BRDF_PROMPT_GAMMA", Num(prompt.pose().gamma(), 10)},
       {"BRDF_PROMPT_DELTA", Num(prompt.pose().delta(), 10)},
   };
+  if (prompt.has_target()) {
+    const v1::Directions& t = prompt.target();
+    env.insert(env.end(), {{"BRDF_PROMPT_THETA_I", Num(t.theta_i(), 10)},
+                           {"BRDF_PROMPT_PHI_I", Num(t.phi_i(), 10)},
+                           {"BRDF_PROMPT_THETA_O", Num(t.theta_o(), 10)},
+                           {"BRDF_PROMPT_PHI_O", Num(t.phi_o(), 10)}});
+  }
+  return env;
 }
 
 Status RunPromptHook(const std::string& command, const std::string& session_id,

@@ -8,6 +8,8 @@
 //                        close_shutter or set_gamma_dial
 //   BRDF_PROMPT_TEXT     the instruction shown to the operator
 //   BRDF_PROMPT_ALPHA, _BETA, _GAMMA, _DELTA   the pose the rig will be in, degrees
+//   BRDF_PROMPT_THETA_I, _PHI_I, _THETA_O, _PHI_O   the sample-fixed method's lamp and detector
+//                        directions to set up, degrees (only when the prompt has a target)
 // CMD's standard output goes to brdfctl's standard error, so that --json output stays parsable.
 // A CMD that fails (non-zero exit) leaves the prompt unanswered.
 #pragma once
