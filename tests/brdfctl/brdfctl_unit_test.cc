@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/geometry.h"
 #include "daemon/config/config.h"
 #include "tests/support/test_env.h"
 #include "tools/brdfctl/commands/sim_mount.h"
@@ -154,6 +155,33 @@ TEST(RoundsText, ARoundAgainstTheTargetAndBudgetsAndWhatItMeasuresNext) {
   EXPECT_EQ(AdaptiveGoalText(readings_only), "target expected error ≤ 0.1; budget 300 readings");
   EXPECT_EQ(AdaptiveGoalText(PaperGoal()), "target U (k = 2) ≤ 0.05; budget 464 readings, " +
                                                Duration(38 * 60) + " rig time, 60 prompts");
+}
+
+// The sample-fixed form: a round's poses are where the operator places lamp and detector, shown
+// as directions (the prompts' whole degrees), and the table's column is the θi range.
+TEST(RoundsText, TheSampleFixedFormShowsDirectionsNotStagePoses) {
+  v1::AdaptiveRound round = RoundOf(1, 0.5, {});
+  const IsoDirection targets[] = {{50, 5, 130}, {65, 10, 30}, {25, 75, 90}};
+  for (const IsoDirection& t : targets) {
+    const Result<Pose> pose = InverseKinematics(t);
+    ASSERT_TRUE(pose.ok()) << pose.status().ToString();
+    v1::Pose* p = round.add_poses();
+    p->set_alpha(pose->alpha);
+    p->set_beta(pose->beta);
+    p->set_delta(pose->delta);
+  }
+  v1::Adaptive fixed = PaperGoal();
+  fixed.mutable_sample_fixed();
+  const std::vector<std::string> lines = AdaptiveRoundLines(round, fixed);
+  ASSERT_EQ(lines.size(), 4u);
+  EXPECT_EQ(lines[3], "  first directions: θi 50° θo 5° φ 130°; θi 65° θo 10° φ 30°");
+  for (const std::string& line : lines) EXPECT_LE(Columns(line), 80u) << line;
+  EXPECT_EQ(AdaptiveRoundLines(round, PaperGoal()).size(), 5u);  // the rotation form's δ lines
+
+  std::ostringstream out;
+  PrintRoundsTable(out, {round}, fixed);
+  EXPECT_NE(out.str().find("poses  θi\n"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("  3  25°–65°\n"), std::string::npos) << out.str();
 }
 
 TEST(RoundsText, TheStopAgainstTheBudgetsWithinEightyColumns) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/geometry.h"
+#include "core/pose.h"
 #include "tools/brdfctl/output/text_format.h"
 
 namespace brdf::ctl {
@@ -65,6 +67,41 @@ std::string FirstPoses(const v1::AdaptiveRound& r) {
     line += more;
   }
   return line;
+}
+
+// The sample-fixed form: a pose is where the operator places lamp and detector, so its
+// directions (the isotropic reduction, whole degrees as the prompts give them) say more than the
+// equivalent stage pose.
+IsoDirection DirectionsOf(const v1::Pose& p) {
+  return ToIsotropic(PoseToDirections(Pose{p.alpha(), p.beta(), p.gamma(), p.delta()}));
+}
+
+std::string IsoText(const IsoDirection& d) {
+  return "θi " + StageAngle(d.theta_i) + "° θo " + StageAngle(d.theta_o) + "° φ " +
+         StageAngle(d.phi) + "°";
+}
+
+// "  first directions: θi 50° θo 5° φ 130°; …", as many as fit.
+std::string FirstDirections(const v1::AdaptiveRound& r) {
+  std::string line = "  first directions:";
+  for (int i = 0; i < r.poses_size(); ++i) {
+    const std::string more = (i == 0 ? " " : "; ") + IsoText(DirectionsOf(r.poses(i)));
+    if (Columns(line + more) > kColumns) break;
+    line += more;
+  }
+  return line;
+}
+
+// "θi 25°–65°": the round's incidence range (the sample-fixed form's table column).
+std::string ThetaIRange(const v1::AdaptiveRound& r) {
+  if (r.poses_size() == 0) return "-";
+  double lo = 90, hi = 0;
+  for (const v1::Pose& p : r.poses()) {
+    lo = std::min(lo, DirectionsOf(p).theta_i);
+    hi = std::max(hi, DirectionsOf(p).theta_i);
+  }
+  return StageAngle(lo) == StageAngle(hi) ? StageAngle(lo) + "°"
+                                          : StageAngle(lo) + "°–" + StageAngle(hi) + "°";
 }
 
 // "   3 0.277 ##############    |" : the uncertainty left as a bar, `scale` per column, the
@@ -167,7 +204,9 @@ std::vector<std::string> AdaptiveRoundLines(const v1::AdaptiveRound& r,
                       std::to_string(r.first_step()) + "–" + std::to_string(last) + ", +" +
                       Duration(r.rig_s()) + " rig time, +" + std::to_string(r.prompts()) +
                       " prompts"));
-  if (r.poses_size() > 0) {
+  if (r.poses_size() > 0 && adaptive.has_sample_fixed()) {
+    lines.push_back(Fit(FirstDirections(r)));
+  } else if (r.poses_size() > 0) {
     lines.push_back(Fit("  " + DeltaPathText(r)));
     lines.push_back(FirstPoses(r));
   }
@@ -203,14 +242,17 @@ void PrintRoundsTable(std::ostream& out, const std::vector<v1::AdaptiveRound>& r
     out << "no round yet (the seed design is measured first)\n";
     return;
   }
-  out << "round  readings  left     gain      rig time  prompts  poses  δ\n";
+  const bool fixed = adaptive.has_sample_fixed();
+  out << "round  readings  left     gain      rig time  prompts  poses  " << (fixed ? "θi" : "δ")
+      << "\n";
   double highest = TargetLevel(adaptive);
   for (const v1::AdaptiveRound& r : rounds) {
     char row[160];
     std::snprintf(row, sizeof row, "%5u  %8u  %-7s  %-8s  %8s  %7u  %5d  %s", r.round(),
                   r.readings_used(), Num(r.uncertainty_left(), 3).c_str(),
                   Num(r.predicted_gain(), 3).c_str(), Duration(r.spent_rig_s()).c_str(),
-                  r.spent_prompts(), r.poses_size(), DeltaRange(r).c_str());
+                  r.spent_prompts(), r.poses_size(),
+                  (fixed ? ThetaIRange(r) : DeltaRange(r)).c_str());
     out << Fit(row) << "\n";
     highest = std::max(highest, r.uncertainty_left());
   }

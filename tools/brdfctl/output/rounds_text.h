@@ -37,6 +37,10 @@ std::string RoundsSoFarText(const std::vector<v1::AdaptiveRound>& rounds);
 //     next: 24 poses, steps 475–527, +4:02 rig time, +2 prompts
 //     δ 45° → 56.25° → 78.75°
 //     first poses: α 10° β −35° γ 0° δ 45°; α 15° β −30° γ 0° δ 45°
+// In the sample-fixed form (adaptive.sample_fixed set) the last two lines are one, the directions
+// where the operator will place lamp and detector:
+//     first directions: θi 50° θo 5° φ 130°; θi 50° θo 5° φ 100°; …
+// and `rounds`' table gives each round's θi range instead of its δ range.
 std::vector<std::string> AdaptiveRoundLines(const v1::AdaptiveRound& round,
                                             const v1::Adaptive& adaptive);
 
