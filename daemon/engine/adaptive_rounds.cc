@@ -175,6 +175,12 @@ v1::AdaptiveRound ToProtoRound(const storage::RoundRecord& round, const RoundSpe
   for (const storage::RoundPick& p : round.picks) {
     *out.add_poses() = ToProtoPose(p.pose);
     out.add_pose_gains(p.predicted_gain);
+    const Directions d = PoseToDirections(p.pose);  // a pick's pose is in model angles
+    v1::Directions* to = out.add_directions();
+    to->set_theta_i(d.theta_i);
+    to->set_phi_i(d.phi_i);
+    to->set_theta_o(d.theta_o);
+    to->set_phi_o(d.phi_o);
   }
   out.set_predicted_gain(round.predicted_gain);
   out.set_uncertainty_left(round.uncertainty_left);

@@ -178,6 +178,17 @@ TEST(RoundsText, TheSampleFixedFormShowsDirectionsNotStagePoses) {
   for (const std::string& line : lines) EXPECT_LE(Columns(line), 80u) << line;
   EXPECT_EQ(AdaptiveRoundLines(round, PaperGoal()).size(), 5u);  // the rotation form's δ lines
 
+  // The daemon sends each pose's directions (AdaptiveRound.directions): those are shown.
+  v1::AdaptiveRound sent = round;
+  for (const IsoDirection& t : targets) {
+    v1::Directions* d = sent.add_directions();
+    d->set_theta_i(t.theta_i + 1);
+    d->set_theta_o(t.theta_o);
+    d->set_phi_o(t.phi);
+  }
+  EXPECT_EQ(AdaptiveRoundLines(sent, fixed)[3],
+            "  first directions: θi 51° θo 5° φ 130°; θi 66° θo 10° φ 30°");
+
   std::ostringstream out;
   PrintRoundsTable(out, {round}, fixed);
   EXPECT_NE(out.str().find("poses  θi\n"), std::string::npos) << out.str();

@@ -36,6 +36,25 @@ function deltaPath(poses) {
   return out.map(deg).join(' → ');
 }
 
+// The sample-fixed form: "θi 50° θo 5° φ 130°", where the operator places lamp and detector
+// (AdaptiveRound.directions; the poses are only their equivalents on a rotation stage).
+function directionText(d) {
+  const ti = Number(d?.theta_i || 0);
+  const to = Number(d?.theta_o || 0);
+  let phi = Math.abs(Number(d?.phi_o || 0) - Number(d?.phi_i || 0)) % 360;
+  if (phi > 180) phi = 360 - phi;
+  if (ti < 1e-9 || to < 1e-9) phi = 0;
+  return `θi ${deg(ti)} θo ${deg(to)} φ ${deg(phi)}`;
+}
+
+// "25°–65°": the round's incidence range.
+function thetaIRange(directions) {
+  if (!directions.length) return '';
+  const t = directions.map((d) => Number(d.theta_i || 0));
+  const [lo, hi] = [Math.min(...t), Math.max(...t)];
+  return lo === hi ? deg(lo) : `${deg(lo)}–${deg(hi)}`;
+}
+
 function spentOf(value, limit, text) {
   return limit ? `${text(value)} of ${text(limit)}` : text(value);
 }
@@ -44,7 +63,7 @@ export function createRoundsView() {
   const goal = el('p', { id: 'rounds-goal' });
   const body = el('tbody');
   const table = el('table', { id: 'rounds-table' },
-    el('thead', {}, el('tr', {}, ['round', 'chosen from', 'uncertainty left', 'against the target', 'predicted gain', 'rig time spent', 'prompts spent', 'poses', 'δ'].map((h) => el('th', {}, h)))),
+    el('thead', {}, el('tr', {}, ['round', 'chosen from', 'uncertainty left', 'against the target', 'predicted gain', 'rig time spent', 'prompts spent', 'poses', el('span', { id: 'rounds-where' }, 'δ')].map((h) => el('th', {}, h)))),
     body);
   const chart = el('div', { id: 'rounds-chart', class: 'plot' });
   const next = el('div', { id: 'next-round' });
@@ -62,6 +81,10 @@ export function createRoundsView() {
     const list = [...rounds.values()].sort((a, b) => a.round - b.round);
     const { level } = targetOf(adaptive);
     const b = adaptive?.budget || {};
+    // The sample-fixed form (plan.adaptive.sample_fixed set): directions, not stage poses.
+    const fixed = !!adaptive?.sample_fixed;
+    const whereHead = element.querySelector('#rounds-where');
+    if (whereHead) whereHead.textContent = fixed ? 'θi' : 'δ';
     const highest = Math.max(level, ...list.map((r) => r.uncertainty_left));
     clear(body).append(...list.map((r) => el('tr', { 'data-round': r.round, 'data-left': r.uncertainty_left },
       el('td', {}, r.round),
@@ -74,14 +97,15 @@ export function createRoundsView() {
       el('td', {}, spentOf(r.spent_rig_s, b.max_rig_minutes * 60, duration)),
       el('td', {}, spentOf(r.spent_prompts, b.max_prompts, (v) => `${v}`)),
       el('td', {}, (r.poses || []).length),
-      el('td', {}, deltaPath(r.poses || [])))));
+      el('td', {}, fixed ? thetaIRange(r.directions || []) : deltaPath(r.poses || [])))));
     const last = list.at(-1);
+    const where = (r) => (fixed ? `θi ${thetaIRange(r.directions || [])}` : `δ ${deltaPath(r.poses || [])}`);
     clear(next).append(last
-      ? el('p', {}, `round ${last.round}: ${(last.poses || []).length} poses, steps ${last.first_step}–${last.first_step + Math.max(last.step_count, 1) - 1}, +${duration(last.rig_s)} of rig time, +${last.prompts} prompts; δ ${deltaPath(last.poses || [])}`)
+      ? el('p', {}, `round ${last.round}: ${(last.poses || []).length} poses, steps ${last.first_step}–${last.first_step + Math.max(last.step_count, 1) - 1}, +${duration(last.rig_s)} of rig time, +${last.prompts} prompts; ${where(last)}`)
       : el('p', { class: 'muted' }, 'no round yet: the seed design is measured first'));
     if (last?.poses?.length) {
       const items = last.poses.slice(0, 8).map((p, i) => el('li', {},
-        `α ${deg(p.alpha)} β ${deg(p.beta)} γ ${deg(p.gamma)} δ ${deg(p.delta)} (gain ${num(last.pose_gains?.[i])})`));
+        `${fixed && last.directions?.[i] ? directionText(last.directions[i]) : `α ${deg(p.alpha)} β ${deg(p.beta)} γ ${deg(p.gamma)} δ ${deg(p.delta)}`} (gain ${num(last.pose_gains?.[i])})`));
       next.append(el('ol', { id: 'next-poses' }, items),
         last.poses.length > 8 ? el('p', { class: 'muted' }, `… and ${last.poses.length - 8} more`) : '');
     }

@@ -8,7 +8,8 @@
 // store. The explorer's uncertainty map: k·u / BRDF at each direction equal to what
 // Interpolation.Interpolate answers for it, halved at k = 1, the readings near its θi drawn.
 // `brdfctl rounds` and `brdfctl watch` on the same session: a row per round, the stop, every
-// line within 80 columns.
+// line within 80 columns. A sample-fixed session: its rounds carry their poses' directions and the
+// console lists those.
 import { execFile } from 'node:child_process';
 import { join } from 'node:path';
 import { startRig, outputDir, check, build, launchBrowser, pageCollectingErrors } from './rig.mjs';
@@ -164,6 +165,66 @@ try {
     `brdfctl watch on the finished session: its goal and the uncertainty falling (${wlines.filter((l) => /round|adaptive/.test(l)).join(' | ')})`);
   const roundLines = wlines.filter((l) => /^(round \d|  |target |\d+ round\(s\)|adaptive stop)/.test(l));
   check(roundLines.length >= 6 && roundLines.every((l) => columns(l) <= 80), `brdfctl watch: the rounds' lines within 80 columns (${roundLines.length} lines)`);
+
+  // The sample-fixed form: each pose is where the operator places lamp and detector by hand, so the
+  // rounds carry each pose's directions and the console lists those, not the equivalent poses.
+  const fixedPlan = {
+    name: 'adaptive sample-fixed, explained',
+    adaptive: {
+      target: { expandedUncertainty: 0.001 },
+      budget: { maxPrompts: 14 },
+      region: { thetaIMaxDeg: 70, thetaOMaxDeg: 70 },
+      seed: { retroReadings: 2 },
+      sampleFixed: { seedReadings: 4 },
+      roundReadings: 3,
+    },
+    reference: { perDetectorPosition: false, everyMinutes: 15 },
+    measurement: { integrationMs: 100, averages: 1 },
+  };
+  const fixedId = (await post('Control/SubmitPlan', { plan: fixedPlan })).session.session_id;
+  await post('Control/StartSession', { session_id: fixedId });
+  const fixedDeadline = Date.now() + 120000;
+  for (;;) {
+    if (Date.now() > fixedDeadline) throw new Error('the sample-fixed session did not finish within 120 s');
+    const s = await post('Control/GetSession', { session_id: fixedId });
+    if (s.state === 'SESSION_STATE_COMPLETED') break;
+    if (['SESSION_STATE_FAILED', 'SESSION_STATE_ABORTED', 'SESSION_STATE_PAUSED'].includes(s.state)) throw new Error(`the sample-fixed session is ${s.state}: ${s.state_reason}`);
+    if (s.state === 'SESSION_STATE_AWAITING_OPERATOR' && s.pending_prompt) {
+      await rig.simMount(s.pending_prompt.kind);
+      await post('Control/AnswerPrompt', { session_id: fixedId, step_index: s.pending_prompt.step_index ?? 0 }).catch(() => {});
+    }
+    await sleep(100);
+  }
+  const fixedRounds = (await post('Control/ListAdaptiveRounds', { session_id: fixedId }, rig.analystToken)).rounds;
+  const whole = (v) => Math.abs(v - Math.round(v)) < 1e-6;
+  check(fixedRounds.length >= 1 && fixedRounds.every((r) => r.directions?.length === r.poses.length && r.directions.every((d) => whole(d.theta_i ?? 0) && whole(d.theta_o ?? 0))),
+    `the sample-fixed rounds carry each pose's directions, whole degrees as the operator sets them (${fixedRounds.map((r) => r.directions?.length).join(', ')})`);
+  const fixedPage = await pageCollectingErrors(browser, errors);
+  await fixedPage.goto(rig.url);
+  await fixedPage.waitForSelector('#login-view:not([hidden])');
+  await fixedPage.type('#token', rig.analystToken);
+  await fixedPage.click('#login-button');
+  // The sessions table is redrawn as it refreshes: click its row (again) until the session shows.
+  await fixedPage.waitForFunction((sid, n) => {
+    const row = document.querySelector(`tr[data-id="${sid}"]`);
+    if (!row) return false;
+    if (document.getElementById('rounds-where')?.textContent !== 'θi') {
+      row.click();
+      return false;
+    }
+    return document.querySelectorAll('#rounds-table tbody tr').length === n;
+  }, { timeout: 15000, polling: 500 }, fixedId, fixedRounds.length);
+  const lastFixed = fixedRounds.at(-1);
+  const d0 = lastFixed.directions[0];
+  let phi0 = Math.abs((d0.phi_o ?? 0) - (d0.phi_i ?? 0)) % 360;
+  if (phi0 > 180) phi0 = 360 - phi0;
+  if (Math.round(d0.theta_i ?? 0) === 0 || Math.round(d0.theta_o ?? 0) === 0) phi0 = 0;
+  const fixedPoses = await fixedPage.$$eval('#next-poses li', (l) => l.map((e) => e.textContent));
+  check(fixedPoses.length === Math.min(8, lastFixed.poses.length) && fixedPoses[0].startsWith(`θi ${Math.round(d0.theta_i ?? 0)}° θo ${Math.round(d0.theta_o ?? 0)}° φ ${Math.round(phi0)}°`),
+    `the console lists the sample-fixed round's directions (${fixedPoses[0]})`);
+  await fixedPage.screenshot({ path: join(out, 'adaptive-03-console-sample-fixed.png'), fullPage: true });
+  await fixedPage.close();
+  check(errors.length === 0, `no errors in the browser on the sample-fixed session${errors.length ? `: ${errors.join(' | ')}` : ''}`);
 } catch (e) {
   failed = true;
   console.error(e.stack || e);

@@ -70,9 +70,14 @@ std::string FirstPoses(const v1::AdaptiveRound& r) {
 }
 
 // The sample-fixed form: a pose is where the operator places lamp and detector, so its
-// directions (the isotropic reduction, whole degrees as the prompts give them) say more than the
-// equivalent stage pose.
-IsoDirection DirectionsOf(const v1::Pose& p) {
+// directions (the isotropic reduction, as the prompts give them) say more than the equivalent
+// stage pose. From the round's directions (AdaptiveRound.directions), else from its poses.
+IsoDirection DirectionsOf(const v1::AdaptiveRound& r, int i) {
+  if (r.directions_size() == r.poses_size()) {
+    const v1::Directions& d = r.directions(i);
+    return ToIsotropic(Directions{d.theta_i(), d.phi_i(), d.theta_o(), d.phi_o()});
+  }
+  const v1::Pose& p = r.poses(i);
   return ToIsotropic(PoseToDirections(Pose{p.alpha(), p.beta(), p.gamma(), p.delta()}));
 }
 
@@ -85,7 +90,7 @@ std::string IsoText(const IsoDirection& d) {
 std::string FirstDirections(const v1::AdaptiveRound& r) {
   std::string line = "  first directions:";
   for (int i = 0; i < r.poses_size(); ++i) {
-    const std::string more = (i == 0 ? " " : "; ") + IsoText(DirectionsOf(r.poses(i)));
+    const std::string more = (i == 0 ? " " : "; ") + IsoText(DirectionsOf(r, i));
     if (Columns(line + more) > kColumns) break;
     line += more;
   }
@@ -96,9 +101,9 @@ std::string FirstDirections(const v1::AdaptiveRound& r) {
 std::string ThetaIRange(const v1::AdaptiveRound& r) {
   if (r.poses_size() == 0) return "-";
   double lo = 90, hi = 0;
-  for (const v1::Pose& p : r.poses()) {
-    lo = std::min(lo, DirectionsOf(p).theta_i);
-    hi = std::max(hi, DirectionsOf(p).theta_i);
+  for (int i = 0; i < r.poses_size(); ++i) {
+    lo = std::min(lo, DirectionsOf(r, i).theta_i);
+    hi = std::max(hi, DirectionsOf(r, i).theta_i);
   }
   return StageAngle(lo) == StageAngle(hi) ? StageAngle(lo) + "°"
                                           : StageAngle(lo) + "°–" + StageAngle(hi) + "°";
