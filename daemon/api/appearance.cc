@@ -133,15 +133,14 @@ std::string DeterministicBytes(const google::protobuf::Message& message) {
 
 // The exports' fill chain (core/export/fill/chain.h) over the cache's indexes, as the sphere's
 // BRDF: the index asked for, then (another method's) the Delaunay fallback, then the model fitted
-// to the samples. The last two are made only when a direction first needs them.
+// to the samples. The last two are made only when a direction first needs them; the fallback
+// answers its first few directions from the readings near each when it can prove that answer the
+// whole triangulation's (NearFallback), and triangulates every reading only otherwise.
 class AppearanceChain {
  public:
   AppearanceChain(IndexCache& cache, grpc::ServerContext& context, const AppearanceSettings& s,
                   const std::shared_ptr<const IndexSnapshot>& index)
       : fallback_([this, &cache, &s](const CancelToken&) -> Result<exports::SpectrumSource> {
-          // A direction the index has no value for: the model is likely needed too (a direction
-          // outside the readings' hull), so it is fitted beside the Delaunay build.
-          model_.Start();
           Result<std::shared_ptr<const IndexSnapshot>> d =
               cache.Get(s.session, Quantity::kBrdf, interp::Method::kDelaunay, s.options);
           if (!d.ok()) return d.status().WithContext("the fill chain's Delaunay fallback");
@@ -156,6 +155,13 @@ class AppearanceChain {
           model_fit_ = std::move(*fitted);
           return exports::ModelSource(*model_fit_);
         }),
+        near_fallback_(
+            [&index, &s] { return interp::NearDelaunay::Create(index->samples, s.options); },
+            fallback_,
+            // A direction the index has no value for: the model is likely needed too
+            // (a direction outside the readings' hull), so it is fitted beside the
+            // fallback's work from here on.
+            [this] { model_.Start(); }),
         chain_(exports::FillPolicy::kChain, Stages(s, *index)),
         source_(chain_.Source()) {}
   AppearanceChain(const AppearanceChain&) = delete;
@@ -186,7 +192,7 @@ class AppearanceChain {
     stages.push_back(
         {exports::Provenance::kInterpolated, exports::InterpolatorSource(*index.interpolator)});
     if (s.method != interp::Method::kDelaunay) {
-      stages.push_back({exports::Provenance::kFallback, fallback_.Source()});
+      stages.push_back({exports::Provenance::kFallback, near_fallback_.Source()});
     }
     stages.push_back({exports::Provenance::kModel, model_.Source()});
     return stages;
@@ -196,6 +202,7 @@ class AppearanceChain {
   std::optional<fit::CookTorranceFit> model_fit_;
   LazyStage fallback_;
   LazyStage model_;
+  NearFallback near_fallback_;
   const exports::FillChain chain_;
   const exports::SpectrumSource source_;
 };

@@ -64,4 +64,42 @@ bool LazyStage::Lasting() const {
          code_ == StatusCode::kNotFound;
 }
 
+std::optional<interp::InterpStatus> NearFallback::Near(const IsoDirection& at,
+                                                       std::span<double> out) {
+  const std::lock_guard lock(mu_);
+  if (first_) {
+    first_ = false;
+    if (asked_) asked_();
+    if (Result<interp::NearDelaunay> made = make_near_(); made.ok()) {
+      near_.emplace(std::move(made).value());
+    } else {
+      to_whole_ = true;  // the whole stage says why, if it cannot be made either
+    }
+  }
+  if (to_whole_ || answered_ >= kNearDirections) {
+    to_whole_ = true;
+    return std::nullopt;
+  }
+  const double query[3] = {at.theta_i, at.theta_o, at.phi};
+  std::optional<interp::InterpStatus> answer = near_->SpectrumAt(query, out);
+  if (!answer) {
+    to_whole_ = true;
+    return std::nullopt;
+  }
+  ++answered_;
+  return answer;
+}
+
+exports::SpectrumSource NearFallback::Source() {
+  return [this](const IsoDirection& at, std::span<double> out) {
+    if (std::optional<interp::InterpStatus> answer = Near(at, out)) return *answer;
+    return whole_source_(at, out);
+  };
+}
+
+std::size_t NearFallback::near_answers() const {
+  const std::lock_guard lock(mu_);
+  return answered_;
+}
+
 }  // namespace brdf::daemon

@@ -17,6 +17,7 @@
 
 #include "core/call_context.h"
 #include "core/export/fill/spectrum_source.h"
+#include "core/interp/delaunay/near.h"
 #include "core/status.h"
 
 namespace brdf::daemon {
@@ -57,6 +58,45 @@ class LazyStage {
   std::optional<exports::SpectrumSource> source_;
   std::string error_;
   StatusCode code_ = StatusCode::kOk;
+};
+
+// The fill chain's Delaunay fallback for the few directions a lit sphere's index has no value
+// for (on a large session: the colour's 45°:0°, on the readings' edge θo = 0): each answered
+// from the readings near it when that is proved to be the whole triangulation's answer
+// (core/interp/delaunay/near.h: the same simplex, the same value up to rounding), so that the
+// whole triangulation (`whole`: seconds for 50,000 readings mirrored and swapped) is made only
+// for a direction that cannot be proved so, and from the (kNearDirections + 1)-th direction on
+// (a session with holes asks it for many pixels: one triangulation is then cheaper).
+//
+// Thread-safe, as SpectrumSource asks. `asked` runs once, at the first lookup (the appearance
+// chain starts its model fit there, as the whole stage's make did).
+class NearFallback {
+ public:
+  static constexpr std::size_t kNearDirections = 32;
+  // Makes the near answers' point set: once, at the first lookup; an error sends every
+  // direction to `whole`.
+  using MakeNear = std::function<Result<interp::NearDelaunay>()>;
+  NearFallback(MakeNear make_near, LazyStage& whole, std::function<void()> asked)
+      : make_near_(std::move(make_near)), whole_source_(whole.Source()), asked_(std::move(asked)) {}
+  NearFallback(const NearFallback&) = delete;
+  NearFallback& operator=(const NearFallback&) = delete;
+
+  exports::SpectrumSource Source();
+  // Directions answered near the readings, so far.
+  std::size_t near_answers() const;
+
+ private:
+  // The near answer at `at`, or nullopt when `whole` must answer it.
+  std::optional<interp::InterpStatus> Near(const IsoDirection& at, std::span<double> out);
+
+  MakeNear make_near_;
+  const exports::SpectrumSource whole_source_;
+  std::function<void()> asked_;
+  mutable std::mutex mu_;
+  bool first_ = true;                         // guarded by mu_
+  bool to_whole_ = false;                     // guarded by mu_: every direction to `whole`
+  std::optional<interp::NearDelaunay> near_;  // guarded by mu_
+  std::size_t answered_ = 0;                  // guarded by mu_
 };
 
 }  // namespace brdf::daemon

@@ -45,6 +45,11 @@
 //   (main 74.17 s, once); again 0.05 s for both. With the fit's sums eight bands at a time
 //   (85e5df8; load 7–13): 101 bands 8.98 s (main 11.36 s), 401 bands 9.30 s. bench/README.md,
 //   "The explorer's first lit spheres", has brdfd's CPU time beside it.
+//   2026-12-07 (issue 41: the fallback answers the colour's 45°:0° from the readings near it,
+//   proved equal to the whole Delaunay triangulation's, instead of triangulating 200,000 points),
+//   BRDF_BENCH_VIEWS=1, 3 repetitions, main's brdfd interleaved, load 14–21: 101 bands median
+//   5.38 s (main 21.61 s), 401 bands 18.09 s (main 27.01 s; the model fit is what is left);
+//   again 0.05 s. brdfd CPU per first render 1.52 s (main 5.08 s) and 4.52 s (main 8.85 s).
 import puppeteer from 'puppeteer-core';
 import { spawn, execFileSync } from 'node:child_process';
 import { mkdtempSync, writeFileSync, openSync, readFileSync, copyFileSync, existsSync } from 'node:fs';

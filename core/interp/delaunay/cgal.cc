@@ -66,4 +66,22 @@ Result<QhullTriangulation> TriangulateWithCgal3(std::span<const double> points) 
   return out;
 }
 
+bool OutsideCircumsphere(std::span<const double> points, const std::array<std::int32_t, 4>& cell,
+                         const std::vector<bool>& exempt) {
+  const auto at = [&points](std::size_t i) {
+    return Kernel::Point_3(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
+  };
+  std::array<Kernel::Point_3, 4> corner;
+  for (std::size_t m = 0; m < 4; ++m) corner[m] = at(static_cast<std::size_t>(cell[m]));
+  const std::size_t count = points.size() / 3;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (exempt[i]) continue;
+    if (CGAL::side_of_bounded_sphere(corner[0], corner[1], corner[2], corner[3], at(i)) !=
+        CGAL::ON_UNBOUNDED_SIDE) {
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace brdf::interp

@@ -5,7 +5,10 @@
 // such ties by symbolic perturbation instead). Pure: no I/O.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <span>
+#include <vector>
 
 #include "core/interp/delaunay/qhull.h"
 #include "core/status.h"
@@ -19,5 +22,11 @@ namespace brdf::interp {
 // Errors: kInvalidArgument for fewer than 4 points or all points on one plane (naming what to
 // measure).
 Result<QhullTriangulation> TriangulateWithCgal3(std::span<const double> points);
+
+// Whether every point of `points` (count * 3 coordinates) for which `exempt` is false lies
+// strictly outside the sphere through the four points `cell` (indices into `points`, not on one
+// plane), decided by CGAL's exact predicate: a point on the sphere counts as not outside.
+bool OutsideCircumsphere(std::span<const double> points, const std::array<std::int32_t, 4>& cell,
+                         const std::vector<bool>& exempt);
 
 }  // namespace brdf::interp

@@ -99,17 +99,13 @@ Interpolation DelaunayInterpolator::Impl::Answer(std::span<const double> query, 
   return out;
 }
 
-Result<std::unique_ptr<DelaunayInterpolator>> DelaunayInterpolator::Create(
-    std::shared_ptr<const SampleSet> samples, const Options& options) {
-  if (samples == nullptr) return InvalidArgument("Delaunay interpolation: no sample set given");
+Result<DistinctCloud> DistinctDelaunayPoints(const SampleSet& samples, const Options& options) {
   // Measured samples, then symmetry copies, scaled: the same cloud every method searches.
-  Result<PointCloud> built = BuildPointCloud(*samples, options);
-  if (!built.ok()) return built.status().WithContext("Delaunay interpolation");
-  const PointCloud& cloud = built.value();
-  const int dims = cloud.dims;
+  BRDF_ASSIGN_OR_RETURN(PointCloud cloud, BuildPointCloud(samples, options));
   const std::size_t count = cloud.size();
-  std::array<double, 4> scale{1, 1, 1, 1};
-  std::copy(cloud.scale.begin(), cloud.scale.end(), scale.begin());
+  DistinctCloud out;
+  out.dims = cloud.dims;
+  std::copy(cloud.scale.begin(), cloud.scale.end(), out.scale.begin());
 
   // Coincident points (after scaling) would make Qhull drop one of them arbitrarily: keep the
   // lowest rank (stable sort, so each run of equal points starts with it).
@@ -125,18 +121,32 @@ Result<std::unique_ptr<DelaunayInterpolator>> DelaunayInterpolator::Create(
   for (std::size_t i = 1; i < count; ++i) {
     if (!less(order[i - 1], order[i])) keep[order[i]] = false;
   }
-
-  std::vector<Impl::Point> points;
-  std::vector<double> distinct;
   for (std::size_t p = 0; p < count; ++p) {
     if (!keep[p]) continue;
-    Impl::Point& point = points.emplace_back();
-    point.sample = cloud.sample[p];
+    out.sample.push_back(cloud.sample[p]);
     const auto raw = cloud.point(p);
-    std::copy(raw.begin(), raw.end(), point.coords.begin());
+    out.coords.insert(out.coords.end(), raw.begin(), raw.end());
     const auto scaled = cloud.scaled_point(p);
-    distinct.insert(distinct.end(), scaled.begin(), scaled.end());
+    out.scaled.insert(out.scaled.end(), scaled.begin(), scaled.end());
   }
+  return out;
+}
+
+Result<std::unique_ptr<DelaunayInterpolator>> DelaunayInterpolator::Create(
+    std::shared_ptr<const SampleSet> samples, const Options& options) {
+  if (samples == nullptr) return InvalidArgument("Delaunay interpolation: no sample set given");
+  Result<DistinctCloud> built = DistinctDelaunayPoints(*samples, options);
+  if (!built.ok()) return built.status().WithContext("Delaunay interpolation");
+  DistinctCloud& cloud = built.value();
+  const int dims = cloud.dims;
+  const std::array<double, 4> scale = cloud.scale;
+  std::vector<Impl::Point> points(cloud.size());
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    points[p].sample = cloud.sample[p];
+    const auto raw = cloud.point(p);
+    std::copy(raw.begin(), raw.end(), points[p].coords.begin());
+  }
+  const std::vector<double>& distinct = cloud.scaled;
 
   // 3-D (isotropic) by CGAL, far faster on a rig's cospherical poses; 4-D by Qhull.
   BRDF_ASSIGN_OR_RETURN(

@@ -19,6 +19,7 @@
 //   vertices' smallest and largest values.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -29,6 +30,26 @@
 #include "core/status.h"
 
 namespace brdf::interp {
+
+// The points the method triangulates: the cloud of point_cloud.h (measured samples, then
+// symmetry copies, scaled) without coincident points (after scaling), each run of equal points
+// kept at its lowest rank, in rank order. Errors: as BuildPointCloud.
+struct DistinctCloud {
+  int dims = 0;
+  std::array<double, 4> scale{1, 1, 1, 1};
+  std::vector<std::size_t> sample;  // per point: the SampleSet index it copies
+  std::vector<double> coords;       // size() × dims, unscaled
+  std::vector<double> scaled;       // size() × dims, scaled: what is triangulated
+
+  std::size_t size() const { return sample.size(); }
+  std::span<const double> point(std::size_t p) const {
+    return {coords.data() + p * static_cast<std::size_t>(dims), static_cast<std::size_t>(dims)};
+  }
+  std::span<const double> scaled_point(std::size_t p) const {
+    return {scaled.data() + p * static_cast<std::size_t>(dims), static_cast<std::size_t>(dims)};
+  }
+};
+Result<DistinctCloud> DistinctDelaunayPoints(const SampleSet& samples, const Options& options);
 
 // Triangulates `samples` (3D or 4D) after Options.axis_scale and symmetry augmentation.
 // Errors: wrong dims, empty set, bad options, too few distinct points, degenerate input (all

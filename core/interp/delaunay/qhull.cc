@@ -146,4 +146,31 @@ Result<QhullTriangulation> TriangulateWithQhull(std::span<const double> points, 
   return out;
 }
 
+Result<std::vector<std::array<double, 4>>> ConvexHullPlanes3(std::span<const double> points) {
+  const std::size_t count = points.size() / 3;
+  if (count < 4 || count > 0x7fffffff) {
+    return InvalidArgument("convex hull of " + std::to_string(count) +
+                           " points: give 4 to 2^31 − 1 points not on one plane");
+  }
+  std::vector<coordT> coords(points.begin(), points.end());
+  char options[] = "qhull Qt";
+  MemoryStream errors;
+  QhullSession session(errors.file());
+  qhT* qh = session.get();
+  const int exit_code = qh_new_qhull(qh, 3, static_cast<int>(count), coords.data(), False, options,
+                                     nullptr, errors.file());
+  if (exit_code != 0) {
+    return InvalidArgument("convex hull of " + std::to_string(count) +
+                           " points failed (Qhull exit code " + std::to_string(exit_code) +
+                           "; are they all on one plane?): " + FirstLines(errors.Text(), 4));
+  }
+  std::vector<std::array<double, 4>> planes;
+  for (facetT* facet = qh->facet_list; facet != nullptr && facet->next != nullptr;
+       facet = facet->next) {
+    if (facet->normal == nullptr) continue;
+    planes.push_back({facet->normal[0], facet->normal[1], facet->normal[2], facet->offset});
+  }
+  return planes;
+}
+
 }  // namespace brdf::interp

@@ -4,6 +4,7 @@
 // end up in the error message).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -29,5 +30,11 @@ struct QhullTriangulation {
 // Errors: kInvalidArgument for degenerate input (all points on a hyperplane, too few points),
 // with Qhull's own explanation appended.
 Result<QhullTriangulation> TriangulateWithQhull(std::span<const double> points, int dims);
+
+// The planes of the convex hull of `points` (count * 3 coordinates) by Qhull ("Qt"): per face
+// its unit normal (pointing out) and offset, n·x + offset > 0 beyond it; every point is on the
+// inner side up to Qhull's precision. Errors (kInvalidArgument): fewer than 4 points, all on one
+// plane.
+Result<std::vector<std::array<double, 4>>> ConvexHullPlanes3(std::span<const double> points);
 
 }  // namespace brdf::interp

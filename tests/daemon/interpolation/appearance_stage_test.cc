@@ -10,6 +10,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
+#include <memory>
 #include <thread>
 #include <vector>
 
@@ -95,6 +97,83 @@ TEST(LazyStageTest, AStartNobodyAskedForIsCancelledAndWaitedForWhenTheStageGoes)
   }
   EXPECT_TRUE(saw_cancel.load());
   EXPECT_TRUE(ended.load());
+}
+
+// NearFallback: the few directions answered near the readings, the whole stage made only after.
+struct NearSetup {
+  std::shared_ptr<interp::SampleSet> samples = std::make_shared<interp::SampleSet>(3, 2);
+  int whole_makes = 0;
+  int asked = 0;
+  LazyStage whole{[this](const CancelToken&) -> Result<exports::SpectrumSource> {
+    ++whole_makes;
+    return Ones();
+  }};
+  NearSetup() {
+    // A lattice of readings θi, θo 0…80, φ 0…180: mirrored and swapped, 45°:0° is inside.
+    std::int64_t id = 0;
+    for (double ti = 0; ti <= 80; ti += 10) {
+      for (double to = 0; to <= 80; to += 10) {
+        for (double phi = 0; phi <= 180; phi += 30) {
+          const std::vector<double> at{ti + 0.01 * id, to, phi};
+          const std::vector<double> spectrum{at[0] + at[1], phi};
+          EXPECT_TRUE(samples->Add(id++, at, spectrum).ok());
+        }
+      }
+    }
+  }
+  NearFallback::MakeNear Make() const {
+    return [set = samples] {
+      interp::Options options;
+      options.mirror_phi = true;
+      options.reciprocity = true;
+      return interp::NearDelaunay::Create(set, options);
+    };
+  }
+};
+
+TEST(NearFallbackTest, AFewDirectionsAreAnsweredWithoutTheWholeStage) {
+  NearSetup setup;
+  NearFallback fallback(setup.Make(), setup.whole, [&setup] { ++setup.asked; });
+  EXPECT_EQ(setup.asked, 0);
+  const exports::SpectrumSource source = fallback.Source();
+  std::vector<double> out(2, -1);
+  EXPECT_EQ(source({45, 0, 0}, out), InterpStatus::kOk);
+  EXPECT_NEAR(out[0], 45, 1e-9);  // θi + θo is linear: every blend reproduces it
+  EXPECT_EQ(source({89.9, 89.9, 10}, out), InterpStatus::kOutsideHull);  // beyond the readings
+  EXPECT_EQ(setup.whole_makes, 0);
+  EXPECT_EQ(setup.asked, 1);
+  EXPECT_EQ(fallback.near_answers(), 2u);
+  EXPECT_EQ(setup.whole.error(), "");
+}
+
+TEST(NearFallbackTest, TheWholeStageAnswersFromTheDirectionAfterTheLast) {
+  NearSetup setup;
+  NearFallback fallback(setup.Make(), setup.whole, [&setup] { ++setup.asked; });
+  const exports::SpectrumSource source = fallback.Source();
+  std::vector<double> out(2, -1);
+  for (std::size_t i = 0; i < NearFallback::kNearDirections; ++i) {
+    EXPECT_EQ(source({20.0 + static_cast<double>(i), 30, 40}, out), InterpStatus::kOk);
+  }
+  EXPECT_EQ(setup.whole_makes, 0);
+  EXPECT_EQ(source({45, 0, 0}, out), InterpStatus::kOk);
+  EXPECT_EQ(out, std::vector<double>(2, 1));  // the whole stage's answer (Ones)
+  EXPECT_EQ(source({20, 30, 40}, out), InterpStatus::kOk);
+  EXPECT_EQ(setup.whole_makes, 1);
+  EXPECT_EQ(fallback.near_answers(), NearFallback::kNearDirections);
+  EXPECT_EQ(setup.asked, 1);
+}
+
+TEST(NearFallbackTest, ReadingsItCannotUseGoToTheWholeStage) {
+  NearSetup setup;
+  NearFallback fallback([] { return Result<interp::NearDelaunay>(InvalidArgument("4D")); },
+                        setup.whole, [&setup] { ++setup.asked; });
+  const exports::SpectrumSource source = fallback.Source();
+  std::vector<double> out(2, -1);
+  EXPECT_EQ(source({45, 0, 0}, out), InterpStatus::kOk);
+  EXPECT_EQ(out, std::vector<double>(2, 1));
+  EXPECT_EQ(setup.whole_makes, 1);
+  EXPECT_EQ(setup.asked, 1);
+  EXPECT_EQ(fallback.near_answers(), 0u);
 }
 
 }  // namespace
