@@ -1,6 +1,7 @@
 #include "storage/session_rows.h"
 
 #include "core/status.h"
+#include "storage/round_picks.h"
 #include "storage/spectrum_blob.h"
 #include "storage/uncertainty_columns.h"
 
@@ -33,6 +34,10 @@ const std::string_view kEventColumns = "id, session_id, at, state, reason";
 
 const std::string_view kReadingPointColumns =
     "id, kind, alpha, beta, gamma, delta, theta_i, phi_i, theta_o, phi_o, flagged";
+
+const std::string_view kRoundColumns =
+    "session_id, round, first_step, step_count, picks, predicted_gain, uncertainty_left, "
+    "readings_used, created_at";
 
 namespace {
 
@@ -81,6 +86,20 @@ Result<SessionEventRecord> ReadEvent(const Statement& st, const std::string& pat
                           "event " + std::to_string(e.id) + " of " + SessionName(e.session_id)));
   e.reason = st.Text(4);
   return e;
+}
+
+Result<RoundRecord> ReadRound(const Statement& st) {
+  RoundRecord r;
+  r.session_id = st.Int64(0);
+  r.round = st.Int(1);
+  r.first_step = st.Int(2);
+  r.step_count = st.Int(3);
+  BRDF_ASSIGN_OR_RETURN(r.picks, DecodePicks(st.Text(4)));
+  r.predicted_gain = st.Double(5);
+  r.uncertainty_left = st.Double(6);
+  r.readings_used = st.Int(7);
+  r.created_at = st.Double(8);
+  return r;
 }
 
 Result<StepRecord> ReadStep(const Statement& st, const std::string& path) {

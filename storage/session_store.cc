@@ -448,26 +448,15 @@ Result<std::vector<RoundRecord>> SessionStore::GetRounds(std::int64_t session) {
   BRDF_ASSIGN_OR_RETURN(ReaderPool::Lease db, readers_->Acquire());
   BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::BeginRead(*db));
   BRDF_RETURN_IF_ERROR(RequireSession(*db, session));
-  BRDF_ASSIGN_OR_RETURN(
-      Statement st,
-      db->Prepare("SELECT round, first_step, step_count, picks, predicted_gain, uncertainty_left, "
-                  "readings_used, created_at FROM adaptive_rounds WHERE session_id = ? "
-                  "ORDER BY round"));
+  BRDF_ASSIGN_OR_RETURN(Statement st,
+                        db->Prepare("SELECT " + std::string(kRoundColumns) +
+                                    " FROM adaptive_rounds WHERE session_id = ? ORDER BY round"));
   st.Bind(1, session);
   std::vector<RoundRecord> out;
   while (true) {
     BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
     if (!row) break;
-    RoundRecord r;
-    r.session_id = session;
-    r.round = st.Int(0);
-    r.first_step = st.Int(1);
-    r.step_count = st.Int(2);
-    BRDF_ASSIGN_OR_RETURN(r.picks, DecodePicks(st.Text(3)));
-    r.predicted_gain = st.Double(4);
-    r.uncertainty_left = st.Double(5);
-    r.readings_used = st.Int(6);
-    r.created_at = st.Double(7);
+    BRDF_ASSIGN_OR_RETURN(RoundRecord r, ReadRound(st));
     out.push_back(std::move(r));
   }
   return out;

@@ -1,5 +1,6 @@
 // SessionStore's side of shipping to the lab archive: the outbox and marks of schema v3 (and the
-// events mark of v4; schema.md, archive-schema.md). The archive side is archive_writer.h.
+// events mark of v4, the adaptive rounds of v6; schema.md, archive/schema.md). The archive side is
+// archive_writer.h.
 #include <set>
 #include <string>
 #include <utility>
@@ -112,6 +113,53 @@ Status ReadChangedSteps(Database& db, const std::string& path, const OutboxChang
   return Status::Ok();
 }
 
+// The rounds the batch's steps begin (a round's steps were noted in the outbox when it was stored,
+// its first among them), and every round of the sessions shipped with all their steps: a round
+// reaches the archive in the same transaction as its first step.
+Status ReadChangedRounds(Database& db, const OutboxChanges& changes, ShipBatch& batch) {
+  const std::string select =
+      "SELECT " + std::string(kRoundColumns) + " FROM adaptive_rounds WHERE session_id = ?";
+  BRDF_ASSIGN_OR_RETURN(Statement all, db.Prepare(select + " ORDER BY round"));
+  BRDF_ASSIGN_OR_RETURN(Statement one, db.Prepare(select + " AND first_step = ?"));
+  auto read = [&batch](Statement& st) -> Status {
+    while (true) {
+      BRDF_ASSIGN_OR_RETURN(bool row, st.Step());
+      if (!row) break;
+      BRDF_ASSIGN_OR_RETURN(RoundRecord r, ReadRound(st));
+      batch.rounds.push_back({std::move(r)});
+    }
+    st.Reset();
+    return Status::Ok();
+  };
+  for (std::int64_t id : changes.all_steps) {
+    all.Bind(1, id);
+    BRDF_RETURN_IF_ERROR(read(all));
+  }
+  for (const auto& [id, index] : changes.steps) {
+    if (changes.all_steps.count(id) != 0) continue;
+    one.Bind(1, id).Bind(2, index);
+    BRDF_RETURN_IF_ERROR(read(one));
+  }
+  return Status::Ok();
+}
+
+// Rounds stored before the shipper sent them (a brdfd older than archive schema v5) reach the
+// archive once: the sessions that have rounds are queued whole, the first time shipping is on
+// with this brdfd, and the mark 'rounds' says it was done. `queued_all`: every session was just
+// queued (shipping was off), so only the mark is set.
+Status QueueStoredRoundsOnce(Database& db, bool queued_all, const std::string& what) {
+  BRDF_ASSIGN_OR_RETURN(std::int64_t done,
+                        db.QueryInt64("SELECT count(*) FROM archive_marks WHERE name = 'rounds'"));
+  if (done != 0) return Status::Ok();
+  if (!queued_all) {
+    BRDF_RETURN_IF_ERROR(db.Exec("INSERT INTO archive_outbox (session_id, step_index) "
+                                 "SELECT DISTINCT session_id, -1 FROM adaptive_rounds "
+                                 "ORDER BY session_id")
+                             .WithContext(what));
+  }
+  return db.Exec("INSERT INTO archive_marks (name, value) VALUES ('rounds', 1)").WithContext(what);
+}
+
 // The readings at or below the readings mark (the archive has them) of the sessions whose budgets
 // were replaced, with their budgets as they are now.
 Status ReadRebudgeted(Database& db, const std::string& path, const std::set<std::int64_t>& sessions,
@@ -211,8 +259,13 @@ Status SessionStore::SetArchiveShipping(bool enabled) {
   Database& db = *writer_;
   BRDF_ASSIGN_OR_RETURN(Transaction tx, Transaction::Begin(db));
   BRDF_ASSIGN_OR_RETURN(std::int64_t was, Mark(db, "enabled"));
+  if (was == 1 && enabled) {
+    BRDF_RETURN_IF_ERROR(QueueStoredRoundsOnce(db, /*queued_all=*/false, what));
+    return tx.Commit().WithContext(what);
+  }
   if ((was == 1) == enabled) return Status::Ok();
   if (enabled) {
+    BRDF_RETURN_IF_ERROR(QueueStoredRoundsOnce(db, /*queued_all=*/true, what));
     BRDF_RETURN_IF_ERROR(db.Exec("INSERT INTO archive_outbox (session_id, step_index) "
                                  "SELECT id, -1 FROM sessions ORDER BY id")
                              .WithContext(what));
@@ -234,6 +287,7 @@ Result<ShipBatch> SessionStore::NextShipBatch(int max_readings, int max_changes)
   BRDF_RETURN_IF_ERROR(ReadOutbox(*db, max_changes, changes, batch));
   BRDF_RETURN_IF_ERROR(ReadChangedSessions(*db, path_, changes.sessions, batch));
   BRDF_RETURN_IF_ERROR(ReadChangedSteps(*db, path_, changes, batch));
+  BRDF_RETURN_IF_ERROR(ReadChangedRounds(*db, changes, batch));
 
   BRDF_ASSIGN_OR_RETURN(batch.readings_through, Mark(*db, "readings"));
   BRDF_ASSIGN_OR_RETURN(batch.devices_through, Mark(*db, "devices"));

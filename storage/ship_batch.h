@@ -1,8 +1,8 @@
 // What the rig ships to the lab archive in one transaction (SessionStore::NextShipBatch): the
-// current rows of the sessions and steps changed since they were last shipped, and the readings,
-// devices, audit entries and session events above their high-water marks, all read from one
-// snapshot of the rig's database. The marks the batch reaches move only once the archive has
-// committed it (SessionStore::MarkShipped).
+// current rows of the sessions and steps changed since they were last shipped, the adaptive
+// rounds those steps begin, and the readings, devices, audit entries and session events above
+// their high-water marks, all read from one snapshot of the rig's database. The marks the batch
+// reaches move only once the archive has committed it (SessionStore::MarkShipped).
 #pragma once
 
 #include <cstdint>
@@ -18,6 +18,20 @@ namespace brdf::storage {
 // (-1: every step of the session; NULL: the session's row; ≥ 0: that step).
 inline constexpr std::int64_t kOutboxBudgetsReplaced = -2;
 
+// A round of an adaptive session as the archive keeps it (archive schema v5, adaptive_rounds):
+// the rig's record and what the round meant for the budget, as the rig's ListAdaptiveRounds
+// answers it (daemon/engine/adaptive_rounds.h, StoredRounds: the plan's timing model for real
+// devices on the rig's description) -- the rig time and prompts the session had spent when the
+// round was chosen, and what the round's own steps cost. NextShipBatch reads the record; the
+// shipper, which knows the rig's description, fills the spend before writing.
+struct ArchivedRound {
+  RoundRecord record;
+  double spent_rig_s = 0;
+  int spent_prompts = 0;
+  double rig_s = 0;
+  int prompts = 0;
+};
+
 struct ShipBatch {
   std::int64_t outbox_through = 0;  // the last outbox entry covered (0: none)
   std::vector<SessionRecord> sessions;
@@ -26,6 +40,9 @@ struct ShipBatch {
   std::vector<DeviceRecord> devices;
   std::vector<AuditRecord> audit;
   std::vector<SessionEventRecord> events;  // (v4) of sessions in `uuids`
+  // The rounds whose first step is among `steps` (a round's steps are noted in the outbox when it
+  // is stored), every round of a session shipped with all its steps; of sessions in `uuids`.
+  std::vector<ArchivedRound> rounds;
   // Readings the archive has already (at or below the readings mark) whose uncertainty budgets the
   // rig replaced since (SessionStore::ReplaceReadingUncertainties, at a session's end): the
   // archive replaces theirs. Sessions in `uuids`.
@@ -38,7 +55,8 @@ struct ShipBatch {
 
   bool empty() const {
     return sessions.empty() && steps.empty() && readings.empty() && devices.empty() &&
-           audit.empty() && events.empty() && rebudgeted.empty() && outbox_through == 0;
+           audit.empty() && events.empty() && rebudgeted.empty() && rounds.empty() &&
+           outbox_through == 0;
   }
 };
 

@@ -206,12 +206,13 @@ grpc::Status ControlService::GetRigStatus(grpc::ServerContext* /*context*/,
 grpc::Status ControlService::ListAdaptiveRounds(grpc::ServerContext* /*context*/,
                                                 const v1::ListAdaptiveRoundsRequest* request,
                                                 v1::ListAdaptiveRoundsResponse* response) {
-  if (rig_ == nullptr) return NoRig("ListAdaptiveRounds", request->session_id());
   SessionId id = 0;
   if (grpc::Status st = ParseSessionIdField(request->session_id(), "session_id", &id); !st.ok()) {
     return st;
   }
-  Result<std::vector<v1::AdaptiveRound>> rounds = rig_->AdaptiveRounds(id);
+  // brdfd: its store; brdf-archive: the rounds the rigs shipped.
+  Result<std::vector<v1::AdaptiveRound>> rounds =
+      rig_ != nullptr ? rig_->AdaptiveRounds(id) : catalogue_.AdaptiveRounds(id);
   if (!rounds.ok()) return ToGrpcStatus(rounds.status());
   response->mutable_rounds()->Reserve(static_cast<int>(rounds->size()));
   for (v1::AdaptiveRound& r : *rounds) *response->add_rounds() = std::move(r);

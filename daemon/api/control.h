@@ -58,7 +58,8 @@ class ControlService final : public ControlServiceBase {
   // (then UNAVAILABLE, after the events already queued were sent).
   grpc::Status WatchSession(grpc::ServerContext* context, const v1::WatchSessionRequest* request,
                             grpc::ServerWriter<v1::SessionEvent>* writer) override;
-  // An adaptive session's stored rounds (the rig's store; brdf-archive has none).
+  // An adaptive session's stored rounds: the rig's store, or on brdf-archive the rounds the rigs
+  // shipped (SessionCatalogue::AdaptiveRounds).
   grpc::Status ListAdaptiveRounds(grpc::ServerContext* context,
                                   const v1::ListAdaptiveRoundsRequest* request,
                                   v1::ListAdaptiveRoundsResponse* response) override;

@@ -31,6 +31,7 @@
 #include "core/export/fill/session_interpolant.h"
 #include "core/export/fill/spectrum_source.h"
 #include "core/export/fill/uncertain_chain.h"
+#include "core/export/fill/uncertain_grid.h"
 #include "core/export/fill/uncertainty_summary.h"
 #include "core/export/grid/npy_writer.h"
 #include "core/export/grid/regular_grid.h"
@@ -418,17 +419,6 @@ std::string FileName(const ExportSettings& s) {
   }
 }
 
-// A companion part's file name: `file` with ".<part>" before its extension
-// ("session-3-grid-brdf.npy", "u" → "session-3-grid-brdf.u.npy"); `extension` replaces the
-// file's when given (".json").
-std::string PartFileName(const std::string& file, const std::string& part,
-                         const std::string& extension = "") {
-  const std::size_t dot = file.rfind('.');
-  const std::string stem = dot == std::string::npos ? file : file.substr(0, dot);
-  const std::string ext = dot == std::string::npos ? "" : file.substr(dot);
-  return stem + "." + part + (extension.empty() ? ext : extension);
-}
-
 void AddSkipped(const std::vector<exports::SkippedReading>& skipped, v1::ExportReport* report) {
   report->set_skipped_readings(skipped.size());
   if (!skipped.empty()) report->set_first_skip_reason(skipped.front().reason);
@@ -508,28 +498,23 @@ Status ExportReadingsCsv(const std::shared_ptr<const exports::Session>& session,
   return Status();
 }
 
-// The grid's uncertainty arrays (include_uncertainty): one .npy writer per uncertainty plane,
-// each streamed as a part of its own (ExportData.part "u", "u_measurement", "u_interpolation").
+// The grid's uncertainty arrays (include_uncertainty): one .npy writer per array
+// (exports::kUncertaintyArrays), each streamed as a part of its own (ExportData.part "u",
+// "u_measurement", "u_interpolation").
 class GridUncertaintyParts {
  public:
-  GridUncertaintyParts(ExportStream& stream, const std::string& file, exports::NpyType type) {
-    for (exports::UncertainPlane plane :
-         {exports::UncertainPlane::kCombined, exports::UncertainPlane::kMeasurement,
-          exports::UncertainPlane::kInterpolation}) {
-      const std::string name = exports::UncertainPlaneName(plane);
-      buffers_.push_back(std::make_unique<ExportStreamBuf>(stream, name));
-      outs_.push_back(std::make_unique<std::ostream>(buffers_.back().get()));
-      writers_.push_back(std::make_unique<exports::NpyGridWriter>(*outs_.back(), type));
-      files_.push_back({plane, PartFileName(file, name)});
+  GridUncertaintyParts(ExportStream& stream, const std::string& file, exports::NpyType type)
+      : files_(exports::UncertaintyFiles(file)) {
+    for (std::size_t i = 0; i < files_.size(); ++i) {
+      buffers_[i] = std::make_unique<ExportStreamBuf>(
+          stream, exports::UncertainPlaneName(exports::kUncertaintyArrays[i]));
+      outs_[i] = std::make_unique<std::ostream>(buffers_[i].get());
+      writers_[i] = std::make_unique<exports::NpyGridWriter>(*outs_[i], type);
     }
   }
-  // The value's sink first, then the planes' (kUncertainPlanes in all).
-  std::vector<exports::GridSink*> Sinks(exports::GridSink& values) const {
-    std::vector<exports::GridSink*> sinks = {&values};
-    for (const auto& w : writers_) sinks.push_back(w.get());
-    return sinks;
+  std::array<exports::GridSink*, 3> Sinks() const {
+    return {writers_[0].get(), writers_[1].get(), writers_[2].get()};
   }
-  const std::vector<exports::UncertaintyFile>& files() const { return files_; }
   // Each part in the report (its bytes are set as the report is sent).
   void AddTo(v1::ExportReport* report) const {
     for (const exports::UncertaintyFile& f : files_) {
@@ -540,10 +525,10 @@ class GridUncertaintyParts {
   }
 
  private:
-  std::vector<std::unique_ptr<ExportStreamBuf>> buffers_;
-  std::vector<std::unique_ptr<std::ostream>> outs_;
-  std::vector<std::unique_ptr<exports::NpyGridWriter>> writers_;
   std::vector<exports::UncertaintyFile> files_;
+  std::array<std::unique_ptr<ExportStreamBuf>, 3> buffers_;
+  std::array<std::unique_ptr<std::ostream>, 3> outs_;
+  std::array<std::unique_ptr<exports::NpyGridWriter>, 3> writers_;
 };
 
 void AddGridCounts(const exports::GridReport& r, v1::ExportReport* report) {
@@ -559,7 +544,7 @@ void AddGridCounts(const exports::GridReport& r, v1::ExportReport* report) {
 }
 
 // A grid as .npy or CSV; with include_uncertainty (.npy only) the same pass through the
-// uncertain fill chain (fill/uncertain_chain.h) also streams the three uncertainty arrays.
+// uncertain fill chain also streams the three uncertainty arrays (fill/uncertain_grid.h).
 Status ExportGrid(const exports::Session& session, const ExportSettings& s, const CallContext& ctx,
                   ExportStream& stream, std::ostream& out, v1::ExportReport* report) {
   BRDF_ASSIGN_OR_RETURN(exports::RegularGrid grid,
@@ -581,42 +566,38 @@ Status ExportGrid(const exports::Session& session, const ExportSettings& s, cons
   exports::CsvGridWriter csv(out, info);
   const bool as_npy = s.format == v1::EXPORT_FORMAT_GRID_NPY;
   exports::GridSink& values = as_npy ? static_cast<exports::GridSink&>(npy) : csv;
-  std::optional<exports::UncertainChain> uncertain;
-  std::optional<GridUncertaintyParts> parts;
-  if (s.uncertainty) {
-    uncertain = exports::MakeUncertainChain(in);
-    parts.emplace(stream, FileName(s), type);
-  }
-  exports::PlaneSplitSink split(parts ? parts->Sinks(values) : std::vector<exports::GridSink*>{});
-  const exports::FillChain& chain = uncertain ? *uncertain->chain : *in.chain;
   exports::RunControl control;
   control.threads = 0;  // every hardware thread: the executor waits on devices, not the CPU
   control.progress = [&stream](double f) { stream.Progress("resampling", 0.05 + 0.95 * f); };
-  BRDF_ASSIGN_OR_RETURN(
-      exports::GridReport r,
-      exports::ResampleOnGrid(chain.Source(), grid, bands, control, ctx,
-                              parts ? static_cast<exports::GridSink&>(split) : values,
-                              parts ? exports::kUncertainPlanes : 1));
+  // With uncertainty: the same pass through the uncertain chain (fill/uncertain_grid.h).
+  std::optional<GridUncertaintyParts> parts;
+  exports::UncertainGrid u;
+  if (s.uncertainty) {
+    parts.emplace(stream, FileName(s), type);
+    BRDF_ASSIGN_OR_RETURN(u, exports::ResampleWithUncertainty(in, grid, s.quantity, control, ctx,
+                                                              values, parts->Sinks(), FileName(s)));
+  } else {
+    BRDF_ASSIGN_OR_RETURN(
+        u.report, exports::ResampleOnGrid(in.chain->Source(), grid, bands, control, ctx, values));
+    u.tally = in.chain->Tally();
+  }
+  const exports::GridReport& r = u.report;
   AddGridCounts(r, report);
   AddSkipped(in.derived->skipped, report);
-  AddFill(chain.Tally(), report);
+  AddFill(u.tally, report);
   if (as_npy) {
     for (std::size_t n : {grid.theta_i.count, grid.theta_o.count, grid.phi.count}) {
       report->add_shape(n);
     }
     report->add_shape(bands.count);
     exports::InterpolantInfo how = in.Info();
-    how.fill_json = chain.Tally().Json();
-    std::string uncertainty_json;
+    how.fill_json = u.tally.Json();
     if (parts) {
-      uncertainty_json = exports::UncertaintyJson(uncertain->coverage, s.quantity, parts->files());
       parts->AddTo(report);
-      for (std::string& w : exports::UncertaintyWarnings(uncertain->coverage)) {
-        report->add_warnings(std::move(w));
-      }
+      for (std::string& w : u.warnings) report->add_warnings(std::move(w));
     }
     report->set_description_json(
-        exports::GridDescriptionJson(grid, bands, info, r, how, uncertainty_json));
+        exports::GridDescriptionJson(grid, bands, info, r, how, u.uncertainty_json));
   }
   return Status();
 }
@@ -639,7 +620,7 @@ Status SendUncertaintySummary(const exports::SessionInterpolant& in, const Expor
   if (!part) return IoError("Export: sending the uncertainty summary failed");
   v1::ExportPart* named = report->add_parts();
   named->set_name("uncertainty");
-  named->set_file_name(PartFileName(FileName(s), "uncertainty", ".json"));
+  named->set_file_name(exports::CompanionFileName(FileName(s), "uncertainty", ".json"));
   return Status();
 }
 

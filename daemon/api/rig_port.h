@@ -1,8 +1,9 @@
 // RigPort: the rig behind a server, when it has one (brdfd; brdf-archive has none). The Control
 // service's rig verbs (SubmitPlan, ValidatePlan, Start/Pause/Resume/Abort, AnswerPrompt),
 // GetRigStatus, WatchSession and ListAdaptiveRounds go through it; without one they answer
-// FAILED_PRECONDITION naming the session's rig (api/control.cc). brdfd plugs in its session manager
-// (rig/port.h).
+// FAILED_PRECONDITION naming the session's rig (api/control.cc), except ListAdaptiveRounds, which
+// brdf-archive answers from the rounds the rigs shipped (SessionCatalogue::AdaptiveRounds). brdfd
+// plugs in its session manager (rig/port.h).
 //
 // Every verb returns the session as the API shows it after the call, or a Status whose code maps
 // onto a gRPC code (api/common.h: ToGrpcStatus); each is audited by the rig with `actor`.

@@ -83,6 +83,15 @@ class SessionCatalogue {
   // on its thread, while the stream lasts.
   virtual SessionFollow Follow(SessionId session) = 0;
 
+  // An adaptive session's rounds, oldest first, for a server without a rig (brdf-archive: the
+  // rounds its rigs shipped, with the spend each rig computed); empty for a session without
+  // rounds, kNotFound for no such session. A server with a rig answers from its RigPort instead;
+  // a catalogue that keeps no rounds says kFailedPrecondition (the default).
+  virtual Result<std::vector<v1::AdaptiveRound>> AdaptiveRounds(SessionId session) {
+    return FailedPrecondition("session " + std::to_string(session) +
+                              ": this server keeps no adaptive rounds; ask its rig's brdfd");
+  }
+
   // The plan's averaging count (the meter's, the same for every reading of the session); 0 when
   // the plan does not say or cannot be read.
   virtual std::uint32_t Averages(SessionId session) = 0;

@@ -9,6 +9,7 @@
 
 #include "daemon/api/common.h"
 #include "daemon/sessions/session_plan.h"
+#include "daemon/wire/round.h"
 #include "daemon/wire/session.h"
 
 namespace brdf::daemon {
@@ -107,6 +108,14 @@ std::uint32_t ArchiveCatalogue::Averages(SessionId session) {
   if (!record.ok()) return 0;
   Result<SessionPlan> plan = ParseSessionPlan(*record);
   return plan.ok() ? plan->plan.measurement().averages() : 0;
+}
+
+Result<std::vector<v1::AdaptiveRound>> ArchiveCatalogue::AdaptiveRounds(SessionId session) {
+  BRDF_ASSIGN_OR_RETURN(std::vector<storage::ArchivedRound> rounds, archive_->GetRounds(session));
+  std::vector<v1::AdaptiveRound> out;
+  out.reserve(rounds.size());
+  for (const storage::ArchivedRound& r : rounds) out.push_back(ToProtoRound(r));
+  return out;
 }
 
 }  // namespace brdf::daemon

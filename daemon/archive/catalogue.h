@@ -26,6 +26,8 @@ class ArchiveCatalogue final : public SessionCatalogue {
   // before its last readings). Waits: a second, or until stopping.
   SessionFollow Follow(SessionId session) override;
   std::uint32_t Averages(SessionId session) override;
+  // The rounds the rigs shipped (archive schema v5), each with the spend its rig computed.
+  Result<std::vector<v1::AdaptiveRound>> AdaptiveRounds(SessionId session) override;
 
  private:
   std::shared_ptr<storage::ArchiveReader> archive_;

@@ -16,6 +16,7 @@
 #include "core/plan/sample.h"
 #include "core/readings/derive.h"
 #include "daemon/wire/plan.h"
+#include "daemon/wire/round.h"
 #include "daemon/wire/values.h"
 #include "storage/session_readings.h"
 
@@ -170,28 +171,8 @@ Result<std::vector<v1::AdaptiveRound>> StoredRounds(storage::SessionStore& store
 }
 
 v1::AdaptiveRound ToProtoRound(const storage::RoundRecord& round, const RoundSpend& spend) {
-  v1::AdaptiveRound out;
-  out.set_round(static_cast<std::uint32_t>(round.round));
-  for (const storage::RoundPick& p : round.picks) {
-    *out.add_poses() = ToProtoPose(p.pose);
-    out.add_pose_gains(p.predicted_gain);
-    const Directions d = PoseToDirections(p.pose);  // a pick's pose is in model angles
-    v1::Directions* to = out.add_directions();
-    to->set_theta_i(d.theta_i);
-    to->set_phi_i(d.phi_i);
-    to->set_theta_o(d.theta_o);
-    to->set_phi_o(d.phi_o);
-  }
-  out.set_predicted_gain(round.predicted_gain);
-  out.set_uncertainty_left(round.uncertainty_left);
-  out.set_readings_used(static_cast<std::uint32_t>(round.readings_used));
-  out.set_first_step(static_cast<std::uint32_t>(round.first_step));
-  out.set_step_count(static_cast<std::uint32_t>(round.step_count));
-  out.set_spent_rig_s(spend.before.seconds);
-  out.set_spent_prompts(static_cast<std::uint32_t>(spend.before.prompts));
-  out.set_rig_s(spend.cost.seconds);
-  out.set_prompts(static_cast<std::uint32_t>(spend.cost.prompts));
-  return out;
+  return ToProtoRound(storage::ArchivedRound{round, spend.before.seconds, spend.before.prompts,
+                                             spend.cost.seconds, spend.cost.prompts});
 }
 
 v1::AdaptiveStop ToProtoStop(const RoundDecision& decision) {

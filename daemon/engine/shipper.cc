@@ -3,8 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <map>
 #include <utility>
+#include <vector>
 
+#include "daemon/engine/adaptive_rounds.h"
+#include "daemon/sessions/session_plan.h"
 #include "daemon/wire/values.h"
 #include "storage/archive/pg.h"
 #include "storage/archive/schema.h"
@@ -43,6 +47,36 @@ v1::ArchiveState FailureState(const Status& st) {
   return st.code() == StatusCode::kDisconnected || st.code() == StatusCode::kTimeout
              ? v1::ARCHIVE_STATE_UNREACHABLE
              : v1::ARCHIVE_STATE_REFUSED;
+}
+
+// The spend of each of the batch's rounds as ListAdaptiveRounds on this rig answers it
+// (StoredRounds: the session's plan and stored steps, on the rig's description).
+Status FillRoundSpends(storage::SessionStore& store, const plan::RigDescription& rig,
+                       storage::ShipBatch& batch) {
+  std::map<std::int64_t, std::vector<v1::AdaptiveRound>> by_session;
+  for (storage::ArchivedRound& a : batch.rounds) {
+    const std::int64_t id = a.record.session_id;
+    auto it = by_session.find(id);
+    if (it == by_session.end()) {
+      BRDF_ASSIGN_OR_RETURN(storage::SessionRecord record, store.GetSession(id));
+      BRDF_ASSIGN_OR_RETURN(SessionPlan plan, ParseSessionPlan(record));
+      BRDF_ASSIGN_OR_RETURN(std::vector<v1::AdaptiveRound> rounds,
+                            StoredRounds(store, id, plan.plan, rig));
+      it = by_session.emplace(id, std::move(rounds)).first;
+    }
+    auto same = std::find_if(it->second.begin(), it->second.end(), [&a](const auto& r) {
+      return static_cast<int>(r.round()) == a.record.round;
+    });
+    if (same == it->second.end()) {
+      return Internal("round " + std::to_string(a.record.round) + " of session " +
+                      std::to_string(id) + " is not among the session's stored rounds");
+    }
+    a.spent_rig_s = same->spent_rig_s();
+    a.spent_prompts = static_cast<int>(same->spent_prompts());
+    a.rig_s = same->rig_s();
+    a.prompts = static_cast<int>(same->prompts());
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -120,6 +154,11 @@ void ArchiveShipper::Run() {
       conn = std::move(*opened);
     }
     Result<storage::ShipBatch> batch = store_->NextShipBatch(options_.batch_readings, kMaxChanges);
+    if (batch.ok()) {
+      if (Status st = FillRoundSpends(*store_, options_.rig_description, *batch); !st.ok()) {
+        batch = st;
+      }
+    }
     if (!batch.ok()) {
       SetState(v1::ARCHIVE_STATE_UNREACHABLE,
                "reading the rig's database: " + batch.status().message());

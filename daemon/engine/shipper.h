@@ -6,6 +6,10 @@
 // the archive exactly once: a batch the archive committed but the rig did not mark is sent again
 // and changes nothing.
 //
+// An adaptive round is shipped with what it meant for the budget as this rig's ListAdaptiveRounds
+// answers it (StoredRounds on the rig's description: only the rig can compute it), so that
+// brdf-archive answers the same rounds (storage/archive/schema.md, adaptive_rounds).
+//
 // It never touches the executor's path: recording goes on whatever the archive does (away, slow,
 // refusing our password, its disk full). On any archive failure it drops the connection, waits
 // retry, reconnects (re-reading the credentials file, so fixing it needs no restart) and
@@ -19,6 +23,7 @@
 
 #include "brdf/v1/brdf.pb.h"
 #include "core/mutex.h"
+#include "core/plan/rig_description.h"
 #include "core/status.h"
 #include "storage/session_store.h"
 
@@ -32,6 +37,7 @@ class ArchiveShipper {
     int batch_readings = 200;               // readings per archive transaction
     std::chrono::milliseconds retry{2000};  // wait after a failure
     std::chrono::milliseconds poll{50};     // wait when caught up
+    plan::RigDescription rig_description;   // the rig's (the rounds' spend); as the manager's
   };
 
   // Turns the rig's outbox on and starts the thread. kIoError when the outbox cannot be enabled.

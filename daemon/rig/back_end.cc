@@ -49,6 +49,7 @@ Status RigBackEnd::StartShipping(const Config& config) {
   options.rig = RigName(config);
   options.batch_readings = config.archive.batch_readings;
   options.retry = std::chrono::milliseconds(config.archive.retry_ms);
+  options.rig_description = ToRigDescription(config);
   Result<std::unique_ptr<ArchiveShipper>> started = ArchiveShipper::Start(store_, options);
   if (!started.ok()) {
     spdlog::critical("cannot start shipping to the archive: {}", started.status().ToString());

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "storage/archive/schema.h"
+#include "storage/round_picks.h"
 #include "storage/spectrum_blob.h"
 #include "storage/uncertainty_columns.h"
 
@@ -60,6 +61,13 @@ constexpr std::string_view kDevicesOfSession = R"sql(
 SELECT rig_device_id, kind, model, serial, first_seen
 FROM devices WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id = $1)
 ORDER BY rig_device_id
+)sql";
+
+constexpr std::string_view kRoundsOfSession = R"sql(
+SELECT round, first_step, step_count, picks, predicted_gain, uncertainty_left, readings_used,
+  created_at, spent_rig_s, spent_prompts, rig_s, prompts
+FROM adaptive_rounds WHERE session_uuid = (SELECT uuid FROM sessions WHERE archive_id = $1)
+ORDER BY round
 )sql";
 
 std::string SessionName(std::int64_t id) {
@@ -158,6 +166,30 @@ Result<ReadingRecord> ReadingAt(const PgResult& r, int row, std::int64_t session
   }
   g.uncertainty = std::move(*budget);
   return g;
+}
+
+Result<ArchivedRound> RoundAt(const PgResult& r, int row, std::int64_t session) {
+  ArchivedRound a;
+  RoundRecord& g = a.record;
+  g.session_id = session;
+  g.round = static_cast<int>(r.Int64(row, 0));
+  g.first_step = static_cast<int>(r.Int64(row, 1));
+  g.step_count = static_cast<int>(r.Int64(row, 2));
+  Result<std::vector<RoundPick>> picks = DecodePicks(r.Text(row, 3));
+  if (!picks.ok()) {
+    return picks.status().WithContext("archived round " + std::to_string(g.round) + " of " +
+                                      SessionName(session));
+  }
+  g.picks = std::move(*picks);
+  g.predicted_gain = r.Double(row, 4);
+  g.uncertainty_left = r.Double(row, 5);
+  g.readings_used = static_cast<int>(r.Int64(row, 6));
+  g.created_at = r.Double(row, 7);
+  a.spent_rig_s = r.Double(row, 8);
+  a.spent_prompts = static_cast<int>(r.Int64(row, 9));
+  a.rig_s = r.Double(row, 10);
+  a.prompts = static_cast<int>(r.Int64(row, 11));
+  return a;
 }
 
 Result<ReadingPointRecord> ReadingPointAt(const PgResult& r, int row, std::int64_t session) {
@@ -292,6 +324,22 @@ Result<std::vector<DeviceRecord>> ArchiveReader::GetSessionDevices(std::int64_t 
     return Status::Ok();
   }));
   return devices;
+}
+
+Result<std::vector<ArchivedRound>> ArchiveReader::GetRounds(std::int64_t session) {
+  BRDF_RETURN_IF_ERROR(GetSession(session).status());
+  std::vector<ArchivedRound> rounds;
+  BRDF_RETURN_IF_ERROR(WithConnection([&](PgConnection& conn) -> Status {
+    BRDF_ASSIGN_OR_RETURN(PgResult r, conn.QueryPrepared("archive_rounds", kRoundsOfSession,
+                                                         PgParams().Add(session)));
+    rounds.clear();
+    for (int i = 0; i < r.rows(); ++i) {
+      BRDF_ASSIGN_OR_RETURN(ArchivedRound round, RoundAt(r, i, session));
+      rounds.push_back(std::move(round));
+    }
+    return Status::Ok();
+  }));
+  return rounds;
 }
 
 template <typename Record>

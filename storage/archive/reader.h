@@ -28,6 +28,7 @@
 #include "storage/archive/pg.h"
 #include "storage/records.h"
 #include "storage/session_reader.h"
+#include "storage/ship_batch.h"
 
 namespace brdf::storage {
 
@@ -64,6 +65,10 @@ class ArchiveReader final : public SessionReader {
   // The devices shipped with the session, in the rig's order (ids the rig's; session_id this
   // archive's id).
   Result<std::vector<DeviceRecord>> GetSessionDevices(std::int64_t session) override;
+  // The adaptive rounds shipped so far (schema v5), oldest first, with what each meant for the
+  // budget as the rig computed it; empty for a session without rounds (another kind of plan, or
+  // none stored yet). Each record's session_id is this archive's id.
+  Result<std::vector<ArchivedRound>> GetRounds(std::int64_t session);
   // True when the session has ended (completed, aborted, failed) and the reading of every
   // measuring step it did is in the archive: nothing more will arrive.
   Result<bool> Finished(std::int64_t session);

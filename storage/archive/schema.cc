@@ -168,11 +168,37 @@ CREATE TABLE reading_uncertainty (
 );
 )sql";
 
-constexpr std::array<ArchiveMigration, 4> kArchiveMigrations{{
+// Version 5: the rounds of adaptive sessions, as their rig stores them (its schema v6;
+// docs/adaptive.md) with what each meant for the budget by the rig's timing model (the rig time
+// and prompts spent before it, its own steps' cost), which ListAdaptiveRounds answers and only the
+// rig can compute (it needs the rig's description). Keyed (session_uuid, round); rounds never
+// change on the rig, so a row is written once.
+constexpr std::string_view kArchiveV5 = R"sql(
+CREATE TABLE adaptive_rounds (
+  session_uuid     uuid    NOT NULL REFERENCES sessions (uuid),
+  round            integer NOT NULL CHECK (round >= 1),
+  first_step       integer NOT NULL CHECK (first_step >= 0),
+  step_count       integer NOT NULL CHECK (step_count >= 1),
+  picks            text    NOT NULL,
+  predicted_gain   double precision NOT NULL,
+  uncertainty_left double precision NOT NULL,
+  readings_used    integer NOT NULL CHECK (readings_used >= 0),
+  created_at       double precision NOT NULL,
+  spent_rig_s      double precision NOT NULL,
+  spent_prompts    integer NOT NULL CHECK (spent_prompts >= 0),
+  rig_s            double precision NOT NULL,
+  prompts          integer NOT NULL CHECK (prompts >= 0),
+  archived_at      timestamptz NOT NULL DEFAULT now(),
+  PRIMARY KEY (session_uuid, round)
+);
+)sql";
+
+constexpr std::array<ArchiveMigration, 5> kArchiveMigrations{{
     {1, "create sessions, steps, readings, devices and audit", kArchiveV1},
     {2, "number the sessions for brdf-archive (sessions.archive_id)", kArchiveV2},
     {3, "keep each session's history of states (session_events)", kArchiveV3},
     {4, "keep each reading's uncertainty budget (reading_uncertainty)", kArchiveV4},
+    {5, "keep the rounds of adaptive sessions (adaptive_rounds)", kArchiveV5},
 }};
 
 // "BRDF": the advisory lock key that serialises migrations across rigs and servers.

@@ -1,5 +1,5 @@
 // The lab archive's schema on PostgreSQL and its migrations. The full description is in
-// storage/archive/schema.md; in short (archive schema version 3):
+// storage/archive/schema.md; in short (archive schema version 5):
 //
 //   archive_schema  version, description, applied_at: one row per migration applied
 //   sessions  uuid (primary key: the session's global identity), rig, rig_session_id (the id on
@@ -15,6 +15,9 @@
 //   audit     (rig, rig_audit_id) primary key; at, role, actor, action, session_uuid, detail
 //   session_events (v3)  (session_uuid, rig_event_id) primary key; at, state, reason,
 //             archived_at: each session's history of states as its rig recorded it
+//   reading_uncertainty (v4)  (session_uuid, step_index) primary key: a sample reading's budget
+//   adaptive_rounds (v5)  (session_uuid, round) primary key: an adaptive session's rounds as its
+//             rig stored them, with the rig time and prompts spent before each and its cost
 //
 // Every write is an idempotent upsert keyed by these keys, so a batch shipped twice (a crash
 // between the archive's commit and the rig's mark) changes nothing the second time.

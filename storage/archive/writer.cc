@@ -3,6 +3,7 @@
 #include <string_view>
 
 #include "core/plan/plan_json.h"
+#include "storage/round_picks.h"
 #include "storage/spectrum_blob.h"
 #include "storage/uncertainty_columns.h"
 
@@ -19,8 +20,9 @@ VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16, $
 ON CONFLICT (uuid) DO UPDATE SET rig = EXCLUDED.rig, name = EXCLUDED.name,
   state = EXCLUDED.state, state_reason = EXCLUDED.state_reason,
   started_at = EXCLUDED.started_at, finished_at = EXCLUDED.finished_at,
-  done_steps = EXCLUDED.done_steps, white_reflectance = EXCLUDED.white_reflectance,
-  meter_serial = EXCLUDED.meter_serial, config_json = EXCLUDED.config_json, updated_at = now()
+  total_steps = EXCLUDED.total_steps, done_steps = EXCLUDED.done_steps,
+  white_reflectance = EXCLUDED.white_reflectance, meter_serial = EXCLUDED.meter_serial,
+  config_json = EXCLUDED.config_json, updated_at = now()
 )sql";
 
 constexpr std::string_view kUpsertStep = R"sql(
@@ -69,6 +71,14 @@ INSERT INTO session_events (session_uuid, rig_event_id, at, state, reason)
 VALUES ($1, $2, $3, $4, $5)
 ON CONFLICT (session_uuid, rig_event_id) DO UPDATE SET at = EXCLUDED.at, state = EXCLUDED.state,
   reason = EXCLUDED.reason
+)sql";
+
+// Rounds never change on the rig: a round shipped again is already there.
+constexpr std::string_view kInsertRound = R"sql(
+INSERT INTO adaptive_rounds (session_uuid, round, first_step, step_count, picks, predicted_gain,
+  uncertainty_left, readings_used, created_at, spent_rig_s, spent_prompts, rig_s, prompts)
+VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13)
+ON CONFLICT (session_uuid, round) DO NOTHING
 )sql";
 
 // A PostgreSQL array literal of text values: {"a","b \"c\""}.
@@ -187,6 +197,27 @@ Status ReplaceUncertainty(PgConnection& conn, const std::string& uuid, const Rea
   return WriteUncertainty(conn, uuid, r, what);
 }
 
+Status WriteRound(PgConnection& conn, const std::string& uuid, const ArchivedRound& a) {
+  const RoundRecord& r = a.record;
+  PgParams p;
+  p.Add(uuid)
+      .Add(r.round)
+      .Add(r.first_step)
+      .Add(r.step_count)
+      .Add(EncodePicks(r.picks))
+      .Add(r.predicted_gain)
+      .Add(r.uncertainty_left)
+      .Add(r.readings_used)
+      .Add(r.created_at)
+      .Add(a.spent_rig_s)
+      .Add(a.spent_prompts)
+      .Add(a.rig_s)
+      .Add(a.prompts);
+  return conn.QueryPrepared("insert_round", kInsertRound, std::move(p))
+      .status()
+      .WithContext("archiving round " + std::to_string(r.round) + " of session " + uuid);
+}
+
 Status WriteReading(PgConnection& conn, const std::string& uuid, const ReadingRecord& r) {
   PgParams p;
   p.Add(uuid)
@@ -230,6 +261,14 @@ Status WriteToArchive(PgConnection& conn, const std::string& rig, const ShipBatc
     std::optional<std::string> uuid = UuidOf(batch, s.session_id);
     if (!uuid) return Internal("step of session " + std::to_string(s.session_id) + " has no uuid");
     BRDF_RETURN_IF_ERROR(WriteStep(conn, *uuid, s));
+  }
+  for (const ArchivedRound& r : batch.rounds) {
+    std::optional<std::string> uuid = UuidOf(batch, r.record.session_id);
+    if (!uuid) {
+      return Internal("round " + std::to_string(r.record.round) + " of session " +
+                      std::to_string(r.record.session_id) + " has no uuid");
+    }
+    BRDF_RETURN_IF_ERROR(WriteRound(conn, *uuid, r));
   }
   for (const ReadingRecord& r : batch.readings) {
     std::optional<std::string> uuid = UuidOf(batch, r.session_id);

@@ -1,7 +1,8 @@
 // Writes a ShipBatch into the lab archive in ONE PostgreSQL transaction, with idempotent upserts
 // keyed by the session's uuid and the step (archive-schema.md): sessions and steps take the rig's
-// current row (ON CONFLICT DO UPDATE), readings, devices and audit entries are inserted once
-// (ON CONFLICT DO NOTHING). Shipping the same batch twice leaves the archive as shipping it once.
+// current row (ON CONFLICT DO UPDATE), readings, devices, audit entries and adaptive rounds are
+// inserted once (ON CONFLICT DO NOTHING). Shipping the same batch twice leaves the archive as
+// shipping it once.
 #pragma once
 
 #include <string>

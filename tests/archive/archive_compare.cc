@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "storage/archive/pg.h"
+#include "storage/round_picks.h"
 #include "storage/spectrum_blob.h"
 #include "storage/uncertainty_columns.h"
 
@@ -35,6 +36,29 @@ void ExpectSameUncertainties(PgConnection& conn, const std::string& uuid,
     ++row;
   }
   EXPECT_EQ(rows->rows(), row) << "the archive holds uncertainties of readings that have none";
+}
+
+// The archive's adaptive_rounds rows of a session are the rig's rounds, field for field (the picks
+// as the rig encodes them), once each.
+void ExpectSameRounds(PgConnection& conn, const std::string& uuid,
+                      const std::vector<RoundRecord>& mine) {
+  Result<PgResult> rows = conn.Query(
+      "SELECT round, first_step, step_count, picks, predicted_gain, uncertainty_left, "
+      "readings_used, created_at FROM adaptive_rounds WHERE session_uuid = $1 ORDER BY round",
+      PgParams().Add(uuid));
+  ASSERT_TRUE(rows.ok()) << rows.status().ToString();
+  ASSERT_EQ(rows->rows(), static_cast<int>(mine.size())) << "rounds of session " << uuid;
+  for (int i = 0; i < rows->rows(); ++i) {
+    const RoundRecord& r = mine[static_cast<std::size_t>(i)];
+    EXPECT_EQ(rows->Int64(i, 0), r.round);
+    EXPECT_EQ(rows->Int64(i, 1), r.first_step) << "round " << r.round;
+    EXPECT_EQ(rows->Int64(i, 2), r.step_count) << "round " << r.round;
+    EXPECT_EQ(rows->Text(i, 3), EncodePicks(r.picks)) << "round " << r.round;
+    EXPECT_EQ(rows->Double(i, 4), r.predicted_gain) << "round " << r.round;
+    EXPECT_EQ(rows->Double(i, 5), r.uncertainty_left) << "round " << r.round;
+    EXPECT_EQ(rows->Int64(i, 6), r.readings_used) << "round " << r.round;
+    EXPECT_EQ(rows->Double(i, 7), r.created_at) << "round " << r.round;
+  }
 }
 
 // Every reading and every event of every session of `store` is in the archive exactly once with
@@ -112,6 +136,10 @@ void ExpectArchiveHoldsExactly(const std::string& conninfo, SessionStore& store,
       EXPECT_EQ(archived->Text(i, 3), e.reason);
     }
     total_events += archived->rows();
+
+    Result<std::vector<RoundRecord>> rounds = store.GetRounds(s.id);
+    ASSERT_TRUE(rounds.ok()) << rounds.status().ToString();
+    ExpectSameRounds(**conn, s.uuid, *rounds);
   }
   Result<PgResult> all = (*conn)->Query(
       "SELECT count(*) FROM readings r JOIN sessions s ON s.uuid = r.session_uuid WHERE s.rig = "

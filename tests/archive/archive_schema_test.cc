@@ -1,6 +1,7 @@
 // The archive's schema on a real PostgreSQL: a new database gets the latest version, migrating
-// again changes nothing, a newer archive is refused, and the libpq layer reports a wrong password
-// and an unreachable server as what they are -- without the password in the message.
+// again changes nothing, an older archive with sessions migrates, a newer archive is refused, and
+// the libpq layer reports a wrong password and an unreachable server as what they are -- without
+// the password in the message.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <spdlog/sinks/ringbuffer_sink.h>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "storage/archive/pg.h"
+#include "storage/archive/reader.h"
 #include "storage/archive/schema.h"
 #include "tests/support/pg/server_fixture.h"
 
@@ -50,7 +52,35 @@ TEST_F(ArchiveSchemaTest, NewArchiveGetsTheLatestSchemaAndMigratingAgainIsANoOp)
   EXPECT_EQ(
       *pg_->Psql("SELECT string_agg(table_name, ',' ORDER BY table_name) FROM "
                  "information_schema.tables WHERE table_schema = 'public'"),
-      "archive_schema,audit,devices,reading_uncertainty,readings,session_events,sessions,steps");
+      "adaptive_rounds,archive_schema,audit,devices,reading_uncertainty,readings,session_events,"
+      "sessions,steps");
+}
+
+// An archive of version 4 (before adaptive rounds) with a session in it migrates to the latest;
+// the session is kept and has no rounds (brdf-archive answers an empty list).
+TEST_F(ArchiveSchemaTest, AnArchiveBeforeRoundsMigratesAndItsSessionsHaveNone) {
+  auto conn = Connect();
+  ASSERT_NE(conn, nullptr);
+  ASSERT_TRUE(MigrateArchive(*conn, ArchiveMigrations().first(4)).ok());
+  EXPECT_EQ(*ArchiveVersion(*conn), 4);
+  EXPECT_EQ(*pg_->Psql("SELECT to_regclass('adaptive_rounds') IS NULL"), "t");
+  ASSERT_TRUE(pg_->Psql("INSERT INTO sessions (uuid, rig, rig_session_id, name, plan_kind, "
+                        "plan_json, state, created_at, total_steps, done_steps) VALUES "
+                        "('7d1c4bd8-7a29-4f6e-9a57-1bb2a5f7c9e1', 'rig-a', 1, 'old', 'adaptive', "
+                        "'{}', 'completed', 1765000000.5, 3, 3)")
+                  .ok());
+  ASSERT_TRUE(MigrateArchive(*conn).ok());
+  EXPECT_EQ(*ArchiveVersion(*conn), LatestArchiveVersion());
+  EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM adaptive_rounds"), "0");
+  auto reader = ArchiveReader::Open(pg_->conninfo());
+  ASSERT_TRUE(reader.ok()) << reader.status().ToString();
+  const std::int64_t id = std::stoll(*pg_->Psql("SELECT archive_id FROM sessions"));
+  Result<SessionRecord> session = (*reader)->GetSession(id);
+  ASSERT_TRUE(session.ok()) << session.status().ToString();
+  EXPECT_EQ(session->name, "old");
+  Result<std::vector<ArchivedRound>> rounds = (*reader)->GetRounds(id);
+  ASSERT_TRUE(rounds.ok()) << rounds.status().ToString();
+  EXPECT_TRUE(rounds->empty());
 }
 
 TEST_F(ArchiveSchemaTest, TwoConnectionsMigratingAtOnceBothSucceed) {

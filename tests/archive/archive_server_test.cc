@@ -2,8 +2,9 @@
 // and ship; two brdf-archive processes serve the archive. For the same session the archive
 // answers Interpolate, InterpolateBatch, StreamReadings and Export exactly as the rig's brdfd does
 // (the messages compared field by field, doubles exactly; the exported files byte for byte),
-// ListSessions filters and pages across the catalogue (brdfd applies the same filters), the rig's
-// verbs are refused naming the rig, and brdfctl works against it unchanged.
+// ListSessions filters and pages across the catalogue (brdfd applies the same filters), an adaptive
+// session's rounds are listed as the rig lists them, the rig's verbs are refused naming the rig,
+// and brdfctl works against it unchanged.
 #include <gmock/gmock.h>
 #include <google/protobuf/util/message_differencer.h>
 #include <gtest/gtest.h>
@@ -542,6 +543,59 @@ TEST_F(ArchiveServerTest, RefusesTheRigsVerbsAndUnknownSessionsAndChecksTokens) 
   st = a.control().ListSessions(DaemonRig::Context().get(), list, &listed);
   EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(st.error_message(), HasSubstr("page_token"));
+}
+
+// An adaptive session (docs/adaptive.md): brdf-archive answers ListAdaptiveRounds with the rounds
+// the rig shipped, message for message what the rig's brdfd answers (the spend the rig computed
+// included); a session of another kind has none, an unknown one is NOT_FOUND.
+TEST_F(ArchiveServerTest, ListAdaptiveRoundsAnswersWhatTheRigAnswers) {
+  // Three detector positions, a seed of 3 + 3 × 4, rounds of 6 to 27 readings.
+  const v1::Session adaptive = Submit(R"({
+    "name": "adaptive, archived",
+    "adaptive": {
+      "target": {"expandedUncertainty": 0.001},
+      "budget": {"maxReadings": 27},
+      "region": {"thetaIMaxDeg": 80, "thetaOMaxDeg": 80},
+      "method": "ADAPTIVE_JUDGE_OCTANT",
+      "delta": {"start": 0, "stop": 22.5, "step": 11.25},
+      "seed": {"retroReadings": 3, "readingsPerDelta": 4},
+      "roundReadings": 6
+    },
+    "reference": {"perDetectorPosition": true},
+    "measurement": {"integrationMs": 100, "averages": 1}
+  })");
+  const v1::Session plain = Submit(plans::TinyPoseList());
+  for (const v1::Session& s : {adaptive, plain}) {
+    ASSERT_EQ(rig_->WaitForState(s.session_id(), v1::SESSION_STATE_COMPLETED, 180s).state(),
+              v1::SESSION_STATE_COMPLETED);
+  }
+  ASSERT_TRUE(WaitCaughtUp());
+  ArchiveProcess& a = StartArchive();
+  auto rounds = [](v1::Control::Stub& control, const std::string& id,
+                   v1::ListAdaptiveRoundsResponse* out) {
+    v1::ListAdaptiveRoundsRequest request;
+    request.set_session_id(id);
+    return control.ListAdaptiveRounds(DaemonRig::Context(kAnalystToken).get(), request, out);
+  };
+  v1::ListAdaptiveRoundsResponse from_rig;
+  grpc::Status st = rounds(rig_->control(), adaptive.session_id(), &from_rig);
+  ASSERT_TRUE(st.ok()) << st.error_message();
+  ASSERT_GE(from_rig.rounds_size(), 1);
+  v1::ListAdaptiveRoundsResponse from_archive;
+  st = rounds(a.control(), ArchiveId(a, adaptive.uuid()), &from_archive);
+  ASSERT_TRUE(st.ok()) << st.error_code() << ": " << st.error_message();
+  EXPECT_TRUE(MessageDifferencer::Equals(from_archive, from_rig))
+      << "archive:\n"
+      << from_archive.DebugString() << "rig:\n"
+      << from_rig.DebugString();
+  EXPECT_GT(from_archive.rounds(0).spent_rig_s(), 0);
+
+  v1::ListAdaptiveRoundsResponse none;
+  st = rounds(a.control(), ArchiveId(a, plain.uuid()), &none);
+  ASSERT_TRUE(st.ok()) << st.error_message();
+  EXPECT_EQ(none.rounds_size(), 0);
+  st = rounds(a.control(), "987654", &none);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::NOT_FOUND) << st.error_message();
 }
 
 TEST_F(ArchiveServerTest, BrdfctlAndThePythonClientReadTheArchiveUnchanged) {

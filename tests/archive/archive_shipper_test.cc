@@ -9,9 +9,13 @@
 #include <atomic>
 #include <chrono>
 #include <cstring>
+#include <functional>
 #include <thread>
 
+#include "core/plan/plan_json.h"
+#include "daemon/engine/adaptive_rounds.h"
 #include "daemon/engine/shipper.h"
+#include "daemon/wire/round.h"
 #include "storage/archive/pg.h"
 #include "storage/archive/reader.h"
 #include "storage/archive/schema.h"
@@ -47,6 +51,56 @@ Status RecordStep(SessionStore& store, std::int64_t session, int i,
   BRDF_ASSIGN_OR_RETURN(std::int64_t id, store.CompleteStepWithReading(session, i, r));
   if (kind == StepKind::kReference) reference = id;
   return Status::Ok();
+}
+
+// An adaptive plan (the rounds' spend is computed from its measurement settings).
+const std::string kAdaptivePlan = R"({"name": "adaptive", "adaptive": {
+  "target": {"expandedUncertainty": 0.001}, "budget": {"maxReadings": 40},
+  "region": {"thetaIMaxDeg": 80, "thetaOMaxDeg": 80}, "method": "ADAPTIVE_JUDGE_OCTANT",
+  "delta": {"start": 0, "stop": 22.5, "step": 11.25},
+  "seed": {"retroReadings": 3, "readingsPerDelta": 4}, "roundReadings": 6},
+  "measurement": {"integrationMs": 100, "averages": 1}})";
+
+// Steps first … first + n − 1 of the standard test plan (moves, references, samples).
+std::vector<StepRecord> StepsFrom(int first, int n) {
+  std::vector<StepRecord> steps = MakeSteps(first + n);
+  return std::vector<StepRecord>(steps.begin() + first, steps.end());
+}
+
+RoundRecord MakeRound(std::int64_t session, int number, int first_step) {
+  RoundRecord r;
+  r.session_id = session;
+  r.round = number;
+  r.first_step = first_step;
+  r.picks = {{Pose{12.5, -35, 0, 11.25}, 0.0123456789012345},
+             {Pose{1.0 / 3, 170.0 - number, 0, 22.5}, 1e-7 * number}};
+  r.predicted_gain = 0.0123457789012345;
+  r.uncertainty_left = 0.0712 / number;
+  r.readings_used = 10 + 6 * number;
+  return r;
+}
+
+// An adaptive session of a 12-step seed and two rounds (steps 12-17 and 18-22), running; the
+// rounds' steps recorded up to `recorded` (exclusive). `after_seed` runs once the seed is
+// recorded, before the first round is stored.
+Result<std::int64_t> RecordAdaptiveSession(
+    SessionStore& store, int recorded, const std::function<void()>& after_seed = [] {}) {
+  NewSession n = MakeNewSession("adaptive paint");
+  n.rig = "rig-a";
+  n.plan_kind = "adaptive";
+  n.plan_json = kAdaptivePlan;
+  BRDF_ASSIGN_OR_RETURN(std::int64_t id, store.CreateSession(n, MakeSteps(12)));
+  BRDF_RETURN_IF_ERROR(store.SetSessionState(id, SessionState::kRunning, ""));
+  std::optional<std::int64_t> ref;
+  for (int i = 0; i < 12; ++i) BRDF_RETURN_IF_ERROR(RecordStep(store, id, i, ref));
+  after_seed();
+  BRDF_RETURN_IF_ERROR(store.AppendRound(MakeRound(id, 1, 12), StepsFrom(12, 6)));
+  for (int i = 12; i < std::min(recorded, 18); ++i) {
+    BRDF_RETURN_IF_ERROR(RecordStep(store, id, i, ref));
+  }
+  BRDF_RETURN_IF_ERROR(store.AppendRound(MakeRound(id, 2, 18), StepsFrom(18, 5)));
+  for (int i = 18; i < recorded; ++i) BRDF_RETURN_IF_ERROR(RecordStep(store, id, i, ref));
+  return id;
 }
 
 class ArchiveShipperTest : public PgServerTest {
@@ -370,6 +424,137 @@ TEST_F(ArchiveShipperTest, SessionsFromBeforeShippingAreShippedWhenItIsTurnedOn)
   auto shipper = StartShipper(store, "rig-a");
   ASSERT_TRUE(WaitCaughtUp(*shipper));
   ExpectArchiveHoldsExactly(*store, "rig-a");
+}
+
+// An adaptive session's rounds reach the archive with its steps (total_steps grown by each round),
+// and brdf-archive's reader gives them back as the rig's ListAdaptiveRounds answers them: the
+// same messages, spend included.
+TEST_F(ArchiveShipperTest, AdaptiveRoundsReachTheArchiveAsTheRigAnswersThem) {
+  auto store = OpenStore("rig-a.db");
+  auto shipper = StartShipper(store, "rig-a");
+  // The seed is in the archive before the rounds are stored: the session's row grows with them.
+  Result<std::int64_t> id = RecordAdaptiveSession(*store, 23, [&] {
+    EXPECT_TRUE(WaitCaughtUp(*shipper)) << shipper->Snapshot().DebugString();
+    EXPECT_EQ(*pg_->Psql("SELECT total_steps FROM sessions"), "12");
+  });
+  ASSERT_TRUE(id.ok()) << id.status().ToString();
+  ASSERT_TRUE(store->SetSessionState(*id, SessionState::kCompleted, "adaptive: done").ok());
+  // A session of another kind has no rounds.
+  NewSession plain = MakeNewSession();
+  plain.rig = "rig-a";
+  Result<std::int64_t> other = store->CreateSession(plain, MakeSteps(5));
+  ASSERT_TRUE(other.ok());
+  ASSERT_TRUE(WaitCaughtUp(*shipper)) << shipper->Snapshot().DebugString();
+  ExpectArchiveHoldsExactly(*store, "rig-a");
+  EXPECT_EQ(*pg_->Psql("SELECT total_steps FROM sessions WHERE name = 'adaptive paint'"), "23");
+
+  Result<v1::Plan> plan = plan::ParsePlanJson(kAdaptivePlan);
+  ASSERT_TRUE(plan.ok()) << plan.status().ToString();
+  Result<std::vector<v1::AdaptiveRound>> rig =
+      daemon::StoredRounds(*store, *id, *plan, plan::RigDescription());
+  ASSERT_TRUE(rig.ok()) << rig.status().ToString();
+  ASSERT_EQ(rig->size(), 2u);
+  auto reader = ArchiveReader::Open(pg_->conninfo());
+  ASSERT_TRUE(reader.ok()) << reader.status().ToString();
+  const std::int64_t archive_id =
+      std::stoll(*pg_->Psql("SELECT archive_id FROM sessions WHERE name = 'adaptive paint'"));
+  Result<std::vector<ArchivedRound>> archived = (*reader)->GetRounds(archive_id);
+  ASSERT_TRUE(archived.ok()) << archived.status().ToString();
+  ASSERT_EQ(archived->size(), rig->size());
+  for (std::size_t i = 0; i < rig->size(); ++i) {
+    EXPECT_EQ((*archived)[i].record.session_id, archive_id);
+    const v1::AdaptiveRound answered = daemon::ToProtoRound((*archived)[i]);
+    EXPECT_EQ(answered.SerializeAsString(), (*rig)[i].SerializeAsString())
+        << "round " << i + 1 << "\narchive: " << answered.DebugString()
+        << "\nrig: " << (*rig)[i].DebugString();
+  }
+  // The spend is the rig's timing, not zeros: the second round starts where the first ended.
+  EXPECT_GT((*rig)[0].spent_rig_s(), 0);
+  EXPECT_GT((*rig)[0].rig_s(), 0);
+  EXPECT_DOUBLE_EQ((*rig)[1].spent_rig_s(), (*rig)[0].spent_rig_s() + (*rig)[0].rig_s());
+  const std::int64_t plain_id =
+      std::stoll(*pg_->Psql("SELECT archive_id FROM sessions WHERE name = 'paint sample'"));
+  Result<std::vector<ArchivedRound>> none = (*reader)->GetRounds(plain_id);
+  ASSERT_TRUE(none.ok()) << none.status().ToString();
+  EXPECT_TRUE(none->empty());
+  EXPECT_EQ((*reader)->GetRounds(archive_id + 1000).status().code(), StatusCode::kNotFound);
+}
+
+// The archive commits a batch holding rounds and the rig dies before recording its marks: the
+// batch is sent again and each round is in the archive once. A round goes with its first step;
+// a later change of another of its steps does not send it again.
+TEST_F(ArchiveShipperTest, ARoundShippedTwiceIsArchivedOnce) {
+  auto store = OpenStore("rig-a.db");
+  ASSERT_TRUE(store->SetArchiveShipping(true).ok());
+  Result<std::int64_t> id = RecordAdaptiveSession(*store, 18);
+  ASSERT_TRUE(id.ok()) << id.status().ToString();
+  Result<std::unique_ptr<PgConnection>> conn = PgConnection::Open(pg_->conninfo());
+  ASSERT_TRUE(conn.ok());
+  ASSERT_TRUE(MigrateArchive(**conn).ok());
+  Result<ShipBatch> batch = store->NextShipBatch(1000, 1000);
+  ASSERT_TRUE(batch.ok()) << batch.status().ToString();
+  ASSERT_EQ(batch->rounds.size(), 2u);
+  ASSERT_TRUE(WriteToArchive(**conn, "rig-a", *batch).ok());
+  // ... kill -9 here: no MarkShipped. The next run sends the same rounds again.
+  Result<ShipBatch> again = store->NextShipBatch(1000, 1000);
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->rounds.size(), 2u);
+  Status st = WriteToArchive(**conn, "rig-a", *again);
+  ASSERT_TRUE(st.ok()) << st.ToString();
+  ASSERT_TRUE(store->MarkShipped(*again).ok());
+  EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM adaptive_rounds"), "2");
+  EXPECT_EQ(*pg_->Psql("SELECT string_agg(round || ':' || first_step || '+' || step_count, ',' "
+                       "ORDER BY round) FROM adaptive_rounds"),
+            "1:12+6,2:18+5");
+  ExpectArchiveHoldsExactly(*store, "rig-a");
+
+  std::optional<std::int64_t> ref;  // step 11's reference reading
+  for (const ReadingRecord& r : *store->GetReadings(*id, 0, 1000)) {
+    if (r.step_index == 11) ref = r.id;
+  }
+  ASSERT_TRUE(RecordStep(*store, *id, 19, ref).ok());  // not round 2's first step
+  Result<ShipBatch> later = store->NextShipBatch(1000, 1000);
+  ASSERT_TRUE(later.ok());
+  EXPECT_EQ(later->steps.size(), 1u);
+  EXPECT_TRUE(later->rounds.empty());
+  ASSERT_TRUE(WriteToArchive(**conn, "rig-a", *later).ok());
+  ASSERT_TRUE(store->MarkShipped(*later).ok());
+  ASSERT_TRUE(RecordStep(*store, *id, 18, ref).ok());  // round 2's first step
+  Result<ShipBatch> first = store->NextShipBatch(1000, 1000);
+  ASSERT_TRUE(first.ok());
+  ASSERT_EQ(first->rounds.size(), 1u);
+  EXPECT_EQ(first->rounds[0].record.round, 2);
+  ASSERT_TRUE(WriteToArchive(**conn, "rig-a", *first).ok());
+  ASSERT_TRUE(store->MarkShipped(*first).ok());
+  EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM adaptive_rounds"), "2");
+  ExpectArchiveHoldsExactly(*store, "rig-a");
+}
+
+// A rig whose rounds were stored before its brdfd shipped them (their steps in the archive, the
+// rounds not): the first start of a shipper that does ships them, once.
+TEST_F(ArchiveShipperTest, RoundsStoredBeforeTheyWereShippedReachTheArchiveOnce) {
+  auto store = OpenStore("rig-a.db");
+  ASSERT_TRUE(store->SetArchiveShipping(true).ok());
+  Result<std::int64_t> id = RecordAdaptiveSession(*store, 23);
+  ASSERT_TRUE(id.ok()) << id.status().ToString();
+  {
+    auto shipper = StartShipper(store, "rig-a");
+    ASSERT_TRUE(WaitCaughtUp(*shipper)) << shipper->Snapshot().DebugString();
+  }
+  // As an older brdfd left them: no rounds in the archive, no 'rounds' mark on the rig.
+  ASSERT_TRUE(pg_->Psql("DELETE FROM adaptive_rounds").ok());
+  auto raw = Database::Open(dir_.File("rig-a.db"));
+  ASSERT_TRUE(raw.ok()) << raw.status().ToString();
+  ASSERT_TRUE((*raw)->Exec("DELETE FROM archive_marks WHERE name = 'rounds'").ok());
+  raw->reset();
+  auto shipper = StartShipper(store, "rig-a");
+  ASSERT_TRUE(WaitCaughtUp(*shipper)) << shipper->Snapshot().DebugString();
+  ExpectArchiveHoldsExactly(*store, "rig-a");
+  EXPECT_EQ(*pg_->Psql("SELECT count(*) FROM adaptive_rounds"), "2");
+  // Once: turning shipping on again queues nothing.
+  shipper.reset();
+  ASSERT_TRUE(store->SetArchiveShipping(true).ok());
+  EXPECT_EQ(store->ShippingLag()->pending_changes, 0);
 }
 
 }  // namespace

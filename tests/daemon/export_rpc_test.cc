@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -153,23 +154,33 @@ class ExportRpcTest : public ::testing::Test {
   }
 
   // brdf-export run on the daemon's database for the suite's session with `args` (the command
-  // and its options, without -o); the file it wrote, or why it failed.
-  static Result<std::string> ToolExport(std::vector<std::string> args) {
+  // and its options, without -o) and -o DIR/out.npy: every file it wrote, by name (out.npy,
+  // out.npy.json, …), or why it failed.
+  static Result<std::map<std::string, std::string>> ToolExportFiles(std::vector<std::string> args) {
     BRDF_ASSIGN_OR_RETURN(
         std::string tool,
         BuiltProgram("brdf-export", "tools/brdf-export/brdf-export", "BRDF_EXPORT_BINARY"));
     TempDir dir("brdf-export-rpc");
-    const std::string path = dir.file("out").string();
     std::vector<std::string> all = {"--db", rig_->database(), "--session", *session_id_, "--quiet"};
     all.insert(all.end(), args.begin(), args.end());
-    all.insert(all.end(), {"-o", path});
+    all.insert(all.end(), {"-o", dir.file("out.npy").string()});
     BRDF_ASSIGN_OR_RETURN(CommandResult run,
                           RunToCompletion("brdf-export", tool, LaunchOptions(all), 120s));
     if (run.exit_code != 0) {
       return Internal("brdf-export exited " + std::to_string(run.exit_code) + ": " + run.err);
     }
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
+    std::map<std::string, std::string> files;
+    for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+      std::ifstream in(entry.path(), std::ios::binary);
+      files[entry.path().filename().string()] = std::string(std::istreambuf_iterator<char>(in), {});
+    }
+    return files;
+  }
+
+  // The same: the file it wrote.
+  static Result<std::string> ToolExport(std::vector<std::string> args) {
+    BRDF_ASSIGN_OR_RETURN(auto files, ToolExportFiles(std::move(args)));
+    return files["out.npy"];
   }
 
   static std::size_t SampleReadings() {
@@ -436,6 +447,51 @@ TEST_F(ExportRpcTest, GridUncertaintyNotCalibratedSaysWhyAndIsTheApisToo) {
   EXPECT_TRUE(check.not_estimated.contains(
       "interpolation: not calibrated (0 held-out readings predicted, fewer than 8); the "
       "vertices' spread as it is"));
+}
+
+// brdf-export grid --uncertainty (the offline tool, on the daemon's database) writes the daemon's
+// arrays: for the same session and options its OUT.u.npy, OUT.u_measurement.npy and
+// OUT.u_interpolation.npy are the export's parts "u", "u_measurement" and "u_interpolation" byte
+// for byte, its grid the export's file, and its .json the report's description (the files named
+// as each names them). Delaunay, whose term is calibrated on the suite's readings; float32.
+TEST_F(ExportRpcTest, GridUncertaintyArraysAreBrdfExportsByteForByte) {
+  v1::ExportRequest request = Request(v1::EXPORT_FORMAT_GRID_NPY);
+  request.set_step_theta_i(10);
+  request.set_step_theta_o(10);
+  request.set_step_phi(20);
+  request.set_method(v1::INTERPOLATION_METHOD_DELAUNAY);
+  request.set_float32(true);
+  request.set_include_uncertainty(true);
+  const ExportResult rpc = Export(request);
+  ExpectCompleteStream(rpc);
+  ASSERT_EQ(rpc.parts.size(), 3u);
+
+  Result<std::map<std::string, std::string>> tool = ToolExportFiles(
+      {"grid", "--steps", "10,10,20", "--method", "delaunay", "--float32", "--uncertainty"});
+  ASSERT_TRUE(tool.ok()) << tool.status().ToString();
+  ASSERT_EQ(tool->size(), 5u) << "out.npy, its .json and three arrays";
+  EXPECT_TRUE(tool->at("out.npy") == rpc.file) << "the grid differs";
+  std::string description = rpc.report->description_json();
+  for (const v1::ExportPart& part : rpc.report->parts()) {
+    const std::string mine = "out." + part.name() + ".npy";
+    ASSERT_TRUE(tool->contains(mine)) << mine;
+    ASSERT_TRUE(rpc.parts.contains(part.name())) << part.name();
+    EXPECT_FALSE(rpc.parts.at(part.name()).empty());
+    EXPECT_TRUE(tool->at(mine) == rpc.parts.at(part.name())) << part.name() << " differs";
+    for (std::size_t at = description.find(part.file_name()); at != std::string::npos;
+         at = description.find(part.file_name(), at + 1)) {
+      description.replace(at, part.file_name().size(), mine);
+    }
+  }
+  EXPECT_NE(description.find("\"uncertainty\": {"), std::string::npos) << description;
+  EXPECT_EQ(tool->at("out.npy.json"), description);
+
+  // A grid as CSV has no room for the arrays: refused, naming the option.
+  Result<std::map<std::string, std::string>> csv =
+      ToolExportFiles({"grid", "--format", "csv", "--uncertainty"});
+  ASSERT_FALSE(csv.ok());
+  EXPECT_NE(csv.status().message().find("--uncertainty is for .npy grids"), std::string::npos)
+      << csv.status().ToString();
 }
 
 // MERL's uncertainty summary (include_uncertainty) rests on the same calibrated term

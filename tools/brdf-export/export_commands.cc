@@ -14,6 +14,7 @@
 #include "core/analytic_brdf.h"
 #include "core/export/fill/chain.h"
 #include "core/export/fill/session_interpolant.h"
+#include "core/export/fill/uncertain_grid.h"
 #include "core/export/grid/npy_writer.h"
 #include "core/export/grid/regular_grid.h"
 #include "core/export/grid/text.h"
@@ -162,6 +163,51 @@ bool EndsWith(const std::string& s, const std::string& suffix) {
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+// `output`'s uncertainty arrays: their names for the sidecar (exports::UncertaintyFiles of the
+// file's name) and where they are written (beside it).
+std::vector<std::pair<exports::UncertaintyFile, std::string>> UncertaintyPaths(
+    const std::string& output) {
+  const std::filesystem::path path(output);
+  std::vector<std::pair<exports::UncertaintyFile, std::string>> out;
+  for (exports::UncertaintyFile& f : exports::UncertaintyFiles(path.filename().string())) {
+    std::string where = (path.parent_path() / f.file_name).string();
+    out.emplace_back(std::move(f), std::move(where));
+  }
+  return out;
+}
+
+// The grid resampled to `values`; with --uncertainty in the same pass as the daemon's export
+// (fill/uncertain_grid.h), the three arrays written and committed beside `output`. The report,
+// the chain's tally and (with --uncertainty) the sidecar's "uncertainty" object and warnings.
+Result<exports::UncertainGrid> Resample(const Interpolation& in, const exports::RegularGrid& grid,
+                                        exports::Quantity q, const GridOptions& o,
+                                        const exports::RunControl& control,
+                                        exports::GridSink& values, const std::string& output) {
+  exports::UncertainGrid out;
+  if (!o.uncertainty) {
+    BRDF_ASSIGN_OR_RETURN(
+        out.report, exports::ResampleOnGrid(in.chain->Source(), grid, in.derived->grid, control,
+                                            RunContext(), values));
+    out.tally = in.chain->Tally();
+    return out;
+  }
+  const exports::NpyType type = o.float32 ? exports::NpyType::kFloat32 : exports::NpyType::kFloat64;
+  std::vector<std::unique_ptr<OutputFile>> files;
+  std::vector<std::unique_ptr<exports::NpyGridWriter>> writers;
+  std::array<exports::GridSink*, 3> sinks{};
+  for (const auto& [file, where] : UncertaintyPaths(output)) {
+    BRDF_ASSIGN_OR_RETURN(std::unique_ptr<OutputFile> opened, OutputFile::Open(where));
+    files.push_back(std::move(opened));
+    writers.push_back(std::make_unique<exports::NpyGridWriter>(files.back()->stream(), type));
+    sinks[writers.size() - 1] = writers.back().get();
+  }
+  BRDF_ASSIGN_OR_RETURN(
+      out, exports::ResampleWithUncertainty(in, grid, q, control, RunContext(), values, sinks,
+                                            std::filesystem::path(output).filename().string()));
+  for (const std::unique_ptr<OutputFile>& f : files) BRDF_RETURN_IF_ERROR(f->Commit());
+  return out;
+}
+
 }  // namespace
 
 int RunCsv(const CommonOptions& c, const CsvOptions& o, std::ostream& err) {
@@ -207,6 +253,11 @@ int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
   if (format == "npy" && c.output == "-") {
     return Fail(err, "grid", InvalidArgument("an .npy grid needs a file: give -o PATH.npy"));
   }
+  if (o.uncertainty && format != "npy") {
+    return Fail(err, "grid",
+                InvalidArgument("--uncertainty is for .npy grids: a grid as CSV has no room for "
+                                "the arrays (export it as .npy, or leave --uncertainty out)"));
+  }
   Result<exports::Session> session = LoadInput(c);
   if (!session.ok()) return Fail(err, "grid", session.status());
   Result<Interpolation> in = BuildInterpolator(*session, *q, c, o.interp, err);
@@ -234,20 +285,30 @@ int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
   exports::CsvGridWriter csv((*file)->stream(), info);
   exports::GridSink& sink = format == "npy" ? static_cast<exports::GridSink&>(npy) : csv;
   ProgressLine line(err, "brdf-export grid", StderrIsTerminal());
-  Result<exports::GridReport> report = exports::ResampleOnGrid(
-      in->chain->Source(), *grid, bands, Control(c, c.quiet ? nullptr : &line), RunContext(), sink);
+  Result<exports::UncertainGrid> u =
+      Resample(*in, *grid, *q, o, Control(c, c.quiet ? nullptr : &line), sink, c.output);
   line.Finish();
-  if (!report.ok()) return Fail(err, "grid", report.status());
+  if (!u.ok()) return Fail(err, "grid", u.status());
   if (Status st = (*file)->Commit(); !st.ok()) return Fail(err, "grid", st);
   if (format == "npy") {
     Result<std::unique_ptr<OutputFile>> json = OutputFile::Open(c.output + ".json");
     if (!json.ok()) return Fail(err, "grid", json.status());
-    (*json)->stream() << exports::GridDescriptionJson(*grid, bands, info, *report, in->Info());
+    exports::InterpolantInfo how = in->Info();
+    how.fill_json = u->tally.Json();
+    (*json)->stream() << exports::GridDescriptionJson(*grid, bands, info, u->report, how,
+                                                      u->uncertainty_json);
     if (Status st = (*json)->Commit(); !st.ok()) return Fail(err, "grid", st);
   }
-  err << "brdf-export grid: fill " << in->chain->Tally().Summary() << "\n";
-  err << "brdf-export grid: " << report->Summary() << " → " << c.output
+  for (const std::string& w : u->warnings) err << "brdf-export grid: warning: " << w << "\n";
+  err << "brdf-export grid: fill " << u->tally.Summary() << "\n";
+  err << "brdf-export grid: " << u->report.Summary() << " → " << c.output
       << (format == "npy" ? " (axes, wavelengths, units: " + c.output + ".json)" : "") << "\n";
+  if (o.uncertainty) {
+    for (const auto& [array, where] : UncertaintyPaths(c.output)) {
+      err << "brdf-export grid: " << exports::UncertainPlaneName(array.plane) << " → " << where
+          << "\n";
+    }
+  }
   return kExitOk;
 }
 

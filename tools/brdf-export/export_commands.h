@@ -51,6 +51,10 @@ struct GridOptions {
   bool nodes = false;           // grid nodes 0…90 (both ends) instead of cell centres
   std::string format;           // npy or csv; empty: from the output's extension (.csv → csv)
   bool float32 = false;         // npy: float32 instead of float64
+  // npy: the uncertainty arrays OUT.u.npy, OUT.u_measurement.npy, OUT.u_interpolation.npy beside
+  // OUT.npy, named in the .json's "uncertainty" (core/export/fill/uncertain_grid.h: the same
+  // arrays as the daemon's export with include_uncertainty)
+  bool uncertainty = false;
 };
 
 struct MerlOptions {

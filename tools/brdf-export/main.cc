@@ -110,6 +110,9 @@ int main(int argc, char** argv) {
   grid_cmd->add_option("--format", grid.format, "npy or csv (default: from -o's extension)");
   grid_cmd->add_flag("--float32", grid.float32,
                      "npy: float32 instead of float64, half the bytes (the .json says dtype)");
+  grid_cmd->add_flag("--uncertainty", grid.uncertainty,
+                     "npy: also OUT.u.npy, OUT.u_measurement.npy and OUT.u_interpolation.npy "
+                     "(standard uncertainties, k = 1; the .json's \"uncertainty\" says what)");
 
   MerlOptions merl;
   CLI::App* merl_cmd = app.add_subcommand(
