@@ -91,6 +91,10 @@ inline constexpr std::uint32_t kMaxPageSize = 1000;
 // How often a long-lived stream (WatchSession, StreamReadings with follow) looks whether its
 // client went away or the daemon is stopping.
 inline constexpr std::chrono::milliseconds kStreamPollInterval{200};
+// How long a stream on the stream pump (pumped_stream.h: WatchSession, StreamReadings) that
+// nothing woke waits before it looks again at its client, its session and the server's stop, as
+// the synchronous streams' waits did (1 s: an event or a commit wakes it at once).
+inline constexpr std::chrono::milliseconds kStreamIdleWait{1000};
 
 // brdfd Status → gRPC status (message through BoundedMessage), code per session_manager.h:
 // kInvalidArgument → INVALID_ARGUMENT,

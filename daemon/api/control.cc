@@ -16,12 +16,13 @@ namespace brdf::daemon {
 
 ControlService::ControlService(SessionCatalogue& catalogue, RigPort* rig, const Authenticator& auth,
                                const StopSignal& stopping, StreamRegistry& streams,
-                               std::string program)
+                               StreamPump& pump, std::string program)
     : catalogue_(catalogue),
       rig_(rig),
       auth_(auth),
       stopping_(stopping),
       streams_(streams),
+      pump_(pump),
       program_(std::move(program)) {}
 
 void ControlService::ServeOn(ControlLoop& loop) {
@@ -58,12 +59,6 @@ grpc::Status ControlService::NoRig(const char* method, const std::string& sessio
 }
 
 namespace {
-
-// How long a WatchSession stream with no event waits before it looks at its client's
-// cancellation and the server's stop again (an event wakes it at once). 1 s, not 200 ms: 400
-// watchers then wake 400 times a second, not 2,000 (issue 40), and a cancelled watch frees its
-// thread within a second.
-constexpr std::chrono::milliseconds kWatchIdleWait{1000};
 
 // The session id of a request, or INVALID_ARGUMENT naming the field.
 grpc::Status ParseId(const std::string& text, SessionId* id) {
@@ -217,49 +212,6 @@ grpc::Status ControlService::ListAdaptiveRounds(grpc::ServerContext* /*context*/
   response->mutable_rounds()->Reserve(static_cast<int>(rounds->size()));
   for (v1::AdaptiveRound& r : *rounds) *response->add_rounds() = std::move(r);
   return grpc::Status::OK;
-}
-
-grpc::Status ControlService::WatchSession(grpc::ServerContext* context,
-                                          const v1::WatchSessionRequest* request,
-                                          grpc::ServerWriter<v1::SessionEvent>* writer) {
-  if (rig_ == nullptr) return NoRig("WatchSession", request->session_id());
-  Caller caller;
-  if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
-  std::unique_ptr<StreamRegistry::Slot> slot;
-  if (grpc::Status st = streams_.Open(*context, &caller, "WatchSession", &slot); !st.ok()) {
-    return st;
-  }
-  SessionId id = 0;
-  if (grpc::Status st = ParseId(request->session_id(), &id); !st.ok()) return st;
-  Result<std::unique_ptr<SessionWatch>> watching = rig_->Watch(id);
-  if (!watching.ok()) return ToGrpcStatus(watching.status());
-  SessionWatch& watch = **watching;
-  spdlog::debug("WatchSession: {} watches session {}", caller.name, id);
-
-  for (;;) {
-    if (context->IsCancelled()) {
-      watch.Close();
-      return grpc::Status(grpc::StatusCode::CANCELLED, "WatchSession: cancelled by the client");
-    }
-    // At shutdown, send what is queued (the pause the shutdown made, typically), then end.
-    const bool stopping = stopping_.stopped();
-    std::optional<v1::SessionEvent> event =
-        watch.Next(stopping ? std::chrono::milliseconds(0) : kWatchIdleWait);
-    if (event.has_value()) {
-      if (!slot->Write(writer, *event)) {
-        watch.Close();
-        return grpc::Status(grpc::StatusCode::CANCELLED, "WatchSession: the client went away");
-      }
-      continue;
-    }
-    if (watch.ended()) return grpc::Status::OK;
-    if (stopping) {
-      watch.Close();
-      return grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                          "WatchSession: the daemon is shutting down; watch again once it is "
-                          "back (the session is kept)");
-    }
-  }
 }
 
 }  // namespace brdf::daemon

@@ -13,25 +13,29 @@
 #include "daemon/api/common.h"
 #include "daemon/api/rig_port.h"
 #include "daemon/api/session_catalogue.h"
+#include "daemon/api/stream_pump.h"
 #include "daemon/rpc/auth.h"
 #include "daemon/rpc/control_loop.h"
 #include "daemon/rpc/stream_registry.h"
 
 namespace brdf::daemon {
 
-// The control plane's methods, served by ControlLoop (control_loop.h), not the synchronous pool.
-using ControlServiceBase =
-    v1::Control::WithAsyncMethod_SubmitPlan<v1::Control::WithAsyncMethod_StartSession<
-        v1::Control::WithAsyncMethod_PauseSession<v1::Control::WithAsyncMethod_ResumeSession<
-            v1::Control::WithAsyncMethod_AbortSession<v1::Control::WithAsyncMethod_AnswerPrompt<
-                v1::Control::WithAsyncMethod_GetRigStatus<v1::Control::Service>>>>>>>;
+// The control plane's methods, served by ControlLoop (control_loop.h), not the synchronous pool;
+// WatchSession on gRPC's callback API (the stream pump: a watch that waits holds no thread).
+using ControlServiceBase = v1::Control::WithAsyncMethod_SubmitPlan<
+    v1::Control::WithAsyncMethod_StartSession<v1::Control::WithAsyncMethod_PauseSession<
+        v1::Control::WithAsyncMethod_ResumeSession<v1::Control::WithAsyncMethod_AbortSession<
+            v1::Control::WithAsyncMethod_AnswerPrompt<v1::Control::WithAsyncMethod_GetRigStatus<
+                v1::Control::WithCallbackMethod_WatchSession<v1::Control::Service>>>>>>>>;
 
 class ControlService final : public ControlServiceBase {
  public:
   // `rig` may be null (a server without a rig). All must outlive the service. `stopping` ends
   // WatchSession streams at shutdown; `program` ("brdfd", "brdf-archive") is WhoAmI's server.
+  // `pump` runs WatchSession's streams.
   ControlService(SessionCatalogue& catalogue, RigPort* rig, const Authenticator& auth,
-                 const StopSignal& stopping, StreamRegistry& streams, std::string program);
+                 const StopSignal& stopping, StreamRegistry& streams, StreamPump& pump,
+                 std::string program);
 
   // Adds the control plane's methods (the operator's verbs and GetRigStatus) to `loop`, which
   // then answers them with the methods below. Before the server is built.
@@ -55,9 +59,10 @@ class ControlService final : public ControlServiceBase {
   grpc::Status GetRigStatus(grpc::ServerContext* context, const v1::GetRigStatusRequest* request,
                             v1::RigStatus* response) override;
   // A snapshot, then every event until the session ends, the client cancels, or the server stops
-  // (then UNAVAILABLE, after the events already queued were sent).
-  grpc::Status WatchSession(grpc::ServerContext* context, const v1::WatchSessionRequest* request,
-                            grpc::ServerWriter<v1::SessionEvent>* writer) override;
+  // (then UNAVAILABLE, after the events already queued were sent). On the stream pump
+  // (watch_session.cc).
+  grpc::ServerWriteReactor<v1::SessionEvent>* WatchSession(
+      grpc::CallbackServerContext* context, const v1::WatchSessionRequest* request) override;
   // An adaptive session's stored rounds: the rig's store, or on brdf-archive the rounds the rigs
   // shipped (SessionCatalogue::AdaptiveRounds).
   grpc::Status ListAdaptiveRounds(grpc::ServerContext* context,
@@ -86,6 +91,7 @@ class ControlService final : public ControlServiceBase {
   const Authenticator& auth_;
   const StopSignal& stopping_;
   StreamRegistry& streams_;
+  StreamPump& pump_;
   std::string program_;
 };
 

@@ -8,22 +8,25 @@
 namespace brdf::daemon {
 
 DataService::DataService(SessionCatalogue& catalogue, const Authenticator& auth,
-                         const StopSignal& stopping, StreamRegistry& streams, std::string program,
-                         ExportInterpolants::Options kept)
+                         const StopSignal& stopping, StreamRegistry& streams, StreamPump& pump,
+                         std::string program, ExportInterpolants::Options kept)
     : catalogue_(catalogue),
       auth_(auth),
       stopping_(stopping),
       streams_(streams),
+      pump_(pump),
       program_(std::move(program)),
       export_interpolants_(streams.budget(), kept) {}
 
-grpc::Status DataService::StreamReadings(grpc::ServerContext* context,
-                                         const v1::StreamReadingsRequest* request,
-                                         grpc::ServerWriter<v1::Reading>* writer) {
-  return Serve(*context, *request, "StreamReadings",
-               [&](StreamReadingsCall& call, const ReadingSource& source) {
-                 return StreamSessionReadings(*context, *request, call, source, writer);
-               });
+grpc::ServerWriteReactor<v1::Reading>* DataService::StreamReadings(
+    grpc::CallbackServerContext* context, const v1::StreamReadingsRequest* request) {
+  return new PumpedStream<v1::Reading>(
+      pump_,
+      StreamReadingsBody(*context, *request, stopping_,
+                         [this, context, request](OpenedReadings* opened) {
+                           return Open(*context, *request, "StreamReadings", opened);
+                         }),
+      kStreamIdleWait);
 }
 
 grpc::Status DataService::StreamReadingPoints(grpc::ServerContext* context,
@@ -38,7 +41,15 @@ grpc::Status DataService::StreamReadingPoints(grpc::ServerContext* context,
 grpc::Status DataService::Serve(grpc::ServerContext& context,
                                 const v1::StreamReadingsRequest& request, const char* rpc,
                                 const ReadingStreamBody& body) {
-  StreamReadingsCall call;
+  OpenedReadings opened;
+  if (grpc::Status st = Open(context, request, rpc, &opened); !st.ok()) return st;
+  return body(opened.call, opened.source);
+}
+
+grpc::Status DataService::Open(grpc::ServerContextBase& context,
+                               const v1::StreamReadingsRequest& request, const char* rpc,
+                               OpenedReadings* opened) {
+  StreamReadingsCall& call = opened->call;
   if (grpc::Status st = CheckStreamReadings(context, request, rpc, auth_, streams_, &call);
       !st.ok()) {
     return st;
@@ -47,18 +58,21 @@ grpc::Status DataService::Serve(grpc::ServerContext& context,
   Result<storage::SessionRecord> session = reader.GetSession(call.session);
   if (!session.ok()) return ToGrpcStatus(session.status());
 
-  const SessionFollow follow = catalogue_.Follow(call.session);
-  ReadingSource source;
+  opened->follow = catalogue_.Follow(call.session);
+  const SessionFollow& follow = opened->follow;
+  ReadingSource& source = opened->source;
   source.reader = &reader;
   source.ended = follow.ended;
-  source.wait = [&](std::int64_t last_id) { return follow.wait(stopping_, last_id); };
+  source.wait = [this, &follow](std::int64_t last_id) { return follow.wait(stopping_, last_id); };
   source.recent = follow.recent;
+  source.notify = follow.notify;
   source.server = program_;
   // Labels and averaging are fixed at submission.
-  source.extras = [&] {
-    return ReadingExtrasOf(reader, call.session, catalogue_.Averages(call.session));
+  const std::int64_t id = call.session;
+  source.extras = [this, &reader, id] {
+    return ReadingExtrasOf(reader, id, catalogue_.Averages(id));
   };
-  return body(call, source);
+  return grpc::Status::OK;
 }
 
 grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportRequest* request,

@@ -13,24 +13,28 @@
 #include "daemon/api/export_cache.h"
 #include "daemon/api/export_loads.h"
 #include "daemon/api/session_catalogue.h"
+#include "daemon/api/stream_pump.h"
 #include "daemon/api/stream_readings.h"
 #include "daemon/rpc/auth.h"
 #include "daemon/rpc/stream_registry.h"
 
 namespace brdf::daemon {
 
-class DataService final : public v1::Data::Service {
+// StreamReadings on gRPC's callback API (the stream pump: a following stream that waits holds no
+// thread); the other methods on the synchronous pool.
+using DataServiceBase = v1::Data::WithCallbackMethod_StreamReadings<v1::Data::Service>;
+
+class DataService final : public DataServiceBase {
  public:
   // All must outlive the service. `program` ("brdfd", "brdf-archive") names the server in the
-  // message that ends a following stream at shutdown; `kept` bounds the exports' kept
-  // interpolants ([export]).
+  // message that ends a following stream at shutdown; `pump` runs StreamReadings; `kept` bounds
+  // the exports' kept interpolants ([export]).
   DataService(SessionCatalogue& catalogue, const Authenticator& auth, const StopSignal& stopping,
-              StreamRegistry& streams, std::string program,
+              StreamRegistry& streams, StreamPump& pump, std::string program,
               ExportInterpolants::Options kept = ExportInterpolants::Options());
 
-  grpc::Status StreamReadings(grpc::ServerContext* context,
-                              const v1::StreamReadingsRequest* request,
-                              grpc::ServerWriter<v1::Reading>* writer) override;
+  grpc::ServerWriteReactor<v1::Reading>* StreamReadings(
+      grpc::CallbackServerContext* context, const v1::StreamReadingsRequest* request) override;
   // The same readings as columns of poses and directions, without spectra.
   grpc::Status StreamReadingPoints(grpc::ServerContext* context,
                                    const v1::StreamReadingsRequest* request,
@@ -47,11 +51,15 @@ class DataService final : public v1::Data::Service {
   // looked up, then `body` with the catalogue as the source.
   grpc::Status Serve(grpc::ServerContext& context, const v1::StreamReadingsRequest& request,
                      const char* rpc, const ReadingStreamBody& body);
+  // What Serve does before `body`, into `opened` (which must not move afterwards).
+  grpc::Status Open(grpc::ServerContextBase& context, const v1::StreamReadingsRequest& request,
+                    const char* rpc, OpenedReadings* opened);
 
   SessionCatalogue& catalogue_;
   const Authenticator& auth_;
   const StopSignal& stopping_;
   StreamRegistry& streams_;
+  StreamPump& pump_;
   std::string program_;
   SharedSessionLoads export_loads_;         // the sessions the exports in flight hold
   ExportInterpolants export_interpolants_;  // their interpolants, kept per snapshot

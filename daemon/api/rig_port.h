@@ -10,6 +10,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -33,6 +34,10 @@ class SessionWatch {
   virtual bool ended() const = 0;
   // The watcher went away.
   virtual void Close() = 0;
+  // `wake` is called after each event is queued (on the publisher's thread: it must not block),
+  // so a watch served without a thread of its own (api/pumped_stream.h) calls Next(0) only when
+  // there may be something. Without it (the default) such a watch looks every second.
+  virtual void OnEvent(std::function<void()> wake) { (void)wake; }
 };
 
 class RigPort {

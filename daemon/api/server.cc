@@ -24,6 +24,11 @@ namespace {
 // store (SubmitPlan's commit).
 constexpr int kControlThreads = 2;
 
+// The stream pump's threads (stream_pump.h): WatchSession and StreamReadings, however many are
+// open. A step writes one message or reads one store page; a few threads keep one slow page
+// from holding up the others.
+constexpr int kStreamPumpThreads = 4;
+
 constexpr const char* kBrdfServices[] = {"brdf.v1.Control", "brdf.v1.Data",
                                          "brdf.v1.Interpolation"};
 
@@ -179,9 +184,12 @@ int InterpolateLoopThreads(unsigned cores) {
 Server::Server(const ServerConfig& config, const BackEnd& back_end, const Authenticator& auth)
     : streams_(config, auth.enabled()),
       control_loop_(kControlThreads),
+      pump_(kStreamPumpThreads),
       health_(stopping_, streams_),
-      control_(*back_end.catalogue, back_end.rig, auth, stopping_, streams_, back_end.program),
-      data_(*back_end.catalogue, auth, stopping_, streams_, back_end.program, back_end.exports),
+      control_(*back_end.catalogue, back_end.rig, auth, stopping_, streams_, pump_,
+               back_end.program),
+      data_(*back_end.catalogue, auth, stopping_, streams_, pump_, back_end.program,
+            back_end.exports),
       interpolation_(*back_end.cache, auth, stopping_, streams_),
       interpolate_loop_(interpolation_,
                         config.interpolate_threads > 0
@@ -256,12 +264,14 @@ void Server::LogLimits(const ServerConfig& config) const {
       "directions in chunks of up to {} results, notes up to {} bytes, pages up to {} sessions, "
       "open streams up to {} per token, {} analyst, {} operator, {} without a token (a stream "
       "not read for {} s is cancelled), heavy calls within a memory budget of {} MB, {} call "
-      "threads, control plane on {} thread(s), "
+      "threads, WatchSession and StreamReadings on {} pump thread(s), control plane on {} "
+      "thread(s), "
       "Interpolate on {} loop thread(s){}",
       kMaxReceiveMessageBytes, kMaxBatchDirections, kMaxChunkSize, kMaxNoteBytes, kMaxPageSize,
       config.max_streams_per_token, config.max_streams_analyst, config.max_streams_operator,
       config.max_streams_unauthenticated, config.stream_stall_timeout_s, config.memory_budget_mb,
-      ServerThreadCap(config), control_loop_.threads(), interpolate_loop_.threads(),
+      ServerThreadCap(config), pump_.threads(), control_loop_.threads(),
+      interpolate_loop_.threads(),
       tls_ ? (config.tls->client_ca.empty() ? "; TLS" : "; TLS, client certificates required")
            : "; plaintext");
 }
@@ -277,12 +287,14 @@ void Server::Shutdown(std::chrono::milliseconds grace) {
   shut_down_ = true;
   health_.SetServingStatus(false);
   stopping_.Stop();
+  pump_.WakeAll();  // the pump's waiting streams see the stop now
   interpolate_loop_.BeginShutdown();
   control_loop_.BeginShutdown();
   server_->Shutdown(std::chrono::system_clock::now() + grace);
   interpolate_loop_.Stop();
   control_loop_.Stop();
   server_->Wait();
+  pump_.Stop();  // after the server: its cancelled streams finish on the pump
 }
 
 }  // namespace brdf::daemon

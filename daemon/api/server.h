@@ -9,8 +9,10 @@
 //    on gRPC's completion-queue API (control_loop.h), whatever the streams hold;
 //  - Interpolate, the call analysis clients make by the thousand: the server's own loop threads on
 //    the completion-queue API (interpolate_loop.h), one per two cores;
-//  - everything else, the streams among them: gRPC's synchronous pool, one thread per call in
-//    flight, capped at ServerThreadCap (stream_registry.h), above the caps on open streams.
+//  - the long-lived streams, WatchSession and StreamReadings: the stream pump's few threads on
+//    gRPC's callback API (stream_pump.h, pumped_stream.h); a stream that waits holds no thread;
+//  - everything else, the other streams among them: gRPC's synchronous pool, one thread per call
+//    in flight, capped at ServerThreadCap (stream_registry.h), above the caps on open streams.
 #pragma once
 
 #include <grpcpp/server.h>
@@ -29,6 +31,7 @@
 #include "daemon/api/reflection.h"
 #include "daemon/api/rig_port.h"
 #include "daemon/api/session_catalogue.h"
+#include "daemon/api/stream_pump.h"
 #include "daemon/config/config.h"
 #include "daemon/index/cache.h"
 #include "daemon/rpc/auth.h"
@@ -96,6 +99,7 @@ class Server {
   StopSignal stopping_;
   StreamRegistry streams_;  // before the services, which hold slots in it
   ControlLoop control_loop_;
+  StreamPump pump_;  // before the services whose streams it runs
   HealthService health_;
   ControlService control_;
   DataService data_;

@@ -59,6 +59,11 @@ struct SessionFollow {
   std::function<Result<std::optional<std::vector<storage::ReadingRecord>>>(std::int64_t after_id,
                                                                            int limit)>
       recent;
+  // For a stream served without a thread of its own (api/pumped_stream.h), instead of `wait`:
+  // calls `wake` once a reading newer than `last_id` is committed (at once when one already was;
+  // from the committing thread: it must not block). Empty: such a stream looks again every
+  // second, as `wait` would.
+  std::function<void(std::int64_t last_id, std::function<void()> wake)> notify;
 };
 
 class SessionCatalogue {

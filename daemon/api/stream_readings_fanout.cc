@@ -20,13 +20,34 @@ void ReadingFanout::Leave(std::int64_t session) {
 }
 
 void ReadingFanout::Committed(std::int64_t session, std::int64_t reading_id) {
+  std::vector<std::function<void()>> woken;
   {
     MutexLock lock(mu_);
     auto it = sessions_.find(session);
     if (it == sessions_.end()) return;  // nobody follows it
-    it->second.committed = std::max(it->second.committed, reading_id);
+    Followed& f = it->second;
+    f.committed = std::max(f.committed, reading_id);
+    auto newer = [&](const auto& n) { return n.first < f.committed; };
+    for (auto& n : f.notified) {
+      if (newer(n)) woken.push_back(std::move(n.second));
+    }
+    f.notified.erase(std::remove_if(f.notified.begin(), f.notified.end(), newer), f.notified.end());
   }
   cv_.NotifyAll();
+  for (const std::function<void()>& wake : woken) wake();
+}
+
+void ReadingFanout::Notify(std::int64_t session, std::int64_t after_id,
+                           std::function<void()> wake) {
+  {
+    MutexLock lock(mu_);
+    auto it = sessions_.find(session);
+    if (it != sessions_.end() && it->second.committed <= after_id) {
+      it->second.notified.emplace_back(after_id, std::move(wake));
+      return;
+    }
+  }
+  wake();  // a newer reading was committed already (or the session has no follower: look)
 }
 
 bool ReadingFanout::Wait(std::int64_t session, std::int64_t after_id,
@@ -42,11 +63,17 @@ bool ReadingFanout::Wait(std::int64_t session, std::int64_t after_id,
 }
 
 void ReadingFanout::Wake() {
+  std::vector<std::function<void()>> woken;
   {
     MutexLock lock(mu_);
     ++wakes_;
+    for (auto& [session, f] : sessions_) {
+      for (auto& n : f.notified) woken.push_back(std::move(n.second));
+      f.notified.clear();
+    }
   }
   cv_.NotifyAll();
+  for (const std::function<void()>& wake : woken) wake();
 }
 
 std::optional<std::vector<storage::ReadingRecord>> ReadingFanout::TakeLocked(const Followed& f,

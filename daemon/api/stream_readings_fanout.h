@@ -25,6 +25,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/mutex.h"
@@ -57,6 +58,12 @@ class ReadingFanout {
   // passed, or Wake() was called. True when such a reading was committed.
   bool Wait(std::int64_t session, std::int64_t after_id, std::chrono::steady_clock::duration d);
 
+  // The same for a follower that holds no thread while it waits (api/pumped_stream.h): `wake` is
+  // called once a reading of `session` newer than `after_id` is committed (at once, here, when
+  // one already was), or at Wake(); on the committing thread, outside the fan-out's lock. A
+  // follower that left meanwhile is woken for nothing (its waker then does nothing).
+  void Notify(std::int64_t session, std::int64_t after_id, std::function<void()> wake);
+
   // Wakes every waiting follower (the server is stopping).
   void Wake();
 
@@ -78,6 +85,9 @@ class ReadingFanout {
     // capacity_). Unset until the first After reads the store.
     std::optional<std::int64_t> floor, through;
     std::deque<storage::ReadingRecord> held;
+    // Notify's followers: the last id each has, and its waker (called and dropped at the commit
+    // of a newer reading).
+    std::vector<std::pair<std::int64_t, std::function<void()>>> notified;
   };
   // Reads what was committed after what is held (after `after_id` when nothing is) into the
   // session's held readings, dropping the oldest beyond capacity_. One fill at a time (fill_mu_);

@@ -12,6 +12,7 @@ EventSubscription::EventSubscription(std::size_t capacity)
     : capacity_(std::max<std::size_t>(capacity, 2)) {}
 
 void EventSubscription::Push(v1::SessionEvent event, bool last) {
+  std::function<void()> listener;
   {
     MutexLock lock(mu_);
     if (closed_ || closing_) return;
@@ -21,8 +22,15 @@ void EventSubscription::Push(v1::SessionEvent event, bool last) {
     }
     queue_.push_back(std::move(event));
     if (last) closing_ = true;
+    listener = listener_;
   }
   cv_.NotifyAll();
+  if (listener) listener();
+}
+
+void EventSubscription::SetListener(std::function<void()> listener) {
+  MutexLock lock(mu_);
+  if (!closed_) listener_ = std::move(listener);
 }
 
 std::optional<v1::SessionEvent> EventSubscription::Next(std::chrono::steady_clock::duration wait,
@@ -66,6 +74,7 @@ void EventSubscription::Close() {
     MutexLock lock(mu_);
     closed_ = true;
     queue_.clear();
+    listener_ = nullptr;
   }
   cv_.NotifyAll();
 }

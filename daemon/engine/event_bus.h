@@ -42,6 +42,11 @@ class EventSubscription {
   std::uint64_t dropped() const;
   // Stops the subscription (the watcher went away); a waiting Next returns nullopt.
   void Close();
+  // `listener` is called after each event is queued (on the publisher's thread, outside the
+  // queue's lock: it must not block nor call back into this subscription's Next), so a watcher
+  // that holds no thread (api/pumped_stream.h) knows when to call Next(0). Replaces any before;
+  // dropped at Close().
+  void SetListener(std::function<void()> listener);
 
  private:
   friend class EventBus;
@@ -56,6 +61,7 @@ class EventSubscription {
   bool closing_ GUARDED_BY(mu_) = false;
   bool closed_ GUARDED_BY(mu_) = false;  // Close() or the terminal event was read
   std::uint64_t dropped_ GUARDED_BY(mu_) = 0;
+  std::function<void()> listener_ GUARDED_BY(mu_);
 };
 
 class EventBus {

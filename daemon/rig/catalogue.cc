@@ -97,6 +97,9 @@ SessionFollow RigCatalogue::Follow(SessionId session) {
   follow.recent = [this, session, joined](std::int64_t after_id, int limit) {
     return fanout_.After(session, after_id, limit);
   };
+  follow.notify = [this, session, joined](std::int64_t last_id, std::function<void()> wake) {
+    fanout_.Notify(session, last_id, std::move(wake));
+  };
   return follow;
 }
 

@@ -18,6 +18,7 @@ class EventWatch final : public SessionWatch {
   }
   bool ended() const override { return subscription_->ended(); }
   void Close() override { subscription_->Close(); }
+  void OnEvent(std::function<void()> wake) override { subscription_->SetListener(std::move(wake)); }
 
  private:
   std::shared_ptr<EventSubscription> subscription_;

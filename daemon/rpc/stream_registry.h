@@ -5,9 +5,11 @@
 // all tokens of the role together (max_streams_analyst, max_streams_operator), and for calls
 // without a token (max_streams_unauthenticated). Open() refuses a stream beyond a cap with
 // RESOURCE_EXHAUSTED naming the cap and its key. With no tokens configured every caller is the
-// operator "anonymous" and only the role cap applies. Each open stream holds a thread of gRPC's
-// synchronous pool, which server.cc sizes above the caps' sum (ServerThreadCap): the streams
-// cannot exhaust it, and the control plane is not on it at all (control_loop.h).
+// operator "anonymous" and only the role cap applies. Each open stream on gRPC's synchronous pool
+// (Export, InterpolateBatch, RenderAppearance, health Watch, reflection) holds one of its
+// threads, which server.cc sizes above the caps' sum (ServerThreadCap): the streams cannot
+// exhaust it, and the control plane is not on it at all (control_loop.h). WatchSession and
+// StreamReadings hold none while they wait (api/stream_pump.h).
 //
 // Bounded work: a stream that computes what it sends (Export, InterpolateBatch: opened with
 // `computes`; RenderAppearance takes one with Slot::Work once it knows it must render) works only
@@ -84,13 +86,17 @@ class StreamRegistry {
     // has work to do (RenderAppearance, on a cache miss). Waits for one; false when the call was
     // cancelled meanwhile.
     bool Work();
+    // What Write does around writer->Write, for a stream that writes asynchronously (gRPC's
+    // callback API: BeginWrite before StartWrite, EndWrite in OnWriteDone): the write is timed for
+    // the stall deadline; BeginWrite gives the work permit back, EndWrite takes one again (waits:
+    // not for a callback stream that computes).
+    void BeginWrite();
+    void EndWrite();
 
    private:
     friend class StreamRegistry;
     Slot(StreamRegistry* registry, std::uint64_t id, Entry* entry, bool computes)
         : registry_(registry), id_(id), entry_(entry), computes_(computes) {}
-    void BeginWrite();  // gives the work permit back
-    void EndWrite();    // takes a work permit again
     StreamRegistry* registry_;
     std::uint64_t id_;
     Entry* entry_;
