@@ -43,7 +43,7 @@ double ConformalScale(std::vector<double>& needed, double coverage) {
 
 // One size bin's c per band: per band group the conformal scale of `points`' needs.
 std::vector<double> FitScale(std::span<const HeldOutPoint* const> points, std::size_t nb,
-                             std::size_t groups, const CalibrationTarget& target) {
+                             std::size_t groups, double k, double coverage) {
   std::vector<double> scale(nb, 0.0);
   std::vector<double> needed;
   for (std::size_t g = 0; g < groups; ++g) {
@@ -53,18 +53,21 @@ std::vector<double> FitScale(std::span<const HeldOutPoint* const> points, std::s
     for (const HeldOutPoint* p : points) {
       for (std::size_t b = first; b < last; ++b) {
         const double noise = p->noise.empty() ? 0.0 : p->noise[b];
-        needed.push_back(NeededScale(p->residual[b], p->spread[b], noise, target.k));
+        needed.push_back(NeededScale(p->residual[b], p->spread[b], noise, k));
       }
     }
-    const double c = ConformalScale(needed, target.coverage);
+    const double c = ConformalScale(needed, coverage);
     std::fill(scale.begin() + static_cast<std::ptrdiff_t>(first),
               scale.begin() + static_cast<std::ptrdiff_t>(last), c);
   }
   return scale;
 }
 
-// `usable` sorted by cell size into `bins` bins of equal counts (the last takes the remainder),
-// each bin's c at least the previous bin's: a larger cell is never promised a smaller error.
+// `usable` sorted by cell size into `bins` bins of equal counts (the last takes the remainder).
+// Each bin's c is the pooled c times the ratio of the bin's kSizeBinQuantile need to the pooled
+// one: the needs of a bin taken as the pooled ones scaled, so that a bin's few held-out readings
+// whose spread explains nothing (needs of 10³–10⁶) cannot set its c alone. Each bin's c is at
+// least the previous bin's: a larger cell is never promised a smaller error.
 void FitSizeBins(std::vector<const HeldOutPoint*> usable, std::size_t bins, std::size_t nb,
                  std::size_t groups, const CalibrationTarget& target,
                  InterpolationCalibration* out) {
@@ -72,11 +75,16 @@ void FitSizeBins(std::vector<const HeldOutPoint*> usable, std::size_t bins, std:
     return a->cell_size < b->cell_size;
   });
   const std::size_t per = usable.size() / bins;
+  const std::vector<double> pooled = FitScale(usable, nb, groups, target.k, target.coverage);
+  const std::vector<double> pooled_q = FitScale(usable, nb, groups, target.k, kSizeBinQuantile);
   std::vector<double> previous;
   for (std::size_t i = 0; i < bins; ++i) {
     const std::size_t end = i + 1 == bins ? usable.size() : (i + 1) * per;
-    std::vector<double> scale =
-        FitScale(std::span(usable).subspan(i * per, end - i * per), nb, groups, target);
+    std::vector<double> scale = FitScale(std::span(usable).subspan(i * per, end - i * per), nb,
+                                         groups, target.k, kSizeBinQuantile);
+    for (std::size_t b = 0; b < nb; ++b) {
+      scale[b] = pooled_q[b] > 0 ? pooled[b] * scale[b] / pooled_q[b] : pooled[b];
+    }
     for (std::size_t b = 0; b < previous.size(); ++b) scale[b] = std::max(scale[b], previous[b]);
     previous = scale;
     if (i == 0) {
@@ -114,7 +122,7 @@ InterpolationCalibration FitInterpolationCalibration(std::span<const HeldOutPoin
   if (target.size_bins > 1) {
     FitSizeBins(usable, bins, nb, groups, target, &out);
   } else {
-    out.scale = FitScale(usable, nb, groups, target);
+    out.scale = FitScale(usable, nb, groups, target.k, target.coverage);
   }
   out.detail = "fitted on " + std::to_string(usable.size()) + " held-out readings, " +
                std::to_string(groups) + " band groups";

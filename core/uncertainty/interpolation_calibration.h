@@ -11,7 +11,8 @@
 // rank (the ⌈(n + 1) · coverage⌉-th smallest of n) keeps a small calibration set from claiming
 // more than it has. With CalibrationTarget::size_bins > 1 c also depends on the cell's size h
 // (CellSize, the vertices' weighted spread of positions): the held-out readings are binned by h
-// (equal counts), each bin gets its own c, never smaller than a smaller bin's, and a cell larger
+// (equal counts), each bin gets its own c — the pooled c times the ratio of the bin's
+// kSizeBinQuantile need to the pooled one — never smaller than a smaller bin's, and a cell larger
 // than every held-out one either gets c · h / h_max or is not estimated (SizeBeyond). Delaunay's
 // large cells across the data's gaps err more, relative to s, than its small ones (docs). Pure:
 // no I/O.
@@ -76,6 +77,10 @@ struct CalibrationTarget {
 // A pair needing a larger c than this has a spread that is rounding beside its residual: it counts
 // as s = 0 (the vertices' spread explains nothing of it). On the simulator's sessions c is 0.5–4.
 inline constexpr double kMaxNeededScale = 1e6;
+
+// The quantile of the needs whose ratio between a size bin and the pooled held-out readings
+// scales the pooled c into the bin's (robust to a bin's few pairs with a spread of nothing).
+inline constexpr double kSizeBinQuantile = 0.9;
 
 // Per band group (and size bin), the smallest c such that |r| ≤ k · sqrt(noise² + (c · s)²) holds
 // for the ⌈(n + 1) · coverage⌉-th smallest of the group's n held-out (reading, band) pairs' needs
