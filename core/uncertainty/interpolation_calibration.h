@@ -82,12 +82,14 @@ inline constexpr double kMaxNeededScale = 1e6;
 // scales the pooled c into the bin's (robust to a bin's few pairs with a spread of nothing).
 inline constexpr double kSizeBinQuantile = 0.9;
 
-// Per band group (and size bin), the smallest c such that |r| ≤ k · sqrt(noise² + (c · s)²) holds
+// Per band group, the smallest c such that |r| ≤ k · sqrt(noise² + (c · s)²) holds
 // for the ⌈(n + 1) · coverage⌉-th smallest of the group's n held-out (reading, band) pairs' needs
 // (all of them when that rank passes n). A pair the noise alone covers needs c = 0; a pair with s =
 // 0 (or a need above kMaxNeededScale) that the noise does not cover needs more than any c: when the
-// rank falls on such a pair, c is the largest finite need. Points whose vectors do not have `bands`
-// values are left out.
+// rank falls on such a pair, c is the largest finite need. With target.size_bins > 1 (and at
+// least min_points readings a bin) that pooled c is scaled per size bin by the ratio of the bin's
+// kSizeBinQuantile need to the pooled one, never below a smaller bin's. Points whose vectors do
+// not have `bands` values are left out.
 InterpolationCalibration FitInterpolationCalibration(std::span<const HeldOutPoint> points,
                                                      int bands, const CalibrationTarget& target);
 
