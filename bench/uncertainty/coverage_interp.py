@@ -16,7 +16,11 @@ goal: intervals at most 2× the error, coverage 93–97 %); then each material p
 --dump keeps each session's answers, uncertainties and truth as .npz. --export-grid STEPS
 counts the same for a grid export with uncertainty (Data.Export, include_uncertainty) instead of
 the batch: its cells' centres (θi, θo ≤ --theta-max) are the directions, each cell's value and u
-(the .npy and its u and u_measurement arrays) the answer, with --fill's chain behind them.
+(the .npy and its u and u_measurement arrays) the answer, with --fill's chain behind them; with
+--fill chain the cells are also counted by kind, "interpolated" (the chosen method's or the
+Delaunay fallback's: u_measurement finite) and "model" (u_measurement NaN), each with the cells
+whose u is not estimated (NaN: model cells beyond the calibration's reach), which no coverage
+counts.
 
     bench/uncertainty/coverage_interp.py --materials paint clay --seeds 1 2 --directions 2000
 
@@ -112,6 +116,20 @@ def summarise(label, y, u, u_meas, t, k):
     return (err <= k * u)[ok], ((y - t) / u)[ok], (k * u)[ok], err[ok]
 
 
+def by_kind(material, seed, y, u, u_meas, t, k, kinds):
+    """A chain's cells split by kind (interpolated: u_measurement finite; model: NaN), each
+    summarised, with the count of its cells whose u is not estimated (NaN)."""
+    model = ~np.isfinite(u_meas[:, 0])
+    for kind, sel in (("interpolated", ~model), ("model", model)):
+        estimated = sel & np.isfinite(u[:, 0])
+        print(json.dumps({"run": f"{material} seed {seed} {kind} cells", "cells": int(sel.sum()),
+                          "not_estimated": int((sel & ~estimated).sum())}), flush=True)
+        if estimated.any():
+            kinds.setdefault((material, kind), []).append(summarise(
+                f"{material} seed {seed} {kind} cells ({int(estimated.sum())} estimated)",
+                y[estimated], u[estimated], u_meas[estimated], t[estimated], k))
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n", maxsplit=1)[0])
     p.add_argument("--materials", nargs="+", default=["paint", "glossy", "clay", "gold",
@@ -145,6 +163,7 @@ def main():
                       "theta_max": args.theta_max}))
     parts = []
     by_material = {}
+    kinds = {}
     for material in args.materials:
         path = os.path.join(coverage.ROOT, "deploy", "materials", material + ".toml")
         for seed in args.seeds:
@@ -170,8 +189,16 @@ def main():
             parts.append(summarise(f"{material} seed {seed} ({int(ok.sum())} ok)",
                                    y[ok], u[ok], u_meas[ok], t[ok], args.k))
             by_material.setdefault(material, []).append(parts[-1])
+            if args.export_grid and args.fill == "chain":
+                by_kind(material, seed, y[ok], u[ok], u_meas[ok], t[ok], args.k, kinds)
     for material, runs in by_material.items():
         pooled(material, runs)
+    for (material, kind), runs in kinds.items():
+        pooled(f"{material} {kind} cells", runs)
+    for kind in ("interpolated", "model"):
+        runs = [r for (m, k), rs in kinds.items() if k == kind for r in rs]
+        if runs:
+            pooled(f"all {kind} cells", runs)
     row = pooled("all", parts)
     return check(args, row)
 

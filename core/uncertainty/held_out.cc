@@ -9,6 +9,7 @@
 
 #include "core/interp/octant/octant.h"
 #include "core/uncertainty/blend.h"
+#include "core/uncertainty/interpolated.h"
 
 namespace brdf::uncertainty {
 namespace {
@@ -21,8 +22,9 @@ std::uint64_t Mix(std::int64_t id) {
   return z ^ (z >> 31);
 }
 
-// The samples' positions in hash order of their ids.
-std::vector<std::size_t> HashOrder(const interp::SampleSet& samples) {
+}  // namespace
+
+std::vector<std::size_t> HeldOutOrder(const interp::SampleSet& samples) {
   std::vector<std::pair<std::uint64_t, std::size_t>> keyed(samples.size());
   for (std::size_t i = 0; i < samples.size(); ++i) keyed[i] = {Mix(samples.id(i)), i};
   std::sort(keyed.begin(), keyed.end());
@@ -30,6 +32,8 @@ std::vector<std::size_t> HashOrder(const interp::SampleSet& samples) {
   for (std::size_t i = 0; i < keyed.size(); ++i) order[i] = keyed[i].second;
   return order;
 }
+
+namespace {
 
 const std::vector<double>* Independent(const BudgetOf& budget_of, std::size_t i) {
   const ReadingBudget* b = budget_of ? budget_of(i) : nullptr;
@@ -55,6 +59,7 @@ bool PredictOne(const interp::SampleSet& samples, const BudgetOf& budget_of, std
   out->residual.resize(bands);
   for (std::size_t b = 0; b < bands; ++b) out->residual[b] = answer.spectrum[b] - truth[b];
   out->spread = InterpolationSpread(weights, spectra, answer.spectrum);
+  out->cell_size = CellSize(answer.vertices);
   out->noise.clear();
   const std::vector<double>* own = Independent(budget_of, j);
   if (own == nullptr || own->size() != bands) return true;
@@ -122,13 +127,19 @@ std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
   const std::size_t folds = std::clamp<std::size_t>(budget / n, 1, std::min(kMaxFolds, n));
   const std::size_t fold =
       std::max<std::size_t>(1, std::min((n + folds - 1) / folds, kMaxHeldOut / folds));
-  const std::vector<std::size_t> order = HashOrder(samples);
+  const std::vector<std::size_t> order = HeldOutOrder(samples);
   for (std::size_t f = 0; f < folds && f * fold < n; ++f) {
     const std::size_t end = std::min(n, (f + 1) * fold);
     PredictFold(samples, budget_of, std::span(order).subspan(f * fold, end - f * fold), method,
                 options, &out);
   }
   return out;
+}
+
+CalibrationTarget TargetOf(interp::Method method) {
+  CalibrationTarget target;
+  if (method == interp::Method::kDelaunay) target.size_bins = kDelaunaySizeBins;
+  return target;
 }
 
 InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples,
@@ -140,7 +151,7 @@ InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples
     return none;
   }
   const std::vector<HeldOutPoint> points = PredictHeldOut(samples, budget_of, method, options);
-  return FitInterpolationCalibration(points, bands, CalibrationTarget{});
+  return FitInterpolationCalibration(points, bands, TargetOf(method));
 }
 
 }  // namespace brdf::uncertainty

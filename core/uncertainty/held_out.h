@@ -34,6 +34,10 @@ inline constexpr std::size_t kMaxFoldSamplesOther = 10000;
 // Sample i's budget, by its position in the sample set (null: none). Unset: no sample has one.
 using BudgetOf = std::function<const ReadingBudget*(std::size_t index)>;
 
+// The samples' positions in the order the folds take them: by a fixed hash of their ids (the
+// folds do not follow the plan's order; the same session gives the same folds).
+std::vector<std::size_t> HeldOutOrder(const interp::SampleSet& samples);
+
 // The held-out predictions over `samples` by `method` with `options`: for each fold, an index
 // over the samples outside it, evaluated at each held-out sample's pose; answers that are not OK
 // are left out. `budget_of` gives each point's noise: the held-out reading's independent part and
@@ -42,9 +46,20 @@ std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
                                          const BudgetOf& budget_of, interp::Method method,
                                          const interp::Options& options);
 
+// Delaunay's held-out readings binned by their cell's size (interpolation_calibration.h): its
+// simplices span the data's gaps, and a large one errs more, relative to its vertices' spread,
+// than a small one (docs/uncertainty.md, "Coverage of the export's cells"). The octant method's
+// cells are bounded by their octants, and it predicts too few held-out readings to bin.
+inline constexpr int kDelaunaySizeBins = 3;
+
+// What `method`'s calibration aims at: CalibrationTarget's defaults, with kDelaunaySizeBins size
+// bins for Delaunay (a cell larger than every held-out one: c grows with its size).
+CalibrationTarget TargetOf(interp::Method method);
+
 // The calibration of the interpolation term of `method` over `samples` (`bands` values a
-// spectrum): not calibrated (detail says why) for the nearest method, which has no interpolation
-// term, and when fewer held-out readings than CalibrationTarget::min_points could be predicted.
+// spectrum), aimed as TargetOf(method): not calibrated (detail says why) for the nearest method,
+// which has no interpolation term, and when fewer held-out readings than
+// CalibrationTarget::min_points could be predicted.
 InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples,
                                                 const BudgetOf& budget_of, interp::Method method,
                                                 const interp::Options& options, int bands);

@@ -1,6 +1,8 @@
 #include "core/uncertainty/interpolated.h"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <span>
 #include <string>
 #include <utility>
@@ -72,13 +74,43 @@ void AddInterpolation(const interp::Interpolation& answer, const InterpolatedInp
   }
   InterpolationSpread(weights, spectra, answer.spectrum, &out.interpolation);
   const InterpolationCalibration* calibration = inputs.calibration;
-  if (calibration != nullptr && !ApplyInterpolationCalibration(*calibration, out.interpolation)) {
+  if (calibration == nullptr) return;
+  const double h = calibration->largest_cell > 0 ? CellSize(answer.vertices) : 0.0;
+  if (BeyondCalibration(*calibration, h)) {
+    out.interpolation.clear();
+    out.not_estimated.push_back(
+        "interpolation: the cell is larger than every held-out reading's (not estimated)");
+  } else if (!ApplyInterpolationCalibration(*calibration, out.interpolation, h)) {
     out.not_estimated.push_back("interpolation: not calibrated (" + calibration->detail +
                                 "); the vertices' spread as it is");
   }
 }
 
 }  // namespace
+
+double CellSize(std::span<const interp::Vertex> vertices) {
+  // A cell's coordinates are the interpolant's (3 or 4); more are left out of its size.
+  std::array<double, 8> centre{};
+  const std::size_t dims =
+      vertices.empty() ? 0 : std::min(centre.size(), vertices[0].coords.size());
+  double total = 0;
+  for (const interp::Vertex& v : vertices) {
+    for (std::size_t d = 0; d < dims && d < v.coords.size(); ++d)
+      centre[d] += v.weight * v.coords[d];
+    total += v.weight;
+  }
+  if (!(total > 0)) return 0;
+  double sum = 0;
+  for (const interp::Vertex& v : vertices) {
+    double d2 = 0;
+    for (std::size_t d = 0; d < dims && d < v.coords.size(); ++d) {
+      const double delta = v.coords[d] - centre[d] / total;
+      d2 += delta * delta;
+    }
+    sum += v.weight * d2;
+  }
+  return std::sqrt(std::max(0.0, sum / total));
+}
 
 void EstimateInterpolatedUncertainty(const interp::Interpolation& answer,
                                      const InterpolatedInputs& inputs,

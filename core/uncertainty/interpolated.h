@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,11 @@ struct InterpolatedInputs {
   // per answer.
   const InterpolationCalibration* calibration = nullptr;
 };
+
+// The size h of an answer's cell: the vertices' weighted spread of positions about their weighted
+// centre (the query, for barycentric weights), sqrt(Σ wᵢ ‖xᵢ − x̄‖² / Σ wᵢ), in the vertices'
+// coordinates (unscaled). 0 for one vertex. The calibration's size bins are of this h.
+double CellSize(std::span<const interp::Vertex> vertices);
 
 // One answer's uncertainty per band, standard uncertainties (k = 1) in the answer's unit.
 struct InterpolatedUncertainty {

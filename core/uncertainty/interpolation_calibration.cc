@@ -41,6 +41,62 @@ double ConformalScale(std::vector<double>& needed, double coverage) {
   return 0;
 }
 
+// One size bin's c per band: per band group the conformal scale of `points`' needs.
+std::vector<double> FitScale(std::span<const HeldOutPoint* const> points, std::size_t nb,
+                             std::size_t groups, double k, double coverage) {
+  std::vector<double> scale(nb, 0.0);
+  std::vector<double> needed;
+  for (std::size_t g = 0; g < groups; ++g) {
+    const std::size_t first = BandGroupFirst(g, groups, nb);
+    const std::size_t last = BandGroupFirst(g + 1, groups, nb);
+    needed.clear();
+    for (const HeldOutPoint* p : points) {
+      for (std::size_t b = first; b < last; ++b) {
+        const double noise = p->noise.empty() ? 0.0 : p->noise[b];
+        needed.push_back(NeededScale(p->residual[b], p->spread[b], noise, k));
+      }
+    }
+    const double c = ConformalScale(needed, coverage);
+    std::fill(scale.begin() + static_cast<std::ptrdiff_t>(first),
+              scale.begin() + static_cast<std::ptrdiff_t>(last), c);
+  }
+  return scale;
+}
+
+// `usable` sorted by cell size into `bins` bins of equal counts (the last takes the remainder).
+// Each bin's c is the pooled c times the ratio of the bin's kSizeBinQuantile need to the pooled
+// one: the needs of a bin taken as the pooled ones scaled, so that a bin's few held-out readings
+// whose spread explains nothing (needs of 10³–10⁶) cannot set its c alone. Each bin's c is at
+// least the previous bin's: a larger cell is never promised a smaller error.
+void FitSizeBins(std::vector<const HeldOutPoint*> usable, std::size_t bins, std::size_t nb,
+                 std::size_t groups, const CalibrationTarget& target,
+                 InterpolationCalibration* out) {
+  std::sort(usable.begin(), usable.end(), [](const HeldOutPoint* a, const HeldOutPoint* b) {
+    return a->cell_size < b->cell_size;
+  });
+  const std::size_t per = usable.size() / bins;
+  const std::vector<double> pooled = FitScale(usable, nb, groups, target.k, target.coverage);
+  const std::vector<double> pooled_q = FitScale(usable, nb, groups, target.k, kSizeBinQuantile);
+  std::vector<double> previous;
+  for (std::size_t i = 0; i < bins; ++i) {
+    const std::size_t end = i + 1 == bins ? usable.size() : (i + 1) * per;
+    std::vector<double> scale = FitScale(std::span(usable).subspan(i * per, end - i * per), nb,
+                                         groups, target.k, kSizeBinQuantile);
+    for (std::size_t b = 0; b < nb; ++b) {
+      scale[b] = pooled_q[b] > 0 ? pooled[b] * scale[b] / pooled_q[b] : pooled[b];
+    }
+    for (std::size_t b = 0; b < previous.size(); ++b) scale[b] = std::max(scale[b], previous[b]);
+    previous = scale;
+    if (i == 0) {
+      out->scale = std::move(scale);
+    } else {
+      out->larger.push_back({usable[i * per - 1]->cell_size, std::move(scale)});
+    }
+  }
+  out->largest_cell = usable.back()->cell_size;
+  out->beyond = target.beyond;
+}
+
 }  // namespace
 
 InterpolationCalibration FitInterpolationCalibration(std::span<const HeldOutPoint> points,
@@ -52,39 +108,60 @@ InterpolationCalibration FitInterpolationCalibration(std::span<const HeldOutPoin
     if (nb > 0 && Fits(p, nb)) usable.push_back(&p);
   }
   out.held_out = usable.size();
-  if (usable.size() < std::max<std::size_t>(1, target.min_points)) {
+  const std::size_t min_points = std::max<std::size_t>(1, target.min_points);
+  if (usable.size() < min_points) {
     out.detail = std::to_string(usable.size()) + " held-out readings predicted, fewer than " +
-                 std::to_string(std::max<std::size_t>(1, target.min_points));
+                 std::to_string(min_points);
     return out;
   }
   const std::size_t groups =
       std::clamp<std::size_t>(static_cast<std::size_t>(std::max(1, target.band_groups)), 1, nb);
-  out.scale.assign(nb, 0.0);
   out.band_groups = groups;
-  std::vector<double> needed;
-  for (std::size_t g = 0; g < groups; ++g) {
-    const std::size_t first = BandGroupFirst(g, groups, nb);
-    const std::size_t last = BandGroupFirst(g + 1, groups, nb);
-    needed.clear();
-    for (const HeldOutPoint* p : usable) {
-      for (std::size_t b = first; b < last; ++b) {
-        const double noise = p->noise.empty() ? 0.0 : p->noise[b];
-        needed.push_back(NeededScale(p->residual[b], p->spread[b], noise, target.k));
-      }
-    }
-    const double c = ConformalScale(needed, target.coverage);
-    std::fill(out.scale.begin() + static_cast<std::ptrdiff_t>(first),
-              out.scale.begin() + static_cast<std::ptrdiff_t>(last), c);
+  const std::size_t bins = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::max(1, target.size_bins)), 1, usable.size() / min_points);
+  if (target.size_bins > 1) {
+    FitSizeBins(usable, bins, nb, groups, target, &out);
+  } else {
+    out.scale = FitScale(usable, nb, groups, target.k, target.coverage);
   }
   out.detail = "fitted on " + std::to_string(usable.size()) + " held-out readings, " +
                std::to_string(groups) + " band groups";
+  if (target.size_bins > 1) {
+    out.detail += ", " + std::to_string(bins) + " cell-size bins up to " +
+                  std::to_string(out.largest_cell).substr(0, 6);
+  }
   return out;
 }
 
+bool BeyondCalibration(const InterpolationCalibration& calibration, double cell_size) {
+  return calibration.largest_cell > 0 && calibration.beyond == SizeBeyond::kNotEstimated &&
+         cell_size > calibration.largest_cell;
+}
+
+double ScaleAt(const InterpolationCalibration& calibration, double cell_size, std::size_t band) {
+  if (band >= calibration.scale.size() || BeyondCalibration(calibration, cell_size)) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  const std::vector<double>* scale = &calibration.scale;
+  for (const SizeBin& bin : calibration.larger) {
+    if (cell_size > bin.above && band < bin.scale.size()) scale = &bin.scale;
+  }
+  double c = (*scale)[band];
+  if (calibration.largest_cell > 0 && cell_size > calibration.largest_cell) {
+    c *= cell_size / calibration.largest_cell;
+  }
+  return c;
+}
+
 bool ApplyInterpolationCalibration(const InterpolationCalibration& calibration,
-                                   std::span<double> spread) {
+                                   std::span<double> spread, double cell_size) {
   if (calibration.scale.empty() || calibration.scale.size() != spread.size()) return false;
-  for (std::size_t b = 0; b < spread.size(); ++b) spread[b] *= calibration.scale[b];
+  if (BeyondCalibration(calibration, cell_size)) return false;
+  if (calibration.largest_cell <= 0) {
+    for (std::size_t b = 0; b < spread.size(); ++b) spread[b] *= calibration.scale[b];
+    return true;
+  }
+  for (std::size_t b = 0; b < spread.size(); ++b) spread[b] *= ScaleAt(calibration, cell_size, b);
   return true;
 }
 

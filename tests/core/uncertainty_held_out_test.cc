@@ -99,6 +99,33 @@ TEST(CalibrateInterpolation, ABudgetsIndependentPartIsTheHeldOutPointsNoise) {
   }
 }
 
+// Delaunay's calibration has cell-size bins (its large cells across gaps err more, relative to
+// their spread, than its small ones); each held-out point carries its cell's size, and a cell
+// larger than every held-out one gets a larger c. The octant method's has one c.
+TEST(CalibrateInterpolation, DelaunaysScaleGrowsWithTheCellsSize) {
+  EXPECT_EQ(TargetOf(interp::Method::kDelaunay).size_bins, kDelaunaySizeBins);
+  EXPECT_EQ(TargetOf(interp::Method::kOctant).size_bins, 1);
+  const auto set = Grid(Curved);
+  const auto points =
+      PredictHeldOut(*set, BudgetOf{}, interp::Method::kDelaunay, interp::Options{});
+  for (const HeldOutPoint& p : points) EXPECT_GT(p.cell_size, 0.0);
+  const InterpolationCalibration c =
+      CalibrateInterpolation(*set, BudgetOf{}, interp::Method::kDelaunay, {}, kBands);
+  ASSERT_FALSE(c.scale.empty()) << c.detail;
+  ASSERT_EQ(c.larger.size(), static_cast<std::size_t>(kDelaunaySizeBins - 1)) << c.detail;
+  EXPECT_GT(c.largest_cell, 0.0);
+  for (std::size_t b = 0; b < c.scale.size(); ++b) {
+    double previous = ScaleAt(c, 0.0, b);
+    for (const SizeBin& bin : c.larger) {
+      EXPECT_GE(ScaleAt(c, bin.above + 1e-9, b), previous);
+      previous = ScaleAt(c, bin.above + 1e-9, b);
+    }
+    EXPECT_GT(ScaleAt(c, 2 * c.largest_cell, b), ScaleAt(c, c.largest_cell, b));
+  }
+  EXPECT_TRUE(
+      CalibrateInterpolation(*set, BudgetOf{}, interp::Method::kOctant, {}, kBands).larger.empty());
+}
+
 TEST(CalibrationOnce, ComputesOnceForAllItsUsers) {
   CalibrationOnce once;
   EXPECT_FALSE(once.computed());

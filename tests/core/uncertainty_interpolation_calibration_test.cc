@@ -114,6 +114,65 @@ TEST(FitInterpolationCalibration, TooFewOrMisshapenPointsAreNotCalibrated) {
   EXPECT_EQ(c.held_out, 5u);
 }
 
+// Size bins: 30 held-out readings whose |r| / s grows with their cell's size h (h = 1, 2, 3 in
+// thirds): each third gets its own c, and a cell larger than every held-out one gets c · h / h_max.
+TEST(FitInterpolationCalibration, WithSizeBinsTheScaleGrowsWithTheCellsSize) {
+  std::vector<HeldOutPoint> points;
+  for (int i = 0; i < 30; ++i) {
+    const double h = 1.0 + i / 10;  // 1, 2, 3
+    HeldOutPoint p = Point(0.1 * h, 0.1, 0.0, 1);
+    p.cell_size = h;
+    points.push_back(p);
+  }
+  CalibrationTarget target;
+  target.size_bins = 3;
+  const InterpolationCalibration c = FitInterpolationCalibration(points, 1, target);
+  ASSERT_EQ(c.scale.size(), 1u);
+  ASSERT_EQ(c.larger.size(), 2u) << c.detail;
+  EXPECT_DOUBLE_EQ(c.largest_cell, 3.0);
+  // Need c = |r| / (k s) = h / 2.
+  EXPECT_NEAR(ScaleAt(c, 1.0, 0), 0.5, 1e-12);
+  EXPECT_NEAR(ScaleAt(c, 2.0, 0), 1.0, 1e-12);
+  EXPECT_NEAR(ScaleAt(c, 3.0, 0), 1.5, 1e-12);
+  EXPECT_NEAR(ScaleAt(c, 6.0, 0), 3.0, 1e-12);  // beyond: c · h / h_max
+  EXPECT_LT(ScaleAt(c, 0.5, 0), ScaleAt(c, 2.5, 0));
+  std::vector<double> spread = {0.1};
+  EXPECT_TRUE(ApplyInterpolationCalibration(c, spread, 2.0));
+  EXPECT_NEAR(spread[0], 0.1, 1e-12);
+  // Without bins the same points get one c, the largest third's rank: too wide for small cells.
+  const InterpolationCalibration one = FitInterpolationCalibration(points, 1, CalibrationTarget{});
+  EXPECT_TRUE(one.larger.empty());
+  EXPECT_NEAR(ScaleAt(one, 1.0, 0), 1.5, 1e-12);
+  EXPECT_NEAR(ScaleAt(one, 6.0, 0), 1.5, 1e-12);
+}
+
+// A larger bin never gets a smaller c than a smaller one, and beyond the largest held-out cell
+// SizeBeyond::kNotEstimated leaves the term unestimated (NaN; Apply refuses).
+TEST(FitInterpolationCalibration, SizeBinsNeverShrinkAndMayStopAtTheLargestCell) {
+  std::vector<HeldOutPoint> points;
+  for (int i = 0; i < 20; ++i) {
+    HeldOutPoint p = Point(i < 10 ? 0.4 : 0.1, 0.1, 0.0, 1);  // the small cells err more
+    p.cell_size = i < 10 ? 1.0 : 2.0;
+    points.push_back(p);
+  }
+  CalibrationTarget target;
+  target.size_bins = 2;
+  target.beyond = SizeBeyond::kNotEstimated;
+  const InterpolationCalibration c = FitInterpolationCalibration(points, 1, target);
+  ASSERT_EQ(c.larger.size(), 1u);
+  EXPECT_NEAR(ScaleAt(c, 1.0, 0), 2.0, 1e-12);
+  EXPECT_NEAR(ScaleAt(c, 2.0, 0), 2.0, 1e-12);  // not 0.5: never smaller than the smaller cells'
+  EXPECT_FALSE(BeyondCalibration(c, 2.0));
+  EXPECT_TRUE(BeyondCalibration(c, 2.5));
+  EXPECT_TRUE(std::isnan(ScaleAt(c, 2.5, 0)));
+  std::vector<double> spread = {0.1};
+  EXPECT_FALSE(ApplyInterpolationCalibration(c, spread, 2.5));
+  EXPECT_DOUBLE_EQ(spread[0], 0.1);
+  // Too few readings for two bins of min_points each: one bin.
+  target.min_points = 15;
+  EXPECT_TRUE(FitInterpolationCalibration(points, 1, target).larger.empty());
+}
+
 TEST(ApplyInterpolationCalibration, ScalesTheSpreadBandByBand) {
   InterpolationCalibration c;
   c.scale = {0.5, 2.0};

@@ -1,6 +1,7 @@
 // fill/uncertain_chain: a session's fill chain answering each direction with its uncertainty —
 // at a reading's pose the measurement part is that reading's budget, NaN where a blended reading
-// has none, model cells carry the model's residual RMS; and the sidecar's "uncertainty" object.
+// has none, model cells far from every reading are not estimated; and the sidecar's
+// "uncertainty" object.
 #include "core/export/fill/uncertain_chain.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/export/fill/model_uncertainty.h"
 #include "core/export/fill/session_interpolant.h"
 #include "core/uncertainty/interpolated.h"
 #include "export_test_util.h"
@@ -121,7 +123,11 @@ TEST(UncertainChain, ABlendedReadingWithoutBudgetMakesTheMeasurementPartNaN) {
             std::string::npos);
 }
 
-TEST(UncertainChain, ModelCellsCarryTheModelsResidualRms) {
+// Model cells' u is local (fill/model_uncertainty.h): c(d) · ρ from the model's calibration on
+// held-out readings by distance (model_uncertainty_test: larger far from the readings, NaN beyond
+// the calibration's reach), not the model's residual RMS over all readings. The sidecar says how
+// it was fitted and how far it reaches.
+TEST(UncertainChain, ModelCellsCarryTheModelsLocalUncertainty) {
   std::optional<testing::PaintGridSamples> paint = testing::PaintLikeGridSamples();
   ASSERT_TRUE(paint.has_value());
   AddBudgets(paint->derived);
@@ -132,16 +138,35 @@ TEST(UncertainChain, ModelCellsCarryTheModelsResidualRms) {
   const UncertainChain chain = MakeUncertainChain(*in);
   // Grazing on both sides: beyond every reading, so neither octant nor Delaunay has a value.
   const std::size_t bands = paint->derived.grid.count;
-  const Row row = Ask(chain, IsoDirection{89.5, 89.5, 0.5}, bands);
+  const IsoDirection grazing{89.5, 89.5, 0.5};
+  const Row row = Ask(chain, grazing, bands);
   ASSERT_EQ(row.status, interp::InterpStatus::kOk);
   ASSERT_EQ(chain.chain->Tally().model, 1u) << chain.chain->Tally().Summary();
   ASSERT_EQ(chain.coverage.model_spread.size(), bands);
+  ASSERT_TRUE(chain.coverage.model_calibration.has_value());
+  const uncertainty::InterpolationCalibration& m = *chain.coverage.model_calibration;
+  ASSERT_FALSE(m.scale.empty()) << m.detail;
+  EXPECT_GT(m.held_out, 8u);
+  EXPECT_GT(m.largest_cell, 0.0);
+  const ModelCellUncertainty local(*in->samples,
+                                   std::make_shared<const std::vector<std::vector<double>>>(
+                                       ModelResiduals(*in->model, *in->samples)),
+                                   m);
+  std::vector<double> expected(bands);
+  local.At(grazing, expected);
+  std::size_t differs_from_rms = 0;
   for (std::size_t b = 0; b < bands; ++b) {
-    EXPECT_EQ(row.plane(UncertainPlane::kInterpolation)[b], in->model->band_residuals[b].rms);
-    EXPECT_EQ(row.plane(UncertainPlane::kCombined)[b], in->model->band_residuals[b].rms);
+    EXPECT_TRUE(std::isfinite(row.plane(UncertainPlane::kValue)[b]));
     EXPECT_TRUE(std::isnan(row.plane(UncertainPlane::kMeasurement)[b]));
-    EXPECT_GT(in->model->band_residuals[b].rms, 0.0);
+    EXPECT_GT(expected[b], 0.0);
+    EXPECT_DOUBLE_EQ(row.plane(UncertainPlane::kInterpolation)[b], expected[b]);
+    EXPECT_DOUBLE_EQ(row.plane(UncertainPlane::kCombined)[b], expected[b]);
+    differs_from_rms += expected[b] != in->model->band_residuals[b].rms;
   }
+  EXPECT_EQ(differs_from_rms, bands);
+  const std::string j = UncertaintyJson(chain.coverage, Quantity::kBrdf, {});
+  EXPECT_NE(j.find("\"model_cells\": {"), std::string::npos) << j;
+  EXPECT_NE(j.find("\"not_estimated_beyond_deg\": "), std::string::npos) << j;
 }
 
 // The interpolation term is c(λ)·s(λ): the vertices' spread scaled by the stage's calibration

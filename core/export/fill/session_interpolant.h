@@ -44,13 +44,14 @@ struct SessionInterpolant {
   std::shared_ptr<const interp::Interpolator> fallback;  // kChain: Delaunay, unless the method is
   std::shared_ptr<const fit::CookTorranceFit> model;     // kChain: the fitted model
   std::unique_ptr<FillChain> chain;                      // ask chain->Source(), read its Tally()
-  // The interpolation term's calibration of the chosen method and of the fallback over these
-  // samples (uncertainty/held_out.h): computed by the first export with uncertainty
-  // (uncertain_chain.h, InterpolantCalibrations) and shared with the other parts, so that a kept
-  // interpolant is calibrated once however many exports ask it.
+  // The interpolation term's calibration of the chosen method and of the fallback, and the model
+  // cells' (fill/model_uncertainty.h), over these samples (uncertainty/held_out.h): computed by the
+  // first export with uncertainty (uncertain_chain.h, InterpolantCalibrations) and shared with the
+  // other parts, so that a kept interpolant is calibrated once however many exports ask it.
   struct Calibrations {
     uncertainty::CalibrationOnce chosen;
     uncertainty::CalibrationOnce fallback;
+    uncertainty::CalibrationOnce model;  // the model cells' (model_uncertainty.h)
   };
   std::shared_ptr<const Calibrations> calibrations = std::make_shared<const Calibrations>();
 

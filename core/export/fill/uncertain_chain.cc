@@ -6,6 +6,7 @@
 #include <span>
 #include <utility>
 
+#include "core/export/fill/model_uncertainty.h"
 #include "core/export/number_text.h"
 #include "core/fit/models.h"
 #include "core/json_text.h"
@@ -73,19 +74,18 @@ SpectrumSource InterpolatorWithUncertainty(const interp::Interpolator& interpola
   return SpectrumSource(std::move(one), std::move(many));
 }
 
-// The model as a stage: its value, its residual spread as the interpolation term and the
-// combined u, no measurement part.
-SpectrumSource ModelWithSpread(const fit::CookTorranceFit& model, std::vector<double> spread) {
-  return [params = model.band, spread = std::move(spread)](const IsoDirection& at,
-                                                           std::span<double> row) {
+// The model as a stage: its value, its local uncertainty (model_uncertainty.h: NaN where it is
+// not estimated) as the interpolation term and the combined u, no measurement part.
+SpectrumSource ModelWithLocalUncertainty(const fit::CookTorranceFit& model,
+                                         std::shared_ptr<const ModelCellUncertainty> local) {
+  return [params = model.band, local = std::move(local)](const IsoDirection& at,
+                                                         std::span<double> row) {
     const std::size_t bands = params.size();
-    for (std::size_t b = 0; b < bands; ++b) {
-      const double u = b < spread.size() ? spread[b] : kNaN;
-      row[b] = fit::CookTorranceBrdf(at, params[b]);
-      Plane(row, UncertainPlane::kCombined, bands)[b] = u;
-      Plane(row, UncertainPlane::kMeasurement, bands)[b] = kNaN;
-      Plane(row, UncertainPlane::kInterpolation, bands)[b] = u;
-    }
+    for (std::size_t b = 0; b < bands; ++b) row[b] = fit::CookTorranceBrdf(at, params[b]);
+    const std::span<double> u = Plane(row, UncertainPlane::kInterpolation, bands);
+    local->At(at, u);
+    std::copy(u.begin(), u.end(), Plane(row, UncertainPlane::kCombined, bands).begin());
+    std::fill_n(Plane(row, UncertainPlane::kMeasurement, bands).begin(), bands, kNaN);
     return interp::InterpStatus::kOk;
   };
 }
@@ -155,7 +155,7 @@ const char* PlaneMeaning(UncertainPlane p) {
   switch (p) {
     case UncertainPlane::kCombined:
       return "combined standard uncertainty (k = 1), sqrt(u_measurement^2 + u_interpolation^2); "
-             "model cells: the model's residual RMS alone";
+             "model cells: the model's local uncertainty alone (model_cells)";
     case UncertainPlane::kMeasurement:
       return "measurement part: the blended vertices' reading budgets, shared terms (white "
              "standard, references, darks, instrument) correlated, as Interpolate gives it";
@@ -163,8 +163,9 @@ const char* PlaneMeaning(UncertainPlane p) {
       return "interpolation term c(lambda) s(lambda): the vertices' weighted spread about the "
              "blend scaled by the session's calibration from held-out readings "
              "(interpolation_calibration), as Interpolate gives it; a stage not calibrated: the "
-             "spread as it is; model cells: the fitted model's residual RMS per band over the "
-             "readings it was fitted to";
+             "spread as it is; model cells: c(d) times the RMS of the model's residuals at the "
+             "nearest readings, c per distance d from the readings fitted on held-out readings "
+             "(model_cells); NaN farther from every reading than the calibration reaches";
     case UncertainPlane::kValue:
       break;
   }
@@ -227,6 +228,33 @@ std::string CalibrationJson(const UncertaintyCoverage& c) {
          stages + "]}";
 }
 
+// "model_cells": how the model cells' u is fitted, its scale per distance bin, and the distance
+// beyond which it is not estimated; null without a model.
+std::string ModelCellsJson(const UncertaintyCoverage& c) {
+  if (!c.model_calibration) return "null";
+  const uncertainty::InterpolationCalibration& m = *c.model_calibration;
+  std::string j = std::string(
+                      "{\"what\": \"u = c(d, lambda) rho(lambda): rho the RMS of the "
+                      "model's residuals at the ") +
+                  std::to_string(kModelNeighbours) +
+                  " nearest readings, d the distance in degrees to the nearest reading (incidence "
+                  "and the outgoing directions' angle in quadrature), c per band group and "
+                  "distance bin fitted on held-out readings (the model refitted without them)\"" +
+                  ", \"calibrated\": " + (m.scale.empty() ? "false" : "true") +
+                  ", \"held_out_readings\": " + std::to_string(m.held_out);
+  if (m.scale.empty()) {
+    return j + ", \"why\": " + JsonString(m.detail) + ", \"u\": \"NaN in every model cell\"}";
+  }
+  j += ", \"not_estimated_beyond_deg\": " + FormatNumber(m.largest_cell) + ", \"bins\": [";
+  for (std::size_t i = 0; i <= m.larger.size(); ++i) {
+    const std::vector<double>& scale = i == 0 ? m.scale : m.larger[i - 1].scale;
+    j += (i ? ", " : "") + std::string("{\"from_deg\": ") +
+         FormatNumber(i == 0 ? 0.0 : m.larger[i - 1].above) + ", \"scale\": " + JsonNumbers(scale) +
+         "}";
+  }
+  return j + "], \"detail\": " + JsonString(m.detail) + "}";
+}
+
 }  // namespace
 
 std::string UncertaintyJson(const UncertaintyCoverage& c, Quantity quantity,
@@ -244,7 +272,9 @@ std::string UncertaintyJson(const UncertaintyCoverage& c, Quantity quantity,
            "NaN in every array where the value is NaN (no stage of the fill chain had "
            "one); u_measurement (and u) NaN where a blended reading has no uncertainty "
            "budget or the quantity has none, and in model cells; u_interpolation (and u) "
-           "NaN for the nearest method (one vertex)");
+           "NaN for the nearest method (one vertex) and in model cells farther from every "
+           "reading than model_cells.not_estimated_beyond_deg (not estimated: nothing "
+           "measured says how far off the model is there)");
   j += ", \"samples\": " + std::to_string(c.samples) +
        ", \"samples_without_budget\": " + std::to_string(c.without_budget);
   j += ", \"measurement_not_estimated\": " +
@@ -252,6 +282,7 @@ std::string UncertaintyJson(const UncertaintyCoverage& c, Quantity quantity,
   j += ", \"budgets_not_estimated\": " + JsonList(c.not_estimated);
   j += ", \"model_residual_rms\": " + JsonNumbers(c.model_spread);
   j += ", \"interpolation_calibration\": " + CalibrationJson(c);
+  j += ", \"model_cells\": " + ModelCellsJson(c);
   j += ", \"docs\": \"docs/uncertainty.md, Exports\"}";
   return j;
 }
@@ -267,6 +298,10 @@ std::vector<std::string> UncertaintyWarnings(const UncertaintyCoverage& c) {
                 " sample readings have no uncertainty budget (recorded before budgets, or "
                 "[uncertainty] enabled = false): the cells blending them have u_measurement and "
                 "u NaN");
+  }
+  if (c.model_calibration && c.model_calibration->scale.empty()) {
+    w.push_back("uncertainty: the model cells' u is not estimated (" + c.model_calibration->detail +
+                "): their u_interpolation and u are NaN");
   }
   for (const StageCalibration& s : c.calibrations) {
     if (!s.fit.scale.empty() || s.method == interp::Method::kNearest) continue;
@@ -285,6 +320,13 @@ const uncertainty::InterpolationCalibration& ChosenCalibration(const SessionInte
 
 const uncertainty::InterpolationCalibration& FallbackCalibration(const SessionInterpolant& in) {
   return in.calibrations->fallback.Get([&in] { return Calibrate(in, interp::Method::kDelaunay); });
+}
+
+const uncertainty::InterpolationCalibration& ModelCalibration(const SessionInterpolant& in) {
+  return in.calibrations->model.Get([&in] {
+    return CalibrateModel(*in.samples, in.derived->grid,
+                          CallContext::WithTimeout(kModelCalibrationTimeout));
+  });
 }
 
 UncertainChain MakeUncertainChain(const SessionInterpolant& in) {
@@ -307,7 +349,12 @@ UncertainChain MakeUncertainChain(const SessionInterpolant& in) {
     stages.push_back({Provenance::kFallback, InterpolatorWithUncertainty(*in.fallback, inputs)});
   }
   if (in.model) {
-    stages.push_back({Provenance::kModel, ModelWithSpread(*in.model, out.coverage.model_spread)});
+    out.coverage.model_calibration = ModelCalibration(in);
+    auto residuals = std::make_shared<const std::vector<std::vector<double>>>(
+        ModelResiduals(*in.model, *in.samples));
+    auto local = std::make_shared<const ModelCellUncertainty>(*in.samples, std::move(residuals),
+                                                              *out.coverage.model_calibration);
+    stages.push_back({Provenance::kModel, ModelWithLocalUncertainty(*in.model, std::move(local))});
   }
   out.chain = std::make_unique<FillChain>(in.chain->Tally().policy, std::move(stages));
   return out;

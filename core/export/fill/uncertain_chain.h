@@ -10,15 +10,17 @@
 //   u_interpolation the interpolation term c(λ)·s(λ): the vertices' spread about the blend
 //                  (InterpolationSpread) scaled by the stage's calibration from held-out readings
 //                  (uncertainty/held_out.h), as the Interpolate API gives it (the spread as it is
-//                  where the stage could not be calibrated); for model cells the model's
-//                  residual RMS per band over the readings it was fitted to; NaN for the nearest
-//                  method (one vertex).
+//                  where the stage could not be calibrated); for model cells the model's local
+//                  uncertainty (fill/model_uncertainty.h: the residuals of the nearest readings
+//                  scaled by a calibration per distance from the readings, NaN farther than it
+//                  reaches); NaN for the nearest method (one vertex).
 // NaN in every plane where no stage has a value. One pass: the values and their uncertainties
 // come from the same answers (Interpolator::EvaluateEach). Pure: no I/O.
 #pragma once
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,7 +50,9 @@ struct UncertaintyCoverage {
   // The union of the samples' budgets' not_estimated entries (each once, at most 20).
   std::vector<std::string> not_estimated;
   std::vector<double> model_spread;  // per band, the model's residual RMS; empty without a model
-  WavelengthGrid grid;               // the bands (the calibration's band groups in nm)
+  // The model cells' calibration (fill/model_uncertainty.h); unset without a model.
+  std::optional<uncertainty::InterpolationCalibration> model_calibration;
+  WavelengthGrid grid;                         // the bands (the calibration's band groups in nm)
   std::vector<StageCalibration> calibrations;  // the chosen method's, then the fallback's
 };
 
@@ -58,6 +62,9 @@ struct UncertaintyCoverage {
 // (SessionInterpolant::calibrations), so that every export sharing them reuses it.
 const uncertainty::InterpolationCalibration& ChosenCalibration(const SessionInterpolant& in);
 const uncertainty::InterpolationCalibration& FallbackCalibration(const SessionInterpolant& in);
+// The model cells' calibration (fill/model_uncertainty.h, CalibrateModel), kept likewise; `in`
+// must have a model.
+const uncertainty::InterpolationCalibration& ModelCalibration(const SessionInterpolant& in);
 
 // A FillChain over `in`'s stages (the chosen method, its Delaunay fallback and its model, as
 // `in.chain` has them) whose sources answer rows of kUncertainPlanes · bands values. `in` must
