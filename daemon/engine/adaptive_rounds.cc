@@ -129,7 +129,7 @@ Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t sessi
   adaptive::Round round = adaptive::ChooseRound(input, *map, cost, options);
   // In measurement order (a sample-fixed round in prompt order), within the budget step by step.
   const std::vector<plan::Step> round_steps =
-      adaptive::RoundSteps(plan, rig, steps, start, spec.budget, round);
+      adaptive::RoundSteps(plan, rig, steps, decision.spent, start, spec.budget, round);
   decision.stop = adaptive::AfterChoosing(round);
   if (decision.stop != adaptive::StopReason::kContinue) return decision;
 

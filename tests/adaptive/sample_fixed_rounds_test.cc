@@ -90,7 +90,8 @@ Session RunSession(const v1::Plan& plan, const UncertaintyModel& model) {
     const RoundInput input{readings, candidates, start.model, spent, spec.budget};
     Round round = ChooseRound(input, *map, cost, {.max_readings = spec.round_readings});
     const std::vector<Pose> picked = Poses(round);
-    const std::vector<plan::Step> added = RoundSteps(plan, rig, s.steps, start, spec.budget, round);
+    const std::vector<plan::Step> added =
+        RoundSteps(plan, rig, s.steps, spent, start, spec.budget, round);
     s.stop = AfterChoosing(round);
     if (s.stop != StopReason::kContinue) break;
     s.picked.push_back(picked);
