@@ -10,10 +10,14 @@
 //   spec    the same along the specular ridge (θi = θo, φ = 180°), 400 points;
 //   retro   the same along the retro-reflection ridge (θi = θo, φ = 0°).
 // A direction the octant method cannot answer takes its nearest reading's value (counted: fb %).
-// Rig time is the plan timing model's (prompts at the rig's 30 s each): the seed's expansion, then
-// each round's cost (round_cost.h); the grid's expansion.
+// Rig time is the plan timing model's (prompts at the rig's 30 s each) over the session's steps, as
+// the daemon sums them: the seed's expansion, then each round expanded after it as the engine
+// stores it (round_steps.h: relocations, and references by the plan's policies, by detector
+// position, count or time); the grid's expansion. --detector-arm: a motorized detector arm (the
+// daemon benchmark's brdf-sim rig) instead of the default manual detector.
 //
 //   bench_adaptive_study --material deploy/materials/paint.toml --seeds 1 2 3
+//   bench_adaptive_study --material deploy/materials/paint.toml --seeds 1 --stages "10 20"
 //   bench_adaptive_study --timing      (Map on 2,000 readings, a round of 24 over 5,000 candidates)
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -34,10 +38,12 @@
 #include "core/adaptive/interpolated_model.h"
 #include "core/adaptive/round_chooser.h"
 #include "core/adaptive/round_cost.h"
+#include "core/adaptive/round_steps.h"
 #include "core/adaptive/seed_design.h"
 #include "core/geometry.h"
 #include "core/interp/interpolator.h"
 #include "core/plan/analyze_plan.h"
+#include "core/plan/expand_steps.h"
 #include "core/plan/plan_json.h"
 #include "tools/brdf-sim/optics/material.h"
 
@@ -96,6 +102,7 @@ ReadingSoFar Measure(const Truth& truth, const Pose& model, const Directions& d,
 
 // The sample steps of an expanded plan: model angles and directions.
 struct Expanded {
+  std::vector<plan::Step> steps;
   std::vector<Pose> poses;
   std::vector<Directions> directions;
   double seconds = 0;
@@ -106,6 +113,7 @@ Expanded Expand(const v1::Plan& plan, const plan::RigDescription& rig) {
   const plan::PlanAnalysis analysis = plan::AnalyzePlan(plan, rig);
   if (!analysis.valid()) Fail("plan not valid: " + analysis.problems.front().message);
   Expanded out;
+  out.steps = analysis.steps;
   for (const plan::Step& s : analysis.steps) {
     if (s.kind != v1::STEP_KIND_SAMPLE || !s.target.has_value()) continue;
     out.poses.push_back(ToModelAngles(s.pose, rig.convention));
@@ -237,6 +245,7 @@ struct Setup {
   double candidate_step_deg = adaptive::kCandidateStepDeg;
   adaptive::RoundOptions round;  // its max_readings from the plan
   Judging judging;
+  std::vector<double> stages = {10, 20, 30, 50};  // % of the grid's readings
 };
 
 Stage GridStage(const Setup& setup, const Truth& truth, std::mt19937_64& rng) {
@@ -252,9 +261,10 @@ Stage GridStage(const Setup& setup, const Truth& truth, std::mt19937_64& rng) {
 
 // One round as chosen: its size, gain, cost and where its picks lie.
 void PrintRound(const adaptive::Spend& spent, const adaptive::Round& round, double remaining) {
-  std::printf("    round at %d readings (U left %.4f): %zu picks, gain %.4f, %.0f s, %d prompts:",
-              spent.readings, remaining, round.poses.size(), round.predicted_gain,
-              round.cost.seconds, round.cost.prompts);
+  std::printf(
+      "    round at %d readings, %.0f s (U left %.4f): %zu picks, gain %.4f, %.0f s, %d prompts:",
+      spent.readings, spent.seconds, remaining, round.poses.size(), round.predicted_gain,
+      round.cost.seconds, round.cost.prompts);
   for (const adaptive::ChosenPose& p : round.poses) {
     const IsoDirection iso = ToIsotropic(PoseToDirections(p.pose));
     std::printf(" (%.0f %.0f %.0f|d%.0f %.4f)", iso.theta_i, iso.theta_o, iso.phi, p.pose.delta,
@@ -280,6 +290,8 @@ Expanded ExpandSeed(const Setup& setup) {
 }
 
 // The adaptive session: the seed, then rounds until each level of readings; one stage per level.
+// Each round is chosen and expanded after the session's steps as the engine does it (NextRound:
+// ChooseRound from the rig's state, then RoundSteps), and the spend is the steps' own.
 std::vector<Stage> AdaptiveStages(const Setup& setup, const Truth& truth, std::mt19937_64& rng,
                                   const std::vector<int>& levels) {
   const Expanded seed = ExpandSeed(setup);
@@ -287,26 +299,29 @@ std::vector<Stage> AdaptiveStages(const Setup& setup, const Truth& truth, std::m
   for (std::size_t i = 0; i < seed.poses.size(); ++i) {
     readings.push_back(Measure(truth, seed.poses[i], seed.directions[i], setup.u, rng));
   }
-  adaptive::Spend spent{static_cast<int>(readings.size()), seed.seconds, seed.prompts};
+  const v1::Plan& plan = setup.adaptive_plan;
+  std::vector<plan::Step> steps = seed.steps;
+  adaptive::Spend spent = adaptive::SpendOfSteps(steps, plan, setup.rig);
   const std::vector<Pose> candidates =
       adaptive::CandidatePoses(setup.spec, setup.rig, setup.candidate_step_deg);
-  const adaptive::RoundCost cost(setup.adaptive_plan, setup.rig);
+  const adaptive::RoundCost cost(plan, setup.rig);
   const auto model = adaptive::MakeInterpolatedModel(setup.spec);
-  Pose at = readings.back().pose;
   std::vector<Stage> stages;
   for (int level : levels) {
     while (spent.readings < level) {
-      const adaptive::Round round = adaptive::ChooseRound(
-          {readings, candidates, at, spent, {level, 0, 0}}, *model, cost, setup.round);
+      const plan::ExpansionStart start = plan::StartAfter(steps, plan, setup.rig);
+      const adaptive::Budget budget{level, 0, 0};
+      adaptive::Round round = adaptive::ChooseRound(
+          {readings, candidates, start.model, spent, budget}, *model, cost, setup.round);
+      const std::vector<plan::Step> added =
+          adaptive::RoundSteps(plan, setup.rig, steps, spent, start, budget, round);
       if (round.poses.empty()) break;
       if (setup.verbose) PrintRound(spent, round, model->Map(readings)->Remaining());
       for (const adaptive::ChosenPose& p : round.poses) {
         readings.push_back(Measure(truth, p.pose, PoseToDirections(p.pose), setup.u, rng));
-        at = p.pose;
       }
-      spent.readings += static_cast<int>(round.poses.size());
-      spent.seconds += round.cost.seconds;
-      spent.prompts += round.cost.prompts;
+      steps.insert(steps.end(), added.begin(), added.end());
+      spent = adaptive::SpendOfSteps(steps, plan, setup.rig);
     }
     stages.push_back({spent.readings, spent.seconds, spent.prompts,
                       model->Map(readings)->Remaining(), Judge_(readings, truth, setup.judging)});
@@ -326,13 +341,15 @@ void RunMaterial(const Setup& setup, const std::string& path, const std::vector<
     const Stage grid = GridStage(setup, truth, grid_rng);
     PrintStage("grid", grid, grid);
     std::vector<int> levels;
-    for (double share : {0.10, 0.20, 0.30, 0.50}) {
-      levels.push_back(static_cast<int>(std::lround(share * grid.readings)));
+    for (double percent : setup.stages) {
+      levels.push_back(static_cast<int>(std::lround(percent / 100 * grid.readings)));
     }
     std::mt19937_64 rng(static_cast<std::uint64_t>(seed) * 1000003 + 2);
     const std::vector<Stage> stages = AdaptiveStages(setup, truth, rng, levels);
-    const char* labels[] = {"adapt 10%", "adapt 20%", "adapt 30%", "adapt 50%"};
-    for (std::size_t i = 0; i < stages.size(); ++i) PrintStage(labels[i], stages[i], grid);
+    for (std::size_t i = 0; i < stages.size(); ++i) {
+      const std::string label = "adapt " + std::to_string(std::lround(setup.stages[i])) + "%";
+      PrintStage(label.c_str(), stages[i], grid);
+    }
     std::fflush(stdout);
   }
 }
@@ -422,8 +439,15 @@ int main(int argc, char** argv) {
   app.add_option("--seed-per-delta", seed_per_delta,
                  "the seed's space-filling readings per δ (default: the plan's)");
   app.add_option("--refine-keep", setup.round.refine.keep, "finer candidates kept per level");
+  app.add_option("--max-relocations", setup.round.max_relocations,
+                 "relocations (a prompt each) a round may make; -1: any (round_chooser.h)");
+  app.add_option("--stages", setup.stages, "% of the grid's readings at which to judge, rising")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_flag("--detector-arm", setup.rig.has_detector_arm,
+               "a motorized detector arm (δ moves are no prompt), as brdf-sim's rig");
 
   CLI11_PARSE(app, argc, argv);
+  std::sort(setup.stages.begin(), setup.stages.end());
   setup.adaptive_plan = LoadPlan(adaptive_path);
   setup.grid_plan = LoadPlan(grid_path);
   if (!setup.adaptive_plan.has_adaptive()) Fail(adaptive_path + " is not an adaptive plan");
@@ -441,10 +465,12 @@ int main(int argc, char** argv) {
   std::printf(
       "readings' u %.3f; judged by the octant method (φ mirrored) at %d random pairs, "
       "θ ≤ region; rig time by the plan timing model (prompts %.0f s); candidates every "
-      "%g° (refined %d levels, %d kept each); seed at every %d-th δ, %d readings each\n",
+      "%g° (refined %d levels, %d kept each); seed at every %d-th δ, %d readings each; "
+      "detector %s; at most %d relocation(s) a round; plan %s\n",
       u, directions, setup.rig.operator_action_s, setup.candidate_step_deg,
       setup.round.refine.levels, setup.round.refine.keep, setup.spec.seed_delta_every,
-      setup.spec.readings_per_delta);
+      setup.spec.readings_per_delta, setup.rig.has_detector_arm ? "on a motorized arm" : "by hand",
+      setup.round.max_relocations, adaptive_path.c_str());
   for (const std::string& path : materials) RunMaterial(setup, path, seeds);
   return 0;
 }

@@ -8,6 +8,8 @@
 #   EXTRA="--candidate-step 2.5" bench/adaptive/study.sh
 #   EXTRA="--plan bench/adaptive/adaptive-cheap-seed.json" bench/adaptive/study.sh   (seed.deltaEvery 4)
 #   EXTRA="--refine-levels 0" bench/adaptive/study.sh          (the 5° lattice alone, as before)
+#   EXTRA="--stages 20 --max-relocations -1" bench/adaptive/study.sh   (20 % only; relocations unlimited)
+#   EXTRA="--detector-arm" bench/adaptive/study.sh   (a motorized detector arm, as brdf-sim's rig)
 set -eu
 BUILD=${BUILD:-build}
 MATERIALS=${MATERIALS:-"paint glossy gold retro-coating"}

@@ -76,7 +76,7 @@ std::vector<Scored> Best(const std::vector<Pose>& poses, const std::vector<Pose>
 std::vector<Pose> RefinedCandidates(std::span<const ReadingSoFar> readings,
                                     std::span<const Pose> candidates, const UncertaintyMap& map,
                                     const RoundCost& cost, const RefineOptions& options) {
-  if (options.levels <= 0 || !(options.step_deg > 0)) return {};
+  if (options.levels <= 0 || !(options.step_deg > 0) || cost.sample_fixed()) return {};
   std::vector<Pose> measured;
   for (const ReadingSoFar& r : readings) measured.push_back(r.pose);
   std::vector<Pose> taken(measured);

@@ -10,7 +10,9 @@
 //
 // Deterministic: the same readings, candidates (in any order) and map give the same poses, in
 // (δ, γ, α, β) order; angles are rounded to 0.01°; a pose equal to a reading's or a candidate's
-// is left out, as is one the rig cannot take (RoundCost::CanReach). Pure.
+// is left out, as is one the rig cannot take (RoundCost::CanReach). None for a sample-fixed plan
+// (RoundCost::sample_fixed): the operator sets its poses by hand in whole degrees, so every
+// caller of ChooseRound gets only the plan's candidates there. Pure.
 #pragma once
 
 #include <span>

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <tuple>
 
 #include "core/adaptive/seed_design.h"
@@ -34,6 +35,45 @@ std::vector<bool> MeasuredAlready(const RoundInput& input) {
   return taken;
 }
 
+// The detector positions (δ, γ) a round has reached so far, the rig's present one first, and how
+// many of them cost the operator a relocation (a prompt) to reach. Grouping measures each setting
+// once (GroupBySetting), so a pick at a setting reached already costs its move and reading alone.
+class Settings {
+ public:
+  // Inactive (every pick costed by RoundCost::Step alone) in the sample-fixed form, where every
+  // pose is its own prompt, and for ungrouped rounds.
+  Settings(const Pose& rig_at, const RoundCost& cost, const RoundOptions& options)
+      : reached_{rig_at},
+        cost_(cost),
+        active_(options.group_by_delta && !cost.sample_fixed()),
+        limit_(options.max_relocations) {}
+
+  bool Reached(const Pose& p) const {
+    return std::any_of(reached_.begin(), reached_.end(),
+                       [&](const Pose& s) { return SameSetting(s, p); });
+  }
+  // What a pick at `to` costs after one at `from` (nullopt: its relocation is one too many).
+  std::optional<PoseCost> Cost(const Pose& from, const Pose& to) const {
+    if (!active_) return cost_.Step(from, to);
+    if (Reached(to)) return PoseCost{cost_.MoveAndReadSeconds(from, to), 0};
+    const PoseCost step = cost_.Step(from, to);
+    if (step.prompts > 0 && limit_ >= 0 && relocations_ >= limit_) return std::nullopt;
+    return step;
+  }
+  void Add(const Pose& p, const PoseCost& paid) {
+    if (!active_ || Reached(p)) return;
+    reached_.push_back(p);
+    if (paid.prompts > 0) ++relocations_;
+  }
+
+ private:
+  std::vector<Pose> reached_;
+  const RoundCost& cost_;
+  bool active_;
+  int limit_;
+  int relocations_ = 0;
+};
+
 // The greedy picks, in pick order.
 std::vector<ChosenPose> PickGreedy(const RoundInput& input, UncertaintyMap& map,
                                    const RoundCost& cost, const RoundOptions& options,
@@ -45,6 +85,7 @@ std::vector<ChosenPose> PickGreedy(const RoundInput& input, UncertaintyMap& map,
   std::vector<ChosenPose> picks;
   Pose at = input.rig_at;
   Spend spent = input.spent;
+  Settings settings(input.rig_at, cost, options);
   while (static_cast<int>(picks.size()) < options.max_readings) {
     std::size_t best = input.candidates.size();
     double best_score = -std::numeric_limits<double>::infinity();
@@ -55,7 +96,9 @@ std::vector<ChosenPose> PickGreedy(const RoundInput& input, UncertaintyMap& map,
       const Pose& c = input.candidates[i];
       const double gain = map.PredictedGain(directions[i]);
       if (!(gain > 0)) continue;
-      const PoseCost step = cost.Step(at, c);
+      const std::optional<PoseCost> priced = settings.Cost(at, c);
+      if (!priced.has_value()) continue;
+      const PoseCost step = *priced;
       if (const StopReason limit = LimitPassed(input.budget, spent, step, 1);
           limit != StopReason::kContinue) {
         if (*limited_by == StopReason::kContinue) *limited_by = limit;
@@ -74,6 +117,7 @@ std::vector<ChosenPose> PickGreedy(const RoundInput& input, UncertaintyMap& map,
     taken[best] = true;
     map.Assume(directions[best]);
     at = input.candidates[best];
+    settings.Add(at, best_cost);
     spent.readings += 1;
     spent.seconds += best_cost.seconds;
     spent.prompts += best_cost.prompts;

@@ -6,10 +6,16 @@
 // stop at the round's size, when nothing affordable gains anything, or at the budget. The
 // candidates are the caller's plus finer ones near the readings and near the coarse candidates
 // that gain most (refine_candidates.h), so that a narrow peak between lattice poses can still be
-// reached. Then the
-// batch is grouped by detector position (the rig's present δ first, then in order of first
-// pick), each group ordered for short moves, so the operator relocates the detector once per δ
-// per round; the batch is costed again in that order and cut from the end to fit the budget.
+// reached. Then the batch is grouped by detector position (the rig's present δ first, then in
+// order of first pick), each group ordered for short moves, so the operator relocates the
+// detector once per δ per round; the batch is costed again in that order and cut from the end to
+// fit the budget.
+//
+// Because of the grouping, a δ change is paid once per round: a pick at a detector position the
+// round has reached already is charged its move and reading alone. And a round relocates the
+// operator's detector (a δ or dial change that is a prompt) at most `max_relocations` times, so
+// that each relocation, and what the policies put after it, is amortised over the picks it
+// opens instead of being paid again a few picks later (docs/adaptive.md, "Fewer relocations").
 //
 // Deterministic: the same readings, candidates (in any order), rig position, spend and budget
 // give the same poses in the same order; equal scores go to the smaller (δ, γ, α, β).
@@ -62,6 +68,9 @@ struct RoundInput {
   Budget budget;
 };
 
+// A round relocates the operator's detector at most once (see RoundOptions::max_relocations).
+inline constexpr int kDefaultMaxRelocations = 1;
+
 struct RoundOptions {
   int max_readings = kDefaultRoundReadings;
   // false, for comparison only: δ changes are not charged when picking and the batch is measured
@@ -69,6 +78,10 @@ struct RoundOptions {
   bool group_by_delta = true;
   // The finer candidates added to the caller's (refine_candidates.h); levels 0: none.
   RefineOptions refine = {};
+  // Detector positions (δ, γ) a round may move to that cost the operator a relocation (a prompt:
+  // a manual detector or dial), beyond the rig's present one; -1: any number. Grouped rounds
+  // only; not in the sample-fixed form (there every pose is a prompt).
+  int max_relocations = kDefaultMaxRelocations;
 };
 
 // The next round; empty when nothing affordable is predicted to gain anything (the caller

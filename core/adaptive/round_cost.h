@@ -57,6 +57,8 @@ class RoundCost {
   PoseCost Sequence(const Pose& from, std::span<const Pose> poses) const;
   // What a change of δ adds to a reading (see above).
   const PoseCost& delta_change() const { return delta_change_; }
+  // True for a sample-fixed plan (plan::SampleFixedMethod): every pose a prompt, set by hand.
+  bool sample_fixed() const { return fixed_pose_.has_value(); }
   // True when the pose (model angles) is within the rig's travel and both its directions lie in
   // the plan's adaptive region (the default region for a plan of another method):
   // seed_design.h's Reachable, as for the candidates.

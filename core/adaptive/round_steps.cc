@@ -16,11 +16,10 @@ Spend SpendOfSteps(std::span<const plan::Step> steps, const v1::Plan& plan,
 }
 
 std::vector<plan::Step> RoundSteps(const v1::Plan& plan, const plan::RigDescription& rig,
-                                   std::span<const plan::Step> stored,
+                                   std::span<const plan::Step> stored, const Spend& stored_spend,
                                    const plan::ExpansionStart& start, const Budget& budget,
                                    Round& round) {
   if (plan::SampleFixedMethod(plan)) OrderRoundForPrompts(round, start.model);
-  const Spend before = SpendOfSteps(stored, plan, rig);
   std::vector<plan::Step> all(stored.begin(), stored.end());
   while (!round.poses.empty()) {
     std::vector<Pose> poses;
@@ -33,7 +32,7 @@ std::vector<plan::Step> RoundSteps(const v1::Plan& plan, const plan::RigDescript
     const PoseCost total{with.seconds, with.prompts};
     const StopReason limit = LimitPassed(budget, Spend{}, total, with.readings);
     if (limit == StopReason::kContinue) {
-      round.cost = {with.seconds - before.seconds, with.prompts - before.prompts};
+      round.cost = {with.seconds - stored_spend.seconds, with.prompts - stored_spend.prompts};
       return added;
     }
     if (round.limited_by == StopReason::kContinue) round.limited_by = limit;

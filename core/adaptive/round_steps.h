@@ -26,12 +26,13 @@ namespace brdf::adaptive {
 Spend SpendOfSteps(std::span<const plan::Step> steps, const v1::Plan& plan,
                    const plan::RigDescription& rig);
 
-// The steps of `round` after `stored` (`start` = plan::StartAfter(stored, ...)), numbered after
-// them. `round` is updated to what the steps measure: its poses in measurement order, those cut
+// The steps of `round` after `stored` (`start` = plan::StartAfter(stored, ...); `stored_spend` =
+// SpendOfSteps(stored, ...), which the caller has for the stop rule), numbered after them.
+// `round` is updated to what the steps measure: its poses in measurement order, those cut
 // left out (its predicted gain the kept poses' sum, its cost what the steps add, and limited_by
 // the budget limit that cut a pose when nothing had before). Empty when no pose fits.
 std::vector<plan::Step> RoundSteps(const v1::Plan& plan, const plan::RigDescription& rig,
-                                   std::span<const plan::Step> stored,
+                                   std::span<const plan::Step> stored, const Spend& stored_spend,
                                    const plan::ExpansionStart& start, const Budget& budget,
                                    Round& round);
 

@@ -124,13 +124,12 @@ Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t sessi
       spec.sample_fixed ? adaptive::FixedCandidates(spec) : adaptive::CandidatePoses(spec, rig);
   const adaptive::RoundInput input{readings, candidates, start.model, decision.spent, spec.budget};
   const adaptive::RoundCost cost(plan, rig);
-  // A sample-fixed pose is set by hand in whole degrees: no finer candidates between them.
-  adaptive::RoundOptions options{.max_readings = spec.round_readings};
-  if (spec.sample_fixed) options.refine.levels = 0;
-  adaptive::Round round = adaptive::ChooseRound(input, *map, cost, options);
+  // (A sample-fixed plan gets no finer candidates: refine_candidates.h.)
+  adaptive::Round round =
+      adaptive::ChooseRound(input, *map, cost, {.max_readings = spec.round_readings});
   // In measurement order (a sample-fixed round in prompt order), within the budget step by step.
   const std::vector<plan::Step> round_steps =
-      adaptive::RoundSteps(plan, rig, steps, start, spec.budget, round);
+      adaptive::RoundSteps(plan, rig, steps, decision.spent, start, spec.budget, round);
   decision.stop = adaptive::AfterChoosing(round);
   if (decision.stop != adaptive::StopReason::kContinue) return decision;
 

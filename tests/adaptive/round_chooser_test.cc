@@ -155,6 +155,42 @@ TEST(RoundChooserTest, GroupingByDeltaSparesTheOperator) {
   EXPECT_EQ(runs.size(), distinct.size());
 }
 
+std::set<double> DeltasOf(const Round& round) {
+  std::set<double> out;
+  for (const ChosenPose& p : round.poses) out.insert(p.pose.delta);
+  return out;
+}
+
+TEST(RoundChooserTest, ARoundRelocatesTheOperatorAtMostOnce) {
+  // A manual detector with a reference per position: each δ change is prompts and a reference.
+  const std::vector<Pose> candidates = Candidates();
+  const RoundCost cost(Policies(), plan::RigDescription{});
+  ASSERT_GT(cost.delta_change().prompts, 0);
+  const KernelModel model = Uniform();
+  const Pose at{0, 10, 0, 0};
+  const RoundInput input{{}, candidates, at, {}, {1000, 0, 0}};
+  const Round once = ChooseRound(input, model, cost, {.max_readings = 200});
+  const Round any = ChooseRound(input, model, cost, {.max_readings = 200, .max_relocations = -1});
+  ASSERT_FALSE(once.poses.empty());
+  std::set<double> deltas = DeltasOf(once);
+  deltas.erase(at.delta);
+  EXPECT_LE(deltas.size(), 1u);
+  EXPECT_LE(once.cost.prompts, cost.delta_change().prompts);
+  EXPECT_GT(DeltasOf(any).size(), 2u);  // the limit is what kept it to one relocation
+  EXPECT_GT(any.cost.prompts, once.cost.prompts);
+  // Where a δ change is no prompt (a motorized arm, references not per position) the limit
+  // does not apply.
+  v1::Plan by_time;
+  by_time.mutable_reference()->set_per_detector_position(false);
+  plan::RigDescription arm;
+  arm.has_detector_arm = true;
+  const RoundCost arm_cost(by_time, arm);
+  ASSERT_EQ(arm_cost.delta_change().prompts, 0);
+  const Round free = ChooseRound(input, model, arm_cost, {.max_readings = 60});
+  EXPECT_EQ(Poses(free), Poses(ChooseRound(input, model, arm_cost,
+                                           {.max_readings = 60, .max_relocations = -1})));
+}
+
 TEST(RoundChooserTest, PosesGatherWhereTheUncertaintyIs) {
   // A motorized arm and no reference per position: where the poses go is the model's doing, not
   // the relocations' cost (GroupingByDeltaSparesTheOperator covers those).

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/adaptive/prompt_order.h"
+#include "core/adaptive/refine_candidates.h"
 #include "core/adaptive/round_chooser.h"
 #include "core/adaptive/round_cost.h"
 #include "core/adaptive/round_steps.h"
@@ -90,7 +91,8 @@ Session RunSession(const v1::Plan& plan, const UncertaintyModel& model) {
     const RoundInput input{readings, candidates, start.model, spent, spec.budget};
     Round round = ChooseRound(input, *map, cost, {.max_readings = spec.round_readings});
     const std::vector<Pose> picked = Poses(round);
-    const std::vector<plan::Step> added = RoundSteps(plan, rig, s.steps, start, spec.budget, round);
+    const std::vector<plan::Step> added =
+        RoundSteps(plan, rig, s.steps, spent, start, spec.budget, round);
     s.stop = AfterChoosing(round);
     if (s.stop != StopReason::kContinue) break;
     s.picked.push_back(picked);
@@ -215,6 +217,34 @@ TEST(SampleFixedRoundsTest, SameReadingsGiveTheSameSession) {
   for (std::size_t i = 0; i < a.steps.size(); ++i) {
     EXPECT_EQ(a.steps[i].prompt_text, b.steps[i].prompt_text);
   }
+}
+
+// The operator sets whole degrees by hand: no finer candidates in this form, whoever chooses
+// (the round chooser's default options refine), so every pick is one of the plan's candidates.
+TEST(SampleFixedRoundsTest, NoFinerCandidatesBetweenTheHandSetPoses) {
+  const v1::Plan plan = FixedPlan(50);
+  const plan::RigDescription rig;
+  const AdaptiveSpec spec = ResolveAdaptive(plan.adaptive());
+  const std::vector<Pose> candidates = FixedCandidates(spec);
+  std::vector<ReadingSoFar> readings;  // every 40th candidate
+  for (std::size_t i = 0; i < candidates.size(); i += 40) {
+    readings.push_back({candidates[i], PoseToDirections(candidates[i]), 0.1, 0.02});
+  }
+  const RoundCost cost(plan, rig);
+  EXPECT_TRUE(cost.sample_fixed());
+  const KernelModel model = Peaked();
+  const auto map = model.Map(readings);
+  EXPECT_TRUE(RefinedCandidates(readings, candidates, *map, cost).empty());
+  const Round round =
+      ChooseRound({readings, candidates, readings.back().pose, {}, spec.budget}, *map, cost, {});
+  ASSERT_FALSE(round.poses.empty());
+  for (const ChosenPose& c : round.poses) {
+    EXPECT_TRUE(std::find(candidates.begin(), candidates.end(), c.pose) != candidates.end());
+  }
+  // The rotation form's cost refines: the same plan without sampleFixed.
+  v1::Plan rotation = plan;
+  rotation.mutable_adaptive()->clear_sample_fixed();
+  EXPECT_FALSE(RoundCost(rotation, rig).sample_fixed());
 }
 
 TEST(SampleFixedRoundsTest, RoundsGoWhereTheUncertaintyIs) {
