@@ -308,6 +308,36 @@ void CookTorranceUncertainties(const Observations& data,
   if (note.empty()) note = group.note;
 }
 
+// The fitted lobe s(i, band) at every observation, each direction's angles taken once: the same
+// value as CookTorranceSpecular(data.direction(i), α, F0) of the band, so that kd/π + ks·s is
+// CookTorranceBrdf's to the bit without its sin and cos for every band. Shared α and F0: one
+// value per observation, computed here; per band: from the angles, when asked.
+class FittedLobe {
+ public:
+  FittedLobe(const Observations& data, const std::vector<CookTorranceParams>& band, bool shared)
+      : band_(band), shared_(shared) {
+    geometry_.reserve(data.size());
+    for (std::size_t i = 0; i < data.size(); ++i) {
+      geometry_.push_back(LobeGeometryOf(data.direction(i)));
+    }
+    if (!shared_ || band.empty()) return;
+    value_.reserve(data.size());
+    for (const LobeGeometry& g : geometry_) {
+      value_.push_back(CookTorranceSpecularAt(g, band.front().alpha, band.front().f0));
+    }
+  }
+
+  double At(std::size_t i, std::size_t b) const {
+    return shared_ ? value_[i] : CookTorranceSpecularAt(geometry_[i], band_[b].alpha, band_[b].f0);
+  }
+
+ private:
+  const std::vector<CookTorranceParams>& band_;
+  const bool shared_;
+  std::vector<LobeGeometry> geometry_;
+  std::vector<double> value_;  // shared_: per observation
+};
+
 }  // namespace
 
 const char* ParameterSharingName(ParameterSharing s) {
@@ -441,8 +471,9 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
       options.progress(static_cast<double>(g + 1) / static_cast<double>(groups));
   }
 
+  const FittedLobe lobe(data, fit.band, groups == 1);
   auto model = [&](std::size_t i, std::size_t b) {
-    return CookTorranceBrdf(data.direction(i), fit.band[b]);
+    return fit.band[b].kd / kPi + fit.band[b].ks * lobe.At(i, b);
   };
   for (std::size_t b = 0; b < nb; ++b) {
     fit.band_residuals.push_back(ResidualsOf(data, b, b + 1, model));
