@@ -88,8 +88,8 @@ LinearSolution SolveBand(const BandSums& s) {
 // The observations' V⁻¹f of every band, 16 bands side by side (observation-major within each
 // panel of 16 bands, the last panel padded with 0), for the lobe sums of all bands in one pass.
 constexpr std::size_t kPanel = 16;
-// Lobe shapes summed in one pass over the panels (the points of up to four searches).
-constexpr std::size_t kMaxShapes = 4;
+// Lobe shapes summed in one pass over the panels (the whole steps of three searches).
+constexpr std::size_t kMaxShapes = 12;
 
 // Σᵢ x_k[i] · panel[i][j] for K shapes x and the 16 bands j of one panel, into sum[k · 16 + j]:
 // each band's sum over the observations in order from 0, each product rounded before it is
@@ -116,6 +116,7 @@ __attribute__((target("avx512f"))) void PanelSumsAvx512(const double* panel, std
   for (std::size_t i = 0; i < n; ++i) {
     const __m512d f0 = _mm512_loadu_pd(panel + i * kPanel);
     const __m512d f1 = _mm512_loadu_pd(panel + i * kPanel + 8);
+#pragma GCC unroll 12
     for (std::size_t k = 0; k < K; ++k) {
       const __m512d xi = _mm512_set1_pd(x[k][i]);
       __m512d t0 = _mm512_mul_pd(xi, f0), t1 = _mm512_mul_pd(xi, f1);
@@ -144,8 +145,10 @@ PanelSumsFn PickPanelSums() {
 // The sums for 1 ≤ k ≤ kMaxShapes shapes.
 void PanelSums(const double* panel, std::size_t n, const double* const* x, std::size_t k,
                double* sum) {
-  static const std::array<PanelSumsFn, kMaxShapes> pick = {PickPanelSums<1>(), PickPanelSums<2>(),
-                                                           PickPanelSums<3>(), PickPanelSums<4>()};
+  static const std::array<PanelSumsFn, kMaxShapes> pick = {
+      PickPanelSums<1>(), PickPanelSums<2>(),  PickPanelSums<3>(),  PickPanelSums<4>(),
+      PickPanelSums<5>(), PickPanelSums<6>(),  PickPanelSums<7>(),  PickPanelSums<8>(),
+      PickPanelSums<9>(), PickPanelSums<10>(), PickPanelSums<11>(), PickPanelSums<12>()};
   pick[k - 1](panel, n, x, sum);
 }
 
@@ -316,6 +319,7 @@ SearchResult Search(Projection& projection, const CookTorranceOptions& options,
   NelderMeadOptions nm;
   nm.max_evaluations = options.max_evaluations;
   nm.stop = [&ctx] { return ctx.cancelled() || ctx.expired(); };
+  nm.speculate = true;  // a whole step per pass over the data
   const double step[2] = {0.7, 1.0};
   struct Run {
     NelderMeadSearch search;

@@ -104,54 +104,35 @@ void NelderMeadSearch::Advance() {
   centroid_ = Centroid(s, order_.back());
   reflected_ = Along(centroid_, pts_[order_.back()], -1.0);
   pending_.assign(1, reflected_);
+  if (options_.speculate) {
+    for (const double t : {-2.0, -0.5, 0.5})
+      pending_.push_back(Along(centroid_, pts_[order_.back()], t));
+  }
   phase_ = Phase::kReflect;
 }
 
 void NelderMeadSearch::Tell(std::span<const double> values) {
-  result_.evaluations += static_cast<int>(values.size());
   const std::size_t n = order_.size() - 1;
-  const std::size_t best = order_.front(), worst = order_.back();
   switch (phase_) {
     case Phase::kStart:
+      result_.evaluations += static_cast<int>(n + 1);
       for (std::size_t i = 0; i <= n; ++i) vals_[i] = Finite(values[i]);
       break;
     case Phase::kReflect:
-      fr_ = Finite(values[0]);
-      if (fr_ < vals_[best]) {
-        pending_.assign(1, Along(centroid_, pts_[worst], -2.0));
-        phase_ = Phase::kExpand;
-        return;
-      }
-      if (fr_ < vals_[order_[n - 1]]) {
-        ReplaceWorst(reflected_, fr_);
-        break;
-      }
-      // Contract: outside when the reflection improved on the worst, inside otherwise.
-      outside_ = fr_ < vals_[worst];
-      pending_.assign(1, Along(centroid_, pts_[worst], outside_ ? -0.5 : 0.5));
-      phase_ = Phase::kContract;
-      return;
+      if (!Reflected(values)) return;
+      break;
     case Phase::kExpand:
-      if (const double fe = Finite(values[0]); fe < fr_) {
-        ReplaceWorst(pending_[0], fe);
-      } else {
-        ReplaceWorst(reflected_, fr_);
-      }
+      ++result_.evaluations;
+      Expanded(pending_[0], Finite(values[0]));
       break;
     case Phase::kContract:
-      if (const double fc = Finite(values[0]); fc < (outside_ ? fr_ : vals_[worst])) {
-        ReplaceWorst(pending_[0], fc);
-        break;
-      }
-      pending_.clear();
-      for (std::size_t i = 0; i <= n; ++i) {
-        if (i != best) pending_.push_back(Along(pts_[best], pts_[i], 0.5));
-      }
-      phase_ = Phase::kShrink;
-      return;
+      ++result_.evaluations;
+      if (!Contracted(pending_[0], Finite(values[0]))) return;
+      break;
     case Phase::kShrink:
+      result_.evaluations += static_cast<int>(n);
       for (std::size_t i = 0, k = 0; i <= n; ++i) {
-        if (i == best) continue;
+        if (i == order_.front()) continue;
         pts_[i] = pending_[k];
         vals_[i] = Finite(values[k++]);
       }
@@ -160,6 +141,59 @@ void NelderMeadSearch::Tell(std::span<const double> values) {
       return;
   }
   Advance();
+}
+
+bool NelderMeadSearch::Reflected(std::span<const double> values) {
+  ++result_.evaluations;
+  const std::size_t n = order_.size() - 1, worst = order_.back();
+  const bool all = values.size() > 1;  // speculated: the other candidates' values too
+  fr_ = Finite(values[0]);
+  if (fr_ < vals_[order_.front()]) {
+    if (!all) {
+      pending_.assign(1, Along(centroid_, pts_[worst], -2.0));
+      phase_ = Phase::kExpand;
+      return false;
+    }
+    ++result_.evaluations;
+    Expanded(pending_[1], Finite(values[1]));
+    return true;
+  }
+  if (fr_ < vals_[order_[n - 1]]) {
+    ReplaceWorst(reflected_, fr_);
+    return true;
+  }
+  // Contract: outside when the reflection improved on the worst, inside otherwise.
+  outside_ = fr_ < vals_[worst];
+  if (!all) {
+    pending_.assign(1, Along(centroid_, pts_[worst], outside_ ? -0.5 : 0.5));
+    phase_ = Phase::kContract;
+    return false;
+  }
+  ++result_.evaluations;
+  const std::size_t c = outside_ ? 2 : 3;
+  return Contracted(pending_[c], Finite(values[c]));
+}
+
+void NelderMeadSearch::Expanded(const std::vector<double>& expanded, double fe) {
+  if (fe < fr_) {
+    ReplaceWorst(expanded, fe);
+  } else {
+    ReplaceWorst(reflected_, fr_);
+  }
+}
+
+bool NelderMeadSearch::Contracted(const std::vector<double>& contracted, double fc) {
+  if (fc < (outside_ ? fr_ : vals_[order_.back()])) {
+    ReplaceWorst(contracted, fc);
+    return true;
+  }
+  std::vector<std::vector<double>> shrunk;  // `contracted` may be one of pending_
+  for (std::size_t i = 0; i < pts_.size(); ++i) {
+    if (i != order_.front()) shrunk.push_back(Along(pts_[order_.front()], pts_[i], 0.5));
+  }
+  pending_ = std::move(shrunk);
+  phase_ = Phase::kShrink;
+  return false;
 }
 
 NelderMeadResult MinimizeNelderMead(const std::function<double(std::span<const double>)>& f,

@@ -17,6 +17,10 @@ struct NelderMeadOptions {
   double x_tolerance = 1e-9;
   // Optional: checked every iteration; true stops the search (cancellation).
   std::function<bool()> stop;
+  // NelderMeadSearch only: Pending() asks for the reflection together with the step's other
+  // candidates (expansion, outside and inside contraction), so that one pass evaluates the whole
+  // step; the step uses the same values as without, and counts only those as evaluations.
+  bool speculate = false;
 };
 
 struct NelderMeadResult {
@@ -43,6 +47,11 @@ class NelderMeadSearch {
  private:
   enum class Phase { kStart, kReflect, kExpand, kContract, kShrink, kDone };
   void Advance();  // ranks, stops or reflects the worst vertex
+  // The reflection's value (and, speculated, the expansion's and the contractions'): false
+  // when the step needs more points.
+  bool Reflected(std::span<const double> values);
+  void Expanded(const std::vector<double>& expanded, double fe);
+  bool Contracted(const std::vector<double>& contracted, double fc);  // false: shrinks
   void ReplaceWorst(const std::vector<double>& p, double v);
   void Finish();
 
