@@ -190,6 +190,8 @@ class Projection {
     }
   }
 
+  bool shared() const { return shared_; }
+
   // Solves for (α, F0) and returns the total (weighted) SSE; fills `out` (b1 − b0 solutions)
   // when given.
   double Evaluate(double alpha, double f0, std::vector<LinearSolution>* out) {
@@ -227,12 +229,14 @@ class Projection {
     for (std::size_t i = 0; i < x.size(); ++i) s += x[i] * y[i];
     return s;
   }
+  // Every band's V the same diagonal one, and at least a panel of bands (with fewer, as when
+  // fitting band by band, BandLobeSums is as quick and gives the same bits).
   static bool SharedDiagonal(const std::vector<BandCovariance>& covariance, std::size_t b0,
                              std::size_t b1) {
     for (std::size_t b = b0 + 1; b < b1; ++b) {
       if (!covariance[b].SameDiagonal(covariance[b0])) return false;
     }
-    return b1 > b0;
+    return b1 >= b0 + kPanel;
   }
 
   // Every band's (kd, ks) for the lobe sums of shape p (shared_: shared_sums_[p], else sums_);
@@ -294,7 +298,7 @@ class Projection {
   const Observations& data_;
   const std::vector<BandCovariance>& covariance_;
   std::size_t b0_, b1_;
-  const bool shared_;  // every band's V the same diagonal one
+  const bool shared_;  // every band's V the same diagonal one (SharedDiagonal)
   std::vector<BandSums> sums_;
   std::vector<std::vector<double>> v_one_, v_f_;  // V⁻¹1 and V⁻¹f per band (shared_: V⁻¹1 once)
   std::vector<double> panels_;                    // shared_: V⁻¹f, kPanel bands side by side
@@ -319,7 +323,9 @@ SearchResult Search(Projection& projection, const CookTorranceOptions& options,
   NelderMeadOptions nm;
   nm.max_evaluations = options.max_evaluations;
   nm.stop = [&ctx] { return ctx.cancelled() || ctx.expired(); };
-  nm.speculate = true;  // a whole step per pass over the data
+  // A whole step per pass over the data when a pass is what costs (many bands); band by band,
+  // the lobe shapes cost more than the sums and are not computed ahead.
+  nm.speculate = projection.shared();
   const double step[2] = {0.7, 1.0};
   struct Run {
     NelderMeadSearch search;
