@@ -199,8 +199,9 @@ class Projection {
     return EvaluateAll({&point, 1}, out).front();
   }
 
-  // Evaluate's total at each (α, F0) of `points`, the same values; with one diagonal V for all
-  // bands, the lobe sums of up to kMaxShapes points are taken in one pass over the data.
+  // Evaluate's total at each (α, F0) of `points`, the same values (`out`, when given: the last
+  // point's solutions); with one diagonal V for all bands, the lobe sums of up to kMaxShapes
+  // points are taken in one pass over the data.
   std::vector<double> EvaluateAll(std::span<const std::array<double, 2>> points,
                                   std::vector<LinearSolution>* out = nullptr) {
     std::vector<double> totals;
