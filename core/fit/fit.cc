@@ -7,6 +7,10 @@
 #include <numbers>
 #include <string>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include "core/fit/band_covariance.h"
 #include "core/fit/nelder_mead.h"
 
@@ -81,6 +85,73 @@ LinearSolution SolveBand(const BandSums& s) {
   return best;
 }
 
+// The observations' V⁻¹f of every band, 16 bands side by side (observation-major within each
+// panel of 16 bands, the last panel padded with 0), for the lobe sums of all bands in one pass.
+constexpr std::size_t kPanel = 16;
+// Lobe shapes summed in one pass over the panels (the whole steps of three searches).
+constexpr std::size_t kMaxShapes = 12;
+
+// Σᵢ x_k[i] · panel[i][j] for K shapes x and the 16 bands j of one panel, into sum[k · 16 + j]:
+// each band's sum over the observations in order from 0, each product rounded before it is
+// added (no fused multiply-add), so every variant gives the bits of the plain scalar sum.
+template <std::size_t K>
+void PanelSumsScalar(const double* panel, std::size_t n, const double* const* x, double* sum) {
+  std::array<double, K * kPanel> acc{};
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* f = panel + i * kPanel;
+    for (std::size_t k = 0; k < K; ++k) {
+      const double xi = x[k][i];
+      for (std::size_t j = 0; j < kPanel; ++j) acc[k * kPanel + j] += xi * f[j];
+    }
+  }
+  std::copy(acc.begin(), acc.end(), sum);
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+template <std::size_t K>
+__attribute__((target("avx512f"))) void PanelSumsAvx512(const double* panel, std::size_t n,
+                                                        const double* const* x, double* sum) {
+  __m512d acc[K][2];
+  for (std::size_t k = 0; k < K; ++k) acc[k][0] = acc[k][1] = _mm512_setzero_pd();
+  for (std::size_t i = 0; i < n; ++i) {
+    const __m512d f0 = _mm512_loadu_pd(panel + i * kPanel);
+    const __m512d f1 = _mm512_loadu_pd(panel + i * kPanel + 8);
+#pragma GCC unroll 12
+    for (std::size_t k = 0; k < K; ++k) {
+      const __m512d xi = _mm512_set1_pd(x[k][i]);
+      __m512d t0 = _mm512_mul_pd(xi, f0), t1 = _mm512_mul_pd(xi, f1);
+      asm("" : "+v"(t0), "+v"(t1));  // round the products: no fused multiply-add
+      acc[k][0] = _mm512_add_pd(acc[k][0], t0);
+      acc[k][1] = _mm512_add_pd(acc[k][1], t1);
+    }
+  }
+  for (std::size_t k = 0; k < K; ++k) {
+    _mm512_storeu_pd(sum + k * kPanel, acc[k][0]);
+    _mm512_storeu_pd(sum + k * kPanel + 8, acc[k][1]);
+  }
+}
+#endif
+
+using PanelSumsFn = void (*)(const double*, std::size_t, const double* const*, double*);
+
+template <std::size_t K>
+PanelSumsFn PickPanelSums() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  if (__builtin_cpu_supports("avx512f")) return &PanelSumsAvx512<K>;
+#endif
+  return &PanelSumsScalar<K>;
+}
+
+// The sums for 1 ≤ k ≤ kMaxShapes shapes.
+void PanelSums(const double* panel, std::size_t n, const double* const* x, std::size_t k,
+               double* sum) {
+  static const std::array<PanelSumsFn, kMaxShapes> pick = {
+      PickPanelSums<1>(), PickPanelSums<2>(),  PickPanelSums<3>(),  PickPanelSums<4>(),
+      PickPanelSums<5>(), PickPanelSums<6>(),  PickPanelSums<7>(),  PickPanelSums<8>(),
+      PickPanelSums<9>(), PickPanelSums<10>(), PickPanelSums<11>(), PickPanelSums<12>()};
+  pick[k - 1](panel, n, x, sum);
+}
+
 // The variable-projection objective over bands [b0, b1): evaluates the lobe shape for (α, F0)
 // at every observation and solves each band's (kd, ks) under that band's V⁻¹ (V = I unweighted).
 class Projection {
@@ -92,13 +163,13 @@ class Projection {
         b0_(b0),
         b1_(b1),
         shared_(SharedDiagonal(covariance, b0, b1)),
-        sums_(b1 - b0),
-        spec_(data.size()) {
+        sums_(b1 - b0) {
     geometry_.reserve(data.size());
     for (std::size_t i = 0; i < data.size(); ++i) {
       geometry_.push_back(LobeGeometryOf(data.direction(i)));
     }
     const std::vector<double> one(data.size(), 1.0);
+    if (shared_) panels_.assign((b1 - b0 + kPanel - 1) / kPanel * kPanel * data.size(), 0.0);
     for (std::size_t b = b0; b < b1; ++b) {
       const BandCovariance& v = covariance[b];
       const std::vector<double> f = BandValues(data, b);
@@ -107,31 +178,50 @@ class Projection {
       s.sw = Dot(one, v_one);
       s.swf = Dot(f, v_one);
       s.swff = Dot(f, v_f);
-      v_one_.push_back(std::move(v_one));
-      v_f_.push_back(std::move(v_f));
+      if (shared_) {
+        double* panel =
+            panels_.data() + (b - b0) / kPanel * kPanel * data.size() + (b - b0) % kPanel;
+        for (std::size_t i = 0; i < data.size(); ++i) panel[i * kPanel] = v_f[i];
+        if (b == b0) v_one_.push_back(std::move(v_one));
+      } else {
+        v_one_.push_back(std::move(v_one));
+        v_f_.push_back(std::move(v_f));
+      }
     }
-    if (shared_) swsf_.resize(b1 - b0);
   }
+
+  bool shared() const { return shared_; }
 
   // Solves for (α, F0) and returns the total (weighted) SSE; fills `out` (b1 − b0 solutions)
   // when given.
   double Evaluate(double alpha, double f0, std::vector<LinearSolution>* out) {
-    for (std::size_t i = 0; i < data_.size(); ++i) {
-      spec_[i] = CookTorranceSpecularAt(geometry_[i], alpha, f0);
+    const std::array<double, 2> point = {alpha, f0};
+    return EvaluateAll({&point, 1}, out).front();
+  }
+
+  // Evaluate's total at each (α, F0) of `points`, the same values (`out`, when given: the last
+  // point's solutions); with one diagonal V for all bands, the lobe sums of up to kMaxShapes
+  // points are taken in one pass over the data.
+  std::vector<double> EvaluateAll(std::span<const std::array<double, 2>> points,
+                                  std::vector<LinearSolution>* out = nullptr) {
+    std::vector<double> totals;
+    for (std::size_t first = 0; first < points.size(); first += kMaxShapes) {
+      const std::size_t k = std::min(kMaxShapes, points.size() - first);
+      shapes_.resize(k * data_.size());
+      for (std::size_t p = 0; p < k; ++p) {
+        const auto [alpha, f0] = points[first + p];
+        double* spec = shapes_.data() + p * data_.size();
+        for (std::size_t i = 0; i < data_.size(); ++i) {
+          spec[i] = CookTorranceSpecularAt(geometry_[i], alpha, f0);
+        }
+      }
+      if (shared_) SharedLobeSums(k);
+      for (std::size_t p = 0; p < k; ++p) {
+        if (!shared_) BandLobeSums({shapes_.data() + p * data_.size(), data_.size()});
+        totals.push_back(Solve(p, out));
+      }
     }
-    if (shared_) {
-      SharedLobeSums();
-    } else {
-      BandLobeSums();
-    }
-    double total = 0;
-    if (out != nullptr) out->clear();
-    for (const BandSums& s : sums_) {
-      const LinearSolution sol = SolveBand(s);
-      total += sol.sse;
-      if (out != nullptr) out->push_back(sol);
-    }
-    return total;
+    return totals;
   }
 
  private:
@@ -140,67 +230,83 @@ class Projection {
     for (std::size_t i = 0; i < x.size(); ++i) s += x[i] * y[i];
     return s;
   }
+  // Every band's V the same diagonal one, and at least a panel of bands (with fewer, as when
+  // fitting band by band, BandLobeSums is as quick and gives the same bits).
   static bool SharedDiagonal(const std::vector<BandCovariance>& covariance, std::size_t b0,
                              std::size_t b1) {
     for (std::size_t b = b0 + 1; b < b1; ++b) {
       if (!covariance[b].SameDiagonal(covariance[b0])) return false;
     }
-    return b1 > b0;
+    return b1 >= b0 + kPanel;
+  }
+
+  // Every band's (kd, ks) for the lobe sums of shape p (shared_: shared_sums_[p], else sums_);
+  // their total SSE.
+  double Solve(std::size_t p, std::vector<LinearSolution>* out) {
+    double total = 0;
+    if (out != nullptr) out->clear();
+    for (BandSums& s : sums_) {
+      if (shared_) {
+        const std::size_t b = static_cast<std::size_t>(&s - sums_.data());
+        s.sws = shared_sums_[p].sws;
+        s.swss = shared_sums_[p].swss;
+        s.swsf = swsf_[p * panels() * kPanel + b];
+      }
+      const LinearSolution sol = SolveBand(s);
+      total += sol.sse;
+      if (out != nullptr) out->push_back(sol);
+    }
+    return total;
   }
 
   // Each band's products with the lobe shape s: 1ᵀV⁻¹s, sᵀV⁻¹f, sᵀV⁻¹s.
-  void BandLobeSums() {
+  void BandLobeSums(std::span<const double> spec) {
     for (std::size_t b = b0_; b < b1_; ++b) {
       BandSums& s = sums_[b - b0_];
-      s.sws = Dot(spec_, v_one_[b - b0_]);
-      s.swsf = Dot(spec_, v_f_[b - b0_]);
-      s.swss = covariance_[b].Product(spec_, spec_);
+      s.sws = Dot(spec, v_one_[b - b0_]);
+      s.swsf = Dot(spec, v_f_[b - b0_]);
+      s.swss = covariance_[b].Product(spec, spec);
     }
   }
 
-  // The same products when every band has the same diagonal V (unweighted data): 1ᵀV⁻¹s and
-  // sᵀV⁻¹s are then one value for all bands, taken once, and the bands' sᵀV⁻¹f are summed eight
-  // at a time. Each band's sum still adds the observations in their order from 0, so every value
-  // is BandLobeSums' to the bit; the eight independent sums pipeline where BandLobeSums waits on
-  // one sum at a time.
-  void SharedLobeSums() {
-    const double sws = Dot(spec_, v_one_[0]);
-    const double swss = covariance_[b0_].Product(spec_, spec_);
-    const std::size_t bands = b1_ - b0_;
-    std::size_t first = 0;
-    for (; first + 8 <= bands; first += 8) SumBands<8>(first);
-    for (; first < bands; ++first) SumBands<1>(first);
-    for (std::size_t b = 0; b < bands; ++b) {
-      sums_[b].sws = sws;
-      sums_[b].swss = swss;
-      sums_[b].swsf = swsf_[b];
-    }
-  }
+  std::size_t panels() const { return (b1_ - b0_ + kPanel - 1) / kPanel; }
 
-  // sᵀV⁻¹f of bands [first, first + N) into swsf_: N sums side by side, each over the
-  // observations in order (N streams of V⁻¹f read once each).
-  template <std::size_t N>
-  void SumBands(std::size_t first) {
-    std::array<const double*, N> f;
-    for (std::size_t k = 0; k < N; ++k) f[k] = v_f_[first + k].data();
-    std::array<double, N> sum{};
-    for (std::size_t i = 0; i < data_.size(); ++i) {
-      const double x = spec_[i];
-#pragma GCC unroll 8
-      for (std::size_t k = 0; k < N; ++k) sum[k] += x * f[k][i];
+  // The same products for k shapes when every band has the same diagonal V (unweighted data):
+  // 1ᵀV⁻¹s and sᵀV⁻¹s are then one value for all bands, taken once per shape, and every band's
+  // sᵀV⁻¹f of all k shapes in one pass over the panels (PanelSums). Each band's sum still adds
+  // the observations in their order from 0, so every value is BandLobeSums' to the bit.
+  void SharedLobeSums(std::size_t k) {
+    const std::size_t n = data_.size();
+    std::array<const double*, kMaxShapes> x{};
+    for (std::size_t p = 0; p < k; ++p) {
+      const std::span<const double> spec(shapes_.data() + p * n, n);
+      x[p] = spec.data();
+      shared_sums_[p].sws = Dot(spec, v_one_[0]);
+      shared_sums_[p].swss = covariance_[b0_].Product(spec, spec);
     }
-    std::copy(sum.begin(), sum.end(), swsf_.begin() + static_cast<std::ptrdiff_t>(first));
+    swsf_.resize(kMaxShapes * panels() * kPanel);
+    std::array<double, kMaxShapes * kPanel> sum;
+    for (std::size_t q = 0; q < panels(); ++q) {
+      PanelSums(panels_.data() + q * kPanel * n, n, x.data(), k, sum.data());
+      for (std::size_t p = 0; p < k; ++p) {
+        std::copy_n(
+            sum.begin() + static_cast<std::ptrdiff_t>(p * kPanel), kPanel,
+            swsf_.begin() + static_cast<std::ptrdiff_t>(p * panels() * kPanel + q * kPanel));
+      }
+    }
   }
 
   const Observations& data_;
   const std::vector<BandCovariance>& covariance_;
   std::size_t b0_, b1_;
-  const bool shared_;  // every band's V the same diagonal one
+  const bool shared_;  // every band's V the same diagonal one (SharedDiagonal)
   std::vector<BandSums> sums_;
-  std::vector<std::vector<double>> v_one_, v_f_;  // V⁻¹1 and V⁻¹f per band
-  std::vector<double> swsf_;                      // shared_: sᵀV⁻¹f per band
+  std::vector<std::vector<double>> v_one_, v_f_;  // V⁻¹1 and V⁻¹f per band (shared_: V⁻¹1 once)
+  std::vector<double> panels_;                    // shared_: V⁻¹f, kPanel bands side by side
+  std::array<BandSums, kMaxShapes> shared_sums_;  // shared_: 1ᵀV⁻¹s and sᵀV⁻¹s per shape
+  std::vector<double> swsf_;                      // shared_: sᵀV⁻¹f per shape and band
   std::vector<LobeGeometry> geometry_;
-  std::vector<double> spec_;
+  std::vector<double> shapes_;  // the lobe shapes being tried, one per observation each
 };
 
 struct SearchResult {
@@ -209,33 +315,60 @@ struct SearchResult {
   bool converged = true;
 };
 
+// From each start, a Nelder-Mead search and a restart from its result (which guards against a
+// simplex that collapsed early); the best result wins, the earlier start on a tie. The searches
+// run side by side, their points evaluated together (Projection::EvaluateAll), each search
+// taking the same steps as alone.
 SearchResult Search(Projection& projection, const CookTorranceOptions& options,
                     const CallContext& ctx) {
-  SearchResult best;
-  best.converged = false;
   NelderMeadOptions nm;
   nm.max_evaluations = options.max_evaluations;
   nm.stop = [&ctx] { return ctx.cancelled() || ctx.expired(); };
-  auto objective = [&](std::span<const double> x) {
-    return projection.Evaluate(AlphaOf(x[0]), F0Of(x[1]), nullptr);
-  };
+  // A whole step per pass over the data when a pass is what costs (many bands); band by band,
+  // the lobe shapes cost more than the sums and are not computed ahead.
+  nm.speculate = projection.shared();
   const double step[2] = {0.7, 1.0};
-  bool all_converged = true;
+  struct Run {
+    NelderMeadSearch search;
+    std::vector<NelderMeadResult> done;  // the search's, then the restart's
+  };
+  std::vector<Run> runs;
   for (double a0 : options.alpha_starts) {
     const double start[2] = {std::log(a0), Logit(options.f0_start)};
-    NelderMeadResult r = MinimizeNelderMead(objective, start, step, nm);
-    // A restart from the result guards against a simplex that collapsed early.
-    NelderMeadResult again = MinimizeNelderMead(objective, r.x, step, nm);
-    best.evaluations += r.evaluations + again.evaluations;
-    all_converged = all_converged && again.converged;
+    runs.push_back({NelderMeadSearch(start, step, nm), {}});
+  }
+  std::vector<std::array<double, 2>> points;
+  for (;;) {
+    points.clear();
+    for (const Run& r : runs) {
+      for (const std::vector<double>& x : r.search.Pending()) {
+        points.push_back({AlphaOf(x[0]), F0Of(x[1])});
+      }
+    }
+    if (points.empty()) break;
+    const std::vector<double> values = projection.EvaluateAll(points);
+    std::size_t at = 0;
+    for (Run& r : runs) {
+      const std::size_t k = r.search.Pending().size();
+      if (k == 0) continue;
+      r.search.Tell({values.data() + at, k});
+      at += k;
+      if (!r.search.done()) continue;
+      r.done.push_back(r.search.result());
+      if (r.done.size() == 1) r.search = NelderMeadSearch(r.done.front().x, step, nm);
+    }
+  }
+  SearchResult best;
+  for (const Run& r : runs) {
+    const NelderMeadResult& again = r.done.back();
+    best.evaluations += r.done.front().evaluations + again.evaluations;
+    best.converged = best.converged && again.converged;
     if (again.value < best.sse) {
       best.sse = again.value;
       best.alpha = AlphaOf(again.x[0]);
       best.f0 = F0Of(again.x[1]);
     }
-    if (ctx.cancelled() || ctx.expired()) break;
   }
-  best.converged = all_converged;
   return best;
 }
 
@@ -307,6 +440,36 @@ void CookTorranceUncertainties(const Observations& data,
   }
   if (note.empty()) note = group.note;
 }
+
+// The fitted lobe s(i, band) at every observation, each direction's angles taken once: the same
+// value as CookTorranceSpecular(data.direction(i), α, F0) of the band, so that kd/π + ks·s is
+// CookTorranceBrdf's to the bit without its sin and cos for every band. Shared α and F0: one
+// value per observation, computed here; per band: from the angles, when asked.
+class FittedLobe {
+ public:
+  FittedLobe(const Observations& data, const std::vector<CookTorranceParams>& band, bool shared)
+      : band_(band), shared_(shared) {
+    geometry_.reserve(data.size());
+    for (std::size_t i = 0; i < data.size(); ++i) {
+      geometry_.push_back(LobeGeometryOf(data.direction(i)));
+    }
+    if (!shared_ || band.empty()) return;
+    value_.reserve(data.size());
+    for (const LobeGeometry& g : geometry_) {
+      value_.push_back(CookTorranceSpecularAt(g, band.front().alpha, band.front().f0));
+    }
+  }
+
+  double At(std::size_t i, std::size_t b) const {
+    return shared_ ? value_[i] : CookTorranceSpecularAt(geometry_[i], band_[b].alpha, band_[b].f0);
+  }
+
+ private:
+  const std::vector<CookTorranceParams>& band_;
+  const bool shared_;
+  std::vector<LobeGeometry> geometry_;
+  std::vector<double> value_;  // shared_: per observation
+};
 
 }  // namespace
 
@@ -441,8 +604,9 @@ Result<CookTorranceFit> FitCookTorrance(const Observations& data,
       options.progress(static_cast<double>(g + 1) / static_cast<double>(groups));
   }
 
+  const FittedLobe lobe(data, fit.band, groups == 1);
   auto model = [&](std::size_t i, std::size_t b) {
-    return CookTorranceBrdf(data.direction(i), fit.band[b]);
+    return fit.band[b].kd / kPi + fit.band[b].ks * lobe.At(i, b);
   };
   for (std::size_t b = 0; b < nb; ++b) {
     fit.band_residuals.push_back(ResidualsOf(data, b, b + 1, model));

@@ -48,6 +48,12 @@ std::vector<double> CholeskyLower(std::vector<double> a, std::size_t n);
 // it is not positive definite (a parameter the data do not determine).
 std::vector<double> InvertSymmetric(std::vector<double> a, std::size_t n);
 
+// The diagonal of InvertSymmetric(a, n), the same values to the bit (zeros aside, whose sign
+// may differ), in far fewer operations for a sparse a (each row's entries before its first
+// non-zero are skipped: the fits' normal matrices, a 2 × 2 block per band and two shared rows,
+// cost about n² instead of n³/2); empty when a is not positive definite.
+std::vector<double> InverseDiagonal(std::vector<double> a, std::size_t n);
+
 // Standard uncertainties √Cₖₖ of the parameters whose normal-matrix row `free[k]` is true, from
 // the normal matrix JᵀV⁻¹J (n × n, row-major); NaN for the others and for all of them when the
 // free block is singular (stats.note says so). Scales by Σ r² / dof when stats is unweighted.

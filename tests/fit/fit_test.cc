@@ -53,6 +53,37 @@ TEST(NelderMead, FindsTheMinimumOfRosenbrock) {
   EXPECT_NEAR(r.x[1], 1.0, 1e-4);
 }
 
+// Asked and told, with the step's candidates asked for together (speculate), the search takes
+// MinimizeNelderMead's steps: the same point, value and evaluation count, to the bit; the
+// speculated points it did not use are asked but not counted.
+TEST(NelderMead, SearchAskedAndToldTakesTheSameSteps) {
+  auto rosenbrock = [](std::span<const double> x) {
+    return 100 * std::pow(x[1] - x[0] * x[0], 2) + std::pow(1 - x[0], 2);
+  };
+  const double start[2] = {-1.2, 1.0};
+  const double step[2] = {0.5, 0.5};
+  for (const int cap : {5000, 37}) {
+    NelderMeadOptions options;
+    options.max_evaluations = cap;
+    const NelderMeadResult alone = MinimizeNelderMead(rosenbrock, start, step, options);
+    options.speculate = true;
+    NelderMeadSearch search(start, step, options);
+    int asked = 0;
+    while (!search.done()) {
+      std::vector<double> values;
+      for (const std::vector<double>& p : search.Pending()) values.push_back(rosenbrock(p));
+      asked += static_cast<int>(values.size());
+      search.Tell(values);
+    }
+    const NelderMeadResult& r = search.result();
+    EXPECT_EQ(r.x, alone.x) << "cap " << cap;
+    EXPECT_EQ(r.value, alone.value);
+    EXPECT_EQ(r.evaluations, alone.evaluations);
+    EXPECT_EQ(r.converged, alone.converged);
+    EXPECT_GT(asked, r.evaluations);
+  }
+}
+
 TEST(NelderMead, StopsWhenAsked) {
   int calls = 0;
   NelderMeadOptions options;

@@ -69,6 +69,32 @@ TEST(InvertSymmetric, InvertsAPositiveDefiniteMatrixAndRefusesASingularOne) {
   EXPECT_TRUE(InvertSymmetric({1, 2, 2, 4}, 2).empty());
 }
 
+// InverseDiagonal skips what lies outside each row's envelope (the Cook-Torrance normal matrix's
+// 2 × 2 blocks per band and its two shared rows): the same diagonal as InvertSymmetric's, bit
+// for bit, for such a matrix and for a dense one; empty for a singular one.
+TEST(InverseDiagonal, EqualsInvertSymmetricsDiagonalBitForBit) {
+  const std::size_t bands = 40, n = 2 * bands + 2;
+  std::vector<double> arrow(n * n, 0.0);
+  for (std::size_t b = 0; b < bands; ++b) {
+    const std::size_t at[4] = {2 * b, 2 * b + 1, n - 2, n - 1};
+    const double x = 1.0 + 0.37 * static_cast<double>(b);
+    const double g[16] = {3 * x, x,   0.2, 0.1,  x,   2 * x, 0.3,  -0.2,
+                          0.2,   0.3, 0.9, 0.05, 0.1, -0.2,  0.05, 0.7};
+    for (int p = 0; p < 4; ++p) {
+      for (int q = 0; q < 4; ++q) arrow[at[p] * n + at[q]] += g[p * 4 + q];
+    }
+  }
+  const std::vector<double> dense = {4, 2, 0.6, 2, 5, 1, 0.6, 1, 3};
+  for (const auto& [a, size] : {std::pair{arrow, n}, std::pair{dense, std::size_t{3}}}) {
+    const std::vector<double> full = InvertSymmetric(a, size);
+    const std::vector<double> diagonal = InverseDiagonal(a, size);
+    ASSERT_EQ(full.size(), size * size);
+    ASSERT_EQ(diagonal.size(), size);
+    for (std::size_t i = 0; i < size; ++i) EXPECT_EQ(diagonal[i], full[i * size + i]) << i;
+  }
+  EXPECT_TRUE(InverseDiagonal({1, 2, 2, 4}, 2).empty());
+}
+
 // χ²/dof of a correct model follows χ²(ν)/ν: mean 1, standard deviation √(2/ν). With ν ≈ 17,000
 // (2,153 directions × 8 bands − 18 parameters) that is 0.011; the tolerance is 5 of them, so a
 // correct fit fails by chance with probability < 10⁻⁶ per repetition.
