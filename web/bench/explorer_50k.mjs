@@ -50,6 +50,10 @@
 //   BRDF_BENCH_VIEWS=1, 3 repetitions, main's brdfd interleaved, load 14–21: 101 bands median
 //   5.38 s (main 21.61 s), 401 bands 18.09 s (main 27.01 s; the model fit is what is left);
 //   again 0.05 s. brdfd CPU per first render 1.52 s (main 5.08 s) and 4.52 s (main 8.85 s).
+//   2026-12-07, later (issue 41: the model fit's lobe once per reading, its three searches side by
+//   side and several evaluations per pass over 16-band panels; the same bits), against the change
+//   above, interleaved, 3 repetitions, load 2.9–8.3: 401 bands 2.13 s (4.45 s), 101 bands
+//   1.40 s (1.83 s); brdfd CPU at load ~3.6: 2.49 s (3.90 s) and 1.20 s (1.48 s). bench/README.md.
 import puppeteer from 'puppeteer-core';
 import { spawn, execFileSync } from 'node:child_process';
 import { mkdtempSync, writeFileSync, openSync, readFileSync, copyFileSync, existsSync } from 'node:fs';
