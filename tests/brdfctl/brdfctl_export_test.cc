@@ -214,7 +214,8 @@ TEST_F(BrdfctlExportTest, AnAnalystExportsMerlGridAndCsvFilesThatTheirReadersLoa
 // and counts them; --rgb on a grid is the user's error.
 TEST_F(BrdfctlExportTest, UncertaintyArraysGoBesideTheGridAndItsSidecarNamesThem) {
   // --uncertainty: three more .npy files named after -o, of the grid's shape and dtype, named in
-  // OUT.json as they are on disk; u is NaN exactly where the values are, and ≥ 0 elsewhere.
+  // OUT.json as they are on disk; u is NaN where the values are, ≥ 0 at every interpolated cell,
+  // and ≥ 0 or NaN (not estimated, beyond the model's calibrated reach) at the chain's model cells.
   const std::string npy = Path("ugrid.npy");
   const CommandResult g =
       Ctl({"export", id_, "grid", "--steps", "10,10,20", "--float32", "--uncertainty", "-o", npy});
@@ -232,9 +233,14 @@ TEST_F(BrdfctlExportTest, UncertaintyArraysGoBesideTheGridAndItsSidecarNamesThem
          "a = np.load(sys.argv[1])\n"
          "d = json.load(open(sys.argv[1] + '.json'))['uncertainty']\n"
          "u = np.load(sys.argv[1][:-4] + '.u.npy')\n"
+         "um = np.load(sys.argv[1][:-4] + '.u_measurement.npy')\n"
          "names = sorted(v['file'] for v in d['arrays'].values())\n"
          "ok = np.isfinite(a)\n"
-         "assert np.isnan(u[~ok]).all() and (u[ok] >= 0).all() and np.isfinite(u[ok]).all()\n"
+         "model = ok & np.isnan(um)\n"  // the fill chain's model cells may be not estimated (NaN)
+         "i = ok & ~model\n"
+         "assert np.isnan(u[~ok]).all() and (u[i] >= 0).all() and np.isfinite(u[i]).all()\n"
+         "m = u[model]\n"
+         "assert (m[np.isfinite(m)] >= 0).all()\n"
          "print(u.dtype, *u.shape, d['k'], *names)\n";
   const CommandResult numpy = RunShell("/usr/bin/python3 '" + script + "' '" + npy + "' 2>&1");
   ASSERT_EQ(numpy.exit_code, 0) << Describe(numpy);

@@ -308,7 +308,9 @@ TEST_F(SimModel, TheControlUnitRefusesBadValuesWithoutApplyingAnything) {
             (std::vector<std::uint8_t>{0x90, 0x03}));  // drop_connection = 2
   EXPECT_EQ(control_.modbus().exception_count, 0);
   EXPECT_EQ(Ask(cm::kDefaultUnitId, WritePdu(5, {1})), (std::vector<std::uint8_t>{0x90, 0x02}));
-  EXPECT_EQ(Ask(cm::kDefaultUnitId, ReadPdu(20, 10)), (std::vector<std::uint8_t>{0x83, 0x02}));
+  // A read past the last register (33) is refused.
+  EXPECT_EQ(Ask(cm::kDefaultUnitId, ReadPdu(cm::kRegisterCount - 4, 10)),
+            (std::vector<std::uint8_t>{0x83, 0x02}));
   EXPECT_EQ(control_.mounted(), MountedTarget::kSample);
 }
 

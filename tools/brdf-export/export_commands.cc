@@ -227,6 +227,32 @@ int RunCsv(const CommonOptions& c, const CsvOptions& o, std::ostream& err) {
   return kExitOk;
 }
 
+namespace {
+
+// The grid's file format, "npy" or "csv" (--format, else from -o's name), with the options that
+// need .npy checked against it.
+Result<std::string> GridFormat(const CommonOptions& c, const GridOptions& o) {
+  std::string format = o.format;
+  if (format.empty()) format = EndsWith(c.output, ".csv") ? "csv" : "npy";
+  if (format != "npy" && format != "csv") {
+    return InvalidArgument("--format '" + format + "': use npy or csv");
+  }
+  if (o.float32 && format != "npy") {
+    return InvalidArgument("--float32 is for .npy grids, not CSV");
+  }
+  if (format == "npy" && c.output == "-") {
+    return InvalidArgument("an .npy grid needs a file: give -o PATH.npy");
+  }
+  if (o.uncertainty && format != "npy") {
+    return InvalidArgument(
+        "--uncertainty is for .npy grids: a grid as CSV has no room for the arrays (export it as "
+        ".npy, or leave --uncertainty out)");
+  }
+  return format;
+}
+
+}  // namespace
+
 int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
   Result<exports::Quantity> q = exports::ParseQuantity(o.quantity);
   if (!q.ok()) return Fail(err, "grid", q.status());
@@ -242,22 +268,9 @@ int RunGrid(const CommonOptions& c, const GridOptions& o, std::ostream& err) {
       (*steps)[0], (*steps)[1], (*steps)[2],
       o.nodes ? exports::GridPlacement::kNodes : exports::GridPlacement::kCellCentres);
   if (!grid.ok()) return Fail(err, "grid", grid.status());
-  std::string format = o.format;
-  if (format.empty()) format = EndsWith(c.output, ".csv") ? "csv" : "npy";
-  if (format != "npy" && format != "csv") {
-    return Fail(err, "grid", InvalidArgument("--format '" + format + "': use npy or csv"));
-  }
-  if (o.float32 && format != "npy") {
-    return Fail(err, "grid", InvalidArgument("--float32 is for .npy grids, not CSV"));
-  }
-  if (format == "npy" && c.output == "-") {
-    return Fail(err, "grid", InvalidArgument("an .npy grid needs a file: give -o PATH.npy"));
-  }
-  if (o.uncertainty && format != "npy") {
-    return Fail(err, "grid",
-                InvalidArgument("--uncertainty is for .npy grids: a grid as CSV has no room for "
-                                "the arrays (export it as .npy, or leave --uncertainty out)"));
-  }
+  Result<std::string> format_or = GridFormat(c, o);
+  if (!format_or.ok()) return Fail(err, "grid", format_or.status());
+  const std::string format = *format_or;
   Result<exports::Session> session = LoadInput(c);
   if (!session.ok()) return Fail(err, "grid", session.status());
   Result<Interpolation> in = BuildInterpolator(*session, *q, c, o.interp, err);
