@@ -52,6 +52,8 @@
 // answer "device busy".
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 namespace brdf::sim::control_map {
@@ -82,6 +84,20 @@ inline constexpr std::uint16_t kModbusOutageMs = 28;
 inline constexpr std::uint16_t kPlacedByHand = 29;
 inline constexpr std::uint16_t kPlacedThetaI = 30;  // then phi_i, theta_o, phi_o
 inline constexpr std::uint16_t kPlacedPhiO = 33;
+// A placed angle in its register: signed centidegrees (two's complement), and back. The writer
+// (brdfctl sim-mount) and the simulator's control unit read the same encoding from here.
+inline std::uint16_t ToCentidegrees(double deg) {
+  return static_cast<std::uint16_t>(
+      static_cast<std::int16_t>(std::clamp<long>(std::lround(deg * 100), -32768, 32767)));
+}
+inline double FromCentidegrees(std::uint16_t reg) {
+  return static_cast<std::int16_t>(reg) / 100.0;
+}
+// Whether `deg` fits placed register `address` (30–33): θ in 0–90°, φ in −180–180°.
+inline bool PlacedAngleInRange(std::uint16_t address, double deg) {
+  const bool theta = (address - kPlacedThetaI) % 2 == 0;
+  return theta ? deg >= 0 && deg <= 90 : deg >= -180 && deg <= 180;
+}
 
 inline constexpr std::uint16_t kRegisterCount = 34;  // addresses 0–33
 

@@ -25,22 +25,6 @@ bool IsFlag(std::uint16_t a) {
          a == cm::kPlacedByHand;
 }
 
-// Signed centidegrees in a register (two's complement) and back.
-std::uint16_t Centidegrees(double deg) {
-  return static_cast<std::uint16_t>(
-      static_cast<std::int16_t>(std::clamp<long>(std::lround(deg * 100), -32768, 32767)));
-}
-double Degrees(std::uint16_t reg) {
-  return static_cast<std::int16_t>(reg) / 100.0;
-}
-
-// A placed direction register holds θ in 0–90° or φ in −180–180°.
-bool PlacedValueInRange(std::uint16_t a, std::uint16_t v) {
-  const int c = static_cast<std::int16_t>(v);
-  const bool theta = (a - cm::kPlacedThetaI) % 2 == 0;
-  return theta ? c >= 0 && c <= 9000 : c >= -18000 && c <= 18000;
-}
-
 std::uint16_t Clamp16(long v) {
   return static_cast<std::uint16_t>(std::clamp<long>(v, 0, 0xFFFF));
 }
@@ -76,10 +60,10 @@ std::vector<std::uint16_t> Snapshot(const SimControl& control) {
   r[cm::kModbusOutageMs] = Clamp16(m.outage_ms);
   const Directions d = control.placed();
   r[cm::kPlacedByHand] = control.by_hand() ? 1 : 0;
-  r[cm::kPlacedThetaI] = Centidegrees(d.theta_i);
-  r[cm::kPlacedThetaI + 1] = Centidegrees(d.phi_i);
-  r[cm::kPlacedThetaI + 2] = Centidegrees(d.theta_o);
-  r[cm::kPlacedPhiO] = Centidegrees(d.phi_o);
+  r[cm::kPlacedThetaI] = cm::ToCentidegrees(d.theta_i);
+  r[cm::kPlacedThetaI + 1] = cm::ToCentidegrees(d.phi_i);
+  r[cm::kPlacedThetaI + 2] = cm::ToCentidegrees(d.theta_o);
+  r[cm::kPlacedPhiO] = cm::ToCentidegrees(d.phi_o);
   return r;
 }
 
@@ -109,7 +93,8 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
     if (IsFlag(a) && v > 1) return modbus::kIllegalDataValue;
     if (a == cm::kModbusExceptionCode && v > 0x0B) return modbus::kIllegalDataValue;
     if (a == cm::kSerialUnitsCode && v > 2) return modbus::kIllegalDataValue;
-    if (a >= cm::kPlacedThetaI && a <= cm::kPlacedPhiO && !PlacedValueInRange(a, v)) {
+    if (a >= cm::kPlacedThetaI && a <= cm::kPlacedPhiO &&
+        !cm::PlacedAngleInRange(a, cm::FromCentidegrees(v))) {
       return modbus::kIllegalDataValue;
     }
   }
@@ -157,10 +142,11 @@ std::uint8_t StageControlUnit::WriteRegisters(std::uint16_t address,
     });
   }
   if (address + values.size() > cm::kPlacedByHand) {
-    control_.set_placed(
-        image[cm::kPlacedByHand] != 0,
-        Directions{Degrees(image[cm::kPlacedThetaI]), Degrees(image[cm::kPlacedThetaI + 1]),
-                   Degrees(image[cm::kPlacedThetaI + 2]), Degrees(image[cm::kPlacedPhiO])});
+    control_.set_placed(image[cm::kPlacedByHand] != 0,
+                        Directions{cm::FromCentidegrees(image[cm::kPlacedThetaI]),
+                                   cm::FromCentidegrees(image[cm::kPlacedThetaI + 1]),
+                                   cm::FromCentidegrees(image[cm::kPlacedThetaI + 2]),
+                                   cm::FromCentidegrees(image[cm::kPlacedPhiO])});
   }
   if (written(cm::kPowerCycleMeter) && image[cm::kPowerCycleMeter] == 1 && power_cycle_meter_) {
     power_cycle_meter_();

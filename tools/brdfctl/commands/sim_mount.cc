@@ -76,14 +76,16 @@ Status SimMount(const std::string& modbus, int unit, int value) {
 Result<std::vector<std::uint16_t>> PlacedRegisters(const Directions& d) {
   const double values[] = {d.theta_i, d.phi_i, d.theta_o, d.phi_o};
   std::vector<std::uint16_t> regs = {1};  // placed by hand
+  namespace cm = sim::control_map;
   for (int k = 0; k < 4; ++k) {
-    const bool theta = k % 2 == 0;
+    const auto address = static_cast<std::uint16_t>(cm::kPlacedThetaI + k);
     const double v = values[k];
-    if (!std::isfinite(v) || (theta && (v < 0 || v > 90)) || (!theta && (v < -180 || v > 180))) {
+    if (!std::isfinite(v) || !cm::PlacedAngleInRange(address, v)) {
       return InvalidArgument(std::string("the placed direction ") + kPlacedNames[k] + " = " +
-                             std::to_string(v) + "° is outside " + (theta ? "0–90°" : "−180–180°"));
+                             std::to_string(v) + "° is outside " +
+                             (k % 2 == 0 ? "0–90°" : "−180–180°"));
     }
-    regs.push_back(static_cast<std::uint16_t>(static_cast<std::int16_t>(std::lround(v * 100))));
+    regs.push_back(cm::ToCentidegrees(v));
   }
   return regs;
 }
