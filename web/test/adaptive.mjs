@@ -12,7 +12,7 @@
 // console lists those.
 import { execFile } from 'node:child_process';
 import { join } from 'node:path';
-import { startRig, outputDir, check, build, launchBrowser, pageCollectingErrors } from './rig.mjs';
+import { startRig, outputDir, check, build, launchBrowser, pageCollectingErrors, signIn } from './rig.mjs';
 
 const out = outputDir();
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
@@ -58,11 +58,7 @@ try {
   browser = await launchBrowser();
   const errors = [];
   const page = await pageCollectingErrors(browser, errors);
-  await page.goto(rig.url);
-  await page.waitForSelector('#login-view:not([hidden])');
-  await page.type('#token', rig.operatorToken);
-  await page.click('#login-button');
-  await page.waitForFunction(() => document.getElementById('who').textContent === 'operator');
+  await signIn(page, rig.url, rig.operatorToken, 'operator');
   await page.waitForFunction(() => document.getElementById('session-state')?.textContent === 'queued');
   await page.waitForSelector('#rounds:not([hidden])');
   check(await page.$eval('#rounds-goal', (e) => e.textContent === 'target: U (k = 2) ≤ 0.001; budget: 33 readings'), `the console states the plan's target and budget (${await page.$eval('#rounds-goal', (e) => e.textContent)})`);
@@ -113,10 +109,7 @@ try {
 
   // A page opened afterwards has the same rounds, from the store.
   const later = await pageCollectingErrors(browser, errors);
-  await later.goto(rig.url);
-  await later.waitForSelector('#login-view:not([hidden])');
-  await later.type('#token', rig.analystToken);
-  await later.click('#login-button');
+  await signIn(later, rig.url, rig.analystToken);
   await later.waitForFunction((n) => document.querySelectorAll('#rounds-table tbody tr').length === n, { timeout: 15000 }, stored.length);
   const laterLeft = await later.$$eval('#rounds-table tbody tr', (r) => r.map((tr) => Number(tr.dataset.left)));
   check(laterLeft.every((v, i) => v === stored[i].uncertainty_left), 'a page opened after the session shows the same rounds (from ListAdaptiveRounds)');
@@ -200,10 +193,7 @@ try {
   check(fixedRounds.length >= 1 && fixedRounds.every((r) => r.directions?.length === r.poses.length && r.directions.every((d) => whole(d.theta_i ?? 0) && whole(d.theta_o ?? 0))),
     `the sample-fixed rounds carry each pose's directions, whole degrees as the operator sets them (${fixedRounds.map((r) => r.directions?.length).join(', ')})`);
   const fixedPage = await pageCollectingErrors(browser, errors);
-  await fixedPage.goto(rig.url);
-  await fixedPage.waitForSelector('#login-view:not([hidden])');
-  await fixedPage.type('#token', rig.analystToken);
-  await fixedPage.click('#login-button');
+  await signIn(fixedPage, rig.url, rig.analystToken);
   // The sessions table is redrawn as it refreshes: click its row (again) until the session shows.
   await fixedPage.waitForFunction((sid, n) => {
     const row = document.querySelector(`tr[data-id="${sid}"]`);

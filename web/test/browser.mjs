@@ -12,7 +12,7 @@ import puppeteer from 'puppeteer-core';
 import { readFileSync, readdirSync, existsSync } from 'node:fs';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { startRig, outputDir, check } from './rig.mjs';
+import { startRig, outputDir, check, signIn } from './rig.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const demo = join(here, '../../examples/plans/demo.json');
@@ -354,11 +354,7 @@ try {
   const context = await browser.createBrowserContext();
   const analyst = await context.newPage();
   watchErrors(analyst, 'analyst');
-  await analyst.goto(rig.url);
-  await analyst.waitForSelector('#login-view:not([hidden])');
-  await analyst.type('#token', rig.analystToken);
-  await analyst.click('#login-button');
-  await analyst.waitForFunction(() => document.getElementById('who').textContent === 'analyst');
+  await signIn(analyst, rig.url, rig.analystToken, 'analyst');
   await analyst.waitForFunction(() => document.getElementById('session-state')?.textContent === 'queued');
   for (const sel of ['#submit-plan', '#submit-start', '#controls', '#start', '#pause-deferred', '#pause-immediate', '#resume', '#abort', '#answer-prompt']) {
     check((await analyst.$(sel)) === null, `analyst: no ${sel}`);

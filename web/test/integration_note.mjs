@@ -4,7 +4,7 @@
 // meter's note; the other readings are not listed. Headless Chromium (puppeteer-core) against a
 // real brdfd on brdf-sim, as an analyst.
 import { join } from 'node:path';
-import { startRig, outputDir, check, launchBrowser, pageCollectingErrors } from './rig.mjs';
+import { startRig, outputDir, check, launchBrowser, pageCollectingErrors, signIn } from './rig.mjs';
 
 const out = outputDir();
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
@@ -43,11 +43,7 @@ try {
   browser = await launchBrowser();
   const errors = [];
   const page = await pageCollectingErrors(browser, errors);
-  await page.goto(rig.url, { waitUntil: 'load' });
-  await page.waitForSelector('#login-view:not([hidden])');
-  await page.type('#token', rig.analystToken);
-  await page.click('#login-button');
-  await page.waitForFunction(() => document.getElementById('who').textContent === 'analyst');
+  await signIn(page, rig.url, rig.analystToken, 'analyst');
   await page.waitForFunction(() => document.getElementById('session-state')?.textContent === 'completed', { timeout: 15000 });
   await page.waitForSelector('#integration-notes li[data-reading]', { timeout: 15000 });
   const items = await page.$$eval('#integration-notes li[data-reading]', (l) => l.map((e) => e.textContent));

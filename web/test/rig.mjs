@@ -22,6 +22,7 @@ function waitFor(child, name, want, seconds, log) {
     const found = {};
     const timer = setTimeout(() => reject(new Error(`${name} did not start in ${seconds} s: ${tail(log)}`)), seconds * 1000);
     child.on('exit', (code) => { clearTimeout(timer); reject(new Error(`${name} exited (${code}): ${tail(log)}`)); });
+    child.on('error', (e) => { clearTimeout(timer); reject(new Error(`${name} could not be started (${e.message}): build it (cmake --build $BRDF_BUILD_DIR)`)); });
     lines(child, (line) => {
       for (const [key, re] of Object.entries(want)) {
         const m = re.exec(line);
@@ -94,8 +95,16 @@ present = true
 white_reflectance = 0.99
 ${tokensWebAndLog(operatorToken, analystToken)}${extraConfig}`);
   const daemonLog = join(dir, 'brdfd.log');
-  const daemon = spawn(brdfd, ['--config', config, '--shutdown-timeout', '3'], { stdio: ['ignore', 'pipe', openSync(daemonLog, 'w')] });
-  const info = await waitFor(daemon, 'brdfd', { web: /^brdfd web console on (\S+)/, grpc: /^brdfd listening on (\S+)/ }, 20, daemonLog);
+  let daemon;
+  let info;
+  try {
+    daemon = spawn(brdfd, ['--config', config, '--shutdown-timeout', '3'], { stdio: ['ignore', 'pipe', openSync(daemonLog, 'w')] });
+    info = await waitFor(daemon, 'brdfd', { web: /^brdfd web console on (\S+)/, grpc: /^brdfd listening on (\S+)/ }, 20, daemonLog);
+  } catch (e) {
+    // brdfd missing or failing to start: the simulator must not outlive the test.
+    await stopProcess(simProc);
+    throw e;
+  }
   const rig = {
     dir, url: info.web, grpc: info.grpc, modbus: simInfo.modbus, operatorToken, analystToken, daemonLog,
     // What an operator does by hand at a prompt, done on the simulator.
@@ -150,6 +159,16 @@ export async function pageCollectingErrors(browser, errors) {
   page.on('pageerror', (e) => errors.push(`page error: ${e.message}`));
   page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()}`); });
   return page;
+}
+
+// Opens `url` in `page` and signs in with `token` at the login form; with `role`, waits until the
+// header says who signed in (operator, analyst, reader).
+export async function signIn(page, url, token, role) {
+  await page.goto(url, { waitUntil: 'load' });
+  await page.waitForSelector('#login-view:not([hidden])');
+  await page.type('#token', token);
+  await page.click('#login-button');
+  if (role) await page.waitForFunction((r) => document.getElementById('who').textContent === r, {}, role);
 }
 
 export function outputDir() {
