@@ -319,7 +319,8 @@ struct Setup {
   bool verbose = false;
   bool breakdown = false;  // print where the error is (Breakdown)
   double candidate_step_deg = adaptive::kCandidateStepDeg;
-  adaptive::RoundOptions round;  // its max_readings from the plan
+  double candidate_theta_max = 0;  // the lattice's θ limit, if not the region's
+  adaptive::RoundOptions round;    // its max_readings from the plan
   Judging judging;
   std::vector<double> stages = {10, 20, 30, 50};  // % of the grid's readings
 };
@@ -382,8 +383,12 @@ std::vector<Stage> AdaptiveStages(const Setup& setup, const Truth& truth, std::m
   const v1::Plan& plan = setup.adaptive_plan;
   std::vector<plan::Step> steps = seed.steps;
   adaptive::Spend spent = adaptive::SpendOfSteps(steps, plan, setup.rig);
+  adaptive::AdaptiveSpec wide = setup.spec;  // --candidate-theta-max: the candidates' region
+  if (setup.candidate_theta_max > 0) {
+    wide.region.theta_i_max_deg = wide.region.theta_o_max_deg = setup.candidate_theta_max;
+  }
   const std::vector<Pose> candidates =
-      adaptive::CandidatePoses(setup.spec, setup.rig, setup.candidate_step_deg);
+      adaptive::CandidatePoses(wide, setup.rig, setup.candidate_step_deg);
   const adaptive::RoundCost cost(plan, setup.rig);
   const auto model = adaptive::MakeInterpolatedModel(setup.spec);
   std::vector<Stage> stages;
@@ -517,6 +522,9 @@ int main(int argc, char** argv) {
   app.add_option("--candidate-step", setup.candidate_step_deg,
                  "the candidates' lattice step, degrees (the planner's: 5)");
   app.add_option("--repeat", repeat, "timing repetitions");
+  app.add_option("--candidate-theta-max", setup.candidate_theta_max,
+                 "the 5° lattice's candidates up to this θi, θo (the model and the finer "
+                 "candidates keep the plan's region)");
   app.add_option("--refine-levels", setup.round.refine.levels,
                  "levels of finer candidates a round adds (refine_candidates.h; 0: none)");
   int seed_every = 0, seed_per_delta = 0;
