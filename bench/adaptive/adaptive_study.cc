@@ -19,6 +19,11 @@
 //   bench_adaptive_study --material deploy/materials/paint.toml --seeds 1 2 3
 //   bench_adaptive_study --material deploy/materials/paint.toml --seeds 1 --stages "10 20"
 //   bench_adaptive_study --timing      (Map on 2,000 readings, a round of 24 over 5,000 candidates)
+//   … --breakdown        each stage's squared error by the half-vector angle θh and by the angle ψ
+//                        between lamp and detector, the unanswered and the grazing directions'
+//                        share, and where the readings are (the same bins)
+//   … --grid bench/adaptive/paper-grid-fifth.json   against the paper grid with β every 25°: its
+//                        loops at 464 readings, a fifth (the goal's "at equal readings")
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -41,6 +46,7 @@
 #include "core/adaptive/round_steps.h"
 #include "core/adaptive/seed_design.h"
 #include "core/geometry.h"
+#include "core/interp/half_difference.h"
 #include "core/interp/interpolator.h"
 #include "core/plan/analyze_plan.h"
 #include "core/plan/expand_steps.h"
@@ -136,9 +142,10 @@ Directions RandomPair(std::mt19937_64& rng, double theta_max) {
   return {ti, phi(rng), to, phi(rng)};
 }
 
-Judging JudgingDirections(const adaptive::Region& region, int count) {
+Judging JudgingDirections(adaptive::Region region, int count, double theta_max) {
   Judging out;
   std::mt19937_64 rng(20261206);
+  if (theta_max > 0) region.theta_i_max_deg = region.theta_o_max_deg = theta_max;
   const double max = std::min(region.theta_i_max_deg, region.theta_o_max_deg);
   while (static_cast<int>(out.random.size()) < count) {
     const Directions d = RandomPair(rng, max);
@@ -152,8 +159,33 @@ Judging JudgingDirections(const adaptive::Region& region, int count) {
   return out;
 }
 
+// Where the error is (--breakdown): each random direction's squared cosine-weighted error, as a
+// share of the sum of the squared cosine-weighted truth (so the shares add up to err²), in bins of
+// the half-vector angle θh (0: the mirror direction, where a specular lobe peaks) and of the angle
+// ψ = 2 θd between lamp and detector (0: retro-reflection; on the rig ψ is the detector position
+// δ, the same for every reading at that δ).
+inline constexpr double kThetaHBins[] = {0, 5, 10, 15, 25, 90.001};
+inline constexpr double kPsiBins[] = {0, 5.625, 11.25, 16.875, 22.5, 33.75, 180.001};
+constexpr int kThetaHCount = 5;
+constexpr int kPsiCount = 6;
+
+struct Breakdown {
+  double by_theta_h[kThetaHCount] = {};
+  double by_psi[kPsiCount] = {};
+  double fallback = 0;  // the directions the octant method did not answer (its nearest reading)
+  double grazing = 0;   // the directions with θi or θo above 75°
+};
+
+int BinOf(double x, const double* edges, int count) {
+  for (int i = 0; i < count; ++i) {
+    if (x < edges[i + 1]) return i;
+  }
+  return count - 1;
+}
+
 struct Error {
   double random = 0, specular = 0, retro = 0, fallback = 0;
+  Breakdown breakdown;
 };
 
 // The octant method's value at `d`, or the nearest reading's where it has none.
@@ -194,10 +226,11 @@ class Judge {
   std::unique_ptr<interp::Interpolator> index_;
 };
 
-// Relative RMS of f · cos θi · cos θo over `at`; counts fallbacks.
+// Relative RMS of f · cos θi · cos θo over `at`; counts fallbacks; the breakdown when asked.
 double RelativeRms(const Judge& judge, const Truth& truth, const std::vector<Directions>& at,
-                   int* fallbacks) {
+                   int* fallbacks, Breakdown* breakdown = nullptr) {
   double err2 = 0, ref2 = 0;
+  Breakdown b;
   for (const Directions& d : at) {
     bool fb = false;
     const double w = std::cos(Rad(d.theta_i)) * std::cos(Rad(d.theta_o));
@@ -206,6 +239,19 @@ double RelativeRms(const Judge& judge, const Truth& truth, const std::vector<Dir
     err2 += e * e;
     ref2 += t * t;
     *fallbacks += fb ? 1 : 0;
+    if (breakdown == nullptr) continue;
+    const interp::HalfDiffAngles hd = interp::ToHalfDifference(ToIsotropic(d));
+    b.by_theta_h[BinOf(hd.theta_h, kThetaHBins, kThetaHCount)] += e * e;
+    b.by_psi[BinOf(2 * hd.theta_d, kPsiBins, kPsiCount)] += e * e;
+    b.fallback += fb ? e * e : 0;
+    b.grazing += std::max(d.theta_i, d.theta_o) > 75 ? e * e : 0;
+  }
+  if (breakdown != nullptr && ref2 > 0) {
+    for (double& x : b.by_theta_h) x /= ref2;
+    for (double& x : b.by_psi) x /= ref2;
+    b.fallback /= ref2;
+    b.grazing /= ref2;
+    *breakdown = b;
   }
   return ref2 > 0 ? std::sqrt(err2 / ref2) : 0;
 }
@@ -214,7 +260,7 @@ Error Judge_(const std::vector<ReadingSoFar>& readings, const Truth& truth, cons
   const Judge judge(readings);
   Error e;
   int fallbacks = 0, ignored = 0;
-  e.random = RelativeRms(judge, truth, at.random, &fallbacks);
+  e.random = RelativeRms(judge, truth, at.random, &fallbacks, &e.breakdown);
   e.fallback = 100.0 * fallbacks / static_cast<double>(at.random.size());
   e.specular = RelativeRms(judge, truth, at.specular, &ignored);
   e.retro = RelativeRms(judge, truth, at.retro, &ignored);
@@ -227,13 +273,42 @@ struct Stage {
   int prompts = 0;
   double remaining = 0;  // the model's Remaining() for these readings
   Error error;
+  Breakdown where;  // the readings' count by θh and ψ bins (--breakdown)
 };
 
-void PrintStage(const char* label, const Stage& s, const Stage& grid) {
+Breakdown WhereReadings(const std::vector<ReadingSoFar>& readings) {
+  Breakdown b;
+  for (const ReadingSoFar& r : readings) {
+    const interp::HalfDiffAngles hd = interp::ToHalfDifference(ToIsotropic(r.directions));
+    b.by_theta_h[BinOf(hd.theta_h, kThetaHBins, kThetaHCount)] += 1;
+    b.by_psi[BinOf(2 * hd.theta_d + 0.01, kPsiBins, kPsiCount)] += 1;
+  }
+  return b;
+}
+
+void PrintStage(const char* label, const Stage& s, const Stage& grid, bool breakdown) {
   std::printf("  %-10s %6d %8.1f %5d %8.4f %8.4f %6.2f %8.4f %8.4f %6.1f %8.3f\n", label,
               s.readings, s.seconds / 60, s.prompts, s.error.random, s.error.specular,
               grid.error.random > 0 ? s.error.random / grid.error.random : 0, s.error.retro,
               s.remaining, s.error.fallback, s.seconds / std::max(grid.seconds, 1e-9));
+  if (!breakdown) return;
+  std::printf("  %-10s err² by θh", "");
+  for (int i = 0; i < kThetaHCount; ++i) {
+    std::printf(" [%g,%g) %.5f", kThetaHBins[i], std::floor(kThetaHBins[i + 1]),
+                s.error.breakdown.by_theta_h[i]);
+  }
+  std::printf("\n  %-10s err² by ψ ", "");
+  for (int i = 0; i < kPsiCount; ++i) {
+    std::printf(" [%g,%g) %.5f", kPsiBins[i], std::floor(kPsiBins[i + 1]),
+                s.error.breakdown.by_psi[i]);
+  }
+  std::printf("; unanswered %.5f; θ > 75° %.5f", s.error.breakdown.fallback,
+              s.error.breakdown.grazing);
+  std::printf("\n  %-10s reads by θh", "");
+  for (double n : s.where.by_theta_h) std::printf(" %5.0f", n);
+  std::printf("; by ψ");
+  for (double n : s.where.by_psi) std::printf(" %5.0f", n);
+  std::printf("\n");
 }
 
 struct Setup {
@@ -242,8 +317,10 @@ struct Setup {
   adaptive::AdaptiveSpec spec;
   double u = 0.015;
   bool verbose = false;
+  bool breakdown = false;  // print where the error is (Breakdown)
   double candidate_step_deg = adaptive::kCandidateStepDeg;
-  adaptive::RoundOptions round;  // its max_readings from the plan
+  double candidate_theta_max = 0;  // the lattice's θ limit, if not the region's
+  adaptive::RoundOptions round;    // its max_readings from the plan
   Judging judging;
   std::vector<double> stages = {10, 20, 30, 50};  // % of the grid's readings
 };
@@ -255,8 +332,12 @@ Stage GridStage(const Setup& setup, const Truth& truth, std::mt19937_64& rng) {
     readings.push_back(Measure(truth, grid.poses[i], grid.directions[i], setup.u, rng));
   }
   const auto model = adaptive::MakeInterpolatedModel(setup.spec);
-  return {static_cast<int>(readings.size()), grid.seconds, grid.prompts,
-          model->Map(readings)->Remaining(), Judge_(readings, truth, setup.judging)};
+  return {static_cast<int>(readings.size()),
+          grid.seconds,
+          grid.prompts,
+          model->Map(readings)->Remaining(),
+          Judge_(readings, truth, setup.judging),
+          WhereReadings(readings)};
 }
 
 // One round as chosen: its size, gain, cost and where its picks lie.
@@ -302,8 +383,12 @@ std::vector<Stage> AdaptiveStages(const Setup& setup, const Truth& truth, std::m
   const v1::Plan& plan = setup.adaptive_plan;
   std::vector<plan::Step> steps = seed.steps;
   adaptive::Spend spent = adaptive::SpendOfSteps(steps, plan, setup.rig);
+  adaptive::AdaptiveSpec wide = setup.spec;  // --candidate-theta-max: the candidates' region
+  if (setup.candidate_theta_max > 0) {
+    wide.region.theta_i_max_deg = wide.region.theta_o_max_deg = setup.candidate_theta_max;
+  }
   const std::vector<Pose> candidates =
-      adaptive::CandidatePoses(setup.spec, setup.rig, setup.candidate_step_deg);
+      adaptive::CandidatePoses(wide, setup.rig, setup.candidate_step_deg);
   const adaptive::RoundCost cost(plan, setup.rig);
   const auto model = adaptive::MakeInterpolatedModel(setup.spec);
   std::vector<Stage> stages;
@@ -324,7 +409,8 @@ std::vector<Stage> AdaptiveStages(const Setup& setup, const Truth& truth, std::m
       spent = adaptive::SpendOfSteps(steps, plan, setup.rig);
     }
     stages.push_back({spent.readings, spent.seconds, spent.prompts,
-                      model->Map(readings)->Remaining(), Judge_(readings, truth, setup.judging)});
+                      model->Map(readings)->Remaining(), Judge_(readings, truth, setup.judging),
+                      WhereReadings(readings)});
   }
   return stages;
 }
@@ -339,7 +425,7 @@ void RunMaterial(const Setup& setup, const std::string& path, const std::vector<
                 "prmpt", "err", "spec", "÷grid", "retro", "U left", "fb %", "÷time");
     std::mt19937_64 grid_rng(static_cast<std::uint64_t>(seed) * 1000003 + 1);
     const Stage grid = GridStage(setup, truth, grid_rng);
-    PrintStage("grid", grid, grid);
+    PrintStage("grid", grid, grid, setup.breakdown);
     std::vector<int> levels;
     for (double percent : setup.stages) {
       levels.push_back(static_cast<int>(std::lround(percent / 100 * grid.readings)));
@@ -348,7 +434,7 @@ void RunMaterial(const Setup& setup, const std::string& path, const std::vector<
     const std::vector<Stage> stages = AdaptiveStages(setup, truth, rng, levels);
     for (std::size_t i = 0; i < stages.size(); ++i) {
       const std::string label = "adapt " + std::to_string(std::lround(setup.stages[i])) + "%";
-      PrintStage(label.c_str(), stages[i], grid);
+      PrintStage(label.c_str(), stages[i], grid, setup.breakdown);
     }
     std::fflush(stdout);
   }
@@ -425,12 +511,20 @@ int main(int argc, char** argv) {
   app.add_option("--plan", adaptive_path, "the adaptive plan (its region, δ, seed, rounds)");
   app.add_option("--grid", grid_path, "the fixed plan compared with");
   app.add_option("--directions", directions, "random direction pairs judged");
+  double judge_theta_max = 0;
+  app.add_option("--judge-theta-max", judge_theta_max,
+                 "judge at θi, θo up to this (default: the plan's region)");
   app.add_option("--u", u, "each reading's relative standard uncertainty");
   app.add_flag("--timing", timing, "time Map and a round instead");
   app.add_flag("--verbose", setup.verbose, "print every round's picks");
+  app.add_flag("--breakdown", setup.breakdown,
+               "print each stage's squared error by θh and by the lamp–detector angle ψ");
   app.add_option("--candidate-step", setup.candidate_step_deg,
                  "the candidates' lattice step, degrees (the planner's: 5)");
   app.add_option("--repeat", repeat, "timing repetitions");
+  app.add_option("--candidate-theta-max", setup.candidate_theta_max,
+                 "the 5° lattice's candidates up to this θi, θo (the model and the finer "
+                 "candidates keep the plan's region)");
   app.add_option("--refine-levels", setup.round.refine.levels,
                  "levels of finer candidates a round adds (refine_candidates.h; 0: none)");
   int seed_every = 0, seed_per_delta = 0;
@@ -461,7 +555,7 @@ int main(int argc, char** argv) {
     Timing(setup, repeat);
     return 0;
   }
-  setup.judging = JudgingDirections(setup.spec.region, directions);
+  setup.judging = JudgingDirections(setup.spec.region, directions, judge_theta_max);
   std::printf(
       "readings' u %.3f; judged by the octant method (φ mirrored) at %d random pairs, "
       "θ ≤ region; rig time by the plan timing model (prompts %.0f s); candidates every "

@@ -10,6 +10,9 @@
 #   EXTRA="--refine-levels 0" bench/adaptive/study.sh          (the 5° lattice alone, as before)
 #   EXTRA="--stages 20 --max-relocations -1" bench/adaptive/study.sh   (20 % only; relocations unlimited)
 #   EXTRA="--detector-arm" bench/adaptive/study.sh   (a motorized detector arm, as brdf-sim's rig)
+#   EXTRA="--stages 20 --detector-arm --breakdown" bench/adaptive/study.sh   (where the error is)
+#   EXTRA="--stages 20 --detector-arm --grid bench/adaptive/paper-grid-fifth.json" bench/adaptive/study.sh
+#                                        (against the paper grid at 464 readings: equal readings)
 set -eu
 BUILD=${BUILD:-build}
 MATERIALS=${MATERIALS:-"paint glossy gold retro-coating"}
