@@ -83,31 +83,11 @@ if [[ $smoke == 1 ]]; then
   materials=paint budgets=50 directions=1000 grid_plan="$root/examples/plans/demo.json"
 fi
 
-if [[ "${BENCH_NO_BUILD:-0}" != 1 ]]; then
-  echo "== building brdfd, brdf-sim, brdfctl and the Python stubs (-j2)" >&2
-  cmake --build "$build" -j2 --target brdfd brdf-sim brdfctl brdf_python_stubs >&2
-fi
-brdfd="$build/daemon/brdfd"
-sim="$build/tools/brdf-sim/brdf-sim"
-ctl="$build/tools/brdfctl/brdfctl"
-for binary in "$brdfd" "$sim" "$ctl"; do
-  [[ -x "$binary" ]] || { echo "daemon_bench: $binary is missing; build it (or unset BENCH_NO_BUILD)" >&2; exit 77; }
-done
-# Debian's python3 has numpy and grpcio (another python3 first on PATH, a venv, may not).
-python=/usr/bin/python3
-[[ -x "$python" ]] || python=python3
-export BRDF_PY_STUBS="${BRDF_PY_STUBS:-$build/clients/python/stubs}"
-
 # shellcheck source=bench/daemon/lib.sh
 source "$root/bench/daemon/lib.sh"
-if [[ -n "$keep" ]]; then
-  mkdir -p "$keep"
-  work="$(cd "$keep" && pwd)" pids=() cleanup_dirs=()
-  trap bench_cleanup EXIT
-  BENCH_KEEP=1
-else
-  bench_workdir_and_cleanup /tmp/brdfd-adaptive-bench.XXXXXX
-fi
+bench_rig_programs daemon_bench "$build" brdf_python_stubs
+bench_python_with_stubs "$build"
+bench_workdir_kept_or_temporary "$keep" /tmp/brdfd-adaptive-bench.XXXXXX
 [[ -n "$out" ]] || out="$([[ $smoke == 1 ]] && echo "$work/table" || echo "$PWD/adaptive-daemon-bench")"
 config_real_meter=1  # estimates at a real PR-650's speed (brdfd's defaults)
 config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'

@@ -47,29 +47,11 @@ while [[ $# -gt 0 ]]; do
 done
 build="${build:-$root/build}"
 case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
-if [[ "${BENCH_NO_BUILD:-0}" != 1 ]]; then
-  echo "== building brdfd, brdf-sim, brdfctl and the Python stubs (-j2)" >&2
-  cmake --build "$build" -j2 --target brdfd brdf-sim brdfctl brdf_python_stubs >&2
-fi
-brdfd="$build/daemon/brdfd"
-sim="$build/tools/brdf-sim/brdf-sim"
-ctl="$build/tools/brdfctl/brdfctl"
-for binary in "$brdfd" "$sim" "$ctl"; do
-  [[ -x "$binary" ]] || { echo "sample_fixed_bench: $binary is missing; build it (or unset BENCH_NO_BUILD)" >&2; exit 77; }
-done
-python=/usr/bin/python3
-[[ -x "$python" ]] || python=python3
-export BRDF_PY_STUBS="${BRDF_PY_STUBS:-$build/clients/python/stubs}"
-
+# shellcheck source=bench/daemon/lib.sh
 source "$root/bench/daemon/lib.sh"
-if [[ -n "$keep" ]]; then
-  mkdir -p "$keep"
-  work="$(cd "$keep" && pwd)" pids=() cleanup_dirs=()
-  trap bench_cleanup EXIT
-  BENCH_KEEP=1
-else
-  bench_workdir_and_cleanup /tmp/brdfd-sample-fixed-bench.XXXXXX
-fi
+bench_rig_programs sample_fixed_bench "$build" brdf_python_stubs
+bench_python_with_stubs "$build"
+bench_workdir_kept_or_temporary "$keep" /tmp/brdfd-sample-fixed-bench.XXXXXX
 config_real_meter=1  # estimates at a real PR-650's speed
 config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
 sim_seed="$seed"

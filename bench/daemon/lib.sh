@@ -17,6 +17,48 @@ bench_workdir_and_cleanup() {
   trap bench_cleanup EXIT
 }
 
+# Like bench_workdir_and_cleanup, but with a directory the user named ($1, e.g. from --keep DIR):
+# the work happens there and stays afterwards (BENCH_KEEP=1). An empty $1 falls back to a
+# temporary directory on template $2.
+bench_workdir_kept_or_temporary() {
+  if [[ -z "$1" ]]; then
+    bench_workdir_and_cleanup "$2"
+    return
+  fi
+  mkdir -p "$1"
+  work="$(cd "$1" && pwd)"
+  pids=()
+  cleanup_dirs=()
+  trap bench_cleanup EXIT
+  BENCH_KEEP=1
+}
+
+# The rig's three programs in build directory $2: builds them and the targets $3… (-j2, on
+# stderr) unless BENCH_NO_BUILD=1, sets `brdfd`, `sim` and `ctl`, and exits 77 (skipped) naming a
+# missing one; $1 names the calling script in that message.
+bench_rig_programs() {
+  local script="$1" dir="$2" binary
+  shift 2
+  if [[ "${BENCH_NO_BUILD:-0}" != 1 ]]; then
+    echo "== building brdfd, brdf-sim, brdfctl${*:+ and $*} (-j2)" >&2
+    cmake --build "$dir" -j2 --target brdfd brdf-sim brdfctl "$@" >&2
+  fi
+  brdfd="$dir/daemon/brdfd"
+  sim="$dir/tools/brdf-sim/brdf-sim"
+  ctl="$dir/tools/brdfctl/brdfctl"
+  for binary in "$brdfd" "$sim" "$ctl"; do
+    [[ -x "$binary" ]] || { echo "$script: $binary is missing; build it (or unset BENCH_NO_BUILD)" >&2; exit 77; }
+  done
+}
+
+# Debian's python3, which has numpy and grpcio (another python3 first on PATH, a venv, may not),
+# in `python`, and the Python client's stubs of build directory $1 in BRDF_PY_STUBS.
+bench_python_with_stubs() {
+  python=/usr/bin/python3
+  [[ -x "$python" ]] || python=python3
+  export BRDF_PY_STUBS="${BRDF_PY_STUBS:-$1/clients/python/stubs}"
+}
+
 # Stops every process in `pids` (SIGTERM, then waits for each), removes `cleanup_dirs`, and removes
 # `work` unless BENCH_KEEP=1.
 bench_cleanup() {
