@@ -210,8 +210,10 @@ Result<std::string> Pr650Spectroradiometer::Exchange(std::string_view command, s
     case StatusCode::kCancelled:
     case StatusCode::kTimeout:
       // A command the meter received may still be answered: remember until when.
-      if (sent && sent_at + timeout > ctx.clock().Now()) {
-        late_reply_until_ = std::max(late_reply_until_.value_or(sent_at), sent_at + timeout);
+      if (const auto until = serial::LateReplyDeadline(
+              sent_at, timeout, ctx.clock().Now(), reply.status().code() == StatusCode::kTimeout);
+          sent && until) {
+        late_reply_until_ = std::max(late_reply_until_.value_or(*until), *until);
       }
       break;
     default:

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <optional>
 #include <string_view>
 
 #include "core/call_context.h"
@@ -15,5 +16,16 @@ namespace brdf::drivers::serial {
 // ("waiting for the meter to wake").
 Status WaitChecked(std::chrono::steady_clock::duration d, const CallContext& ctx,
                    std::string_view what);
+
+// Until when the command after one left unanswered first waits for that reply, to discard it:
+// a reply read after the next command went out would be taken for its answer, and every later
+// reply would be one behind. A command cancelled early may be answered until sent_at + timeout;
+// one that timed out is already late, so the wait is one more timeout from `now`, capped at
+// `timed_out_cap` (a meter slow once answers soon after; a silent one costs at most the cap per
+// retry). nullopt: nothing to wait for.
+std::optional<std::chrono::steady_clock::time_point> LateReplyDeadline(
+    std::chrono::steady_clock::time_point sent_at, std::chrono::steady_clock::duration timeout,
+    std::chrono::steady_clock::time_point now, bool timed_out,
+    std::chrono::steady_clock::duration timed_out_cap = std::chrono::seconds(1));
 
 }  // namespace brdf::drivers::serial

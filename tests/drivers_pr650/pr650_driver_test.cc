@@ -351,6 +351,29 @@ INSTANTIATE_TEST_SUITE_P(
                       // every reply starts late in the wait (300 of 400 ms)
                       Quirks(Eol::kCrLf, false, 0, 0ms, 300ms)));
 
+// A reply that comes after its command timed out, while the driver already retries: it is
+// discarded, never taken as the retry's answer (which would leave every later reply one behind:
+// the layout query D120 read the serial number once under load).
+TEST_F(Pr650DriverTest, AReplyLaterThanItsTimeoutIsNotTakenForTheNextCommands) {
+  sim::Pr650EndpointOptions o = FastEndpointOptions();
+  // The reply timeout is 400 ms: the first wake-up attempt times out, its reply comes while the
+  // second attempt waits, and the second attempt's own reply comes after the next command went out.
+  o.quirks.reply_delay = 550ms;
+  o.quirks.delayed_replies = 2;
+  StartEndpoint(o);
+  auto meter = Driver();
+  ASSERT_TRUE(meter->Connect(Ctx()).ok()) << log_.All();
+  auto id = meter->Identify(Ctx());
+  ASSERT_TRUE(id.ok()) << id.status().ToString() << "\n" << log_.All();
+  EXPECT_EQ(id->serial_number, "60925301");
+  EXPECT_EQ(id->grid.count, 101u);
+  ASSERT_TRUE(meter->Configure({100, 1, false}, Ctx()).ok());
+  ASSERT_TRUE(meter->Measure(Ctx()).ok());
+  auto report = meter->TransferSpectrum(Ctx());
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  ExpectSpectrumOf(*report, backend_.level());
+}
+
 // ---- link failures ----------------------------------------------------------------------------
 
 TEST_F(Pr650DriverTest, SilentMeterTimesOutWithTheOperatorHint) {

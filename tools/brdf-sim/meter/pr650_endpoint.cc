@@ -335,7 +335,9 @@ void Pr650Endpoint::Reply(std::vector<std::string> lines, double vanish_seconds)
   }
   if (truncate) bytes.resize(bytes.size() / 2);
 
-  if (q.reply_delay.count() > 0 && !SleepReal(q.reply_delay)) return;
+  const bool delayed = q.delayed_replies == 0 || replies_sent_ < q.delayed_replies;
+  ++replies_sent_;
+  if (delayed && q.reply_delay.count() > 0 && !SleepReal(q.reply_delay)) return;
   if (vanish_seconds > 0) {
     // Part of the report goes out, then the port is gone.
     if (!WriteOut(bytes.substr(0, bytes.size() / 3))) return;

@@ -70,8 +70,11 @@ struct Pr650WireQuirks {
   // > 0: replies leave in pieces of this many bytes, piece_gap apart (real time).
   int piece_bytes = 0;
   std::chrono::milliseconds piece_gap{0};
-  // Real-time delay before each reply starts.
+  // Real-time delay before each reply starts ...
   std::chrono::milliseconds reply_delay{0};
+  // ... or, when > 0, before the first this many replies only (a meter slow once, say while it
+  // wakes, whose late reply a driver must not take for the next command's).
+  int delayed_replies = 0;
 };
 
 struct Pr650EndpointOptions {
@@ -182,7 +185,8 @@ class Pr650Endpoint final : public MeterPort {
   bool standalone_ = false;  // the wake-up window was missed: silent until power-cycled
   MeterSetup setup_;
   bool sync_ = false;
-  int last_setup_reply_ = 0;  // the last S command's reply code, for D201
+  int last_setup_reply_ = 0;
+  int replies_sent_ = 0;      // for Pr650WireQuirks::delayed_replies  // the last S command's reply code, for D201
   Measurement last_;
   std::vector<std::string> commands_;
   std::vector<MeterSetup> measured_setups_;
