@@ -108,8 +108,7 @@ Result<std::string> CommandChannel::Read(std::string_view command, const ReplySh
     case StatusCode::kCancelled:
     case StatusCode::kTimeout: {
       // The meter may still answer what it received: remember until when.
-      if (const auto until = LateReplyDeadline(sent_at, shape.first_byte_timeout,
-                                               ctx.clock().Now(),
+      if (const auto until = LateReplyDeadline(sent_at, shape.first_byte_timeout, ctx.clock().Now(),
                                                reply.status().code() == StatusCode::kTimeout)) {
         late_reply_until_ = std::max(late_reply_until_.value_or(*until), *until);
       }

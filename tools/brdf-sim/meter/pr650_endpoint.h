@@ -185,8 +185,8 @@ class Pr650Endpoint final : public MeterPort {
   bool standalone_ = false;  // the wake-up window was missed: silent until power-cycled
   MeterSetup setup_;
   bool sync_ = false;
-  int last_setup_reply_ = 0;
-  int replies_sent_ = 0;      // for Pr650WireQuirks::delayed_replies  // the last S command's reply code, for D201
+  int last_setup_reply_ = 0;  // the last S command's reply code, for D201
+  int replies_sent_ = 0;      // for Pr650WireQuirks::delayed_replies
   Measurement last_;
   std::vector<std::string> commands_;
   std::vector<MeterSetup> measured_setups_;
