@@ -22,8 +22,8 @@ struct RunControl {
   unsigned threads = 1;
   // Called on the calling thread only, never concurrently, with fractions that never decrease:
   // about every 1/1000 of the work or after each batch of cells the interpolator answers at once
-  // (grids: at least 64 per grid; MERL: 1/22 of the table), whichever is coarser, and exactly
-  // once with 1.0 when the work is complete (not after a cancellation). May be empty.
+  // (grids: after each θi slice the sink took; MERL: 1/22 of the table), whichever is coarser,
+  // and exactly once with 1.0 when the work is complete (not after a cancellation). May be empty.
   ProgressFn progress;
 };
 

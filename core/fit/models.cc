@@ -53,8 +53,12 @@ double CookTorranceSpecular(const IsoDirection& at, double alpha, double f0) {
   return CookTorranceSpecularAt(LobeGeometryOf(at), alpha, f0);
 }
 
+double CookTorranceBrdfWith(const CookTorranceParams& p, double specular) {
+  return p.kd / kPi + p.ks * specular;
+}
+
 double CookTorranceBrdf(const IsoDirection& at, const CookTorranceParams& p) {
-  return p.kd / kPi + p.ks * CookTorranceSpecular(at, p.alpha, p.f0);
+  return CookTorranceBrdfWith(p, CookTorranceSpecular(at, p.alpha, p.f0));
 }
 
 }  // namespace brdf::fit

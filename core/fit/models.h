@@ -43,5 +43,8 @@ double CookTorranceSpecularAt(const LobeGeometry& g, double alpha, double f0);
 double CookTorranceSpecular(const IsoDirection& at, double alpha, double f0);
 
 double CookTorranceBrdf(const IsoDirection& at, const CookTorranceParams& p);
+// The same from the lobe's value for p's α and F0 (CookTorranceSpecularAt): kd / π + ks · it,
+// bit for bit as CookTorranceBrdf. For many bands at one direction, whose α and F0 are shared.
+double CookTorranceBrdfWith(const CookTorranceParams& p, double specular);
 
 }  // namespace brdf::fit

@@ -94,6 +94,19 @@ interp::InterpStatus FillChain::AnswerOne(const IsoDirection& at, std::span<doub
   return first;
 }
 
+std::unique_ptr<FillChain::Scratch> FillChain::TakeScratch() const {
+  MutexLock lock(scratch_mu_);
+  if (scratch_.empty()) return std::make_unique<Scratch>();
+  std::unique_ptr<Scratch> taken = std::move(scratch_.back());
+  scratch_.pop_back();
+  return taken;
+}
+
+void FillChain::GiveScratch(std::unique_ptr<Scratch> scratch) const {
+  MutexLock lock(scratch_mu_);
+  scratch_.push_back(std::move(scratch));
+}
+
 void FillChain::AnswerMany(std::span<const double> directions,
                            std::span<interp::InterpStatus> statuses,
                            std::span<double> spectra) const {
@@ -101,14 +114,17 @@ void FillChain::AnswerMany(std::span<const double> directions,
   if (n == 0) return;
   const std::size_t bands = spectra.size() / n;
   stages_.front().source.Spectra(directions, statuses, spectra);
-  std::vector<std::size_t> missing;
+  std::unique_ptr<Scratch> scratch = TakeScratch();
+  std::vector<std::size_t>& missing = scratch->missing;
+  missing.clear();
   for (std::size_t i = 0; i < n; ++i) {
     if (statuses[i] != interp::InterpStatus::kOk) missing.push_back(i);
   }
   Count(0, n - missing.size());
-  std::vector<double> dirs;
-  std::vector<interp::InterpStatus> sub_status;
-  std::vector<double> sub_spectra;
+  std::vector<double>& dirs = scratch->directions;
+  std::vector<interp::InterpStatus>& sub_status = scratch->statuses;
+  std::vector<double>& sub_spectra = scratch->spectra;
+  std::vector<std::size_t>& still = scratch->still;
   for (std::size_t s = 1; s < stages_.size() && !missing.empty(); ++s) {
     dirs.clear();
     for (std::size_t i : missing) {
@@ -118,7 +134,7 @@ void FillChain::AnswerMany(std::span<const double> directions,
     sub_status.assign(missing.size(), interp::InterpStatus::kOk);
     sub_spectra.assign(missing.size() * bands, 0.0);
     stages_[s].source.Spectra(dirs, sub_status, sub_spectra);
-    std::vector<std::size_t> still;
+    still.clear();
     for (std::size_t q = 0; q < missing.size(); ++q) {
       const std::size_t i = missing[q];
       if (sub_status[q] != interp::InterpStatus::kOk) {
@@ -130,9 +146,10 @@ void FillChain::AnswerMany(std::span<const double> directions,
                   spectra.begin() + static_cast<std::ptrdiff_t>(i * bands));
     }
     Count(s, missing.size() - still.size());
-    missing = std::move(still);
+    missing.swap(still);
   }
   Count(stages_.size(), missing.size());  // rows stay NaN with the first stage's status
+  GiveScratch(std::move(scratch));
 }
 
 SpectrumSource FillChain::Source() const {
@@ -153,9 +170,23 @@ FillTally FillChain::Tally() const {
 }
 
 SpectrumSource ModelSource(const fit::CookTorranceFit& model) {
+  // The lobe's angles once per direction and its value once per (α, F0) — every band's when the
+  // fit shares them — instead of both per band: the same numbers as CookTorranceBrdf per band.
   return [params = model.band](const IsoDirection& at, std::span<double> out) {
     const std::size_t n = std::min(out.size(), params.size());
-    for (std::size_t b = 0; b < n; ++b) out[b] = fit::CookTorranceBrdf(at, params[b]);
+    const fit::LobeGeometry lobe = fit::LobeGeometryOf(at);
+    double alpha = std::numeric_limits<double>::quiet_NaN();
+    double f0 = alpha;
+    double specular = 0;
+    for (std::size_t b = 0; b < n; ++b) {
+      const fit::CookTorranceParams& p = params[b];
+      if (b == 0 || p.alpha != alpha || p.f0 != f0) {
+        alpha = p.alpha;
+        f0 = p.f0;
+        specular = fit::CookTorranceSpecularAt(lobe, alpha, f0);
+      }
+      out[b] = fit::CookTorranceBrdfWith(p, specular);
+    }
     return interp::InterpStatus::kOk;
   };
 }

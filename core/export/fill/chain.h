@@ -17,6 +17,7 @@
 
 #include "core/export/fill/spectrum_source.h"
 #include "core/fit/fit.h"
+#include "core/mutex.h"
 #include "core/status.h"
 #include "core/wavelength_grid.h"
 
@@ -80,10 +81,21 @@ class FillChain {
   interp::InterpStatus AnswerOne(const IsoDirection& at, std::span<double> out) const;
   void AnswerMany(std::span<const double> directions, std::span<interp::InterpStatus> statuses,
                   std::span<double> spectra) const;
+  // What a batch's later stages work in. Kept between batches (one per thread at work), so that
+  // their memory is allocated and first touched once per chain, not once per batch.
+  struct Scratch {
+    std::vector<std::size_t> missing, still;
+    std::vector<double> directions, spectra;
+    std::vector<interp::InterpStatus> statuses;
+  };
+  std::unique_ptr<Scratch> TakeScratch() const;
+  void GiveScratch(std::unique_ptr<Scratch> scratch) const;
 
   FillPolicy policy_;
   std::vector<Stage> stages_;
   std::unique_ptr<Counters> counters_;
+  mutable Mutex scratch_mu_;
+  mutable std::vector<std::unique_ptr<Scratch>> scratch_ GUARDED_BY(scratch_mu_);
 };
 
 // The fitted Cook-Torrance model (core/fit) as a source: its per-band parameters evaluated at

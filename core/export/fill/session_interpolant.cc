@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -77,6 +78,21 @@ InterpolantInfo SessionInterpolant::Info() const {
 
 namespace {
 
+// Joins a thread (if it runs) when asked or on the way out.
+class JoinOnExit {
+ public:
+  explicit JoinOnExit(std::thread& thread) : thread_(thread) {}
+  JoinOnExit(const JoinOnExit&) = delete;
+  JoinOnExit& operator=(const JoinOnExit&) = delete;
+  ~JoinOnExit() { Join(); }
+  void Join() const {
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  std::thread& thread_;
+};
+
 // The chain over the parts `in` has: the chosen method, then (kChain) the fallback and the model.
 std::unique_ptr<FillChain> MakeChain(const SessionInterpolant& in) {
   std::vector<FillChain::Stage> stages;
@@ -100,18 +116,27 @@ Result<SessionInterpolant> BuildSessionInterpolant(std::shared_ptr<const Derived
   in.options = options;
   in.policy = policy;
   BRDF_ASSIGN_OR_RETURN(in.samples, ToSampleSet(*in.derived));
+  // The chain's Delaunay fallback is built on a thread of its own while this one builds the
+  // chosen method and fits the model: the parts do not depend on each other, and on a large
+  // session each takes seconds. Errors come in the chain's order all the same.
+  const bool chain = policy == FillPolicy::kChain;
+  Result<std::unique_ptr<interp::Interpolator>> fallback = std::unique_ptr<interp::Interpolator>();
+  std::thread building;
+  if (chain && method != interp::Method::kDelaunay) {
+    building = std::thread([&] {
+      fallback = interp::MakeInterpolator(interp::Method::kDelaunay, in.samples, options);
+    });
+  }
+  const JoinOnExit join(building);
   Result<std::unique_ptr<interp::Interpolator>> chosen =
       interp::MakeInterpolator(method, in.samples, options);
   if (!chosen.ok()) return chosen.status();
   in.interpolator = std::move(*chosen);
-  if (policy == FillPolicy::kChain) {
-    if (method != interp::Method::kDelaunay) {
-      Result<std::unique_ptr<interp::Interpolator>> d =
-          interp::MakeInterpolator(interp::Method::kDelaunay, in.samples, options);
-      if (!d.ok()) return d.status().WithContext("the fill chain's Delaunay fallback");
-      in.fallback = std::move(*d);
-    }
+  if (chain) {
     Result<fit::CookTorranceFit> model = FitSampleModel(*in.samples, in.derived->grid, ctx);
+    join.Join();
+    if (!fallback.ok()) return fallback.status().WithContext("the fill chain's Delaunay fallback");
+    in.fallback = std::move(*fallback);
     if (!model.ok()) return model.status().WithContext("the fill chain's model");
     in.model = std::make_shared<const fit::CookTorranceFit>(*std::move(model));
   }

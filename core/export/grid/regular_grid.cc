@@ -1,8 +1,12 @@
 #include "core/export/grid/regular_grid.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include "core/export/number_text.h"
 
@@ -18,9 +22,85 @@ constexpr double kPhi = 180.0;
 std::size_t BatchCells(std::size_t cells) {
   return std::clamp<std::size_t>(cells / 64, 1024, 16384);
 }
-// Slices are computed a window of at least this many cells at a time before they go to the sink,
-// which bounds the memory to about that many spectra (1° × 1° × 2°, 101 bands: 8 slices, 52 MB).
+// Slices are computed two windows of at least half this many cells at a time (one computed while
+// the other goes to the sink), which bounds the memory to about that many spectra (1° × 1° × 2°,
+// 101 bands: twice 4 slices, 52 MB).
 constexpr std::size_t kWindowCells = 65536;
+
+// What every window of a resampling shares.
+struct WindowShape {
+  const SpectrumSource& source;
+  const RegularGrid& grid;
+  std::size_t values_per_cell;  // bands · planes
+  unsigned threads;
+  std::size_t batch_cells;  // BatchCells of the grid
+  const CallContext& ctx;
+};
+
+// A window of whole θi slices, [first, first + slices): the cells' directions and answers.
+struct GridWindow {
+  std::size_t first = 0;
+  std::size_t slices = 0;
+  std::vector<double> directions;
+  std::vector<double> values;
+  std::vector<interp::InterpStatus> statuses;
+  void Size(std::size_t cells, std::size_t values_per_cell) {
+    directions.resize(3 * cells);
+    values.resize(cells * values_per_cell);
+    statuses.resize(cells);
+  }
+};
+
+// Answers every cell of `w` in batches spread over the threads: batches of at most
+// shape.batch_cells, as many as a multiple of the threads so that none waits on the last one.
+Status ComputeWindow(const WindowShape& shape, GridWindow& w) {
+  const RegularGrid& grid = shape.grid;
+  const std::size_t slice_cells = grid.theta_o.count * grid.phi.count;
+  const std::size_t cells = w.slices * slice_cells;
+  const std::size_t threads = std::max<std::size_t>(1, shape.threads);
+  const std::size_t batches = (cells + shape.batch_cells - 1) / shape.batch_cells;
+  const std::size_t even = (batches + threads - 1) / threads * threads;
+  const std::size_t batch = (cells + even - 1) / even;
+  const std::size_t nb = shape.values_per_cell;
+  return ParallelForChunks(cells, batch, shape.threads, shape.ctx, nullptr, 0, "grid resampling",
+                           [&](std::size_t begin, std::size_t end) {
+                             for (std::size_t c = begin; c < end; ++c) {
+                               const std::size_t in_slice = c % slice_cells;
+                               double* at = w.directions.data() + 3 * c;
+                               at[0] = grid.theta_i.at(w.first + c / slice_cells);
+                               at[1] = grid.theta_o.at(in_slice / grid.phi.count);
+                               at[2] = grid.phi.at(in_slice % grid.phi.count);
+                             }
+                             shape.source.Spectra(
+                                 std::span(w.directions).subspan(3 * begin, 3 * (end - begin)),
+                                 std::span(w.statuses).subspan(begin, end - begin),
+                                 std::span(w.values).subspan(begin * nb, (end - begin) * nb));
+                           });
+}
+
+// Hands the slices of `w` to the sink in order, counting their statuses and reporting progress
+// after each; stops between slices once `ctx` is cancelled or past its deadline.
+Status SendWindow(const GridWindow& w, const RegularGrid& grid, std::size_t values_per_cell,
+                  const CallContext& ctx, GridSink& sink, GridReport& report,
+                  ProgressReporter& progress) {
+  const std::size_t slice_cells = grid.theta_o.count * grid.phi.count;
+  for (std::size_t s = 0; s < w.slices; ++s) {
+    const auto slice_statuses = std::span(w.statuses).subspan(s * slice_cells, slice_cells);
+    for (interp::InterpStatus st : slice_statuses) ++report.by_status[st];
+    const std::size_t n = slice_cells * values_per_cell;
+    BRDF_RETURN_IF_ERROR(
+        sink.WriteSlice(w.first + s, std::span(w.values).subspan(s * n, n), slice_statuses));
+    const std::size_t done = (w.first + s + 1) * slice_cells;
+    progress.Report(done);
+    if (ctx.cancelled() || ctx.expired()) {
+      const std::string where = "grid resampling stopped after " + std::to_string(done) + " of " +
+                                std::to_string(grid.cells()) + " cells";
+      if (ctx.cancelled()) return Cancelled(where + ": " + ctx.cancel().reason());
+      return Timeout(where + ": the deadline passed; allow more time or export a coarser grid");
+    }
+  }
+  return Status::Ok();
+}
 
 Result<GridAxis> MakeAxis(const char* name, double span, double step, GridPlacement placement) {
   const std::string where = std::string("grid step for ") + name + " (" + FormatNumber(step) + "°)";
@@ -103,45 +183,41 @@ Result<GridReport> ResampleOnGrid(const SpectrumSource& source, const RegularGri
     return InvalidArgument("resampling onto a grid: the wavelength grid is invalid (no bands)");
   }
   if (planes < 1) return InvalidArgument("resampling onto a grid: planes must be at least 1");
-  const std::size_t nb = bands.count * planes;  // values per cell
   const std::size_t slice_cells = grid.theta_o.count * grid.phi.count;
-  const unsigned threads = ResolveThreads(control.threads);
+  const WindowShape shape{
+      source, grid, bands.count * planes, ResolveThreads(control.threads), BatchCells(grid.cells()),
+      ctx};
   BRDF_RETURN_IF_ERROR(sink.Begin(grid, bands));
 
   GridReport report;
   report.cells = grid.cells();
   ProgressReporter progress(control.progress, report.cells);
-  // Whole slices go through in windows of at least kWindowCells cells, each window in batches of
-  // BatchCells (SpectrumSource::Spectra) spread over the threads, then slice by slice to the sink.
-  const std::size_t window_slices =
-      std::min(grid.theta_i.count, std::max<std::size_t>(1, kWindowCells / planes / slice_cells));
-  std::vector<double> directions(3 * window_slices * slice_cells);
-  std::vector<double> values(window_slices * slice_cells * nb);
-  std::vector<interp::InterpStatus> statuses(window_slices * slice_cells);
-
-  for (std::size_t first = 0; first < grid.theta_i.count; first += window_slices) {
-    const std::size_t slices = std::min(window_slices, grid.theta_i.count - first);
-    BRDF_RETURN_IF_ERROR(ParallelForChunks(
-        slices * slice_cells, BatchCells(report.cells), threads, ctx, &progress,
-        first * slice_cells, "grid resampling", [&](std::size_t begin, std::size_t end) {
-          for (std::size_t c = begin; c < end; ++c) {
-            const std::size_t in_slice = c % slice_cells;
-            double* at = directions.data() + 3 * c;
-            at[0] = grid.theta_i.at(first + c / slice_cells);
-            at[1] = grid.theta_o.at(in_slice / grid.phi.count);
-            at[2] = grid.phi.at(in_slice % grid.phi.count);
-          }
-          source.Spectra(std::span(directions).subspan(3 * begin, 3 * (end - begin)),
-                         std::span(statuses).subspan(begin, end - begin),
-                         std::span(values).subspan(begin * nb, (end - begin) * nb));
-        }));
-    for (std::size_t s = 0; s < slices; ++s) {
-      const auto slice_statuses = std::span(statuses).subspan(s * slice_cells, slice_cells);
-      for (interp::InterpStatus st : slice_statuses) ++report.by_status[st];
-      BRDF_RETURN_IF_ERROR(sink.WriteSlice(
-          first + s, std::span(values).subspan(s * slice_cells * nb, slice_cells * nb),
-          slice_statuses));
+  // Two windows of whole slices: while one is computed (on a thread of its own, which spreads its
+  // batches over the threads), the calling thread hands the other's slices to the sink.
+  const std::size_t window_slices = std::min(
+      grid.theta_i.count, std::max<std::size_t>(1, kWindowCells / 2 / planes / slice_cells));
+  std::array<GridWindow, 2> windows;
+  for (GridWindow& w : windows) w.Size(window_slices * slice_cells, shape.values_per_cell);
+  GridWindow* ready = &windows[0];
+  GridWindow* next = &windows[1];
+  ready->slices = window_slices;
+  BRDF_RETURN_IF_ERROR(ComputeWindow(shape, *ready));
+  for (;;) {
+    const std::size_t after = ready->first + ready->slices;
+    Status computed;
+    std::thread computing;
+    if (after < grid.theta_i.count) {
+      next->first = after;
+      next->slices = std::min(window_slices, grid.theta_i.count - after);
+      computing = std::thread([&] { computed = ComputeWindow(shape, *next); });
     }
+    const Status sent =
+        SendWindow(*ready, grid, shape.values_per_cell, ctx, sink, report, progress);
+    if (computing.joinable()) computing.join();
+    BRDF_RETURN_IF_ERROR(sent);
+    BRDF_RETURN_IF_ERROR(computed);
+    if (after >= grid.theta_i.count) break;
+    std::swap(ready, next);
   }
   const auto ok = report.by_status.find(interp::InterpStatus::kOk);
   report.filled = ok == report.by_status.end() ? 0 : ok->second;

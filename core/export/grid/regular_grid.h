@@ -5,8 +5,9 @@
 //
 // The work goes slice by slice (one θi value at a time, C order θi, θo, φ, band) to a GridSink,
 // so that a 1° grid of 101 bands (90 × 90 × 180 × 101 doubles, 1.2 GB) never has to sit in
-// memory: the .npy and CSV writers stream it out. Slices are computed a window of at least 65,536
-// cells at a time (1° × 1° × 2°, 101 bands: 8 slices, 52 MB) before they go to the sink.
+// memory: the .npy and CSV writers stream it out. Slices are computed a window of at least 32,768
+// cells at a time, on threads of their own, while the calling thread hands the window before to
+// the sink (1° × 1° × 2°, 101 bands: two windows of 4 slices, 52 MB).
 #pragma once
 
 #include <cstddef>
