@@ -10,7 +10,8 @@
 #        brdfctl and bench_interp_uncertainty unless BENCH_NO_BUILD=1)
 # Environment: COST_CALLS (Interpolate calls per timing, 2000), COST_DIRECTIONS (batch size,
 # 20000), COST_REPS (5), COST_METHOD (octant), COST_SHARED=1 (the batch's answers also carry the
-# shared part: include_uncertainty_shared), BENCH_KEEP=1 keeps the work directory.
+# shared part: include_uncertainty_shared), BENCH_KEEP=1 keeps the work directory,
+# COST_PERF=FILE records brdfd with `perf record -g` into FILE while the timed calls run.
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -41,8 +42,18 @@ budgets="$(sqlite3 -readonly "$work/brdfd.db" \
    WHERE r.session_id = $session")"
 echo "session $session recorded (demo plan); sample readings with a budget: $budgets"
 
+perf_pid=""
+if [[ -n "${COST_PERF:-}" ]]; then
+  perf record -g -q -o "$COST_PERF" -p "$brdfd_pid" 2>/dev/null &
+  perf_pid=$!
+  sleep 1
+fi
 "$bench" --address "$BRDF_ADDRESS" --token "$analyst_token" --session "$session" \
   --calls "${COST_CALLS:-2000}" --directions "${COST_DIRECTIONS:-20000}" \
   --reps "${COST_REPS:-5}" --method "${COST_METHOD:-octant}" --daemon-pid "$brdfd_pid" \
   ${COST_SHARED:+--shared}
+if [[ -n "$perf_pid" ]]; then
+  kill -INT "$perf_pid" 2>/dev/null || true
+  wait "$perf_pid" 2>/dev/null || true
+fi
 echo "load at end: $(cut -d' ' -f1-3 /proc/loadavg)"
