@@ -54,7 +54,11 @@ double CookTorranceSpecular(const IsoDirection& at, double alpha, double f0) {
 }
 
 double CookTorranceBrdf(const IsoDirection& at, const CookTorranceParams& p) {
-  return p.kd / kPi + p.ks * CookTorranceSpecular(at, p.alpha, p.f0);
+  return CookTorranceBrdfAt(LobeGeometryOf(at), p);
+}
+
+double CookTorranceBrdfAt(const LobeGeometry& g, const CookTorranceParams& p) {
+  return p.kd / kPi + p.ks * CookTorranceSpecularAt(g, p.alpha, p.f0);
 }
 
 }  // namespace brdf::fit

@@ -43,5 +43,8 @@ double CookTorranceSpecularAt(const LobeGeometry& g, double alpha, double f0);
 double CookTorranceSpecular(const IsoDirection& at, double alpha, double f0);
 
 double CookTorranceBrdf(const IsoDirection& at, const CookTorranceParams& p);
+// The same with the direction's geometry computed once (LobeGeometryOf), for many bands at one
+// direction: the same value, bit for bit.
+double CookTorranceBrdfAt(const LobeGeometry& g, const CookTorranceParams& p);
 
 }  // namespace brdf::fit

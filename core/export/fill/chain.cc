@@ -155,7 +155,8 @@ FillTally FillChain::Tally() const {
 SpectrumSource ModelSource(const fit::CookTorranceFit& model) {
   return [params = model.band](const IsoDirection& at, std::span<double> out) {
     const std::size_t n = std::min(out.size(), params.size());
-    for (std::size_t b = 0; b < n; ++b) out[b] = fit::CookTorranceBrdf(at, params[b]);
+    const fit::LobeGeometry g = fit::LobeGeometryOf(at);  // once per cell, not per band
+    for (std::size_t b = 0; b < n; ++b) out[b] = fit::CookTorranceBrdfAt(g, params[b]);
     return interp::InterpStatus::kOk;
   };
 }

@@ -81,7 +81,8 @@ SpectrumSource ModelWithLocalUncertainty(const fit::CookTorranceFit& model,
   return [params = model.band, local = std::move(local)](const IsoDirection& at,
                                                          std::span<double> row) {
     const std::size_t bands = params.size();
-    for (std::size_t b = 0; b < bands; ++b) row[b] = fit::CookTorranceBrdf(at, params[b]);
+    const fit::LobeGeometry g = fit::LobeGeometryOf(at);  // once per cell, not per band
+    for (std::size_t b = 0; b < bands; ++b) row[b] = fit::CookTorranceBrdfAt(g, params[b]);
     const std::span<double> u = Plane(row, UncertainPlane::kInterpolation, bands);
     local->At(at, u);
     std::copy(u.begin(), u.end(), Plane(row, UncertainPlane::kCombined, bands).begin());
@@ -336,6 +337,7 @@ UncertainChain MakeUncertainChain(const SessionInterpolant& in) {
   inputs.samples = in.samples.get();
   inputs.budget_of = BudgetsOf(in);
   inputs.no_budgets = out.coverage.no_budgets;
+  inputs.shared = false;  // the grid has no array for it
   // Each interpolating stage's term scaled by its own calibration, as Interpolate's is.
   inputs.calibration = &ChosenCalibration(in);
   out.coverage.calibrations.push_back({Provenance::kInterpolated, in.method, *inputs.calibration});
