@@ -72,6 +72,7 @@ class ReadingNeighbours {
 
   std::vector<IsoDirection> at_;        // bucket by bucket
   std::vector<std::size_t> index_;      // at_[i]'s position in the set
+  std::vector<double> cos_o_, sin_o_;   // cos and sin of at_[i]'s θo
   std::vector<std::size_t> start_;      // bucket b's readings: at_[start_[b] .. start_[b + 1])
   double theta_i0_ = 0, theta_o0_ = 0;  // the buckets' lower corner, degrees
   double width_ = 1;                    // a bucket's side, degrees
