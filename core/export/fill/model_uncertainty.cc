@@ -1,6 +1,7 @@
 #include "core/export/fill/model_uncertainty.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -93,12 +94,23 @@ void PredictModelFold(const interp::SampleSet& samples, std::span<const std::siz
 
 }  // namespace
 
-double ReadingDistance(const IsoDirection& a, const IsoDirection& b) {
-  const double to = a.theta_o * kRadian, to2 = b.theta_o * kRadian;
-  const double cos_gamma = std::cos(to) * std::cos(to2) +
-                           std::sin(to) * std::sin(to2) * std::cos((a.phi - b.phi) * kRadian);
+namespace {
+
+// ReadingDistance's formula from the cosines and sines of the two θo, computed once per direction
+// for the many distances it takes part in: the same operations in the same order, so the same
+// value, bit for bit.
+double DistanceFrom(const IsoDirection& a, double cos_a, double sin_a, const IsoDirection& b,
+                    double cos_b, double sin_b) {
+  const double cos_gamma = cos_a * cos_b + sin_a * sin_b * std::cos((a.phi - b.phi) * kRadian);
   const double gamma = std::acos(std::clamp(cos_gamma, -1.0, 1.0)) / kRadian;
   return std::hypot(a.theta_i - b.theta_i, gamma);
+}
+
+}  // namespace
+
+double ReadingDistance(const IsoDirection& a, const IsoDirection& b) {
+  const double to = a.theta_o * kRadian, to2 = b.theta_o * kRadian;
+  return DistanceFrom(a, std::cos(to), std::sin(to), b, std::cos(to2), std::sin(to2));
 }
 
 namespace {
@@ -114,6 +126,13 @@ constexpr double kBoundSlack = 1e-3;
 int BucketOf(double theta, double origin, double width, int count) {
   const double b = std::floor((theta - origin) / width);
   return static_cast<int>(std::clamp(b, 0.0, static_cast<double>(count - 1)));
+}
+
+// The outgoing direction (θo, φ) as a unit vector: the chord between two of them is at most their
+// angle, so hypot(Δθi, chord) bounds a distance from below without trigonometry.
+std::array<double, 3> OutgoingUnit(const IsoDirection& d) {
+  const double to = d.theta_o * kRadian, ph = d.phi * kRadian;
+  return {std::sin(to) * std::cos(ph), std::sin(to) * std::sin(ph), std::cos(to)};
 }
 
 // The gap between `theta` and bucket `b`'s interval along one axis (0 inside it).
@@ -150,21 +169,33 @@ ReadingNeighbours::ReadingNeighbours(const interp::SampleSet& samples) {
   }
   for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
   std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
-  at_.resize(n);
-  index_.resize(n);
+  readings_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t slot = next[bucket[i]]++;
-    at_[slot] = At(samples, i);
-    index_[slot] = i;
+    const IsoDirection d = At(samples, i);
+    const double to = d.theta_o * kRadian;
+    readings_[next[bucket[i]]++] = {{d, std::cos(to), std::sin(to), OutgoingUnit(d)}, i};
   }
 }
 
-void ReadingNeighbours::ScanBucket(const IsoDirection& at, std::size_t k, int r, int c,
+void ReadingNeighbours::ScanBucket(const Query& q, std::size_t k, int r, int c,
                                    std::vector<std::pair<double, std::size_t>>* best) const {
   const std::size_t b = static_cast<std::size_t>(r) * static_cast<std::size_t>(columns_) +
                         static_cast<std::size_t>(c);
   for (std::size_t s = start_[b]; s < start_[b + 1]; ++s) {
-    const std::pair<double, std::size_t> p(ReadingDistance(at, at_[s]), index_[s]);
+    const Reading& to = readings_[s];
+    if (best->size() == k) {
+      // Its distance is at least hypot(Δθi, max(|Δθo|, chord)): skip the trigonometry of a
+      // reading that bound already puts beyond the k-th nearest (with kBoundSlack, as buckets).
+      const double di = q.at.theta_i - to.at.theta_i;
+      const double dx = q.unit[0] - to.unit[0], dy = q.unit[1] - to.unit[1],
+                   dz = q.unit[2] - to.unit[2];
+      const double chord = std::sqrt(dx * dx + dy * dy + dz * dz) / kRadian;
+      const double gamma = std::max(std::abs(q.at.theta_o - to.at.theta_o), chord);
+      const double reach = best->back().first + kBoundSlack;
+      if (di * di + gamma * gamma > reach * reach) continue;
+    }
+    const std::pair<double, std::size_t> p(
+        DistanceFrom(q.at, q.cos_o, q.sin_o, to.at, to.cos_o, to.sin_o), to.index);
     if (best->size() == k && !(p < best->back())) continue;
     best->insert(std::upper_bound(best->begin(), best->end(), p), p);
     if (best->size() > k) best->pop_back();
@@ -178,6 +209,8 @@ void ReadingNeighbours::Nearest(const IsoDirection& at, std::size_t k,
   // (m − 1) widths away along θi or θo, so once that exceeds the k-th nearest, no farther ring can
   // hold a nearer reading. Within a ring, a bucket whose box is farther is skipped.
   std::vector<std::pair<double, std::size_t>> best;
+  const double to = at.theta_o * kRadian;
+  const Query q{at, std::cos(to), std::sin(to), OutgoingUnit(at)};
   const int r0 = BucketOf(at.theta_i, theta_i0_, width_, rows_);
   const int c0 = BucketOf(at.theta_o, theta_o0_, width_, columns_);
   auto full = [&] { return k > 0 && best.size() == k; };
@@ -186,7 +219,7 @@ void ReadingNeighbours::Nearest(const IsoDirection& at, std::size_t k,
     const double gap = std::hypot(GapTo(at.theta_i, theta_i0_, width_, r),
                                   GapTo(at.theta_o, theta_o0_, width_, c));
     if (full() && gap - kBoundSlack > best.back().first) return;
-    ScanBucket(at, k, r, c, &best);
+    ScanBucket(q, k, r, c, &best);
   };
   const int rings = std::max({r0, rows_ - 1 - r0, c0, columns_ - 1 - c0});
   for (int m = 0; m <= rings && k > 0; ++m) {

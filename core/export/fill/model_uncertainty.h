@@ -14,6 +14,7 @@
 // off the model is there. Pure: no I/O.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <memory>
@@ -66,14 +67,21 @@ class ReadingNeighbours {
                std::vector<double>* distance) const;
 
  private:
+  // A direction with what its distances need: cos and sin of θo, and (θo, φ) as a unit vector.
+  struct Query {
+    IsoDirection at;
+    double cos_o = 1, sin_o = 0;
+    std::array<double, 3> unit{};
+  };
+  struct Reading : Query {
+    std::size_t index = 0;  // its position in the set
+  };
   // The readings of bucket (row r of θi, column c of θo) into *best (the k smallest pairs).
-  void ScanBucket(const IsoDirection& at, std::size_t k, int r, int c,
+  void ScanBucket(const Query& q, std::size_t k, int r, int c,
                   std::vector<std::pair<double, std::size_t>>* best) const;
 
-  std::vector<IsoDirection> at_;        // bucket by bucket
-  std::vector<std::size_t> index_;      // at_[i]'s position in the set
-  std::vector<double> cos_o_, sin_o_;   // cos and sin of at_[i]'s θo
-  std::vector<std::size_t> start_;      // bucket b's readings: at_[start_[b] .. start_[b + 1])
+  std::vector<Reading> readings_;       // bucket by bucket
+  std::vector<std::size_t> start_;      // bucket b's: readings_[start_[b] .. start_[b + 1])
   double theta_i0_ = 0, theta_o0_ = 0;  // the buckets' lower corner, degrees
   double width_ = 1;                    // a bucket's side, degrees
   int rows_ = 1, columns_ = 1;          // buckets along θi and along θo
