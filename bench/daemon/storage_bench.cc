@@ -5,11 +5,14 @@
 //     readings ingested per second: CompleteStepWithReading, one transaction per reading (reading
 //     and done mark), synchronous=FULL (storage/sqlite.cc), 101-band PR-650 spectra, on the disk
 //     FILE is on. Stops after N readings or S seconds, whichever first.
-//   create --db FILE --readings N [--bands 101|201|401]
+//   create --db FILE --readings N [--bands 101|201|401] [--budgets]
 //     a COMPLETED isotropic session of N sample readings (plus its white reference and dark) as
 //     brdfd would have stored it: what the memory figure loads into brdfd and the web explorer's
 //     bench (web/bench/explorer_50k.mjs) shows. Put FILE on a tmpfs (the one-fsync-per-reading
-//     cost is what `ingest` measures, not this).
+//     cost is what `ingest` measures, not this). --budgets: each sample reading also stores its
+//     uncertainty budget (docs/uncertainty.md; the meter's default noise model, white standard
+//     0.99 ± 0.0058, no lamp drift or pose term: both named not estimated), for the cost of
+//     interpolated values' and exports' uncertainties (bench/uncertainty/).
 //
 // The readings are at the rig's poses (RigPoses: the paper's sample-rotation grid, passes after
 // the first jittered), their directions from the pose by the rig's kinematics, their radiance
@@ -30,6 +33,7 @@
 
 #include "core/analytic_brdf.h"
 #include "core/geometry.h"
+#include "core/uncertainty/budget.h"
 #include "core/wavelength_grid.h"
 #include "storage/session_store.h"
 
@@ -39,6 +43,28 @@ using namespace brdf;
 
 // The session's white standard (Session.white_reflectance), ρw in the readings' derivation.
 constexpr double kWhiteReflectance = 0.99;
+
+// The white standard's standard uncertainty (a rectangular ±1 %).
+constexpr double kWhiteReflectanceU = 0.0058;
+
+// Sample reading `r`'s budget against its reference and dark (BudgetInputs' defaults otherwise).
+Result<uncertainty::ReadingBudget> BudgetOf(std::int64_t session, const storage::ReadingRecord& r,
+                                            const storage::ReadingRecord& reference,
+                                            std::int64_t reference_id,
+                                            const storage::ReadingRecord& dark,
+                                            std::int64_t dark_id) {
+  uncertainty::BudgetInputs in;
+  in.session_id = session;
+  in.grid = r.grid;
+  in.sample = {0, r.spectrum, r.integration_ms, 1};
+  in.reference = {reference_id, reference.spectrum, reference.integration_ms, 1};
+  in.dark = uncertainty::MeasuredSignal{dark_id, dark.spectrum, dark.integration_ms, 1};
+  in.white_reflectance = {kWhiteReflectance};
+  in.white_reflectance_u = {kWhiteReflectanceU};
+  in.theta_i_deg = r.directions.theta_i;
+  in.theta_r_deg = reference.directions.theta_i;
+  return uncertainty::EstimateReadingBudget(in);
+}
 
 // A session of `samples` sample steps after a reference and a dark; returns its id.
 Result<std::int64_t> NewSessionWith(storage::SessionStore& store, int samples) {
@@ -103,7 +129,7 @@ class RigPoses {
 // calls `tick` after each sample (false: stop).
 template <typename Tick>
 Result<int> Fill(storage::SessionStore& store, std::int64_t session, int samples,
-                 const WavelengthGrid& grid, Tick tick) {
+                 const WavelengthGrid& grid, bool budgets, Tick tick) {
   BRDF_ASSIGN_OR_RETURN(RigPoses poses, RigPoses::Make());
   // The white reference's spectrum I0 (lamp and detector 10° off the normal), the dark D; a
   // sample's radiance is D + (I0 − D)·f·π/ρw·cos θi/cos θi,ref for the paint's BRDF f, i.e. what
@@ -139,19 +165,22 @@ Result<int> Fill(storage::SessionStore& store, std::int64_t session, int samples
     r.integration_ms = 100;
     return r;
   };
-  BRDF_ASSIGN_OR_RETURN(
-      std::int64_t reference,
-      store.CompleteStepWithReading(session, 0,
-                                    reading(storage::ReadingKind::kReference, {}, reference_at)));
-  BRDF_ASSIGN_OR_RETURN(
-      std::int64_t dark,
-      store.CompleteStepWithReading(session, 1, reading(storage::ReadingKind::kDark, {}, {})));
+  const storage::ReadingRecord reference_reading =
+      reading(storage::ReadingKind::kReference, {}, reference_at);
+  const storage::ReadingRecord dark_reading = reading(storage::ReadingKind::kDark, {}, {});
+  BRDF_ASSIGN_OR_RETURN(std::int64_t reference,
+                        store.CompleteStepWithReading(session, 0, reference_reading));
+  BRDF_ASSIGN_OR_RETURN(std::int64_t dark, store.CompleteStepWithReading(session, 1, dark_reading));
   int written = 0;
   for (int i = 0; i < samples; ++i) {
     const auto [pose, directions] = poses.Next(static_cast<std::size_t>(i));
     storage::ReadingRecord r = reading(storage::ReadingKind::kSample, pose, directions);
     r.reference_reading_id = reference;
     r.dark_reading_id = dark;
+    if (budgets) {
+      BRDF_ASSIGN_OR_RETURN(r.uncertainty,
+                            BudgetOf(session, r, reference_reading, reference, dark_reading, dark));
+    }
     BRDF_RETURN_IF_ERROR(store.CompleteStepWithReading(session, 2 + i, r).status());
     ++written;
     if (!tick()) break;
@@ -182,6 +211,8 @@ int main(int argc, char** argv) {
                    "bands from 380 to 780 nm: 101 (PR-650, 4 nm), 201 (PR-670, 2 nm) or 401 "
                    "(CS-2000, 1 nm)")
       ->check(CLI::IsMember({101, 201, 401}));
+  bool budgets = false;
+  create->add_flag("--budgets", budgets, "store each sample reading's uncertainty budget");
   CLI11_PARSE(app, argc, argv);
   const WavelengthGrid grid{380, 400.0 / (bands - 1), static_cast<std::size_t>(bands)};
 
@@ -201,8 +232,8 @@ int main(int argc, char** argv) {
   const Clock::time_point until =
       start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   const bool timed = ingest->parsed();
-  Result<int> written =
-      Fill(**store, *session, readings, grid, [&] { return !timed || Clock::now() < until; });
+  Result<int> written = Fill(**store, *session, readings, grid, budgets,
+                             [&] { return !timed || Clock::now() < until; });
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   if (!written.ok()) {
     std::fprintf(stderr, "bench_storage: %s\n", written.status().ToString().c_str());

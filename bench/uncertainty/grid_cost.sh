@@ -10,7 +10,10 @@
 # Usage: bench/uncertainty/grid_cost.sh [BUILD_DIR]   (default ./build; builds brdfd, brdf-sim
 #        and brdfctl unless BENCH_NO_BUILD=1)
 # Environment: COST_STEPS (grid steps, "2,2,2": 45 × 45 × 90 cells), COST_REPS (5),
-# COST_METHOD (octant), COST_FILL (chain), BENCH_KEEP=1 keeps the work directory.
+# COST_METHOD (octant), COST_FILL (chain), COST_DB=FILE and COST_SESSION=ID (time that session
+# instead of recording the demo plan: e.g. `bench_storage create --db FILE --readings 50000
+# --bands 401 --budgets`), BENCH_KEEP=1 keeps the work directory,
+# COST_PERF=FILE records brdfd with `perf record -g` into FILE while the timed calls run.
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -33,9 +36,17 @@ config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
 
 echo "grid export's uncertainty: cost — $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) CPUs"
 echo "load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
-start_rig_on_sim "$work" 8 warn
-record_session_on_sim "$root/examples/plans/demo.json" "$work/watch.out"
-echo "session $session recorded (demo plan)"
+if [[ -n "${COST_DB:-}" ]]; then
+  # A session made elsewhere (bench_storage create --budgets), copied: brdfd opens the copy.
+  cp "$COST_DB" "$work/brdfd.db"
+  start_rig_on_sim "$work" 8 warn
+  session="${COST_SESSION:?COST_SESSION: the session id in COST_DB}"
+  echo "session $session of $COST_DB"
+else
+  start_rig_on_sim "$work" 8 warn
+  record_session_on_sim "$root/examples/plans/demo.json" "$work/watch.out"
+  echo "session $session recorded (demo plan)"
+fi
 
 steps="${COST_STEPS:-2,2,2}"
 cpu_ticks() {  # brdfd's user + system time so far, clock ticks
@@ -56,6 +67,12 @@ export_once() {  # $1: "" or --uncertainty; prints "wall_seconds cpu_seconds"
   c1="$(cpu_ticks)"
   echo "$(echo "$t1 - $t0" | bc) $(echo "scale=3; ($c1 - $c0) / $(getconf CLK_TCK)" | bc)"
 }
+perf_pid=""
+if [[ -n "${COST_PERF:-}" ]]; then
+  perf record -g -q -o "$COST_PERF" -p "$brdfd_pid" 2>/dev/null &
+  perf_pid=$!
+  sleep 1
+fi
 plain=()
 with=()
 for ((r = 0; r < ${COST_REPS:-5}; r++)); do
@@ -67,6 +84,10 @@ for ((r = 0; r < ${COST_REPS:-5}; r++)); do
     plain+=("$(export_once "")")
   fi
 done
+if [[ -n "$perf_pid" ]]; then
+  kill -INT "$perf_pid" 2>/dev/null || true
+  wait "$perf_pid" 2>/dev/null || true
+fi
 find "$work" -maxdepth 1 -name 'g.*' -printf '  %s bytes  %p\n' | sort -k3
 python3 - "${plain[*]}" "${with[*]}" <<'PY'
 import statistics, sys

@@ -14,6 +14,9 @@
 // /proc/<pid>/task/*/schedstat: evaluating, building and sending the answers) and this client's
 // (receiving and parsing them), medians beside the wall-clock ones.
 //
+// With --dump FILE, one more batch with every part (include_uncertainty and _shared) is written
+// to FILE, its chunks serialised one after the other, to compare two builds' answers (cmp).
+//
 // Output: "key=value" lines, then a summary table (bench/uncertainty/interp_cost.sh).
 #include <grpcpp/grpcpp.h>
 #include <time.h>
@@ -192,6 +195,26 @@ bool PrintBatchBytes(v1::Interpolation::Stub& stub, const Setup& batch, int dire
   return true;
 }
 
+// One batch of `batch`'s directions with every part of the uncertainty, its chunks serialised
+// into `file` in order. False on an RPC or write error.
+bool DumpBatch(v1::Interpolation::Stub& stub, Setup batch, const std::string& file) {
+  v1::InterpolateBatchRequest request;
+  request.set_session_id(batch.session);
+  request.set_method(batch.method);
+  request.set_include_uncertainty(true);
+  request.set_include_uncertainty_shared(true);
+  for (const v1::DirectionQuery& q : batch.directions) *request.add_directions() = q;
+  grpc::ClientContext context;
+  Authorize(context, batch.token);
+  std::ofstream out(file, std::ios::binary);
+  auto reader = stub.InterpolateBatch(&context, request);
+  v1::InterpolateBatchChunk chunk;
+  while (reader->Read(&chunk)) out << chunk.SerializeAsString();
+  const grpc::Status st = reader->Finish();
+  if (!st.ok()) std::fprintf(stderr, "InterpolateBatch: %s\n", st.error_message().c_str());
+  return st.ok() && static_cast<bool>(out);
+}
+
 // The timings of every repetition, [0] without and [1] with the uncertainty.
 struct Timings {
   const std::vector<double>* unary;
@@ -248,6 +271,8 @@ int main(int argc, char** argv) {
   app.add_flag("--shared", s.shared, "the batch's answers also carry the shared part");
   app.add_option("--daemon-pid", s.daemon_pid,
                  "brdfd's process id: also report the daemon's CPU time per batch");
+  std::string dump;
+  app.add_option("--dump", dump, "also write one batch's answers with every part to this file");
   CLI11_PARSE(app, argc, argv);
   s.method = method == "delaunay"  ? v1::INTERPOLATION_METHOD_DELAUNAY
              : method == "nearest" ? v1::INTERPOLATION_METHOD_NEAREST
@@ -273,6 +298,7 @@ int main(int argc, char** argv) {
   // Warm-up: builds the index and the connection; not timed.
   if (TimeUnary(*stub, s, 50, true, &ok) < 0 || TimeBatch(*stub, batch, true, &ok) < 0) return 1;
   if (!PrintBatchBytes(*stub, batch, directions)) return 1;
+  if (!dump.empty() && !DumpBatch(*stub, batch, dump)) return 1;
   std::vector<double> unary[2], batched[2], daemon_cpu[2], client_cpu[2];
   int unary_ok = 0, batch_ok = 0;
   for (int r = 0; r < reps; ++r) {

@@ -10,7 +10,10 @@
 #        brdfctl and bench_interp_uncertainty unless BENCH_NO_BUILD=1)
 # Environment: COST_CALLS (Interpolate calls per timing, 2000), COST_DIRECTIONS (batch size,
 # 20000), COST_REPS (5), COST_METHOD (octant), COST_SHARED=1 (the batch's answers also carry the
-# shared part: include_uncertainty_shared), BENCH_KEEP=1 keeps the work directory.
+# shared part: include_uncertainty_shared), COST_DB=FILE and COST_SESSION=ID (that session
+# instead of recording the demo plan), COST_DUMP=FILE (one batch's answers with every part, to
+# compare builds), COST_BENCH (another bench_interp_uncertainty), BENCH_KEEP=1 keeps the work directory,
+# COST_PERF=FILE records brdfd with `perf record -g` into FILE while the timed calls run.
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -25,7 +28,7 @@ fi
 brdfd="$build/daemon/brdfd"
 sim="$build/tools/brdf-sim/brdf-sim"
 ctl="$build/tools/brdfctl/brdfctl"
-bench="$build/bench/uncertainty/bench_interp_uncertainty"
+bench="${COST_BENCH:-$build/bench/uncertainty/bench_interp_uncertainty}"
 
 # shellcheck source=bench/daemon/lib.sh
 source "$root/bench/daemon/lib.sh"
@@ -34,15 +37,32 @@ config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
 
 echo "interpolated values' uncertainty: cost — $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) CPUs"
 echo "load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
-start_rig_on_sim "$work" 8 warn
-record_session_on_sim "$root/examples/plans/demo.json" "$work/watch.out"
+if [[ -n "${COST_DB:-}" ]]; then
+  # A session recorded or made before (BENCH_KEEP=1 keeps one), copied: brdfd opens the copy.
+  cp "$COST_DB" "$work/brdfd.db"
+  start_rig_on_sim "$work" 8 warn
+  session="${COST_SESSION:?COST_SESSION: the session id in COST_DB}"
+else
+  start_rig_on_sim "$work" 8 warn
+  record_session_on_sim "$root/examples/plans/demo.json" "$work/watch.out"
+fi
 budgets="$(sqlite3 -readonly "$work/brdfd.db" \
   "SELECT count(*) FROM reading_uncertainty u JOIN readings r ON r.id = u.reading_id
    WHERE r.session_id = $session")"
 echo "session $session recorded (demo plan); sample readings with a budget: $budgets"
 
+perf_pid=""
+if [[ -n "${COST_PERF:-}" ]]; then
+  perf record -g -q -o "$COST_PERF" -p "$brdfd_pid" 2>/dev/null &
+  perf_pid=$!
+  sleep 1
+fi
 "$bench" --address "$BRDF_ADDRESS" --token "$analyst_token" --session "$session" \
   --calls "${COST_CALLS:-2000}" --directions "${COST_DIRECTIONS:-20000}" \
   --reps "${COST_REPS:-5}" --method "${COST_METHOD:-octant}" --daemon-pid "$brdfd_pid" \
-  ${COST_SHARED:+--shared}
+  ${COST_SHARED:+--shared} ${COST_DUMP:+--dump "$COST_DUMP"}
+if [[ -n "$perf_pid" ]]; then
+  kill -INT "$perf_pid" 2>/dev/null || true
+  wait "$perf_pid" 2>/dev/null || true
+fi
 echo "load at end: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -58,7 +58,11 @@ double CookTorranceBrdfWith(const CookTorranceParams& p, double specular) {
 }
 
 double CookTorranceBrdf(const IsoDirection& at, const CookTorranceParams& p) {
-  return CookTorranceBrdfWith(p, CookTorranceSpecular(at, p.alpha, p.f0));
+  return CookTorranceBrdfAt(LobeGeometryOf(at), p);
+}
+
+double CookTorranceBrdfAt(const LobeGeometry& g, const CookTorranceParams& p) {
+  return CookTorranceBrdfWith(p, CookTorranceSpecularAt(g, p.alpha, p.f0));
 }
 
 }  // namespace brdf::fit

@@ -46,5 +46,8 @@ double CookTorranceBrdf(const IsoDirection& at, const CookTorranceParams& p);
 // The same from the lobe's value for p's α and F0 (CookTorranceSpecularAt): kd / π + ks · it,
 // bit for bit as CookTorranceBrdf. For many bands at one direction, whose α and F0 are shared.
 double CookTorranceBrdfWith(const CookTorranceParams& p, double specular);
+// The same with the direction's geometry computed once (LobeGeometryOf), for many bands at one
+// direction: the same value, bit for bit.
+double CookTorranceBrdfAt(const LobeGeometry& g, const CookTorranceParams& p);
 
 }  // namespace brdf::fit

@@ -50,10 +50,11 @@ struct BlendedUncertainty {
 Result<BlendedUncertainty> BlendMeasurementUncertainty(std::span<const BlendVertex> vertices,
                                                        int bands);
 // The same into *out, its contents replaced and its storage reused: a caller blending many
-// answers (a batch) allocates nothing for the spectra once *out has grown. On an error *out is
-// left unspecified.
+// answers (a batch) allocates nothing for the spectra once *out has grown. With `with_shared`
+// false, out->shared is left empty (a caller that does not hand it on saves its square roots;
+// measurement is the same). On an error *out is left unspecified.
 Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int bands,
-                                   BlendedUncertainty* out);
+                                   BlendedUncertainty* out, bool with_shared = true);
 
 // The interpolation term per band: the vertices' weighted spread about the blend,
 //   u_int(λ) = sqrt( Σᵢ |wᵢ| (fᵢ(λ) − y(λ))² / Σᵢ |wᵢ| ),

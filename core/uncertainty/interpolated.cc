@@ -5,6 +5,7 @@
 #include <cmath>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -28,11 +29,31 @@ struct Scratch {
   }
 };
 
+// An answer's not_estimated, filled anew into the strings an earlier answer left (their storage
+// reused: a batch's answers allocate nothing for their texts); Finish drops the ones not used.
+class Notes {
+ public:
+  explicit Notes(std::vector<std::string>& list) : list_(list) {}
+  void Add(std::string_view entry) {
+    if (used_ < list_.size()) {
+      list_[used_].assign(entry);
+    } else {
+      list_.emplace_back(entry);
+    }
+    ++used_;
+  }
+  void Finish() { list_.resize(used_); }
+
+ private:
+  std::vector<std::string>& list_;
+  std::size_t used_ = 0;
+};
+
 // The measurement part into `out`, or the reason it has none.
 void AddMeasurement(const interp::Interpolation& answer, const InterpolatedInputs& inputs,
-                    InterpolatedUncertainty& out) {
+                    InterpolatedUncertainty& out, Notes& notes) {
   if (!inputs.budget_of) {
-    out.not_estimated.push_back("measurement: " + inputs.no_budgets);
+    notes.Add("measurement: " + inputs.no_budgets);
     return;
   }
   Scratch<BlendVertex> scratch;
@@ -44,22 +65,22 @@ void AddMeasurement(const interp::Interpolation& answer, const InterpolatedInput
   // The blend's working storage, kept by each thread: a batch's answers allocate nothing once it
   // has grown (the vectors are swapped with `out`'s, so both keep their capacity).
   thread_local BlendedUncertainty blended;
-  const Status st =
-      BlendMeasurementUncertainty(vertices, static_cast<int>(answer.spectrum.size()), &blended);
+  const Status st = BlendMeasurementUncertainty(vertices, static_cast<int>(answer.spectrum.size()),
+                                                &blended, inputs.shared);
   if (!st.ok()) {
-    out.not_estimated.push_back("measurement: " + st.message());
+    notes.Add("measurement: " + st.message());
     return;
   }
   std::swap(out.measurement, blended.measurement);
   std::swap(out.shared, blended.shared);
-  for (std::string& entry : blended.not_estimated) out.not_estimated.push_back(std::move(entry));
+  for (const std::string& entry : blended.not_estimated) notes.Add(entry);
 }
 
 // The interpolation term into `out`, or the reason it has none.
 void AddInterpolation(const interp::Interpolation& answer, const InterpolatedInputs& inputs,
-                      InterpolatedUncertainty& out) {
+                      InterpolatedUncertainty& out, Notes& notes) {
   if (answer.method == interp::Method::kNearest) {
-    out.not_estimated.push_back(
+    notes.Add(
         "interpolation: the nearest method blends one reading, so its spread says nothing; use "
         "octant or delaunay for an estimate");
     return;
@@ -78,11 +99,10 @@ void AddInterpolation(const interp::Interpolation& answer, const InterpolatedInp
   const double h = calibration->largest_cell > 0 ? CellSize(answer.vertices) : 0.0;
   if (BeyondCalibration(*calibration, h)) {
     out.interpolation.clear();
-    out.not_estimated.push_back(
-        "interpolation: the cell is larger than every held-out reading's (not estimated)");
+    notes.Add("interpolation: the cell is larger than every held-out reading's (not estimated)");
   } else if (!ApplyInterpolationCalibration(*calibration, out.interpolation, h)) {
-    out.not_estimated.push_back("interpolation: not calibrated (" + calibration->detail +
-                                "); the vertices' spread as it is");
+    notes.Add("interpolation: not calibrated (" + calibration->detail +
+              "); the vertices' spread as it is");
   }
 }
 
@@ -118,10 +138,12 @@ void EstimateInterpolatedUncertainty(const interp::Interpolation& answer,
   out->measurement.clear();
   out->shared.clear();
   out->interpolation.clear();
-  out->not_estimated.clear();
-  if (answer.status != interp::InterpStatus::kOk) return;
-  AddMeasurement(answer, inputs, *out);
-  AddInterpolation(answer, inputs, *out);
+  Notes notes(out->not_estimated);
+  if (answer.status == interp::InterpStatus::kOk) {
+    AddMeasurement(answer, inputs, *out, notes);
+    AddInterpolation(answer, inputs, *out, notes);
+  }
+  notes.Finish();
 }
 
 InterpolatedUncertainty EstimateInterpolatedUncertainty(const interp::Interpolation& answer,

@@ -35,6 +35,9 @@ struct InterpolatedInputs {
   // "interpolation: not calibrated (…)" in not_estimated. Null: the spread as it is, with no note
   // per answer.
   const InterpolationCalibration* calibration = nullptr;
+  // False: InterpolatedUncertainty.shared is left empty, for a caller that does not hand it on
+  // (a batch not asked for it, a grid's cells); the other parts are the same.
+  bool shared = true;
 };
 
 // The size h of an answer's cell: the vertices' weighted spread of positions about their weighted
@@ -45,7 +48,8 @@ double CellSize(std::span<const interp::Vertex> vertices);
 // One answer's uncertainty per band, standard uncertainties (k = 1) in the answer's unit.
 struct InterpolatedUncertainty {
   std::vector<double> measurement;         // empty: not estimated (the reason in not_estimated)
-  std::vector<double> shared;              // the shared part of measurement; empty with it
+  std::vector<double> shared;              // the shared part of measurement; empty with it, or
+                                           // when not asked (InterpolatedInputs.shared)
   std::vector<double> interpolation;       // empty: not estimated
   std::vector<std::string> not_estimated;  // "measurement: …", "interpolation: …", vertices' own
 };

@@ -422,6 +422,7 @@ grpc::Status InterpolationService::InterpolateBatch(
       outcome = grpc::Status(grpc::StatusCode::CANCELLED, "InterpolateBatch: the client went away");
       return false;
     }
+    RecycleUncertainties(&out);  // the next chunk's answers reuse their storage
     out.Clear();
     return true;
   };

@@ -29,6 +29,37 @@ TEST(ReadingDistance, IsTheIncidenceAndTheOutgoingAngleInQuadrature) {
   EXPECT_LT(ReadingDistance({0, 5, 0}, {0, 5, 90}), 8.0);
 }
 
+// The k smallest (distance, position) pairs over every reading: what Nearest must give.
+std::vector<std::pair<double, std::size_t>> BruteForceNearest(const interp::SampleSet& samples,
+                                                              const IsoDirection& at,
+                                                              std::size_t k) {
+  std::vector<std::pair<double, std::size_t>> all;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const std::span<const double> c = samples.coords(i);
+    all.emplace_back(ReadingDistance(at, {c[0], c[1], c[2]}), i);
+  }
+  std::sort(all.begin(), all.end());
+  all.resize(std::min(k, all.size()));
+  return all;
+}
+
+// Every query's k nearest as positions and distances, equal to the brute force's, bit for bit.
+void ExpectNearestAsBruteForce(const interp::SampleSet& samples,
+                               const std::vector<IsoDirection>& queries, std::size_t k) {
+  const ReadingNeighbours neighbours(samples);
+  std::vector<std::size_t> index;
+  std::vector<double> distance;
+  for (const IsoDirection& at : queries) {
+    neighbours.Nearest(at, k, &index, &distance);
+    const auto expected = BruteForceNearest(samples, at, k);
+    ASSERT_EQ(distance.size(), expected.size());
+    for (std::size_t j = 0; j < expected.size(); ++j) {
+      EXPECT_EQ(distance[j], expected[j].first) << at.theta_i << " " << at.theta_o << " " << j;
+      EXPECT_EQ(index[j], expected[j].second) << at.theta_i << " " << at.theta_o << " " << j;
+    }
+  }
+}
+
 TEST(ReadingNeighbours, FindsTheNearestReadingsAsABruteForceSearchDoes) {
   interp::SampleSet samples(3, 1);
   std::mt19937 rng(7);
@@ -38,21 +69,44 @@ TEST(ReadingNeighbours, FindsTheNearestReadingsAsABruteForceSearchDoes) {
     const double v[1] = {1.0};
     ASSERT_TRUE(samples.Add(i, c, v).ok());
   }
-  const ReadingNeighbours neighbours(samples);
-  std::vector<std::size_t> index;
-  std::vector<double> distance;
-  for (int q = 0; q < 50; ++q) {
-    const IsoDirection at{theta(rng), theta(rng), phi(rng)};
-    neighbours.Nearest(at, 4, &index, &distance);
-    std::vector<double> all;
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      const std::span<const double> c = samples.coords(i);
-      all.push_back(ReadingDistance(at, {c[0], c[1], c[2]}));
+  std::vector<IsoDirection> queries;
+  for (int q = 0; q < 50; ++q) queries.push_back({theta(rng), theta(rng), phi(rng)});
+  ExpectNearestAsBruteForce(samples, queries, 4);
+}
+
+TEST(ReadingNeighbours, AgreesWithTheBruteForceOnAGridWithTiesAndQueriesBeyondIt) {
+  // A rig-like grid (many readings on the same θi and θo, equal distances everywhere), some
+  // readings twice, and queries inside it, between its rows, beyond its edges and at the pole.
+  interp::SampleSet samples(3, 1);
+  std::int64_t id = 0;
+  for (double ti = 10; ti <= 60; ti += 10) {
+    for (double to = 0; to <= 70; to += 5) {
+      for (double ph = 0; ph <= 180; ph += 30) {
+        const double c[3] = {ti, to, ph};
+        const double v[1] = {1.0};
+        ASSERT_TRUE(samples.Add(id++, c, v).ok());
+        if (ph == 90) {
+          ASSERT_TRUE(samples.Add(id++, c, v).ok());
+        }
+      }
     }
-    std::sort(all.begin(), all.end());
-    ASSERT_EQ(distance.size(), 4u);
-    for (std::size_t k = 0; k < 4; ++k) EXPECT_DOUBLE_EQ(distance[k], all[k]);
   }
+  std::vector<IsoDirection> queries = {{10, 0, 0},   {35, 32.5, 45}, {0, 0, 0},    {89, 89, 180},
+                                       {60, 70, 90}, {25, 80, 10},   {70, 5, 170}, {40, 20, 90}};
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> theta(0, 90), phi(0, 180);
+  for (int q = 0; q < 200; ++q) queries.push_back({theta(rng), theta(rng), phi(rng)});
+  for (const std::size_t k : {std::size_t{1}, std::size_t{4}, std::size_t{9}}) {
+    ExpectNearestAsBruteForce(samples, queries, k);
+  }
+  // More than there are: every reading, in order.
+  interp::SampleSet few(3, 1);
+  for (int i = 0; i < 3; ++i) {
+    const double c[3] = {10.0 * i, 5.0, 0.0};
+    const double v[1] = {1.0};
+    ASSERT_TRUE(few.Add(i, c, v).ok());
+  }
+  ExpectNearestAsBruteForce(few, {{50, 50, 50}, {0, 0, 0}}, 4);
 }
 
 // Readings every 20° in θi and θo in the plane, each with a model residual of 0.01 in its one

@@ -1,6 +1,7 @@
 #include "core/export/fill/model_uncertainty.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -79,8 +80,9 @@ void PredictModelFold(const interp::SampleSet& samples, std::span<const std::siz
     const std::span<const double> f = samples.spectrum(j);
     uncertainty::HeldOutPoint p;
     p.residual.resize(f.size());
+    const fit::LobeGeometry g = fit::LobeGeometryOf(at);
     for (std::size_t b = 0; b < f.size() && b < model->band.size(); ++b) {
-      p.residual[b] = fit::CookTorranceBrdf(at, model->band[b]) - f[b];
+      p.residual[b] = fit::CookTorranceBrdfAt(g, model->band[b]) - f[b];
     }
     neighbours.Nearest(at, kModelNeighbours, &near, &distance);
     p.spread.resize(f.size());
@@ -92,45 +94,148 @@ void PredictModelFold(const interp::SampleSet& samples, std::span<const std::siz
 
 }  // namespace
 
-double ReadingDistance(const IsoDirection& a, const IsoDirection& b) {
-  const double to = a.theta_o * kRadian, to2 = b.theta_o * kRadian;
-  const double cos_gamma = std::cos(to) * std::cos(to2) +
-                           std::sin(to) * std::sin(to2) * std::cos((a.phi - b.phi) * kRadian);
+namespace {
+
+// ReadingDistance's formula from the cosines and sines of the two θo, computed once per direction
+// for the many distances it takes part in: the same operations in the same order, so the same
+// value, bit for bit.
+double DistanceFrom(const IsoDirection& a, double cos_a, double sin_a, const IsoDirection& b,
+                    double cos_b, double sin_b) {
+  const double cos_gamma = cos_a * cos_b + sin_a * sin_b * std::cos((a.phi - b.phi) * kRadian);
   const double gamma = std::acos(std::clamp(cos_gamma, -1.0, 1.0)) / kRadian;
   return std::hypot(a.theta_i - b.theta_i, gamma);
 }
 
+}  // namespace
+
+double ReadingDistance(const IsoDirection& a, const IsoDirection& b) {
+  const double to = a.theta_o * kRadian, to2 = b.theta_o * kRadian;
+  return DistanceFrom(a, std::cos(to), std::sin(to), b, std::cos(to2), std::sin(to2));
+}
+
+namespace {
+
+// Readings per bucket aimed at, and the most buckets along an axis.
+constexpr double kPerBucket = 4;
+constexpr int kMostBuckets = 1024;
+// Slack on a bucket's distance bound, degrees: far above the rounding of ReadingDistance (acos near
+// 1 loses up to ~1e-6°), so a bucket is skipped only when every reading in it is strictly farther
+// than the k-th nearest.
+constexpr double kBoundSlack = 1e-3;
+
+int BucketOf(double theta, double origin, double width, int count) {
+  const double b = std::floor((theta - origin) / width);
+  return static_cast<int>(std::clamp(b, 0.0, static_cast<double>(count - 1)));
+}
+
+// The outgoing direction (θo, φ) as a unit vector: the chord between two of them is at most their
+// angle, so hypot(Δθi, chord) bounds a distance from below without trigonometry.
+std::array<double, 3> OutgoingUnit(const IsoDirection& d) {
+  const double to = d.theta_o * kRadian, ph = d.phi * kRadian;
+  return {std::sin(to) * std::cos(ph), std::sin(to) * std::sin(ph), std::cos(to)};
+}
+
+// The gap between `theta` and bucket `b`'s interval along one axis (0 inside it).
+double GapTo(double theta, double origin, double width, int b) {
+  const double lo = origin + width * b, hi = lo + width;
+  return std::max({0.0, lo - theta, theta - hi});
+}
+
+}  // namespace
+
 ReadingNeighbours::ReadingNeighbours(const interp::SampleSet& samples) {
-  index_.resize(samples.size());
-  for (std::size_t i = 0; i < index_.size(); ++i) index_[i] = i;
-  std::sort(index_.begin(), index_.end(), [&samples](std::size_t x, std::size_t y) {
-    return samples.coords(x)[0] < samples.coords(y)[0];
-  });
-  at_.reserve(index_.size());
-  for (const std::size_t i : index_) at_.push_back(At(samples, i));
+  const std::size_t n = samples.size();
+  double hi_i = 0, hi_o = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const IsoDirection d = At(samples, i);
+    theta_i0_ = i == 0 ? d.theta_i : std::min(theta_i0_, d.theta_i);
+    theta_o0_ = i == 0 ? d.theta_o : std::min(theta_o0_, d.theta_o);
+    hi_i = i == 0 ? d.theta_i : std::max(hi_i, d.theta_i);
+    hi_o = i == 0 ? d.theta_o : std::max(hi_o, d.theta_o);
+  }
+  const double side = std::clamp(std::floor(std::sqrt(static_cast<double>(n) / kPerBucket)), 1.0,
+                                 static_cast<double>(kMostBuckets - 1));
+  width_ = std::max({hi_i - theta_i0_, hi_o - theta_o0_, 1e-6}) / side;
+  rows_ = static_cast<int>((hi_i - theta_i0_) / width_) + 1;
+  columns_ = static_cast<int>((hi_o - theta_o0_) / width_) + 1;
+  std::vector<std::size_t> bucket(n);
+  start_.assign(static_cast<std::size_t>(rows_) * static_cast<std::size_t>(columns_) + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const IsoDirection d = At(samples, i);
+    bucket[i] = static_cast<std::size_t>(BucketOf(d.theta_i, theta_i0_, width_, rows_)) *
+                    static_cast<std::size_t>(columns_) +
+                static_cast<std::size_t>(BucketOf(d.theta_o, theta_o0_, width_, columns_));
+    ++start_[bucket[i] + 1];
+  }
+  for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
+  std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
+  readings_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const IsoDirection d = At(samples, i);
+    const double to = d.theta_o * kRadian;
+    readings_[next[bucket[i]]++] = {{d, std::cos(to), std::sin(to), OutgoingUnit(d)}, i};
+  }
+}
+
+void ReadingNeighbours::ScanBucket(const Query& q, std::size_t k, int r, int c,
+                                   std::vector<std::pair<double, std::size_t>>* best) const {
+  const std::size_t b = static_cast<std::size_t>(r) * static_cast<std::size_t>(columns_) +
+                        static_cast<std::size_t>(c);
+  for (std::size_t s = start_[b]; s < start_[b + 1]; ++s) {
+    const Reading& to = readings_[s];
+    if (best->size() == k) {
+      // Its distance is at least hypot(Δθi, max(|Δθo|, chord)): skip the trigonometry of a
+      // reading that bound already puts beyond the k-th nearest (with kBoundSlack, as buckets).
+      const double di = q.at.theta_i - to.at.theta_i;
+      const double dx = q.unit[0] - to.unit[0], dy = q.unit[1] - to.unit[1],
+                   dz = q.unit[2] - to.unit[2];
+      const double chord = std::sqrt(dx * dx + dy * dy + dz * dz) / kRadian;
+      const double gamma = std::max(std::abs(q.at.theta_o - to.at.theta_o), chord);
+      const double reach = best->back().first + kBoundSlack;
+      if (di * di + gamma * gamma > reach * reach) continue;
+    }
+    const std::pair<double, std::size_t> p(
+        DistanceFrom(q.at, q.cos_o, q.sin_o, to.at, to.cos_o, to.sin_o), to.index);
+    if (best->size() == k && !(p < best->back())) continue;
+    best->insert(std::upper_bound(best->begin(), best->end(), p), p);
+    if (best->size() > k) best->pop_back();
+  }
 }
 
 void ReadingNeighbours::Nearest(const IsoDirection& at, std::size_t k,
                                 std::vector<std::size_t>* index,
                                 std::vector<double>* distance) const {
-  // Outward from `at`'s θi in both directions; a reading whose θi alone is farther than the k-th
-  // nearest so far ends that direction (the distance is at least |Δθi|).
+  // Ring by ring (Chebyshev, in buckets) around `at`'s bucket: a bucket of ring m is at least
+  // (m − 1) widths away along θi or θo, so once that exceeds the k-th nearest, no farther ring can
+  // hold a nearer reading. Within a ring, a bucket whose box is farther is skipped.
   std::vector<std::pair<double, std::size_t>> best;
-  auto consider = [&](std::size_t s) {
-    best.emplace_back(ReadingDistance(at, at_[s]), index_[s]);
-    std::sort(best.begin(), best.end());
-    if (best.size() > k) best.pop_back();
+  const double to = at.theta_o * kRadian;
+  const Query q{at, std::cos(to), std::sin(to), OutgoingUnit(at)};
+  const int r0 = BucketOf(at.theta_i, theta_i0_, width_, rows_);
+  const int c0 = BucketOf(at.theta_o, theta_o0_, width_, columns_);
+  auto full = [&] { return k > 0 && best.size() == k; };
+  auto visit = [&](int r, int c) {
+    if (r < 0 || r >= rows_ || c < 0 || c >= columns_) return;
+    const double gap = std::hypot(GapTo(at.theta_i, theta_i0_, width_, r),
+                                  GapTo(at.theta_o, theta_o0_, width_, c));
+    if (full() && gap - kBoundSlack > best.back().first) return;
+    ScanBucket(q, k, r, c, &best);
   };
-  auto bound = [&] {
-    return best.size() < k ? std::numeric_limits<double>::infinity() : best.back().first;
-  };
-  const auto mid = std::lower_bound(at_.begin(), at_.end(), at.theta_i,
-                                    [](const IsoDirection& d, double t) { return d.theta_i < t; });
-  for (auto it = mid; it != at_.end() && it->theta_i - at.theta_i <= bound(); ++it) {
-    consider(static_cast<std::size_t>(it - at_.begin()));
-  }
-  for (auto it = mid; it != at_.begin() && at.theta_i - std::prev(it)->theta_i <= bound(); --it) {
-    consider(static_cast<std::size_t>(std::prev(it) - at_.begin()));
+  const int rings = std::max({r0, rows_ - 1 - r0, c0, columns_ - 1 - c0});
+  for (int m = 0; m <= rings && k > 0; ++m) {
+    if (full() && width_ * (m - 1) - kBoundSlack > best.back().first) break;
+    if (m == 0) {
+      visit(r0, c0);
+      continue;
+    }
+    for (int c = c0 - m; c <= c0 + m; ++c) {
+      visit(r0 - m, c);
+      visit(r0 + m, c);
+    }
+    for (int r = r0 - m + 1; r <= r0 + m - 1; ++r) {
+      visit(r, c0 - m);
+      visit(r, c0 + m);
+    }
   }
   index->clear();
   distance->clear();
@@ -147,8 +252,9 @@ std::vector<std::vector<double>> ModelResiduals(const fit::CookTorranceFit& mode
     const IsoDirection at = At(samples, i);
     const std::span<const double> f = samples.spectrum(i);
     out[i].assign(f.size(), 0.0);
+    const fit::LobeGeometry g = fit::LobeGeometryOf(at);
     for (std::size_t b = 0; b < f.size() && b < model.band.size(); ++b) {
-      out[i][b] = fit::CookTorranceBrdf(at, model.band[b]) - f[b];
+      out[i][b] = fit::CookTorranceBrdfAt(g, model.band[b]) - f[b];
     }
   }
   return out;

@@ -14,10 +14,12 @@
 // off the model is there. Pure: no I/O.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/call_context.h"
@@ -50,17 +52,39 @@ inline constexpr auto kModelCalibrationTimeout = std::chrono::minutes(10);
 // θo = 0 the azimuth does not count, as it does not for the direction.
 double ReadingDistance(const IsoDirection& a, const IsoDirection& b);
 
-// The readings of a sample set (coordinates θi, θo, φ) by distance to a direction.
+// The readings of a sample set (coordinates θi, θo, φ) by distance to a direction. The readings
+// are put in square buckets of (θi, θo), about four a bucket, and a query scans the buckets in
+// rings around its own, skipping those whose (θi, θo) box is farther than the k-th nearest so far
+// (a reading's distance is at least the box's: |Δθi| and, for the outgoing directions' angle,
+// |Δθo|). The answer is that of a search over every reading: the k smallest (distance, position)
+// pairs, so ties go to the lower position.
 class ReadingNeighbours {
  public:
   explicit ReadingNeighbours(const interp::SampleSet& samples);
-  // The `k` readings nearest `at` (positions in the set), nearest first, and their distances.
+  // The `k` readings nearest `at` (positions in the set), nearest first (equal distances by
+  // position), and their distances.
   void Nearest(const IsoDirection& at, std::size_t k, std::vector<std::size_t>* index,
                std::vector<double>* distance) const;
 
  private:
-  std::vector<IsoDirection> at_;    // by ascending θi
-  std::vector<std::size_t> index_;  // at_[i]'s position in the set
+  // A direction with what its distances need: cos and sin of θo, and (θo, φ) as a unit vector.
+  struct Query {
+    IsoDirection at;
+    double cos_o = 1, sin_o = 0;
+    std::array<double, 3> unit{};
+  };
+  struct Reading : Query {
+    std::size_t index = 0;  // its position in the set
+  };
+  // The readings of bucket (row r of θi, column c of θo) into *best (the k smallest pairs).
+  void ScanBucket(const Query& q, std::size_t k, int r, int c,
+                  std::vector<std::pair<double, std::size_t>>* best) const;
+
+  std::vector<Reading> readings_;       // bucket by bucket
+  std::vector<std::size_t> start_;      // bucket b's: readings_[start_[b] .. start_[b + 1])
+  double theta_i0_ = 0, theta_o0_ = 0;  // the buckets' lower corner, degrees
+  double width_ = 1;                    // a bucket's side, degrees
+  int rows_ = 1, columns_ = 1;          // buckets along θi and along θo
 };
 
 // The model's residual (model − reading) at every reading of `samples`, per band.

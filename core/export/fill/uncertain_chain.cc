@@ -10,6 +10,7 @@
 #include "core/export/number_text.h"
 #include "core/fit/models.h"
 #include "core/json_text.h"
+#include "core/uncertainty/band_sums.h"
 #include "core/uncertainty/held_out.h"
 #include "core/uncertainty/interpolated.h"
 
@@ -22,6 +23,13 @@ constexpr std::size_t kMostNotEstimated = 20;
 // Plane `p` of a row of kUncertainPlanes · bands values.
 std::span<double> Plane(std::span<double> row, UncertainPlane p, std::size_t bands) {
   return row.subspan(static_cast<std::size_t>(p) * bands, bands);
+}
+
+// `from` into `to`, NaN past its end (an empty part: NaN in every band).
+void CopyOrNaN(std::span<const double> from, std::span<double> to) {
+  const std::size_t n = std::min(from.size(), to.size());
+  std::copy_n(from.begin(), n, to.begin());
+  std::fill(to.begin() + static_cast<std::ptrdiff_t>(n), to.end(), kNaN);
 }
 
 // One answer's row: the value, then its uncertainty planes (NaN where a part is missing).
@@ -40,11 +48,12 @@ void WriteAnswer(const interp::Interpolation& answer, const uncertainty::Interpo
   const std::span<double> m = Plane(row, UncertainPlane::kMeasurement, bands);
   const std::span<double> i = Plane(row, UncertainPlane::kInterpolation, bands);
   const std::span<double> c = Plane(row, UncertainPlane::kCombined, bands);
-  for (std::size_t b = 0; b < bands; ++b) {
-    m[b] = every_budget && b < u.measurement.size() ? u.measurement[b] : kNaN;
-    i[b] = b < u.interpolation.size() ? u.interpolation[b] : kNaN;
-    c[b] = std::sqrt(m[b] * m[b] + i[b] * i[b]);
-  }
+  // Each plane whole, then c = sqrt(m² + i²) a vector of bands at a time (SqrtBands rounds as
+  // std::sqrt does): the same values as band by band.
+  CopyOrNaN(every_budget ? std::span<const double>(u.measurement) : std::span<const double>(), m);
+  CopyOrNaN(u.interpolation, i);
+  for (std::size_t b = 0; b < bands; ++b) c[b] = m[b] * m[b] + i[b] * i[b];
+  uncertainty::SqrtBands(c);
 }
 
 // An interpolator as a stage answering rows with their uncertainties.
@@ -81,7 +90,8 @@ SpectrumSource ModelWithLocalUncertainty(const fit::CookTorranceFit& model,
   return [params = model.band, local = std::move(local)](const IsoDirection& at,
                                                          std::span<double> row) {
     const std::size_t bands = params.size();
-    for (std::size_t b = 0; b < bands; ++b) row[b] = fit::CookTorranceBrdf(at, params[b]);
+    const fit::LobeGeometry g = fit::LobeGeometryOf(at);  // once per cell, not per band
+    for (std::size_t b = 0; b < bands; ++b) row[b] = fit::CookTorranceBrdfAt(g, params[b]);
     const std::span<double> u = Plane(row, UncertainPlane::kInterpolation, bands);
     local->At(at, u);
     std::copy(u.begin(), u.end(), Plane(row, UncertainPlane::kCombined, bands).begin());
@@ -336,6 +346,7 @@ UncertainChain MakeUncertainChain(const SessionInterpolant& in) {
   inputs.samples = in.samples.get();
   inputs.budget_of = BudgetsOf(in);
   inputs.no_budgets = out.coverage.no_budgets;
+  inputs.shared = false;  // the grid has no array for it
   // Each interpolating stage's term scaled by its own calibration, as Interpolate's is.
   inputs.calibration = &ChosenCalibration(in);
   out.coverage.calibrations.push_back({Provenance::kInterpolated, in.method, *inputs.calibration});
