@@ -21,16 +21,9 @@ root="$(cd "$here/../.." && pwd)"
 build="${1:-$root/build}"
 case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
 
-if [[ "${BENCH_NO_BUILD:-0}" != 1 ]]; then
-  echo "== building brdfd, brdf-sim, brdfctl (-j2)" >&2
-  cmake --build "$build" -j2 --target brdfd brdf-sim brdfctl >&2
-fi
-brdfd="$build/daemon/brdfd"
-sim="$build/tools/brdf-sim/brdf-sim"
-ctl="$build/tools/brdfctl/brdfctl"
-
 # shellcheck source=bench/daemon/lib.sh
 source "$root/bench/daemon/lib.sh"
+bench_rig_programs grid_cost "$build"
 bench_workdir_and_cleanup /tmp/brdfd-grid-cost.XXXXXX
 config_extra=$'[meter.quality]\n"10" = "accept_and_flag"'
 
