@@ -70,7 +70,8 @@ grpc::Status DataService::Open(grpc::ServerContextBase& context,
   // Labels and averaging are fixed at submission.
   const std::int64_t id = call.session;
   source.extras = [this, &reader, id] {
-    return ReadingExtrasOf(reader, id, catalogue_.Averages(id));
+    return reading_extras_.Get(
+        id, [&] { return ReadingExtrasOf(reader, id, catalogue_.Averages(id)); });
   };
   return grpc::Status::OK;
 }

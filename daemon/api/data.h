@@ -13,6 +13,7 @@
 #include "daemon/api/export_cache.h"
 #include "daemon/api/export_loads.h"
 #include "daemon/api/session_catalogue.h"
+#include "daemon/api/shared_extras.h"
 #include "daemon/api/stream_pump.h"
 #include "daemon/api/stream_readings.h"
 #include "daemon/rpc/auth.h"
@@ -61,6 +62,7 @@ class DataService final : public DataServiceBase {
   StreamRegistry& streams_;
   StreamPump& pump_;
   std::string program_;
+  SharedReadingExtras reading_extras_;      // the step labels the readings streams hold
   SharedSessionLoads export_loads_;         // the sessions the exports in flight hold
   ExportInterpolants export_interpolants_;  // their interpolants, kept per snapshot
 };

@@ -326,6 +326,12 @@ grpc::Status CheckBatchDirections(const v1::InterpolateBatchRequest& request,
 // once the last chunk of this one was taken by the transport (the writer blocks under flow
 // control), so a batch holds at most a slice's answers ahead of its client, however long it is.
 constexpr int kSliceChunks = 4;
+// The first chunk holds at most this many results; each one the transport took doubles the next,
+// up to the batch's chunk size (issue 40). A client that does not read fills HTTP/2's 64 KiB
+// stream window with the first few small chunks, and the batch then waits holding one of ~32
+// results (~40 kB on the wire, ~60 kB as a message at 101 bands), not one of 256 (~0.3 MB and
+// ~0.5 MB): with 200 such batches open that was ~150 MB of brdfd's memory.
+constexpr int kFirstChunkResults = 8;
 
 // The uncertainty a batch's results carry, for their size.
 BatchUncertainty UncertaintyOf(const v1::InterpolateBatchRequest& request) {
@@ -357,6 +363,81 @@ grpc::Status FitChunkAndReserve(const v1::InterpolateBatchRequest& request,
   return slot.Reserve(BatchBytes(request, *chunk, index.grid.count));
 }
 
+// A batch's results on their way out: gathered into chunks that grow from kFirstChunkResults to
+// the batch's chunk size, each written when full (the write blocks while the client is slow to
+// read: HTTP/2 flow control) or at the last result.
+class BatchChunks {
+ public:
+  // `n` results in all, chunks of at most `chunk`.
+  BatchChunks(grpc::ServerContext& context, const StopSignal& stopping, StreamRegistry::Slot& slot,
+              grpc::ServerWriter<v1::InterpolateBatchChunk>& writer, int n, int chunk)
+      : context_(context),
+        stopping_(stopping),
+        slot_(slot),
+        writer_(writer),
+        n_(n),
+        chunk_(chunk),
+        size_(std::min(chunk, kFirstChunkResults)) {}
+
+  // Where result `i` goes, or null when the batch must stop (outcome() says why): the client
+  // cancelled or the daemon is stopping, looked at as each chunk starts.
+  v1::InterpolationResult* Add(int i) {
+    if (out_.results_size() == 0) {
+      if (context_.IsCancelled()) {
+        outcome_ = grpc::Status(grpc::StatusCode::CANCELLED,
+                                "InterpolateBatch: cancelled by the client after " +
+                                    std::to_string(i) + " of " + std::to_string(n_) + " results");
+        return nullptr;
+      }
+      if (stopping_.stopped()) {
+        outcome_ = grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                                "InterpolateBatch: the daemon is shutting down after " +
+                                    std::to_string(i) + " of " + std::to_string(n_) +
+                                    " results; ask again for the rest once it is back");
+        return nullptr;
+      }
+      out_.set_first_index(static_cast<std::uint32_t>(i));
+    }
+    return out_.add_results();
+  }
+
+  // Result `i` is filled in: writes the chunk if it is full or `i` the last. False when the
+  // client went away.
+  bool Filled(int i) {
+    if (out_.results_size() < size_ && i + 1 < n_) return true;
+    // Slot::Write's steps, with the chunk's memory given back between the write (serialized
+    // now) and the wait for a work permit: Clear() would keep every result's spectrum and
+    // vertices for reuse, ~0.4 MB for 256 results, while the batch waits its turn (issue 40:
+    // 200 waiting batches held ~74 MB so).
+    slot_.BeginWrite();
+    const bool written = writer_.Write(out_);
+    out_ = v1::InterpolateBatchChunk();
+    slot_.EndWrite();
+    if (!written) {
+      outcome_ =
+          grpc::Status(grpc::StatusCode::CANCELLED, "InterpolateBatch: the client went away");
+      return false;
+    }
+    size_ = std::min(chunk_, 2 * size_);
+    return true;
+  }
+
+  // Directions to evaluate at a time: kSliceChunks chunks of the current size.
+  int slice() const { return kSliceChunks * size_; }
+  const grpc::Status& outcome() const { return outcome_; }
+
+ private:
+  grpc::ServerContext& context_;
+  const StopSignal& stopping_;
+  StreamRegistry::Slot& slot_;
+  grpc::ServerWriter<v1::InterpolateBatchChunk>& writer_;
+  const int n_;
+  const int chunk_;
+  int size_;  // of the chunk being filled
+  v1::InterpolateBatchChunk out_;
+  grpc::Status outcome_ = grpc::Status::OK;
+};
+
 }  // namespace
 
 grpc::Status InterpolationService::InterpolateBatch(
@@ -382,62 +463,35 @@ grpc::Status InterpolationService::InterpolateBatch(
   if (grpc::Status st = CheckOptionsFit(settings.options, index); !st.ok()) return st;
   if (grpc::Status st = FitChunkAndReserve(*request, index, *slot, &chunk); !st.ok()) return st;
 
-  // A slice of kSliceChunks chunks at a time in one EvaluateEach (the octant method sorts it by
-  // cell), its answers streamed chunk by chunk as they come, in order.
+  // A slice of kSliceChunks chunks (of the size they have then) at a time in one EvaluateEach
+  // (the octant method sorts it by cell), its answers streamed chunk by chunk as they come, in
+  // order.
   const int n = request->directions_size();
-  const int slice = kSliceChunks * chunk;
-  if (grpc::Status st = CheckBatchDirections(*request, index, slice); !st.ok()) return st;
-  grpc::Status outcome = grpc::Status::OK;
-  v1::InterpolateBatchChunk out;
-  auto start_chunk = [&](int first) {
-    if (context->IsCancelled()) {
-      outcome = grpc::Status(grpc::StatusCode::CANCELLED,
-                             "InterpolateBatch: cancelled by the client after " +
-                                 std::to_string(first) + " of " + std::to_string(n) + " results");
-      return false;
-    }
-    if (stopping_.stopped()) {
-      outcome = grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                             "InterpolateBatch: the daemon is shutting down after " +
-                                 std::to_string(first) + " of " + std::to_string(n) +
-                                 " results; ask again for the rest once it is back");
-      return false;
-    }
-    out.Clear();
-    out.set_first_index(static_cast<std::uint32_t>(first));
-    return true;
-  };
+  if (grpc::Status st = CheckBatchDirections(*request, index, kSliceChunks * chunk); !st.ok()) {
+    return st;
+  }
+  BatchChunks chunks(*context, stopping_, *slot, *writer, n, chunk);
   // A batch's answers leave `combined` to the client, and `shared` unless asked (brdf.proto).
   const WithUncertainty with_uncertainty =
       request->include_uncertainty()
           ? WithUncertainty(UncertaintyParts{request->include_uncertainty_shared(), false})
           : std::nullopt;
-  auto take = [&](int i, interp::Interpolation&& answer) {
-    if (i % chunk == 0 && !start_chunk(i)) return false;
-    ToResult(request->directions(i), std::move(answer), settings, index, VertexSpectra::kOmit,
-             with_uncertainty, out.add_results());
-    if (out.results_size() < chunk && i + 1 < n) return true;
-    // Blocks while the client is slow to read (flow control); false: the client went away.
-    if (!slot->Write(writer, out)) {
-      outcome = grpc::Status(grpc::StatusCode::CANCELLED, "InterpolateBatch: the client went away");
-      return false;
-    }
-    RecycleUncertainties(&out);  // the next chunk's answers reuse their storage
-    out.Clear();
-    return true;
-  };
   std::vector<double> coords;
-  for (int first = 0; first < n && outcome.ok(); first += slice) {
-    const int count = std::min(slice, n - first);
+  for (int first = 0, count = 0; first < n && chunks.outcome().ok(); first += count) {
+    count = std::min(chunks.slice(), n - first);
     if (grpc::Status st = BatchCoords(*request, index, first, count, &coords); !st.ok()) return st;
     bool going = true;
     index.interpolator->EvaluateEach(coords, [&](std::size_t k, interp::Interpolation&& answer) {
-      going = take(first + static_cast<int>(k), std::move(answer));
-      return going;
+      const int i = first + static_cast<int>(k);
+      v1::InterpolationResult* result = chunks.Add(i);
+      if (result == nullptr) return going = false;
+      ToResult(request->directions(i), std::move(answer), settings, index, VertexSpectra::kOmit,
+               with_uncertainty, result);
+      return going = chunks.Filled(i);
     });
     if (!going) break;
   }
-  return outcome;
+  return chunks.outcome();
 }
 
 }  // namespace brdf::daemon

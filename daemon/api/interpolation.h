@@ -19,8 +19,10 @@
 // even while the session goes on. Chunks are written with the synchronous writer, which blocks
 // while the client is slow to read (gRPC flow control): each chunk is evaluated only once the
 // previous one has been taken by the transport, so the server holds about one chunk per stream
-// (plus what HTTP/2's flow-control window lets through), never the whole answer. A client that
-// cancels stops the batch at the next chunk.
+// (plus what HTTP/2's flow-control window lets through), never the whole answer. The first chunk
+// holds 8 results and each one taken doubles the next up to the chunk size (issue 40): a client
+// that does not read leaves one chunk of ~32 results waiting in brdfd, not one of 256. A client
+// that cancels stops the batch at the next chunk.
 //
 // RenderAppearance (service_appearance.cc) renders the sample's colour and a lit sphere under
 // CIE illuminants (core/appearance.h) from the session's BRDF index in this cache, behind the

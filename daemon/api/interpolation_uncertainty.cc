@@ -45,42 +45,13 @@ uncertainty::InterpolatedInputs InputsOf(const IndexSnapshot& index) {
   return inputs;
 }
 
-// Uncertainty messages kept for reuse by this thread, cleared (their repeated fields keep their
-// storage and their cleared strings).
-constexpr std::size_t kMostPooled = 4096;
-
-std::vector<std::unique_ptr<v1::InterpolationUncertainty>>& Pool() {
-  thread_local std::vector<std::unique_ptr<v1::InterpolationUncertainty>> pool;
-  return pool;
-}
-
-// out's uncertainty message, a pooled one when there is one.
-v1::InterpolationUncertainty* UncertaintyOf(v1::InterpolationResult* out) {
-  std::vector<std::unique_ptr<v1::InterpolationUncertainty>>& pool = Pool();
-  if (out->has_uncertainty() || pool.empty()) return out->mutable_uncertainty();
-  v1::InterpolationUncertainty* u = pool.back().release();
-  pool.pop_back();
-  out->set_allocated_uncertainty(u);
-  return u;
-}
-
-// `entries` as u's not_estimated, each into a string u kept from before when it has one.
+// `entries` as u's not_estimated.
 void SetNotEstimated(const std::vector<std::string>& entries, v1::InterpolationUncertainty* u) {
   google::protobuf::RepeatedPtrField<std::string>* to = u->mutable_not_estimated();
   for (const std::string& entry : entries) to->Add()->assign(entry);
 }
 
 }  // namespace
-
-void RecycleUncertainties(v1::InterpolateBatchChunk* chunk) {
-  std::vector<std::unique_ptr<v1::InterpolationUncertainty>>& pool = Pool();
-  for (v1::InterpolationResult& r : *chunk->mutable_results()) {
-    if (!r.has_uncertainty() || pool.size() >= kMostPooled) continue;
-    std::unique_ptr<v1::InterpolationUncertainty> u(r.release_uncertainty());
-    u->Clear();
-    pool.push_back(std::move(u));
-  }
-}
 
 void AddInterpolationUncertainty(const interp::Interpolation& answer, const IndexSnapshot& index,
                                  UncertaintyParts parts, v1::InterpolationResult* out) {
@@ -90,7 +61,7 @@ void AddInterpolationUncertainty(const interp::Interpolation& answer, const Inde
   uncertainty::InterpolatedInputs inputs = InputsOf(index);
   inputs.shared = parts.shared;
   uncertainty::EstimateInterpolatedUncertainty(answer, inputs, &found);
-  v1::InterpolationUncertainty* u = UncertaintyOf(out);
+  v1::InterpolationUncertainty* u = out->mutable_uncertainty();
   SetFloats(found.measurement, u->mutable_measurement());
   if (parts.shared) SetFloats(found.shared, u->mutable_shared());
   SetFloats(found.interpolation, u->mutable_interpolation());

@@ -25,14 +25,7 @@ struct UncertaintyParts {
 // Fills out->uncertainty for `answer`, evaluated on `index`, with `parts`; nothing when the
 // answer is not OK. The spectra are floats; `combined` is evaluated from the two rounded parts
 // (sqrt(m² + i²) in double, rounded to float), as a client computes it from a batch's answer.
-// The uncertainty message comes from this thread's pool (RecycleUncertainties) when it has one:
-// its spectra's and texts' storage is reused, so a batch's answers allocate nothing for them.
 void AddInterpolationUncertainty(const interp::Interpolation& answer, const IndexSnapshot& index,
                                  UncertaintyParts parts, v1::InterpolationResult* out);
-
-// Takes the uncertainty messages out of `chunk`'s results into this thread's pool (at most a few
-// thousand kept), for the next answers' AddInterpolationUncertainty: call it before clearing a
-// chunk that has been sent. The results lose their uncertainty.
-void RecycleUncertainties(v1::InterpolateBatchChunk* chunk);
 
 }  // namespace brdf::daemon

@@ -184,7 +184,7 @@ class ReadingsBody final : public StreamBody<v1::Reading> {
     }
     for (;;) {
       if (next_ < pager_->kept().size()) {
-        *message = ToProtoReading(*pager_->kept()[next_++], extras_);
+        *message = ToProtoReading(*pager_->kept()[next_++], *extras_);
         return Next::kWrite;
       }
       ReadingPager<storage::ReadingRecord>::Step step = pager_->Next();
@@ -246,7 +246,7 @@ class ReadingsBody final : public StreamBody<v1::Reading> {
   const StopSignal& stopping_;
   const OpenReadings open_;
   std::unique_ptr<OpenedReadings> opened_;
-  ReadingExtras extras_;
+  std::shared_ptr<const ReadingExtras> extras_;
   std::unique_ptr<ReadingPager<storage::ReadingRecord>> pager_;
   std::size_t next_ = 0;  // the next of the page's kept readings to write (all written: wait)
   bool waiting_ = false;  // the last step waited for more

@@ -57,8 +57,9 @@ struct ReadingSource {
   std::string server = "the server";  // in the stopping message ("brdfd is shutting down; …")
   // The session's step labels and averaging (ReadingExtrasOf), for the readings that carry them:
   // StreamReadings asks once, before its first page; StreamReadingPoints never (a session of
-  // 50,000 steps is 50,000 labels read for nothing).
-  std::function<ReadingExtras()> extras;
+  // 50,000 steps is 50,000 labels read for nothing). Shared by the streams of the session
+  // (shared_extras.h).
+  std::function<std::shared_ptr<const ReadingExtras>()> extras;
   // For StreamReadings (served without a thread of its own), instead of `wait`: the catalogue's
   // SessionFollow::notify (empty: the stream looks again every second).
   std::function<void(std::int64_t last_id, std::function<void()> wake)> notify;

@@ -503,7 +503,7 @@ class BrdfClient:
         step_theta_i, step_theta_o, step_phi: grids: degrees, dividing 90 (θ) or 180 (φ);
             0: 1°. grid_nodes: sample 0, step, …, 90 (180) instead of the cells' centres.
         exclude_flagged: leave out readings the quality policy flagged.
-        chunk_bytes: the daemon's largest data message; 0: 1 MiB.
+        chunk_bytes: the daemon's largest data message; 0: 128 KiB.
         on_progress(stage, fraction): called for each progress message ("loading readings",
             "resampling", "building the MERL table", "sending", "done"; fraction in [0, 1],
             never decreasing).

@@ -10,6 +10,7 @@
 #include <grpcpp/support/server_interceptor.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include <memory>
 #include <random>
 #include <thread>
+#include <vector>
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/api/common.h"
@@ -144,12 +146,20 @@ TEST_F(InterpStreamTest, BatchStreamsChunkByChunkUnderTheClientsFlowControl) {
     *request.add_directions() = asked.back();
   }
 
+  // The chunks' sizes: 8 results, then each twice the last up to chunk_size (brdf.proto), and a
+  // last one with what is left.
+  std::vector<int> sizes;
+  for (int left = kDirections, size = 8; left > 0; size = std::min(kChunk, 2 * size)) {
+    sizes.push_back(std::min(size, left));
+    left -= sizes.back();
+  }
+
   auto context = Context(60s);
   auto reader = stub_->InterpolateBatch(context.get(), request);
   v1::InterpolateBatchChunk chunk;
   ASSERT_TRUE(reader->Read(&chunk));
   EXPECT_EQ(chunk.first_index(), 0u);
-  EXPECT_EQ(chunk.results_size(), kChunk);
+  EXPECT_EQ(chunk.results_size(), sizes[0]);
   // The client stops reading. The server must stop writing once the stream's window is full:
   // its count of written chunks levels off far below the 200 of the answer (were the answer
   // queued whole, it would reach 200 within milliseconds).
@@ -163,9 +173,11 @@ TEST_F(InterpStreamTest, BatchStreamsChunkByChunkUnderTheClientsFlowControl) {
                       << " chunks while the client read one: it does not wait for flow control";
 
   // Reading on: every result, in order, each chunk starting where the previous one ended.
-  int next = kChunk;
+  int next = sizes[0];
   int chunks = 1;
   while (reader->Read(&chunk)) {
+    ASSERT_LT(static_cast<std::size_t>(chunks), sizes.size());
+    EXPECT_EQ(chunk.results_size(), sizes[static_cast<std::size_t>(chunks)]);
     ++chunks;
     ASSERT_EQ(static_cast<int>(chunk.first_index()), next);
     for (int i = 0; i < chunk.results_size(); ++i) {
@@ -178,20 +190,25 @@ TEST_F(InterpStreamTest, BatchStreamsChunkByChunkUnderTheClientsFlowControl) {
   const grpc::Status finished = reader->Finish();
   ASSERT_TRUE(finished.ok()) << finished.error_message();
   EXPECT_EQ(next, kDirections);
-  EXPECT_EQ(chunks, kDirections / kChunk);
-  EXPECT_EQ(sent_.load(), kDirections / kChunk);
+  EXPECT_EQ(static_cast<std::size_t>(chunks), sizes.size());
+  EXPECT_EQ(static_cast<std::size_t>(sent_.load()), sizes.size());
 
-  // The default chunk size, and a last chunk that is short.
+  // The default chunk size (8, 16, …, 256, 256), and a last chunk that is short.
   v1::InterpolateBatchRequest small;
   small.set_session_id(session);
-  const int n = static_cast<int>(kDefaultChunkSize) + 3;
+  const int grown = 8 + 16 + 32 + 64 + 128;
+  const int n = grown + 2 * static_cast<int>(kDefaultChunkSize) + 3;
   for (int i = 0; i < n; ++i) *small.add_directions() = asked[static_cast<std::size_t>(i)];
   std::vector<v1::InterpolateBatchChunk> got;
   ASSERT_TRUE(Batch(small, &got).ok());
-  ASSERT_EQ(got.size(), 2u);
-  EXPECT_EQ(got[0].results_size(), static_cast<int>(kDefaultChunkSize));
-  EXPECT_EQ(got[1].first_index(), kDefaultChunkSize);
-  EXPECT_EQ(got[1].results_size(), 3);
+  ASSERT_EQ(got.size(), 8u);
+  EXPECT_EQ(got[0].results_size(), 8);
+  EXPECT_EQ(got[4].results_size(), 128);
+  EXPECT_EQ(got[5].first_index(), static_cast<std::uint32_t>(grown));
+  EXPECT_EQ(got[5].results_size(), static_cast<int>(kDefaultChunkSize));
+  EXPECT_EQ(got[6].results_size(), static_cast<int>(kDefaultChunkSize));
+  EXPECT_EQ(got[7].first_index(), grown + 2 * kDefaultChunkSize);
+  EXPECT_EQ(got[7].results_size(), 3);
 }
 
 TEST_F(InterpStreamTest, ErrorsNameTheFieldAndTheIndex) {
@@ -230,7 +247,9 @@ TEST_F(InterpStreamTest, ErrorsNameTheFieldAndTheIndex) {
   v1::InterpolateBatchRequest batch;
   batch.set_session_id(session);
   for (int i = 0; i < 10; ++i) *batch.add_directions() = Iso(10 + i, 20, 30);
-  ASSERT_TRUE(Batch(batch).ok());
+  std::vector<v1::InterpolateBatchChunk> good;
+  ASSERT_TRUE(Batch(batch, &good).ok());
+  ASSERT_EQ(good.size(), 2u);  // 8 results, then 2 (the first chunk holds 8)
   v1::InterpolateBatchRequest bad = batch;
   bad.mutable_directions(7)->mutable_iso()->set_phi(inf);
   bad.mutable_directions(8)->mutable_iso()->set_theta_i(nan);
@@ -259,8 +278,8 @@ TEST_F(InterpStreamTest, ErrorsNameTheFieldAndTheIndex) {
   v1::InterpolateBatchRequest unknown = batch;
   unknown.set_session_id("987654");
   expect(Batch(unknown), grpc::StatusCode::NOT_FOUND, "");
-  // Only the good batch wrote a chunk: every error comes before any work.
-  EXPECT_EQ(sent_.load(), sent_before + 1);
+  // Only the good batch wrote chunks: every error comes before any work.
+  EXPECT_EQ(sent_.load(), sent_before + 2);
 }
 
 TEST_F(InterpStreamTest, NewReadingsAreAppendedToTheIndexNotReadAgain) {
