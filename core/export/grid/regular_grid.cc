@@ -196,8 +196,12 @@ Result<GridReport> ResampleOnGrid(const SpectrumSource& source, const RegularGri
   // batches over the threads), the calling thread hands the other's slices to the sink.
   const std::size_t window_slices = std::min(
       grid.theta_i.count, std::max<std::size_t>(1, kWindowCells / 2 / planes / slice_cells));
+  // The second window only when the grid needs more than one: a small grid costs one window.
   std::array<GridWindow, 2> windows;
-  for (GridWindow& w : windows) w.Size(window_slices * slice_cells, shape.values_per_cell);
+  const std::size_t window_count = grid.theta_i.count > window_slices ? 2 : 1;
+  for (std::size_t k = 0; k < window_count; ++k) {
+    windows[k].Size(window_slices * slice_cells, shape.values_per_cell);
+  }
   GridWindow* ready = &windows[0];
   GridWindow* next = &windows[1];
   ready->slices = window_slices;
