@@ -374,7 +374,7 @@ TEST_F(InterpStreamTest, ShutdownWithCallsInFlightEndsEveryCall) {
     call->context.set_deadline(std::chrono::system_clock::now() + 20s);
     v1::InterpolateRequest request;
     request.set_session_id(i % 2 == 0 ? hot : cold);
-    *request.mutable_direction() = Iso(20 + i % 40, 30, 3 * i);
+    *request.mutable_direction() = Iso(20 + i % 40, 30, (3 * i) % 180);  // φ within [0, 180]
     call->reader = stub_->AsyncInterpolate(&call->context, request, &queue);
     call->reader->Finish(&call->response, &call->status, call.get());
     calls.push_back(std::move(call));
