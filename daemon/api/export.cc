@@ -174,16 +174,11 @@ class ExportStream {
     p.buffer.reserve(next_chunk_bytes_);
   }
 
-  // Slot::Write's steps, with `chunk` emptied between the write (Write serialized it) and the
-  // wait for a work permit: a hundred exports waiting their turn then hold no chunk each (issue
-  // 40: up to chunk_bytes apiece).
+  // `chunk` is emptied before the wait for a work permit (Slot::WriteAndRelease): a hundred
+  // exports waiting their turn then hold no chunk each (issue 40: up to chunk_bytes apiece).
   void Send(v1::ExportChunk& chunk) {
     if (broken_) return;
-    slot_.BeginWrite();
-    const bool written = writer_.Write(chunk);
-    chunk = v1::ExportChunk();
-    slot_.EndWrite();
-    if (!written) {
+    if (!slot_.WriteAndRelease(&writer_, &chunk)) {
       broken_ = true;
       CheckCancelled();
     }

@@ -76,6 +76,17 @@ class StreamRegistry {
       EndWrite();
       return ok;
     }
+    // The same for a message the stream builds again: *message is emptied (its memory freed) after
+    // the write serialized it and before the wait for the next work permit, so a stream waiting
+    // its turn holds no message (issue 40: a hundred waiting exports or batches held one each).
+    template <class Writer, class Message>
+    bool WriteAndRelease(Writer* writer, Message* message) {
+      BeginWrite();
+      const bool ok = writer->Write(*message);
+      *message = Message();
+      EndWrite();
+      return ok;
+    }
     // Releases the work permit (if any) before it goes away.
     void Close();
     // Reserves `bytes` of the memory budget (memory_budget.h) for the rest of the stream: OK, or
