@@ -53,16 +53,21 @@ double CookTorranceSpecular(const IsoDirection& at, double alpha, double f0) {
   return CookTorranceSpecularAt(LobeGeometryOf(at), alpha, f0);
 }
 
-double CookTorranceBrdfWith(const CookTorranceParams& p, double specular) {
-  return p.kd / kPi + p.ks * specular;
-}
-
 double CookTorranceBrdf(const IsoDirection& at, const CookTorranceParams& p) {
-  return CookTorranceBrdfAt(LobeGeometryOf(at), p);
+  return p.kd / kPi + p.ks * CookTorranceSpecular(at, p.alpha, p.f0);
 }
 
-double CookTorranceBrdfAt(const LobeGeometry& g, const CookTorranceParams& p) {
-  return CookTorranceBrdfWith(p, CookTorranceSpecularAt(g, p.alpha, p.f0));
+void CookTorranceSpectrumAt(const LobeGeometry& g, std::span<const CookTorranceParams> band,
+                            std::span<double> out) {
+  const std::size_t n = std::min(out.size(), band.size());
+  double specular = 0;
+  for (std::size_t b = 0; b < n; ++b) {
+    const CookTorranceParams& p = band[b];
+    if (b == 0 || p.alpha != band[b - 1].alpha || p.f0 != band[b - 1].f0) {
+      specular = CookTorranceSpecularAt(g, p.alpha, p.f0);
+    }
+    out[b] = p.kd / kPi + p.ks * specular;
+  }
 }
 
 }  // namespace brdf::fit

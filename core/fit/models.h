@@ -14,6 +14,8 @@
 // stays finite at grazing directions.
 #pragma once
 
+#include <span>
+
 #include "core/pose.h"
 
 namespace brdf::fit {
@@ -43,11 +45,12 @@ double CookTorranceSpecularAt(const LobeGeometry& g, double alpha, double f0);
 double CookTorranceSpecular(const IsoDirection& at, double alpha, double f0);
 
 double CookTorranceBrdf(const IsoDirection& at, const CookTorranceParams& p);
-// The same from the lobe's value for p's α and F0 (CookTorranceSpecularAt): kd / π + ks · it,
-// bit for bit as CookTorranceBrdf. For many bands at one direction, whose α and F0 are shared.
-double CookTorranceBrdfWith(const CookTorranceParams& p, double specular);
-// The same with the direction's geometry computed once (LobeGeometryOf), for many bands at one
-// direction: the same value, bit for bit.
-double CookTorranceBrdfAt(const LobeGeometry& g, const CookTorranceParams& p);
+
+// A fitted model's spectrum at one direction: out[b] = CookTorranceBrdf(at, band[b]) bit for bit
+// for b < min(band.size(), out.size()) (later entries of out untouched), with the direction's
+// geometry g = LobeGeometryOf(at) computed once by the caller and the lobe's value once per run
+// of bands with the same α and F0 (every band's, when the fit shares them).
+void CookTorranceSpectrumAt(const LobeGeometry& g, std::span<const CookTorranceParams> band,
+                            std::span<double> out);
 
 }  // namespace brdf::fit

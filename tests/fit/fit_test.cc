@@ -112,6 +112,25 @@ TEST(Models, GgxLobeIsReciprocalAndPeaksAtTheSpecularDirection) {
   EXPECT_DOUBLE_EQ(CookTorranceBrdf({10, 20, 30}, {0.5, 0.0, 0.3, 0.04}), 0.5 / kPi);
 }
 
+TEST(Models, SpectrumAtIsCookTorranceBrdfPerBandBitForBit) {
+  // Runs of shared (α, F0) and bands with their own, at directions above, grazing and below.
+  const std::vector<CookTorranceParams> band = {{0.2, 0.5, 0.3, 0.04}, {0.3, 0.6, 0.3, 0.04},
+                                                {0.1, 0.9, 0.05, 0.9}, {0.4, 0.1, 0.3, 0.04},
+                                                {0.4, 0.1, 0.3, 0.5},  {0.7, 1.2, 0.3, 0.5}};
+  for (const IsoDirection& at : std::vector<IsoDirection>{
+           {10, 20, 30}, {40, 40, 180}, {89.9, 89.9, 180}, {95, 30, 180}, {0, 0, 0}}) {
+    std::vector<double> out(band.size() + 2, -1.0);
+    CookTorranceSpectrumAt(LobeGeometryOf(at), band, out);
+    for (std::size_t b = 0; b < band.size(); ++b) {
+      EXPECT_EQ(out[b], CookTorranceBrdf(at, band[b])) << "band " << b << " θi " << at.theta_i;
+    }
+    EXPECT_EQ(out[band.size()], -1.0) << "past the model's bands: untouched";
+    std::vector<double> fewer(3);
+    CookTorranceSpectrumAt(LobeGeometryOf(at), band, fewer);
+    EXPECT_EQ(fewer[2], out[2]);
+  }
+}
+
 TEST(Models, GgxDistributionIsNormalised) {
   // ∫ D(h) (n·h) dω_h = 1 over the hemisphere, for any α (checked numerically).
   for (double alpha : {0.1, 0.3, 0.7}) {

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <limits>
 
 #include "core/fit/models.h"
 
@@ -170,23 +169,8 @@ FillTally FillChain::Tally() const {
 }
 
 SpectrumSource ModelSource(const fit::CookTorranceFit& model) {
-  // The lobe's angles once per direction and its value once per (α, F0) — every band's when the
-  // fit shares them — instead of both per band: the same numbers as CookTorranceBrdf per band.
   return [params = model.band](const IsoDirection& at, std::span<double> out) {
-    const std::size_t n = std::min(out.size(), params.size());
-    const fit::LobeGeometry lobe = fit::LobeGeometryOf(at);
-    double alpha = std::numeric_limits<double>::quiet_NaN();
-    double f0 = alpha;
-    double specular = 0;
-    for (std::size_t b = 0; b < n; ++b) {
-      const fit::CookTorranceParams& p = params[b];
-      if (b == 0 || p.alpha != alpha || p.f0 != f0) {
-        alpha = p.alpha;
-        f0 = p.f0;
-        specular = fit::CookTorranceSpecularAt(lobe, alpha, f0);
-      }
-      out[b] = fit::CookTorranceBrdfWith(p, specular);
-    }
+    fit::CookTorranceSpectrumAt(fit::LobeGeometryOf(at), params, out);
     return interp::InterpStatus::kOk;
   };
 }

@@ -22,6 +22,15 @@ IsoDirection At(const interp::SampleSet& samples, std::size_t i) {
   return {c[0], c[1], c[2]};
 }
 
+// The model's value minus the reading's, per band of the reading (0 past the model's bands).
+std::vector<double> ModelMinusReading(const fit::CookTorranceFit& model, const IsoDirection& at,
+                                      std::span<const double> f) {
+  std::vector<double> d(f.size(), 0.0);
+  fit::CookTorranceSpectrumAt(fit::LobeGeometryOf(at), model.band, d);
+  for (std::size_t b = 0; b < f.size() && b < model.band.size(); ++b) d[b] -= f[b];
+  return d;
+}
+
 // ρ per band: the RMS of `residuals` over the readings `near`.
 void LocalScale(const std::vector<std::vector<double>>& residuals,
                 std::span<const std::size_t> near, std::span<double> rho) {
@@ -79,11 +88,7 @@ void PredictModelFold(const interp::SampleSet& samples, std::span<const std::siz
     const IsoDirection at = At(samples, j);
     const std::span<const double> f = samples.spectrum(j);
     uncertainty::HeldOutPoint p;
-    p.residual.resize(f.size());
-    const fit::LobeGeometry g = fit::LobeGeometryOf(at);
-    for (std::size_t b = 0; b < f.size() && b < model->band.size(); ++b) {
-      p.residual[b] = fit::CookTorranceBrdfAt(g, model->band[b]) - f[b];
-    }
+    p.residual = ModelMinusReading(*model, at, f);
     neighbours.Nearest(at, kModelNeighbours, &near, &distance);
     p.spread.resize(f.size());
     LocalScale(residuals, near, p.spread);
@@ -251,11 +256,7 @@ std::vector<std::vector<double>> ModelResiduals(const fit::CookTorranceFit& mode
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const IsoDirection at = At(samples, i);
     const std::span<const double> f = samples.spectrum(i);
-    out[i].assign(f.size(), 0.0);
-    const fit::LobeGeometry g = fit::LobeGeometryOf(at);
-    for (std::size_t b = 0; b < f.size() && b < model.band.size(); ++b) {
-      out[i][b] = fit::CookTorranceBrdfAt(g, model.band[b]) - f[b];
-    }
+    out[i] = ModelMinusReading(model, at, f);
   }
   return out;
 }

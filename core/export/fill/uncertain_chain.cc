@@ -90,8 +90,7 @@ SpectrumSource ModelWithLocalUncertainty(const fit::CookTorranceFit& model,
   return [params = model.band, local = std::move(local)](const IsoDirection& at,
                                                          std::span<double> row) {
     const std::size_t bands = params.size();
-    const fit::LobeGeometry g = fit::LobeGeometryOf(at);  // once per cell, not per band
-    for (std::size_t b = 0; b < bands; ++b) row[b] = fit::CookTorranceBrdfAt(g, params[b]);
+    fit::CookTorranceSpectrumAt(fit::LobeGeometryOf(at), params, row.first(bands));
     const std::span<double> u = Plane(row, UncertainPlane::kInterpolation, bands);
     local->At(at, u);
     std::copy(u.begin(), u.end(), Plane(row, UncertainPlane::kCombined, bands).begin());
