@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/uncertainty/band_sums.h"
+#include "core/uncertainty/note_list.h"
 
 namespace brdf::uncertainty {
 namespace {
@@ -70,20 +71,6 @@ Status CheckBands(const Blended& b, std::size_t bands) {
                          " bands, the blend's; were the readings measured on another grid?");
 }
 
-// Adds `entry` to the first `*used` entries of `list` unless it is among them, into a string an
-// earlier blend left there when there is one (its storage reused: a batch's blends allocate
-// nothing for their texts). The caller drops the entries past *used at the end.
-void AddNotEstimated(std::vector<std::string>& list, std::size_t* used, const std::string& entry) {
-  const auto first = list.begin(), last = first + static_cast<std::ptrdiff_t>(*used);
-  if (std::find(first, last, entry) != last) return;
-  if (*used < list.size()) {
-    list[*used].assign(entry);
-  } else {
-    list.push_back(entry);
-  }
-  ++*used;
-}
-
 // The shared input `c` is shared through, added (with no contributions yet) when it is the first
 // component met of that input.
 SharedInput& InputOf(const Component& c, Scratch& s) {
@@ -126,23 +113,22 @@ Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int ba
   Scratch& s = ThreadScratch();
   BRDF_RETURN_IF_ERROR(MergeByReading(vertices, s.readings));
   const auto n = static_cast<std::size_t>(bands);
-  std::size_t notes = 0;  // out->not_estimated's entries of this blend
+  NoteList notes(out->not_estimated);
   s.independent.assign(n, 0.0);
   s.used = 0;
   for (const Blended& b : s.readings) {
     if (b.budget == nullptr) {
-      AddNotEstimated(
-          out->not_estimated, &notes,
-          "reading " + std::to_string(b.reading_id) + ": no uncertainty budget (not estimated)");
+      notes.AddUnique("reading " + std::to_string(b.reading_id) +
+                      ": no uncertainty budget (not estimated)");
       continue;
     }
     BRDF_RETURN_IF_ERROR(CheckBands(b, n));
     for (const std::string& entry : b.budget->not_estimated) {
-      AddNotEstimated(out->not_estimated, &notes, entry);
+      notes.AddUnique(entry);
     }
     AddReading(b, s);
   }
-  out->not_estimated.resize(notes);
+  notes.Finish();
   // shared² = Σ over inputs of (Σ wᵢ uⱼ,ᵢ)², an input at a time; measurement² = shared² +
   // independent²; then both roots.
   out->shared.assign(n, 0.0);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/uncertainty/blend.h"
+#include "core/uncertainty/note_list.h"
 
 namespace brdf::uncertainty {
 namespace {
@@ -29,29 +30,9 @@ struct Scratch {
   }
 };
 
-// An answer's not_estimated, filled anew into the strings an earlier answer left (their storage
-// reused: a batch's answers allocate nothing for their texts); Finish drops the ones not used.
-class Notes {
- public:
-  explicit Notes(std::vector<std::string>& list) : list_(list) {}
-  void Add(std::string_view entry) {
-    if (used_ < list_.size()) {
-      list_[used_].assign(entry);
-    } else {
-      list_.emplace_back(entry);
-    }
-    ++used_;
-  }
-  void Finish() { list_.resize(used_); }
-
- private:
-  std::vector<std::string>& list_;
-  std::size_t used_ = 0;
-};
-
 // The measurement part into `out`, or the reason it has none.
 void AddMeasurement(const interp::Interpolation& answer, const InterpolatedInputs& inputs,
-                    InterpolatedUncertainty& out, Notes& notes) {
+                    InterpolatedUncertainty& out, NoteList& notes) {
   if (!inputs.budget_of) {
     notes.Add("measurement: " + inputs.no_budgets);
     return;
@@ -78,7 +59,7 @@ void AddMeasurement(const interp::Interpolation& answer, const InterpolatedInput
 
 // The interpolation term into `out`, or the reason it has none.
 void AddInterpolation(const interp::Interpolation& answer, const InterpolatedInputs& inputs,
-                      InterpolatedUncertainty& out, Notes& notes) {
+                      InterpolatedUncertainty& out, NoteList& notes) {
   if (answer.method == interp::Method::kNearest) {
     notes.Add(
         "interpolation: the nearest method blends one reading, so its spread says nothing; use "
@@ -138,7 +119,7 @@ void EstimateInterpolatedUncertainty(const interp::Interpolation& answer,
   out->measurement.clear();
   out->shared.clear();
   out->interpolation.clear();
-  Notes notes(out->not_estimated);
+  NoteList notes(out->not_estimated);
   if (answer.status == interp::InterpStatus::kOk) {
     AddMeasurement(answer, inputs, *out, notes);
     AddInterpolation(answer, inputs, *out, notes);
