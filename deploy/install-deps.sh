@@ -7,6 +7,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git
+  clang-format # tests: the sources as .clang-format lays them out (tools/check/format.py)
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   libserialport-dev libmodbus-dev libspdlog-dev libfmt-dev libsqlite3-dev sqlite3
   libqhull-dev libcgal-dev libtomlplusplus-dev libcli11-dev libsystemd-dev

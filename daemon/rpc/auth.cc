@@ -96,8 +96,7 @@ grpc::Status Authenticator::Admit(std::string_view path, std::string_view header
   return Check(header, *access, MethodName(path), peer, caller);
 }
 
-grpc::Status Authenticator::CallerOf(const grpc::ServerContextBase& context,
-                                     Caller* caller) const {
+grpc::Status Authenticator::CallerOf(const grpc::ServerContextBase& context, Caller* caller) const {
   // Read access is all this grants: the call's door checked what the method needs.
   return Check(AuthorizationOf(context), Access::kRead, "call", context.peer(), caller);
 }

@@ -2,8 +2,8 @@
 // (operator, analyst) and the token's name. A call carries the metadata
 // "authorization: Bearer <token>". Mutating Control calls need an operator; read-only calls
 // (ValidatePlan, GetSession, ListSessions, ListSessionEvents, ListAdaptiveRounds, GetRigStatus,
-// WatchSession, Data.*, Interpolation.*) accept either role (brdf.proto's header). The health service and reflection
-// need no token.
+// WatchSession, Data.*, Interpolation.*) accept either role (brdf.proto's header). The health
+// service and reflection need no token.
 //
 // Tokens are secrets: they are never logged and never stored (the audit log gets the token's
 // NAME). A presented token is compared with EVERY configured token in time that depends only on

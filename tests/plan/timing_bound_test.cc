@@ -12,8 +12,12 @@
 namespace brdf::plan {
 namespace {
 
-Step Move(double alpha, double beta) { return testing::MoveTo(alpha, beta); }
-Step Sample() { return testing::StepOfKind(v1::STEP_KIND_SAMPLE); }
+Step Move(double alpha, double beta) {
+  return testing::MoveTo(alpha, beta);
+}
+Step Sample() {
+  return testing::StepOfKind(v1::STEP_KIND_SAMPLE);
+}
 
 RigDescription Rig() {
   RigDescription rig;

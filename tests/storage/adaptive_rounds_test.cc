@@ -26,8 +26,7 @@ RoundRecord Round(std::int64_t session, int number, int first_step) {
   r.session_id = session;
   r.round = number;
   r.first_step = first_step;
-  r.picks = {{Pose{12.5, -35, 0, 11.25}, 0.0123456789012345},
-             {Pose{1.0 / 3, 170, 0, 22.5}, 1e-7}};
+  r.picks = {{Pose{12.5, -35, 0, 11.25}, 0.0123456789012345}, {Pose{1.0 / 3, 170, 0, 22.5}, 1e-7}};
   r.predicted_gain = 0.0123457789012345;
   r.uncertainty_left = 0.0712;
   r.readings_used = 15;

@@ -6,8 +6,8 @@
 
 #include "core/export/fill/uncertain_chain.h"
 #include "core/export/grid/regular_grid.h"
-#include "core/json_text.h"
 #include "core/export/number_text.h"
+#include "core/json_text.h"
 
 namespace brdf::exports {
 namespace {

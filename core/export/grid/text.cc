@@ -2,8 +2,8 @@
 
 #include <utility>
 
-#include "core/json_text.h"
 #include "core/export/number_text.h"
+#include "core/json_text.h"
 
 namespace brdf::exports {
 

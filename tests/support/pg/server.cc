@@ -1,9 +1,9 @@
 #include "tests/support/pg/server.h"
 
 #include <fcntl.h>
+#include <grp.h>
 #include <pwd.h>
 #include <signal.h>
-#include <grp.h>
 #include <sys/mount.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -86,8 +86,7 @@ std::string PgServer::BinDir() {
   std::string best;
   for (const auto& entry : fs::directory_iterator("/usr/lib/postgresql", ec)) {
     const fs::path bin = entry.path() / "bin";
-    if (fs::exists(bin / "initdb", ec) && fs::exists(bin / "postgres", ec) &&
-        bin.string() > best) {
+    if (fs::exists(bin / "initdb", ec) && fs::exists(bin / "postgres", ec) && bin.string() > best) {
       best = bin.string();
     }
   }
@@ -286,9 +285,9 @@ Result<std::string> PgServer::Psql(const std::string& sql) const {
     std::ofstream out(sql_file);
     out << sql << "\n";
   }
-  const std::string command = "PGPASSWORD=" + password_ + " " + psql + " -X -At -v ON_ERROR_STOP=1 -h " +
-                              dir_ + " -p " + std::to_string(port_) +
-                              " -U brdf -d postgres -f " + sql_file + " 2>&1";
+  const std::string command =
+      "PGPASSWORD=" + password_ + " " + psql + " -X -At -v ON_ERROR_STOP=1 -h " + dir_ + " -p " +
+      std::to_string(port_) + " -U brdf -d postgres -f " + sql_file + " 2>&1";
   std::FILE* p = ::popen(command.c_str(), "r");
   if (p == nullptr) return IoError("popen psql failed");
   std::string out;

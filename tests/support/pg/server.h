@@ -55,8 +55,7 @@ class PgServer {
   std::string tcp_conninfo() const;
   std::string conninfo_with_password(const std::string& password) const;
   // Writes `conninfo` to a credentials file `path` (mode 0600) and returns the path.
-  static Result<std::string> WriteCredentials(const std::string& path,
-                                              const std::string& conninfo);
+  static Result<std::string> WriteCredentials(const std::string& path, const std::string& conninfo);
 
   // Runs `sql` with psql (-At: unaligned, tuples only) and returns its output, trimmed.
   Result<std::string> Psql(const std::string& sql) const;
