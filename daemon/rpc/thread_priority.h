@@ -11,14 +11,22 @@
 //    without the privilege above; gRPC's pool threads that served a stream then stay at 10.
 #pragma once
 
+#include <chrono>
+
 namespace brdf::daemon {
 
 inline constexpr int kControlNice = -5;
 inline constexpr int kInterpolateNice = 5;
 inline constexpr int kStreamNice = 10;
+// The control plane's slice: the shortest Linux takes (0.1 ms).
+inline constexpr std::chrono::microseconds kControlSlice{100};
 
 // setpriority on the calling thread (its tid); false when not allowed (the value stays).
 bool SetThisThreadNice(int nice);
+
+// SCHED_OTHER at `nice` with a slice of `slice` (sched_setattr's sched_runtime) on the calling
+// thread; false when the nice value is not allowed (nothing changes then).
+bool SetThisThreadNiceAndSlice(int nice, std::chrono::nanoseconds slice);
 
 // The calling thread's name as ps, top and /proc/PID/task/TID/comm show it (at most 15
 // characters): "ctl-plane" (the control plane), "interp-loop" and "interp-slow" (Interpolate).
