@@ -47,7 +47,7 @@ struct Options {
   std::string data_session;   // with readings: Interpolate, batches, exports
   int streams = 1000;
   int interpolate_clients = 8;
-  int calls = 200;  // control calls per phase (half PauseSession, half GetRigStatus)
+  int calls = 200;     // control calls per phase (half PauseSession, half GetRigStatus)
   double slow_ms = 0;  // > 0: each control call slower than this is printed to stderr
   bool operator_in_load_process = false;
 };

@@ -35,7 +35,7 @@ TEST(StreamPriorityTest, AComputingStreamIsAtNice10OnlyWhileItHoldsAWorkPermit) 
   StreamRegistry streams(ServerConfig{}, false);
   grpc::ServerContext context;
   int opened = -1, writing = -1, written = -1, ended = -1;
-  std::thread([&] {  // a thread of its own, as gRPC's pool gives each call
+  std::thread call([&] {  // a thread of its own, as gRPC's pool gives each call
     std::unique_ptr<StreamRegistry::Slot> slot;
     ASSERT_TRUE(streams.Open(context, nullptr, "Export", &slot, /*computes=*/true).ok());
     opened = ThisThreadNice();
@@ -45,7 +45,8 @@ TEST(StreamPriorityTest, AComputingStreamIsAtNice10OnlyWhileItHoldsAWorkPermit) 
     written = ThisThreadNice();
     slot.reset();
     ended = ThisThreadNice();
-  }).join();
+  });
+  call.join();
   EXPECT_EQ(opened, kStreamNice) << "computing, with its permit";
   EXPECT_EQ(writing, 0) << "writing: its thread may poll the operator's calls";
   EXPECT_EQ(written, kStreamNice) << "computing again";
@@ -57,13 +58,14 @@ TEST(StreamPriorityTest, AStreamThatDoesNotComputeLeavesItsThreadAlone) {
   StreamRegistry streams(ServerConfig{}, false);
   grpc::ServerContext context;
   int opened = -1, ended = -1;
-  std::thread([&] {
+  std::thread call([&] {
     std::unique_ptr<StreamRegistry::Slot> slot;
     ASSERT_TRUE(streams.Open(context, nullptr, "health Watch", &slot).ok());
     opened = ThisThreadNice();
     slot.reset();
     ended = ThisThreadNice();
-  }).join();
+  });
+  call.join();
   EXPECT_EQ(opened, 0);
   EXPECT_EQ(ended, 0);
 }
