@@ -47,7 +47,8 @@ struct Options {
   std::string data_session;   // with readings: Interpolate, batches, exports
   int streams = 1000;
   int interpolate_clients = 8;
-  int calls = 200;  // control calls per phase (half PauseSession, half GetRigStatus)
+  int calls = 200;     // control calls per phase (half PauseSession, half GetRigStatus)
+  double slow_ms = 0;  // > 0: each control call slower than this is printed to stderr
   bool operator_in_load_process = false;
 };
 
@@ -114,6 +115,12 @@ ControlFigures MeasureControl(const Options& o, brdf::v1::Control::Stub& control
                                 &response);
     }
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - begin).count();
+    if (o.slow_ms > 0 && ms > o.slow_ms) {
+      // steady_clock is CLOCK_MONOTONIC: `perf record -k CLOCK_MONOTONIC` timestamps match.
+      std::fprintf(stderr, "slow control call: %s %.3f ms from %.6f s (CLOCK_MONOTONIC)\n",
+                   i % 2 == 0 ? "PauseSession" : "GetRigStatus", ms,
+                   std::chrono::duration<double>(begin.time_since_epoch()).count());
+    }
     if (!st.ok()) {
       if (f.failed++ == 0) {
         f.first_failure = std::to_string(st.error_code()) + " " + st.error_message();
@@ -295,6 +302,8 @@ int main(int argc, char** argv) {
   app.add_option("--streams", o.streams);
   app.add_option("--interpolate-clients", o.interpolate_clients);
   app.add_option("--calls", o.calls);
+  app.add_option("--slow-ms", o.slow_ms,
+                 "print each control call slower than this (ms) with its start, to correlate");
   app.add_flag("--operator-in-load-process", o.operator_in_load_process,
                "measure the control calls from the analysts' process (shares its gRPC pollers)");
   CLI11_PARSE(app, argc, argv);

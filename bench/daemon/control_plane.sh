@@ -14,7 +14,9 @@
 # paused at its first prompt) for the verbs.
 # Usage: bench/daemon/control_plane.sh [BUILD_DIR] (default: build-bench; builds what it needs
 # unless BENCH_NO_BUILD=1). BENCH_STREAMS (default 1000), BENCH_MEMORY_BUDGET_MB ([server]
-# memory_budget_mb; default the daemon's), BENCH_KEEP=1 keeps the logs.
+# memory_budget_mb; default the daemon's), BENCH_KEEP=1 keeps the logs, BENCH_SLOW_MS prints each
+# control call slower than that to stderr with its start on CLOCK_MONOTONIC (to set beside
+# `perf sched record -k CLOCK_MONOTONIC -p $(pgrep brdfd)`).
 set -euo pipefail
 
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -85,7 +87,8 @@ sampler=$!
 pids+=("$sampler")
 line="$("$bin/bench_control_plane" --address "$address" --operator-token "$operator_token" \
   --analyst-token "$analyst_token" --pause-session "$paused" --data-session 1 \
-  --streams "$streams" ${BENCH_OPERATOR_IN_LOAD_PROCESS:+--operator-in-load-process})" || rc=$?
+  --streams "$streams" ${BENCH_OPERATOR_IN_LOAD_PROCESS:+--operator-in-load-process} \
+  ${BENCH_SLOW_MS:+--slow-ms "$BENCH_SLOW_MS"})" || rc=$?
 rss_ended_kb="$(rss_kb "$brdfd_pid")"
 settle="${BENCH_SETTLE_S:-60}"
 sleep "$settle"

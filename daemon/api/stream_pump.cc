@@ -87,8 +87,6 @@ void StreamPump::Run() {
       lock.Unlock();
       task();
       task = nullptr;  // what it held goes with it, outside the lock
-      // A stream's slot, if it ended here, set the thread's nice value back to 0 (when allowed).
-      (void)SetThisThreadNice(kStreamNice);
       lock.Lock();
       continue;
     }

@@ -11,10 +11,10 @@ namespace brdf::daemon {
 namespace {
 
 void RaisePriority() {
-  if (!SetThisThreadNice(kControlNice)) {
-    spdlog::debug("control plane: cannot raise its threads' priority (nice {}): {}; they run at 0",
-                  kControlNice, std::strerror(errno));
-  }
+  if (SetThisThreadNiceAndSlice(kControlNice, kControlSlice)) return;
+  spdlog::debug("control plane: cannot raise its threads' priority (nice {}): {}; they run at 0",
+                kControlNice, std::strerror(errno));
+  (void)SetThisThreadNiceAndSlice(0, kControlSlice);
 }
 
 }  // namespace

@@ -9,9 +9,11 @@
 // read from their own completion queue by their own threads, so whatever the streams hold, a
 // control call waits only for the control calls ahead of it. The streams are capped besides
 // (stream_registry.h), so the synchronous pool is never exhausted either. The threads ask for nice
-// -5 (CAP_SYS_NICE or RLIMIT_NICE: the systemd unit's LimitNICE=-5; else they stay at 0) and the
-// streams' work runs at +10: with the cores busy (Interpolate clients, exports), a control call
-// still gets one at once (bench/daemon/control_plane.sh).
+// -5 (CAP_SYS_NICE or RLIMIT_NICE: the systemd unit's LimitNICE=-5; else they stay at 0) and a
+// slice of 0.1 ms, so a woken control thread preempts a running analyst's thread instead of
+// waiting out its slice; the streams' work runs at +10: with the cores busy (Interpolate clients,
+// exports), a control call still gets one at once (thread_priority.h,
+// bench/daemon/control_plane.sh).
 //
 // Each method is added with Add() before the server is built, from a service that marked it
 // async (WithAsyncMethod_X) and a handler with the synchronous signature (the service's own

@@ -105,13 +105,14 @@ grpc::Status StreamRegistry::Open(grpc::ServerContextBase& context, const Caller
     entries_.emplace(id, std::move(entry));
     slot->reset(new Slot(this, id, raw, computes));
   }
-  (void)SetThisThreadNice(kStreamNice);
   if (computes) (*slot)->holding_ = AcquireWork(context, (*slot)->entry_->token);
   return grpc::Status::OK;
 }
 
 bool StreamRegistry::AcquireWork(const grpc::ServerContextBase& context, const std::string& token) {
-  return work_.Acquire(token, [&context] { return context.IsCancelled(); });
+  if (!work_.Acquire(token, [&context] { return context.IsCancelled(); })) return false;
+  (void)SetThisThreadNice(kStreamNice);  // the work runs below the control plane and the transport
+  return true;
 }
 
 void StreamRegistry::Release(std::uint64_t id) {
@@ -164,12 +165,15 @@ StreamRegistry::Slot::~Slot() {
   Close();
   reservations_.clear();
   registry_->Release(id_);
-  (void)SetThisThreadNice(0);
 }
 
 void StreamRegistry::Slot::Close() {
-  if (holding_) registry_->work_.Release(entry_->token);
+  if (!holding_) return;
+  registry_->work_.Release(entry_->token);
   holding_ = false;
+  // Back to 0 (where allowed) before the thread writes or waits: a thread of gRPC's pool polls
+  // the transport for every connection, the control plane's too (thread_priority.h).
+  (void)SetThisThreadNice(0);
 }
 
 grpc::Status StreamRegistry::Slot::Reserve(std::uint64_t bytes) {

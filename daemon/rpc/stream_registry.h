@@ -17,9 +17,10 @@
 // write waits for the client. Permits are shared fairly between tokens (work_permits.h): a free
 // one goes to the waiting token that holds the fewest, so one analyst's hundred exports do not
 // keep another's one waiting behind them. A thousand exports then take turns on the
-// cores instead of all running at once. Every stream's thread runs at nice 10 while the stream is
-// open (back to 0 after), below the control plane's threads and Interpolate's loop, which get a
-// core when they need one.
+// cores instead of all running at once. A stream's thread runs at nice 10 while it holds a permit,
+// below the control plane's threads and Interpolate's loop, which get a core when they need one,
+// and is back at 0 (where allowed) when it gives the permit back, before it writes or waits: a
+// thread of gRPC's pool polls the transport for every connection (thread_priority.h).
 //
 // Memory: a heavy stream reserves what it will hold from the memory budget (Slot::Reserve,
 // memory_budget.h) once it knows its request; the watchdog gives freed memory back to the system

@@ -7,6 +7,7 @@
 // and these calls failed with "Server Threadpool Exhausted" (as main's brdfd did here: at 300
 // streams some of them still finished in time, at 400 GetRigStatus, Health and Pause failed).
 #include <gtest/gtest.h>
+#include <sys/utsname.h>
 
 #include <algorithm>
 #include <atomic>
@@ -36,11 +37,32 @@ const std::string kLongPlan = PlanFixture("control plane under load")
                                   .Measurement(100, 1)
                                   .Retry(3, 0);
 
-// Each thread of process `pid` as /proc shows it: its name (comm) and nice value.
+// Each thread of process `pid` as /proc shows it: its name (comm), nice value and the slice the
+// scheduler gives it (ns; -1 when /proc does not show it).
 struct ThreadNice {
   std::string name;
   int nice = 0;
+  long long slice_ns = -1;
 };
+
+// The slice of a task as /proc/PID/task/TID/sched shows it ("se.slice : N"), or -1.
+long long SliceNs(const std::filesystem::path& task) {
+  std::ifstream sched(task / "sched");
+  for (std::string line; std::getline(sched, line);) {
+    if (line.rfind("se.slice", 0) == 0) return std::stoll(line.substr(line.find(':') + 1));
+  }
+  return -1;
+}
+
+// Linux 6.12 or later: a thread's slice may be asked for (sched_setattr's sched_runtime).
+bool KernelTakesSlices() {
+  utsname u{};
+  if (::uname(&u) != 0) return false;
+  int major = 0, minor = 0;
+  if (std::sscanf(u.release, "%d.%d", &major, &minor) != 2) return false;
+  return major > 6 || (major == 6 && minor >= 12);
+}
+
 std::vector<ThreadNice> Threads(pid_t pid) {
   std::vector<ThreadNice> threads;
   const std::filesystem::path tasks = "/proc/" + std::to_string(pid) + "/task";
@@ -60,6 +82,7 @@ std::vector<ThreadNice> Threads(pid_t pid) {
     for (int i = 3; i <= 19 && rest >> field; ++i) {
       if (i == 19) t.nice = std::stoi(field);
     }
+    t.slice_ns = SliceNs(task.path());
     threads.push_back(t);
   }
   return threads;
@@ -280,6 +303,10 @@ TEST(ControlPlaneLoadTest, OperatorCallsAnswerWhile400AnalystStreamsAreOpen) {
     if (t.name == "ctl-plane") {
       ++control;
       EXPECT_LE(t.nice, 0) << "a control plane thread";
+      // Its short slice lets it preempt an analyst's thread when it wakes (thread_priority.h).
+      if (KernelTakesSlices() && t.slice_ns >= 0) {
+        EXPECT_EQ(t.slice_ns, 100'000) << "a control plane thread's slice";
+      }
     } else if (t.name == "interp-loop" || t.name == "interp-slow") {
       ++interpolate;
       EXPECT_EQ(t.nice, 5) << t.name;
