@@ -76,10 +76,14 @@ grpc::Status DataService::Open(grpc::ServerContextBase& context,
   return grpc::Status::OK;
 }
 
-grpc::Status DataService::Export(grpc::ServerContext* context, const v1::ExportRequest* request,
-                                 grpc::ServerWriter<v1::ExportChunk>* writer) {
-  return ExportSession(*context, *request, *writer, auth_, streams_, stopping_, catalogue_.reader(),
-                       export_loads_, export_interpolants_);
+grpc::Status DataService::WireExport(grpc::ServerContext* context, ExportStreamer* streamer) {
+  v1::ExportRequest request;
+  if (!streamer->Read(&request)) {
+    return grpc::Status(grpc::StatusCode::INTERNAL,
+                        "Export: the request could not be read; send an ExportRequest");
+  }
+  return ExportSession(*context, request, *streamer, auth_, streams_, stopping_,
+                       catalogue_.reader(), export_loads_, export_interpolants_);
 }
 
 }  // namespace brdf::daemon

@@ -6,12 +6,17 @@
 // exports to files (Export) live in export.cc.
 #pragma once
 
+#include <grpcpp/support/byte_buffer.h>
+#include <grpcpp/support/method_handler.h>
+#include <grpcpp/support/sync_stream.h>
+
 #include <string>
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "daemon/api/common.h"
 #include "daemon/api/export_cache.h"
 #include "daemon/api/export_loads.h"
+#include "daemon/api/export_session.h"
 #include "daemon/api/session_catalogue.h"
 #include "daemon/api/shared_extras.h"
 #include "daemon/api/stream_pump.h"
@@ -21,9 +26,40 @@
 
 namespace brdf::daemon {
 
+// Export on the synchronous pool as the generated service runs it, but writing gRPC's buffers
+// (export_session.h: the data messages built as wire bytes, without protobuf's serialization
+// copy). gRPC's split-streaming handler reads the one request and hands the stream to
+// WireExport; the wire is unchanged (the same ExportChunk messages), so are the clients.
+template <class Base>
+class WithWireExport : public Base {
+ public:
+  using ExportStreamer = grpc::ServerSplitStreamer<v1::ExportRequest, grpc::ByteBuffer>;
+
+  WithWireExport() {
+    this->MarkMethodStreamed(
+        kExportMethod,
+        new grpc::internal::SplitServerStreamingHandler<v1::ExportRequest, grpc::ByteBuffer>(
+            [this](grpc::ServerContext* context, ExportStreamer* streamer) {
+              return this->WireExport(context, streamer);
+            }));
+  }
+  // The generated handler, replaced by WireExport's.
+  grpc::Status Export(grpc::ServerContext* /*context*/, const v1::ExportRequest* /*request*/,
+                      grpc::ServerWriter<v1::ExportChunk>* /*writer*/) final {
+    return grpc::Status(grpc::StatusCode::UNIMPLEMENTED, "Data.Export is served by WireExport");
+  }
+  virtual grpc::Status WireExport(grpc::ServerContext* context, ExportStreamer* streamer) = 0;
+
+ private:
+  // Export's index among Data's methods (brdf.proto's order: StreamReadings, Export,
+  // StreamReadingPoints), as the generated code numbers them.
+  static constexpr int kExportMethod = 1;
+};
+
 // StreamReadings on gRPC's callback API (the stream pump: a following stream that waits holds no
-// thread); the other methods on the synchronous pool.
-using DataServiceBase = v1::Data::WithCallbackMethod_StreamReadings<v1::Data::Service>;
+// thread); Export as above; the other methods on the synchronous pool.
+using DataServiceBase =
+    WithWireExport<v1::Data::WithCallbackMethod_StreamReadings<v1::Data::Service>>;
 
 class DataService final : public DataServiceBase {
  public:
@@ -44,8 +80,7 @@ class DataService final : public DataServiceBase {
   // A session exported to a file (readings CSV, grid .npy/CSV, MERL .binary, RGL .bsdf), streamed
   // as progress, the file's bytes in chunks, then the report (export_session.h). The same
   // session gives the same file from either server.
-  grpc::Status Export(grpc::ServerContext* context, const v1::ExportRequest* request,
-                      grpc::ServerWriter<v1::ExportChunk>* writer) override;
+  grpc::Status WireExport(grpc::ServerContext* context, ExportStreamer* streamer) override;
 
  private:
   // Both readings streams (`rpc`: which one, for its errors): the request checked, the session

@@ -47,6 +47,7 @@
 #include "daemon/api/export_cache.h"
 #include "daemon/api/export_loads.h"
 #include "daemon/api/export_session.h"
+#include "daemon/api/export_wire.h"
 #include "data/cie_tables.h"
 #include "storage/session_readings.h"
 
@@ -55,9 +56,10 @@ namespace {
 
 // ExportRequest.chunk_bytes: default and largest (a chunk must stay under a client's default
 // 4 MiB receive limit together with its framing). The default is small (issue 40): an export
-// whose client reads nothing waits in a write holding one chunk as the message and its serialized
-// copy once the client's window is full; at 1 MiB, 60 of the bench's 100 unread exports held ~2
-// MB each so on a quiet machine. A client that wants larger messages asks for them.
+// whose client reads nothing waits in a write holding one chunk once the client's window is full
+// (the message and its serialized copy until issue 41 built the message in place, export_wire.h);
+// at 1 MiB, 60 of the bench's 100 unread exports held ~2 MB each so on a quiet machine. A client
+// that wants larger messages asks for them.
 constexpr std::uint32_t kDefaultExportChunkBytes = 128 * 1024;
 constexpr std::uint32_t kMaxExportChunkBytes = 4 * 1024 * 1024 - 1024;
 // The most bands a session holds: the CS-2000/3000's 380–780 nm every 1 nm
@@ -66,8 +68,8 @@ constexpr std::size_t kMostBands = 401;
 // Exports have no deadline of their own beyond the client's; this caps a client without one.
 constexpr std::chrono::hours kLongestExport{24};
 // The first data message holds at most this much; each one the client takes doubles the next, up
-// to the request's chunk_bytes. A client that never reads so leaves at most this much (and its
-// serialized copy) waiting in brdfd, not a whole chunk_bytes (issue 40).
+// to the request's chunk_bytes. A client that never reads so leaves at most this much waiting in
+// brdfd, not a whole chunk_bytes (issue 40).
 constexpr std::size_t kFirstExportChunkBytes = 32 * 1024;
 // A progress message goes out when the fraction moved by this much (or the stage changed).
 constexpr double kProgressStep = 0.005;
@@ -81,9 +83,8 @@ constexpr std::uint32_t kMaxRglResolution = 128;
 // its calling thread). A failed Write means the client went away: the export is cancelled.
 class ExportStream {
  public:
-  ExportStream(grpc::ServerContext& context, grpc::ServerWriter<v1::ExportChunk>& writer,
-               StreamRegistry::Slot& slot, const StopSignal& stopping, std::size_t chunk_bytes,
-               CancelToken cancel)
+  ExportStream(grpc::ServerContext& context, ExportWriter& writer, StreamRegistry::Slot& slot,
+               const StopSignal& stopping, std::size_t chunk_bytes, CancelToken cancel)
       : context_(context),
         writer_(writer),
         slot_(slot),
@@ -111,13 +112,13 @@ class ExportStream {
   // full chunks. False once the stream is broken.
   bool Append(const std::string& part, const char* data, std::size_t n) {
     CheckCancelled();
-    Part& p = parts_[part];
+    Part& p = parts_.try_emplace(part, part).first->second;
     while (n > 0 && !broken_) {
-      const std::size_t take = std::min(n, next_chunk_bytes_ - p.buffer.size());
-      p.buffer.append(data, take);
-      data += take;
-      n -= take;
-      if (p.buffer.size() == next_chunk_bytes_) SendBuffer(part, p);
+      if (p.message.capacity() == 0) p.message.Reset(next_chunk_bytes_);
+      const std::size_t took = p.message.Append(data, n);
+      data += took;
+      n -= took;
+      if (p.message.full()) SendBuffer(p);
     }
     return !broken_;
   }
@@ -125,7 +126,7 @@ class ExportStream {
   // Sends what is buffered, of every part. False once the stream is broken.
   bool Flush() {
     for (auto& [name, p] : parts_) {
-      if (!p.buffer.empty() && !broken_) SendBuffer(name, p);
+      if (p.message.size() > 0 && !broken_) SendBuffer(p);
     }
     return !broken_;
   }
@@ -133,8 +134,8 @@ class ExportStream {
   // Sends the report with the file's size and each of its parts' (report.parts by name).
   bool SendReport(v1::ExportReport report) {
     if (!Flush()) return false;
-    report.set_bytes(parts_[""].offset);
-    for (v1::ExportPart& part : *report.mutable_parts()) part.set_bytes(parts_[part.name()].offset);
+    report.set_bytes(SentOf(""));
+    for (v1::ExportPart& part : *report.mutable_parts()) part.set_bytes(SentOf(part.name()));
     v1::ExportChunk chunk;
     *chunk.mutable_report() = std::move(report);
     Send(chunk);
@@ -145,9 +146,15 @@ class ExportStream {
 
  private:
   struct Part {
-    std::string buffer;
-    std::uint64_t offset = 0;  // bytes sent
+    explicit Part(const std::string& name) : message(name) {}
+    ExportDataMessage message;  // the next data message, being filled
+    std::uint64_t offset = 0;   // bytes sent
   };
+
+  std::uint64_t SentOf(const std::string& part) const {
+    const auto it = parts_.find(part);
+    return it == parts_.end() ? 0 : it->second.offset;
+  }
 
   void CheckCancelled() {
     if (cancel_.cancelled()) return;
@@ -158,34 +165,35 @@ class ExportStream {
     }
   }
 
-  // The buffer's bytes move into the message (no copy kept while the write waits), and the
-  // next chunk may be twice as large once this one was taken. The message's memory goes back
-  // once it is written (Send), before the export waits for its next work permit; the next
-  // chunk's buffer is reserved at its size after that wait, when the export works again.
-  void SendBuffer(const std::string& name, Part& p) {
-    v1::ExportChunk chunk;
-    chunk.mutable_data()->set_offset(p.offset);
-    if (!name.empty()) chunk.mutable_data()->set_part(name);
-    p.offset += p.buffer.size();
-    chunk.mutable_data()->set_content(std::move(p.buffer));
-    Send(chunk);
-    p.buffer.clear();
+  // The message's bytes go to gRPC as they are (export_wire.h: no serialization copy, none kept
+  // here while the write waits), and the next chunk may be twice as large once this one was
+  // taken. gRPC frees the message once it is sent; the next chunk's buffer is allocated when the
+  // export appends again, after the wait for its next work permit (Send).
+  void SendBuffer(Part& p) {
+    const std::uint64_t offset = p.offset;
+    p.offset += p.message.size();
+    grpc::ByteBuffer message = p.message.Take(offset);
+    Write(&message);
     next_chunk_bytes_ = std::min(chunk_bytes_, 2 * next_chunk_bytes_);
-    p.buffer.reserve(next_chunk_bytes_);
   }
 
-  // `chunk` is emptied before the wait for a work permit (Slot::WriteAndRelease): a hundred
+  void Send(const v1::ExportChunk& chunk) {
+    grpc::ByteBuffer message = SerializeExportChunk(chunk);
+    Write(&message);
+  }
+
+  // `message` is emptied before the wait for a work permit (Slot::WriteAndRelease): a hundred
   // exports waiting their turn then hold no chunk each (issue 40: up to chunk_bytes apiece).
-  void Send(v1::ExportChunk& chunk) {
+  void Write(grpc::ByteBuffer* message) {
     if (broken_) return;
-    if (!slot_.WriteAndRelease(&writer_, &chunk)) {
+    if (!slot_.WriteAndRelease(&writer_, message)) {
       broken_ = true;
       CheckCancelled();
     }
   }
 
   grpc::ServerContext& context_;
-  grpc::ServerWriter<v1::ExportChunk>& writer_;
+  ExportWriter& writer_;
   StreamRegistry::Slot& slot_;
   const StopSignal& stopping_;
   const std::size_t chunk_bytes_;
@@ -747,10 +755,9 @@ bool KeepsInterpolants(storage::SessionReader& reader, std::int64_t session) {
 }  // namespace
 
 grpc::Status ExportSession(grpc::ServerContext& context, const v1::ExportRequest& request,
-                           grpc::ServerWriter<v1::ExportChunk>& writer, const Authenticator& auth,
-                           StreamRegistry& streams, const StopSignal& stopping,
-                           storage::SessionReader& reader, SharedSessionLoads& loads,
-                           ExportInterpolants& kept) {
+                           ExportWriter& writer, const Authenticator& auth, StreamRegistry& streams,
+                           const StopSignal& stopping, storage::SessionReader& reader,
+                           SharedSessionLoads& loads, ExportInterpolants& kept) {
   Caller caller;
   if (grpc::Status st = auth.CallerOf(context, &caller); !st.ok()) return st;
   std::unique_ptr<StreamRegistry::Slot> slot;

@@ -34,6 +34,8 @@ class Client {
   v1::Control::Stub& control() { return *control_; }
   v1::Data::Stub& data() { return *data_; }
   v1::Interpolation::Stub& interpolation() { return *interpolation_; }
+  // The channel itself, for a call made without the stubs (export_stream.h).
+  const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
 
   // A context for one unary call: token metadata and the configured deadline.
   std::unique_ptr<grpc::ClientContext> UnaryContext() const;

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <utility>
 
+#include "tools/brdfctl/commands/export_stream.h"
 #include "tools/brdfctl/exit_codes.h"
 #include "tools/brdfctl/output/json.h"
 #include "tools/brdfctl/output/text_format.h"
@@ -273,12 +274,15 @@ class ExportDestination {
   ExportDestination(std::ostream& standard_output, std::string partial, bool to_stdout)
       : standard_output_(standard_output), partial_(std::move(partial)), to_stdout_(to_stdout) {}
 
-  bool Open() {
-    if (to_stdout_) return true;
-    file_.open(partial_, std::ios::binary | std::ios::trunc);
-    return static_cast<bool>(file_);
+  bool Open() { return to_stdout_ || file_.Open(partial_); }
+  // Appends the pieces; false when the write fails.
+  bool Write(const std::vector<std::string_view>& pieces) {
+    if (!to_stdout_) return file_.Write(pieces);
+    for (std::string_view p : pieces) {
+      standard_output_.write(p.data(), static_cast<std::streamsize>(p.size()));
+    }
+    return static_cast<bool>(standard_output_);
   }
-  std::ostream& out() { return to_stdout_ ? standard_output_ : file_; }
   // For messages: "standard output" or the .partial file.
   std::string name() const { return to_stdout_ ? "standard output" : partial_; }
   const std::string& partial() const { return partial_; }
@@ -286,27 +290,26 @@ class ExportDestination {
 
   void Discard() {
     if (to_stdout_) return;
-    file_.close();
+    file_.Close();
     std::remove(partial_.c_str());
   }
   // Closes the file and renames it to `path`; false (the .partial file left) when either fails.
   bool Keep(const std::string& path) {
-    file_.close();
-    return file_ && std::rename(partial_.c_str(), path.c_str()) == 0;
+    return file_.Close() && std::rename(partial_.c_str(), path.c_str()) == 0;
   }
 
  private:
   std::ostream& standard_output_;
   std::string partial_;
   bool to_stdout_;
-  std::ofstream file_;
+  ExportFile file_;  // written from the received messages (export_stream.h)
 };
 
 // A companion part of the export (ExportData.part, with --uncertainty): PARTIAL.<part>, renamed
 // beside the file once the report has come.
 struct PartFile {
   std::string partial;
-  std::ofstream file;
+  ExportFile file;
   std::uint64_t bytes = 0;
 };
 
@@ -318,37 +321,37 @@ struct Received {
 
 // Writes a chunk of a companion part at the offset expected; false (the message printed) when
 // the offset, the part's file or the write is wrong.
-bool WritePartChunk(CommandContext& ctx, const v1::ExportData& data,
+bool WritePartChunk(CommandContext& ctx, const ExportMessage& data,
                     const ExportDestination& destination, Received* received) {
-  PartFile& part = received->parts[data.part()];
+  PartFile& part = received->parts[data.part];
   if (part.partial.empty()) {
-    part.partial = destination.partial() + "." + data.part();
-    part.file.open(part.partial, std::ios::binary | std::ios::trunc);
+    part.partial = destination.partial() + "." + data.part;
+    part.file.Open(part.partial);
   }
-  if (data.offset() != part.bytes || !part.file) {
-    ctx.err << "brdfctl export: part '" << data.part()
-            << "': " << (part.file ? "bytes out of order" : "cannot create " + part.partial)
+  if (data.offset != part.bytes || !part.file.ok()) {
+    ctx.err << "brdfctl export: part '" << data.part
+            << "': " << (part.file.ok() ? "bytes out of order" : "cannot create " + part.partial)
             << "; try again\n";
     return false;
   }
-  part.file.write(data.content().data(), static_cast<std::streamsize>(data.content().size()));
-  part.bytes += data.content().size();
-  if (!part.file) ctx.err << "brdfctl export: writing " << part.partial << " failed (disk full?)\n";
-  return static_cast<bool>(part.file);
+  part.bytes += data.content_size;
+  if (!part.file.Write(data.content)) {
+    ctx.err << "brdfctl export: writing " << part.partial << " failed (disk full?)\n";
+    return false;
+  }
+  return true;
 }
 
 // Writes a data chunk at the offset expected; false (the message printed) when the offset or
 // the write is wrong.
-bool WriteChunk(CommandContext& ctx, const v1::ExportData& data, ExportDestination& destination,
+bool WriteChunk(CommandContext& ctx, const ExportMessage& data, ExportDestination& destination,
                 std::uint64_t received) {
-  if (data.offset() != received) {
-    ctx.err << "brdfctl export: the daemon sent bytes at offset " << data.offset() << " after "
+  if (data.offset != received) {
+    ctx.err << "brdfctl export: the daemon sent bytes at offset " << data.offset << " after "
             << received << " bytes; try again\n";
     return false;
   }
-  destination.out().write(data.content().data(),
-                          static_cast<std::streamsize>(data.content().size()));
-  if (!destination.out()) {
+  if (!destination.Write(data.content)) {
     ctx.err << "brdfctl export: writing " << destination.name() << " failed (disk full?)\n";
     return false;
   }
@@ -361,36 +364,41 @@ int ReceiveExport(CommandContext& ctx, const ExportOptions& o, const v1::ExportR
                   ExportDestination& destination, Received* received) {
   ExportProgressLine line(ctx.err, o.what, o.progress, o.progress_tty);
   std::unique_ptr<grpc::ClientContext> call = ctx.client.StreamContext();
-  std::unique_ptr<grpc::ClientReader<v1::ExportChunk>> reader =
-      ctx.client.data().Export(call.get(), request);
-  v1::ExportChunk chunk;
+  ExportStreamReader reader(ctx.client.channel(), call.get(), request);
+  ExportMessage m;
   std::string stage = "waiting";
   double fraction = 0;
-  while (reader->Read(&chunk)) {
-    if (chunk.has_progress()) {
-      stage = chunk.progress().stage();
-      fraction = chunk.progress().fraction();
-      line.Update(stage, fraction, received->bytes);
-    } else if (chunk.has_data() && !chunk.data().part().empty()) {
-      if (destination.to_stdout() || !WritePartChunk(ctx, chunk.data(), destination, received)) {
+  while (reader.Read(&m)) {
+    if (m.data && !m.part.empty()) {
+      if (destination.to_stdout() || !WritePartChunk(ctx, m, destination, received)) {
         call->TryCancel();
         line.Finish();
         return kExitFailure;
       }
-    } else if (chunk.has_data()) {
-      if (!WriteChunk(ctx, chunk.data(), destination, received->bytes)) {
+    } else if (m.data) {
+      if (!WriteChunk(ctx, m, destination, received->bytes)) {
         call->TryCancel();
         line.Finish();
         return kExitFailure;
       }
-      received->bytes += chunk.data().content().size();
+      received->bytes += m.content_size;
       line.Update(stage, fraction, received->bytes);
-    } else if (chunk.has_report()) {
-      received->report = chunk.report();
+    } else if (m.chunk.has_progress()) {
+      stage = m.chunk.progress().stage();
+      fraction = m.chunk.progress().fraction();
+      line.Update(stage, fraction, received->bytes);
+    } else if (m.chunk.has_report()) {
+      received->report = m.chunk.report();
     }
   }
   line.Finish();
-  const grpc::Status status = reader->Finish();
+  if (reader.malformed()) {
+    call->TryCancel();
+    ctx.err << "brdfctl export: the daemon sent a message that is not an ExportChunk; is "
+            << ctx.client.options().address << " brdfd?\n";
+    return kExitFailure;
+  }
+  const grpc::Status status = reader.Finish();
   if (!status.ok()) {
     return ReportRpcError(ctx.err, status, "Export", ctx.client.options().address);
   }
@@ -410,9 +418,8 @@ bool KeepParts(std::ostream& err, const v1::ExportReport& report, const std::str
   for (const v1::ExportPart& p : report.parts()) {
     PartFile& part = received->parts[p.name()];
     if (part.partial.empty() && p.bytes() == 0) continue;
-    part.file.close();
     const std::string to = PartPath(path, p);
-    if (part.bytes != p.bytes() || !part.file ||
+    if (part.bytes != p.bytes() || !part.file.Close() ||
         std::rename(part.partial.c_str(), to.c_str()) != 0) {
       err << "brdfctl export: part '" << p.name() << "' (" << part.bytes << " of " << p.bytes()
           << " bytes) could not be kept as " << to << "; try again\n";
@@ -471,7 +478,7 @@ int RunExport(CommandContext& ctx, const ExportOptions& o) {
   if (int rc = ReceiveExport(ctx, o, request, destination, &received); rc != kExitOk) {
     destination.Discard();
     for (auto& [name, part] : received.parts) {
-      part.file.close();
+      part.file.Close();
       std::remove(part.partial.c_str());
     }
     return rc;
