@@ -26,7 +26,10 @@ daemon is asked at the four angles themselves, φ not mirrored (mirror_phi is fo
 sessions).
 
 Prints one JSON object per session on stdout: label, session, err, peak, retro, fallback (share
-of the random directions), n (directions), and progress on stderr.
+of the random directions), n (directions), and progress on stderr. --breakdown adds the random
+directions' err² split as the offline study's --breakdown splits it (shares adding up to err²): by
+the half-vector angle θh (bins 0, 5, 10, 15, 25, 90°), by the lamp–detector angle ψ (bins 0, 5.625,
+11.25, 16.875, 22.5, 33.75, 180°), at θi or θo above 75°, and where the octant method had no answer.
 
     daemon_bench_error.py --address 127.0.0.1:50051 --token T --sim build/tools/brdf-sim/brdf-sim \\
         --material deploy/materials/paint.toml --session grid=1 --session adapt20=3
@@ -141,6 +144,38 @@ def relative_rms(estimate, truth, d4):
     return float(np.sqrt(np.sum(((estimate - truth) * w) ** 2) / np.sum((truth * w) ** 2)))
 
 
+THETA_H_BINS = (0.0, 5.0, 10.0, 15.0, 25.0, 90.001)  # degrees: the offline study's --breakdown
+PSI_BINS = (0.0, 5.625, 11.25, 16.875, 22.5, 33.75, 180.001)  # ψ, the lamp–detector angle: the same
+
+
+def half_angles(d4):
+    """(θh, ψ) in degrees of each row (θi, φi, θo, φo): the half vector's angle from the normal
+    and the angle between lamp and detector."""
+    t = np.radians(d4)
+    lamp = np.column_stack([np.sin(t[:, 0]) * np.cos(t[:, 1]), np.sin(t[:, 0]) * np.sin(t[:, 1]),
+                            np.cos(t[:, 0])])
+    det = np.column_stack([np.sin(t[:, 2]) * np.cos(t[:, 3]), np.sin(t[:, 2]) * np.sin(t[:, 3]),
+                           np.cos(t[:, 2])])
+    h = lamp + det
+    h /= np.linalg.norm(h, axis=1, keepdims=True)
+    psi = np.degrees(np.arccos(np.clip(np.sum(lamp * det, axis=1), -1.0, 1.0)))
+    return np.degrees(np.arccos(np.clip(h[:, 2], -1.0, 1.0))), psi
+
+
+def breakdown(estimate, truth, d4, missing):
+    """The squared error's shares (adding up to err²) by θh bin, by ψ bin, at θi or θo above 75°,
+    and where the octant method had no answer, as the offline study's --breakdown splits them."""
+    w = np.cos(np.radians(d4[:, 0])) * np.cos(np.radians(d4[:, 2]))
+    e2 = ((estimate - truth) * w) ** 2 / np.sum((truth * w) ** 2)
+    theta_h, psi = half_angles(d4)
+    bins = np.digitize(theta_h, THETA_H_BINS) - 1
+    psi_bins = np.digitize(psi, PSI_BINS) - 1
+    return {"by_theta_h": [float(e2[bins == b].sum()) for b in range(len(THETA_H_BINS) - 1)],
+            "by_psi": [float(e2[psi_bins == b].sum()) for b in range(len(PSI_BINS) - 1)],
+            "grazing": float(e2[np.maximum(d4[:, 0], d4[:, 2]) > 75.0].sum()),
+            "unanswered": float(e2[missing].sum())}
+
+
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--address", required=True, help="brdfd's gRPC address, host:port")
@@ -154,6 +189,8 @@ def parse_args():
     p.add_argument("--seed", type=int, default=20261206, help="the random directions' seed")
     p.add_argument("--theta-max", type=float, default=80.0, help="θi, θo at most, degrees")
     p.add_argument("--truth-cache", default="", help="an .npz file caching the truth")
+    p.add_argument("--breakdown", action="store_true",
+                   help="add the random directions' err² by θh and ψ bin, at θ > 75° and unanswered")
     p.add_argument("--four-angles", action="store_true",
                    help="anisotropic sessions: ask at (θi, φi, θo, φo), φ not mirrored")
     return p.parse_args()
@@ -185,6 +222,9 @@ def main():
                    "fallback": float(missing[parts["err"]].mean())}
             for name, part in parts.items():
                 row[name] = relative_rms(values[part], truth[part], every[part])
+            if a.breakdown:
+                part = parts["err"]
+                row["breakdown"] = breakdown(values[part], truth[part], every[part], missing[part])
             log(f"{label} (session {sid}): err {row['err']:.4f}, peak {row['peak']:.4f}, "
                 f"retro {row['retro']:.4f}, fallback {100 * row['fallback']:.1f} % "
                 f"({time.monotonic() - start:.1f} s)")
