@@ -6,6 +6,7 @@
 // exports to files (Export) live in export.cc.
 #pragma once
 
+#include <google/protobuf/descriptor.h>
 #include <grpcpp/support/byte_buffer.h>
 #include <grpcpp/support/method_handler.h>
 #include <grpcpp/support/sync_stream.h>
@@ -37,7 +38,7 @@ class WithWireExport : public Base {
 
   WithWireExport() {
     this->MarkMethodStreamed(
-        kExportMethod,
+        ExportMethodIndex(),
         new grpc::internal::SplitServerStreamingHandler<v1::ExportRequest, grpc::ByteBuffer>(
             [this](grpc::ServerContext* context, ExportStreamer* streamer) {
               return this->WireExport(context, streamer);
@@ -51,9 +52,14 @@ class WithWireExport : public Base {
   virtual grpc::Status WireExport(grpc::ServerContext* context, ExportStreamer* streamer) = 0;
 
  private:
-  // Export's index among Data's methods (brdf.proto's order: StreamReadings, Export,
-  // StreamReadingPoints), as the generated code numbers them.
-  static constexpr int kExportMethod = 1;
+  // Export's index among Data's methods as the generated service numbers them: the proto's
+  // order, read from its descriptor so that a reordered brdf.proto cannot misroute the handler.
+  static int ExportMethodIndex() {
+    const google::protobuf::ServiceDescriptor* data =
+        google::protobuf::DescriptorPool::generated_pool()->FindServiceByName(
+            v1::Data::service_full_name());
+    return data->FindMethodByName("Export")->index();
+  }
 };
 
 // StreamReadings on gRPC's callback API (the stream pump: a following stream that waits holds no

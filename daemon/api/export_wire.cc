@@ -1,9 +1,5 @@
-// ExportDataMessage (export_wire.h): the wire form of ExportChunk {data: ExportData}, as protobuf
-// writes it (fields in number order, zero and empty fields left out, lengths as varints):
-//   0x12 len(ExportData)          ExportChunk.data, field 2, length-delimited
-//     0x08 varint(offset)         ExportData.offset, field 1 (when not 0)
-//     0x12 varint(n) content      ExportData.content, field 2 (when not empty)
-//     0x1a varint(m) part         ExportData.part, field 3 (when not empty)
+// ExportDataMessage (export_wire.h): the wire form of ExportChunk {data: ExportData} laid out as
+// core/export/chunk_wire.h describes it.
 #include "daemon/api/export_wire.h"
 
 #include <grpcpp/impl/codegen/proto_utils.h>
@@ -12,40 +8,32 @@
 #include <algorithm>
 #include <cstring>
 
+#include "core/export/chunk_wire.h"
+
 namespace brdf::daemon {
 namespace {
 
-constexpr std::uint8_t kChunkData = 0x12;    // ExportChunk.data: field 2, wire type 2
-constexpr std::uint8_t kDataOffset = 0x08;   // ExportData.offset: field 1, wire type 0
-constexpr std::uint8_t kDataContent = 0x12;  // ExportData.content: field 2, wire type 2
-constexpr std::uint8_t kDataPart = 0x1a;     // ExportData.part: field 3, wire type 2
-constexpr std::size_t kLongestVarint = 10;   // a uint64
+using exports::chunk_wire::BytesFieldSize;
+using exports::chunk_wire::kChunkData;
+using exports::chunk_wire::kDataContent;
+using exports::chunk_wire::kDataOffset;
+using exports::chunk_wire::kDataPart;
+using exports::chunk_wire::kLengthType;
+using exports::chunk_wire::kLongestVarint;
+using exports::chunk_wire::kVarintType;
+using exports::chunk_wire::PutVarint;
+using exports::chunk_wire::Tag;
+using exports::chunk_wire::VarintSize;
+
+// The layout's tags are the generated messages' field numbers (a renumbered proto fails here).
+static_assert(kChunkData == Tag(v1::ExportChunk::kDataFieldNumber, kLengthType));
+static_assert(kDataOffset == Tag(v1::ExportData::kOffsetFieldNumber, kVarintType));
+static_assert(kDataContent == Tag(v1::ExportData::kContentFieldNumber, kLengthType));
+static_assert(kDataPart == Tag(v1::ExportData::kPartFieldNumber, kLengthType));
+
 // Room before the content: the chunk's tag and length, the offset's tag and value, the content's
 // tag and length.
 constexpr std::size_t kHeaderRoom = 3 * (1 + kLongestVarint);
-
-std::size_t VarintSize(std::uint64_t v) {
-  std::size_t n = 1;
-  while (v >= 0x80) {
-    v >>= 7;
-    ++n;
-  }
-  return n;
-}
-
-std::uint8_t* PutVarint(std::uint8_t* at, std::uint64_t v) {
-  while (v >= 0x80) {
-    *at++ = static_cast<std::uint8_t>(v | 0x80);
-    v >>= 7;
-  }
-  *at++ = static_cast<std::uint8_t>(v);
-  return at;
-}
-
-// A length-delimited field's size on the wire, with its tag: 0 when empty (left out).
-std::size_t BytesFieldSize(std::size_t n) {
-  return n == 0 ? 0 : 1 + VarintSize(n) + n;
-}
 
 }  // namespace
 

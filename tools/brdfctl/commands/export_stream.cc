@@ -9,9 +9,12 @@
 #include <climits>
 
 #include "brdf/v1/brdf.grpc.pb.h"
+#include "core/export/chunk_wire.h"
 
 namespace brdf::ctl {
 namespace {
+
+namespace chunk_wire = exports::chunk_wire;
 
 // The method's path, "/brdf.v1.Data/Export", from the generated service's name.
 const char* ExportMethodPath() {
@@ -35,14 +38,7 @@ class SliceCursor {
   }
 
   bool Varint(std::uint64_t* v) {
-    *v = 0;
-    for (int shift = 0; shift < 64; shift += 7) {
-      std::uint8_t b = 0;
-      if (!Byte(&b)) return false;
-      *v |= static_cast<std::uint64_t>(b & 0x7f) << shift;
-      if ((b & 0x80) == 0) return true;
-    }
-    return false;
+    return exports::chunk_wire::GetVarint([this](std::uint8_t* b) { return Byte(b); }, v);
   }
 
   // The next `n` bytes as pieces of the slices.
@@ -72,25 +68,27 @@ class SliceCursor {
   std::uint64_t position_ = 0;
 };
 
-// A data message as brdfd lays it out: ExportChunk holding only ExportData (field 2), whose
-// fields are offset (1), content (2) and part (3). False for anything else (protobuf parses it).
+// A data message as brdfd lays it out (core/export/chunk_wire.h): ExportChunk holding only
+// ExportData, whose fields are offset, content and part. False for anything else (protobuf
+// parses it).
 bool ParseDataInPlace(std::uint64_t total, ExportMessage* out) {
   SliceCursor in(out->slices);
   std::uint64_t tag = 0;
   std::uint64_t length = 0;
-  if (!in.Varint(&tag) || tag != 0x12 || !in.Varint(&length) || in.position() + length != total) {
+  if (!in.Varint(&tag) || tag != chunk_wire::kChunkData || !in.Varint(&length) ||
+      in.position() + length != total) {
     return false;
   }
   while (in.position() < total) {
     std::uint64_t n = 0;
     if (!in.Varint(&tag)) return false;
-    if (tag == 0x08) {
+    if (tag == chunk_wire::kDataOffset) {
       if (!in.Varint(&out->offset)) return false;
-    } else if (tag == 0x12) {
+    } else if (tag == chunk_wire::kDataContent) {
       out->content.clear();
       if (!in.Varint(&n) || !in.Take(n, &out->content)) return false;
       out->content_size = n;
-    } else if (tag == 0x1a) {
+    } else if (tag == chunk_wire::kDataPart) {
       std::vector<std::string_view> name;
       if (!in.Varint(&n) || n > 256 || !in.Take(n, &name)) return false;
       out->part.clear();

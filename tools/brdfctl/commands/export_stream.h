@@ -1,7 +1,7 @@
 // brdfctl export's end of Data.Export (issue 41, exports at the disk's speed): the stream read as
 // gRPC's buffers; a data message's content found in the received slices instead of copied out by
 // protobuf's parser, and written to its file with writev straight from them. Progress, the
-// report, and any data message not laid out as brdfd writes it (daemon/api/export_wire.h) are
+// report, and any data message not laid out as brdfd writes it (core/export/chunk_wire.h) are
 // parsed by protobuf: the stream is the same ExportChunk messages whoever sent them.
 #pragma once
 
