@@ -10,7 +10,7 @@ import { readFileSync, readdirSync, mkdirSync, mkdtempSync, writeFileSync } from
 import { tmpdir } from 'node:os';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { startRig, startArchive, outputDir, check } from './rig.mjs';
+import { startRig, startArchive, outputDir, check, removeTestDir } from './rig.mjs';
 import { startPostgres } from './pg.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
@@ -32,11 +32,12 @@ let rig = null;
 let archive = null;
 let browser = null;
 let failed = false;
+let secrets = null;
 const errors = [];
 try {
   // --- the archive, a rig shipping to it, one recorded session --------------------------------
   pg = await startPostgres();
-  const secrets = mkdtempSync(join(tmpdir(), 'brdf-web-rig-'));
+  secrets = mkdtempSync(join(tmpdir(), 'brdf-web-rig-'));
   const credentials = join(secrets, 'archive.conninfo');
   writeFileSync(credentials, `${pg.conninfo}\n`, { mode: 0o600 });
   rig = await startRig({ timeScale: 40, extraConfig: `[rig]\nname = "rig-web"\n[archive]\ncredentials = "${credentials}"\n` });
@@ -144,5 +145,6 @@ try {
 } finally {
   if (browser) { await Promise.race([browser.close().catch(() => {}), sleep(5000)]); browser.process()?.kill('SIGKILL'); }
   for (const p of [archive, rig, pg]) if (p) await p.stop().catch(() => {});
+  if (secrets) removeTestDir(secrets);
 }
 process.exit(failed ? 1 : 0);

@@ -2,7 +2,7 @@
 // the stage on Modbus TCP), brdfd with an operator and an analyst token and the web console on a
 // free port. Paths come from BRDF_BUILD_DIR (the CMake build tree).
 import { spawn, execFile } from 'node:child_process';
-import { mkdtempSync, writeFileSync, readFileSync, existsSync, mkdirSync } from 'node:fs';
+import { mkdtempSync, writeFileSync, readFileSync, existsSync, mkdirSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { createInterface } from 'node:readline';
@@ -53,6 +53,16 @@ listen = "127.0.0.1:0"
 [log]
 level = "info"
 `;
+}
+
+// A test's working directory removed once its processes are gone (databases, logs, credentials),
+// unless BRDF_KEEP_TEST_DIRS is set to look at them; tests print the logs they need before.
+export function removeTestDir(dir) {
+  if (process.env.BRDF_KEEP_TEST_DIRS) {
+    console.error(`kept ${dir} (BRDF_KEEP_TEST_DIRS)`);
+    return;
+  }
+  rmSync(dir, { recursive: true, force: true });
 }
 
 // SIGTERM, then SIGKILL after 8 s; resolves once the process has exited.
@@ -115,6 +125,7 @@ ${tokensWebAndLog(operatorToken, analystToken)}${extraConfig}`);
     },
     async stop() {
       for (const p of [daemon, simProc]) await stopProcess(p);
+      removeTestDir(dir);
     },
   };
   return rig;
@@ -138,7 +149,10 @@ ${tokensWebAndLog(operatorToken, analystToken)}`, { mode: 0o600 });
   const info = await waitFor(proc, 'brdf-archive', { web: /^brdf-archive web explorer on (\S+)/, grpc: /^brdf-archive listening on (\S+)/ }, 20, log);
   return {
     url: info.web, grpc: info.grpc, log,
-    stop() { return stopProcess(proc); },
+    async stop() {
+      await stopProcess(proc);
+      removeTestDir(dir);
+    },
   };
 }
 
