@@ -4,11 +4,13 @@
 //   search  SpectraAt on one thread, one θi slice per batch (core/export/grid/regular_grid.cc
 //           batches a 1° × 1° × 2° grid that way): the time in SpectraAt and a checksum of the
 //           statuses and spectra (equal checksums: the same answers, bit for bit);
+//   random  SpectraAt of 100,000 uniform random directions (θi, θo ∈ [0, 90), φ ∈ [0, 180)) in
+//           one call, as bench_interpolate_batch's (not the same numbers): the other batch shape;
 //   write   ResampleOnGrid on every core into an .npy file with NpyGridWriter: what an export
 //           that brdfd wrote to the file itself would cost (no fallback for the cells the octant
 //           method leaves empty: they hold NaN).
 //
-// Usage: bench_grid_search search|write POINTS.f64 VALUES.f64 BANDS [OUT.npy] [REPS]
+// Usage: bench_grid_search search|random|write POINTS.f64 VALUES.f64 BANDS [OUT.npy] [REPS]
 //   POINTS.f64: n × 3 doubles (θi, θo, φ in degrees, as brdfd reduces a reading); VALUES.f64:
 //   n × BANDS doubles (numpy's tofile of a readings CSV's BRDF, bench/README.md says how).
 #include <chrono>
@@ -18,6 +20,7 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -83,6 +86,28 @@ void Search(const brdf::interp::OctantInterpolator& interp, const brdf::exports:
               static_cast<unsigned long long>(h));
 }
 
+// SpectraAt of 100,000 random directions (a fixed seed) in one call; prints the time and checksum.
+void Random(const brdf::interp::OctantInterpolator& interp, int bands) {
+  constexpr std::size_t kQueries = 100000;
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> q(3 * kQueries);
+  for (std::size_t i = 0; i < kQueries; ++i) {
+    q[3 * i] = 90.0 * u(rng);
+    q[3 * i + 1] = 90.0 * u(rng);
+    q[3 * i + 2] = 180.0 * u(rng);
+  }
+  std::vector<brdf::interp::InterpStatus> st(kQueries);
+  std::vector<double> out(kQueries * static_cast<std::size_t>(bands));
+  const auto t0 = Clock::now();
+  interp.SpectraAt(q, st, out);
+  const double s = Since(t0);
+  std::uint64_t h = Mix(1469598103934665603ull, st.data(), st.size() * sizeof(st[0]));
+  h = Mix(h, out.data(), out.size() * sizeof(double));
+  std::printf("random_s=%.3f queries=%zu checksum=%016llx\n", s, kQueries,
+              static_cast<unsigned long long>(h));
+}
+
 // ResampleOnGrid on every core into `path`; prints the time (the file closed).
 int Write(const brdf::interp::OctantInterpolator& interp, const brdf::exports::RegularGrid& grid,
           int bands, const char* path) {
@@ -109,7 +134,8 @@ int Write(const brdf::interp::OctantInterpolator& interp, const brdf::exports::R
 
 int main(int argc, char** argv) {
   if (argc < 5) {
-    std::fprintf(stderr, "usage: %s search|write POINTS.f64 VALUES.f64 BANDS [OUT.npy] [REPS]\n",
+    std::fprintf(stderr,
+                 "usage: %s search|random|write POINTS.f64 VALUES.f64 BANDS [OUT.npy] [REPS]\n",
                  argv[0]);
     return 2;
   }
@@ -138,7 +164,9 @@ int main(int argc, char** argv) {
   auto grid = brdf::exports::MakeRegularGrid(1, 1, 2, brdf::exports::GridPlacement::kCellCentres);
   if (!grid.ok()) return 1;
   for (int r = 0; r < reps; ++r) {
-    if (!write) {
+    if (mode == "random") {
+      Random(**made, bands);
+    } else if (!write) {
       Search(**made, *grid, bands);
     } else if (Write(**made, *grid, bands, argv[5]) != 0) {
       return 1;
