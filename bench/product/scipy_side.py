@@ -6,6 +6,8 @@
         slice of θi into a .npy of shape (nθi, nθo, nφ, bands), as `brdfctl export <id> grid` does
   batch READINGS_CSV DIRECTIONS_CSV OUT_RAW  LinearNDInterpolator at the directions (one call),
         raw doubles n × bands, as InterpolateBatch answers them
+  points READINGS_CSV POINTS_F64 VALUES_F64  the same samples as raw doubles (n × 3 directions,
+        n × bands values), the input of bench_grid_search (grid_search.cc); no interpolation
 
 Both print one JSON line: the wall seconds of each part and in total (reading the CSV included:
 brdfd reads its SQLite database too). The samples are the readings CSV's sample rows, at (θi, θo,
@@ -48,6 +50,11 @@ def main():
     t0 = time.perf_counter()
     pts, vals = load(sys.argv[2])
     t1 = time.perf_counter()
+    if what == "points":
+        np.ascontiguousarray(pts, dtype="<f8").tofile(sys.argv[3])
+        np.ascontiguousarray(vals, dtype="<f8").tofile(sys.argv[4])
+        print(json.dumps({"what": what, "samples": len(pts), "bands": vals.shape[1]}))
+        return
     interp = LinearNDInterpolator(pts, vals)
     t2 = time.perf_counter()
     out = {"what": what, "samples": len(pts), "bands": vals.shape[1], "load_s": t1 - t0,
