@@ -56,16 +56,29 @@ void AppendLittleEndian(std::span<const double> values, std::string& out) {
 
 namespace {
 
-// `values` rounded to floats, little-endian, into dst (4 bytes a value).
+// `values` rounded to floats, little-endian, into dst (4 bytes a value). On a little-endian host
+// a block at a time through a float array, a loop the compiler vectorises (the same conversion,
+// value by value, as static_cast<float>).
 void Float32Into(std::span<const double> values, char* dst) {
+  if constexpr (std::endian::native == std::endian::little) {
+    constexpr std::size_t kBlock = 8;
+    const double* from = values.data();
+    const std::size_t n = values.size();
+    std::size_t i = 0;
+    for (; i + kBlock <= n; i += kBlock) {
+      float block[kBlock];
+      for (std::size_t j = 0; j < kBlock; ++j) block[j] = static_cast<float>(from[i + j]);
+      std::memcpy(dst + i * sizeof(float), block, sizeof block);
+    }
+    for (; i < n; ++i) {
+      const float f = static_cast<float>(from[i]);
+      std::memcpy(dst + i * sizeof(float), &f, sizeof f);
+    }
+    return;
+  }
   for (double v : values) {
     const auto bits = std::bit_cast<std::uint32_t>(static_cast<float>(v));
-    if constexpr (std::endian::native == std::endian::little) {
-      std::memcpy(dst, &bits, sizeof bits);
-      dst += sizeof bits;
-    } else {
-      for (int b = 0; b < 4; ++b) *dst++ = static_cast<char>((bits >> (8 * b)) & 0xff);
-    }
+    for (int b = 0; b < 4; ++b) *dst++ = static_cast<char>((bits >> (8 * b)) & 0xff);
   }
 }
 
