@@ -109,10 +109,88 @@ template <int W>
   }
 }
 
+// BlendSquaredBands' pass (band_sums.h): each band's expressions exactly as the loops above write
+// them, so that the compiler forms them alike (the same fused multiply-adds).
+template <int W>
+[[gnu::always_inline]] inline void BlendSquaredLanes(
+    double* __restrict measurement, double* __restrict shared, const double* const* independent,
+    const double* scales, std::size_t r, const WeightedRows* inputs, std::size_t m, std::size_t n) {
+  const Lanes<W> zero = {};
+  Lanes<W> u, s, v, t;
+  std::size_t k = 0;
+  for (; k + W <= n; k += W) {
+    u = zero;
+    for (std::size_t i = 0; i < r; ++i) {
+      std::memcpy(&v, independent[i] + k, sizeof v);
+      u += scales[i] * (v * v);
+    }
+    s = zero;
+    for (std::size_t j = 0; j < m; ++j) {
+      const WeightedRows& in = inputs[j];
+      std::memcpy(&v, in.rows[0] + k, sizeof v);
+      t = in.weights[0] * v;
+      for (std::size_t i = 1; i < in.count; ++i) {
+        std::memcpy(&v, in.rows[i] + k, sizeof v);
+        t += in.weights[i] * v;
+      }
+      s += t * t;
+    }
+    if (shared != nullptr) std::memcpy(shared + k, &s, sizeof s);
+    s += u;
+    std::memcpy(measurement + k, &s, sizeof s);
+  }
+  for (; k < n; ++k) {
+    double ind = 0;
+    for (std::size_t i = 0; i < r; ++i) ind += scales[i] * (independent[i][k] * independent[i][k]);
+    double acc = 0;
+    for (std::size_t j = 0; j < m; ++j) {
+      const WeightedRows& in = inputs[j];
+      double sum = in.weights[0] * in.rows[0][k];
+      for (std::size_t i = 1; i < in.count; ++i) sum += in.weights[i] * in.rows[i][k];
+      acc += sum * sum;
+    }
+    if (shared != nullptr) shared[k] = acc;
+    measurement[k] = acc + ind;
+  }
+}
+
+template <int W>
+[[gnu::always_inline]] inline void SquaredDifferencesLanes(double* __restrict acc,
+                                                           const double* const* x,
+                                                           const double* __restrict y,
+                                                           const double* a, std::size_t m,
+                                                           std::size_t n) {
+  const Lanes<W> zero = {};
+  Lanes<W> s, v, w;
+  std::size_t k = 0;
+  for (; k + W <= n; k += W) {
+    std::memcpy(&w, y + k, sizeof w);
+    s = zero;
+    for (std::size_t i = 0; i < m; ++i) {
+      std::memcpy(&v, x[i] + k, sizeof v);
+      v -= w;
+      s += a[i] * (v * v);
+    }
+    std::memcpy(acc + k, &s, sizeof s);
+  }
+  for (; k < n; ++k) {
+    double sum = 0;
+    for (std::size_t i = 0; i < m; ++i) {
+      const double d = x[i][k] - y[k];
+      sum += a[i] * (d * d);
+    }
+    acc[k] = sum;
+  }
+}
+
 using ScaledFn = void (*)(double*, const double*, double, std::size_t);
 using SumFn = void (*)(double*, const double* const*, const double*, std::size_t, std::size_t);
 using DifferenceFn = void (*)(double*, const double*, const double*, double, std::size_t);
 using SqrtFn = void (*)(double*, std::size_t);
+using BlendFn = void (*)(double*, double*, const double* const*, const double*, std::size_t,
+                         const WeightedRows*, std::size_t, std::size_t);
+using DifferencesFn = void (*)(double*, const double* const*, const double*, const double*,
+                               std::size_t, std::size_t);
 
 struct Kernels {
   ScaledFn add_scaled;
@@ -120,6 +198,8 @@ struct Kernels {
   DifferenceFn add_squared_difference;
   SumFn add_squared_sum;
   SqrtFn sqrt;
+  BlendFn blend_squared;
+  DifferencesFn squared_differences;
 };
 
 // The scalar square root (the vector extension has none; the vector variants use intrinsics).
@@ -140,6 +220,14 @@ void AddSquaredDifference2(double* acc, const double* x, const double* y, double
 void AddSquaredSum2(double* acc, const double* const* x, const double* w, std::size_t m,
                     std::size_t n) {
   AddSquaredSumLanes<2>(acc, x, w, m, n);
+}
+void BlendSquared2(double* m, double* shared, const double* const* ind, const double* scales,
+                   std::size_t r, const WeightedRows* inputs, std::size_t count, std::size_t n) {
+  BlendSquaredLanes<2>(m, shared, ind, scales, r, inputs, count, n);
+}
+void SquaredDifferences2(double* acc, const double* const* x, const double* y, const double* a,
+                         std::size_t m, std::size_t n) {
+  SquaredDifferencesLanes<2>(acc, x, y, a, m, n);
 }
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 void Sqrt2(double* x, std::size_t n) {
@@ -171,6 +259,17 @@ __attribute__((target("avx2"))) void AddSquaredSum4(double* acc, const double* c
                                                     const double* w, std::size_t m, std::size_t n) {
   AddSquaredSumLanes<4>(acc, x, w, m, n);
 }
+__attribute__((target("avx2"))) void BlendSquared4(double* m, double* shared,
+                                                   const double* const* ind, const double* scales,
+                                                   std::size_t r, const WeightedRows* inputs,
+                                                   std::size_t count, std::size_t n) {
+  BlendSquaredLanes<4>(m, shared, ind, scales, r, inputs, count, n);
+}
+__attribute__((target("avx2"))) void SquaredDifferences4(double* acc, const double* const* x,
+                                                         const double* y, const double* a,
+                                                         std::size_t m, std::size_t n) {
+  SquaredDifferencesLanes<4>(acc, x, y, a, m, n);
+}
 __attribute__((target("avx2"))) void Sqrt4(double* x, std::size_t n) {
   std::size_t k = 0;
   for (; k + 4 <= n; k += 4) _mm256_storeu_pd(x + k, _mm256_sqrt_pd(_mm256_loadu_pd(x + k)));
@@ -194,6 +293,18 @@ __attribute__((target("avx512f"))) void AddSquaredSum8(double* acc, const double
                                                        std::size_t n) {
   AddSquaredSumLanes<8>(acc, x, w, m, n);
 }
+__attribute__((target("avx512f"))) void BlendSquared8(double* m, double* shared,
+                                                      const double* const* ind,
+                                                      const double* scales, std::size_t r,
+                                                      const WeightedRows* inputs, std::size_t count,
+                                                      std::size_t n) {
+  BlendSquaredLanes<8>(m, shared, ind, scales, r, inputs, count, n);
+}
+__attribute__((target("avx512f"))) void SquaredDifferences8(double* acc, const double* const* x,
+                                                            const double* y, const double* a,
+                                                            std::size_t m, std::size_t n) {
+  SquaredDifferencesLanes<8>(acc, x, y, a, m, n);
+}
 __attribute__((target("avx512f"))) void Sqrt8(double* x, std::size_t n) {
   std::size_t k = 0;
   for (; k + 8 <= n; k += 8) _mm512_storeu_pd(x + k, _mm512_sqrt_pd(_mm512_loadu_pd(x + k)));
@@ -204,11 +315,14 @@ __attribute__((target("avx512f"))) void Sqrt8(double* x, std::size_t n) {
 Kernels PickKernels() {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
   if (__builtin_cpu_supports("avx512f"))
-    return {&AddScaled8, &AddSquared8, &AddSquaredDifference8, &AddSquaredSum8, &Sqrt8};
+    return {&AddScaled8, &AddSquared8,   &AddSquaredDifference8, &AddSquaredSum8,
+            &Sqrt8,      &BlendSquared8, &SquaredDifferences8};
   if (__builtin_cpu_supports("avx2"))
-    return {&AddScaled4, &AddSquared4, &AddSquaredDifference4, &AddSquaredSum4, &Sqrt4};
+    return {&AddScaled4, &AddSquared4,   &AddSquaredDifference4, &AddSquaredSum4,
+            &Sqrt4,      &BlendSquared4, &SquaredDifferences4};
 #endif
-  return {&AddScaled2, &AddSquared2, &AddSquaredDifference2, &AddSquaredSum2, &Sqrt2};
+  return {&AddScaled2, &AddSquared2,   &AddSquaredDifference2, &AddSquaredSum2,
+          &Sqrt2,      &BlendSquared2, &SquaredDifferences2};
 }
 
 const Kernels& Picked() {
@@ -235,6 +349,19 @@ void AddSquaredSumBands(std::span<double> acc, std::span<const double* const> x,
                         std::span<const double> w) {
   if (w.empty()) return;
   Picked().add_squared_sum(acc.data(), x.data(), w.data(), w.size(), acc.size());
+}
+
+void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,
+                       std::span<const double* const> independent_rows,
+                       std::span<const double> scales, std::span<const WeightedRows> inputs) {
+  Picked().blend_squared(measurement.data(), shared.empty() ? nullptr : shared.data(),
+                         independent_rows.data(), scales.data(), independent_rows.size(),
+                         inputs.data(), inputs.size(), measurement.size());
+}
+
+void SquaredDifferencesBands(std::span<double> acc, std::span<const double* const> x,
+                             std::span<const double> y, std::span<const double> a) {
+  Picked().squared_differences(acc.data(), x.data(), y.data(), a.data(), x.size(), acc.size());
 }
 
 void SqrtBands(std::span<double> x) {

@@ -6,6 +6,7 @@
 // Each span is the accumulator's size (the caller checks). Pure: no I/O.
 #pragma once
 
+#include <cstddef>
 #include <span>
 
 namespace brdf::uncertainty {
@@ -25,6 +26,31 @@ void AddSquaredDifferenceBands(std::span<double> acc, std::span<const double> x,
 // pass over the bands.
 void AddSquaredSumBands(std::span<double> acc, std::span<const double* const> x,
                         std::span<const double> w);
+
+// One shared input of a blend (blend.h): its contributions from `count` ≥ 1 vertices, each a row
+// of the accumulator's size, with their weights.
+struct WeightedRows {
+  const double* const* rows = nullptr;
+  const double* weights = nullptr;
+  std::size_t count = 0;
+};
+
+// A blend's measurement² in one pass over the bands, the same values to the last bit as
+//   independent = 0;  AddSquaredBands(independent, independent_rows[r], scales[r]) for each r;
+//   s = 0;  AddSquaredSumBands(s, input.rows, input.weights) for each input, in order;
+//   measurement = s;  AddScaledBands(measurement, independent, 1.0);
+// (the same operations on each band in the same order, without the accumulators' trips through
+// memory between them): measurement[k] = s[k] + independent[k], and shared[k] = s[k] unless
+// `shared` is empty. independent_rows.size() == scales.size(); every row of measurement's size.
+void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,
+                       std::span<const double* const> independent_rows,
+                       std::span<const double> scales, std::span<const WeightedRows> inputs);
+
+// acc = 0, then AddSquaredDifferenceBands(acc, x[i], y, a[i]) for each i in order, in one pass
+// over the bands (the same values to the last bit). x.size() == a.size(); every x[i] and y of
+// acc's size.
+void SquaredDifferencesBands(std::span<double> acc, std::span<const double* const> x,
+                             std::span<const double> y, std::span<const double> a);
 
 // x[k] = sqrt(x[k]) (correctly rounded, as std::sqrt; a negative x[k] gives NaN).
 void SqrtBands(std::span<double> x);

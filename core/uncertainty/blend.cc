@@ -1,6 +1,7 @@
 #include "core/uncertainty/blend.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -32,10 +33,13 @@ struct SharedInput {
 // thousands): after the first few, a blend allocates nothing here.
 struct Scratch {
   std::vector<Blended> readings;
-  std::vector<double> independent;  // Σ wᵢ² u_ind,ᵢ² per band
+  // Each reading's independent part and its weight², summed squared into the measurement.
+  std::vector<const double*> independent;
+  std::vector<double> independent_scales;
   // The first `used` are this blend's shared inputs; the rest are kept for their storage.
   std::vector<SharedInput> inputs;
   std::size_t used = 0;
+  std::vector<WeightedRows> rows;  // the used inputs as BlendSquaredBands takes them
 };
 
 Scratch& ThreadScratch() {
@@ -73,9 +77,17 @@ Status CheckBands(const Blended& b, std::size_t bands) {
 
 // The shared input `c` is shared through, added (with no contributions yet) when it is the first
 // component met of that input.
-SharedInput& InputOf(const Component& c, Scratch& s) {
+// `hint`: where to look first (the readings of a session list their components in the same order,
+// so a reading's n-th shared component is most often the n-th input); inputs are unique by
+// (name, sharing, id), so the one found there is the one a scan would find.
+bool IsInput(const SharedInput& input, const Component& c) {
+  return input.through == c.shared && *input.name == c.name;
+}
+
+SharedInput& InputOf(const Component& c, std::size_t hint, Scratch& s) {
+  if (hint < s.used && IsInput(s.inputs[hint], c)) return s.inputs[hint];
   for (std::size_t j = 0; j < s.used; ++j) {
-    if (s.inputs[j].through == c.shared && *s.inputs[j].name == c.name) return s.inputs[j];
+    if (IsInput(s.inputs[j], c)) return s.inputs[j];
   }
   if (s.used == s.inputs.size()) s.inputs.emplace_back();
   SharedInput& input = s.inputs[s.used++];
@@ -86,13 +98,15 @@ SharedInput& InputOf(const Component& c, Scratch& s) {
   return input;
 }
 
-// Adds one reading: its independent part (the budget's, sqrt(Σ independent uⱼ²)) squared and
-// weighted into `independent`, its shared components to their inputs, with its weight.
+// Adds one reading: its independent part (the budget's, sqrt(Σ independent uⱼ²)) to be squared
+// with its weight², its shared components to their inputs, with its weight.
 void AddReading(const Blended& b, Scratch& s) {
-  AddSquaredBands(s.independent, b.budget->independent, b.weight * b.weight);
+  s.independent.push_back(b.budget->independent.data());
+  s.independent_scales.push_back(b.weight * b.weight);
+  std::size_t shared = 0;
   for (const Component& c : b.budget->components) {
     if (c.shared.kind == Sharing::kIndependent) continue;
-    SharedInput& input = InputOf(c, s);
+    SharedInput& input = InputOf(c, shared++, s);
     input.contributions.push_back(c.contribution.data());
     input.weights.push_back(b.weight);
   }
@@ -114,7 +128,8 @@ Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int ba
   BRDF_RETURN_IF_ERROR(MergeByReading(vertices, s.readings));
   const auto n = static_cast<std::size_t>(bands);
   NoteList notes(out->not_estimated);
-  s.independent.assign(n, 0.0);
+  s.independent.clear();
+  s.independent_scales.clear();
   s.used = 0;
   for (const Blended& b : s.readings) {
     if (b.budget == nullptr) {
@@ -129,20 +144,18 @@ Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int ba
     AddReading(b, s);
   }
   notes.Finish();
-  // shared² = Σ over inputs of (Σ wᵢ uⱼ,ᵢ)², an input at a time; measurement² = shared² +
-  // independent²; then both roots.
-  out->shared.assign(n, 0.0);
+  // shared² = Σ over inputs of (Σ wᵢ uⱼ,ᵢ)², measurement² = shared² + independent², in one pass
+  // over the bands; then the roots.
+  s.rows.clear();
   for (std::size_t j = 0; j < s.used; ++j) {
-    AddSquaredSumBands(out->shared, s.inputs[j].contributions, s.inputs[j].weights);
+    const SharedInput& input = s.inputs[j];
+    s.rows.push_back({input.contributions.data(), input.weights.data(), input.weights.size()});
   }
-  out->measurement.assign(out->shared.begin(), out->shared.end());
-  AddScaledBands(out->measurement, s.independent, 1.0);
+  out->measurement.resize(n);
+  out->shared.resize(with_shared ? n : 0);
+  BlendSquaredBands(out->measurement, out->shared, s.independent, s.independent_scales, s.rows);
   SqrtBands(out->measurement);
-  if (with_shared) {
-    SqrtBands(out->shared);
-  } else {
-    out->shared.clear();
-  }
+  SqrtBands(out->shared);
   return Status::Ok();
 }
 
@@ -161,10 +174,25 @@ void InterpolationSpread(std::span<const double> weights,
   double total = 0;
   for (double w : weights) total += std::abs(w);
   if (total <= 0) return;
-  for (std::size_t i = 0; i < spectra.size() && i < weights.size(); ++i) {
-    const std::size_t bands = std::min(blend.size(), spectra[i].size());
-    AddSquaredDifferenceBands(std::span<double>(*out).first(bands), spectra[i].first(bands),
-                              blend.first(bands), std::abs(weights[i]) / total);
+  const std::size_t m = std::min(spectra.size(), weights.size());
+  // Every vertex on the blend's bands (as always from the API): one pass over the bands.
+  constexpr std::size_t kInline = 8;
+  bool whole = m <= kInline;
+  for (std::size_t i = 0; i < m && whole; ++i) whole = spectra[i].size() >= blend.size();
+  if (whole) {
+    std::array<const double*, kInline> rows{};
+    std::array<double, kInline> scales{};
+    for (std::size_t i = 0; i < m; ++i) {
+      rows[i] = spectra[i].data();
+      scales[i] = std::abs(weights[i]) / total;
+    }
+    SquaredDifferencesBands(*out, std::span(rows).first(m), blend, std::span(scales).first(m));
+  } else {
+    for (std::size_t i = 0; i < m; ++i) {
+      const std::size_t bands = std::min(blend.size(), spectra[i].size());
+      AddSquaredDifferenceBands(std::span<double>(*out).first(bands), spectra[i].first(bands),
+                                blend.first(bands), std::abs(weights[i]) / total);
+    }
   }
   SqrtBands(*out);
 }

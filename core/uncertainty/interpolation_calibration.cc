@@ -161,7 +161,27 @@ bool ApplyInterpolationCalibration(const InterpolationCalibration& calibration,
     for (std::size_t b = 0; b < spread.size(); ++b) spread[b] *= calibration.scale[b];
     return true;
   }
-  for (std::size_t b = 0; b < spread.size(); ++b) spread[b] *= ScaleAt(calibration, cell_size, b);
+  // The size's scale and stretch found once for every band: the values ScaleAt gives band by
+  // band, when every size bin has a scale for each band (as CalibrateInterpolation makes them).
+  const std::vector<double>* scale = &calibration.scale;
+  bool every_band = true;
+  for (const SizeBin& bin : calibration.larger) {
+    every_band = every_band && bin.scale.size() >= spread.size();
+    if (cell_size > bin.above) scale = &bin.scale;
+  }
+  if (!every_band) {
+    for (std::size_t b = 0; b < spread.size(); ++b) {
+      spread[b] *= ScaleAt(calibration, cell_size, b);
+    }
+    return true;
+  }
+  const bool stretched = cell_size > calibration.largest_cell;
+  const double stretch = cell_size / calibration.largest_cell;
+  for (std::size_t b = 0; b < spread.size(); ++b) {
+    double c = (*scale)[b];
+    if (stretched) c *= stretch;
+    spread[b] *= c;
+  }
   return true;
 }
 

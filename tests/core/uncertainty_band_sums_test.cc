@@ -95,5 +95,73 @@ TEST(BandSums, SqrtIsStdSqrtInEveryBand) {
   }
 }
 
+// The one-pass sums give the bits of the calls they replace (blend.h's former loops), for every
+// length and any number of readings and inputs.
+TEST(BandSums, BlendSquaredIsTheSeparateSumsBitForBit) {
+  for (std::size_t n : kLengths) {
+    std::vector<std::vector<double>> rows;
+    for (int r = 0; r < 9; ++r) rows.push_back(Ramp(n, 0.01 * (r + 1), 0.0013 * (r % 4 - 1.5)));
+    const std::vector<double> w = {0.31, 0.27, 0.19, 0.23, 0.11};
+    for (std::size_t readings = 0; readings <= 4; ++readings) {
+      std::vector<const double*> independent;
+      std::vector<double> scales;
+      for (std::size_t i = 0; i < readings; ++i) {
+        independent.push_back(rows[i].data());
+        scales.push_back(w[i] * w[i]);
+      }
+      // Inputs of 1, 2, 3 and 4 vertices' contributions.
+      std::vector<std::vector<const double*>> input_rows = {
+          {rows[4].data()},
+          {rows[5].data(), rows[6].data()},
+          {rows[7].data(), rows[8].data(), rows[0].data()},
+          {rows[1].data(), rows[3].data(), rows[5].data(), rows[7].data()}};
+      std::vector<WeightedRows> inputs;
+      for (const auto& in : input_rows) inputs.push_back({in.data(), w.data(), in.size()});
+      std::vector<double> independent_sum(n, 0.0), shared_want(n, 0.0);
+      for (std::size_t i = 0; i < readings; ++i) {
+        AddSquaredBands(independent_sum, std::span(independent[i], n), scales[i]);
+      }
+      for (const WeightedRows& in : inputs) {
+        AddSquaredSumBands(shared_want, std::span(in.rows, in.count),
+                           std::span(in.weights, in.count));
+      }
+      std::vector<double> measurement_want = shared_want;
+      AddScaledBands(measurement_want, independent_sum, 1.0);
+      std::vector<double> measurement(n + 1, -1.0), shared(n + 1, -1.0);
+      BlendSquaredBands(std::span(measurement).first(n), std::span(shared).first(n), independent,
+                        scales, inputs);
+      for (std::size_t k = 0; k < n; ++k) {
+        EXPECT_EQ(measurement[k], measurement_want[k]) << "band " << k << " of " << n;
+        EXPECT_EQ(shared[k], shared_want[k]) << "band " << k << " of " << n;
+      }
+      EXPECT_EQ(measurement[n], -1.0);
+      EXPECT_EQ(shared[n], -1.0);
+      // Without the shared part kept: the same measurement.
+      std::vector<double> alone(n, -1.0);
+      BlendSquaredBands(alone, {}, independent, scales, inputs);
+      for (std::size_t k = 0; k < n; ++k) EXPECT_EQ(alone[k], measurement_want[k]);
+    }
+  }
+}
+
+TEST(BandSums, SquaredDifferencesIsTheSeparateSumsBitForBit) {
+  for (std::size_t n : kLengths) {
+    const std::vector<double> y = Ramp(n, 0.9, 0.025);
+    std::vector<std::vector<double>> x;
+    for (int i = 0; i < 5; ++i) x.push_back(Ramp(n, 1.0 - 0.07 * i, 0.02 + 0.003 * i));
+    const std::vector<double> a = {0.4, 0.1, 0.25, 0.2, 0.05};
+    for (std::size_t m = 0; m <= x.size(); ++m) {
+      std::vector<const double*> rows;
+      for (std::size_t i = 0; i < m; ++i) rows.push_back(x[i].data());
+      std::vector<double> want(n, 0.0);
+      for (std::size_t i = 0; i < m; ++i) AddSquaredDifferenceBands(want, x[i], y, a[i]);
+      std::vector<double> got(n + 1, -1.0);
+      SquaredDifferencesBands(std::span(got).first(n), rows, y, std::span(a).first(m));
+      for (std::size_t k = 0; k < n; ++k) EXPECT_EQ(got[k], want[k]) << "band " << k;
+      EXPECT_EQ(got[n], -1.0);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace brdf::uncertainty

@@ -67,6 +67,48 @@ TEST(FillChain, FirstOkAnswerWinsAndIsCounted) {
   EXPECT_NE(t.Summary().find("25.000 %"), std::string::npos);
 }
 
+// A batch source: the same answers as Limited, through the batch path (as an interpolator).
+SpectrumSource LimitedBatch(double limit, double value) {
+  SpectrumSource one = Limited(limit, value);
+  return SpectrumSource(
+      [one](const IsoDirection& at, std::span<double> out) { return one(at, out); },
+      [one](std::span<const double> dirs, std::span<InterpStatus> st, std::span<double> rows) {
+        one.Spectra(dirs, st, rows);
+      });
+}
+
+// A later stage without a batch path (the model) answers rows where they lie: the same rows,
+// statuses and counts as through a batch, NaN left where it has no answer.
+TEST(FillChain, AStageWithoutABatchPathAnswersInPlaceAsABatchWould) {
+  const std::vector<double> dirs = {85, 0, 0, 10, 0, 0, 40, 0, 0, 70, 0, 0, 75, 3, 9};
+  for (bool batched : {false, true}) {
+    FillChain chain(FillPolicy::kChain,
+                    {{Provenance::kInterpolated, LimitedBatch(30, 1)},
+                     {Provenance::kFallback, LimitedBatch(60, 2)},
+                     {Provenance::kModel, batched ? LimitedBatch(72, 3) : Limited(72, 3)}});
+    EXPECT_EQ(chain.Tally().asked(), 0u);
+    std::vector<InterpStatus> st(5);
+    std::vector<double> rows(10, -7.0);
+    chain.Source().Spectra(dirs, st, rows);
+    EXPECT_EQ(st[0], InterpStatus::kOutsideHull) << batched;
+    EXPECT_EQ(st[3], InterpStatus::kOk) << batched;
+    EXPECT_EQ(st[4], InterpStatus::kOutsideHull) << batched;
+    const double want[] = {NAN, NAN, 1, 1, 2, 2, 3, 3, NAN, NAN};
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      if (std::isnan(want[k])) {
+        EXPECT_TRUE(std::isnan(rows[k])) << "value " << k << (batched ? " batched" : "");
+      } else {
+        EXPECT_EQ(rows[k], want[k]) << "value " << k << (batched ? " batched" : "");
+      }
+    }
+    const FillTally t = chain.Tally();
+    EXPECT_EQ(t.interpolated, 1u);
+    EXPECT_EQ(t.fallback, 1u);
+    EXPECT_EQ(t.model, 1u);
+    EXPECT_EQ(t.empty, 2u);
+  }
+}
+
 TEST(FillChain, PolicyNoneAsksTheMethodAlone) {
   FillChain chain(FillPolicy::kNone, {{Provenance::kInterpolated, Limited(30, 1)},
                                       {Provenance::kModel, Limited(90, 3)}});

@@ -389,7 +389,12 @@ interp::InterpStatus PlanesSource(const IsoDirection& at, std::span<double> row)
   return st;
 }
 
-TEST(Npy, UncertaintyPlanesGoToFilesOfTheValuesShapeAndDtype) {
+// Each plane's file as its values' own (float32: converted where the plane lies in the rows;
+// float64: gathered first), the same bytes either way as the plane written alone.
+class NpyPlanes : public ::testing::TestWithParam<NpyType> {};
+
+TEST_P(NpyPlanes, UncertaintyPlanesGoToFilesOfTheValuesShapeAndDtype) {
+  const NpyType type = GetParam();
   Result<RegularGrid> grid = MakeRegularGrid(10, 15, 30, GridPlacement::kCellCentres);
   ASSERT_TRUE(grid.ok());
   const WavelengthGrid bands{400, 100, 3};
@@ -397,7 +402,7 @@ TEST(Npy, UncertaintyPlanesGoToFilesOfTheValuesShapeAndDtype) {
   std::vector<std::unique_ptr<NpyGridWriter>> writers;
   std::vector<GridSink*> sinks;
   for (std::ostringstream& f : files) {
-    writers.push_back(std::make_unique<NpyGridWriter>(f, NpyType::kFloat32));
+    writers.push_back(std::make_unique<NpyGridWriter>(f, type));
     sinks.push_back(writers.back().get());
   }
   PlaneSplitSink split(sinks);
@@ -412,20 +417,26 @@ TEST(Npy, UncertaintyPlanesGoToFilesOfTheValuesShapeAndDtype) {
     f.bytes = files[p].str();
     f.parsed = ParseNpy(f.bytes);
     ASSERT_TRUE(f.parsed.ok) << "plane " << p;
-    EXPECT_EQ(f.parsed.descr, "<f4");
+    const bool f32 = type == NpyType::kFloat32;
+    EXPECT_EQ(f.parsed.descr, f32 ? "<f4" : "<f8");
     EXPECT_EQ(f.parsed.shape, (std::vector<std::size_t>{9, 6, 6, 3}));
-    ASSERT_EQ(f.bytes.size(), f.parsed.data_offset + 9 * 6 * 6 * 3 * 4);
+    ASSERT_EQ(f.bytes.size(), f.parsed.data_offset + 9 * 6 * 6 * 3 * (f32 ? 4 : 8));
     for (std::size_t i = 0; i < plain.values().size(); ++i) {
       const double want = plain.values()[i] * (p == 0 ? 1.0 : 0.001 * static_cast<double>(p));
-      const float got = LittleEndianValue<float, std::uint32_t>(f, i);
+      const double got = f32 ? LittleEndianValue<float, std::uint32_t>(f, i)
+                             : LittleEndianValue<double, std::uint64_t>(f, i);
       if (std::isnan(want)) {
         EXPECT_TRUE(std::isnan(got)) << "plane " << p << " value " << i;
-      } else {
+      } else if (f32) {
         EXPECT_EQ(got, static_cast<float>(want)) << "plane " << p << " value " << i;
+      } else {
+        EXPECT_EQ(got, want) << "plane " << p << " value " << i;
       }
     }
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Npy, NpyPlanes, ::testing::Values(NpyType::kFloat32, NpyType::kFloat64));
 
 TEST(Npy, PlaneSplitRefusesASliceWithoutItsPlanes) {
   MemoryGrid a, b;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 
 #include "core/fit/models.h"
 
@@ -106,6 +107,24 @@ void FillChain::GiveScratch(std::unique_ptr<Scratch> scratch) const {
   scratch_.push_back(std::move(scratch));
 }
 
+void FillChain::AnswerInPlace(const SpectrumSource& source, std::span<const double> directions,
+                              std::span<interp::InterpStatus> statuses, std::span<double> spectra,
+                              std::size_t bands, const std::vector<std::size_t>& missing,
+                              std::vector<std::size_t>& still) {
+  still.clear();
+  for (const std::size_t i : missing) {
+    const std::span<double> row = spectra.subspan(i * bands, bands);
+    const IsoDirection at{directions[3 * i], directions[3 * i + 1], directions[3 * i + 2]};
+    if (source(at, row) == interp::InterpStatus::kOk) {
+      statuses[i] = interp::InterpStatus::kOk;
+    } else {
+      // As if it had not been asked: the row stays NaN with the first stage's status.
+      std::fill(row.begin(), row.end(), std::numeric_limits<double>::quiet_NaN());
+      still.push_back(i);
+    }
+  }
+}
+
 void FillChain::AnswerMany(std::span<const double> directions,
                            std::span<interp::InterpStatus> statuses,
                            std::span<double> spectra) const {
@@ -125,13 +144,21 @@ void FillChain::AnswerMany(std::span<const double> directions,
   std::vector<double>& sub_spectra = scratch->spectra;
   std::vector<std::size_t>& still = scratch->still;
   for (std::size_t s = 1; s < stages_.size() && !missing.empty(); ++s) {
+    if (stages_[s].source.one_by_one()) {
+      AnswerInPlace(stages_[s].source, directions, statuses, spectra, bands, missing, still);
+      Count(s, missing.size() - still.size());
+      missing.swap(still);
+      continue;
+    }
     dirs.clear();
     for (std::size_t i : missing) {
       dirs.insert(dirs.end(), directions.begin() + static_cast<std::ptrdiff_t>(3 * i),
                   directions.begin() + static_cast<std::ptrdiff_t>(3 * i + 3));
     }
     sub_status.assign(missing.size(), interp::InterpStatus::kOk);
-    sub_spectra.assign(missing.size() * bands, 0.0);
+    // Not cleared: the stage writes every row it answers (and NaN in the others), and only rows
+    // it answered are copied out.
+    sub_spectra.resize(missing.size() * bands);
     stages_[s].source.Spectra(dirs, sub_status, sub_spectra);
     still.clear();
     for (std::size_t q = 0; q < missing.size(); ++q) {

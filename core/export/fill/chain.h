@@ -81,6 +81,13 @@ class FillChain {
   interp::InterpStatus AnswerOne(const IsoDirection& at, std::span<double> out) const;
   void AnswerMany(std::span<const double> directions, std::span<interp::InterpStatus> statuses,
                   std::span<double> spectra) const;
+  // A later stage without a batch path (the model) asked for the rows `missing` where they lie,
+  // instead of through a gathered batch copied back: statuses[i] becomes kOk where it answers,
+  // `still` gets the rows it did not answer (left NaN).
+  static void AnswerInPlace(const SpectrumSource& source, std::span<const double> directions,
+                            std::span<interp::InterpStatus> statuses, std::span<double> spectra,
+                            std::size_t bands, const std::vector<std::size_t>& missing,
+                            std::vector<std::size_t>& still);
   // What a batch's later stages work in. Kept between batches (one per thread at work), so that
   // their memory is allocated and first touched once per chain, not once per batch.
   struct Scratch {

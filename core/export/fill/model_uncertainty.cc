@@ -36,9 +36,11 @@ void LocalScale(const std::vector<std::vector<double>>& residuals,
                 std::span<const std::size_t> near, std::span<double> rho) {
   std::fill(rho.begin(), rho.end(), 0.0);
   for (const std::size_t i : near) {
-    for (std::size_t b = 0; b < rho.size() && b < residuals[i].size(); ++b) {
-      rho[b] += residuals[i][b] * residuals[i][b];
-    }
+    // The bands both have, in a loop the compiler vectorises (the same sums band by band).
+    const std::size_t bands = std::min(rho.size(), residuals[i].size());
+    const double* r = residuals[i].data();
+    double* to = rho.data();
+    for (std::size_t b = 0; b < bands; ++b) to[b] += r[b] * r[b];
   }
   const double n = static_cast<double>(std::max<std::size_t>(1, near.size()));
   for (double& r : rho) r = std::sqrt(r / n);
@@ -135,9 +137,10 @@ int BucketOf(double theta, double origin, double width, int count) {
 
 // The outgoing direction (θo, φ) as a unit vector: the chord between two of them is at most their
 // angle, so hypot(Δθi, chord) bounds a distance from below without trigonometry.
-std::array<double, 3> OutgoingUnit(const IsoDirection& d) {
-  const double to = d.theta_o * kRadian, ph = d.phi * kRadian;
-  return {std::sin(to) * std::cos(ph), std::sin(to) * std::sin(ph), std::cos(to)};
+// `cos_o` and `sin_o` are those of d.theta_o in radians (as the caller has them already).
+std::array<double, 3> OutgoingUnit(const IsoDirection& d, double cos_o, double sin_o) {
+  const double ph = d.phi * kRadian;
+  return {sin_o * std::cos(ph), sin_o * std::sin(ph), cos_o};
 }
 
 // The gap between `theta` and bucket `b`'s interval along one axis (0 inside it).
@@ -178,7 +181,8 @@ ReadingNeighbours::ReadingNeighbours(const interp::SampleSet& samples) {
   for (std::size_t i = 0; i < n; ++i) {
     const IsoDirection d = At(samples, i);
     const double to = d.theta_o * kRadian;
-    readings_[next[bucket[i]]++] = {{d, std::cos(to), std::sin(to), OutgoingUnit(d)}, i};
+    const double cos_o = std::cos(to), sin_o = std::sin(to);
+    readings_[next[bucket[i]]++] = {{d, cos_o, sin_o, OutgoingUnit(d, cos_o, sin_o)}, i};
   }
 }
 
@@ -213,17 +217,25 @@ void ReadingNeighbours::Nearest(const IsoDirection& at, std::size_t k,
   // Ring by ring (Chebyshev, in buckets) around `at`'s bucket: a bucket of ring m is at least
   // (m − 1) widths away along θi or θo, so once that exceeds the k-th nearest, no farther ring can
   // hold a nearer reading. Within a ring, a bucket whose box is farther is skipped.
-  std::vector<std::pair<double, std::size_t>> best;
+  // Kept by each thread from query to query (a grid asks one per model cell).
+  thread_local std::vector<std::pair<double, std::size_t>> best;
+  best.clear();
   const double to = at.theta_o * kRadian;
-  const Query q{at, std::cos(to), std::sin(to), OutgoingUnit(at)};
+  const double cos_o = std::cos(to), sin_o = std::sin(to);
+  const Query q{at, cos_o, sin_o, OutgoingUnit(at, cos_o, sin_o)};
   const int r0 = BucketOf(at.theta_i, theta_i0_, width_, rows_);
   const int c0 = BucketOf(at.theta_o, theta_o0_, width_, columns_);
   auto full = [&] { return k > 0 && best.size() == k; };
   auto visit = [&](int r, int c) {
     if (r < 0 || r >= rows_ || c < 0 || c >= columns_) return;
-    const double gap = std::hypot(GapTo(at.theta_i, theta_i0_, width_, r),
-                                  GapTo(at.theta_o, theta_o0_, width_, c));
-    if (full() && gap - kBoundSlack > best.back().first) return;
+    const double gap_i = GapTo(at.theta_i, theta_i0_, width_, r);
+    const double gap_o = GapTo(at.theta_o, theta_o0_, width_, c);
+    if (full()) {
+      // hypot(gap_i, gap_o) ≥ either gap: a bucket the larger gap already puts beyond is skipped
+      // without the square root (the same buckets are skipped as by the hypot alone).
+      if (std::max(gap_i, gap_o) - kBoundSlack > best.back().first) return;
+      if (std::hypot(gap_i, gap_o) - kBoundSlack > best.back().first) return;
+    }
     ScanBucket(q, k, r, c, &best);
   };
   const int rings = std::max({r0, rows_ - 1 - r0, c0, columns_ - 1 - c0});
@@ -313,6 +325,12 @@ void ModelCellUncertainty::At(const IsoDirection& at, std::span<double> u) const
     return;
   }
   LocalScale(*residuals_, near, u);
+  // c(d) per band. With a reach (largest_cell > 0, as CalibrateModel fits it)
+  // ApplyInterpolationCalibration multiplies by ScaleAt's values, its bin found once per cell.
+  if (calibration_.largest_cell > 0) {
+    uncertainty::ApplyInterpolationCalibration(calibration_, u, d);
+    return;
+  }
   for (std::size_t b = 0; b < u.size(); ++b) u[b] *= uncertainty::ScaleAt(calibration_, d, b);
 }
 

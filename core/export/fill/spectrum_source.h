@@ -45,6 +45,9 @@ class SpectrumSource {
   // Many's contract; directions.size() == 3 × statuses.size(), spectra.size() a multiple of it.
   void Spectra(std::span<const double> directions, std::span<interp::InterpStatus> statuses,
                std::span<double> spectra) const;
+  // True when the source has no batch path: Spectra asks One direction by direction, so a caller
+  // filling scattered rows may as well ask One on each row where it lies.
+  bool one_by_one() const { return !many_; }
 
  private:
   One one_;

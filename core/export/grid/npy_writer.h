@@ -46,9 +46,18 @@ class NpyGridWriter : public GridSink {
   Status Begin(const RegularGrid& grid, const WavelengthGrid& bands) override;
   Status WriteSlice(std::size_t theta_i_index, std::span<const double> values,
                     std::span<const interp::InterpStatus> statuses) override;
+  // float32: each cell's row of the plane converted where it lies (no gathered copy first);
+  // float64: GridSink's.
+  Status WritePlane(std::size_t theta_i_index, std::span<const double> rows, std::size_t planes,
+                    std::size_t plane, std::size_t bands,
+                    std::span<const interp::InterpStatus> statuses,
+                    std::vector<double>& scratch) override;
   Status Finish(const GridReport& report) override;
 
  private:
+  Status NextSlice(std::size_t theta_i_index);
+  Status Written(std::size_t theta_i_index);
+
   std::ostream& out_;
   NpyType type_;
   RegularGrid grid_;

@@ -250,13 +250,22 @@ Status PlaneSplitSink::WriteSlice(std::size_t theta_i_index, std::span<const dou
   }
   for (std::size_t p = 0; p < planes; ++p) {
     if (sinks_[p] == nullptr) continue;
-    for (std::size_t c = 0; c < statuses.size(); ++c) {
-      std::copy_n(values.begin() + static_cast<std::ptrdiff_t>((c * planes + p) * bands_), bands_,
-                  plane_.begin() + static_cast<std::ptrdiff_t>(c * bands_));
-    }
-    BRDF_RETURN_IF_ERROR(sinks_[p]->WriteSlice(theta_i_index, plane_, statuses));
+    BRDF_RETURN_IF_ERROR(
+        sinks_[p]->WritePlane(theta_i_index, values, planes, p, bands_, statuses, plane_));
   }
   return Status::Ok();
+}
+
+Status GridSink::WritePlane(std::size_t theta_i_index, std::span<const double> rows,
+                            std::size_t planes, std::size_t plane, std::size_t bands,
+                            std::span<const interp::InterpStatus> statuses,
+                            std::vector<double>& scratch) {
+  scratch.resize(statuses.size() * bands);
+  for (std::size_t c = 0; c < statuses.size(); ++c) {
+    std::copy_n(rows.begin() + static_cast<std::ptrdiff_t>((c * planes + plane) * bands), bands,
+                scratch.begin() + static_cast<std::ptrdiff_t>(c * bands));
+  }
+  return WriteSlice(theta_i_index, scratch, statuses);
 }
 
 Status PlaneSplitSink::Finish(const GridReport& report) {

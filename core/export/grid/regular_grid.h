@@ -80,6 +80,14 @@ class GridSink {
   // φ index k; every value of a cell whose status is not ok is NaN.
   virtual Status WriteSlice(std::size_t theta_i_index, std::span<const double> values,
                             std::span<const interp::InterpStatus> statuses) = 0;
+  // Plane `plane` of slice `theta_i_index` whose cells hold `planes` planes of `bands` values each
+  // (rows[(c·planes + plane)·bands + b] for cell c; PlaneSplitSink), as WriteSlice takes that
+  // plane gathered. This default gathers it into `scratch` and calls WriteSlice; a sink that
+  // converts what it writes (NpyGridWriter's float32) reads it where it lies instead.
+  virtual Status WritePlane(std::size_t theta_i_index, std::span<const double> rows,
+                            std::size_t planes, std::size_t plane, std::size_t bands,
+                            std::span<const interp::InterpStatus> statuses,
+                            std::vector<double>& scratch);
   virtual Status Finish(const GridReport& report) = 0;
 };
 
