@@ -4,6 +4,7 @@
 #include <grpcpp/impl/codegen/proto_utils.h>
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <new>
 
@@ -57,6 +58,32 @@ void ToQuery(const QueryAngles& angles, v1::DirectionQuery* query) {
   }
 }
 
+void PackedDirections::Assign(
+    const google::protobuf::RepeatedPtrField<v1::DirectionQuery>& queries) {
+  const bool four = std::any_of(queries.begin(), queries.end(), [](const v1::DirectionQuery& q) {
+    return q.direction_case() == v1::DirectionQuery::kFour;
+  });
+  stride_ = four ? 4 : 3;
+  forms_.clear();
+  angles_.clear();
+  forms_.reserve(static_cast<std::size_t>(queries.size()));
+  angles_.reserve(stride_ * static_cast<std::size_t>(queries.size()));
+  for (const v1::DirectionQuery& query : queries) {
+    const QueryAngles q = AnglesOf(query);
+    forms_.push_back(static_cast<std::uint8_t>(q.form));
+    angles_.insert(angles_.end(), q.angles.begin(),
+                   q.angles.begin() + static_cast<std::ptrdiff_t>(stride_));
+  }
+}
+
+QueryAngles PackedDirections::operator[](std::size_t i) const {
+  QueryAngles q;
+  q.form = static_cast<v1::DirectionQuery::DirectionCase>(forms_[i]);
+  std::copy_n(angles_.begin() + static_cast<std::ptrdiff_t>(i * stride_), stride_,
+              q.angles.begin());
+  return q;
+}
+
 grpc::Status ReadBatchRequest(BatchStreamer& streamer, BatchRequest* out) {
   grpc::ByteBuffer wire;
   if (!streamer.Read(&wire)) {
@@ -77,11 +104,7 @@ grpc::Status ReadBatchRequest(BatchStreamer& streamer, BatchRequest* out) {
       !st.ok()) {
     return st;
   }
-  out->directions.clear();
-  out->directions.reserve(static_cast<std::size_t>(parsed->directions_size()));
-  for (const v1::DirectionQuery& query : parsed->directions()) {
-    out->directions.push_back(AnglesOf(query));
-  }
+  out->directions.Assign(parsed->directions());
   parsed->clear_directions();
   out->settings.CopyFrom(*parsed);
   return grpc::Status::OK;

@@ -1,13 +1,15 @@
 // InterpolateBatch's request as the batch holds it (issue 40's memory goal). gRPC's synchronous
 // server parses a request before its handler runs, and a parsed batch of 100,000 directions is
-// ~15 MB of small messages (a DirectionQuery and its IsoDirection each, ~150 bytes with malloc's
+// ~13 MB of small messages (a DirectionQuery and its IsoDirection each, ~130 bytes with malloc's
 // overhead, for 24 bytes of angles; 2.4 MB on the wire), held while the batch waits for a work
 // permit and while it waits for its client. So InterpolateBatch is served as gRPC's split
 // streaming handler (WithWireBatchRequest): the handler takes its work permit first, then reads
 // the request's wire bytes, parses them on an arena of blocks mapped for that parse alone, and
-// keeps the directions as a packed list (40 bytes each) and the other fields as a message. The
-// wire is unchanged (the same InterpolateBatchRequest and InterpolateBatchChunk), so are the
-// clients; a request the client has sent but brdfd has not read stays in HTTP/2's flow control.
+// keeps the directions packed (25 bytes each, 33 with four-angle ones) and the other fields as a
+// message. The wire is unchanged (the same InterpolateBatchRequest and InterpolateBatchChunk), so
+// are the clients and the errors (a request gRPC cannot parse: INTERNAL; one over the receive
+// limit: RESOURCE_EXHAUSTED from the transport). Until the handler reads it, a request stays in
+// gRPC's transport, within HTTP/2's flow-control window.
 #pragma once
 
 #include <google/protobuf/descriptor.h>
@@ -17,6 +19,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "brdf/v1/brdf.grpc.pb.h"
@@ -34,16 +37,29 @@ QueryAngles AnglesOf(const v1::DirectionQuery& query);
 // The query as it was sent (AnglesOf's inverse).
 void ToQuery(const QueryAngles& angles, v1::DirectionQuery* query);
 
+// A batch's directions packed: each one's form a byte, its angles a row of 3 doubles while every
+// direction is isotropic (25 bytes a direction), of 4 when one is not (33 bytes).
+class PackedDirections {
+ public:
+  void Assign(const google::protobuf::RepeatedPtrField<v1::DirectionQuery>& queries);
+  std::size_t size() const { return forms_.size(); }
+  QueryAngles operator[](std::size_t i) const;
+  std::size_t Bytes() const { return forms_.capacity() + angles_.capacity() * sizeof(double); }
+
+ private:
+  std::size_t stride_ = 3;           // angles per direction
+  std::vector<std::uint8_t> forms_;  // DirectionCase
+  std::vector<double> angles_;
+};
+
 // A parsed InterpolateBatchRequest: every field but `directions` in `settings`, the directions
 // packed in `directions`.
 struct BatchRequest {
   v1::InterpolateBatchRequest settings;
-  std::vector<QueryAngles> directions;
+  PackedDirections directions;
 
   // What it holds, bytes (for the memory budget).
-  std::size_t Bytes() const {
-    return settings.ByteSizeLong() + directions.capacity() * sizeof(QueryAngles);
-  }
+  std::size_t Bytes() const { return settings.ByteSizeLong() + directions.Bytes(); }
 };
 
 using BatchStreamer = grpc::ServerSplitStreamer<grpc::ByteBuffer, v1::InterpolateBatchChunk>;
