@@ -51,7 +51,7 @@ grpc::Status ParseSettings(int method, int quantity, const v1::InterpolationOpti
 }
 
 // Ranges and finiteness, independent of the session. `field` is the DirectionQuery's path.
-grpc::Status CheckDirection(const v1::DirectionQuery& q, const std::string& field) {
+grpc::Status CheckDirection(const QueryAngles& q, const std::string& field) {
   // The field's name is only put together for an error (a valid query costs no allocation).
   auto check = [&field](double v, double lo, double hi, const char* suffix, const char* hint) {
     if (std::isfinite(v) && v >= lo && v <= hi) return grpc::Status::OK;
@@ -59,23 +59,19 @@ grpc::Status CheckDirection(const v1::DirectionQuery& q, const std::string& fiel
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
                         BoundedMessage(st.message() + ": " + hint));
   };
+  const std::array<double, 4>& a = q.angles;
   grpc::Status st;
-  switch (q.direction_case()) {
+  switch (q.form) {
     case v1::DirectionQuery::kIso:
-      if (st = check(q.iso().theta_i(), 0, kThetaMax, ".iso.theta_i", kThetaHint); !st.ok())
-        return st;
-      if (st = check(q.iso().theta_o(), 0, kThetaMax, ".iso.theta_o", kThetaHint); !st.ok())
-        return st;
-      return check(q.iso().phi(), 0, kRelativePhiMax, ".iso.phi", kRelativePhiHint);
+      if (st = check(a[0], 0, kThetaMax, ".iso.theta_i", kThetaHint); !st.ok()) return st;
+      if (st = check(a[1], 0, kThetaMax, ".iso.theta_o", kThetaHint); !st.ok()) return st;
+      return check(a[2], 0, kRelativePhiMax, ".iso.phi", kRelativePhiHint);
     case v1::DirectionQuery::kFour:
-      if (st = check(q.four().theta_i(), 0, kThetaMax, ".four.theta_i", kThetaHint); !st.ok())
+      if (st = check(a[0], 0, kThetaMax, ".four.theta_i", kThetaHint); !st.ok()) return st;
+      if (st = check(a[1], -kAzimuthLimit, kAzimuthLimit, ".four.phi_i", kAzimuthHint); !st.ok())
         return st;
-      if (st = check(q.four().phi_i(), -kAzimuthLimit, kAzimuthLimit, ".four.phi_i", kAzimuthHint);
-          !st.ok())
-        return st;
-      if (st = check(q.four().theta_o(), 0, kThetaMax, ".four.theta_o", kThetaHint); !st.ok())
-        return st;
-      return check(q.four().phi_o(), -kAzimuthLimit, kAzimuthLimit, ".four.phi_o", kAzimuthHint);
+      if (st = check(a[2], 0, kThetaMax, ".four.theta_o", kThetaHint); !st.ok()) return st;
+      return check(a[3], -kAzimuthLimit, kAzimuthLimit, ".four.phi_o", kAzimuthHint);
     case v1::DirectionQuery::DIRECTION_NOT_SET:
       break;
   }
@@ -91,27 +87,25 @@ double WrapAzimuth(double phi) {
 }
 
 // The query in the index's coordinates.
-grpc::Status ToCoords(const v1::DirectionQuery& q, const IndexSnapshot& index,
-                      const std::string& field, std::array<double, 4>* coords) {
+grpc::Status ToCoords(const QueryAngles& q, const IndexSnapshot& index, const std::string& field,
+                      std::array<double, 4>* coords) {
+  const std::array<double, 4>& a = q.angles;
   if (index.anisotropic) {
-    if (q.direction_case() != v1::DirectionQuery::kFour) {
+    if (q.form != v1::DirectionQuery::kFour) {
       return InvalidField(field + ".iso", "session " + std::to_string(index.session) +
                                               " is anisotropic; give four angles (" + field +
                                               ".four: θi, φi, θo, φo)");
     }
-    *coords = {q.four().theta_i(), WrapAzimuth(q.four().phi_i()), q.four().theta_o(),
-               WrapAzimuth(q.four().phi_o())};
+    *coords = {a[0], WrapAzimuth(a[1]), a[2], WrapAzimuth(a[3])};
     return grpc::Status::OK;
   }
   IsoDirection iso;
-  if (q.direction_case() == v1::DirectionQuery::kFour) {
-    iso = ToIsotropic(
-        Directions{q.four().theta_i(), q.four().phi_i(), q.four().theta_o(), q.four().phi_o()});
+  if (q.form == v1::DirectionQuery::kFour) {
+    iso = ToIsotropic(Directions{a[0], a[1], a[2], a[3]});
   } else {
     // φ is in [0, 180] (CheckDirection); φ = 0 at the normal, exactly as the readings were
     // reduced.
-    iso = ToIsotropic(
-        CanonicalDirections(IsoDirection{q.iso().theta_i(), q.iso().theta_o(), q.iso().phi()}));
+    iso = ToIsotropic(CanonicalDirections(IsoDirection{a[0], a[1], a[2]}));
   }
   *coords = {iso.theta_i, iso.theta_o, iso.phi, 0};
   return grpc::Status::OK;
@@ -123,10 +117,10 @@ enum class VertexSpectra { kOmit, kInclude };
 using WithUncertainty = std::optional<UncertaintyParts>;
 
 // One answer as the API gives it.
-void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const Settings& settings,
+void ToResult(const QueryAngles& query, interp::Interpolation&& r, const Settings& settings,
               const IndexSnapshot& index, VertexSpectra vertex_spectra,
               WithUncertainty with_uncertainty, v1::InterpolationResult* out) {
-  *out->mutable_query() = query;
+  ToQuery(query, out->mutable_query());
   if (with_uncertainty) AddInterpolationUncertainty(r, index, *with_uncertainty, out);
   out->set_status(ToProtoInterpStatus(r.status));
   out->set_method(ToProtoMethod(r.method));
@@ -153,7 +147,7 @@ void ToResult(const v1::DirectionQuery& query, interp::Interpolation&& r, const 
   out->set_detail(std::move(detail));
 }
 
-void Evaluate(const v1::DirectionQuery& query, const std::array<double, 4>& coords,
+void Evaluate(const QueryAngles& query, const std::array<double, 4>& coords,
               const Settings& settings, const IndexSnapshot& index, VertexSpectra vertex_spectra,
               WithUncertainty with_uncertainty, v1::InterpolationResult* out) {
   ToResult(query,
@@ -217,7 +211,8 @@ std::optional<grpc::Status> InterpolationService::Respond(const v1::InterpolateR
       !st.ok()) {
     return st;
   }
-  if (grpc::Status st = CheckDirection(request.direction(), "direction"); !st.ok()) return st;
+  const QueryAngles direction = AnglesOf(request.direction());
+  if (grpc::Status st = CheckDirection(direction, "direction"); !st.ok()) return st;
 
   std::shared_ptr<const IndexSnapshot> index;
   if (may_load) {
@@ -231,10 +226,8 @@ std::optional<grpc::Status> InterpolationService::Respond(const v1::InterpolateR
   }
   if (grpc::Status st = CheckOptionsFit(settings.options, *index); !st.ok()) return st;
   std::array<double, 4> coords{};
-  if (grpc::Status st = ToCoords(request.direction(), *index, "direction", &coords); !st.ok()) {
-    return st;
-  }
-  Evaluate(request.direction(), coords, settings, *index,
+  if (grpc::Status st = ToCoords(direction, *index, "direction", &coords); !st.ok()) return st;
+  Evaluate(direction, coords, settings, *index,
            request.include_vertex_spectra() ? VertexSpectra::kInclude : VertexSpectra::kOmit,
            request.include_uncertainty() ? WithUncertainty(UncertaintyParts{}) : std::nullopt,
            response->mutable_result());
@@ -245,15 +238,15 @@ namespace {
 
 // An InterpolateBatch request checked before any index is asked: the session, the settings, the
 // directions' count and ranges, and the results per chunk.
-grpc::Status CheckBatch(const v1::InterpolateBatchRequest& request, SessionId* id,
-                        Settings* settings, int* chunk) {
+grpc::Status CheckBatch(const BatchRequest& batch, SessionId* id, Settings* settings, int* chunk) {
+  const v1::InterpolateBatchRequest& request = batch.settings;
   if (grpc::Status st = SessionOf(request.session_id(), id); !st.ok()) return st;
   if (grpc::Status st =
           ParseSettings(request.method(), request.quantity(), request.options(), settings);
       !st.ok()) {
     return st;
   }
-  const int n = request.directions_size();
+  const int n = static_cast<int>(batch.directions.size());
   if (n == 0)
     return InvalidField("directions",
                         "empty; give 1 to " + std::to_string(kMaxBatchDirections) + " directions");
@@ -279,8 +272,8 @@ grpc::Status CheckBatch(const v1::InterpolateBatchRequest& request, SessionId* i
   }
   *chunk = static_cast<int>(request.chunk_size() == 0 ? kDefaultChunkSize : request.chunk_size());
   for (int i = 0; i < n; ++i) {
-    if (grpc::Status st =
-            CheckDirection(request.directions(i), "directions[" + std::to_string(i) + "]");
+    if (grpc::Status st = CheckDirection(batch.directions[static_cast<std::size_t>(i)],
+                                         "directions[" + std::to_string(i) + "]");
         !st.ok()) {
       return st;
     }
@@ -290,15 +283,15 @@ grpc::Status CheckBatch(const v1::InterpolateBatchRequest& request, SessionId* i
 
 // Directions [first, first + count) of the batch in the index's coordinates, row-major (the
 // index's dims per row).
-grpc::Status BatchCoords(const v1::InterpolateBatchRequest& request, const IndexSnapshot& index,
-                         int first, int count, std::vector<double>* coords) {
+grpc::Status BatchCoords(const BatchRequest& request, const IndexSnapshot& index, int first,
+                         int count, std::vector<double>* coords) {
   const auto d = static_cast<std::size_t>(index.dims);
   coords->assign(static_cast<std::size_t>(count) * d, 0);
   for (int k = 0; k < count; ++k) {
     const int i = first + k;
     std::array<double, 4> at{};
-    if (grpc::Status st =
-            ToCoords(request.directions(i), index, "directions[" + std::to_string(i) + "]", &at);
+    if (grpc::Status st = ToCoords(request.directions[static_cast<std::size_t>(i)], index,
+                                   "directions[" + std::to_string(i) + "]", &at);
         !st.ok()) {
       return st;
     }
@@ -309,9 +302,9 @@ grpc::Status BatchCoords(const v1::InterpolateBatchRequest& request, const Index
 
 // Every direction of the batch checked against the session, a slice at a time, so that a bad
 // one is refused before the first result goes out.
-grpc::Status CheckBatchDirections(const v1::InterpolateBatchRequest& request,
-                                  const IndexSnapshot& index, int slice) {
-  const int n = request.directions_size();
+grpc::Status CheckBatchDirections(const BatchRequest& request, const IndexSnapshot& index,
+                                  int slice) {
+  const int n = static_cast<int>(request.directions.size());
   std::vector<double> probe;
   for (int first = 0; first < n; first += slice) {
     if (grpc::Status st = BatchCoords(request, index, first, std::min(slice, n - first), &probe);
@@ -334,30 +327,30 @@ constexpr int kSliceChunks = 4;
 constexpr int kFirstChunkResults = 8;
 
 // The uncertainty a batch's results carry, for their size.
-BatchUncertainty UncertaintyOf(const v1::InterpolateBatchRequest& request) {
+BatchUncertainty UncertaintyOf(const BatchRequest& batch) {
+  const v1::InterpolateBatchRequest& request = batch.settings;
   if (!request.include_uncertainty()) return BatchUncertainty::kNone;
   return request.include_uncertainty_shared() ? BatchUncertainty::kPartsAndShared
                                               : BatchUncertainty::kParts;
 }
 
 // What a batch holds while it streams, bytes (for the memory budget, rpc/memory_budget.h): its
-// request (as received and parsed), and per slice the coordinates, the octant method's sort and
+// request (as parsed: batch_request.h), and per slice the coordinates, the octant method's sort and
 // blends (~200 bytes a query) and the chunks of full answers (ResultBytes: ~1.2 kB each with
 // provenance at 101 bands, ~3.6 kB at 401; two or three more spectra of floats with the
 // uncertainty).
-std::uint64_t BatchBytes(const v1::InterpolateBatchRequest& request, int chunk, std::size_t bands) {
-  const auto n = static_cast<std::uint64_t>(request.directions_size());
+std::uint64_t BatchBytes(const BatchRequest& request, int chunk, std::size_t bands) {
+  const auto n = static_cast<std::uint64_t>(request.directions.size());
   const std::uint64_t slice = std::min<std::uint64_t>(n, std::uint64_t{kSliceChunks} * chunk);
   const std::uint64_t answer = ResultBytes(bands, UncertaintyOf(request));
-  return 3 * request.ByteSizeLong() + slice * (200 + answer) + 2ULL * chunk * answer;
+  return request.Bytes() + slice * (200 + answer) + 2ULL * chunk * answer;
 }
 
 // A chunk stays under half a client's receive limit whatever the session's grid (the same answer
 // in more chunks; clients place results by first_index); then the batch's memory is reserved
 // (RESOURCE_EXHAUSTED naming [server] memory_budget_mb when it does not fit).
-grpc::Status FitChunkAndReserve(const v1::InterpolateBatchRequest& request,
-                                const IndexSnapshot& index, StreamRegistry::Slot& slot,
-                                int* chunk) {
+grpc::Status FitChunkAndReserve(const BatchRequest& request, const IndexSnapshot& index,
+                                StreamRegistry::Slot& slot, int* chunk) {
   *chunk = static_cast<int>(MaxChunkResults(static_cast<std::uint32_t>(*chunk), index.grid.count,
                                             UncertaintyOf(request)));
   return slot.Reserve(BatchBytes(request, *chunk, index.grid.count));
@@ -370,7 +363,7 @@ class BatchChunks {
  public:
   // `n` results in all, chunks of at most `chunk`.
   BatchChunks(grpc::ServerContext& context, const StopSignal& stopping, StreamRegistry::Slot& slot,
-              grpc::ServerWriter<v1::InterpolateBatchChunk>& writer, int n, int chunk)
+              BatchStreamer& writer, int n, int chunk)
       : context_(context),
         stopping_(stopping),
         slot_(slot),
@@ -425,7 +418,7 @@ class BatchChunks {
   grpc::ServerContext& context_;
   const StopSignal& stopping_;
   StreamRegistry::Slot& slot_;
-  grpc::ServerWriter<v1::InterpolateBatchChunk>& writer_;
+  BatchStreamer& writer_;
   const int n_;
   const int chunk_;
   int size_;  // of the chunk being filled
@@ -435,9 +428,8 @@ class BatchChunks {
 
 }  // namespace
 
-grpc::Status InterpolationService::InterpolateBatch(
-    grpc::ServerContext* context, const v1::InterpolateBatchRequest* request,
-    grpc::ServerWriter<v1::InterpolateBatchChunk>* writer) {
+grpc::Status InterpolationService::WireBatch(grpc::ServerContext* context,
+                                             BatchStreamer* streamer) {
   Caller caller;
   if (grpc::Status st = auth_.CallerOf(*context, &caller); !st.ok()) return st;
   std::unique_ptr<StreamRegistry::Slot> slot;
@@ -445,10 +437,13 @@ grpc::Status InterpolationService::InterpolateBatch(
           streams_.Open(*context, &caller, "InterpolateBatch", &slot, /*computes=*/true);
       !st.ok())
     return st;
+  // Read only now, with the work permit: a batch waiting for one holds no request.
+  BatchRequest request;
+  if (grpc::Status st = ReadBatchRequest(*streamer, &request); !st.ok()) return st;
   SessionId id = 0;
   Settings settings;
   int chunk = 0;
-  if (grpc::Status st = CheckBatch(*request, &id, &settings, &chunk); !st.ok()) return st;
+  if (grpc::Status st = CheckBatch(request, &id, &settings, &chunk); !st.ok()) return st;
 
   // One snapshot for the whole batch: every result sees the same readings.
   Result<std::shared_ptr<const IndexSnapshot>> got =
@@ -456,32 +451,32 @@ grpc::Status InterpolationService::InterpolateBatch(
   if (!got.ok()) return ToGrpcStatus(got.status());
   const IndexSnapshot& index = **got;
   if (grpc::Status st = CheckOptionsFit(settings.options, index); !st.ok()) return st;
-  if (grpc::Status st = FitChunkAndReserve(*request, index, *slot, &chunk); !st.ok()) return st;
+  if (grpc::Status st = FitChunkAndReserve(request, index, *slot, &chunk); !st.ok()) return st;
 
   // A slice of kSliceChunks chunks (of the size they have then) at a time in one EvaluateEach
   // (the octant method sorts it by cell), its answers streamed chunk by chunk as they come, in
   // order.
-  const int n = request->directions_size();
-  if (grpc::Status st = CheckBatchDirections(*request, index, kSliceChunks * chunk); !st.ok()) {
+  const int n = static_cast<int>(request.directions.size());
+  if (grpc::Status st = CheckBatchDirections(request, index, kSliceChunks * chunk); !st.ok()) {
     return st;
   }
-  BatchChunks chunks(*context, stopping_, *slot, *writer, n, chunk);
+  BatchChunks chunks(*context, stopping_, *slot, *streamer, n, chunk);
   // A batch's answers leave `combined` to the client, and `shared` unless asked (brdf.proto).
   const WithUncertainty with_uncertainty =
-      request->include_uncertainty()
-          ? WithUncertainty(UncertaintyParts{request->include_uncertainty_shared(), false})
+      request.settings.include_uncertainty()
+          ? WithUncertainty(UncertaintyParts{request.settings.include_uncertainty_shared(), false})
           : std::nullopt;
   std::vector<double> coords;
   for (int first = 0, count = 0; first < n && chunks.outcome().ok(); first += count) {
     count = std::min(chunks.slice(), n - first);
-    if (grpc::Status st = BatchCoords(*request, index, first, count, &coords); !st.ok()) return st;
+    if (grpc::Status st = BatchCoords(request, index, first, count, &coords); !st.ok()) return st;
     bool going = true;
     index.interpolator->EvaluateEach(coords, [&](std::size_t k, interp::Interpolation&& answer) {
       const int i = first + static_cast<int>(k);
       v1::InterpolationResult* result = chunks.Add(i);
       if (result == nullptr) return going = false;
-      ToResult(request->directions(i), std::move(answer), settings, index, VertexSpectra::kOmit,
-               with_uncertainty, result);
+      ToResult(request.directions[static_cast<std::size_t>(i)], std::move(answer), settings, index,
+               VertexSpectra::kOmit, with_uncertainty, result);
       return going = chunks.Filled(i);
     });
     if (!going) break;

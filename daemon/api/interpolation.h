@@ -50,6 +50,7 @@
 
 #include "brdf/v1/brdf.grpc.pb.h"
 #include "core/mutex.h"
+#include "daemon/api/batch_request.h"
 #include "daemon/api/common.h"
 #include "daemon/index/cache.h"
 #include "daemon/rpc/auth.h"
@@ -78,18 +79,18 @@ grpc::Status CheckOptionsFit(const interp::Options& options, const IndexSnapshot
 // Interpolate is served on gRPC's completion-queue API by InterpolateLoop (interpolate_loop.h),
 // from threads of brdfd's own: the answer takes microseconds, so a loop thread computes it where
 // it took the request (AnswerIfReady) and only a query that must first load or extend the index
-// goes to a thread that may block (Answer). InterpolateBatch stays on the synchronous API: its
-// writer blocks under flow control.
+// goes to a thread that may block (Answer). InterpolateBatch stays on the synchronous API (its
+// writer blocks under flow control), reading its own request once it has a work permit
+// (batch_request.h).
 class InterpolationService final
-    : public v1::Interpolation::WithAsyncMethod_Interpolate<v1::Interpolation::Service> {
+    : public WithWireBatchRequest<
+          v1::Interpolation::WithAsyncMethod_Interpolate<v1::Interpolation::Service>> {
  public:
   // All three must outlive the service.
   InterpolationService(IndexCache& cache, const Authenticator& auth, const StopSignal& stopping,
                        StreamRegistry& streams);
 
-  grpc::Status InterpolateBatch(grpc::ServerContext* context,
-                                const v1::InterpolateBatchRequest* request,
-                                grpc::ServerWriter<v1::InterpolateBatchChunk>* writer) override;
+  grpc::Status WireBatch(grpc::ServerContext* context, BatchStreamer* streamer) override;
   grpc::Status RenderAppearance(grpc::ServerContext* context, const v1::AppearanceRequest* request,
                                 v1::AppearanceResponse* response) override;
 
