@@ -13,27 +13,19 @@
 namespace brdf::daemon {
 namespace {
 
-using exports::chunk_wire::BytesFieldSize;
-using exports::chunk_wire::kChunkData;
-using exports::chunk_wire::kDataContent;
-using exports::chunk_wire::kDataOffset;
-using exports::chunk_wire::kDataPart;
-using exports::chunk_wire::kLengthType;
-using exports::chunk_wire::kLongestVarint;
-using exports::chunk_wire::kVarintType;
-using exports::chunk_wire::PutVarint;
-using exports::chunk_wire::Tag;
-using exports::chunk_wire::VarintSize;
+namespace wire = exports::chunk_wire;
 
 // The layout's tags are the generated messages' field numbers (a renumbered proto fails here).
-static_assert(kChunkData == Tag(v1::ExportChunk::kDataFieldNumber, kLengthType));
-static_assert(kDataOffset == Tag(v1::ExportData::kOffsetFieldNumber, kVarintType));
-static_assert(kDataContent == Tag(v1::ExportData::kContentFieldNumber, kLengthType));
-static_assert(kDataPart == Tag(v1::ExportData::kPartFieldNumber, kLengthType));
+static_assert(wire::kChunkData == wire::Tag(v1::ExportChunk::kDataFieldNumber, wire::kLengthType));
+static_assert(wire::kDataOffset ==
+              wire::Tag(v1::ExportData::kOffsetFieldNumber, wire::kVarintType));
+static_assert(wire::kDataContent ==
+              wire::Tag(v1::ExportData::kContentFieldNumber, wire::kLengthType));
+static_assert(wire::kDataPart == wire::Tag(v1::ExportData::kPartFieldNumber, wire::kLengthType));
 
 // Room before the content: the chunk's tag and length, the offset's tag and value, the content's
 // tag and length.
-constexpr std::size_t kHeaderRoom = 3 * (1 + kLongestVarint);
+constexpr std::size_t kHeaderRoom = 3 * (1 + wire::kLongestVarint);
 
 }  // namespace
 
@@ -50,7 +42,7 @@ void ExportDataMessage::Release() {
 
 void ExportDataMessage::Reset(std::size_t capacity) {
   Release();
-  const std::size_t trailer = 1 + kLongestVarint + part_.size();
+  const std::size_t trailer = 1 + wire::kLongestVarint + part_.size();
   buffer_ = grpc_slice_malloc(kHeaderRoom + capacity + trailer);
   capacity_ = capacity;
 }
@@ -64,28 +56,29 @@ std::size_t ExportDataMessage::Append(const char* data, std::size_t n) {
 
 grpc::ByteBuffer ExportDataMessage::Take(std::uint64_t offset) {
   if (GRPC_SLICE_LENGTH(buffer_) == 0) Reset(0);
-  const std::size_t offset_field = offset == 0 ? 0 : 1 + VarintSize(offset);
-  const std::size_t inner = offset_field + BytesFieldSize(size_) + BytesFieldSize(part_.size());
+  const std::size_t offset_field = offset == 0 ? 0 : 1 + wire::VarintSize(offset);
+  const std::size_t inner =
+      offset_field + wire::BytesFieldSize(size_) + wire::BytesFieldSize(part_.size());
   // The header, written where it ends right before the content.
   std::uint8_t header[kHeaderRoom];
   std::uint8_t* end = header;
-  *end++ = kChunkData;
-  end = PutVarint(end, inner);
+  *end++ = wire::kChunkData;
+  end = wire::PutVarint(end, inner);
   if (offset != 0) {
-    *end++ = kDataOffset;
-    end = PutVarint(end, offset);
+    *end++ = wire::kDataOffset;
+    end = wire::PutVarint(end, offset);
   }
   if (size_ > 0) {
-    *end++ = kDataContent;
-    end = PutVarint(end, size_);
+    *end++ = wire::kDataContent;
+    end = wire::PutVarint(end, size_);
   }
   const std::size_t header_size = static_cast<std::size_t>(end - header);
   std::uint8_t* const content = GRPC_SLICE_START_PTR(buffer_) + kHeaderRoom;
   std::memcpy(content - header_size, header, header_size);
   std::uint8_t* tail = content + size_;
   if (!part_.empty()) {
-    *tail++ = kDataPart;
-    tail = PutVarint(tail, part_.size());
+    *tail++ = wire::kDataPart;
+    tail = wire::PutVarint(tail, part_.size());
     tail = std::copy(part_.begin(), part_.end(), tail);
   }
   const std::size_t first = kHeaderRoom - header_size;
