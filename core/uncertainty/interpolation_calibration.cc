@@ -138,18 +138,32 @@ bool BeyondCalibration(const InterpolationCalibration& calibration, double cell_
          cell_size > calibration.largest_cell;
 }
 
-double ScaleAt(const InterpolationCalibration& calibration, double cell_size, std::size_t band) {
-  if (band >= calibration.scale.size() || BeyondCalibration(calibration, cell_size)) {
-    return std::numeric_limits<double>::quiet_NaN();
-  }
+namespace {
+
+// The row ScaleAt takes `band`'s scale from: the last size bin `cell_size` lies above that has
+// the band, else the calibration's own.
+const std::vector<double>& ScaleRow(const InterpolationCalibration& calibration, double cell_size,
+                                    std::size_t band) {
   const std::vector<double>* scale = &calibration.scale;
   for (const SizeBin& bin : calibration.larger) {
     if (cell_size > bin.above && band < bin.scale.size()) scale = &bin.scale;
   }
-  double c = (*scale)[band];
-  if (calibration.largest_cell > 0 && cell_size > calibration.largest_cell) {
-    c *= cell_size / calibration.largest_cell;
+  return *scale;
+}
+
+// Beyond the largest calibrated cell the scale grows with the cell's size.
+bool Stretched(const InterpolationCalibration& calibration, double cell_size) {
+  return calibration.largest_cell > 0 && cell_size > calibration.largest_cell;
+}
+
+}  // namespace
+
+double ScaleAt(const InterpolationCalibration& calibration, double cell_size, std::size_t band) {
+  if (band >= calibration.scale.size() || BeyondCalibration(calibration, cell_size)) {
+    return std::numeric_limits<double>::quiet_NaN();
   }
+  double c = ScaleRow(calibration, cell_size, band)[band];
+  if (Stretched(calibration, cell_size)) c *= cell_size / calibration.largest_cell;
   return c;
 }
 
@@ -161,24 +175,22 @@ bool ApplyInterpolationCalibration(const InterpolationCalibration& calibration,
     for (std::size_t b = 0; b < spread.size(); ++b) spread[b] *= calibration.scale[b];
     return true;
   }
-  // The size's scale and stretch found once for every band: the values ScaleAt gives band by
-  // band, when every size bin has a scale for each band (as CalibrateInterpolation makes them).
-  const std::vector<double>* scale = &calibration.scale;
-  bool every_band = true;
-  for (const SizeBin& bin : calibration.larger) {
-    every_band = every_band && bin.scale.size() >= spread.size();
-    if (cell_size > bin.above) scale = &bin.scale;
-  }
+  // When every size bin has a scale for each band (as CalibrateInterpolation makes them), ScaleAt's
+  // row is the same for every band: found once.
+  const bool every_band =
+      std::all_of(calibration.larger.begin(), calibration.larger.end(),
+                  [&](const SizeBin& bin) { return bin.scale.size() >= spread.size(); });
   if (!every_band) {
     for (std::size_t b = 0; b < spread.size(); ++b) {
       spread[b] *= ScaleAt(calibration, cell_size, b);
     }
     return true;
   }
-  const bool stretched = cell_size > calibration.largest_cell;
+  const std::vector<double>& scale = ScaleRow(calibration, cell_size, 0);
+  const bool stretched = Stretched(calibration, cell_size);
   const double stretch = cell_size / calibration.largest_cell;
   for (std::size_t b = 0; b < spread.size(); ++b) {
-    double c = (*scale)[b];
+    double c = scale[b];
     if (stretched) c *= stretch;
     spread[b] *= c;
   }
