@@ -12,7 +12,6 @@
 // gRPC's transport, within HTTP/2's flow-control window.
 #pragma once
 
-#include <google/protobuf/descriptor.h>
 #include <grpcpp/support/byte_buffer.h>
 #include <grpcpp/support/method_handler.h>
 #include <grpcpp/support/sync_stream.h>
@@ -23,6 +22,7 @@
 #include <vector>
 
 #include "brdf/v1/brdf.grpc.pb.h"
+#include "daemon/rpc/method_index.h"
 
 namespace brdf::daemon {
 
@@ -76,7 +76,7 @@ class WithWireBatchRequest : public Base {
  public:
   WithWireBatchRequest() {
     this->MarkMethodStreamed(
-        BatchMethodIndex(),
+        MethodIndex(v1::Interpolation::service_full_name(), "InterpolateBatch"),
         new grpc::internal::SplitServerStreamingHandler<grpc::ByteBuffer,
                                                         v1::InterpolateBatchChunk>(
             [this](grpc::ServerContext* context, BatchStreamer* streamer) {
@@ -91,16 +91,6 @@ class WithWireBatchRequest : public Base {
                         "Interpolation.InterpolateBatch is served by WireBatch");
   }
   virtual grpc::Status WireBatch(grpc::ServerContext* context, BatchStreamer* streamer) = 0;
-
- private:
-  // InterpolateBatch's index among the service's methods, read from its descriptor so that a
-  // reordered brdf.proto cannot misroute the handler.
-  static int BatchMethodIndex() {
-    return google::protobuf::DescriptorPool::generated_pool()
-        ->FindServiceByName(v1::Interpolation::service_full_name())
-        ->FindMethodByName("InterpolateBatch")
-        ->index();
-  }
 };
 
 }  // namespace brdf::daemon

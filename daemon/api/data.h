@@ -6,7 +6,6 @@
 // exports to files (Export) live in export.cc.
 #pragma once
 
-#include <google/protobuf/descriptor.h>
 #include <grpcpp/support/byte_buffer.h>
 #include <grpcpp/support/method_handler.h>
 #include <grpcpp/support/sync_stream.h>
@@ -23,6 +22,7 @@
 #include "daemon/api/stream_pump.h"
 #include "daemon/api/stream_readings.h"
 #include "daemon/rpc/auth.h"
+#include "daemon/rpc/method_index.h"
 #include "daemon/rpc/stream_registry.h"
 
 namespace brdf::daemon {
@@ -38,7 +38,7 @@ class WithWireExport : public Base {
 
   WithWireExport() {
     this->MarkMethodStreamed(
-        ExportMethodIndex(),
+        MethodIndex(v1::Data::service_full_name(), "Export"),
         new grpc::internal::SplitServerStreamingHandler<v1::ExportRequest, grpc::ByteBuffer>(
             [this](grpc::ServerContext* context, ExportStreamer* streamer) {
               return this->WireExport(context, streamer);
@@ -50,16 +50,6 @@ class WithWireExport : public Base {
     return grpc::Status(grpc::StatusCode::UNIMPLEMENTED, "Data.Export is served by WireExport");
   }
   virtual grpc::Status WireExport(grpc::ServerContext* context, ExportStreamer* streamer) = 0;
-
- private:
-  // Export's index among Data's methods as the generated service numbers them: the proto's
-  // order, read from its descriptor so that a reordered brdf.proto cannot misroute the handler.
-  static int ExportMethodIndex() {
-    const google::protobuf::ServiceDescriptor* data =
-        google::protobuf::DescriptorPool::generated_pool()->FindServiceByName(
-            v1::Data::service_full_name());
-    return data->FindMethodByName("Export")->index();
-  }
 };
 
 // StreamReadings on gRPC's callback API (the stream pump: a following stream that waits holds no
