@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <type_traits>
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
@@ -31,6 +32,24 @@ struct LanesOf<8> {
 template <int W>
 using Lanes = typename LanesOf<W>::type;
 static_assert(sizeof(Lanes<2>) == 16 && sizeof(Lanes<4>) == 32 && sizeof(Lanes<8>) == 64);
+
+// W floats, widened to Lanes<W> as they are read (a blend's shared rows, blend_budget.h).
+template <int W>
+struct FloatLanesOf;
+template <>
+struct FloatLanesOf<2> {
+  using type = float __attribute__((vector_size(8)));
+};
+template <>
+struct FloatLanesOf<4> {
+  using type = float __attribute__((vector_size(16)));
+};
+template <>
+struct FloatLanesOf<8> {
+  using type = float __attribute__((vector_size(32)));
+};
+template <int W>
+using FloatLanes = typename FloatLanesOf<W>::type;
 
 // The loops below keep their vectors in locals (never passed or returned: that would change the
 // calling convention between targets), loaded and stored with memcpy (no alignment assumed).
@@ -110,13 +129,17 @@ template <int W>
 }
 
 // BlendSquaredBands' pass (band_sums.h): each band's expressions exactly as the loops above write
-// them, so that the compiler forms them alike (the same fused multiply-adds).
-template <int W>
+// them, so that the compiler forms them alike (the same fused multiply-adds). `Rows` is
+// WeightedRows (double rows) or WeightedFloatRows (float rows, each value widened to double as it
+// is read, then the same operations).
+template <int W, typename Rows>
 [[gnu::always_inline]] inline void BlendSquaredLanes(
     double* __restrict measurement, double* __restrict shared, const double* const* independent,
-    const double* scales, std::size_t r, const WeightedRows* inputs, std::size_t m, std::size_t n) {
+    const double* scales, std::size_t r, const Rows* inputs, std::size_t m, std::size_t n) {
+  constexpr bool kFloat = std::is_same_v<Rows, WeightedFloatRows>;
   const Lanes<W> zero = {};
   Lanes<W> u, s, v, t;
+  FloatLanes<W> f;
   std::size_t k = 0;
   for (; k + W <= n; k += W) {
     u = zero;
@@ -126,11 +149,21 @@ template <int W>
     }
     s = zero;
     for (std::size_t j = 0; j < m; ++j) {
-      const WeightedRows& in = inputs[j];
-      std::memcpy(&v, in.rows[0] + k, sizeof v);
+      const Rows& in = inputs[j];
+      if constexpr (kFloat) {
+        std::memcpy(&f, in.rows[0] + k, sizeof f);
+        v = __builtin_convertvector(f, Lanes<W>);
+      } else {
+        std::memcpy(&v, in.rows[0] + k, sizeof v);
+      }
       t = in.weights[0] * v;
       for (std::size_t i = 1; i < in.count; ++i) {
-        std::memcpy(&v, in.rows[i] + k, sizeof v);
+        if constexpr (kFloat) {
+          std::memcpy(&f, in.rows[i] + k, sizeof f);
+          v = __builtin_convertvector(f, Lanes<W>);
+        } else {
+          std::memcpy(&v, in.rows[i] + k, sizeof v);
+        }
         t += in.weights[i] * v;
       }
       s += t * t;
@@ -144,9 +177,10 @@ template <int W>
     for (std::size_t i = 0; i < r; ++i) ind += scales[i] * (independent[i][k] * independent[i][k]);
     double acc = 0;
     for (std::size_t j = 0; j < m; ++j) {
-      const WeightedRows& in = inputs[j];
-      double sum = in.weights[0] * in.rows[0][k];
-      for (std::size_t i = 1; i < in.count; ++i) sum += in.weights[i] * in.rows[i][k];
+      const Rows& in = inputs[j];
+      double sum = in.weights[0] * static_cast<double>(in.rows[0][k]);
+      for (std::size_t i = 1; i < in.count; ++i)
+        sum += in.weights[i] * static_cast<double>(in.rows[i][k]);
       acc += sum * sum;
     }
     if (shared != nullptr) shared[k] = acc;
@@ -189,6 +223,8 @@ using DifferenceFn = void (*)(double*, const double*, const double*, double, std
 using SqrtFn = void (*)(double*, std::size_t);
 using BlendFn = void (*)(double*, double*, const double* const*, const double*, std::size_t,
                          const WeightedRows*, std::size_t, std::size_t);
+using BlendFloatFn = void (*)(double*, double*, const double* const*, const double*, std::size_t,
+                              const WeightedFloatRows*, std::size_t, std::size_t);
 using DifferencesFn = void (*)(double*, const double* const*, const double*, const double*,
                                std::size_t, std::size_t);
 
@@ -200,6 +236,7 @@ struct Kernels {
   SqrtFn sqrt;
   BlendFn blend_squared;
   DifferencesFn squared_differences;
+  BlendFloatFn blend_squared_float;
 };
 
 // The scalar square root (the vector extension has none; the vector variants use intrinsics).
@@ -223,6 +260,11 @@ void AddSquaredSum2(double* acc, const double* const* x, const double* w, std::s
 }
 void BlendSquared2(double* m, double* shared, const double* const* ind, const double* scales,
                    std::size_t r, const WeightedRows* inputs, std::size_t count, std::size_t n) {
+  BlendSquaredLanes<2>(m, shared, ind, scales, r, inputs, count, n);
+}
+void BlendSquaredFloat2(double* m, double* shared, const double* const* ind, const double* scales,
+                        std::size_t r, const WeightedFloatRows* inputs, std::size_t count,
+                        std::size_t n) {
   BlendSquaredLanes<2>(m, shared, ind, scales, r, inputs, count, n);
 }
 void SquaredDifferences2(double* acc, const double* const* x, const double* y, const double* a,
@@ -265,6 +307,13 @@ __attribute__((target("avx2"))) void BlendSquared4(double* m, double* shared,
                                                    std::size_t count, std::size_t n) {
   BlendSquaredLanes<4>(m, shared, ind, scales, r, inputs, count, n);
 }
+__attribute__((target("avx2"))) void BlendSquaredFloat4(double* m, double* shared,
+                                                        const double* const* ind,
+                                                        const double* scales, std::size_t r,
+                                                        const WeightedFloatRows* inputs,
+                                                        std::size_t count, std::size_t n) {
+  BlendSquaredLanes<4>(m, shared, ind, scales, r, inputs, count, n);
+}
 __attribute__((target("avx2"))) void SquaredDifferences4(double* acc, const double* const* x,
                                                          const double* y, const double* a,
                                                          std::size_t m, std::size_t n) {
@@ -300,6 +349,13 @@ __attribute__((target("avx512f"))) void BlendSquared8(double* m, double* shared,
                                                       std::size_t n) {
   BlendSquaredLanes<8>(m, shared, ind, scales, r, inputs, count, n);
 }
+__attribute__((target("avx512f"))) void BlendSquaredFloat8(double* m, double* shared,
+                                                           const double* const* ind,
+                                                           const double* scales, std::size_t r,
+                                                           const WeightedFloatRows* inputs,
+                                                           std::size_t count, std::size_t n) {
+  BlendSquaredLanes<8>(m, shared, ind, scales, r, inputs, count, n);
+}
 __attribute__((target("avx512f"))) void SquaredDifferences8(double* acc, const double* const* x,
                                                             const double* y, const double* a,
                                                             std::size_t m, std::size_t n) {
@@ -316,13 +372,13 @@ Kernels PickKernels() {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
   if (__builtin_cpu_supports("avx512f"))
     return {&AddScaled8, &AddSquared8,   &AddSquaredDifference8, &AddSquaredSum8,
-            &Sqrt8,      &BlendSquared8, &SquaredDifferences8};
+            &Sqrt8,      &BlendSquared8, &SquaredDifferences8,   &BlendSquaredFloat8};
   if (__builtin_cpu_supports("avx2"))
     return {&AddScaled4, &AddSquared4,   &AddSquaredDifference4, &AddSquaredSum4,
-            &Sqrt4,      &BlendSquared4, &SquaredDifferences4};
+            &Sqrt4,      &BlendSquared4, &SquaredDifferences4,   &BlendSquaredFloat4};
 #endif
   return {&AddScaled2, &AddSquared2,   &AddSquaredDifference2, &AddSquaredSum2,
-          &Sqrt2,      &BlendSquared2, &SquaredDifferences2};
+          &Sqrt2,      &BlendSquared2, &SquaredDifferences2,   &BlendSquaredFloat2};
 }
 
 const Kernels& Picked() {
@@ -357,6 +413,14 @@ void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,
   Picked().blend_squared(measurement.data(), shared.empty() ? nullptr : shared.data(),
                          independent_rows.data(), scales.data(), independent_rows.size(),
                          inputs.data(), inputs.size(), measurement.size());
+}
+
+void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,
+                       std::span<const double* const> independent_rows,
+                       std::span<const double> scales, std::span<const WeightedFloatRows> inputs) {
+  Picked().blend_squared_float(measurement.data(), shared.empty() ? nullptr : shared.data(),
+                               independent_rows.data(), scales.data(), independent_rows.size(),
+                               inputs.data(), inputs.size(), measurement.size());
 }
 
 void SquaredDifferencesBands(std::span<double> acc, std::span<const double* const> x,

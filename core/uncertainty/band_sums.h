@@ -46,6 +46,20 @@ void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,
                        std::span<const double* const> independent_rows,
                        std::span<const double> scales, std::span<const WeightedRows> inputs);
 
+// One shared input whose contributions are floats (blend_budget.h's rows).
+struct WeightedFloatRows {
+  const float* const* rows = nullptr;
+  const double* weights = nullptr;
+  std::size_t count = 0;
+};
+
+// The same pass with float rows for the shared inputs: each value widened to double as it is
+// read, then the same operations, so the result equals BlendSquaredBands' over the widened rows to
+// the last bit.
+void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,
+                       std::span<const double* const> independent_rows,
+                       std::span<const double> scales, std::span<const WeightedFloatRows> inputs);
+
 // acc = 0, then AddSquaredDifferenceBands(acc, x[i], y, a[i]) for each i in order, in one pass
 // over the bands (the same values to the last bit). x.size() == a.size(); every x[i] and y of
 // acc's size.

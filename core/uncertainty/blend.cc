@@ -14,11 +14,13 @@ namespace brdf::uncertainty {
 namespace {
 
 // One reading of the blend, its weights summed over its copies.
-struct Blended {
+template <typename Budget>
+struct BlendedOf {
   std::int64_t reading_id = 0;
   double weight = 0;
-  const ReadingBudget* budget = nullptr;
+  const Budget* budget = nullptr;
 };
+using Blended = BlendedOf<ReadingBudget>;
 
 // A shared input (name, sharing, id) and the vertices' contributions to it with their weights:
 // its Σ wᵢ uⱼ,ᵢ per band is formed in one pass when it is squared.
@@ -47,17 +49,19 @@ Scratch& ThreadScratch() {
   return scratch;
 }
 
-Status MergeByReading(std::span<const BlendVertex> vertices, std::vector<Blended>& out) {
+template <typename Vertex, typename Budget>
+Status MergeByReading(std::span<const Vertex> vertices, std::vector<BlendedOf<Budget>>& out) {
   out.clear();
-  for (const BlendVertex& v : vertices) {
+  for (const Vertex& v : vertices) {
     if (!std::isfinite(v.weight)) {
       return InvalidArgument("reading " + std::to_string(v.reading_id) +
                              ": its blend weight is not a finite number");
     }
-    auto same = std::find_if(out.begin(), out.end(),
-                             [&](const Blended& b) { return b.reading_id == v.reading_id; });
+    auto same = std::find_if(out.begin(), out.end(), [&](const BlendedOf<Budget>& b) {
+      return b.reading_id == v.reading_id;
+    });
     if (same == out.end()) {
-      out.push_back(Blended{v.reading_id, v.weight, v.budget});
+      out.push_back(BlendedOf<Budget>{v.reading_id, v.weight, v.budget});
     } else {
       same->weight += v.weight;
       if (same->budget == nullptr) same->budget = v.budget;
@@ -66,13 +70,20 @@ Status MergeByReading(std::span<const BlendVertex> vertices, std::vector<Blended
   return Status::Ok();
 }
 
+std::string NoBudget(std::int64_t reading_id) {
+  return "reading " + std::to_string(reading_id) + ": no uncertainty budget (not estimated)";
+}
+
+std::string OtherBands(std::int64_t reading_id, std::size_t bands) {
+  return "reading " + std::to_string(reading_id) + ": its uncertainty budget does not have " +
+         std::to_string(bands) + " bands, the blend's; were the readings measured on another grid?";
+}
+
 Status CheckBands(const Blended& b, std::size_t bands) {
   bool fits = b.budget->combined.size() == bands && b.budget->independent.size() == bands;
   for (const Component& c : b.budget->components) fits = fits && c.contribution.size() == bands;
   if (fits) return Status::Ok();
-  return InvalidArgument("reading " + std::to_string(b.reading_id) +
-                         ": its uncertainty budget does not have " + std::to_string(bands) +
-                         " bands, the blend's; were the readings measured on another grid?");
+  return InvalidArgument(OtherBands(b.reading_id, bands));
 }
 
 // The shared input `c` is shared through, added (with no contributions yet) when it is the first
@@ -112,6 +123,64 @@ void AddReading(const Blended& b, Scratch& s) {
   }
 }
 
+// The blend over BlendBudgets (blend_budget.h): the same sums, its inputs found by their integer
+// keys and their rows read as floats.
+struct FloatInput {
+  SharedKey key;
+  std::vector<const float*> rows;
+  std::vector<double> weights;
+};
+
+struct FloatScratch {
+  std::vector<BlendedOf<BlendBudget>> readings;
+  std::vector<const double*> independent;
+  std::vector<double> independent_scales;
+  std::vector<FloatInput> inputs;  // the first `used` are this blend's
+  std::size_t used = 0;
+  std::vector<WeightedFloatRows> rows;
+  std::vector<const std::vector<std::string>*> notes_added;  // lists already in not_estimated
+};
+
+FloatScratch& ThreadFloatScratch() {
+  thread_local FloatScratch scratch;
+  return scratch;
+}
+
+// As InputOf: `hint` first (the readings of a session list their components in the same order).
+FloatInput& FloatInputOf(const SharedKey& key, std::size_t hint, FloatScratch& s) {
+  if (hint < s.used && s.inputs[hint].key == key) return s.inputs[hint];
+  for (std::size_t j = 0; j < s.used; ++j) {
+    if (s.inputs[j].key == key) return s.inputs[j];
+  }
+  if (s.used == s.inputs.size()) s.inputs.emplace_back();
+  FloatInput& input = s.inputs[s.used++];
+  input.key = key;
+  input.rows.clear();
+  input.weights.clear();
+  return input;
+}
+
+void AddFloatReading(const BlendedOf<BlendBudget>& b, FloatScratch& s) {
+  const BlendBudget& budget = *b.budget;
+  s.independent.push_back(budget.independent.data());
+  s.independent_scales.push_back(b.weight * b.weight);
+  for (std::size_t j = 0; j < budget.keys.size(); ++j) {
+    FloatInput& input = FloatInputOf(budget.keys[j], j, s);
+    input.rows.push_back(budget.row(j));
+    input.weights.push_back(b.weight);
+  }
+}
+
+// The reading's not_estimated entries, each once: a list already added (shared by readings with
+// the same entries) is skipped whole.
+void AddNotes(const BlendBudget& budget, FloatScratch& s, NoteList& notes) {
+  const std::vector<std::string>* list = budget.not_estimated.get();
+  if (list == nullptr || list->empty()) return;
+  if (std::find(s.notes_added.begin(), s.notes_added.end(), list) != s.notes_added.end()) return;
+  s.notes_added.push_back(list);
+  for (const std::string& entry : *list) notes.AddUnique(entry);
+}
+
 }  // namespace
 
 Result<BlendedUncertainty> BlendMeasurementUncertainty(std::span<const BlendVertex> vertices,
@@ -125,7 +194,7 @@ Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int ba
                                    BlendedUncertainty* out, bool with_shared) {
   if (bands < 1) return InvalidArgument("a blend needs at least one band");
   Scratch& s = ThreadScratch();
-  BRDF_RETURN_IF_ERROR(MergeByReading(vertices, s.readings));
+  BRDF_RETURN_IF_ERROR(MergeByReading<BlendVertex>(vertices, s.readings));
   const auto n = static_cast<std::size_t>(bands);
   NoteList notes(out->not_estimated);
   s.independent.clear();
@@ -133,8 +202,7 @@ Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int ba
   s.used = 0;
   for (const Blended& b : s.readings) {
     if (b.budget == nullptr) {
-      notes.AddUnique("reading " + std::to_string(b.reading_id) +
-                      ": no uncertainty budget (not estimated)");
+      notes.AddUnique(NoBudget(b.reading_id));
       continue;
     }
     BRDF_RETURN_IF_ERROR(CheckBands(b, n));
@@ -150,6 +218,40 @@ Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int ba
   for (std::size_t j = 0; j < s.used; ++j) {
     const SharedInput& input = s.inputs[j];
     s.rows.push_back({input.contributions.data(), input.weights.data(), input.weights.size()});
+  }
+  out->measurement.resize(n);
+  out->shared.resize(with_shared ? n : 0);
+  BlendSquaredBands(out->measurement, out->shared, s.independent, s.independent_scales, s.rows);
+  SqrtBands(out->measurement);
+  SqrtBands(out->shared);
+  return Status::Ok();
+}
+
+Status BlendMeasurementUncertainty(std::span<const BlendBudgetVertex> vertices, int bands,
+                                   BlendedUncertainty* out, bool with_shared) {
+  if (bands < 1) return InvalidArgument("a blend needs at least one band");
+  FloatScratch& s = ThreadFloatScratch();
+  BRDF_RETURN_IF_ERROR(MergeByReading<BlendBudgetVertex>(vertices, s.readings));
+  const auto n = static_cast<std::size_t>(bands);
+  NoteList notes(out->not_estimated);
+  s.independent.clear();
+  s.independent_scales.clear();
+  s.notes_added.clear();
+  s.used = 0;
+  for (const BlendedOf<BlendBudget>& b : s.readings) {
+    if (b.budget == nullptr) {
+      notes.AddUnique(NoBudget(b.reading_id));
+      continue;
+    }
+    if (b.budget->bands != n) return InvalidArgument(OtherBands(b.reading_id, n));
+    AddNotes(*b.budget, s, notes);
+    AddFloatReading(b, s);
+  }
+  notes.Finish();
+  s.rows.clear();
+  for (std::size_t j = 0; j < s.used; ++j) {
+    const FloatInput& input = s.inputs[j];
+    s.rows.push_back({input.rows.data(), input.weights.data(), input.weights.size()});
   }
   out->measurement.resize(n);
   out->shared.resize(with_shared ? n : 0);

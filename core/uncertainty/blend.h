@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/status.h"
+#include "core/uncertainty/blend_budget.h"
 #include "core/uncertainty/budget.h"
 
 namespace brdf::uncertainty {
@@ -54,6 +55,22 @@ Result<BlendedUncertainty> BlendMeasurementUncertainty(std::span<const BlendVert
 // false, out->shared is left empty (a caller that does not hand it on saves its square roots;
 // measurement is the same). On an error *out is left unspecified.
 Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int bands,
+                                   BlendedUncertainty* out, bool with_shared = true);
+
+// One blended reading with its budget in an index's form (blend_budget.h).
+struct BlendBudgetVertex {
+  std::int64_t reading_id = 0;
+  double weight = 0;
+  const BlendBudget* budget = nullptr;  // null: not estimated
+};
+
+// The same blend of budgets in BlendBudget's form (brdfd's interpolation index): the same sums
+// in the same order, its shared contributions read as the floats BlendBudget holds, so the result
+// equals the blend of the ReadingBudgets they were made from up to a float's rounding of each
+// shared contribution (relative 2⁻²⁴; its independent parts are the same doubles). The same
+// not_estimated entries in the same order, the same errors (a budget whose bands are not
+// `bands`).
+Status BlendMeasurementUncertainty(std::span<const BlendBudgetVertex> vertices, int bands,
                                    BlendedUncertainty* out, bool with_shared = true);
 
 // The interpolation term per band: the vertices' weighted spread about the blend,

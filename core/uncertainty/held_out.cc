@@ -35,14 +35,22 @@ std::vector<std::size_t> HeldOutOrder(const interp::SampleSet& samples) {
 
 namespace {
 
-const std::vector<double>* Independent(const BudgetOf& budget_of, std::size_t i) {
-  const ReadingBudget* b = budget_of ? budget_of(i) : nullptr;
-  return b != nullptr ? &b->independent : nullptr;
+const std::vector<double>* Independent(const IndependentOf& independent_of, std::size_t i) {
+  return independent_of ? independent_of(i) : nullptr;
+}
+
+// `budget_of`'s independent parts (the function refers to `budget_of`: used within the call).
+IndependentOf IndependentParts(const BudgetOf& budget_of) {
+  if (!budget_of) return {};
+  return [&budget_of](std::size_t i) -> const std::vector<double>* {
+    const ReadingBudget* b = budget_of(i);
+    return b != nullptr ? &b->independent : nullptr;
+  };
 }
 
 // One held-out sample predicted by `interpolator` over `rest` (rest_to_all: rest's positions in
 // the full set); false when the answer is not OK.
-bool PredictOne(const interp::SampleSet& samples, const BudgetOf& budget_of, std::size_t j,
+bool PredictOne(const interp::SampleSet& samples, const IndependentOf& budget_of, std::size_t j,
                 const interp::Interpolator& interpolator, const interp::SampleSet& rest,
                 const std::vector<std::size_t>& rest_to_all, HeldOutPoint* out) {
   interp::Interpolation answer = interpolator.Evaluate(samples.coords(j));
@@ -91,7 +99,7 @@ Result<std::unique_ptr<interp::Interpolator>> MakeFoldIndex(
 }
 
 // One fold: an index over every sample not in `held`, evaluated at each held one.
-void PredictFold(const interp::SampleSet& samples, const BudgetOf& budget_of,
+void PredictFold(const interp::SampleSet& samples, const IndependentOf& budget_of,
                  std::span<const std::size_t> held, interp::Method method,
                  const interp::Options& options, std::vector<HeldOutPoint>* out) {
   std::vector<bool> is_held(samples.size(), false);
@@ -119,6 +127,12 @@ void PredictFold(const interp::SampleSet& samples, const BudgetOf& budget_of,
 std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
                                          const BudgetOf& budget_of, interp::Method method,
                                          const interp::Options& options) {
+  return PredictHeldOut(samples, IndependentParts(budget_of), method, options);
+}
+
+std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
+                                         const IndependentOf& budget_of, interp::Method method,
+                                         const interp::Options& options) {
   std::vector<HeldOutPoint> out;
   const std::size_t n = samples.size();
   if (n < 2) return out;
@@ -144,6 +158,13 @@ CalibrationTarget TargetOf(interp::Method method) {
 
 InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples,
                                                 const BudgetOf& budget_of, interp::Method method,
+                                                const interp::Options& options, int bands) {
+  return CalibrateInterpolation(samples, IndependentParts(budget_of), method, options, bands);
+}
+
+InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples,
+                                                const IndependentOf& budget_of,
+                                                interp::Method method,
                                                 const interp::Options& options, int bands) {
   if (method == interp::Method::kNearest) {
     InterpolationCalibration none;

@@ -33,6 +33,9 @@ inline constexpr std::size_t kMaxFoldSamplesOther = 10000;
 
 // Sample i's budget, by its position in the sample set (null: none). Unset: no sample has one.
 using BudgetOf = std::function<const ReadingBudget*(std::size_t index)>;
+// Sample i's independent part (its budget's, a value per band), or null when it has none: all
+// the held-out points' noise reads of a budget (brdfd's index gives it from its BlendBudgets).
+using IndependentOf = std::function<const std::vector<double>*(std::size_t index)>;
 
 // The samples' positions in the order the folds take them: by a fixed hash of their ids (the
 // folds do not follow the plan's order; the same session gives the same folds).
@@ -44,6 +47,10 @@ std::vector<std::size_t> HeldOutOrder(const interp::SampleSet& samples);
 // its vertices' (weighted) in quadrature; a point whose reading has no budget has none.
 std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
                                          const BudgetOf& budget_of, interp::Method method,
+                                         const interp::Options& options);
+// The same with each sample's independent part given directly (the same points).
+std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
+                                         const IndependentOf& independent_of, interp::Method method,
                                          const interp::Options& options);
 
 // Delaunay's held-out readings binned by their cell's size (interpolation_calibration.h): its
@@ -62,6 +69,11 @@ CalibrationTarget TargetOf(interp::Method method);
 // CalibrationTarget::min_points could be predicted.
 InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples,
                                                 const BudgetOf& budget_of, interp::Method method,
+                                                const interp::Options& options, int bands);
+// The same with each sample's independent part given directly (the same calibration).
+InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples,
+                                                const IndependentOf& independent_of,
+                                                interp::Method method,
                                                 const interp::Options& options, int bands);
 
 // A calibration computed once, on first use, and kept (an index snapshot's, an export

@@ -21,34 +21,39 @@ std::size_t StringBytes(const std::string& s) {
   return s.capacity() <= kInline ? 0 : s.capacity() + 1 + kAllocationOverhead;
 }
 
-// One budget as make_shared allocates it (with the control block) and what its members hold.
-std::size_t BudgetBytes(const uncertainty::ReadingBudget& b) {
+// One budget as make_shared allocates it (with the control block) and what its members hold;
+// its not_estimated list when it is not the previous budget's.
+std::size_t BudgetBytes(const uncertainty::BlendBudget& b, bool own_notes) {
   std::size_t bytes = sizeof(b) + 2 * sizeof(void*) + kAllocationOverhead;
-  bytes += VectorBytes(b.value) + VectorBytes(b.combined) + VectorBytes(b.independent);
-  bytes += VectorBytes(b.components) + VectorBytes(b.not_estimated);
-  for (const uncertainty::Component& c : b.components) {
-    bytes += StringBytes(c.name) + VectorBytes(c.contribution);
+  bytes += VectorBytes(b.independent) + VectorBytes(b.keys) + VectorBytes(b.shared_rows);
+  if (own_notes) {
+    bytes += sizeof(*b.not_estimated) + 2 * sizeof(void*) + kAllocationOverhead;
+    bytes += VectorBytes(*b.not_estimated);
+    for (const std::string& s : *b.not_estimated) bytes += StringBytes(s);
   }
-  for (const std::string& s : b.not_estimated) bytes += StringBytes(s);
   return bytes;
 }
 
 }  // namespace
 
-uncertainty::ReadingBudget BudgetForBlend(const uncertainty::ReadingBudget& budget) {
-  uncertainty::ReadingBudget kept;
-  kept.quantity = budget.quantity;
-  for (const uncertainty::Component& c : budget.components) {
-    if (c.shared.kind != uncertainty::Sharing::kIndependent) kept.components.push_back(c);
+void BudgetList::Add(const uncertainty::ReadingBudget* budget) {
+  if (budget == nullptr) {
+    Append(nullptr);
+    return;
   }
-  kept.components.shrink_to_fit();
-  kept.combined = budget.combined;
-  kept.independent = budget.independent;
-  kept.not_estimated = budget.not_estimated;
-  return kept;
+  Result<uncertainty::BlendBudget> kept = uncertainty::ToBlendBudget(*budget, last_notes_);
+  if (!kept.ok()) {
+    Append(nullptr);
+    return;
+  }
+  const bool own_notes = kept->not_estimated != last_notes_;
+  last_notes_ = kept->not_estimated;
+  auto shared = std::make_shared<const uncertainty::BlendBudget>(std::move(kept).value());
+  bytes_ += BudgetBytes(*shared, own_notes);
+  Append(std::move(shared));
 }
 
-void BudgetList::Add(std::shared_ptr<const uncertainty::ReadingBudget> budget) {
+void BudgetList::Append(std::shared_ptr<const uncertainty::BlendBudget> budget) {
   if (size_ % kChunk == 0) {
     chunks_.push_back(std::make_shared<Chunk>());
     chunks_.back()->reserve(kChunk);
@@ -61,7 +66,6 @@ void BudgetList::Add(std::shared_ptr<const uncertainty::ReadingBudget> budget) {
     chunks_.back() = std::move(own);
   }
   if (size_ % kChunk == 0) bytes_ += kChunk * sizeof(budget) + kAllocationOverhead;
-  if (budget) bytes_ += BudgetBytes(*budget);
   chunks_.back()->push_back(std::move(budget));
   ++size_;
 }

@@ -8,34 +8,34 @@
 // another list holds it too), so a snapshot's list never changes while later readings are added.
 // Not thread-safe for Add; a published list is read-only and may be read by many threads.
 //
-// The index holds what the blend needs of each budget (BudgetForBlend): a paper-grid session's
-// 2,112 whole budgets would be most of its cached memory.
+// The index holds what the blend needs of each budget, in the blend's form
+// (core/uncertainty/blend_budget.h: the independent part, the shared contributions as floats,
+// integer keys): a paper-grid session's 2,112 whole budgets would be most of its cached memory,
+// and a batch's blends read half the bytes.
 #pragma once
 
 #include <cstddef>
 #include <memory>
+#include <string>
 #include <vector>
 
+#include "core/uncertainty/blend_budget.h"
 #include "core/uncertainty/budget.h"
 
 namespace brdf::daemon {
-
-// The part of a reading's budget an interpolated value's uncertainty reads (core/uncertainty's
-// blend.h and held_out.h): its quantity, shared components, combined, independent and
-// not_estimated. The value and the independent components are left out (their sum is
-// `independent`), so a blend of it equals the blend of the whole budget, bit for bit.
-uncertainty::ReadingBudget BudgetForBlend(const uncertainty::ReadingBudget& budget);
 
 class BudgetList {
  public:
   static constexpr std::size_t kChunk = 128;
 
-  // Appends the next sample's budget (null: not estimated).
-  void Add(std::shared_ptr<const uncertainty::ReadingBudget> budget);
+  // Appends the next sample's budget in the blend's form (uncertainty::ToBlendBudget; its
+  // not_estimated list shared with the previous budget's when they hold the same entries). Null,
+  // or a budget whose parts do not all have the same number of bands: not estimated.
+  void Add(const uncertainty::ReadingBudget* budget);
 
   std::size_t size() const { return size_; }
   // Sample i's budget, or null when it has none or i is beyond the list.
-  const uncertainty::ReadingBudget* at(std::size_t i) const {
+  const uncertainty::BlendBudget* at(std::size_t i) const {
     return i < size_ ? (*chunks_[i / kChunk])[i % kChunk].get() : nullptr;
   }
   // Heap held by the list and its budgets (for the cache's bound): each budget's allocation, its
@@ -43,8 +43,11 @@ class BudgetList {
   std::size_t bytes() const { return bytes_; }
 
  private:
-  using Chunk = std::vector<std::shared_ptr<const uncertainty::ReadingBudget>>;
+  using Chunk = std::vector<std::shared_ptr<const uncertainty::BlendBudget>>;
+  void Append(std::shared_ptr<const uncertainty::BlendBudget> budget);
+
   std::vector<std::shared_ptr<Chunk>> chunks_;
+  std::shared_ptr<const std::vector<std::string>> last_notes_;  // the last budget's
   std::size_t size_ = 0;
   std::size_t bytes_ = 0;
 };

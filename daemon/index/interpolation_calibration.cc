@@ -1,6 +1,7 @@
 #include "daemon/index/interpolation_calibration.h"
 
 #include <memory>
+#include <vector>
 
 #include "daemon/index/cache.h"
 
@@ -13,9 +14,13 @@ uncertainty::InterpolationCalibration CalibrateInterpolation(const IndexSnapshot
     return none;
   }
   const BudgetList& budgets = snapshot.budgets;
-  return uncertainty::CalibrateInterpolation(
-      *snapshot.samples, [&budgets](std::size_t i) { return budgets.at(i); }, snapshot.method,
-      snapshot.options, snapshot.grid.count);
+  const uncertainty::IndependentOf independent_of =
+      [&budgets](std::size_t i) -> const std::vector<double>* {
+    const uncertainty::BlendBudget* b = budgets.at(i);
+    return b != nullptr ? &b->independent : nullptr;
+  };
+  return uncertainty::CalibrateInterpolation(*snapshot.samples, independent_of, snapshot.method,
+                                             snapshot.options, snapshot.grid.count);
 }
 
 std::shared_ptr<const CalibrationSlot> CarriedCalibration(const IndexSnapshot* previous,

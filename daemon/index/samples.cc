@@ -57,9 +57,7 @@ void IndexSamples::Add(Quantity q, const storage::ReadingRecord& record,
     // as the blend needs it (budgets.h: the whole budgets would be most of the session's memory).
     const bool of_brdf =
         record.uncertainty.has_value() && record.uncertainty->quantity == Quantity::kBrdf;
-    working_.brdf_budgets.Add(of_brdf ? std::make_shared<const uncertainty::ReadingBudget>(
-                                            BudgetForBlend(*record.uncertainty))
-                                      : nullptr);
+    working_.brdf_budgets.Add(of_brdf ? &*record.uncertainty : nullptr);
   }
 }
 
