@@ -28,12 +28,16 @@ void AddSquaredSumBands(std::span<double> acc, std::span<const double* const> x,
                         std::span<const double> w);
 
 // One shared input of a blend (blend.h): its contributions from `count` ≥ 1 vertices, each a row
-// of the accumulator's size, with their weights.
-struct WeightedRows {
-  const double* const* rows = nullptr;
+// of the accumulator's size, with their weights. The rows are doubles (a ReadingBudget's) or
+// floats (a BlendBudget's, blend_budget.h).
+template <typename Value>
+struct WeightedRowsOf {
+  const Value* const* rows = nullptr;
   const double* weights = nullptr;
   std::size_t count = 0;
 };
+using WeightedRows = WeightedRowsOf<double>;
+using WeightedFloatRows = WeightedRowsOf<float>;
 
 // A blend's measurement² in one pass over the bands, the same values to the last bit as
 //   independent = 0;  AddSquaredBands(independent, independent_rows[r], scales[r]) for each r;
@@ -45,13 +49,6 @@ struct WeightedRows {
 void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,
                        std::span<const double* const> independent_rows,
                        std::span<const double> scales, std::span<const WeightedRows> inputs);
-
-// One shared input whose contributions are floats (blend_budget.h's rows).
-struct WeightedFloatRows {
-  const float* const* rows = nullptr;
-  const double* weights = nullptr;
-  std::size_t count = 0;
-};
 
 // The same pass with float rows for the shared inputs: each value widened to double as it is
 // read, then the same operations, so the result equals BlendSquaredBands' over the widened rows to

@@ -127,7 +127,7 @@ void AddReading(const Blended& b, Scratch& s) {
 // keys and their rows read as floats.
 struct FloatInput {
   SharedKey key;
-  std::vector<const float*> rows;
+  std::vector<const float*> contributions;
   std::vector<double> weights;
 };
 
@@ -155,7 +155,7 @@ FloatInput& FloatInputOf(const SharedKey& key, std::size_t hint, FloatScratch& s
   if (s.used == s.inputs.size()) s.inputs.emplace_back();
   FloatInput& input = s.inputs[s.used++];
   input.key = key;
-  input.rows.clear();
+  input.contributions.clear();
   input.weights.clear();
   return input;
 }
@@ -166,7 +166,7 @@ void AddFloatReading(const BlendedOf<BlendBudget>& b, FloatScratch& s) {
   s.independent_scales.push_back(b.weight * b.weight);
   for (std::size_t j = 0; j < budget.keys.size(); ++j) {
     FloatInput& input = FloatInputOf(budget.keys[j], j, s);
-    input.rows.push_back(budget.row(j));
+    input.contributions.push_back(budget.row(j));
     input.weights.push_back(b.weight);
   }
 }
@@ -179,6 +179,22 @@ void AddNotes(const BlendBudget& budget, FloatScratch& s, NoteList& notes) {
   if (std::find(s.notes_added.begin(), s.notes_added.end(), list) != s.notes_added.end()) return;
   s.notes_added.push_back(list);
   for (const std::string& entry : *list) notes.AddUnique(entry);
+}
+
+// shared² = Σ over inputs of (Σ wᵢ uⱼ,ᵢ)², measurement² = shared² + independent², in one pass
+// over the bands, from the inputs `s` gathered (Scratch or FloatScratch); then the roots.
+template <typename GatheredScratch>
+void SumAndRoot(GatheredScratch& s, std::size_t n, bool with_shared, BlendedUncertainty* out) {
+  s.rows.clear();
+  for (std::size_t j = 0; j < s.used; ++j) {
+    const auto& input = s.inputs[j];
+    s.rows.push_back({input.contributions.data(), input.weights.data(), input.weights.size()});
+  }
+  out->measurement.resize(n);
+  out->shared.resize(with_shared ? n : 0);
+  BlendSquaredBands(out->measurement, out->shared, s.independent, s.independent_scales, s.rows);
+  SqrtBands(out->measurement);
+  SqrtBands(out->shared);
 }
 
 }  // namespace
@@ -212,18 +228,7 @@ Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int ba
     AddReading(b, s);
   }
   notes.Finish();
-  // shared² = Σ over inputs of (Σ wᵢ uⱼ,ᵢ)², measurement² = shared² + independent², in one pass
-  // over the bands; then the roots.
-  s.rows.clear();
-  for (std::size_t j = 0; j < s.used; ++j) {
-    const SharedInput& input = s.inputs[j];
-    s.rows.push_back({input.contributions.data(), input.weights.data(), input.weights.size()});
-  }
-  out->measurement.resize(n);
-  out->shared.resize(with_shared ? n : 0);
-  BlendSquaredBands(out->measurement, out->shared, s.independent, s.independent_scales, s.rows);
-  SqrtBands(out->measurement);
-  SqrtBands(out->shared);
+  SumAndRoot(s, n, with_shared, out);
   return Status::Ok();
 }
 
@@ -248,16 +253,7 @@ Status BlendMeasurementUncertainty(std::span<const BlendBudgetVertex> vertices, 
     AddFloatReading(b, s);
   }
   notes.Finish();
-  s.rows.clear();
-  for (std::size_t j = 0; j < s.used; ++j) {
-    const FloatInput& input = s.inputs[j];
-    s.rows.push_back({input.rows.data(), input.weights.data(), input.weights.size()});
-  }
-  out->measurement.resize(n);
-  out->shared.resize(with_shared ? n : 0);
-  BlendSquaredBands(out->measurement, out->shared, s.independent, s.independent_scales, s.rows);
-  SqrtBands(out->measurement);
-  SqrtBands(out->shared);
+  SumAndRoot(s, n, with_shared, out);
   return Status::Ok();
 }
 
