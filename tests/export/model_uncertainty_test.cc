@@ -109,6 +109,52 @@ TEST(ReadingNeighbours, AgreesWithTheBruteForceOnAGridWithTiesAndQueriesBeyondIt
   ExpectNearestAsBruteForce(few, {{50, 50, 50}, {0, 0, 0}}, 4);
 }
 
+TEST(ReadingNeighbours, AgreesWithTheBruteForceForQueriesInAGridsOrder) {
+  // A grid asks for neighbouring cells in turn, so each query starts from the last one's reach:
+  // cells in the export's order (φ fastest, then θo, then θi) beyond and among rig-like readings
+  // with ties, two sets asked alternately and k changing, all as the brute force's, bit for bit.
+  interp::SampleSet rig(3, 1), scattered(3, 1);
+  std::int64_t id = 0;
+  for (double ti = 10; ti <= 50; ti += 20) {
+    for (double to = 0; to <= 60; to += 15) {
+      for (double ph = 0; ph <= 180; ph += 45) {
+        const double c[3] = {ti, to, ph};
+        const double v[1] = {1.0};
+        ASSERT_TRUE(rig.Add(id++, c, v).ok());
+      }
+    }
+  }
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> theta(0, 70), phi(0, 180);
+  for (int i = 0; i < 90; ++i) {
+    const double c[3] = {theta(rng), theta(rng), phi(rng)};
+    const double v[1] = {1.0};
+    ASSERT_TRUE(scattered.Add(i, c, v).ok());
+  }
+  std::vector<IsoDirection> cells;
+  for (double ti = 5; ti < 90; ti += 10) {
+    for (double to = 2.5; to < 90; to += 7.5) {
+      for (double ph = 1; ph < 180; ph += 6) cells.push_back({ti, to, ph});
+    }
+  }
+  const ReadingNeighbours on_rig(rig), on_scattered(scattered);
+  std::vector<std::size_t> index;
+  std::vector<double> distance;
+  for (std::size_t n = 0; n < cells.size(); ++n) {
+    const IsoDirection& at = cells[n];
+    const bool first = n % 50 < 40;  // the two sets in runs, so each starts warm and cold
+    const interp::SampleSet& samples = first ? rig : scattered;
+    const std::size_t k = n % 200 < 150 ? 4 : 2;
+    (first ? on_rig : on_scattered).Nearest(at, k, &index, &distance);
+    const auto expected = BruteForceNearest(samples, at, k);
+    ASSERT_EQ(distance.size(), expected.size());
+    for (std::size_t j = 0; j < expected.size(); ++j) {
+      ASSERT_EQ(distance[j], expected[j].first) << at.theta_i << " " << at.theta_o << " " << j;
+      ASSERT_EQ(index[j], expected[j].second) << at.theta_i << " " << at.theta_o << " " << j;
+    }
+  }
+}
+
 // Readings every 20° in θi and θo in the plane, each with a model residual of 0.01 in its one
 // band, and a calibration whose c is 1 up to 5° from a reading, 3 beyond, reaching 30°.
 struct Fixture {
