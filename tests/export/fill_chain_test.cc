@@ -119,8 +119,8 @@ SpectrumSource AnsweredRowsOnly(double limit, double value) {
       [one](std::span<const double> dirs, std::span<InterpStatus> st, std::span<double> rows) {
         const std::size_t width = rows.size() / st.size();
         for (std::size_t i = 0; i < st.size(); ++i) {
-          st[i] = one({dirs[3 * i], dirs[3 * i + 1], dirs[3 * i + 2]},
-                      rows.subspan(i * width, width));
+          st[i] =
+              one({dirs[3 * i], dirs[3 * i + 1], dirs[3 * i + 2]}, rows.subspan(i * width, width));
         }
       });
 }
