@@ -264,10 +264,11 @@ void ReadingNeighbours::Nearest(const IsoDirection& at, std::size_t k,
     if (r < 0 || r >= rows_ || c < 0 || c >= columns_) return;
     const double gap_i = GapTo(at.theta_i, theta_i0_, width_, r);
     const double gap_o = GapTo(at.theta_o, theta_o0_, width_, c);
-    // hypot(gap_i, gap_o) ≥ either gap: a bucket the larger gap already puts beyond is skipped
-    // without the square root (the same buckets are skipped as by the hypot alone).
-    if (std::max(gap_i, gap_o) - kBoundSlack > limit()) return;
-    if (std::hypot(gap_i, gap_o) - kBoundSlack > limit()) return;
+    // A bucket whose box is beyond the limit (with kBoundSlack, far above the rounding of either
+    // side) is skipped: the larger gap first, then both in quadrature, squared (no hypot).
+    const double beyond = limit() + kBoundSlack;
+    if (std::max(gap_i, gap_o) > beyond) return;
+    if (gap_i * gap_i + gap_o * gap_o > beyond * beyond) return;
     ScanBucket(q, k, warm, r, c, &best);
   };
   const int rings = std::max({r0, rows_ - 1 - r0, c0, columns_ - 1 - c0});
