@@ -558,15 +558,15 @@ int main(int argc, char** argv) {
     return 0;
   }
   setup.judging = JudgingDirections(setup.spec.region, directions, judge_theta_max);
+  const double judged_theta_max = judge_theta_max > 0 ? judge_theta_max
+                                                      : std::min(setup.spec.region.theta_i_max_deg,
+                                                                 setup.spec.region.theta_o_max_deg);
   std::printf(
       "readings' u %.3f; judged by the octant method (φ mirrored) at %d random pairs, "
       "θ ≤ %g°; rig time by the plan timing model (prompts %.0f s); candidates every "
       "%g° (refined %d levels, %d kept each); seed at every %d-th δ, %d readings each; "
       "detector %s; at most %d relocation(s) a round; plan %s\n",
-      u, directions,
-      judge_theta_max > 0 ? judge_theta_max
-                          : std::min(setup.spec.region.theta_i_max_deg, setup.spec.region.theta_o_max_deg),
-      setup.rig.operator_action_s, setup.candidate_step_deg,
+      u, directions, judged_theta_max, setup.rig.operator_action_s, setup.candidate_step_deg,
       setup.round.refine.levels, setup.round.refine.keep, setup.spec.seed_delta_every,
       setup.spec.readings_per_delta, setup.rig.has_detector_arm ? "on a motorized arm" : "by hand",
       setup.round.max_relocations, adaptive_path.c_str());
