@@ -6,7 +6,8 @@
 // Stops at 10, 20, 30 and 50 % of the paper grid's sample readings and judges each stage, and the
 // paper grid itself measured the same way, by the octant method (JudgeOptions) against the truth:
 //   err     relative RMS of the cosine-weighted BRDF f · cos θi · cos θo at --directions random
-//           direction pairs in the region (lamp and detector each uniform in solid angle);
+//           direction pairs with θi, θo ≤ 80° (--judge-theta-max; the daemon benchmark's), within
+//           the plan's region's lower limits (lamp and detector each uniform in solid angle);
 //   spec    the same along the specular ridge (θi = θo, φ = 180°), 400 points;
 //   retro   the same along the retro-reflection ridge (θi = θo, φ = 0°).
 // A direction the octant method cannot answer takes its nearest reading's value (counted: fb %).
@@ -511,9 +512,10 @@ int main(int argc, char** argv) {
   app.add_option("--plan", adaptive_path, "the adaptive plan (its region, δ, seed, rounds)");
   app.add_option("--grid", grid_path, "the fixed plan compared with");
   app.add_option("--directions", directions, "random direction pairs judged");
-  double judge_theta_max = 0;
+  double judge_theta_max = 80;  // the daemon benchmark's judging (daemon_bench_error.py)
   app.add_option("--judge-theta-max", judge_theta_max,
-                 "judge at θi, θo up to this (default: the plan's region)");
+                 "judge at θi, θo up to this (default 80, as the daemon benchmark; 0: the plan's "
+                 "region)");
   app.add_option("--u", u, "each reading's relative standard uncertainty");
   app.add_flag("--timing", timing, "time Map and a round instead");
   app.add_flag("--verbose", setup.verbose, "print every round's picks");
@@ -556,12 +558,15 @@ int main(int argc, char** argv) {
     return 0;
   }
   setup.judging = JudgingDirections(setup.spec.region, directions, judge_theta_max);
+  const double judged_theta_max = judge_theta_max > 0 ? judge_theta_max
+                                                      : std::min(setup.spec.region.theta_i_max_deg,
+                                                                 setup.spec.region.theta_o_max_deg);
   std::printf(
       "readings' u %.3f; judged by the octant method (φ mirrored) at %d random pairs, "
-      "θ ≤ region; rig time by the plan timing model (prompts %.0f s); candidates every "
+      "θ ≤ %g°; rig time by the plan timing model (prompts %.0f s); candidates every "
       "%g° (refined %d levels, %d kept each); seed at every %d-th δ, %d readings each; "
       "detector %s; at most %d relocation(s) a round; plan %s\n",
-      u, directions, setup.rig.operator_action_s, setup.candidate_step_deg,
+      u, directions, judged_theta_max, setup.rig.operator_action_s, setup.candidate_step_deg,
       setup.round.refine.levels, setup.round.refine.keep, setup.spec.seed_delta_every,
       setup.spec.readings_per_delta, setup.rig.has_detector_arm ? "on a motorized arm" : "by hand",
       setup.round.max_relocations, adaptive_path.c_str());

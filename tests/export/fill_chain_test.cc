@@ -109,6 +109,45 @@ TEST(FillChain, AStageWithoutABatchPathAnswersInPlaceAsABatchWould) {
   }
 }
 
+// A batch that writes only the rows it answers (FillChain::Stage allows it: the uncertain
+// chain's interpolating stages): the rows no stage answers are NaN all the same, the others the
+// stage's that answered, under either policy.
+SpectrumSource AnsweredRowsOnly(double limit, double value) {
+  SpectrumSource one = Limited(limit, value);
+  return SpectrumSource(
+      [one](const IsoDirection& at, std::span<double> out) { return one(at, out); },
+      [one](std::span<const double> dirs, std::span<InterpStatus> st, std::span<double> rows) {
+        const std::size_t width = rows.size() / st.size();
+        for (std::size_t i = 0; i < st.size(); ++i) {
+          st[i] =
+              one({dirs[3 * i], dirs[3 * i + 1], dirs[3 * i + 2]}, rows.subspan(i * width, width));
+        }
+      });
+}
+
+TEST(FillChain, RowsNoStageAnsweredAreNaNWhenAStageLeavesThemAlone) {
+  const std::vector<double> dirs = {85, 0, 0, 10, 0, 0, 40, 0, 0, 70, 0, 0};
+  for (const FillPolicy policy : {FillPolicy::kChain, FillPolicy::kNone}) {
+    FillChain chain(policy, {{Provenance::kInterpolated, AnsweredRowsOnly(30, 1)},
+                             {Provenance::kFallback, AnsweredRowsOnly(60, 2)},
+                             {Provenance::kModel, Limited(65, 3)}});
+    std::vector<InterpStatus> st(4);
+    std::vector<double> rows(8, -7.0);
+    chain.Source().Spectra(dirs, st, rows);
+    const bool chained = policy == FillPolicy::kChain;
+    const double want[] = {NAN, NAN, 1, 1, chained ? 2 : NAN, chained ? 2 : NAN, NAN, NAN};
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      if (std::isnan(want[k])) {
+        EXPECT_TRUE(std::isnan(rows[k])) << "value " << k << " " << FillPolicyName(policy);
+      } else {
+        EXPECT_EQ(rows[k], want[k]) << "value " << k << " " << FillPolicyName(policy);
+      }
+    }
+    EXPECT_EQ(st[3], InterpStatus::kOutsideHull);
+    EXPECT_EQ(chain.Tally().empty, chained ? 2u : 3u);
+  }
+}
+
 TEST(FillChain, PolicyNoneAsksTheMethodAlone) {
   FillChain chain(FillPolicy::kNone, {{Provenance::kInterpolated, Limited(30, 1)},
                                       {Provenance::kModel, Limited(90, 3)}});

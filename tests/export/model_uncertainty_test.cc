@@ -43,40 +43,52 @@ std::vector<std::pair<double, std::size_t>> BruteForceNearest(const interp::Samp
   return all;
 }
 
-// Every query's k nearest as positions and distances, equal to the brute force's, bit for bit.
-void ExpectNearestAsBruteForce(const interp::SampleSet& samples,
-                               const std::vector<IsoDirection>& queries, std::size_t k) {
-  const ReadingNeighbours neighbours(samples);
+// One query's k nearest as positions and distances, equal to the brute force's, bit for bit.
+void ExpectAsBruteForce(const ReadingNeighbours& neighbours, const interp::SampleSet& samples,
+                        const IsoDirection& at, std::size_t k) {
   std::vector<std::size_t> index;
   std::vector<double> distance;
-  for (const IsoDirection& at : queries) {
-    neighbours.Nearest(at, k, &index, &distance);
-    const auto expected = BruteForceNearest(samples, at, k);
-    ASSERT_EQ(distance.size(), expected.size());
-    for (std::size_t j = 0; j < expected.size(); ++j) {
-      EXPECT_EQ(distance[j], expected[j].first) << at.theta_i << " " << at.theta_o << " " << j;
-      EXPECT_EQ(index[j], expected[j].second) << at.theta_i << " " << at.theta_o << " " << j;
-    }
+  neighbours.Nearest(at, k, &index, &distance);
+  const auto expected = BruteForceNearest(samples, at, k);
+  ASSERT_EQ(distance.size(), expected.size());
+  for (std::size_t j = 0; j < expected.size(); ++j) {
+    EXPECT_EQ(distance[j], expected[j].first) << at.theta_i << " " << at.theta_o << " " << j;
+    EXPECT_EQ(index[j], expected[j].second) << at.theta_i << " " << at.theta_o << " " << j;
   }
 }
 
-TEST(ReadingNeighbours, FindsTheNearestReadingsAsABruteForceSearchDoes) {
+// Every query's k nearest, as above.
+void ExpectNearestAsBruteForce(const interp::SampleSet& samples,
+                               const std::vector<IsoDirection>& queries, std::size_t k) {
+  const ReadingNeighbours neighbours(samples);
+  for (const IsoDirection& at : queries) ExpectAsBruteForce(neighbours, samples, at, k);
+}
+
+// `n` readings at random (θi, θo) in [0, theta_max) and φ in [0, 180), one band each.
+interp::SampleSet ScatteredReadings(unsigned seed, int n, double theta_max) {
   interp::SampleSet samples(3, 1);
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> theta(0, 80), phi(0, 180);
-  for (int i = 0; i < 200; ++i) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> theta(0, theta_max), phi(0, 180);
+  for (int i = 0; i < n; ++i) {
     const double c[3] = {theta(rng), theta(rng), phi(rng)};
     const double v[1] = {1.0};
-    ASSERT_TRUE(samples.Add(i, c, v).ok());
+    EXPECT_TRUE(samples.Add(i, c, v).ok());
   }
+  return samples;
+}
+
+TEST(ReadingNeighbours, FindsTheNearestReadingsAsABruteForceSearchDoes) {
+  const interp::SampleSet samples = ScatteredReadings(7, 200, 80);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> theta(0, 80), phi(0, 180);
   std::vector<IsoDirection> queries;
   for (int q = 0; q < 50; ++q) queries.push_back({theta(rng), theta(rng), phi(rng)});
   ExpectNearestAsBruteForce(samples, queries, 4);
 }
 
-TEST(ReadingNeighbours, AgreesWithTheBruteForceOnAGridWithTiesAndQueriesBeyondIt) {
-  // A rig-like grid (many readings on the same θi and θo, equal distances everywhere), some
-  // readings twice, and queries inside it, between its rows, beyond its edges and at the pole.
+// A rig-like grid of readings: θi 10–60° by 10, θo 0–70° by 5, φ 0–180° by 30 (many readings on
+// the same θi and θo, equal distances everywhere), the readings at φ = 90° twice.
+interp::SampleSet RigLikeReadings() {
   interp::SampleSet samples(3, 1);
   std::int64_t id = 0;
   for (double ti = 10; ti <= 60; ti += 10) {
@@ -84,13 +96,20 @@ TEST(ReadingNeighbours, AgreesWithTheBruteForceOnAGridWithTiesAndQueriesBeyondIt
       for (double ph = 0; ph <= 180; ph += 30) {
         const double c[3] = {ti, to, ph};
         const double v[1] = {1.0};
-        ASSERT_TRUE(samples.Add(id++, c, v).ok());
+        EXPECT_TRUE(samples.Add(id++, c, v).ok());
         if (ph == 90) {
-          ASSERT_TRUE(samples.Add(id++, c, v).ok());
+          EXPECT_TRUE(samples.Add(id++, c, v).ok());
         }
       }
     }
   }
+  return samples;
+}
+
+TEST(ReadingNeighbours, AgreesWithTheBruteForceOnAGridWithTiesAndQueriesBeyondIt) {
+  // A rig-like grid (many readings on the same θi and θo, equal distances everywhere), some
+  // readings twice, and queries inside it, between its rows, beyond its edges and at the pole.
+  const interp::SampleSet samples = RigLikeReadings();
   std::vector<IsoDirection> queries = {{10, 0, 0},   {35, 32.5, 45}, {0, 0, 0},    {89, 89, 180},
                                        {60, 70, 90}, {25, 80, 10},   {70, 5, 170}, {40, 20, 90}};
   std::mt19937 rng(3);
@@ -107,6 +126,26 @@ TEST(ReadingNeighbours, AgreesWithTheBruteForceOnAGridWithTiesAndQueriesBeyondIt
     ASSERT_TRUE(few.Add(i, c, v).ok());
   }
   ExpectNearestAsBruteForce(few, {{50, 50, 50}, {0, 0, 0}}, 4);
+}
+
+TEST(ReadingNeighbours, AgreesWithTheBruteForceForQueriesInAGridsOrder) {
+  // A grid asks for neighbouring cells in turn, so each query starts from the last one's reach:
+  // cells in the export's order (φ fastest, then θo, then θi) beyond and among rig-like readings
+  // with ties, two sets asked alternately and k changing, all as the brute force's, bit for bit.
+  const interp::SampleSet rig = RigLikeReadings();
+  const interp::SampleSet scattered = ScatteredReadings(11, 90, 70);
+  std::vector<IsoDirection> cells;
+  for (double ti = 5; ti < 90; ti += 10) {
+    for (double to = 2.5; to < 90; to += 7.5) {
+      for (double ph = 1; ph < 180; ph += 6) cells.push_back({ti, to, ph});
+    }
+  }
+  const ReadingNeighbours on_rig(rig), on_scattered(scattered);
+  for (std::size_t n = 0; n < cells.size(); ++n) {
+    const bool first = n % 50 < 40;  // the two sets in runs, so each starts warm and cold
+    const std::size_t k = n % 200 < 150 ? 4 : 2;
+    ExpectAsBruteForce(first ? on_rig : on_scattered, first ? rig : scattered, cells[n], k);
+  }
 }
 
 // Readings every 20° in θi and θo in the plane, each with a model residual of 0.01 in its one

@@ -174,7 +174,13 @@ void FillChain::AnswerMany(std::span<const double> directions,
     Count(s, missing.size() - still.size());
     missing.swap(still);
   }
-  Count(stages_.size(), missing.size());  // rows stay NaN with the first stage's status
+  // Rows no stage answered: NaN with the first stage's status (a stage need not have written
+  // them, FillChain::Stage).
+  for (const std::size_t i : missing) {
+    std::fill_n(spectra.begin() + static_cast<std::ptrdiff_t>(i * bands), bands,
+                std::numeric_limits<double>::quiet_NaN());
+  }
+  Count(stages_.size(), missing.size());
   GiveScratch(std::move(scratch));
 }
 

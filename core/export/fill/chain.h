@@ -54,6 +54,8 @@ struct FillTally {
 
 class FillChain {
  public:
+  // A stage's batch (SpectrumSource::Spectra) may leave the rows it does not answer as they
+  // were, unlike a SpectrumSource's: the chain fills NaN in the rows no stage answers.
   struct Stage {
     Provenance provenance;
     SpectrumSource source;

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <utility>
@@ -15,6 +17,7 @@ namespace brdf::exports {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kRadian = std::numbers::pi / 180.0;
 
 IsoDirection At(const interp::SampleSet& samples, std::size_t i) {
@@ -149,9 +152,35 @@ double GapTo(double theta, double origin, double width, int b) {
   return std::max({0.0, lo - theta, theta - hi});
 }
 
+// This thread's last query of a ReadingNeighbours (WarmReach).
+struct LastQuery {
+  std::uint64_t serial = 0;  // the set's; 0: none
+  std::size_t k = 0;
+  IsoDirection at;
+  double cos_o = 1, sin_o = 0;
+  double kth = 0;  // its k-th nearest distance
+};
+thread_local LastQuery last_query;
+
+std::atomic<std::uint64_t> next_serial{1};
+
 }  // namespace
 
-ReadingNeighbours::ReadingNeighbours(const interp::SampleSet& samples) {
+double ReadingNeighbours::WarmReach(const Query& q, std::size_t k) const {
+  const LastQuery& last = last_query;
+  if (k == 0 || last.serial != serial_ || last.k != k) return kInfinity;
+  // The k readings nearest the last query lie within kth + step of this one (the triangle
+  // inequality); a slack more covers the rounding of both distances.
+  const double step = DistanceFrom(q.at, q.cos_o, q.sin_o, last.at, last.cos_o, last.sin_o);
+  return last.kth + step + kBoundSlack;
+}
+
+void ReadingNeighbours::RememberQuery(const Query& q, std::size_t k, double kth) const {
+  LastQuery& last = last_query;
+  last = {std::isfinite(kth) ? serial_ : 0, k, q.at, q.cos_o, q.sin_o, kth};
+}
+
+ReadingNeighbours::ReadingNeighbours(const interp::SampleSet& samples) : serial_(next_serial++) {
   const std::size_t n = samples.size();
   double hi_i = 0, hi_o = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -186,22 +215,24 @@ ReadingNeighbours::ReadingNeighbours(const interp::SampleSet& samples) {
   }
 }
 
-void ReadingNeighbours::ScanBucket(const Query& q, std::size_t k, int r, int c,
+void ReadingNeighbours::ScanBucket(const Query& q, std::size_t k, double reach, int r, int c,
                                    std::vector<std::pair<double, std::size_t>>* best) const {
   const std::size_t b = static_cast<std::size_t>(r) * static_cast<std::size_t>(columns_) +
                         static_cast<std::size_t>(c);
   for (std::size_t s = start_[b]; s < start_[b + 1]; ++s) {
     const Reading& to = readings_[s];
-    if (best->size() == k) {
+    const double bound = best->size() == k ? best->back().first : reach;
+    if (bound < kInfinity) {
       // Its distance is at least hypot(Δθi, max(|Δθo|, chord)): skip the trigonometry of a
-      // reading that bound already puts beyond the k-th nearest (with kBoundSlack, as buckets).
+      // reading that bound already puts beyond the k-th nearest, or beyond the query's reach
+      // (with kBoundSlack, as buckets).
       const double di = q.at.theta_i - to.at.theta_i;
       const double dx = q.unit[0] - to.unit[0], dy = q.unit[1] - to.unit[1],
                    dz = q.unit[2] - to.unit[2];
       const double chord = std::sqrt(dx * dx + dy * dy + dz * dz) / kRadian;
       const double gamma = std::max(std::abs(q.at.theta_o - to.at.theta_o), chord);
-      const double reach = best->back().first + kBoundSlack;
-      if (di * di + gamma * gamma > reach * reach) continue;
+      const double beyond = bound + kBoundSlack;
+      if (di * di + gamma * gamma > beyond * beyond) continue;
     }
     const std::pair<double, std::size_t> p(
         DistanceFrom(q.at, q.cos_o, q.sin_o, to.at, to.cos_o, to.sin_o), to.index);
@@ -225,22 +256,24 @@ void ReadingNeighbours::Nearest(const IsoDirection& at, std::size_t k,
   const Query q{at, cos_o, sin_o, OutgoingUnit(at, cos_o, sin_o)};
   const int r0 = BucketOf(at.theta_i, theta_i0_, width_, rows_);
   const int c0 = BucketOf(at.theta_o, theta_o0_, width_, columns_);
-  auto full = [&] { return k > 0 && best.size() == k; };
+  // No reading farther than this can be among the k nearest: the k-th nearest so far, or before
+  // there are k the reach the last query gives (infinite without one).
+  const double warm = WarmReach(q, k);
+  auto limit = [&] { return k > 0 && best.size() == k ? best.back().first : warm; };
   auto visit = [&](int r, int c) {
     if (r < 0 || r >= rows_ || c < 0 || c >= columns_) return;
     const double gap_i = GapTo(at.theta_i, theta_i0_, width_, r);
     const double gap_o = GapTo(at.theta_o, theta_o0_, width_, c);
-    if (full()) {
-      // hypot(gap_i, gap_o) ≥ either gap: a bucket the larger gap already puts beyond is skipped
-      // without the square root (the same buckets are skipped as by the hypot alone).
-      if (std::max(gap_i, gap_o) - kBoundSlack > best.back().first) return;
-      if (std::hypot(gap_i, gap_o) - kBoundSlack > best.back().first) return;
-    }
-    ScanBucket(q, k, r, c, &best);
+    // A bucket whose box is beyond the limit (with kBoundSlack, far above the rounding of either
+    // side) is skipped: the larger gap first, then both in quadrature, squared (no hypot).
+    const double beyond = limit() + kBoundSlack;
+    if (std::max(gap_i, gap_o) > beyond) return;
+    if (gap_i * gap_i + gap_o * gap_o > beyond * beyond) return;
+    ScanBucket(q, k, warm, r, c, &best);
   };
   const int rings = std::max({r0, rows_ - 1 - r0, c0, columns_ - 1 - c0});
   for (int m = 0; m <= rings && k > 0; ++m) {
-    if (full() && width_ * (m - 1) - kBoundSlack > best.back().first) break;
+    if (width_ * (m - 1) - kBoundSlack > limit()) break;
     if (m == 0) {
       visit(r0, c0);
       continue;
@@ -254,6 +287,7 @@ void ReadingNeighbours::Nearest(const IsoDirection& at, std::size_t k,
       visit(r, c0 + m);
     }
   }
+  RememberQuery(q, k, best.size() == k && k > 0 ? best.back().first : kInfinity);
   index->clear();
   distance->clear();
   for (const auto& [d, i] : best) {

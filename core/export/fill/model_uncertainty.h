@@ -17,6 +17,7 @@
 #include <array>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <utility>
@@ -58,6 +59,10 @@ double ReadingDistance(const IsoDirection& a, const IsoDirection& b);
 // (a reading's distance is at least the box's: |Δθi| and, for the outgoing directions' angle,
 // |Δθo|). The answer is that of a search over every reading: the k smallest (distance, position)
 // pairs, so ties go to the lower position.
+// A grid asks for cells next to each other in turn: each thread keeps its last query and its
+// k-th distance, and a query starts with that distance plus the step between the two as its
+// reach (the distance is a metric, so the k nearest lie within it), which skips most readings
+// before any trigonometry. The answer is the same as without it.
 class ReadingNeighbours {
  public:
   explicit ReadingNeighbours(const interp::SampleSet& samples);
@@ -77,9 +82,18 @@ class ReadingNeighbours {
     std::size_t index = 0;  // its position in the set
   };
   // The readings of bucket (row r of θi, column c of θo) into *best (the k smallest pairs).
-  void ScanBucket(const Query& q, std::size_t k, int r, int c,
+  // Readings farther than `reach` (when finite, and until *best holds k) are skipped.
+  void ScanBucket(const Query& q, std::size_t k, double reach, int r, int c,
                   std::vector<std::pair<double, std::size_t>>* best) const;
+  // The reach a query at `q` may start with: this thread's last query's k-th distance plus the
+  // distance from it to `q`; infinite when the last query was of another set or another k.
+  double WarmReach(const Query& q, std::size_t k) const;
+  // Keeps `q` and its k-th nearest distance `kth` (infinite: fewer than k) for WarmReach.
+  void RememberQuery(const Query& q, std::size_t k, double kth) const;
 
+  // This set's number, unique in the process: a thread's last query is kept under it (never
+  // under an address another set could reuse).
+  std::uint64_t serial_ = 0;
   std::vector<Reading> readings_;       // bucket by bucket
   std::vector<std::size_t> start_;      // bucket b's: readings_[start_[b] .. start_[b + 1])
   double theta_i0_ = 0, theta_o0_ = 0;  // the buckets' lower corner, degrees

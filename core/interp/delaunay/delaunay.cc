@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <numeric>
 #include <string>
 #include <utility>
@@ -21,12 +21,16 @@ const char* AxisNames(int dims) {
   return dims == 3 ? "(θi, θo, φ)" : "(θi, φi, θo, φo)";
 }
 
+// Each coordinate as printf's "%.6g" writes it (std::to_chars's general form with a precision is
+// specified as that), without printf's cost: a grid export asks for thousands of these.
 std::string FormatPoint(std::span<const double> x) {
   std::string out = "(";
   char buffer[32];
   for (std::size_t i = 0; i < x.size(); ++i) {
-    std::snprintf(buffer, sizeof buffer, "%s%.6g", i == 0 ? "" : ", ", x[i]);
-    out += buffer;
+    if (i > 0) out += ", ";
+    const auto written =
+        std::to_chars(buffer, buffer + sizeof buffer, x[i], std::chars_format::general, 6);
+    out.append(buffer, written.ptr);
   }
   return out + ")";
 }

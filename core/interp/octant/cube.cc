@@ -79,9 +79,16 @@ char OctantLetter(int orthant) {
   return '?';
 }
 
-std::string OrthantName(int orthant, int dims) {
-  if (dims == 3) return std::string("octant ") + OctantLetter(orthant) + " " + Signs(orthant, 3);
-  return "orthant " + std::to_string(orthant) + " " + Signs(orthant, dims);
+const std::string& OrthantName(int orthant, int dims) {
+  static const auto kNames = [] {
+    std::array<std::array<std::string, 16>, 2> names;  // [0]: 3D (8 used), [1]: 4D
+    for (int o = 0; o < 8; ++o) {
+      names[0][o] = std::string("octant ") + OctantLetter(o) + " " + Signs(o, 3);
+    }
+    for (int o = 0; o < 16; ++o) names[1][o] = "orthant " + std::to_string(o) + " " + Signs(o, 4);
+    return names;
+  }();
+  return kNames[dims == 3 ? 0 : 1][static_cast<std::size_t>(orthant)];
 }
 
 std::span<const CubeSimplex> CubeSimplices(int dims) {

@@ -38,8 +38,9 @@ inline int OrthantOf(const double* x, const double* p, int dims) {
 
 // "A" … "H" for 3D orthants (the paper's corner letters).
 char OctantLetter(int orthant);
-// "octant E (θi−, θo−, φ+)" in 3D, "orthant 5 (θi+, φi−, θo+, φo−)" in 4D.
-std::string OrthantName(int orthant, int dims);
+// "octant E (θi−, θo−, φ+)" in 3D, "orthant 5 (θi+, φi−, θo+, φo−)" in 4D; made once (an empty
+// octant's answer names them, and a grid export asks for thousands).
+const std::string& OrthantName(int orthant, int dims);
 
 // The simplices of the cube of winners, in the order they are tried, as orthant numbers
 // (dims + 1 per simplex; the vertices of an answer come in this order).

@@ -66,7 +66,7 @@ Cs2000Endpoint::~Cs2000Endpoint() {
   Stop();
 }
 
-void Cs2000Endpoint::OnPowerCycle() {
+void Cs2000Endpoint::OnPowerOn() {
   forget_ = true;
 }
 

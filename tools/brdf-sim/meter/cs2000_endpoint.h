@@ -45,7 +45,7 @@ class Cs2000Endpoint final : public LineMeterEndpoint {
 
  protected:
   void Handle(const std::string& command) override;
-  void OnPowerCycle() override;
+  void OnPowerOn() override;
 
  private:
   struct Measurement {

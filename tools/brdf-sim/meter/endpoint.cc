@@ -30,6 +30,8 @@ Status LineMeterEndpoint::Start() {
     remote_ = false;
   }
   input_.clear();
+  replies_sent_ = 0;
+  OnPowerOn();
   stop_ = false;
   thread_ = std::thread([this] { Run(); });
   return Status::Ok();
@@ -60,7 +62,7 @@ void LineMeterEndpoint::PowerCycle() {
     // Whatever was sent to the meter while it was off is lost.
     if (port_.is_open()) ::tcflush(port_.master_fd(), TCIFLUSH);
   }
-  OnPowerCycle();
+  OnPowerOn();
 }
 
 bool LineMeterEndpoint::remote_mode() const {
@@ -114,6 +116,10 @@ void LineMeterEndpoint::OnCharacter(char c) {
   const std::string command = UpperAscii(TrimBlanks(input_));
   input_.clear();
   if (!command.empty()) Handle(command);
+}
+
+std::string LineMeterEndpoint::LineEnd(std::size_t, std::size_t) const {
+  return options_.eol;
 }
 
 bool LineMeterEndpoint::Admit(const std::string& command, bool enters_remote) {
@@ -179,9 +185,15 @@ void LineMeterEndpoint::Reply(const std::vector<std::string>& lines, double vani
   std::string bytes;
   for (std::size_t i = 0; i < lines.size(); ++i) {
     bytes += garble ? GarbleLine(lines[i], static_cast<unsigned>(i)) : lines[i];
-    bytes += options_.eol;
+    bytes += LineEnd(i, lines.size());
   }
   if (truncate) bytes.resize(bytes.size() / 2);
+  const bool delayed = options_.delayed_replies == 0 || replies_sent_ < options_.delayed_replies;
+  ++replies_sent_;
+  if (delayed && options_.reply_delay.count() > 0 &&
+      !SleepUnlessStopped(options_.reply_delay, stop_)) {
+    return;
+  }
   if (vanish_seconds > 0) {
     // Part of the reply goes out, then the port is gone.
     if (!WriteOut(bytes.substr(0, bytes.size() / 3))) return;
@@ -198,7 +210,7 @@ bool LineMeterEndpoint::WriteOut(const std::string& bytes) {
     fd = port_.master_fd();
   }
   const WirePace pace{options_.time_scale, options_.pace_replies, options_.baud,
-                      options_.fifo_bytes};
+                      options_.fifo_bytes, options_.piece_bytes,  options_.piece_gap};
   return WriteWire(fd, bytes, pace, stop_);
 }
 

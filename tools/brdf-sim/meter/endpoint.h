@@ -1,9 +1,10 @@
 // The simulated meters' serial endpoints, as brdf-sim's main and the control unit see them
-// (MeterPort), and what the line-oriented ones after the PR-650 share (LineMeterEndpoint): a
-// pseudo-terminal behind a stable link (meter/pr650_pty.h), a thread that reads the characters a
-// driver types, remote mode, the injected faults (silence, leaving remote mode, garbage,
-// truncation, a vanishing port, forced codes), and replies written at the serial rate. A derived
-// endpoint speaks its meter's protocol (meter/pr670_endpoint.h, meter/cs2000_endpoint.h).
+// (MeterPort), and what every one of them shares (LineMeterEndpoint): a pseudo-terminal behind a
+// stable link (meter/pr650_pty.h), a thread that reads the characters a driver types, remote
+// mode, the injected faults (silence, leaving remote mode, garbage, truncation, a vanishing port,
+// forced codes), and replies written at the serial rate, delayed or in pieces as some meters and
+// adapters send them. A derived endpoint speaks its meter's protocol (meter/pr650_endpoint.h,
+// meter/pr670_endpoint.h, meter/cs2000_endpoint.h).
 #pragma once
 
 #include <atomic>
@@ -45,6 +46,11 @@ struct LineEndpointOptions {
   std::string link_path;      // where the stable link goes; empty: a private temp directory
   std::string eol = "\r\n";   // what ends each reply line
   std::string serial_number;  // what the meter reports as its serial number
+  // How replies leave, as some meters and USB adapters deliver them (a driver must cope):
+  int piece_bytes = 0;  // > 0: in pieces of this many bytes, piece_gap (real time) apart
+  std::chrono::milliseconds piece_gap{0};
+  std::chrono::milliseconds reply_delay{0};  // real time before each reply starts ...
+  int delayed_replies = 0;  // ... or, when > 0, before the first this many replies only
 };
 
 class LineMeterEndpoint : public MeterPort {
@@ -81,8 +87,11 @@ class LineMeterEndpoint : public MeterPort {
   virtual void OnCharacter(char c);
   // A complete command, trimmed and upper-cased.
   virtual void Handle(const std::string& command) = 0;
-  // What the meter forgets when switched off (its setup, its measurement).
-  virtual void OnPowerCycle() {}
+  // The meter is switched on (Start, PowerCycle), from the caller's thread: what it forgets (its
+  // setup, its measurement), and when it woke.
+  virtual void OnPowerOn() {}
+  // What ends line `line` of a reply of `count` lines; options.eol unless a meter says otherwise.
+  virtual std::string LineEnd(std::size_t line, std::size_t count) const;
 
   // Notes `command` and says whether the meter answers it: not while the silent fault holds, not
   // outside remote mode unless `enters_remote`; the leave-remote fault takes effect here.
@@ -93,8 +102,9 @@ class LineMeterEndpoint : public MeterPort {
   // measurement before its time passes (the CS-2000 announces its measuring time).
   std::optional<Taken> TakeMeasurement(const MeterSetup& setup,
                                        const std::function<void(const Taken&)>& announce = nullptr);
-  // Sends `lines` as one reply, each ended by options.eol, with the garbage and truncation faults
-  // applied; `vanish_seconds` > 0: the port vanishes a third of the way through, back after that.
+  // Sends `lines` as one reply, each ended by LineEnd, with the garbage and truncation faults
+  // applied, after options.reply_delay; `vanish_seconds` > 0: the port vanishes a third of the
+  // way through, back after that.
   void Reply(const std::vector<std::string>& lines, double vanish_seconds = 0);
   // The vanish fault, consumed (0 when not armed).
   double TakeVanish();
@@ -114,6 +124,7 @@ class LineMeterEndpoint : public MeterPort {
   const LineEndpointOptions options_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
+  int replies_sent_ = 0;  // for options.delayed_replies (endpoint thread only)
 
   mutable std::mutex mu_;  // guards everything below
   PtyPort port_;

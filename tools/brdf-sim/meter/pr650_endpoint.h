@@ -1,5 +1,6 @@
-// The simulated PR-650 on a pseudo-terminal: a thread that speaks the meter's remote-mode protocol
-// (docs/pr650.md) byte for byte, asking a MeterBackend what it would measure.
+// The simulated PR-650 on a pseudo-terminal: a LineMeterEndpoint (meter/endpoint.h: the pty, its
+// thread, the faults, paced replies) that speaks the meter's remote-mode protocol (docs/pr650.md)
+// byte for byte, asking a MeterBackend what it would measure.
 //
 //   commands (case-insensitive, ended by CR or LF)     replies (lines end CR LF)
 //   B0 … B3                                             000
@@ -34,8 +35,9 @@
 // a spectrum it has not measured. The reports carry SerialFaults::units_code (0 unless set).
 // Remote mode starts only if the first command arrives within wake_window_s (simulated) of
 // power-on (Start or PowerCycle); otherwise the meter stays in stand-alone mode and answers
-// nothing until power-cycled. Faults come from SimControl::serial() at each command; the "next N"
-// counters are counted down through SimControl::UpdateSerial.
+// nothing until power-cycled (as after the leave-remote fault, which takes the meter out of
+// remote mode outside the window). Faults come from SimControl::serial() at each command; the
+// "next N" counters are counted down through SimControl::UpdateSerial.
 //
 // The port path is a stable symlink to the current pty slave (path()). When the port "vanishes"
 // (SerialFaults::vanish_seconds, during the next D5 or M5 report) the pty is closed (a driver
@@ -46,15 +48,12 @@
 
 #include <atomic>
 #include <chrono>
-#include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "core/status.h"
 #include "tools/brdf-sim/meter/endpoint.h"
-#include "tools/brdf-sim/meter/pr650_pty.h"
 #include "tools/brdf-sim/sim_shared.h"
 
 namespace brdf::sim {
@@ -106,32 +105,13 @@ struct Pr650EndpointOptions {
 // The reply to a report asked for before any measurement.
 inline constexpr const char* kNoMeasurementReply = "-1";
 
-class Pr650Endpoint final : public MeterPort {
+class Pr650Endpoint final : public LineMeterEndpoint {
  public:
   Pr650Endpoint(MeterBackend& backend, SimControl& control, Pr650EndpointOptions options = {});
   ~Pr650Endpoint() override;
-  Pr650Endpoint(const Pr650Endpoint&) = delete;
-  Pr650Endpoint& operator=(const Pr650Endpoint&) = delete;
-
-  // Creates the pty and the link, powers the meter on and starts the thread.
-  Status Start() override;
-  // Stops the thread and removes the pty and the link. Idempotent.
-  void Stop() override;
-
-  // The path drivers open: the stable link. brdf-sim prints it as "pr650 <path>".
-  std::string path() const override;
-  // The current pty slave (/dev/pts/N); changes when the port vanishes and comes back.
-  std::string slave_path() const override;
-
-  // Switches the meter off and on: it leaves remote mode, forgets its setup and last measurement,
-  // and the wake-up window starts again.
-  void PowerCycle() override;
-
-  bool remote_mode() const;
-  // Every command received so far, upper-cased, without its line end (also those not answered).
-  std::vector<std::string> commands() const;
-  // Setups the backend has been asked to measure with, in order.
-  std::vector<MeterSetup> measured_setups() const;
+  // Start, Stop, path (brdf-sim prints it as "pr650 <path>"), slave_path, PowerCycle (the meter
+  // also leaves remote mode and the wake-up window starts again), remote_mode, commands and
+  // measured_setups: LineMeterEndpoint's.
 
  private:
   using SteadyClock = std::chrono::steady_clock;
@@ -143,53 +123,40 @@ class Pr650Endpoint final : public MeterPort {
     std::vector<double> radiance;
   };
 
-  void Run();
-  void Handle(const std::string& command);
-  // Notes the command; false when the meter does not answer it (silent fault, or stand-alone:
-  // the first command came after the wake window). `epoch`: the power cycle it is answered in.
-  bool Admit(const std::string& command, unsigned& epoch);
+  void OnPowerOn() override;
+  void OnCharacter(char c) override;
+  void Handle(const std::string& command) override;
+  // The D5 header and integrated line run together with a bare CR (Pr650WireQuirks).
+  std::string LineEnd(std::size_t line, std::size_t count) const override;
+  // What a power-on made the meter forget (its setup, measurement, stand-alone mode and the
+  // command being typed), forgotten on the endpoint thread before the next character.
+  void ForgetIfSwitchedOff();
+  // Notes the command; false when the meter does not answer it (a fault, or stand-alone: the
+  // first command came after the wake window).
+  bool AdmitCommand(const std::string& command);
   // S: applies the setup and replies with its code.
   void HandleSetup(const std::string& command);
   // M0 measures and holds; Mn (n a served report) is M0 followed by report n, in one reply.
-  void HandleMeasure(int code, unsigned epoch);
+  void HandleMeasure(int code);
   // Dn: a served report, the serial number (110), the layout (120) or the last S reply (201).
   void HandleReport(int code);
   // Takes a measurement (its simulated duration in real time) into last_ and returns its quality
   // code; nullopt if stopped or switched off meanwhile (no reply then).
-  std::optional<int> Measure(unsigned epoch);
+  std::optional<int> Measure();
   // Report 1, 2, 3 or 5 of last_ (the D5 report with the vanish fault, if armed), or
   // kNoMeasurementReply when there is none.
   void ReplyReport(int report);
-  // Sends `lines` as one reply (line ends, quirks and faults applied). `vanish_after`: for a D5
-  // with the vanish fault, the number of bytes after which the port vanishes.
-  void Reply(std::vector<std::string> lines, double vanish_seconds = 0);
-  // Writes `bytes` to the master, paced; false if the port went away or the endpoint stopped.
-  bool WriteOut(const std::string& bytes);
-  // Sleeps `d` real time unless stopping; false if stopped.
-  bool SleepReal(std::chrono::nanoseconds d);
-  void Vanish(double seconds);
 
-  MeterBackend& backend_;
-  SimControl& control_;
-  const Pr650EndpointOptions options_;
+  const Pr650EndpointOptions pr650_;
+  std::atomic<SteadyClock::rep> power_on_{0};  // SteadyClock ticks at the last power-on
+  std::atomic<bool> forget_{false};            // set by OnPowerOn, acted on by the thread
 
-  std::thread thread_;
-  std::atomic<bool> stop_{false};
-
-  mutable std::mutex mu_;  // guards everything below
-  PtyPort port_;
-  std::string input_;  // bytes of a command not yet ended
-  SteadyClock::time_point power_on_;
-  unsigned power_epoch_ = 0;  // bumped by PowerCycle; a measurement spanning one is dropped
-  bool remote_ = false;
+  // The endpoint thread's own:
   bool standalone_ = false;  // the wake-up window was missed: silent until power-cycled
   MeterSetup setup_;
   bool sync_ = false;
   int last_setup_reply_ = 0;  // the last S command's reply code, for D201
-  int replies_sent_ = 0;      // for Pr650WireQuirks::delayed_replies
   Measurement last_;
-  std::vector<std::string> commands_;
-  std::vector<MeterSetup> measured_setups_;
 };
 
 }  // namespace brdf::sim

@@ -70,7 +70,7 @@ Pr670Endpoint::~Pr670Endpoint() {
   Stop();
 }
 
-void Pr670Endpoint::OnPowerCycle() {
+void Pr670Endpoint::OnPowerOn() {
   forget_ = true;
 }
 

@@ -45,7 +45,7 @@ class Pr670Endpoint final : public LineMeterEndpoint {
  protected:
   void OnCharacter(char c) override;
   void Handle(const std::string& command) override;
-  void OnPowerCycle() override;
+  void OnPowerOn() override;
 
  private:
   struct Measurement {
