@@ -17,6 +17,8 @@ session-wide draws (white standard, wavelength shift) are independent across all
         --seeds $(seq 1 12) --json campaign.json
     bench/uncertainty/coverage.py --materials paint clay --seeds 1 2 3 --sources white_error
 
+A material is a name in deploy/materials/ or a path to a .toml file (docs/materials.md), named
+in the output by its file name (coverage_interp.py and fit_check.py take the same).
 `--sources` switches on only the named error sources (in the simulator and the budget alike) to
 tell which term is over- or under-stated; the `--expect-*` flags make it a test (the ctest
 `uncertainty_coverage_short`, bench/uncertainty/CMakeLists.txt). Exit 77: brdf-sim or brdfd not
@@ -73,6 +75,14 @@ stage_repeatability_deg = {errors["pose_jitter"]}
 lamp_drift_per_hour = {errors["lamp_drift"]}
 meter_gain_repeatability = {errors["gain_noise"]}
 """
+
+
+def material_file(material):
+    """(label, path) of a --materials entry: a name in deploy/materials/ or a path to a .toml
+    file (a material written elsewhere), labelled by its file name without .toml."""
+    if material.endswith(".toml"):
+        return os.path.basename(material).removesuffix(".toml"), os.path.abspath(material)
+    return material, os.path.join(ROOT, "deploy", "materials", material + ".toml")
 
 
 def sim_seed(material, seed):
@@ -237,8 +247,8 @@ def main():
     print(json.dumps({"errors": errors, "k": args.k, "plan": os.path.basename(args.plan)}))
     results = {"errors": errors, "materials": {}, "pose_not_estimated": 0}
     every_inside, every_z = [], []
-    for material in args.materials:
-        path = os.path.join(ROOT, "deploy", "materials", material + ".toml")
+    for entry in args.materials:
+        material, path = material_file(entry)
         inside_runs, z_runs = [], []
         for seed in args.seeds:
             run = run_session(sim, daemon, path, sim_seed(material, seed), plan, errors)

@@ -164,8 +164,8 @@ def main():
     parts = []
     by_material = {}
     kinds = {}
-    for material in args.materials:
-        path = os.path.join(coverage.ROOT, "deploy", "materials", material + ".toml")
+    for entry in args.materials:
+        material, path = coverage.material_file(entry)
         for seed in args.seeds:
             rng = np.random.default_rng(seed)
             dirs = np.column_stack([rng.uniform(0, args.theta_max, args.directions),

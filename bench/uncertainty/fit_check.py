@@ -158,10 +158,8 @@ def main():
     print(json.dumps({"errors": errors, "plan": plan["name"]}), flush=True)
     with tempfile.TemporaryDirectory() as work:
         for material in args.materials:
-            path = material if material.endswith(".toml") else os.path.join(
-                coverage.ROOT, "deploy", "materials", material + ".toml")
+            label, path = coverage.material_file(material)
             for seed in args.seeds:
-                label = os.path.basename(material).removesuffix(".toml")
                 csv_path = os.path.join(work, f"{label}-{seed}.csv")
                 gls_out = os.path.join(work, f"{label}-{seed}-fit-gls.csv")
                 independent, gls = export_session(
