@@ -74,7 +74,7 @@ bool Probe(const std::shared_ptr<brdf::storage::SessionStore>& store, std::int64
       "sets_and_budgets_heap_mb=%.1f "
       "octant_index_mb=%.1f octant_index_heap_mb=%.1f",
       static_cast<long long>(session), brdf_set->size(), brdf_set->bands(), Mb(sets),
-      Mb(state.brdf_budgets.bytes()), heap1 - heap0, Mb(brdf::daemon::IndexBytes(*brdf_set)),
+      Mb(state.brdf_budgets.bytes()), heap1 - heap0, Mb(brdf::daemon::IndexBytes(**index)),
       heap2 - heap1);
   index->reset();
   samples.reset();

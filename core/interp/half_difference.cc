@@ -53,11 +53,16 @@ void ToIncidenceVertices(Interpolation& answer, std::size_t measured) {
 
 class HalfDifferenceInterpolator final : public Interpolator {
  public:
-  HalfDifferenceInterpolator(std::unique_ptr<Interpolator> inner, std::size_t measured)
-      : inner_(std::move(inner)), measured_(measured) {}
+  // `images_bytes`: the heap of the set of images `inner` was built over.
+  HalfDifferenceInterpolator(std::unique_ptr<Interpolator> inner, std::size_t measured,
+                             std::size_t images_bytes)
+      : inner_(std::move(inner)), measured_(measured), images_bytes_(images_bytes) {}
 
   Method method() const override { return inner_->method(); }
   int dims() const override { return 3; }
+  std::size_t HeapBytes() const override {
+    return sizeof(*this) + images_bytes_ + inner_->HeapBytes();
+  }
 
   Interpolation Evaluate(std::span<const double> query) const override {
     if (query.size() != 3) return inner_->Evaluate(query);  // the method's own "wrong size"
@@ -103,6 +108,7 @@ class HalfDifferenceInterpolator final : public Interpolator {
 
   std::unique_ptr<Interpolator> inner_;
   std::size_t measured_;
+  std::size_t images_bytes_;
 };
 
 }  // namespace
@@ -196,9 +202,11 @@ Result<std::unique_ptr<Interpolator>> MakeHalfDifferenceInterpolator(
   if (inner.axis_scale.empty()) {
     inner.axis_scale.assign(kHalfDifferenceScale.begin(), kHalfDifferenceScale.end());
   }
+  const std::size_t images_bytes = sizeof(SampleSet) + set->HeapBytes();
   BRDF_ASSIGN_OR_RETURN(std::unique_ptr<Interpolator> made,
                         MakeInterpolator(method, std::move(set), inner));
-  return std::unique_ptr<Interpolator>(new HalfDifferenceInterpolator(std::move(made), n));
+  return std::unique_ptr<Interpolator>(
+      new HalfDifferenceInterpolator(std::move(made), n, images_bytes));
 }
 
 }  // namespace brdf::interp

@@ -62,6 +62,16 @@ const char* InterpStatusName(InterpStatus s) {
   return "unknown";
 }
 
+std::size_t SampleSet::HeapBytes() const {
+  std::size_t bytes = (chunks_.capacity() * sizeof(chunks_[0])) +
+                      (coords_.capacity() + values_.capacity()) * sizeof(const double*);
+  for (const auto& chunk : chunks_) {
+    bytes += sizeof(Chunk) + chunk->ids.capacity() * sizeof(std::int64_t) +
+             (chunk->coords.capacity() + chunk->values.capacity()) * sizeof(double);
+  }
+  return bytes;
+}
+
 Status SampleSet::Add(std::int64_t id, std::span<const double> coords,
                       std::span<const double> spectrum) {
   const std::string where = "sample " + std::to_string(size()) + " (id " + std::to_string(id) + ")";

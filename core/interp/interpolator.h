@@ -100,6 +100,9 @@ class SampleSet {
     return {values_[i / kChunkSamples] + (i % kChunkSamples) * static_cast<std::size_t>(bands_),
             static_cast<std::size_t>(bands_)};
   }
+  // Heap the set holds (its chunks, whoever else shares them, and its chunk tables), for memory
+  // bounds.
+  std::size_t HeapBytes() const;
   // True when sample i of both sets is stored once, in memory both share (for tests and for
   // callers that check that a set grew from another by Add).
   bool SharesStorageWith(const SampleSet& other, std::size_t i) const {
@@ -148,6 +151,11 @@ class Interpolator {
   virtual int dims() const = 0;
   // query.size() == dims(). Thread-safe (const): many threads may evaluate at once.
   virtual Interpolation Evaluate(std::span<const double> query) const = 0;
+  // Heap the index holds beyond the SampleSet it was given: its copies of the coordinates (and
+  // their symmetry images), its search tree or triangulation, and any sample set it made (the
+  // half/difference images, the trend's residuals). For memory bounds (the daemon's caches);
+  // within a few per cent of what the allocator hands out for them.
+  virtual std::size_t HeapBytes() const = 0;
 
   // The same answer's status and spectrum only, for callers that need no provenance (batches,
   // grids, rendering): the spectrum is written into `spectrum` (the sample set's bands() values)

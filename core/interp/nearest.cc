@@ -19,6 +19,9 @@ class NearestInterpolator final : public Interpolator {
 
   Method method() const override { return Method::kNearest; }
   int dims() const override { return cloud_.dims; }
+  std::size_t HeapBytes() const override {
+    return sizeof(*this) + cloud_.HeapBytes() + tree_.HeapBytes();
+  }
 
   InterpStatus SpectrumAt(std::span<const double> query,
                           std::span<double> spectrum) const override {

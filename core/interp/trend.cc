@@ -107,11 +107,16 @@ constexpr double kSmoothness = 1e-2;
 
 class TrendInterpolator final : public Interpolator {
  public:
-  TrendInterpolator(std::unique_ptr<Interpolator> inner, BivariateTrend trend)
-      : inner_(std::move(inner)), trend_(std::move(trend)) {}
+  // `residuals_bytes`: the heap of the set of residuals `inner` was built over.
+  TrendInterpolator(std::unique_ptr<Interpolator> inner, BivariateTrend trend,
+                    std::size_t residuals_bytes)
+      : inner_(std::move(inner)), trend_(std::move(trend)), residuals_bytes_(residuals_bytes) {}
 
   Method method() const override { return inner_->method(); }
   int dims() const override { return 3; }
+  std::size_t HeapBytes() const override {
+    return sizeof(*this) + residuals_bytes_ + trend_.HeapBytes() + inner_->HeapBytes();
+  }
 
   Interpolation Evaluate(std::span<const double> query) const override {
     Interpolation answer = inner_->Evaluate(query);
@@ -165,6 +170,7 @@ class TrendInterpolator final : public Interpolator {
 
   std::unique_ptr<Interpolator> inner_;
   BivariateTrend trend_;
+  std::size_t residuals_bytes_;
 };
 
 }  // namespace
@@ -272,10 +278,12 @@ Result<std::unique_ptr<Interpolator>> MakeTrendInterpolator(
   if (!trend.ok()) return trend.status().WithContext("options.trend bivariate");
   Options inner_options = options;
   inner_options.trend = Trend::kNone;
+  std::shared_ptr<SampleSet> residuals = TrendResiduals(*samples, *trend);
+  const std::size_t residuals_bytes = sizeof(SampleSet) + residuals->HeapBytes();
   BRDF_ASSIGN_OR_RETURN(std::unique_ptr<Interpolator> inner,
-                        MakeInterpolator(method, TrendResiduals(*samples, *trend), inner_options));
+                        MakeInterpolator(method, std::move(residuals), inner_options));
   return std::unique_ptr<Interpolator>(
-      std::make_unique<TrendInterpolator>(std::move(inner), std::move(*trend)));
+      std::make_unique<TrendInterpolator>(std::move(inner), std::move(*trend), residuals_bytes));
 }
 
 }  // namespace brdf::interp

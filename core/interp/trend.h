@@ -50,6 +50,10 @@ class BivariateTrend {
   int bands() const { return bands_; }
   const std::vector<double>& theta_h_knots() const { return knots_h_; }
   const std::vector<double>& theta_d_knots() const { return knots_d_; }
+  // Heap of the knots and the fitted values.
+  std::size_t HeapBytes() const {
+    return (knots_h_.capacity() + knots_d_.capacity() + values_.capacity()) * sizeof(double);
+  }
 
  private:
   BivariateTrend() = default;

@@ -46,10 +46,11 @@ std::uint64_t ExportInterpolants::DerivedBytes(const exports::DerivedSamples& de
 
 std::uint64_t ExportInterpolants::OwnBytesOf(const exports::SessionInterpolant& in) {
   if (!in.samples) return 0;
-  // The chosen index and the fallback; symmetry options index up to four copies of each sample.
-  const std::uint64_t copies = (in.options.mirror_phi ? 2 : 1) * (in.options.reciprocity ? 2 : 1);
-  const std::uint64_t indexes = in.fallback ? 2 : 1;
-  return SetBytes(*in.samples) + indexes * copies * IndexBytes(*in.samples);
+  // The chosen index and the fallback, each with its copies and images of the samples.
+  std::uint64_t bytes = SetBytes(*in.samples);
+  if (in.interpolator) bytes += IndexBytes(*in.interpolator);
+  if (in.fallback) bytes += IndexBytes(*in.fallback);
+  return bytes;
 }
 
 Result<exports::SessionInterpolant> ExportInterpolants::Get(

@@ -129,13 +129,11 @@ Result<MadeIndex> MakeIndex(std::shared_ptr<const interp::SampleSet> samples, in
 }
 
 std::size_t SetBytes(const interp::SampleSet& set) {
-  return set.size() * (static_cast<std::size_t>(set.dims() + set.bands()) * sizeof(double) +
-                       sizeof(std::int64_t));
+  return sizeof(interp::SampleSet) + set.HeapBytes();
 }
 
-// 8 doubles per coordinate is a generous estimate for every method.
-std::size_t IndexBytes(const interp::SampleSet& set) {
-  return set.size() * static_cast<std::size_t>(set.dims()) * sizeof(double) * 8;
+std::size_t IndexBytes(const interp::Interpolator& index) {
+  return index.HeapBytes();
 }
 
 }  // namespace brdf::daemon

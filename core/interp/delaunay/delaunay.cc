@@ -171,6 +171,10 @@ int DelaunayInterpolator::dims() const {
   return impl_->dims;
 }
 
+std::size_t DelaunayInterpolator::HeapBytes() const {
+  return sizeof(Impl) + impl_->points.capacity() * sizeof(Impl::Point) + impl_->locator.HeapBytes();
+}
+
 Interpolation DelaunayInterpolator::Evaluate(std::span<const double> query) const {
   std::int32_t found = -1;
   return impl_->Answer(query, -1, &found);

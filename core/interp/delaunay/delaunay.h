@@ -73,6 +73,7 @@ class DelaunayInterpolator final : public Interpolator {
 
   Method method() const override { return Method::kDelaunay; }
   int dims() const override;
+  std::size_t HeapBytes() const override;
   // Thread-safe. The search starts from a precomputed simplex near the query.
   Interpolation Evaluate(std::span<const double> query) const override;
   // Thread-safe for distinct hints. Tries hint.simplex first (else searches as Evaluate does)

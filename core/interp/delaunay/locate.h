@@ -43,6 +43,11 @@ class SimplexLocator {
 
   int dims() const { return dims_; }
   std::size_t simplex_count() const { return simplex_count_; }
+  // Heap of the simplices' records and the start grid (for memory bounds).
+  std::size_t HeapBytes() const {
+    return records3_.capacity() * sizeof(Record<3>) + records4_.capacity() * sizeof(Record<4>) +
+           grid_.capacity() * sizeof(std::int32_t);
+  }
   // Flat simplices (zero volume, from Qt on cospherical input): the walk passes through them but
   // never answers with one.
   std::size_t degenerate_count() const { return degenerate_count_; }

@@ -452,6 +452,15 @@ std::size_t OctantInterpolator::tail_size() const {
   return impl_->total - impl_->indexed;
 }
 
+// The tree shared with the index this one was extended from is counted here too: whichever is
+// kept holds it.
+std::size_t OctantInterpolator::HeapBytes() const {
+  const Impl& i = *impl_;
+  return sizeof(Impl) + sizeof(SearchIndex) + i.index->cloud.HeapBytes() +
+         i.index->tree.HeapBytes() + i.tail.HeapBytes() +
+         i.tail_rank.capacity() * sizeof(std::uint32_t);
+}
+
 Interpolation OctantInterpolator::Evaluate(std::span<const double> query) const {
   OctantBlend blend;
   if (!impl_->Blend(query, blend)) {

@@ -99,6 +99,7 @@ class OctantInterpolator final : public Interpolator {
   std::size_t tail_size() const;
 
   Interpolation Evaluate(std::span<const double> query) const override;
+  std::size_t HeapBytes() const override;
   InterpStatus SpectrumAt(std::span<const double> query, std::span<double> spectrum) const override;
   // Same answers as SpectrumAt, query by query, bit for bit. Pipelined: while one query's vertex
   // spectra are on their way from memory, the next query is searched. A 3D batch large enough

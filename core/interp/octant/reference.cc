@@ -16,6 +16,7 @@ class OctantReferenceInterpolator final : public Interpolator {
 
   Method method() const override { return Method::kOctant; }
   int dims() const override { return cloud_.dims; }
+  std::size_t HeapBytes() const override { return sizeof(*this) + cloud_.HeapBytes(); }
 
   Interpolation Evaluate(std::span<const double> query) const override {
     const int d = cloud_.dims;

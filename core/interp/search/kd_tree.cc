@@ -888,6 +888,13 @@ void KdTree::BuildSeeds() {
   }
 }
 
+std::size_t KdTree::HeapBytes() const {
+  std::size_t bytes = nodes_.capacity() * sizeof(Node) +
+                      (rank_.capacity() + seeds_.capacity()) * sizeof(std::uint32_t);
+  for (const std::vector<double>& axis : axis_) bytes += axis.capacity() * sizeof(double);
+  return bytes + grid_.bytes();
+}
+
 std::uint32_t KdTree::SeedCell(const double* p) const {
   std::size_t cell = 0;
   for (std::size_t j = 0; j < static_cast<std::size_t>(dims_); ++j) {

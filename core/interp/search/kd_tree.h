@@ -101,6 +101,8 @@ class KdTree {
   void NearestPerOrthantInCell(std::uint32_t cell, const double* const* queries, int count,
                                WinnerCube3* cubes) const;
 
+  // Heap of the tree, its seeds and its grid shortcut (not the cloud's, which it points into).
+  std::size_t HeapBytes() const;
   // Nodes in the tree and points per leaf (for benchmarks).
   std::size_t node_count() const { return nodes_.size(); }
   std::uint32_t leaf_size() const { return leaf_size_; }

@@ -39,6 +39,11 @@ struct PointCloud {
   std::vector<std::uint32_t> sample;  // size(): the SampleSet index the point copies
 
   std::size_t size() const { return sample.size(); }
+  // Heap of the four arrays (for memory bounds).
+  std::size_t HeapBytes() const {
+    return (scale.capacity() + coords.capacity() + scaled.capacity()) * sizeof(double) +
+           sample.capacity() * sizeof(std::uint32_t);
+  }
   std::span<const double> point(std::size_t rank) const {
     return {coords.data() + rank * static_cast<std::size_t>(dims), static_cast<std::size_t>(dims)};
   }
