@@ -171,7 +171,7 @@ bool ApplyInterpolationCalibration(const InterpolationCalibration& calibration,
                                    std::span<double> spread, double cell_size) {
   if (calibration.scale.empty() || calibration.scale.size() != spread.size()) return false;
   if (BeyondCalibration(calibration, cell_size)) return false;
-  if (calibration.largest_cell <= 0) {
+  if (calibration.largest_cell <= 0 && calibration.larger.empty()) {
     for (std::size_t b = 0; b < spread.size(); ++b) spread[b] *= calibration.scale[b];
     return true;
   }

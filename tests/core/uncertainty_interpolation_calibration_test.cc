@@ -190,21 +190,26 @@ TEST(ApplyInterpolationCalibration, WithSizeBinsEachBandGetsScaleAtsValue) {
   InterpolationCalibration c;
   c.scale = {0.5, 2.0, 1.25};
   c.larger = {{1.0, {0.75, 2.5, 1.5}}, {3.0, {1.1, 2.9, 1.7}}};
-  c.largest_cell = 5;
-  for (SizeBeyond beyond : {SizeBeyond::kGrow, SizeBeyond::kNotEstimated}) {
-    c.beyond = beyond;
-    for (double h : {0.0, 0.5, 1.0, 2.0, 3.0, 4.9, 5.0, 7.3}) {
-      std::vector<double> spread = {1.0 / 3.0, 3.7, 0.011};
-      const std::vector<double> before = spread;
-      if (!ApplyInterpolationCalibration(c, spread, h)) {
-        EXPECT_TRUE(BeyondCalibration(c, h)) << h;
-        continue;
-      }
-      for (std::size_t b = 0; b < spread.size(); ++b) {
-        EXPECT_EQ(spread[b], before[b] * ScaleAt(c, h, b)) << "h " << h << " band " << b;
+  // largest_cell 0: bins without a reach (every held-out cell of size 0), still ScaleAt's bins.
+  for (double largest : {5.0, 0.0}) {
+    c.largest_cell = largest;
+    for (SizeBeyond beyond : {SizeBeyond::kGrow, SizeBeyond::kNotEstimated}) {
+      c.beyond = beyond;
+      for (double h : {0.0, 0.5, 1.0, 2.0, 3.0, 4.9, 5.0, 7.3}) {
+        std::vector<double> spread = {1.0 / 3.0, 3.7, 0.011};
+        const std::vector<double> before = spread;
+        if (!ApplyInterpolationCalibration(c, spread, h)) {
+          EXPECT_TRUE(BeyondCalibration(c, h)) << h;
+          continue;
+        }
+        for (std::size_t b = 0; b < spread.size(); ++b) {
+          EXPECT_EQ(spread[b], before[b] * ScaleAt(c, h, b))
+              << "largest " << largest << " h " << h << " band " << b;
+        }
       }
     }
   }
+  c.largest_cell = 5;
   // A bin without a scale for every band: the band's own (ScaleAt's rule) still.
   c.beyond = SizeBeyond::kGrow;
   c.larger = {{1.0, {0.75}}};

@@ -359,13 +359,8 @@ void ModelCellUncertainty::At(const IsoDirection& at, std::span<double> u) const
     return;
   }
   LocalScale(*residuals_, near, u);
-  // c(d) per band. With a reach (largest_cell > 0, as CalibrateModel fits it)
-  // ApplyInterpolationCalibration multiplies by ScaleAt's values, its bin found once per cell.
-  if (calibration_.largest_cell > 0) {
-    uncertainty::ApplyInterpolationCalibration(calibration_, u, d);
-    return;
-  }
-  for (std::size_t b = 0; b < u.size(); ++b) u[b] *= uncertainty::ScaleAt(calibration_, d, b);
+  // c(d) per band: ScaleAt's values, its bin found once per cell.
+  uncertainty::ApplyInterpolationCalibration(calibration_, u, d);
 }
 
 }  // namespace brdf::exports
