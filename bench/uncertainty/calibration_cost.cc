@@ -81,7 +81,8 @@ int main(int argc, char** argv) {
       return 1;
     }
     t0 = Clock::now();
-    const auto points = uncertainty::PredictHeldOut(*samples, uncertainty::BudgetOf{}, *method, {});
+    const auto points =
+        uncertainty::PredictHeldOut(*samples, uncertainty::IndependentOf{}, *method, {});
     const auto fit = uncertainty::FitInterpolationCalibration(points, bands, {});
     calibrate.push_back(Seconds(t0));
     held_out = fit.held_out;

@@ -10,7 +10,6 @@
 #include "core/geometry.h"
 #include "core/interp/octant/octant.h"
 #include "core/uncertainty/blend.h"
-#include "core/uncertainty/budget.h"
 #include "core/uncertainty/held_out.h"
 #include "core/uncertainty/interpolation_calibration.h"
 
@@ -58,15 +57,15 @@ double MeasurementPart(const interp::Interpolation& answer, const interp::Sample
   return std::sqrt(u2);
 }
 
-// Each reading's measurement noise as held_out.h reads it: a one-band budget whose independent
-// part is the reading's relative u times its BRDF (absolute).
-std::vector<uncertainty::ReadingBudget> ScalarBudgets(const interp::SampleSet& samples,
-                                                      std::span<const double> relative_u) {
-  std::vector<uncertainty::ReadingBudget> budgets(samples.size());
+// Each reading's measurement noise as held_out.h reads it: a one-band independent part, the
+// reading's relative u times its BRDF (absolute).
+std::vector<std::vector<double>> ScalarNoise(const interp::SampleSet& samples,
+                                             std::span<const double> relative_u) {
+  std::vector<std::vector<double>> noise(samples.size());
   for (std::size_t i = 0; i < samples.size(); ++i) {
-    budgets[i].independent = {relative_u[i] * samples.spectrum(i)[0]};
+    noise[i] = {relative_u[i] * samples.spectrum(i)[0]};
   }
-  return budgets;
+  return noise;
 }
 
 }  // namespace
@@ -90,9 +89,9 @@ JudgedReadings::JudgedReadings(std::span<const ReadingSoFar> readings, Judge jud
   if (index_ == nullptr) return;
   // Held out as the daemon's calibration is (held_out.h): folds by a hash of the sample ids,
   // which are the readings' positions here.
-  const std::vector<uncertainty::ReadingBudget> budgets = ScalarBudgets(*samples_, relative_u_);
+  const std::vector<std::vector<double>> noise = ScalarNoise(*samples_, relative_u_);
   const std::vector<uncertainty::HeldOutPoint> points = uncertainty::PredictHeldOut(
-      *samples_, [&budgets](std::size_t i) { return &budgets[i]; }, method, JudgeOptions());
+      *samples_, [&noise](std::size_t i) { return &noise[i]; }, method, JudgeOptions());
   held_out_ = points.size();
   const uncertainty::InterpolationCalibration fit =
       uncertainty::FitInterpolationCalibration(points, 1, uncertainty::CalibrationTarget{});

@@ -14,25 +14,22 @@ namespace brdf::uncertainty {
 namespace {
 
 // One reading of the blend, its weights summed over its copies.
-template <typename Budget>
-struct BlendedOf {
+struct Blended {
   std::int64_t reading_id = 0;
   double weight = 0;
-  const Budget* budget = nullptr;
+  const BlendBudget* budget = nullptr;
 };
-using Blended = BlendedOf<ReadingBudget>;
 
-// A shared input (name, sharing, id) and the vertices' contributions to it with their weights:
-// its Σ wᵢ uⱼ,ᵢ per band is formed in one pass when it is squared.
+// A shared input (name, sharing, id: its key) and the vertices' contributions to it with their
+// weights: its Σ wᵢ uⱼ,ᵢ per band is formed in one pass when it is squared.
 struct SharedInput {
-  const std::string* name = nullptr;
-  SharedThrough through;
-  std::vector<const double*> contributions;
+  SharedKey key;
+  std::vector<const float*> contributions;
   std::vector<double> weights;
 };
 
-// What one blend works in, kept by each thread from one blend to the next (a batch blends
-// thousands): after the first few, a blend allocates nothing here.
+// What one blend works in, kept by each thread from one blend to the next (a batch or a grid
+// blends thousands): after the first few, a blend allocates nothing here.
 struct Scratch {
   std::vector<Blended> readings;
   // Each reading's independent part and its weight², summed squared into the measurement.
@@ -41,7 +38,8 @@ struct Scratch {
   // The first `used` are this blend's shared inputs; the rest are kept for their storage.
   std::vector<SharedInput> inputs;
   std::size_t used = 0;
-  std::vector<WeightedRows> rows;  // the used inputs as BlendSquaredBands takes them
+  std::vector<WeightedFloatRows> rows;  // the used inputs as BlendSquaredBands takes them
+  std::vector<const std::vector<std::string>*> notes_added;  // lists already in not_estimated
 };
 
 Scratch& ThreadScratch() {
@@ -49,19 +47,17 @@ Scratch& ThreadScratch() {
   return scratch;
 }
 
-template <typename Vertex, typename Budget>
-Status MergeByReading(std::span<const Vertex> vertices, std::vector<BlendedOf<Budget>>& out) {
+Status MergeByReading(std::span<const BlendVertex> vertices, std::vector<Blended>& out) {
   out.clear();
-  for (const Vertex& v : vertices) {
+  for (const BlendVertex& v : vertices) {
     if (!std::isfinite(v.weight)) {
       return InvalidArgument("reading " + std::to_string(v.reading_id) +
                              ": its blend weight is not a finite number");
     }
-    auto same = std::find_if(out.begin(), out.end(), [&](const BlendedOf<Budget>& b) {
-      return b.reading_id == v.reading_id;
-    });
+    auto same = std::find_if(out.begin(), out.end(),
+                             [&](const Blended& b) { return b.reading_id == v.reading_id; });
     if (same == out.end()) {
-      out.push_back(BlendedOf<Budget>{v.reading_id, v.weight, v.budget});
+      out.push_back(Blended{v.reading_id, v.weight, v.budget});
     } else {
       same->weight += v.weight;
       if (same->budget == nullptr) same->budget = v.budget;
@@ -79,93 +75,31 @@ std::string OtherBands(std::int64_t reading_id, std::size_t bands) {
          std::to_string(bands) + " bands, the blend's; were the readings measured on another grid?";
 }
 
-Status CheckBands(const Blended& b, std::size_t bands) {
-  bool fits = b.budget->combined.size() == bands && b.budget->independent.size() == bands;
-  for (const Component& c : b.budget->components) fits = fits && c.contribution.size() == bands;
-  if (fits) return Status::Ok();
-  return InvalidArgument(OtherBands(b.reading_id, bands));
-}
-
-// The shared input `c` is shared through, added (with no contributions yet) when it is the first
-// component met of that input.
+// The shared input `key` names, added (with no contributions yet) when it is the first met.
 // `hint`: where to look first (the readings of a session list their components in the same order,
-// so a reading's n-th shared component is most often the n-th input); inputs are unique by
-// (name, sharing, id), so the one found there is the one a scan would find.
-bool IsInput(const SharedInput& input, const Component& c) {
-  return input.through == c.shared && *input.name == c.name;
-}
-
-SharedInput& InputOf(const Component& c, std::size_t hint, Scratch& s) {
-  if (hint < s.used && IsInput(s.inputs[hint], c)) return s.inputs[hint];
-  for (std::size_t j = 0; j < s.used; ++j) {
-    if (IsInput(s.inputs[j], c)) return s.inputs[j];
-  }
-  if (s.used == s.inputs.size()) s.inputs.emplace_back();
-  SharedInput& input = s.inputs[s.used++];
-  input.name = &c.name;
-  input.through = c.shared;
-  input.contributions.clear();
-  input.weights.clear();
-  return input;
-}
-
-// Adds one reading: its independent part (the budget's, sqrt(Σ independent uⱼ²)) to be squared
-// with its weight², its shared components to their inputs, with its weight.
-void AddReading(const Blended& b, Scratch& s) {
-  s.independent.push_back(b.budget->independent.data());
-  s.independent_scales.push_back(b.weight * b.weight);
-  std::size_t shared = 0;
-  for (const Component& c : b.budget->components) {
-    if (c.shared.kind == Sharing::kIndependent) continue;
-    SharedInput& input = InputOf(c, shared++, s);
-    input.contributions.push_back(c.contribution.data());
-    input.weights.push_back(b.weight);
-  }
-}
-
-// The blend over BlendBudgets (blend_budget.h): the same sums, its inputs found by their integer
-// keys and their rows read as floats.
-struct FloatInput {
-  SharedKey key;
-  std::vector<const float*> contributions;
-  std::vector<double> weights;
-};
-
-struct FloatScratch {
-  std::vector<BlendedOf<BlendBudget>> readings;
-  std::vector<const double*> independent;
-  std::vector<double> independent_scales;
-  std::vector<FloatInput> inputs;  // the first `used` are this blend's
-  std::size_t used = 0;
-  std::vector<WeightedFloatRows> rows;
-  std::vector<const std::vector<std::string>*> notes_added;  // lists already in not_estimated
-};
-
-FloatScratch& ThreadFloatScratch() {
-  thread_local FloatScratch scratch;
-  return scratch;
-}
-
-// As InputOf: `hint` first (the readings of a session list their components in the same order).
-FloatInput& FloatInputOf(const SharedKey& key, std::size_t hint, FloatScratch& s) {
+// so a reading's n-th shared component is most often the n-th input); inputs are unique by key,
+// so the one found there is the one a scan would find.
+SharedInput& InputOf(const SharedKey& key, std::size_t hint, Scratch& s) {
   if (hint < s.used && s.inputs[hint].key == key) return s.inputs[hint];
   for (std::size_t j = 0; j < s.used; ++j) {
     if (s.inputs[j].key == key) return s.inputs[j];
   }
   if (s.used == s.inputs.size()) s.inputs.emplace_back();
-  FloatInput& input = s.inputs[s.used++];
+  SharedInput& input = s.inputs[s.used++];
   input.key = key;
   input.contributions.clear();
   input.weights.clear();
   return input;
 }
 
-void AddFloatReading(const BlendedOf<BlendBudget>& b, FloatScratch& s) {
+// Adds one reading: its independent part (sqrt(Σ independent uⱼ²), blend_budget.h) to be squared
+// with its weight², its shared components' rows to their inputs, with its weight.
+void AddReading(const Blended& b, Scratch& s) {
   const BlendBudget& budget = *b.budget;
   s.independent.push_back(budget.independent.data());
   s.independent_scales.push_back(b.weight * b.weight);
   for (std::size_t j = 0; j < budget.keys.size(); ++j) {
-    FloatInput& input = FloatInputOf(budget.keys[j], j, s);
+    SharedInput& input = InputOf(budget.keys[j], j, s);
     input.contributions.push_back(budget.row(j));
     input.weights.push_back(b.weight);
   }
@@ -173,7 +107,7 @@ void AddFloatReading(const BlendedOf<BlendBudget>& b, FloatScratch& s) {
 
 // The reading's not_estimated entries, each once: a list already added (shared by readings with
 // the same entries) is skipped whole.
-void AddNotes(const BlendBudget& budget, FloatScratch& s, NoteList& notes) {
+void AddNotes(const BlendBudget& budget, Scratch& s, NoteList& notes) {
   const std::vector<std::string>* list = budget.not_estimated.get();
   if (list == nullptr || list->empty()) return;
   if (std::find(s.notes_added.begin(), s.notes_added.end(), list) != s.notes_added.end()) return;
@@ -182,12 +116,11 @@ void AddNotes(const BlendBudget& budget, FloatScratch& s, NoteList& notes) {
 }
 
 // shared² = Σ over inputs of (Σ wᵢ uⱼ,ᵢ)², measurement² = shared² + independent², in one pass
-// over the bands, from the inputs `s` gathered (Scratch or FloatScratch); then the roots.
-template <typename GatheredScratch>
-void SumAndRoot(GatheredScratch& s, std::size_t n, bool with_shared, BlendedUncertainty* out) {
+// over the bands, from the inputs `s` gathered; then the roots.
+void SumAndRoot(Scratch& s, std::size_t n, bool with_shared, BlendedUncertainty* out) {
   s.rows.clear();
   for (std::size_t j = 0; j < s.used; ++j) {
-    const auto& input = s.inputs[j];
+    const SharedInput& input = s.inputs[j];
     s.rows.push_back({input.contributions.data(), input.weights.data(), input.weights.size()});
   }
   out->measurement.resize(n);
@@ -210,47 +143,21 @@ Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int ba
                                    BlendedUncertainty* out, bool with_shared) {
   if (bands < 1) return InvalidArgument("a blend needs at least one band");
   Scratch& s = ThreadScratch();
-  BRDF_RETURN_IF_ERROR(MergeByReading<BlendVertex>(vertices, s.readings));
-  const auto n = static_cast<std::size_t>(bands);
-  NoteList notes(out->not_estimated);
-  s.independent.clear();
-  s.independent_scales.clear();
-  s.used = 0;
-  for (const Blended& b : s.readings) {
-    if (b.budget == nullptr) {
-      notes.AddUnique(NoBudget(b.reading_id));
-      continue;
-    }
-    BRDF_RETURN_IF_ERROR(CheckBands(b, n));
-    for (const std::string& entry : b.budget->not_estimated) {
-      notes.AddUnique(entry);
-    }
-    AddReading(b, s);
-  }
-  notes.Finish();
-  SumAndRoot(s, n, with_shared, out);
-  return Status::Ok();
-}
-
-Status BlendMeasurementUncertainty(std::span<const BlendBudgetVertex> vertices, int bands,
-                                   BlendedUncertainty* out, bool with_shared) {
-  if (bands < 1) return InvalidArgument("a blend needs at least one band");
-  FloatScratch& s = ThreadFloatScratch();
-  BRDF_RETURN_IF_ERROR(MergeByReading<BlendBudgetVertex>(vertices, s.readings));
+  BRDF_RETURN_IF_ERROR(MergeByReading(vertices, s.readings));
   const auto n = static_cast<std::size_t>(bands);
   NoteList notes(out->not_estimated);
   s.independent.clear();
   s.independent_scales.clear();
   s.notes_added.clear();
   s.used = 0;
-  for (const BlendedOf<BlendBudget>& b : s.readings) {
+  for (const Blended& b : s.readings) {
     if (b.budget == nullptr) {
       notes.AddUnique(NoBudget(b.reading_id));
       continue;
     }
     if (b.budget->bands != n) return InvalidArgument(OtherBands(b.reading_id, n));
     AddNotes(*b.budget, s, notes);
-    AddFloatReading(b, s);
+    AddReading(b, s);
   }
   notes.Finish();
   SumAndRoot(s, n, with_shared, out);

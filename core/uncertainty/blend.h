@@ -24,11 +24,12 @@
 
 namespace brdf::uncertainty {
 
-// One blended reading.
+// One blended reading, its budget in the blend's form (blend_budget.h: ToBlendBudget, once per
+// reading by whoever keeps the readings: brdfd's index, the grid export's chain).
 struct BlendVertex {
   std::int64_t reading_id = 0;
-  double weight = 0;                      // its barycentric weight (finite)
-  const ReadingBudget* budget = nullptr;  // null: the reading has no budget (not estimated)
+  double weight = 0;                    // its barycentric weight (finite)
+  const BlendBudget* budget = nullptr;  // null: the reading has no budget (not estimated)
 };
 
 // The measurement uncertainty of a blend, per band (standard uncertainties, k = 1).
@@ -43,34 +44,20 @@ struct BlendedUncertainty {
   std::vector<std::string> not_estimated;
 };
 
-// The blend's measurement uncertainty over `bands` bands. Errors (kInvalidArgument, naming the
-// reading): a non-finite weight, a budget whose components, combined or independent do not have
-// `bands` values, bands < 1. A budget's independent part is taken as it is stored (sqrt of its
-// independent components' squares, budget.h). No vertex with a budget gives zeros with every vertex
-// named as not estimated.
+// The blend's measurement uncertainty over `bands` bands. The shared contributions are read as
+// the floats BlendBudget holds, widened to double, and summed in double; so the result is the
+// blend of the ReadingBudgets they were made from up to a float's rounding of each shared
+// contribution (relative 2⁻²⁴; the independent parts are the budgets' doubles). Errors
+// (kInvalidArgument, naming the reading): a non-finite weight, a budget whose bands are not
+// `bands`, bands < 1. No vertex with a budget gives zeros with every vertex named as not
+// estimated.
 Result<BlendedUncertainty> BlendMeasurementUncertainty(std::span<const BlendVertex> vertices,
                                                        int bands);
 // The same into *out, its contents replaced and its storage reused: a caller blending many
-// answers (a batch) allocates nothing for the spectra once *out has grown. With `with_shared`
-// false, out->shared is left empty (a caller that does not hand it on saves its square roots;
-// measurement is the same). On an error *out is left unspecified.
+// answers (a batch, a grid) allocates nothing for the spectra once *out has grown. With
+// `with_shared` false, out->shared is left empty (a caller that does not hand it on saves its
+// square roots; measurement is the same). On an error *out is left unspecified.
 Status BlendMeasurementUncertainty(std::span<const BlendVertex> vertices, int bands,
-                                   BlendedUncertainty* out, bool with_shared = true);
-
-// One blended reading with its budget in an index's form (blend_budget.h).
-struct BlendBudgetVertex {
-  std::int64_t reading_id = 0;
-  double weight = 0;
-  const BlendBudget* budget = nullptr;  // null: not estimated
-};
-
-// The same blend of budgets in BlendBudget's form (brdfd's interpolation index): the same sums
-// in the same order, its shared contributions read as the floats BlendBudget holds, so the result
-// equals the blend of the ReadingBudgets they were made from up to a float's rounding of each
-// shared contribution (relative 2⁻²⁴; its independent parts are the same doubles). The same
-// not_estimated entries in the same order, the same errors (a budget whose bands are not
-// `bands`).
-Status BlendMeasurementUncertainty(std::span<const BlendBudgetVertex> vertices, int bands,
                                    BlendedUncertainty* out, bool with_shared = true);
 
 // The interpolation term per band: the vertices' weighted spread about the blend,

@@ -1,23 +1,24 @@
 #include "core/uncertainty/blend_budget.h"
 
-#include <map>
-#include <mutex>
+#include <algorithm>
+#include <iterator>
 #include <utility>
 
 namespace brdf::uncertainty {
 
-std::uint32_t NameCode(std::string_view name) {
-  static std::mutex mutex;
-  static std::map<std::string, std::uint32_t, std::less<>> codes;
-  const std::lock_guard<std::mutex> lock(mutex);
-  const auto found = codes.find(name);
-  if (found != codes.end()) return found->second;
-  const auto code = static_cast<std::uint32_t>(codes.size());
-  codes.emplace(std::string(name), code);
-  return code;
+std::uint32_t NameCodes::Code(std::string_view name) {
+  constexpr auto kKnown = std::size(kSharedComponentNames);
+  const auto known =
+      std::find(std::begin(kSharedComponentNames), std::end(kSharedComponentNames), name);
+  if (known != std::end(kSharedComponentNames)) {
+    return static_cast<std::uint32_t>(known - std::begin(kSharedComponentNames));
+  }
+  auto other = std::find(others_.begin(), others_.end(), name);
+  if (other == others_.end()) other = others_.insert(others_.end(), std::string(name));
+  return static_cast<std::uint32_t>(kKnown + static_cast<std::size_t>(other - others_.begin()));
 }
 
-Result<BlendBudget> ToBlendBudget(const ReadingBudget& budget,
+Result<BlendBudget> ToBlendBudget(const ReadingBudget& budget, NameCodes& codes,
                                   std::shared_ptr<const std::vector<std::string>> notes) {
   BlendBudget out;
   out.bands = budget.combined.size();
@@ -33,7 +34,7 @@ Result<BlendBudget> ToBlendBudget(const ReadingBudget& budget,
                              std::to_string(c.contribution.size()) + " bands, its combined " +
                              std::to_string(out.bands));
     }
-    out.keys.push_back({NameCode(c.name), c.shared.kind, c.shared.id});
+    out.keys.push_back({codes.Code(c.name), c.shared.kind, c.shared.id});
     out.shared_rows.insert(out.shared_rows.end(), c.contribution.begin(), c.contribution.end());
   }
   out.keys.shrink_to_fit();

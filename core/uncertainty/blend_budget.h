@@ -8,13 +8,16 @@
 //     answer instead of ~23 kB). An uncertainty has two significant digits of meaning (GUM 7.2.6)
 //     and the API sends it as floats; a float's rounding (2⁻²⁴ relative) changes an answer's
 //     measurement part by at most a few units in its last float place;
-//   - each shared component's input as three integers (the component's name by NameCode, its
-//     sharing and the id it is shared through), compared instead of strings;
+//   - each shared component's input as three integers (the component's name by the list's
+//     NameCodes, its sharing and the id it is shared through), compared instead of strings;
 //   - the not_estimated entries, held by a list that consecutive readings with the same entries
 //     share (a blend then adds them once by pointer instead of comparing ~100-character texts).
-// Pure: no I/O (NameCode keeps a process-wide table of the names it has seen, under a mutex).
+// Whoever builds a list of BlendBudgets (brdfd's index, the grid export's chain) holds its
+// NameCodes: budgets are blended only with budgets of the same list. Pure: no I/O, no
+// process-wide state.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -25,14 +28,32 @@
 
 namespace brdf::uncertainty {
 
-// A small number for each distinct component name, the same for the same name in the whole
-// process (names are the budget's vocabulary: "reference_signal", "white_standard", …).
-std::uint32_t NameCode(std::string_view name);
+// A small number for each distinct shared component's name, the same for the same name within one
+// list of BlendBudgets. The names budget.cc gives shared components ("reference_signal",
+// "white_standard", …, kSharedComponentNames) have fixed codes; any other name (a budget stored
+// by another version) gets the next code of this table, so a table is extended rarely if ever.
+// A copy of the table (a list copied to add to it) gives the same codes for the names it holds.
+// Not thread-safe: one builder at a time.
+class NameCodes {
+ public:
+  std::uint32_t Code(std::string_view name);
+  // How many names outside kSharedComponentNames it has coded.
+  std::size_t others() const { return others_.size(); }
+
+ private:
+  std::vector<std::string> others_;
+};
+
+// The shared components' names budget.cc gives (EstimateReadingBudget), in a fixed order.
+inline constexpr std::string_view kSharedComponentNames[] = {
+    "reference_signal",    "dark_signal",          "white_standard",      "reference_pose",
+    "lamp_drift",          "wavelength_scale",     "stray_light",         "pose_alignment_alpha",
+    "pose_alignment_beta", "pose_alignment_gamma", "pose_alignment_delta"};
 
 // The input one shared component is shared through: its name, its sharing and the thing's id
 // (blend.h: contributions of the same input add linearly).
 struct SharedKey {
-  std::uint32_t name = 0;  // NameCode
+  std::uint32_t name = 0;  // NameCodes::Code
   Sharing kind = Sharing::kIndependent;
   std::int64_t id = 0;
   friend bool operator==(const SharedKey&, const SharedKey&) = default;
@@ -50,11 +71,11 @@ struct BlendBudget {
 };
 
 // The blend's form of `budget` (its independent components are already summed in
-// `independent`; its value and combined are not kept). kInvalidArgument when its independent
-// part or a shared component does not have the same number of bands as its combined.
-// `notes`: a list to share when it holds the same entries as budget.not_estimated (the previous
-// reading's), else a new one is made.
-Result<BlendBudget> ToBlendBudget(const ReadingBudget& budget,
+// `independent`; its value and combined are not kept), its names coded by `codes` (the list's).
+// kInvalidArgument when its independent part or a shared component does not have the same number
+// of bands as its combined. `notes`: a list to share when it holds the same entries as
+// budget.not_estimated (the previous reading's), else a new one is made.
+Result<BlendBudget> ToBlendBudget(const ReadingBudget& budget, NameCodes& codes,
                                   std::shared_ptr<const std::vector<std::string>> notes = nullptr);
 
 }  // namespace brdf::uncertainty

@@ -39,20 +39,12 @@ const std::vector<double>* Independent(const IndependentOf& independent_of, std:
   return independent_of ? independent_of(i) : nullptr;
 }
 
-// `budget_of`'s independent parts (the function refers to `budget_of`: used within the call).
-IndependentOf IndependentParts(const BudgetOf& budget_of) {
-  if (!budget_of) return {};
-  return [&budget_of](std::size_t i) -> const std::vector<double>* {
-    const ReadingBudget* b = budget_of(i);
-    return b != nullptr ? &b->independent : nullptr;
-  };
-}
-
 // One held-out sample predicted by `interpolator` over `rest` (rest_to_all: rest's positions in
 // the full set); false when the answer is not OK.
-bool PredictOne(const interp::SampleSet& samples, const IndependentOf& budget_of, std::size_t j,
-                const interp::Interpolator& interpolator, const interp::SampleSet& rest,
-                const std::vector<std::size_t>& rest_to_all, HeldOutPoint* out) {
+bool PredictOne(const interp::SampleSet& samples, const IndependentOf& independent_of,
+                std::size_t j, const interp::Interpolator& interpolator,
+                const interp::SampleSet& rest, const std::vector<std::size_t>& rest_to_all,
+                HeldOutPoint* out) {
   interp::Interpolation answer = interpolator.Evaluate(samples.coords(j));
   if (answer.status != interp::InterpStatus::kOk) return false;
   const std::span<const double> truth = samples.spectrum(j);
@@ -69,12 +61,12 @@ bool PredictOne(const interp::SampleSet& samples, const IndependentOf& budget_of
   out->spread = InterpolationSpread(weights, spectra, answer.spectrum);
   out->cell_size = CellSize(answer.vertices);
   out->noise.clear();
-  const std::vector<double>* own = Independent(budget_of, j);
+  const std::vector<double>* own = Independent(independent_of, j);
   if (own == nullptr || own->size() != bands) return true;
   out->noise.assign(own->begin(), own->end());
   for (double& n : out->noise) n *= n;
   for (const interp::Vertex& v : answer.vertices) {
-    const std::vector<double>* u = Independent(budget_of, rest_to_all[v.index]);
+    const std::vector<double>* u = Independent(independent_of, rest_to_all[v.index]);
     if (u == nullptr || u->size() != bands) continue;
     for (std::size_t b = 0; b < bands; ++b)
       out->noise[b] += v.weight * v.weight * (*u)[b] * (*u)[b];
@@ -99,7 +91,7 @@ Result<std::unique_ptr<interp::Interpolator>> MakeFoldIndex(
 }
 
 // One fold: an index over every sample not in `held`, evaluated at each held one.
-void PredictFold(const interp::SampleSet& samples, const IndependentOf& budget_of,
+void PredictFold(const interp::SampleSet& samples, const IndependentOf& independent_of,
                  std::span<const std::size_t> held, interp::Method method,
                  const interp::Options& options, std::vector<HeldOutPoint>* out) {
   std::vector<bool> is_held(samples.size(), false);
@@ -116,7 +108,7 @@ void PredictFold(const interp::SampleSet& samples, const IndependentOf& budget_o
   if (!interpolator.ok()) return;  // e.g. too few readings left for Delaunay: no points
   HeldOutPoint point;
   for (std::size_t j : held) {
-    if (PredictOne(samples, budget_of, j, **interpolator, *rest, rest_to_all, &point)) {
+    if (PredictOne(samples, independent_of, j, **interpolator, *rest, rest_to_all, &point)) {
       out->push_back(point);
     }
   }
@@ -125,13 +117,7 @@ void PredictFold(const interp::SampleSet& samples, const IndependentOf& budget_o
 }  // namespace
 
 std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
-                                         const BudgetOf& budget_of, interp::Method method,
-                                         const interp::Options& options) {
-  return PredictHeldOut(samples, IndependentParts(budget_of), method, options);
-}
-
-std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
-                                         const IndependentOf& budget_of, interp::Method method,
+                                         const IndependentOf& independent_of, interp::Method method,
                                          const interp::Options& options) {
   std::vector<HeldOutPoint> out;
   const std::size_t n = samples.size();
@@ -144,7 +130,7 @@ std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
   const std::vector<std::size_t> order = HeldOutOrder(samples);
   for (std::size_t f = 0; f < folds && f * fold < n; ++f) {
     const std::size_t end = std::min(n, (f + 1) * fold);
-    PredictFold(samples, budget_of, std::span(order).subspan(f * fold, end - f * fold), method,
+    PredictFold(samples, independent_of, std::span(order).subspan(f * fold, end - f * fold), method,
                 options, &out);
   }
   return out;
@@ -157,13 +143,7 @@ CalibrationTarget TargetOf(interp::Method method) {
 }
 
 InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples,
-                                                const BudgetOf& budget_of, interp::Method method,
-                                                const interp::Options& options, int bands) {
-  return CalibrateInterpolation(samples, IndependentParts(budget_of), method, options, bands);
-}
-
-InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples,
-                                                const IndependentOf& budget_of,
+                                                const IndependentOf& independent_of,
                                                 interp::Method method,
                                                 const interp::Options& options, int bands) {
   if (method == interp::Method::kNearest) {
@@ -171,7 +151,7 @@ InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples
     none.detail = "the nearest method has no interpolation term";
     return none;
   }
-  const std::vector<HeldOutPoint> points = PredictHeldOut(samples, budget_of, method, options);
+  const std::vector<HeldOutPoint> points = PredictHeldOut(samples, independent_of, method, options);
   return FitInterpolationCalibration(points, bands, TargetOf(method));
 }
 

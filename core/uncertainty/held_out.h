@@ -31,10 +31,9 @@ inline constexpr std::size_t kMaxFolds = 32;
 inline constexpr std::size_t kMaxFoldSamplesOctant = 60000;
 inline constexpr std::size_t kMaxFoldSamplesOther = 10000;
 
-// Sample i's budget, by its position in the sample set (null: none). Unset: no sample has one.
-using BudgetOf = std::function<const ReadingBudget*(std::size_t index)>;
-// Sample i's independent part (its budget's, a value per band), or null when it has none: all
-// the held-out points' noise reads of a budget (brdfd's index gives it from its BlendBudgets).
+// Sample i's independent part (its budget's, a value per band: ReadingBudget::independent,
+// BlendBudget::independent), by its position in the sample set, or null when it has none: all
+// the held-out points' noise reads of a budget. Unset: no sample has one.
 using IndependentOf = std::function<const std::vector<double>*(std::size_t index)>;
 
 // The samples' positions in the order the folds take them: by a fixed hash of their ids (the
@@ -43,12 +42,8 @@ std::vector<std::size_t> HeldOutOrder(const interp::SampleSet& samples);
 
 // The held-out predictions over `samples` by `method` with `options`: for each fold, an index
 // over the samples outside it, evaluated at each held-out sample's pose; answers that are not OK
-// are left out. `budget_of` gives each point's noise: the held-out reading's independent part and
-// its vertices' (weighted) in quadrature; a point whose reading has no budget has none.
-std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
-                                         const BudgetOf& budget_of, interp::Method method,
-                                         const interp::Options& options);
-// The same with each sample's independent part given directly (the same points).
+// are left out. `independent_of` gives each point's noise: the held-out reading's independent part
+// and its vertices' (weighted) in quadrature; a point whose reading has none has none.
 std::vector<HeldOutPoint> PredictHeldOut(const interp::SampleSet& samples,
                                          const IndependentOf& independent_of, interp::Method method,
                                          const interp::Options& options);
@@ -64,13 +59,9 @@ inline constexpr int kDelaunaySizeBins = 3;
 CalibrationTarget TargetOf(interp::Method method);
 
 // The calibration of the interpolation term of `method` over `samples` (`bands` values a
-// spectrum), aimed as TargetOf(method): not calibrated (detail says why) for the nearest method,
-// which has no interpolation term, and when fewer held-out readings than
-// CalibrationTarget::min_points could be predicted.
-InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples,
-                                                const BudgetOf& budget_of, interp::Method method,
-                                                const interp::Options& options, int bands);
-// The same with each sample's independent part given directly (the same calibration).
+// spectrum; `independent_of` as PredictHeldOut's), aimed as TargetOf(method): not calibrated
+// (detail says why) for the nearest method, which has no interpolation term, and when fewer
+// held-out readings than CalibrationTarget::min_points could be predicted.
 InterpolationCalibration CalibrateInterpolation(const interp::SampleSet& samples,
                                                 const IndependentOf& independent_of,
                                                 interp::Method method,

@@ -32,33 +32,30 @@ struct Scratch {
 
 // The blend of the answer's vertices with their budgets (`budget_of` gives a vertex's, by its
 // position in the sample set) into `blended`.
-template <typename Vertex, typename BudgetOf>
-Status BlendVertices(const interp::Interpolation& answer, const BudgetOf& budget_of, bool shared,
+Status BlendVertices(const interp::Interpolation& answer,
+                     const std::function<const BlendBudget*(std::size_t)>& budget_of, bool shared,
                      BlendedUncertainty& blended) {
-  Scratch<Vertex> scratch;
-  const std::span<Vertex> vertices = scratch.Take(answer.vertices.size());
+  Scratch<BlendVertex> scratch;
+  const std::span<BlendVertex> vertices = scratch.Take(answer.vertices.size());
   for (std::size_t i = 0; i < vertices.size(); ++i) {
     const interp::Vertex& v = answer.vertices[i];
     vertices[i] = {v.id, v.weight, budget_of(v.index)};
   }
-  return BlendMeasurementUncertainty(std::span<const Vertex>(vertices),
+  return BlendMeasurementUncertainty(std::span<const BlendVertex>(vertices),
                                      static_cast<int>(answer.spectrum.size()), &blended, shared);
 }
 
 // The measurement part into `out`, or the reason it has none.
 void AddMeasurement(const interp::Interpolation& answer, const InterpolatedInputs& inputs,
                     InterpolatedUncertainty& out, NoteList& notes) {
-  if (!inputs.budget_of && !inputs.blend_budget_of) {
+  if (!inputs.budget_of) {
     notes.Add("measurement: " + inputs.no_budgets);
     return;
   }
   // The blend's working storage, kept by each thread: a batch's answers allocate nothing once it
   // has grown (the vectors are swapped with `out`'s, so both keep their capacity).
   thread_local BlendedUncertainty blended;
-  const Status st =
-      inputs.blend_budget_of
-          ? BlendVertices<BlendBudgetVertex>(answer, inputs.blend_budget_of, inputs.shared, blended)
-          : BlendVertices<BlendVertex>(answer, inputs.budget_of, inputs.shared, blended);
+  const Status st = BlendVertices(answer, inputs.budget_of, inputs.shared, blended);
   if (!st.ok()) {
     notes.Add("measurement: " + st.message());
     return;

@@ -17,7 +17,6 @@
 
 #include "core/interp/interpolator.h"
 #include "core/uncertainty/blend_budget.h"
-#include "core/uncertainty/budget.h"
 #include "core/uncertainty/interpolation_calibration.h"
 
 namespace brdf::uncertainty {
@@ -27,13 +26,11 @@ namespace brdf::uncertainty {
 struct InterpolatedInputs {
   // The samples the answer blended (their spectra give the interpolation term).
   const interp::SampleSet* samples = nullptr;
-  // Sample i's budget of the answer's quantity (null: none, not estimated). Unset when the
-  // answer's quantity has no budgets: then `no_budgets` says why, in not_estimated.
-  std::function<const ReadingBudget*(std::size_t index)> budget_of;
-  // The same in an index's form (blend_budget.h: the shared contributions as floats); when set,
-  // it is read instead of budget_of (brdfd's interpolation index sets it, the grid export
-  // budget_of).
-  std::function<const BlendBudget*(std::size_t index)> blend_budget_of;
+  // Sample i's budget of the answer's quantity in the blend's form (blend_budget.h; null: none,
+  // not estimated), built once per reading by whoever keeps the samples (brdfd's index, the grid
+  // export's chain). Unset when the answer's quantity has no budgets: then `no_budgets` says
+  // why, in not_estimated.
+  std::function<const BlendBudget*(std::size_t index)> budget_of;
   std::string no_budgets;
   // The session's calibration of the interpolation term (interpolation_calibration.h): the
   // spread s becomes c(λ)·s(λ). A calibration without a scale: the spread as it is and

@@ -35,7 +35,7 @@ uncertainty::InterpolatedInputs InputsOf(const IndexSnapshot& index) {
   uncertainty::InterpolatedInputs inputs;
   inputs.samples = index.samples.get();
   if (index.quantity == Quantity::kBrdf) {
-    inputs.blend_budget_of = [&index](std::size_t i) { return index.budgets.at(i); };
+    inputs.budget_of = [&index](std::size_t i) { return index.budgets.at(i); };
   } else {
     inputs.no_budgets = std::string("the readings' budgets are of the BRDF, this answer is ") +
                         QuantityName(index.quantity) + "; ask for quantity BRDF";

@@ -41,7 +41,7 @@ void BudgetList::Add(const uncertainty::ReadingBudget* budget) {
     Append(nullptr);
     return;
   }
-  Result<uncertainty::BlendBudget> kept = uncertainty::ToBlendBudget(*budget, last_notes_);
+  Result<uncertainty::BlendBudget> kept = uncertainty::ToBlendBudget(*budget, codes_, last_notes_);
   if (!kept.ok()) {
     Append(nullptr);
     return;

@@ -28,8 +28,9 @@ class BudgetList {
  public:
   static constexpr std::size_t kChunk = 128;
 
-  // Appends the next sample's budget in the blend's form (uncertainty::ToBlendBudget; its
-  // not_estimated list shared with the previous budget's when they hold the same entries). Null,
+  // Appends the next sample's budget in the blend's form (uncertainty::ToBlendBudget, its names
+  // coded by the list's own NameCodes, copied with it; its not_estimated list shared with the
+  // previous budget's when they hold the same entries). Null,
   // or a budget whose parts do not all have the same number of bands: not estimated.
   void Add(const uncertainty::ReadingBudget* budget);
 
@@ -47,6 +48,10 @@ class BudgetList {
   void Append(std::shared_ptr<const uncertainty::BlendBudget> budget);
 
   std::vector<std::shared_ptr<Chunk>> chunks_;
+  // The codes of the budgets' shared components' names. A copy (the next snapshot's list) codes
+  // the names it holds as this one does, so the budgets they share keep their meaning; budgets
+  // are blended only with those of the same list.
+  uncertainty::NameCodes codes_;
   std::shared_ptr<const std::vector<std::string>> last_notes_;  // the last budget's
   std::size_t size_ = 0;
   std::size_t bytes_ = 0;

@@ -44,7 +44,7 @@ double Curved(double ti, double to, double phi) {
 TEST(PredictHeldOut, ALinearBrdfIsPredictedExactlyAndTheScaleIsZero) {
   const auto set = Grid(Linear);
   const auto points =
-      PredictHeldOut(*set, BudgetOf{}, interp::Method::kDelaunay, interp::Options{});
+      PredictHeldOut(*set, IndependentOf{}, interp::Method::kDelaunay, interp::Options{});
   ASSERT_GE(points.size(), 100u);  // the interior readings, at least
   EXPECT_LE(points.size(), kMaxHeldOut);
   for (const HeldOutPoint& p : points) {
@@ -60,8 +60,8 @@ TEST(PredictHeldOut, ALinearBrdfIsPredictedExactlyAndTheScaleIsZero) {
 TEST(PredictHeldOut, AHeldOutReadingIsNotItsOwnVertexAndTheFoldsAreFixed) {
   // On a curved BRDF a reading predicted with itself in the index would have residual 0.
   const auto set = Grid(Curved);
-  const auto first = PredictHeldOut(*set, BudgetOf{}, interp::Method::kOctant, {});
-  const auto again = PredictHeldOut(*set, BudgetOf{}, interp::Method::kOctant, {});
+  const auto first = PredictHeldOut(*set, IndependentOf{}, interp::Method::kOctant, {});
+  const auto again = PredictHeldOut(*set, IndependentOf{}, interp::Method::kOctant, {});
   ASSERT_GE(first.size(), 50u);
   ASSERT_EQ(first.size(), again.size());
   std::size_t nonzero = 0;
@@ -78,7 +78,7 @@ TEST(PredictHeldOut, AHeldOutReadingIsNotItsOwnVertexAndTheFoldsAreFixed) {
 
 TEST(CalibrateInterpolation, TheNearestMethodIsNotCalibratedAndSaysWhy) {
   const InterpolationCalibration c =
-      CalibrateInterpolation(*Grid(Linear), BudgetOf{}, interp::Method::kNearest, {}, kBands);
+      CalibrateInterpolation(*Grid(Linear), IndependentOf{}, interp::Method::kNearest, {}, kBands);
   EXPECT_TRUE(c.scale.empty());
   EXPECT_NE(c.detail.find("nearest"), std::string::npos) << c.detail;
 }
@@ -87,8 +87,8 @@ TEST(CalibrateInterpolation, ABudgetsIndependentPartIsTheHeldOutPointsNoise) {
   const auto set = Grid(Curved);
   ReadingBudget budget;
   budget.independent.assign(kBands, 0.003);
-  const auto points =
-      PredictHeldOut(*set, [&budget](std::size_t) { return &budget; }, interp::Method::kOctant, {});
+  const auto points = PredictHeldOut(*set, [&budget](std::size_t) { return &budget.independent; },
+                                     interp::Method::kOctant, {});
   ASSERT_FALSE(points.empty());
   for (const HeldOutPoint& p : points) {
     ASSERT_EQ(p.noise.size(), static_cast<std::size_t>(kBands));
@@ -107,10 +107,10 @@ TEST(CalibrateInterpolation, DelaunaysScaleGrowsWithTheCellsSize) {
   EXPECT_EQ(TargetOf(interp::Method::kOctant).size_bins, 1);
   const auto set = Grid(Curved);
   const auto points =
-      PredictHeldOut(*set, BudgetOf{}, interp::Method::kDelaunay, interp::Options{});
+      PredictHeldOut(*set, IndependentOf{}, interp::Method::kDelaunay, interp::Options{});
   for (const HeldOutPoint& p : points) EXPECT_GT(p.cell_size, 0.0);
   const InterpolationCalibration c =
-      CalibrateInterpolation(*set, BudgetOf{}, interp::Method::kDelaunay, {}, kBands);
+      CalibrateInterpolation(*set, IndependentOf{}, interp::Method::kDelaunay, {}, kBands);
   ASSERT_FALSE(c.scale.empty()) << c.detail;
   ASSERT_EQ(c.larger.size(), static_cast<std::size_t>(kDelaunaySizeBins - 1)) << c.detail;
   EXPECT_GT(c.largest_cell, 0.0);
@@ -122,8 +122,8 @@ TEST(CalibrateInterpolation, DelaunaysScaleGrowsWithTheCellsSize) {
     }
     EXPECT_GT(ScaleAt(c, 2 * c.largest_cell, b), ScaleAt(c, c.largest_cell, b));
   }
-  EXPECT_TRUE(
-      CalibrateInterpolation(*set, BudgetOf{}, interp::Method::kOctant, {}, kBands).larger.empty());
+  EXPECT_TRUE(CalibrateInterpolation(*set, IndependentOf{}, interp::Method::kOctant, {}, kBands)
+                  .larger.empty());
 }
 
 TEST(CalibrationOnce, ComputesOnceForAllItsUsers) {

@@ -332,9 +332,16 @@ class GridUncertaintyCheck {
   }
   const v1::ExportRequest& request() const { return request_; }
 
-  void Compare(const std::vector<double>& values, const std::vector<double>& u_int) {
+  // `u_meas` (optional): the grid's u_measurement, which must be Interpolate's measurement part
+  // bit for bit once rounded to the API's float (the same blend of the same budgets in the
+  // blend's form, core/uncertainty/blend.h).
+  void Compare(const std::vector<double>& values, const std::vector<double>& u_int,
+               const std::vector<double>* u_meas = nullptr) {
     ASSERT_EQ(values.size(), kCells * kBands);
     ASSERT_EQ(u_int.size(), kCells * kBands);
+    if (u_meas != nullptr) {
+      ASSERT_EQ(u_meas->size(), kCells * kBands);
+    }
     for (std::size_t cell = 0; cell < kCells; cell += 3) {
       if (std::isnan(values[cell * kBands])) continue;
       const v1::InterpolateResponse answer = Ask(cell);
@@ -347,6 +354,11 @@ class GridUncertaintyCheck {
         EXPECT_NEAR(u_int[cell * kBands + b], want, 0x1p-23 * std::abs(want))
             << "cell " << cell << ", band " << b << ", method " << answer.result().method();
         nonzero += want > 0;
+        if (u_meas == nullptr || u.measurement_size() != static_cast<int>(kBands)) continue;
+        const float m = static_cast<float>((*u_meas)[cell * kBands + b]);
+        EXPECT_EQ(m, u.measurement(static_cast<int>(b)))
+            << "cell " << cell << ", band " << b << ", method " << answer.result().method();
+        measurement_compared += 1;
       }
       for (const std::string& n : u.not_estimated()) not_estimated.insert(n);
     }
@@ -354,7 +366,8 @@ class GridUncertaintyCheck {
 
   std::map<v1::InterpolationMethod, std::size_t> compared;
   std::size_t nonzero = 0;
-  std::set<std::string> not_estimated;  // the API's, over the answers compared
+  std::size_t measurement_compared = 0;  // bands of u_measurement compared
+  std::set<std::string> not_estimated;   // the API's, over the answers compared
 
  private:
   // Interpolate at cell's centre (θ 5°, 15°, …, 85°; φ 10°, 30°, …, 170°) in the chain's order:
@@ -386,9 +399,10 @@ class GridUncertaintyCheck {
 
 // With include_uncertainty a grid's u_interpolation is the Interpolate API's calibrated
 // interpolation term at the same direction of the same (ended) session, to the API's float
-// rounding, and the sidecar says the term is calibrated and how; a second export of the snapshot
-// (its kept interpolant and calibration) gives the same arrays. Delaunay: the suite's 24 readings
-// give it held-out readings to calibrate on.
+// rounding, its u_measurement the API's measurement part bit for bit (as a float), and the sidecar
+// says the term is calibrated and how; a second export of the snapshot (its kept interpolant and
+// calibration) gives the same arrays. Delaunay: the suite's 24 readings give it held-out readings
+// to calibrate on.
 TEST_F(ExportRpcTest, GridUncertaintyIsInterpolatesCalibratedInterpolationTerm) {
   GridUncertaintyCheck check(*rig_, *session_id_, Request(v1::EXPORT_FORMAT_GRID_NPY),
                              v1::INTERPOLATION_METHOD_DELAUNAY);
@@ -402,9 +416,11 @@ TEST_F(ExportRpcTest, GridUncertaintyIsInterpolatesCalibratedInterpolationTerm) 
                          "\"scale\": "),
             std::string::npos)
       << sidecar;
-  check.Compare(NpyDoubles(grid.file), NpyDoubles(grid.parts.at("u_interpolation")));
+  const std::vector<double> u_meas = NpyDoubles(grid.parts.at("u_measurement"));
+  check.Compare(NpyDoubles(grid.file), NpyDoubles(grid.parts.at("u_interpolation")), &u_meas);
   EXPECT_GE(check.compared[v1::INTERPOLATION_METHOD_DELAUNAY], 20u);
   EXPECT_GT(check.nonzero, 0u);
+  EXPECT_GE(check.measurement_compared, 20u * GridUncertaintyCheck::kBands);
   for (const std::string& n : check.not_estimated) {
     EXPECT_EQ(n.find("interpolation:"), std::string::npos) << "the API's term is calibrated: " << n;
   }
@@ -441,7 +457,8 @@ TEST_F(ExportRpcTest, GridUncertaintyNotCalibratedSaysWhyAndIsTheApisToo) {
     warned = warned || w.find("(octant) is not calibrated") != std::string::npos;
   }
   EXPECT_TRUE(warned);
-  check.Compare(NpyDoubles(grid.file), NpyDoubles(grid.parts.at("u_interpolation")));
+  const std::vector<double> u_meas = NpyDoubles(grid.parts.at("u_measurement"));
+  check.Compare(NpyDoubles(grid.file), NpyDoubles(grid.parts.at("u_interpolation")), &u_meas);
   EXPECT_GE(check.compared[v1::INTERPOLATION_METHOD_OCTANT], 3u);
   EXPECT_GE(check.compared[v1::INTERPOLATION_METHOD_DELAUNAY], 3u);
   EXPECT_TRUE(check.not_estimated.contains(

@@ -2,15 +2,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <span>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "core/export/fill/model_uncertainty.h"
 #include "core/export/number_text.h"
 #include "core/fit/models.h"
 #include "core/json_text.h"
 #include "core/uncertainty/band_sums.h"
+#include "core/uncertainty/blend_budget.h"
 #include "core/uncertainty/held_out.h"
 #include "core/uncertainty/interpolated.h"
 
@@ -100,18 +105,50 @@ SpectrumSource ModelWithLocalUncertainty(const fit::CookTorranceFit& model,
   };
 }
 
-// Sample i's budget; unset for a quantity other than the BRDF (the budgets are of the BRDF).
-uncertainty::BudgetOf BudgetsOf(const SessionInterpolant& in) {
+// Sample i's independent part (its budget's); unset for a quantity other than the BRDF (the
+// budgets are of the BRDF).
+uncertainty::IndependentOf IndependentParts(const SessionInterpolant& in) {
   if (in.derived->quantity != Quantity::kBrdf) return {};
-  return [&samples = in.derived->samples](std::size_t i) {
-    return i < samples.size() ? samples[i].budget.get() : nullptr;
+  return [&samples = in.derived->samples](std::size_t i) -> const std::vector<double>* {
+    const uncertainty::ReadingBudget* b = i < samples.size() ? samples[i].budget.get() : nullptr;
+    return b != nullptr ? &b->independent : nullptr;
   };
 }
 
 uncertainty::InterpolationCalibration Calibrate(const SessionInterpolant& in,
                                                 interp::Method method) {
-  return uncertainty::CalibrateInterpolation(*in.samples, BudgetsOf(in), method, in.options,
+  return uncertainty::CalibrateInterpolation(*in.samples, IndependentParts(in), method, in.options,
                                              static_cast<int>(in.derived->grid.count));
+}
+
+// Sample i's budget in the blend's form, as brdfd's index keeps them (daemon/index/budgets.h):
+// each made once per chain (uncertainty::ToBlendBudget, with the chain's own name codes and
+// not_estimated lists shared by consecutive readings), so that a cell's measurement part is the
+// same blend of the same values as Interpolate's answer at its direction. Null: the sample has no
+// budget, or one whose parts do not all have the same number of bands (not estimated). Unset for
+// a quantity other than the BRDF (the budgets are of the BRDF).
+std::function<const uncertainty::BlendBudget*(std::size_t)> BlendBudgetsOf(
+    const SessionInterpolant& in) {
+  if (in.derived->quantity != Quantity::kBrdf) return {};
+  using Kept = std::vector<std::unique_ptr<const uncertainty::BlendBudget>>;
+  auto kept = std::make_shared<Kept>();
+  kept->reserve(in.derived->samples.size());
+  uncertainty::NameCodes codes;
+  std::shared_ptr<const std::vector<std::string>> notes;
+  for (const DerivedSample& s : in.derived->samples) {
+    std::unique_ptr<const uncertainty::BlendBudget> made;
+    if (s.budget) {
+      Result<uncertainty::BlendBudget> b = uncertainty::ToBlendBudget(*s.budget, codes, notes);
+      if (b.ok()) {
+        notes = b->not_estimated;
+        made = std::make_unique<const uncertainty::BlendBudget>(std::move(b).value());
+      }
+    }
+    kept->push_back(std::move(made));
+  }
+  return [kept = std::shared_ptr<const Kept>(std::move(kept))](std::size_t i) {
+    return i < kept->size() ? (*kept)[i].get() : nullptr;
+  };
 }
 
 UncertaintyCoverage CoverageOf(const SessionInterpolant& in) {
@@ -344,7 +381,7 @@ UncertainChain MakeUncertainChain(const SessionInterpolant& in) {
   out.coverage = CoverageOf(in);
   uncertainty::InterpolatedInputs inputs;
   inputs.samples = in.samples.get();
-  inputs.budget_of = BudgetsOf(in);
+  inputs.budget_of = BlendBudgetsOf(in);
   inputs.no_budgets = out.coverage.no_budgets;
   inputs.shared = false;  // the grid has no array for it
   // Each interpolating stage's term scaled by its own calibration, as Interpolate's is.

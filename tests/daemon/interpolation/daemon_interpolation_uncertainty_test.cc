@@ -26,7 +26,8 @@ namespace {
 // The API's uncertainties are floats: a value equals its double to within 2⁻²⁴ of itself.
 constexpr double kFloatRounding = 0x1p-24;
 // The index keeps the budgets' shared contributions as floats (core/uncertainty/blend_budget.h):
-// its measurement part is the blend of the stored budgets to within a float's rounding of each
+// its measurement part is the core blend of the stored budgets in that form (bit for bit, once
+// rounded to the API's float), and a sum of their doubles to within a float's rounding of each
 // contribution, relative; twice that is allowed here for the signed contributions' sums.
 constexpr double kIndexRows = 2 * 0x1p-24;
 
@@ -176,6 +177,7 @@ TEST_F(DaemonInterpolationUncertaintyTest, InterpolatedValuesCarryTheirVerticesB
 
   int checked = 0;
   std::vector<v1::InterpolationResult> singles;
+  uncertainty::NameCodes codes;
   for (const IsoDirection& q : queries) {
     v1::InterpolationResult plain, r;
     ASSERT_TRUE(
@@ -193,11 +195,16 @@ TEST_F(DaemonInterpolationUncertaintyTest, InterpolatedValuesCarryTheirVerticesB
 
     // The daemon's measurement part is the blend of these vertices' own stored budgets.
     std::vector<uncertainty::BlendVertex> vertices;
+    std::vector<uncertainty::BlendBudget> blendable;
+    blendable.reserve(static_cast<std::size_t>(r.vertices_size()));
     double white = 0;  // Σ wᵢ u_white,ᵢ at band 50
     for (const v1::InterpolationVertex& v : r.vertices()) {
       ASSERT_TRUE(budgets.count(v.reading_id())) << v.reading_id();
       const uncertainty::ReadingBudget& b = budgets[v.reading_id()];
-      vertices.push_back({v.reading_id(), v.weight(), &b});
+      Result<uncertainty::BlendBudget> made = uncertainty::ToBlendBudget(b, codes);
+      ASSERT_TRUE(made.ok()) << made.status().message();
+      blendable.push_back(*std::move(made));
+      vertices.push_back({v.reading_id(), v.weight(), &blendable.back()});
       const uncertainty::Component* w = b.Find("white_standard");
       ASSERT_NE(w, nullptr);
       white += v.weight() * w->contribution[50];
@@ -207,7 +214,7 @@ TEST_F(DaemonInterpolationUncertaintyTest, InterpolatedValuesCarryTheirVerticesB
     ASSERT_TRUE(expected.ok()) << expected.status().message();
     for (int k = 0; k < r.spectrum_size(); ++k) {
       const double m = expected->measurement[static_cast<std::size_t>(k)];
-      EXPECT_NEAR(u.measurement(k), m, (kFloatRounding + kIndexRows) * m) << "band " << k;
+      EXPECT_EQ(u.measurement(k), static_cast<float>(m)) << "band " << k;
       EXPECT_GT(u.measurement(k), 0) << "band " << k;
       EXPECT_NEAR(u.combined(k), std::hypot(u.measurement(k), u.interpolation(k)),
                   kFloatRounding * u.combined(k));
