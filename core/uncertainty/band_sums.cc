@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
-#include <type_traits>
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
@@ -129,14 +128,15 @@ template <int W>
 }
 
 // BlendSquaredBands' pass (band_sums.h): each band's expressions exactly as the loops above write
-// them, so that the compiler forms them alike (the same fused multiply-adds). `Rows` is
-// WeightedRows (double rows) or WeightedFloatRows (float rows, each value widened to double as it
-// is read, then the same operations).
-template <int W, typename Rows>
-[[gnu::always_inline]] inline void BlendSquaredLanes(
-    double* __restrict measurement, double* __restrict shared, const double* const* independent,
-    const double* scales, std::size_t r, const Rows* inputs, std::size_t m, std::size_t n) {
-  constexpr bool kFloat = std::is_same_v<Rows, WeightedFloatRows>;
+// them, so that the compiler forms them alike (the same fused multiply-adds); each float of a
+// shared row widened to double as it is read.
+template <int W>
+[[gnu::always_inline]] inline void BlendSquaredLanes(double* __restrict measurement,
+                                                     double* __restrict shared,
+                                                     const double* const* independent,
+                                                     const double* scales, std::size_t r,
+                                                     const WeightedFloatRows* inputs, std::size_t m,
+                                                     std::size_t n) {
   const Lanes<W> zero = {};
   Lanes<W> u, s, v, t;
   FloatLanes<W> f;
@@ -149,21 +149,13 @@ template <int W, typename Rows>
     }
     s = zero;
     for (std::size_t j = 0; j < m; ++j) {
-      const Rows& in = inputs[j];
-      if constexpr (kFloat) {
-        std::memcpy(&f, in.rows[0] + k, sizeof f);
-        v = __builtin_convertvector(f, Lanes<W>);
-      } else {
-        std::memcpy(&v, in.rows[0] + k, sizeof v);
-      }
+      const WeightedFloatRows& in = inputs[j];
+      std::memcpy(&f, in.rows[0] + k, sizeof f);
+      v = __builtin_convertvector(f, Lanes<W>);
       t = in.weights[0] * v;
       for (std::size_t i = 1; i < in.count; ++i) {
-        if constexpr (kFloat) {
-          std::memcpy(&f, in.rows[i] + k, sizeof f);
-          v = __builtin_convertvector(f, Lanes<W>);
-        } else {
-          std::memcpy(&v, in.rows[i] + k, sizeof v);
-        }
+        std::memcpy(&f, in.rows[i] + k, sizeof f);
+        v = __builtin_convertvector(f, Lanes<W>);
         t += in.weights[i] * v;
       }
       s += t * t;
@@ -177,7 +169,7 @@ template <int W, typename Rows>
     for (std::size_t i = 0; i < r; ++i) ind += scales[i] * (independent[i][k] * independent[i][k]);
     double acc = 0;
     for (std::size_t j = 0; j < m; ++j) {
-      const Rows& in = inputs[j];
+      const WeightedFloatRows& in = inputs[j];
       double sum = in.weights[0] * static_cast<double>(in.rows[0][k]);
       for (std::size_t i = 1; i < in.count; ++i)
         sum += in.weights[i] * static_cast<double>(in.rows[i][k]);
@@ -221,8 +213,6 @@ using ScaledFn = void (*)(double*, const double*, double, std::size_t);
 using SumFn = void (*)(double*, const double* const*, const double*, std::size_t, std::size_t);
 using DifferenceFn = void (*)(double*, const double*, const double*, double, std::size_t);
 using SqrtFn = void (*)(double*, std::size_t);
-using BlendFn = void (*)(double*, double*, const double* const*, const double*, std::size_t,
-                         const WeightedRows*, std::size_t, std::size_t);
 using BlendFloatFn = void (*)(double*, double*, const double* const*, const double*, std::size_t,
                               const WeightedFloatRows*, std::size_t, std::size_t);
 using DifferencesFn = void (*)(double*, const double* const*, const double*, const double*,
@@ -234,7 +224,6 @@ struct Kernels {
   DifferenceFn add_squared_difference;
   SumFn add_squared_sum;
   SqrtFn sqrt;
-  BlendFn blend_squared;
   DifferencesFn squared_differences;
   BlendFloatFn blend_squared_float;
 };
@@ -257,10 +246,6 @@ void AddSquaredDifference2(double* acc, const double* x, const double* y, double
 void AddSquaredSum2(double* acc, const double* const* x, const double* w, std::size_t m,
                     std::size_t n) {
   AddSquaredSumLanes<2>(acc, x, w, m, n);
-}
-void BlendSquared2(double* m, double* shared, const double* const* ind, const double* scales,
-                   std::size_t r, const WeightedRows* inputs, std::size_t count, std::size_t n) {
-  BlendSquaredLanes<2>(m, shared, ind, scales, r, inputs, count, n);
 }
 void BlendSquaredFloat2(double* m, double* shared, const double* const* ind, const double* scales,
                         std::size_t r, const WeightedFloatRows* inputs, std::size_t count,
@@ -301,12 +286,6 @@ __attribute__((target("avx2"))) void AddSquaredSum4(double* acc, const double* c
                                                     const double* w, std::size_t m, std::size_t n) {
   AddSquaredSumLanes<4>(acc, x, w, m, n);
 }
-__attribute__((target("avx2"))) void BlendSquared4(double* m, double* shared,
-                                                   const double* const* ind, const double* scales,
-                                                   std::size_t r, const WeightedRows* inputs,
-                                                   std::size_t count, std::size_t n) {
-  BlendSquaredLanes<4>(m, shared, ind, scales, r, inputs, count, n);
-}
 __attribute__((target("avx2"))) void BlendSquaredFloat4(double* m, double* shared,
                                                         const double* const* ind,
                                                         const double* scales, std::size_t r,
@@ -342,13 +321,6 @@ __attribute__((target("avx512f"))) void AddSquaredSum8(double* acc, const double
                                                        std::size_t n) {
   AddSquaredSumLanes<8>(acc, x, w, m, n);
 }
-__attribute__((target("avx512f"))) void BlendSquared8(double* m, double* shared,
-                                                      const double* const* ind,
-                                                      const double* scales, std::size_t r,
-                                                      const WeightedRows* inputs, std::size_t count,
-                                                      std::size_t n) {
-  BlendSquaredLanes<8>(m, shared, ind, scales, r, inputs, count, n);
-}
 __attribute__((target("avx512f"))) void BlendSquaredFloat8(double* m, double* shared,
                                                            const double* const* ind,
                                                            const double* scales, std::size_t r,
@@ -371,14 +343,14 @@ __attribute__((target("avx512f"))) void Sqrt8(double* x, std::size_t n) {
 Kernels PickKernels() {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
   if (__builtin_cpu_supports("avx512f"))
-    return {&AddScaled8, &AddSquared8,   &AddSquaredDifference8, &AddSquaredSum8,
-            &Sqrt8,      &BlendSquared8, &SquaredDifferences8,   &BlendSquaredFloat8};
+    return {&AddScaled8, &AddSquared8,         &AddSquaredDifference8, &AddSquaredSum8,
+            &Sqrt8,      &SquaredDifferences8, &BlendSquaredFloat8};
   if (__builtin_cpu_supports("avx2"))
-    return {&AddScaled4, &AddSquared4,   &AddSquaredDifference4, &AddSquaredSum4,
-            &Sqrt4,      &BlendSquared4, &SquaredDifferences4,   &BlendSquaredFloat4};
+    return {&AddScaled4, &AddSquared4,         &AddSquaredDifference4, &AddSquaredSum4,
+            &Sqrt4,      &SquaredDifferences4, &BlendSquaredFloat4};
 #endif
-  return {&AddScaled2, &AddSquared2,   &AddSquaredDifference2, &AddSquaredSum2,
-          &Sqrt2,      &BlendSquared2, &SquaredDifferences2,   &BlendSquaredFloat2};
+  return {&AddScaled2, &AddSquared2,         &AddSquaredDifference2, &AddSquaredSum2,
+          &Sqrt2,      &SquaredDifferences2, &BlendSquaredFloat2};
 }
 
 const Kernels& Picked() {
@@ -405,14 +377,6 @@ void AddSquaredSumBands(std::span<double> acc, std::span<const double* const> x,
                         std::span<const double> w) {
   if (w.empty()) return;
   Picked().add_squared_sum(acc.data(), x.data(), w.data(), w.size(), acc.size());
-}
-
-void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,
-                       std::span<const double* const> independent_rows,
-                       std::span<const double> scales, std::span<const WeightedRows> inputs) {
-  Picked().blend_squared(measurement.data(), shared.empty() ? nullptr : shared.data(),
-                         independent_rows.data(), scales.data(), independent_rows.size(),
-                         inputs.data(), inputs.size(), measurement.size());
 }
 
 void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,

@@ -28,31 +28,21 @@ void AddSquaredSumBands(std::span<double> acc, std::span<const double* const> x,
                         std::span<const double> w);
 
 // One shared input of a blend (blend.h): its contributions from `count` ≥ 1 vertices, each a row
-// of the accumulator's size, with their weights. The rows are doubles (a ReadingBudget's) or
-// floats (a BlendBudget's, blend_budget.h).
-template <typename Value>
-struct WeightedRowsOf {
-  const Value* const* rows = nullptr;
+// of floats (a BlendBudget's, blend_budget.h) of the accumulator's size, with their weights.
+struct WeightedFloatRows {
+  const float* const* rows = nullptr;
   const double* weights = nullptr;
   std::size_t count = 0;
 };
-using WeightedRows = WeightedRowsOf<double>;
-using WeightedFloatRows = WeightedRowsOf<float>;
 
 // A blend's measurement² in one pass over the bands, the same values to the last bit as
 //   independent = 0;  AddSquaredBands(independent, independent_rows[r], scales[r]) for each r;
-//   s = 0;  AddSquaredSumBands(s, input.rows, input.weights) for each input, in order;
-//   measurement = s;  AddScaledBands(measurement, independent, 1.0);
-// (the same operations on each band in the same order, without the accumulators' trips through
-// memory between them): measurement[k] = s[k] + independent[k], and shared[k] = s[k] unless
-// `shared` is empty. independent_rows.size() == scales.size(); every row of measurement's size.
-void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,
-                       std::span<const double* const> independent_rows,
-                       std::span<const double> scales, std::span<const WeightedRows> inputs);
-
-// The same pass with float rows for the shared inputs: each value widened to double as it is
-// read, then the same operations, so the result equals BlendSquaredBands' over the widened rows to
-// the last bit.
+//   s = 0;  AddSquaredSumBands(s, input.rows widened to double, input.weights) for each input,
+//   in order;  measurement = s;  AddScaledBands(measurement, independent, 1.0);
+// (the same operations on each band in the same order, each float widened as it is read, without
+// the accumulators' trips through memory between them): measurement[k] = s[k] + independent[k],
+// and shared[k] = s[k] unless `shared` is empty. independent_rows.size() == scales.size(); every
+// row of measurement's size.
 void BlendSquaredBands(std::span<double> measurement, std::span<double> shared,
                        std::span<const double* const> independent_rows,
                        std::span<const double> scales, std::span<const WeightedFloatRows> inputs);

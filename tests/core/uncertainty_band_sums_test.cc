@@ -109,21 +109,33 @@ TEST(BandSums, BlendSquaredIsTheSeparateSumsBitForBit) {
         independent.push_back(rows[i].data());
         scales.push_back(w[i] * w[i]);
       }
-      // Inputs of 1, 2, 3 and 4 vertices' contributions.
-      std::vector<std::vector<const double*>> input_rows = {
-          {rows[4].data()},
-          {rows[5].data(), rows[6].data()},
-          {rows[7].data(), rows[8].data(), rows[0].data()},
-          {rows[1].data(), rows[3].data(), rows[5].data(), rows[7].data()}};
-      std::vector<WeightedRows> inputs;
+      // Inputs of 1, 2, 3 and 4 vertices' contributions, held as floats (a BlendBudget's rows);
+      // the separate sums read the same floats widened to double.
+      const std::vector<std::vector<int>> input_of = {{4}, {5, 6}, {7, 8, 0}, {1, 3, 5, 7}};
+      std::vector<std::vector<float>> float_rows;
+      std::vector<std::vector<double>> widened;
+      for (const auto& r : rows) {
+        float_rows.emplace_back(r.begin(), r.end());
+        widened.emplace_back(float_rows.back().begin(), float_rows.back().end());
+      }
+      std::vector<std::vector<const float*>> input_rows;
+      std::vector<std::vector<const double*>> widened_rows;
+      for (const auto& in : input_of) {
+        input_rows.emplace_back();
+        widened_rows.emplace_back();
+        for (int r : in) {
+          input_rows.back().push_back(float_rows[r].data());
+          widened_rows.back().push_back(widened[r].data());
+        }
+      }
+      std::vector<WeightedFloatRows> inputs;
       for (const auto& in : input_rows) inputs.push_back({in.data(), w.data(), in.size()});
       std::vector<double> independent_sum(n, 0.0), shared_want(n, 0.0);
       for (std::size_t i = 0; i < readings; ++i) {
         AddSquaredBands(independent_sum, std::span(independent[i], n), scales[i]);
       }
-      for (const WeightedRows& in : inputs) {
-        AddSquaredSumBands(shared_want, std::span(in.rows, in.count),
-                           std::span(in.weights, in.count));
+      for (const auto& in : widened_rows) {
+        AddSquaredSumBands(shared_want, in, std::span(w).first(in.size()));
       }
       std::vector<double> measurement_want = shared_want;
       AddScaledBands(measurement_want, independent_sum, 1.0);
