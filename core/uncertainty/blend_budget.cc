@@ -46,4 +46,12 @@ Result<BlendBudget> ToBlendBudget(const ReadingBudget& budget, NameCodes& codes,
   return out;
 }
 
+Result<BlendBudget> BlendBudgetMaker::Make(const ReadingBudget& budget, bool* new_notes) {
+  Result<BlendBudget> made = ToBlendBudget(budget, codes_, last_notes_);
+  if (!made.ok()) return made;
+  if (new_notes != nullptr) *new_notes = made->not_estimated != last_notes_;
+  last_notes_ = made->not_estimated;
+  return made;
+}
+
 }  // namespace brdf::uncertainty

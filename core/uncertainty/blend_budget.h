@@ -78,4 +78,18 @@ struct BlendBudget {
 Result<BlendBudget> ToBlendBudget(const ReadingBudget& budget, NameCodes& codes,
                                   std::shared_ptr<const std::vector<std::string>> notes = nullptr);
 
+// A list's BlendBudgets made in order (brdfd's index, the grid export's chain): ToBlendBudget with
+// the list's NameCodes, each budget's not_estimated shared with the previous one's when it holds
+// the same entries. A copy goes on with the same codes.
+class BlendBudgetMaker {
+ public:
+  // The next budget's form (ToBlendBudget's errors); *new_notes, when given, says whether its
+  // not_estimated list is a new one (not the previous budget's).
+  Result<BlendBudget> Make(const ReadingBudget& budget, bool* new_notes = nullptr);
+
+ private:
+  NameCodes codes_;
+  std::shared_ptr<const std::vector<std::string>> last_notes_;  // the last budget made's
+};
+
 }  // namespace brdf::uncertainty

@@ -41,13 +41,12 @@ void BudgetList::Add(const uncertainty::ReadingBudget* budget) {
     Append(nullptr);
     return;
   }
-  Result<uncertainty::BlendBudget> kept = uncertainty::ToBlendBudget(*budget, codes_, last_notes_);
+  bool own_notes = false;
+  Result<uncertainty::BlendBudget> kept = maker_.Make(*budget, &own_notes);
   if (!kept.ok()) {
     Append(nullptr);
     return;
   }
-  const bool own_notes = kept->not_estimated != last_notes_;
-  last_notes_ = kept->not_estimated;
   auto shared = std::make_shared<const uncertainty::BlendBudget>(std::move(kept).value());
   bytes_ += BudgetBytes(*shared, own_notes);
   Append(std::move(shared));

@@ -48,11 +48,10 @@ class BudgetList {
   void Append(std::shared_ptr<const uncertainty::BlendBudget> budget);
 
   std::vector<std::shared_ptr<Chunk>> chunks_;
-  // The codes of the budgets' shared components' names. A copy (the next snapshot's list) codes
-  // the names it holds as this one does, so the budgets they share keep their meaning; budgets
-  // are blended only with those of the same list.
-  uncertainty::NameCodes codes_;
-  std::shared_ptr<const std::vector<std::string>> last_notes_;  // the last budget's
+  // Its codes of the budgets' shared components' names and the last budget's notes. A copy (the
+  // next snapshot's list) codes the names it holds as this one does, so the budgets they share
+  // keep their meaning; budgets are blended only with those of the same list.
+  uncertainty::BlendBudgetMaker maker_;
   std::size_t size_ = 0;
   std::size_t bytes_ = 0;
 };

@@ -122,27 +122,22 @@ uncertainty::InterpolationCalibration Calibrate(const SessionInterpolant& in,
 }
 
 // Sample i's budget in the blend's form, as brdfd's index keeps them (daemon/index/budgets.h):
-// each made once per chain (uncertainty::ToBlendBudget, with the chain's own name codes and
-// not_estimated lists shared by consecutive readings), so that a cell's measurement part is the
-// same blend of the same values as Interpolate's answer at its direction. Null: the sample has no
-// budget, or one whose parts do not all have the same number of bands (not estimated). Unset for
-// a quantity other than the BRDF (the budgets are of the BRDF).
+// each made once per chain (uncertainty::BlendBudgetMaker, the chain's own), so that a cell's
+// measurement part is the same blend of the same values as Interpolate's answer at its direction.
+// Null: the sample has no budget, or one whose parts do not all have the same number of bands (not
+// estimated). Unset for a quantity other than the BRDF (the budgets are of the BRDF).
 std::function<const uncertainty::BlendBudget*(std::size_t)> BlendBudgetsOf(
     const SessionInterpolant& in) {
   if (in.derived->quantity != Quantity::kBrdf) return {};
   using Kept = std::vector<std::unique_ptr<const uncertainty::BlendBudget>>;
   auto kept = std::make_shared<Kept>();
   kept->reserve(in.derived->samples.size());
-  uncertainty::NameCodes codes;
-  std::shared_ptr<const std::vector<std::string>> notes;
+  uncertainty::BlendBudgetMaker maker;
   for (const DerivedSample& s : in.derived->samples) {
     std::unique_ptr<const uncertainty::BlendBudget> made;
     if (s.budget) {
-      Result<uncertainty::BlendBudget> b = uncertainty::ToBlendBudget(*s.budget, codes, notes);
-      if (b.ok()) {
-        notes = b->not_estimated;
-        made = std::make_unique<const uncertainty::BlendBudget>(std::move(b).value());
-      }
+      Result<uncertainty::BlendBudget> b = maker.Make(*s.budget);
+      if (b.ok()) made = std::make_unique<const uncertainty::BlendBudget>(std::move(b).value());
     }
     kept->push_back(std::move(made));
   }
