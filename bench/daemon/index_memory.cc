@@ -1,9 +1,9 @@
 // bench_index_memory: where a cached session's memory goes in the index cache (daemon/index),
 // session by session of a brdfd database: its sample sets (one per quantity), the BRDF readings'
 // uncertainty budgets, the octant BRDF index, each as the cache accounts it (SetBytes,
-// BudgetList::bytes, IndexBytes) and as the heap holds it (glibc's mallinfo2, in use before and
-// after; one thread, so the difference is what the step kept). Then the whole entry through an
-// IndexCache of one session (stats().bytes) against the heap.
+// BudgetList::bytes, Interpolator::HeapBytes) and as the heap holds it (glibc's mallinfo2, in use
+// before and after; one thread, so the difference is what the step kept). Then the whole entry
+// through an IndexCache of one session (stats().bytes) against the heap.
 //
 // Usage: bench_index_memory --database brdfd.db (a copy: it is opened as brdfd would open it)
 // Prints one line per session.
@@ -74,8 +74,7 @@ bool Probe(const std::shared_ptr<brdf::storage::SessionStore>& store, std::int64
       "sets_and_budgets_heap_mb=%.1f "
       "octant_index_mb=%.1f octant_index_heap_mb=%.1f",
       static_cast<long long>(session), brdf_set->size(), brdf_set->bands(), Mb(sets),
-      Mb(state.brdf_budgets.bytes()), heap1 - heap0, Mb(brdf::daemon::IndexBytes(**index)),
-      heap2 - heap1);
+      Mb(state.brdf_budgets.bytes()), heap1 - heap0, Mb((*index)->HeapBytes()), heap2 - heap1);
   index->reset();
   samples.reset();
 

@@ -48,8 +48,8 @@ std::uint64_t ExportInterpolants::OwnBytesOf(const exports::SessionInterpolant& 
   if (!in.samples) return 0;
   // The chosen index and the fallback, each with its copies and images of the samples.
   std::uint64_t bytes = SetBytes(*in.samples);
-  if (in.interpolator) bytes += IndexBytes(*in.interpolator);
-  if (in.fallback) bytes += IndexBytes(*in.fallback);
+  if (in.interpolator) bytes += in.interpolator->HeapBytes();
+  if (in.fallback) bytes += in.fallback->HeapBytes();
   return bytes;
 }
 

@@ -132,8 +132,4 @@ std::size_t SetBytes(const interp::SampleSet& set) {
   return sizeof(interp::SampleSet) + set.HeapBytes();
 }
 
-std::size_t IndexBytes(const interp::Interpolator& index) {
-  return index.HeapBytes();
-}
-
 }  // namespace brdf::daemon

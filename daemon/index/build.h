@@ -55,10 +55,9 @@ Result<MadeIndex> MakeIndex(std::shared_ptr<const interp::SampleSet> samples, in
                             std::int64_t session);
 
 // Memory for the caches' bounds: a set's samples (its chunks, shared with other snapshots or
-// not), and what an index holds beyond its set (interp::Interpolator::HeapBytes: its copies and
-// images of the coordinates, its tree or triangulation, the sets it made; a Delaunay index over
-// a set's mirror images is about 2.8 kB a sample, an octant one about 0.3 kB).
+// not). An index's own is interp::Interpolator::HeapBytes (its copies and images of the
+// coordinates, its tree or triangulation, the sets it made; a Delaunay index over a set's mirror
+// images is about 2.8 kB a sample, an octant one about 0.3 kB).
 std::size_t SetBytes(const interp::SampleSet& set);
-std::size_t IndexBytes(const interp::Interpolator& index);
 
 }  // namespace brdf::daemon

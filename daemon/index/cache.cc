@@ -335,7 +335,7 @@ std::size_t IndexCache::EntryBytes(const Entry& entry) {
     if (set) bytes += SetBytes(*set);
   }
   bytes += entry.samples->published().brdf_budgets.bytes();
-  for (const KeptIndex& kept : entry.indexes) bytes += IndexBytes(*kept.index->interpolator);
+  for (const KeptIndex& kept : entry.indexes) bytes += kept.index->interpolator->HeapBytes();
   return bytes;
 }
 

@@ -1,6 +1,7 @@
 // Interpolator::HeapBytes against what the allocator holds for an index (glibc's mallinfo2, in use
 // after the build less before it; one thread builds, so the difference is what the index kept).
-// The daemon's caches bound their memory by these figures (daemon/index/build.h, IndexBytes).
+// The daemon's caches bound their memory by these figures (daemon/index/cache.cc,
+// daemon/api/export_cache.cc).
 #include <gtest/gtest.h>
 #include <malloc.h>
 
