@@ -5,6 +5,7 @@
 
 #include "core/plan/plan_json.h"
 #include "core/plan/sample.h"
+#include "core/uncertainty/loaded_budget.h"
 
 namespace brdf::storage {
 namespace {
@@ -25,7 +26,7 @@ std::vector<double> RatioPartOf(const uncertainty::ReadingBudget& budget) {
 
 }  // namespace
 
-Reading ToReading(const ReadingRecord& r) {
+Reading ToReading(const ReadingRecord& r, uncertainty::BlendBudgetMaker* budgets) {
   Reading out;
   out.id = r.id;
   out.kind = r.kind;
@@ -41,7 +42,10 @@ Reading ToReading(const ReadingRecord& r) {
   if (r.uncertainty.has_value()) {
     out.brdf_u = r.uncertainty->combined;
     out.brdf_u_of_ratio = RatioPartOf(*r.uncertainty);
-    out.budget = std::make_shared<const uncertainty::ReadingBudget>(*r.uncertainty);
+    if (budgets != nullptr && r.uncertainty->quantity == Quantity::kBrdf) {
+      out.budget = std::make_shared<const uncertainty::LoadedBudget>(
+          uncertainty::LoadBudget(*r.uncertainty, *budgets));
+    }
   }
   return out;
 }
@@ -78,10 +82,11 @@ constexpr int kReadingsPerPage = 4096;
 
 Result<SessionReadings> LoadSessionReadings(SessionReader& reader, std::int64_t session_id) {
   BRDF_ASSIGN_OR_RETURN(SessionReadings session, LoadSessionRecord(reader, session_id));
+  uncertainty::BlendBudgetMaker budgets;  // one list: the session's budgets blend together
   for (std::int64_t after = 0;;) {
     BRDF_ASSIGN_OR_RETURN(std::vector<ReadingRecord> page,
                           reader.GetReadings(session_id, after, kReadingsPerPage));
-    for (const ReadingRecord& r : page) session.readings.push_back(ToReading(r));
+    for (const ReadingRecord& r : page) session.readings.push_back(ToReading(r, &budgets));
     if (page.size() < static_cast<std::size_t>(kReadingsPerPage)) break;
     after = page.back().id;
   }

@@ -14,6 +14,7 @@
 # instead of recording the demo plan: e.g. `bench_storage create --db FILE --readings 50000
 # --bands 401 --budgets`), BENCH_KEEP=1 keeps the work directory,
 # COST_PERF=FILE records brdfd with `perf record -g` into FILE while the timed calls run.
+# Prints brdfd's peak memory (VmHWM) at the end.
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -92,4 +93,6 @@ for col, what in ((0, "wall"), (1, "brdfd's CPU")):
     print(f"grid export ({what}), with uncertainty:    {' '.join(f'{x:.2f}' for x in with_u)} s, median {b:.2f} s")
     print(f"ratio (medians, {what}): {b / a:.2f}")
 PY
+# The most brdfd held at once over the run (both kinds of export and the session's load).
+echo "brdfd's peak memory (VmHWM): $(awk '/^VmHWM/ {print $2, $3}' "/proc/$brdfd_pid/status")"
 echo "load at end: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -29,12 +29,8 @@ std::vector<double> UncertaintyOf(const Reading& r, Quantity quantity, const Sam
 }
 
 // The reading's budget when it is of the BRDF and the samples are (else null).
-std::shared_ptr<const uncertainty::ReadingBudget> BrdfBudgetOf(const Reading& r,
-                                                               Quantity quantity) {
-  if (quantity != Quantity::kBrdf || !r.budget || r.budget->quantity != Quantity::kBrdf) {
-    return nullptr;
-  }
-  return r.budget;
+std::shared_ptr<const uncertainty::LoadedBudget> BrdfBudgetOf(const Reading& r, Quantity quantity) {
+  return quantity == Quantity::kBrdf ? r.budget : nullptr;
 }
 
 }  // namespace

@@ -20,7 +20,7 @@
 #include "core/readings/reading.h"
 #include "core/spectrum.h"
 #include "core/status.h"
-#include "core/uncertainty/budget.h"
+#include "core/uncertainty/loaded_budget.h"
 
 namespace brdf::exports {
 
@@ -47,10 +47,12 @@ struct DerivedSample {
   // (Reading::brdf_u), the reflectance's (Reading::brdf_u_of_ratio · R / f, NaN where f = 0);
   // empty when the reading has none (not estimated) and for radiance.
   std::vector<double> u;
-  // The reading's stored budget of the BRDF, for blending into an interpolated value's
-  // measurement part (core/uncertainty/interpolated.h); null for other quantities and readings
-  // without one.
-  std::shared_ptr<const uncertainty::ReadingBudget> budget;
+  // The reading's stored budget of the BRDF as the loaded session keeps it (Reading::budget,
+  // shared, not copied): its blend form, which the grid's fill chain blends into a cell's
+  // measurement part (core/uncertainty/interpolated.h) and whose independent part its calibration
+  // reads, and its white standard's contribution; null for other quantities and readings without
+  // one.
+  std::shared_ptr<const uncertainty::LoadedBudget> budget;
 };
 
 struct SkippedReading {

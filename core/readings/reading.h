@@ -17,7 +17,7 @@
 namespace brdf {
 
 namespace uncertainty {
-struct ReadingBudget;  // core/uncertainty/budget.h
+struct LoadedBudget;  // core/uncertainty/loaded_budget.h
 }  // namespace uncertainty
 
 // What a reading measured: the sample I, the white standard I0, or the dark (ambient) D.
@@ -46,9 +46,11 @@ struct Reading {
   // The part of brdf_u the reflectance R = (I − D) / (I0 − D) carries too: without the white
   // standard's and the reference pose's terms, which scale the BRDF only; u(R) = this · R / f.
   std::vector<double> brdf_u_of_ratio;
-  // The stored budget itself, components and all (null when not estimated): what an interpolated
-  // value's measurement part blends (core/uncertainty/interpolated.h), shared terms correlated.
-  std::shared_ptr<const uncertainty::ReadingBudget> budget;
+  // What the exports read of the stored budget of the BRDF (null when not estimated, not of the
+  // BRDF, or not loaded): its blend form, which an interpolated value's measurement part blends
+  // (core/uncertainty/interpolated.h), shared terms correlated, and its white standard's
+  // contribution. Set by storage's LoadSessionReadings, one BlendBudgetMaker for the session.
+  std::shared_ptr<const uncertainty::LoadedBudget> budget;
 };
 
 // A session's readings, with what the derivation needs of the session itself.

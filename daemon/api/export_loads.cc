@@ -1,9 +1,10 @@
 #include "daemon/api/export_loads.h"
 
+#include <string>
 #include <utility>
 #include <vector>
 
-#include "core/uncertainty/budget.h"
+#include "core/uncertainty/loaded_budget.h"
 #include "storage/session_readings.h"
 
 namespace brdf::daemon {
@@ -14,6 +15,23 @@ bool Current(storage::SessionReader& reader, const SessionReadings& copy) {
   const std::int64_t last = copy.readings.empty() ? 0 : copy.readings.back().id;
   Result<std::vector<storage::ReadingRecord>> newer = reader.GetReadings(copy.id, last, 1);
   return newer.ok() && newer->empty();
+}
+
+// A reading's loaded budget's bytes; its not_estimated list too unless it is `last_notes` (the
+// previous reading's, which consecutive readings share: counted once, with the first of them).
+std::uint64_t LoadedBudgetBytes(const uncertainty::LoadedBudget& budget,
+                                const std::vector<std::string>* last_notes) {
+  const uncertainty::BlendBudget& blend = budget.blend;
+  std::uint64_t bytes =
+      sizeof(budget) +
+      (blend.independent.capacity() + budget.white_standard.capacity()) * sizeof(double) +
+      blend.keys.capacity() * sizeof(uncertainty::SharedKey) +
+      blend.shared_rows.capacity() * sizeof(float);
+  if (blend.not_estimated && blend.not_estimated.get() != last_notes) {
+    bytes += sizeof(*blend.not_estimated) + blend.not_estimated->capacity() * sizeof(std::string);
+    for (const std::string& note : *blend.not_estimated) bytes += note.capacity();
+  }
+  return bytes;
 }
 
 }  // namespace
@@ -69,13 +87,14 @@ Result<std::shared_ptr<const exports::DerivedSamples>> SharedSessionLoads::Deriv
 
 std::uint64_t SharedSessionLoads::BytesOf(const SessionReadings& session) {
   std::uint64_t bytes = sizeof(SessionReadings);
+  const std::vector<std::string>* last_notes = nullptr;
   for (const Reading& r : session.readings) {
-    bytes += sizeof(Reading) + r.spectrum.values.capacity() * sizeof(double);
+    bytes += sizeof(Reading) +
+             (r.spectrum.values.capacity() + r.brdf_u.capacity() + r.brdf_u_of_ratio.capacity()) *
+                 sizeof(double);
     if (r.budget) {
-      for (const uncertainty::Component& c : r.budget->components) {
-        bytes += sizeof(c) + c.name.capacity() + c.contribution.capacity() * sizeof(double);
-      }
-      bytes += sizeof(*r.budget) + 3 * r.budget->combined.capacity() * sizeof(double);
+      bytes += LoadedBudgetBytes(*r.budget, last_notes);
+      last_notes = r.budget->blend.not_estimated.get();
     }
   }
   return bytes;

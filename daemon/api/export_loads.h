@@ -37,7 +37,8 @@ class SharedSessionLoads {
       const std::shared_ptr<const SessionReadings>& session, exports::Quantity quantity,
       bool exclude_flagged, bool* derived_here = nullptr);
 
-  // The readings' memory, roughly (spectra and records): what an export of `session` holds.
+  // The readings' memory, roughly (spectra, u and the budgets' loaded form): what an export of
+  // `session` holds.
   static std::uint64_t BytesOf(const SessionReadings& session);
 
  private:

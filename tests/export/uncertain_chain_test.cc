@@ -14,6 +14,7 @@
 #include "core/export/fill/model_uncertainty.h"
 #include "core/export/fill/session_interpolant.h"
 #include "core/uncertainty/interpolated.h"
+#include "core/uncertainty/loaded_budget.h"
 #include "export_test_util.h"
 
 namespace brdf::exports {
@@ -23,20 +24,27 @@ CallContext LongContext() {
   return CallContext::WithTimeout(std::chrono::hours(1));
 }
 
-// Each sample gets a budget of 1 % shared (the session's white standard) and 2 % independent.
+// A budget of 1 % shared (the session's white standard) and 2 % independent of `values`.
+uncertainty::ReadingBudget OnePlusTwoPercent(const std::vector<double>& values) {
+  uncertainty::ReadingBudget b;
+  uncertainty::Component white{"white_standard", {uncertainty::Sharing::kWhiteStandard, 1}, {}};
+  uncertainty::Component signal{"sample_signal", {uncertainty::Sharing::kIndependent, 0}, {}};
+  for (double f : values) {
+    white.contribution.push_back(0.01 * f);
+    signal.contribution.push_back(0.02 * f);
+    b.combined.push_back(std::hypot(0.01 * f, 0.02 * f));
+    b.independent.push_back(0.02 * f);
+  }
+  b.components = {white, signal};
+  return b;
+}
+
+// Each sample gets that budget, in the form a loaded session keeps it (one maker: one list).
 void AddBudgets(DerivedSamples& derived) {
+  uncertainty::BlendBudgetMaker maker;
   for (DerivedSample& s : derived.samples) {
-    auto b = std::make_shared<uncertainty::ReadingBudget>();
-    uncertainty::Component white{"white_standard", {uncertainty::Sharing::kWhiteStandard, 1}, {}};
-    uncertainty::Component signal{"sample_signal", {uncertainty::Sharing::kIndependent, 0}, {}};
-    for (double f : s.values) {
-      white.contribution.push_back(0.01 * f);
-      signal.contribution.push_back(0.02 * f);
-      b->combined.push_back(std::hypot(0.01 * f, 0.02 * f));
-      b->independent.push_back(0.02 * f);
-    }
-    b->components = {white, signal};
-    s.budget = b;
+    s.budget = std::make_shared<const uncertainty::LoadedBudget>(
+        uncertainty::LoadBudget(OnePlusTwoPercent(s.values), maker));
   }
 }
 
@@ -94,14 +102,14 @@ TEST(UncertainChain, AtAReadingsPoseTheMeasurementPartIsItsBudget) {
   const auto [index, row] = AnsweredSample(chain, paint->derived);
   ASSERT_EQ(row.status, interp::InterpStatus::kOk);
   const DerivedSample& reading = paint->derived.samples[index];
+  const std::vector<double> combined = OnePlusTwoPercent(reading.values).combined;
   const std::size_t bands = reading.values.size();
   for (std::size_t b = 0; b < bands; ++b) {
     EXPECT_NEAR(row.plane(UncertainPlane::kValue)[b], reading.values[b], 1e-12);
     // The blend reads the shared contributions as floats (blend_budget.h): 2⁻²⁴ relative.
-    EXPECT_NEAR(row.plane(UncertainPlane::kMeasurement)[b], reading.budget->combined[b],
-                0x1p-24 * reading.budget->combined[b]);
+    EXPECT_NEAR(row.plane(UncertainPlane::kMeasurement)[b], combined[b], 0x1p-24 * combined[b]);
     EXPECT_NEAR(row.plane(UncertainPlane::kInterpolation)[b], 0.0, 1e-9);
-    EXPECT_NEAR(row.plane(UncertainPlane::kCombined)[b], reading.budget->combined[b], 1e-9);
+    EXPECT_NEAR(row.plane(UncertainPlane::kCombined)[b], combined[b], 1e-9);
   }
   EXPECT_EQ(chain.coverage.without_budget, 0u);
   EXPECT_GE(chain.chain->Tally().interpolated, 1u);

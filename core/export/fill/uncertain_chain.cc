@@ -18,6 +18,7 @@
 #include "core/uncertainty/blend_budget.h"
 #include "core/uncertainty/held_out.h"
 #include "core/uncertainty/interpolated.h"
+#include "core/uncertainty/loaded_budget.h"
 
 namespace brdf::exports {
 namespace {
@@ -110,8 +111,8 @@ SpectrumSource ModelWithLocalUncertainty(const fit::CookTorranceFit& model,
 uncertainty::IndependentOf IndependentParts(const SessionInterpolant& in) {
   if (in.derived->quantity != Quantity::kBrdf) return {};
   return [&samples = in.derived->samples](std::size_t i) -> const std::vector<double>* {
-    const uncertainty::ReadingBudget* b = i < samples.size() ? samples[i].budget.get() : nullptr;
-    return b != nullptr ? &b->independent : nullptr;
+    const uncertainty::LoadedBudget* b = i < samples.size() ? samples[i].budget.get() : nullptr;
+    return b != nullptr ? &b->blend.independent : nullptr;
   };
 }
 
@@ -122,27 +123,17 @@ uncertainty::InterpolationCalibration Calibrate(const SessionInterpolant& in,
 }
 
 // Sample i's budget in the blend's form, as brdfd's index keeps them (daemon/index/budgets.h):
-// each made once per chain (uncertainty::BlendBudgetMaker, the chain's own), so that a cell's
-// measurement part is the same blend of the same values as Interpolate's answer at its direction.
-// Null: the sample has no budget, or one whose parts do not all have the same number of bands (not
-// estimated). Unset for a quantity other than the BRDF (the budgets are of the BRDF).
+// the loaded session's (DerivedSample::budget, made once per reading by the session's
+// BlendBudgetMaker when it was loaded), so that a cell's measurement part is the same blend of the
+// same values as Interpolate's answer at its direction. Null: the sample has no budget, or one
+// whose parts do not all have the same number of bands (not estimated). Unset for a quantity other
+// than the BRDF (the budgets are of the BRDF).
 std::function<const uncertainty::BlendBudget*(std::size_t)> BlendBudgetsOf(
     const SessionInterpolant& in) {
   if (in.derived->quantity != Quantity::kBrdf) return {};
-  using Kept = std::vector<std::unique_ptr<const uncertainty::BlendBudget>>;
-  auto kept = std::make_shared<Kept>();
-  kept->reserve(in.derived->samples.size());
-  uncertainty::BlendBudgetMaker maker;
-  for (const DerivedSample& s : in.derived->samples) {
-    std::unique_ptr<const uncertainty::BlendBudget> made;
-    if (s.budget) {
-      Result<uncertainty::BlendBudget> b = maker.Make(*s.budget);
-      if (b.ok()) made = std::make_unique<const uncertainty::BlendBudget>(std::move(b).value());
-    }
-    kept->push_back(std::move(made));
-  }
-  return [kept = std::shared_ptr<const Kept>(std::move(kept))](std::size_t i) {
-    return i < kept->size() ? (*kept)[i].get() : nullptr;
+  return [&samples = in.derived->samples](std::size_t i) -> const uncertainty::BlendBudget* {
+    const uncertainty::LoadedBudget* b = i < samples.size() ? samples[i].budget.get() : nullptr;
+    return b != nullptr && b->blendable ? &b->blend : nullptr;
   };
 }
 
@@ -161,7 +152,7 @@ UncertaintyCoverage CoverageOf(const SessionInterpolant& in) {
       ++c.without_budget;
       continue;
     }
-    for (const std::string& entry : s.budget->not_estimated) {
+    for (const std::string& entry : *s.budget->blend.not_estimated) {
       if (c.not_estimated.size() < kMostNotEstimated &&
           std::find(c.not_estimated.begin(), c.not_estimated.end(), entry) ==
               c.not_estimated.end()) {

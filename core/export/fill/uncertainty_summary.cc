@@ -56,11 +56,9 @@ std::vector<double> WhiteStandardPart(const DerivedSamples& derived) {
   for (std::size_t b = 0; b < bands; ++b) {
     rel.clear();
     for (const DerivedSample& s : derived.samples) {
-      const uncertainty::Component* w = s.budget ? s.budget->Find("white_standard") : nullptr;
-      if (w == nullptr || b >= w->contribution.size() || b >= s.values.size() || s.values[b] <= 0) {
-        continue;
-      }
-      rel.push_back(std::abs(w->contribution[b]) / s.values[b]);
+      const std::vector<double>* w = s.budget ? &s.budget->white_standard : nullptr;
+      if (w == nullptr || b >= w->size() || b >= s.values.size() || s.values[b] <= 0) continue;
+      rel.push_back(std::abs((*w)[b]) / s.values[b]);
     }
     out[b] = Quantile(rel, 0.5);
   }
