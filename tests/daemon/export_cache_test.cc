@@ -7,11 +7,14 @@
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <string>
 #include <thread>
 #include <vector>
 
 #include "core/call_context.h"
 #include "core/export/fill/uncertain_chain.h"
+#include "core/uncertainty/loaded_budget.h"
+#include "daemon/api/export_loads.h"
 #include "daemon/config/config.h"
 
 namespace brdf::daemon {
@@ -50,6 +53,45 @@ ExportInterpolants::Build Builder(std::atomic<int>* builds,
                                             exports::FillPolicy::kNone,
                                             CallContext::WithTimeout(std::chrono::minutes(1)));
   };
+}
+
+// A loaded session's bytes count each reading's budget in the form it keeps (LoadedBudget: the
+// blend form's double independent part and float rows, the white standard's doubles), and a
+// not_estimated list consecutive readings share once.
+TEST(ExportInterpolantsTest, ASessionsBytesCountItsReadingsLoadedBudgets) {
+  constexpr std::size_t kBands = 401;
+  constexpr std::size_t kShared = 7;
+  auto notes = std::make_shared<const std::vector<std::string>>(
+      std::vector<std::string>{std::string(200, 'n')});
+  auto loaded = std::make_shared<uncertainty::LoadedBudget>();
+  loaded->blend.bands = kBands;
+  loaded->blend.independent.assign(kBands, 1e-3);
+  loaded->blend.keys.resize(kShared);
+  loaded->blend.shared_rows.assign(kShared * kBands, 1e-4f);
+  loaded->blend.not_estimated = notes;
+  loaded->blendable = true;
+  loaded->white_standard.assign(kBands, 1e-3);
+  auto session = [&](int readings, bool budgets) {
+    SessionReadings s;
+    for (int i = 0; i < readings; ++i) {
+      Reading r;
+      r.spectrum.values.assign(kBands, 0.5);
+      r.brdf_u.assign(kBands, 1e-3);
+      if (budgets) r.budget = loaded;
+      s.readings.push_back(std::move(r));
+    }
+    return s;
+  };
+  const std::uint64_t plain = SharedSessionLoads::BytesOf(session(1, false));
+  const std::uint64_t one = SharedSessionLoads::BytesOf(session(1, true)) - plain;
+  const std::uint64_t arrays = 2 * kBands * sizeof(double) + kShared * kBands * sizeof(float);
+  EXPECT_GE(one, arrays + 200);
+  EXPECT_LT(one, arrays + 2048) << "the form kept, not a whole budget's ~39 kB";
+  EXPECT_GE(plain, sizeof(Reading) + 2 * kBands * sizeof(double)) << "spectrum and brdf_u";
+  // Two readings sharing their notes: the list once.
+  const std::uint64_t two = SharedSessionLoads::BytesOf(session(2, true)) -
+                            SharedSessionLoads::BytesOf(session(2, false));
+  EXPECT_LT(two, 2 * one - 200);
 }
 
 TEST(ExportInterpolantsTest, TheSecondExportOfASnapshotReusesTheFirstsInterpolant) {

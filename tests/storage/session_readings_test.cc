@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
+#include "core/uncertainty/loaded_budget.h"
 #include "storage/session_store.h"
 #include "storage_test_util.h"
 
@@ -79,6 +81,54 @@ TEST(SessionReadingsTest, AReadingsBudgetComesWithItAsItsStandardUncertainty) {
   }
   // Not estimated: nothing.
   EXPECT_TRUE(ToReading(MakeReading(3, ReadingKind::kSample)).brdf_u.empty());
+}
+
+// What the exports read of a stored budget of the BRDF is kept in their form, made by the one
+// maker the session's load passes (Reading::budget): the blend form ToBlendBudget gives (the grid
+// export's cells blend it as Interpolate does), the white standard's contribution in double (the
+// MERL and RGL sidecar's relative_white_standard), one not_estimated list for consecutive readings
+// with the same entries. Without a maker (the daemon's index folding records), and for a budget of
+// another quantity, nothing is kept.
+TEST(SessionReadingsTest, ABudgetOfTheBrdfIsKeptInTheExportsForm) {
+  const WavelengthGrid grid{500, 100, 2};
+  ReadingRecord first = MakeReading(4, ReadingKind::kSample);
+  first.uncertainty = MakeBudget(4, grid, 1);  // step 4: of the BRDF
+  first.uncertainty->components.push_back(
+      {"white_standard", {uncertainty::Sharing::kWhiteStandard, 1}, {4e-4, 5e-4}});
+  ReadingRecord second = MakeReading(8, ReadingKind::kSample);
+  second.uncertainty = MakeBudget(8, grid, 1);
+  uncertainty::BlendBudgetMaker maker;
+  const Reading a = ToReading(first, &maker);
+  const Reading b = ToReading(second, &maker);
+  ASSERT_NE(a.budget, nullptr);
+  ASSERT_NE(b.budget, nullptr);
+  EXPECT_TRUE(a.budget->blendable);
+  uncertainty::NameCodes codes;
+  Result<uncertainty::BlendBudget> expected = uncertainty::ToBlendBudget(*first.uncertainty, codes);
+  ASSERT_TRUE(expected.ok());
+  EXPECT_EQ(a.budget->blend.bands, expected->bands);
+  EXPECT_EQ(a.budget->blend.independent, expected->independent);
+  EXPECT_EQ(a.budget->blend.keys, expected->keys);
+  EXPECT_EQ(a.budget->blend.shared_rows, expected->shared_rows);
+  EXPECT_EQ(*a.budget->blend.not_estimated, first.uncertainty->not_estimated);
+  EXPECT_EQ(a.budget->white_standard, (std::vector<double>{4e-4, 5e-4}));
+  EXPECT_TRUE(b.budget->white_standard.empty());
+  EXPECT_EQ(a.budget->blend.not_estimated, b.budget->blend.not_estimated) << "one list, shared";
+
+  EXPECT_EQ(ToReading(first).budget, nullptr) << "no maker: not kept";
+  EXPECT_EQ(ToReading(first).brdf_u, first.uncertainty->combined);
+  ReadingRecord reflectance = MakeReading(5, ReadingKind::kSample);
+  reflectance.uncertainty = MakeBudget(5, grid, 1);  // of the reflectance
+  EXPECT_EQ(ToReading(reflectance, &maker).budget, nullptr);
+
+  // A budget whose parts disagree in bands: not blendable, its notes and independent part kept.
+  ReadingRecord bad = second;
+  bad.uncertainty->components[1].contribution.push_back(1e-5);
+  const Reading c = ToReading(bad, &maker);
+  ASSERT_NE(c.budget, nullptr);
+  EXPECT_FALSE(c.budget->blendable);
+  EXPECT_EQ(c.budget->blend.independent, bad.uncertainty->independent);
+  EXPECT_EQ(*c.budget->blend.not_estimated, bad.uncertainty->not_estimated);
 }
 
 // A session keeps one wavelength grid, its first reading's (issue 41): the session record says
