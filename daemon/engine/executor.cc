@@ -378,8 +378,10 @@ bool Executor::SkipsOverloadedPose(const Context& c, int index, const Status& fa
 
 Executor::Outcome Executor::SkipOverloadedPose(Context& c, int index, const Status& failure) {
   const storage::StepRecord& step = c.steps[static_cast<std::size_t>(index)];
-  const std::string note = "the meter overloads at pose " + PoseText(step.pose) +
-                           " even at its shortest integration (" + failure.message() + ")";
+  const std::string note =
+      "the meter overloaded at pose " + PoseText(step.pose) +
+      " on every attempt, its quality policy's shorter integration included (" + failure.message() +
+      ")";
   if (Status skipped = store_->SkipStep(session_, index, note); !skipped.ok()) {
     return Stop(c, index, skipped, "recording " + StepName(step) + " as skipped", false);
   }

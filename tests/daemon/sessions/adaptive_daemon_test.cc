@@ -27,44 +27,38 @@ constexpr int kRoundReadings = 6;
 constexpr int kMaxReadings = 33;  // the seed's 15 (if all fit) and three rounds of 6
 
 // examples/plans/adaptive.json made small: three detector positions, a seed of 3 + 3 × 4, rounds
-// of 6; the target is out of reach, so the reading budget (or an empty round) stops it.
-const std::string kAdaptivePlan = R"({
-  "name": "adaptive, killed mid-round",
+// of 6; the target is out of reach, so the reading budget (or an empty round) stops it. `policies`
+// follow the adaptive block.
+std::string SmallAdaptivePlan(const std::string& name, const std::string& policies) {
+  return R"({
+  "name": ")" +
+         name + R"(",
   "adaptive": {
     "target": {"expandedUncertainty": 0.001},
-    "budget": {"maxReadings": )" + std::to_string(kMaxReadings) +
-                                  R"(},
+    "budget": {"maxReadings": )" +
+         std::to_string(kMaxReadings) + R"(},
     "region": {"thetaIMaxDeg": 80, "thetaOMaxDeg": 80},
     "method": "ADAPTIVE_JUDGE_OCTANT",
     "delta": {"start": 0, "stop": 22.5, "step": 11.25},
     "seed": {"retroReadings": 3, "readingsPerDelta": 4},
-    "roundReadings": )" + std::to_string(kRoundReadings) +
-                                  R"(
+    "roundReadings": )" +
+         std::to_string(kRoundReadings) + R"(
   },
+  )" + policies +
+         "\n}";
+}
+
+const std::string kAdaptivePlan = SmallAdaptivePlan("adaptive, killed mid-round", R"(
   "reference": {"perDetectorPosition": true},
-  "measurement": {"integrationMs": 100, "averages": 1}
-})";
+  "measurement": {"integrationMs": 100, "averages": 1})");
 
 // The same made to meet an overload: adaptive integration (the driver cannot shorten it, so a
 // quality 19 fails the attempt at once), two attempts a step, and one reference (at the start),
 // so every measurement after the first sample is a sample's.
-const std::string kOverloadedAdaptivePlan = R"({
-  "name": "adaptive, an overloaded pose",
-  "adaptive": {
-    "target": {"expandedUncertainty": 0.001},
-    "budget": {"maxReadings": )" + std::to_string(kMaxReadings) +
-                                            R"(},
-    "region": {"thetaIMaxDeg": 80, "thetaOMaxDeg": 80},
-    "method": "ADAPTIVE_JUDGE_OCTANT",
-    "delta": {"start": 0, "stop": 22.5, "step": 11.25},
-    "seed": {"retroReadings": 3, "readingsPerDelta": 4},
-    "roundReadings": )" + std::to_string(kRoundReadings) +
-                                            R"(
-  },
+const std::string kOverloadedAdaptivePlan = SmallAdaptivePlan("adaptive, an overloaded pose", R"(
   "reference": {"perDetectorPosition": false},
   "measurement": {"integrationMs": 0, "averages": 1},
-  "retry": {"maxAttempts": 2, "backoffMs": 0}
-})";
+  "retry": {"maxAttempts": 2, "backoffMs": 0})");
 
 // A fixed plan with the same settings: twelve poses at one detector position.
 const std::string kOverloadedFixedPlan = R"({
