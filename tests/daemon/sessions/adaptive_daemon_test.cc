@@ -74,31 +74,31 @@ const std::string kOverloadedFixedPlan = R"({
   "retry": {"maxAttempts": 2, "backoffMs": 0}
 })";
 
-std::vector<storage::StepRecord> StoredSteps(const std::string& database, std::int64_t id) {
+// What `read` reads from the session store at `database` (a failure to open or read is a test
+// failure, and gives T's empty value).
+template <typename T, typename Read>
+T FromStore(const std::string& database, const Read& read) {
   auto store = storage::SessionStore::Open(database);
   EXPECT_TRUE(store.ok()) << store.status().ToString();
-  if (!store.ok()) return {};
-  auto steps = (*store)->GetSteps(id);
-  EXPECT_TRUE(steps.ok()) << steps.status().ToString();
-  return steps.ok() ? *steps : std::vector<storage::StepRecord>{};
+  if (!store.ok()) return T{};
+  Result<T> got = read(**store);
+  EXPECT_TRUE(got.ok()) << got.status().ToString();
+  return got.ok() ? *got : T{};
+}
+
+std::vector<storage::StepRecord> StoredSteps(const std::string& database, std::int64_t id) {
+  return FromStore<std::vector<storage::StepRecord>>(
+      database, [id](storage::SessionStore& s) { return s.GetSteps(id); });
 }
 
 std::vector<storage::RoundRecord> StoredRounds(const std::string& database, std::int64_t id) {
-  auto store = storage::SessionStore::Open(database);
-  EXPECT_TRUE(store.ok()) << store.status().ToString();
-  if (!store.ok()) return {};
-  auto rounds = (*store)->GetRounds(id);
-  EXPECT_TRUE(rounds.ok()) << rounds.status().ToString();
-  return rounds.ok() ? *rounds : std::vector<storage::RoundRecord>{};
+  return FromStore<std::vector<storage::RoundRecord>>(
+      database, [id](storage::SessionStore& s) { return s.GetRounds(id); });
 }
 
 std::optional<int> FirstUnfinished(const std::string& database, std::int64_t id) {
-  auto store = storage::SessionStore::Open(database);
-  EXPECT_TRUE(store.ok()) << store.status().ToString();
-  if (!store.ok()) return std::nullopt;
-  auto first = (*store)->FirstUnfinishedStep(id);
-  EXPECT_TRUE(first.ok()) << first.status().ToString();
-  return first.ok() ? *first : std::nullopt;
+  return FromStore<std::optional<int>>(
+      database, [id](storage::SessionStore& s) { return s.FirstUnfinishedStep(id); });
 }
 
 void ExpectSameRound(const storage::RoundRecord& after, const storage::RoundRecord& before) {
