@@ -2,7 +2,7 @@
 # Issue 38's benchmark (deliverable 5) through the real daemon (docs/adaptive.md, "The benchmark
 # through the daemon"): for each material file, brdf-sim mounts it and brdfd runs on a fresh
 # SQLite database; brdfctl records the paper grid and adaptive sessions at reading budgets of 10,
-# 20, 30 and 50 % of the grid's readings (examples/plans/adaptive.json with the budget changed),
+# 20, 30 and 50 % of the grid's readings (examples/plans/adaptive.json with the budgets changed),
 # the prompts answered on the simulator (`brdfctl watch --auto-confirm --on-prompt "brdfctl
 # sim-mount from-prompt …"`, as the quickstart does); then daemon_bench_error.py measures each
 # session's error against `brdf-sim truth` through the daemon's InterpolateBatch (octant method).
@@ -21,6 +21,11 @@
 #   --time-scale S       brdf-sim's --time-scale (default 1000; see docs/adaptive.md)
 #   --grid-plan FILE     the reference plan (default examples/plans/paper-grid.json)
 #   --adaptive-plan FILE the adaptive plan whose budget is changed (examples/plans/adaptive.json)
+#   --time-share F       the adaptive sessions' rig-time budget: F × max(budget, 20) / 20 of the
+#                        grid's rig time on this rig (default 0.245: at 20 % of the readings,
+#                        within the goal's quarter of the grid's time with some margin; the
+#                        planner costs its budget with the same timing model as the table's rig
+#                        time); 0: the reading budget alone (not with --smoke)
 #   --out PREFIX         write PREFIX.csv and PREFIX.txt (default ./adaptive-daemon-bench; with
 #                        --smoke, in the work directory)
 #   --keep DIR           keep the work (databases, plans, logs, watch output) in DIR
@@ -51,6 +56,7 @@ directions=20000
 scale=1000
 grid_plan="$root/examples/plans/paper-grid.json"
 adaptive_plan="$root/examples/plans/adaptive.json"
+time_share=0.245
 out=""
 keep=""
 smoke=0
@@ -66,6 +72,7 @@ while [[ $# -gt 0 ]]; do
     --time-scale) scale="$2"; shift ;;
     --grid-plan) grid_plan="$2"; shift ;;
     --adaptive-plan) adaptive_plan="$2"; shift ;;
+    --time-share) time_share="$2"; shift ;;
     --out) out="$2"; shift ;;
     --keep) keep="$2"; shift ;;
     --gamma) gamma="$2"; shift ;;
@@ -81,6 +88,7 @@ build="${build:-$root/build}"
 case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
 if [[ $smoke == 1 ]]; then
   materials=paint budgets=50 directions=1000 grid_plan="$root/examples/plans/demo.json"
+  time_share=0
 fi
 
 # shellcheck source=bench/daemon/lib.sh
@@ -107,17 +115,20 @@ say() { echo "daemon_bench: $*" >&2; }
 fail() { echo "daemon_bench: $*" >&2; exit 1; }
 material_file() { if [[ -f "$1" ]]; then echo "$1"; else echo "$root/deploy/materials/$1.toml"; fi; }
 
-# The adaptive plan with its reading budget set to $1 (other budgets dropped), written to $2.
+# The adaptive plan with its reading budget set to $1 and its rig-time budget to $3 minutes (0:
+# none; other budgets dropped), written to $2.
 adaptive_plan_for() {
-  # shellcheck disable=SC2016  # $n and $g are jq's
-  local filter='.name = "adaptive, \($n) readings" | .adaptive.budget = {maxReadings: $n}'
+  # shellcheck disable=SC2016  # $n, $m and $g are jq's
+  local filter='.name = "adaptive, \($n) readings" | .adaptive.budget = {maxReadings: $n}
+    + (if $m > 0 then {maxRigMinutes: $m} else {} end)'
   if [[ $smoke == 1 ]]; then
     filter+=' | .adaptive.delta = {start: 0, stop: 45, step: 22.5}
       | .adaptive.seed = {retroReadings: 4, readingsPerDelta: 8} | .adaptive.roundReadings = 8'
   fi
   # shellcheck disable=SC2016
   [[ -z "$gamma" ]] || filter+=' | .anisotropic = true | .adaptive.gamma = $g'
-  jq --argjson n "$1" --argjson g "${gamma_json:-[0]}" "$filter" "$adaptive_plan" >"$2"
+  jq --argjson n "$1" --argjson m "$3" --argjson g "${gamma_json:-[0]}" "$filter" \
+    "$adaptive_plan" >"$2"
 }
 
 # Prints a progress line every 20 s from the watch output $1 (JSON lines) until killed.
@@ -166,7 +177,7 @@ rows="$work/rows.tsv"  # material label budget_readings readings rig_s prompts w
 : >"$rows"
 : >"$work/errors.tsv"  # material label err peak retro fallback
 echo "$(date -u '+%Y-%m-%d %H:%M UTC'), commit $(git -C "$root" rev-parse --short HEAD)," \
-  "brdf-sim seed $seed, time scale $scale, $directions directions${gamma:+, γ $gamma}$(
+  "brdf-sim seed $seed, time scale $scale, $directions directions, time share $time_share${gamma:+, γ $gamma}$(
     [[ $accept_overload == 0 ]] || echo ", overloaded readings kept (flagged)")," \
   "load at the start $(cut -d' ' -f1-3 /proc/loadavg)" >"$work/meta.txt"
 for m in $materials; do
@@ -190,8 +201,10 @@ for m in $materials; do
 
   for b in $budgets; do
     n=$(((grid_readings * b + 50) / 100))
+    minutes="$(awk -v s="$time_share" -v b="$b" -v t="$grid_rig_s" \
+      'BEGIN { printf "%.2f", s * (b > 20 ? b : 20) / 20 * t / 60 }')"
     plan="$dir/adaptive-$b.json"
-    adaptive_plan_for "$n" "$plan"
+    adaptive_plan_for "$n" "$plan" "$minutes"
     "$ctl" validate "$plan" >"$dir/adaptive-$b.validate" 2>&1 ||
       fail "$plan is not valid: $(cat "$dir/adaptive-$b.validate")"
     record "$plan" "adapt$b"

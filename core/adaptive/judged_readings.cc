@@ -41,17 +41,30 @@ std::unique_ptr<interp::Interpolator> BuildIndex(std::shared_ptr<const interp::S
   return index.ok() ? std::move(*index) : nullptr;
 }
 
-// The answer's vertices' weights and values, and its blend's measurement part (absolute).
+// The answer's vertices' weights and values, and its blend's measurement part (absolute). A
+// reading blended more than once (its mirror images in φ keep its index) is one reading, as in
+// the daemon's blend (core/uncertainty/blend.h): its weights are summed before its noise is
+// squared, since its copies carry the same error.
 double MeasurementPart(const interp::Interpolation& answer, const interp::SampleSet& set,
                        std::span<const double> relative_u, std::vector<double>* weights,
                        std::vector<std::span<const double>>* values) {
   weights->clear();
   values->clear();
-  double u2 = 0;
+  std::vector<std::pair<std::size_t, double>> per_reading;  // index, summed weight
   for (const interp::Vertex& v : answer.vertices) {
     weights->push_back(v.weight);
     values->push_back(set.spectrum(v.index));
-    const double u = v.weight * relative_u[v.index] * set.spectrum(v.index)[0];
+    auto same = std::find_if(per_reading.begin(), per_reading.end(),
+                             [&v](const auto& r) { return r.first == v.index; });
+    if (same == per_reading.end()) {
+      per_reading.emplace_back(v.index, v.weight);
+    } else {
+      same->second += v.weight;
+    }
+  }
+  double u2 = 0;
+  for (const auto& [index, weight] : per_reading) {
+    const double u = weight * relative_u[index] * set.spectrum(index)[0];
     u2 += u * u;
   }
   return std::sqrt(u2);

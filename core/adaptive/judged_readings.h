@@ -31,7 +31,9 @@ namespace brdf::adaptive {
 // sr⁻¹).
 struct JudgedAnswer {
   double value = 0;
-  double u_measurement = 0;  // sqrt(Σ (wᵢ uᵢ fᵢ)²), the vertices' relative u as independent
+  // sqrt(Σ (wᵢ uᵢ fᵢ)²) over the blended readings, their relative u as independent; a reading
+  // blended more than once (mirror images) counts once, with its weights summed.
+  double u_measurement = 0;
   double u_interpolation = 0;                   // c · s
   std::vector<std::array<double, 3>> vertices;  // where the blended readings are (mirror images
                                                 // where the method used one)

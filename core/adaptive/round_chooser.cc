@@ -21,9 +21,9 @@ bool SameSetting(const Pose& a, const Pose& b) {
   return a.delta == b.delta && a.gamma == b.gamma;
 }
 
-// Candidates already measured (a reading's pose) start out taken.
+// Candidates already measured (a reading's pose) or unreadable start out taken.
 std::vector<bool> MeasuredAlready(const RoundInput& input) {
-  std::vector<Pose> measured;
+  std::vector<Pose> measured(input.unreadable.begin(), input.unreadable.end());
   for (const ReadingSoFar& r : input.readings) measured.push_back(r.pose);
   std::sort(measured.begin(), measured.end(),
             [](const Pose& a, const Pose& b) { return Key(a) < Key(b); });

@@ -66,6 +66,9 @@ struct RoundInput {
   Pose rig_at;                             // where the rig is (model angles): the last reading
   Spend spent;
   Budget budget;
+  // Poses the rig could not read (an adaptive session's skipped steps, model angles): never
+  // chosen, as if measured, though no reading informs the map there.
+  std::span<const Pose> unreadable = {};
 };
 
 // A round relocates the operator's detector at most once (see RoundOptions::max_relocations).
@@ -85,8 +88,8 @@ struct RoundOptions {
 };
 
 // The next round; empty when nothing affordable is predicted to gain anything (the caller
-// stops: stop_rule.h). A candidate equal to a reading's pose or to an earlier pick is skipped;
-// a pick may be a finer candidate, not one of input.candidates.
+// stops: stop_rule.h). A candidate equal to a reading's pose, to an unreadable pose or to an
+// earlier pick is skipped; a pick may be a finer candidate, not one of input.candidates.
 Round ChooseRound(const RoundInput& input, const UncertaintyModel& model, const RoundCost& cost,
                   const RoundOptions& options = {});
 // The same from a map already built from input.readings (model.Map(input.readings)), for a

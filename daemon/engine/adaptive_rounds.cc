@@ -70,6 +70,19 @@ storage::RoundRecord MakeRecord(std::int64_t session, int number, int first_step
   return r;
 }
 
+// The poses (model angles) of the sample steps the executor skipped: the meter could not read
+// them (executor.h), so the chooser never picks them again.
+std::vector<Pose> SkippedPoses(const std::vector<storage::StepRecord>& steps,
+                               const plan::RigDescription& rig) {
+  std::vector<Pose> out;
+  for (const storage::StepRecord& s : steps) {
+    if (s.kind == storage::StepKind::kSample && s.state == storage::StepState::kSkipped) {
+      out.push_back(ToModelAngles(s.pose, rig.convention));
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 Result<std::vector<adaptive::ReadingSoFar>> ReadingsSoFar(storage::SessionStore& store,
@@ -122,7 +135,9 @@ Result<RoundDecision> NextRound(storage::SessionStore& store, std::int64_t sessi
   const plan::ExpansionStart start = plan::StartAfter(steps, plan, rig);
   const std::vector<Pose> candidates =
       spec.sample_fixed ? adaptive::FixedCandidates(spec) : adaptive::CandidatePoses(spec, rig);
-  const adaptive::RoundInput input{readings, candidates, start.model, decision.spent, spec.budget};
+  const std::vector<Pose> unreadable = SkippedPoses(stored, rig);
+  const adaptive::RoundInput input{readings,       candidates,  start.model,
+                                   decision.spent, spec.budget, unreadable};
   const adaptive::RoundCost cost(plan, rig);
   // (A sample-fixed plan gets no finer candidates: refine_candidates.h.)
   adaptive::Round round =

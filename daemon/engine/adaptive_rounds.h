@@ -20,6 +20,9 @@
 //     operator's time), prompts.
 //   - the candidates: adaptive::CandidatePoses, or in the sample-fixed form FixedCandidates
 //     (core/adaptive/sample_fixed_design.h).
+//   - the unreadable poses: those of the sample steps the executor skipped because the meter
+//     overloaded there (executor.h); they are never chosen again. The skipped marks are stored,
+//     so a restarted daemon gives the chooser the same set.
 // The chosen round becomes steps by adaptive::RoundSteps (core/adaptive/round_steps.h): a
 // sample-fixed round in prompt order, and poses cut from the end while the steps would pass the
 // budget.

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <utility>
 
 #include "core/plan/plan_settings.h"
@@ -29,6 +30,18 @@ std::string StepName(const storage::StepRecord& step) {
   return name;
 }
 
+// "α 0.73°, β 72.84°, δ 157.5°" (γ too when not 0): a pose as the operator reads it.
+std::string PoseText(const Pose& p) {
+  char text[160];
+  std::snprintf(text, sizeof text, "α %.4g°, β %.4g°, δ %.4g°", p.alpha, p.beta, p.delta);
+  std::string out = text;
+  if (p.gamma != 0) {
+    std::snprintf(text, sizeof text, ", γ %.4g°", p.gamma);
+    out += text;
+  }
+  return out;
+}
+
 }  // namespace
 
 struct Executor::Context {
@@ -36,6 +49,8 @@ struct Executor::Context {
   std::vector<storage::StepRecord> steps;
   plan::PlanSettings settings;
   bool sample_fixed = false;       // lamp and detector set by hand (plan::SampleFixedMethod)
+  bool adaptive = false;           // an adaptive plan: a sample pose the meter overloads at is
+                                   // skipped (SkipsOverloadedPose)
   std::vector<double> estimate_s;  // per step, by the timing model
   double remaining_s = 0;          // estimate of the pending steps
   std::vector<int> move_before;    // index of the last move step before each step, or -1
@@ -50,10 +65,11 @@ struct Executor::Context {
   std::optional<ReadingBudgeter> budgeter;  // Options::uncertainty set
   std::uint32_t next_move_first_attempt = 1;
 
-  void MarkDone(int index) {
+  // A pending step finished: done, or skipped (counted as TallySteps counts it on a restart).
+  void MarkDone(int index, storage::StepState state = storage::StepState::kDone) {
     storage::StepRecord& s = steps[static_cast<std::size_t>(index)];
     if (s.state != storage::StepState::kPending) return;
-    s.state = storage::StepState::kDone;
+    s.state = state;
     --pending;
     ++done_steps;
     if (s.kind == storage::StepKind::kSample) ++done_samples;
@@ -177,6 +193,7 @@ bool Executor::Load(Context& c, const std::string& where) {
   }
   c.settings = (*plan)->settings;
   c.sample_fixed = plan::SampleFixedMethod((*plan)->plan);
+  c.adaptive = (*plan)->plan.has_adaptive();
   if (options_.uncertainty.has_value()) {
     c.budgeter.emplace(*options_.uncertainty, session_,
                        c.session.white_reflectance.value_or(kWhiteStandardReflectance),
@@ -259,6 +276,9 @@ Status Executor::WithRetry(Context& c, int index, std::uint32_t first_attempt,
   return RunWithRetry(
       c.settings.retry, first_attempt, *options_.clock, cancel_, attempt,
       [&](const Status& st, std::uint32_t n, std::uint32_t max_attempts, bool will_retry) {
+        // A pose skipped on its overload gets its own fault event (SkipOverloadedPose), not the
+        // one of a session that pauses.
+        if (!will_retry && SkipsOverloadedPose(c, index, st)) return;
         host_.Fault(session_, FaultFor(index, st, n, will_retry, c.meter.last_quality));
         spdlog::warn("session {}: step {} attempt {}/{} failed: {}{}", session_, index, n,
                      max_attempts, st.ToString(), will_retry ? " (will retry)" : "");
@@ -347,6 +367,32 @@ Executor::Outcome Executor::RunPrompt(Context& c, int index) {
   c.MarkDone(index);
   host_.StepCompleted(session_, Completion(c, index), nullptr);
   return Outcome::kContinue;
+}
+
+bool Executor::SkipsOverloadedPose(const Context& c, int index, const Status& failure) const {
+  return c.adaptive &&
+         c.steps[static_cast<std::size_t>(index)].kind == storage::StepKind::kSample &&
+         failure.code() != StatusCode::kCancelled && !cancel_.cancelled() &&
+         MeterOverloaded(rig_.meter_identity(), failure);
+}
+
+Executor::Outcome Executor::SkipOverloadedPose(Context& c, int index, const Status& failure) {
+  const storage::StepRecord& step = c.steps[static_cast<std::size_t>(index)];
+  const std::string note =
+      "the meter overloaded at pose " + PoseText(step.pose) +
+      " on every attempt, its quality policy's shorter integration included (" + failure.message() +
+      ")";
+  if (Status skipped = store_->SkipStep(session_, index, note); !skipped.ok()) {
+    return Stop(c, index, skipped, "recording " + StepName(step) + " as skipped", false);
+  }
+  c.MarkDone(index, storage::StepState::kSkipped);
+  const std::string reason = std::string(kSkippedFaultPrefix) + StepName(step) + ": " + note +
+                             "; the adaptive session goes on without this pose, and its rounds "
+                             "will not choose it again";
+  const std::uint32_t attempts = std::max<std::uint32_t>(1, c.settings.retry.max_attempts);
+  host_.Fault(session_, FaultFor(index, failure, attempts, false, c.meter.last_quality, reason));
+  spdlog::warn("session {}: {}", session_, reason);
+  return AfterStep(c);
 }
 
 ReadingRequest Executor::PlanReading(const Context& c, int index) {
@@ -440,6 +486,9 @@ Executor::Outcome Executor::RunReading(Context& c, int index, int& advanced) {
       c.stage, c.meter, move);
   if (!taken.ok()) {
     move.Settle(c.stage);
+    if (SkipsOverloadedPose(c, index, taken.status())) {
+      return SkipOverloadedPose(c, index, taken.status());
+    }
     return Stop(c, index, taken.status(), "taking the reading of " + StepName(step), true);
   }
   if (cancel_.cancelled()) {  // nothing is written after a cancel: resume redoes the step

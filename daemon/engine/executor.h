@@ -23,6 +23,12 @@
 // committed first, the move's done mark after it; a failed transfer waits for the move and moves
 // back before measuring again. Not done while a deferred pause is pending.
 //
+// An adaptive session lives with a pose the meter cannot read: when a sample step of an adaptive
+// plan fails on the meter's overload (quality 19, or the code a PR-670 or CS-2000 maps onto it)
+// after the quality policy's shorter integration and the retry policy, the step is marked skipped
+// with a note, a fault event (will_retry false, reason "step skipped: …" naming the pose) tells
+// the watchers, and the session runs on. Fixed plans pause as below.
+//
 // Failures: a device call that fails is retried per the plan's retry policy (a fault event per
 // failed attempt, with will_retry); when the attempts are used up, or the error cannot be cured by
 // retrying (a pose beyond travel), the executor reports a fault and the session pauses with the
@@ -38,6 +44,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "brdf/v1/brdf.pb.h"
@@ -60,6 +67,9 @@ class PipelinedMove;
 
 // What the executor needs from whoever runs it (the SessionManager). Called on the executor's
 // thread.
+// The start of the reason of the fault event a skipped step publishes (the session runs on).
+inline constexpr std::string_view kSkippedFaultPrefix = "step skipped: ";
+
 class ExecutorHost {
  public:
   // Every stored step is done: the session goes on with steps the host has just stored (an
@@ -152,6 +162,13 @@ class Executor {
   // pipelined, FinishPipelinedMove). Returns how many steps were completed (1, or 2 with a
   // pipelined move) through `advanced`.
   Outcome RunReading(Context& c, int index, int& advanced);
+  // Whether reading step `index` is skipped on `failure` (the retry policy used up): a sample
+  // step of an adaptive plan whose meter overloaded (MeterOverloaded).
+  bool SkipsOverloadedPose(const Context& c, int index, const Status& failure) const;
+  // Marks the step skipped in the store with why (SessionStore::SkipStep), publishes a fault
+  // event whose reason starts with kSkippedFaultPrefix and names the pose, and runs on
+  // (AfterStep). The rounds never choose a skipped step's pose again (adaptive_rounds.h).
+  Outcome SkipOverloadedPose(Context& c, int index, const Status& failure);
   // What measuring step `index` needs: its pose, where the stage must be, the meter's settings,
   // and the next step's move when it may be pipelined (pipelining on, the next step a pending
   // move, the session running).

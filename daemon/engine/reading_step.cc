@@ -5,7 +5,21 @@
 #include <algorithm>
 #include <utility>
 
+#include "drivers/cs2000/protocol.h"
+#include "drivers/pr670/protocol.h"
+
 namespace brdf::daemon {
+
+bool MeterOverloaded(const std::optional<drivers::MeterIdentity>& meter, const Status& failure) {
+  constexpr int kOverload = 19;  // the PR-650's quality code the policy is keyed by
+  if (!meter.has_value() || failure.code() != StatusCode::kDeviceError) return false;
+  const std::string& model = meter->model;
+  const int code = failure.device_code();
+  if (model == "PR-650") return code == kOverload;
+  if (model.rfind("CS-", 0) == 0) return drivers::cs2000::PolicyCodeFor(code) == kOverload;
+  if (model.rfind("PR-6", 0) == 0) return drivers::pr670::PolicyCodeFor(code) == kOverload;
+  return false;
+}
 
 Result<Pose> MoveStageTo(Rig& rig, const Pose& pose, const CallContext& ctx) {
   Pose reached = pose;

@@ -51,6 +51,14 @@ struct MeterKnowledge {
   int last_quality = -1;    // the last quality code the meter reported (-1: none yet)
 };
 
+// Whether `failure` (a step's error after the retry policy) is the meter's overload: the light
+// too bright even at the shortest integration the quality policy may use. Keyed by the meter's
+// model, since the device code is the meter's own: a PR-650's quality 19; a CS-2000's ER10, which
+// the policy handles as 19 (drivers/cs2000/protocol.h); a PR-655/670 code the policy handles as
+// 19 (drivers/pr670/protocol.h; none of the codes it knows today). False for any other error or
+// an unknown meter.
+bool MeterOverloaded(const std::optional<drivers::MeterIdentity>& meter, const Status& failure);
+
 // Moves the motorized axes of the rig's stage to `pose` (α, β; γ and δ where the stage has them)
 // and reads the pose back. Returns the feedback on the moved axes, the commanded value where the
 // feedback cannot be read, or the move's error.

@@ -102,6 +102,25 @@ TEST(RoundChooserTest, NeverChoosesAReadingsPoseOrOneTwice) {
   }
 }
 
+TEST(RoundChooserTest, NeverChoosesAnUnreadablePose) {
+  // The peak's best poses, as a first round picks them, made unreadable (the meter overloaded
+  // there): the next choice from the same readings leaves them out and picks others.
+  const std::vector<Pose> candidates = Candidates();
+  const RoundCost cost(Policies(), plan::RigDescription{});
+  const KernelModel model = Peaked();
+  const Pose at{0, 10, 0, 0};
+  const Round first = ChooseRound({{}, candidates, at, {}, {1000, 0, 0}}, model, cost);
+  ASSERT_GE(first.poses.size(), 3u);
+  const std::vector<Pose> unreadable = {first.poses[0].pose, first.poses[1].pose};
+  const RoundInput input{{}, candidates, at, {}, {1000, 0, 0}, unreadable};
+  const Round again = ChooseRound(input, model, cost);
+  ASSERT_FALSE(again.poses.empty());
+  for (const ChosenPose& p : again.poses) {
+    for (const Pose& u : unreadable) EXPECT_FALSE(u == p.pose);
+  }
+  EXPECT_EQ(Poses(ChooseRound(input, model, cost)), Poses(again));  // deterministic
+}
+
 TEST(RoundChooserTest, RespectsEveryBudget) {
   const std::vector<Pose> candidates = Candidates();
   const RoundCost cost(Policies(), plan::RigDescription{});

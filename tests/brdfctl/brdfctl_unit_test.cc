@@ -276,6 +276,24 @@ TEST(RoundsText, TheTableHasARowAndABarPerRoundWithinEightyColumns) {
             "4 round(s) so far; uncertainty left 0.739 → 0.461 → 0.277 → 0.027");
 }
 
+TEST(FaultText, SaysWhetherTheSessionPausedOrGoesOnPastASkippedPose) {
+  v1::Fault f;
+  f.set_step_index(12);
+  f.set_code("device_error");
+  f.set_device_code(19);
+  f.set_attempt(2);
+  f.set_reason("quality 19 (light level too high (overload))");
+  EXPECT_NE(FaultText(f).find("— session paused"), std::string::npos) << FaultText(f);
+  f.set_will_retry(true);
+  EXPECT_NE(FaultText(f).find("— will retry"), std::string::npos) << FaultText(f);
+  f.set_will_retry(false);
+  f.set_reason("step skipped: step 12: the meter overloads at pose α 0°, β 72.8°, δ 157.5°");
+  const std::string text = FaultText(f);
+  EXPECT_NE(text.find("device_error 19: step skipped: step 12"), std::string::npos) << text;
+  EXPECT_EQ(text.substr(text.size() - std::string("— the session goes on").size()),
+            "— the session goes on");
+}
+
 TEST(ProgressLine, ShowsCountsPercentEtaPoseAndQuality) {
   ProgressView v;
   v.state = "running";

@@ -679,5 +679,26 @@ TEST_F(StoredSession, TheCommitStoresTheReadingAndHandsItToTheHostWithItsId) {
   EXPECT_EQ(r.stage->moves().size(), 2u);
 }
 
+TEST(MeterOverloadedTest, KnowsEachMetersOverloadByItsOwnCode) {
+  auto meter = [](const std::string& model) {
+    return std::optional<drivers::MeterIdentity>(drivers::MeterIdentity{model, "1", {}});
+  };
+  const Status quality19 = DeviceError(19, "quality 19 (overload)");
+  EXPECT_TRUE(MeterOverloaded(meter("PR-650"), quality19));
+  EXPECT_TRUE(MeterOverloaded(meter("PR-650"), quality19.WithContext("measuring step 4")));
+  EXPECT_FALSE(MeterOverloaded(meter("PR-650"), DeviceError(14, "quality 14")));
+  EXPECT_FALSE(MeterOverloaded(meter("PR-650"), DeviceError(10, "quality 10 (weak)")));
+  // The CS-2000's ER10 (over the measurement range) is its overload; its own 19 is not.
+  EXPECT_TRUE(MeterOverloaded(meter("CS-2000"), DeviceError(10, "ER10")));
+  EXPECT_TRUE(MeterOverloaded(meter("CS-2000A"), DeviceError(10, "ER10")));
+  EXPECT_FALSE(MeterOverloaded(meter("CS-2000"), DeviceError(19, "ER19")));
+  // The PR-670's codes map onto no overload (too dark, sync failures).
+  EXPECT_FALSE(MeterOverloaded(meter("PR-670"), DeviceError(-8, "too dark")));
+  EXPECT_FALSE(MeterOverloaded(meter("PR-670"), DeviceError(19, "19")));
+  // Not a device's code, or no meter known.
+  EXPECT_FALSE(MeterOverloaded(meter("PR-650"), Timeout("no reply")));
+  EXPECT_FALSE(MeterOverloaded(std::nullopt, quality19));
+}
+
 }  // namespace
 }  // namespace brdf::daemon

@@ -40,17 +40,17 @@ TEST(AdaptivePlanTest, ExampleIsValidAndExpandsToItsSeed) {
   std::fclose(f);
   const PlanAnalysis a = AnalyzePlan(PlanFromJson(text), RigDescription{});
   ASSERT_TRUE(a.valid()) << FormatProblems(a.problems);
-  // 8 retro-reflection readings and up to 24 at every fourth of the 27 detector positions (δ every
-  // 5.625°, seeded every 22.5°: 7 positions), as many as 12 at each of 14 would be.
-  EXPECT_GT(a.summary.sample_readings, 8 + 24 * 5);
-  EXPECT_LE(a.summary.sample_readings, 8 + 24 * 7);
+  // 8 retro-reflection readings and up to 21 at every fourth of the 29 detector positions (δ every
+  // 5.625° to 157.5°, seeded every 22.5°: 8 positions), as many as 24 at each of 7 would be.
+  EXPECT_GT(a.summary.sample_readings, 8 + 21 * 6);
+  EXPECT_LE(a.summary.sample_readings, 8 + 21 * 8);
   std::vector<double> deltas;
   for (const Step& s : OfKind(a.steps, v1::STEP_KIND_SAMPLE)) {
     if (deltas.empty() || deltas.back() != s.pose.delta) deltas.push_back(s.pose.delta);
   }
-  EXPECT_EQ(deltas, (std::vector<double>{0, 22.5, 45, 67.5, 90, 112.5, 135}));
+  EXPECT_EQ(deltas, (std::vector<double>{0, 22.5, 45, 67.5, 90, 112.5, 135, 157.5}));
   // One relocation per seeded δ: the seed visits each of its detector positions once.
-  EXPECT_EQ(Prompts(a.steps, v1::PROMPT_KIND_RELOCATE_DETECTOR).size(), 7u);
+  EXPECT_EQ(Prompts(a.steps, v1::PROMPT_KIND_RELOCATE_DETECTOR).size(), 8u);
 }
 
 TEST(AdaptivePlanTest, ACheaperSeedAtEveryNthDeltaPassesItsChecksWithFewerPrompts) {

@@ -61,7 +61,10 @@ class Event:
                     f"{p.done_steps}/{p.total_steps} steps, {p.done_samples}/{p.total_samples} "
                     f"samples, ETA {d.eta_s:.0f} s")
         if self.kind == "fault":
-            retry = "will retry" if d.will_retry else "session paused"
+            # An adaptive session's skipped pose ("step skipped: ...") does not pause it.
+            skipped = d.reason.startswith("step skipped: ")
+            retry = ("will retry" if d.will_retry
+                     else "the session goes on" if skipped else "session paused")
             return f"fault at step {d.step_index} ({d.code}, attempt {d.attempt}, {retry}): {d.reason}"
         if self.kind == "adaptive_round":
             return (f"round {d.round}: {len(d.poses)} poses, predicted gain {d.predicted_gain:.3g}, "

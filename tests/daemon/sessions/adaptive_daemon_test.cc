@@ -3,7 +3,8 @@
 // driven over gRPC. brdfd is killed with SIGKILL in the middle of a round, restarted on the same
 // database, and the session resumed: the rounds stored before the kill are kept as they were,
 // later ones follow, the session completes with an adaptive stop, and every reading step holds
-// exactly one reading, within the reading budget.
+// exactly one reading, within the reading budget. A sample pose the meter overloads at is skipped
+// and never chosen again (the session completes); a fixed plan still pauses on it.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -26,40 +27,78 @@ constexpr int kRoundReadings = 6;
 constexpr int kMaxReadings = 33;  // the seed's 15 (if all fit) and three rounds of 6
 
 // examples/plans/adaptive.json made small: three detector positions, a seed of 3 + 3 × 4, rounds
-// of 6; the target is out of reach, so the reading budget (or an empty round) stops it.
-const std::string kAdaptivePlan = R"({
-  "name": "adaptive, killed mid-round",
+// of 6; the target is out of reach, so the reading budget (or an empty round) stops it. `policies`
+// follow the adaptive block.
+std::string SmallAdaptivePlan(const std::string& name, const std::string& policies) {
+  return R"({
+  "name": ")" +
+         name + R"(",
   "adaptive": {
     "target": {"expandedUncertainty": 0.001},
-    "budget": {"maxReadings": )" + std::to_string(kMaxReadings) +
-                                  R"(},
+    "budget": {"maxReadings": )" +
+         std::to_string(kMaxReadings) + R"(},
     "region": {"thetaIMaxDeg": 80, "thetaOMaxDeg": 80},
     "method": "ADAPTIVE_JUDGE_OCTANT",
     "delta": {"start": 0, "stop": 22.5, "step": 11.25},
     "seed": {"retroReadings": 3, "readingsPerDelta": 4},
-    "roundReadings": )" + std::to_string(kRoundReadings) +
-                                  R"(
+    "roundReadings": )" +
+         std::to_string(kRoundReadings) + R"(
   },
+  )" + policies +
+         "\n}";
+}
+
+const std::string kAdaptivePlan = SmallAdaptivePlan("adaptive, killed mid-round", R"(
   "reference": {"perDetectorPosition": true},
-  "measurement": {"integrationMs": 100, "averages": 1}
+  "measurement": {"integrationMs": 100, "averages": 1})");
+
+// The same made to meet an overload: adaptive integration (the driver cannot shorten it, so a
+// quality 19 fails the attempt at once), two attempts a step, and one reference (at the start),
+// so every measurement after the first sample is a sample's.
+const std::string kOverloadedAdaptivePlan = SmallAdaptivePlan("adaptive, an overloaded pose", R"(
+  "reference": {"perDetectorPosition": false},
+  "measurement": {"integrationMs": 0, "averages": 1},
+  "retry": {"maxAttempts": 2, "backoffMs": 0})");
+
+// A fixed plan with the same settings: twelve poses at one detector position.
+const std::string kOverloadedFixedPlan = R"({
+  "name": "fixed, an overloaded pose",
+  "poseList": {"poses": [
+    {"alpha": 0, "beta": 0, "delta": 40}, {"alpha": 0, "beta": 5, "delta": 40},
+    {"alpha": 0, "beta": 10, "delta": 40}, {"alpha": 0, "beta": 15, "delta": 40},
+    {"alpha": 0, "beta": 20, "delta": 40}, {"alpha": 0, "beta": 25, "delta": 40},
+    {"alpha": 0, "beta": 30, "delta": 40}, {"alpha": 0, "beta": 35, "delta": 40},
+    {"alpha": 0, "beta": 40, "delta": 40}, {"alpha": 0, "beta": 45, "delta": 40},
+    {"alpha": 0, "beta": 50, "delta": 40}, {"alpha": 0, "beta": 55, "delta": 40}]},
+  "measurement": {"integrationMs": 0, "averages": 1},
+  "retry": {"maxAttempts": 2, "backoffMs": 0}
 })";
 
-std::vector<storage::RoundRecord> StoredRounds(const std::string& database, std::int64_t id) {
+// What `read` reads from the session store at `database` (a failure to open or read is a test
+// failure, and gives T's empty value).
+template <typename T, typename Read>
+T FromStore(const std::string& database, const Read& read) {
   auto store = storage::SessionStore::Open(database);
   EXPECT_TRUE(store.ok()) << store.status().ToString();
-  if (!store.ok()) return {};
-  auto rounds = (*store)->GetRounds(id);
-  EXPECT_TRUE(rounds.ok()) << rounds.status().ToString();
-  return rounds.ok() ? *rounds : std::vector<storage::RoundRecord>{};
+  if (!store.ok()) return T{};
+  Result<T> got = read(**store);
+  EXPECT_TRUE(got.ok()) << got.status().ToString();
+  return got.ok() ? *got : T{};
+}
+
+std::vector<storage::StepRecord> StoredSteps(const std::string& database, std::int64_t id) {
+  return FromStore<std::vector<storage::StepRecord>>(
+      database, [id](storage::SessionStore& s) { return s.GetSteps(id); });
+}
+
+std::vector<storage::RoundRecord> StoredRounds(const std::string& database, std::int64_t id) {
+  return FromStore<std::vector<storage::RoundRecord>>(
+      database, [id](storage::SessionStore& s) { return s.GetRounds(id); });
 }
 
 std::optional<int> FirstUnfinished(const std::string& database, std::int64_t id) {
-  auto store = storage::SessionStore::Open(database);
-  EXPECT_TRUE(store.ok()) << store.status().ToString();
-  if (!store.ok()) return std::nullopt;
-  auto first = (*store)->FirstUnfinishedStep(id);
-  EXPECT_TRUE(first.ok()) << first.status().ToString();
-  return first.ok() ? *first : std::nullopt;
+  return FromStore<std::optional<int>>(
+      database, [id](storage::SessionStore& s) { return s.FirstUnfinishedStep(id); });
 }
 
 void ExpectSameRound(const storage::RoundRecord& after, const storage::RoundRecord& before) {
@@ -77,6 +116,22 @@ void ExpectSameRound(const storage::RoundRecord& after, const storage::RoundReco
 
 class AdaptiveDaemonTest : public SessionRigTest {
  protected:
+  // Once `id` has taken `samples` sample readings, the simulated PR-650 overloads (quality 19)
+  // for its next two measurements: both attempts of the next sample step.
+  void OverloadAfter(const std::string& id, int samples) {
+    const v1::Session running = rig_.WaitFor(
+        id,
+        [&](const v1::Session& x) {
+          return IsTerminal(x.state()) || static_cast<int>(x.progress().done_samples()) >= samples;
+        },
+        60s);
+    ASSERT_FALSE(IsTerminal(running.state())) << running.DebugString();
+    sim::SerialFaults faults;
+    faults.quality_code = 19;
+    faults.quality_count = 2;
+    ASSERT_TRUE(rig_.sim_control().SetSerialFaults(faults).ok());
+  }
+
   std::set<std::int64_t> ReadingIds(const std::string& id) {
     Result<std::vector<v1::Reading>> r = rig_.Readings(id);
     EXPECT_TRUE(r.ok()) << r.status().ToString();
@@ -182,6 +237,89 @@ TEST_F(AdaptiveDaemonTest, KillNineMidRoundRestartResumeContinuesTheDesign) {
   EXPECT_EQ(static_cast<int>(readings_after.size()), c->readings);
   EXPECT_EQ(static_cast<int>(done.progress().done_samples()), samples_before_round);
   EXPECT_LE(samples_before_round, kMaxReadings);
+}
+
+TEST_F(AdaptiveDaemonTest, AnOverloadedPoseIsSkippedNeverChosenAgainAndTheSessionCompletes) {
+  Result<v1::Session> submitted = rig_.Submit(kOverloadedAdaptivePlan);
+  ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
+  const std::string id = submitted->session_id();
+  const std::int64_t sid = std::stoll(id);
+  GrpcOperator& op = Watch(id);
+  OverloadAfter(id, 2);
+
+  const v1::Session done = rig_.WaitForState(id, v1::SESSION_STATE_COMPLETED, 90s);
+  ASSERT_EQ(done.state(), v1::SESSION_STATE_COMPLETED) << done.DebugString() << rig_.log();
+  EXPECT_EQ(done.state_reason().rfind("adaptive: ", 0), 0u) << done.state_reason();
+
+  // One sample step skipped, with why; every other step done, each measuring one with its reading.
+  const std::vector<storage::StepRecord> steps = StoredSteps(rig_.database(), sid);
+  std::vector<storage::StepRecord> skipped;
+  for (const storage::StepRecord& s : steps) {
+    if (s.state == storage::StepState::kSkipped)
+      skipped.push_back(s);
+    else
+      EXPECT_EQ(s.state, storage::StepState::kDone) << "step " << s.step_index;
+  }
+  ASSERT_EQ(skipped.size(), 1u);
+  const storage::StepRecord& lost = skipped.front();
+  EXPECT_EQ(lost.kind, storage::StepKind::kSample);
+  ASSERT_TRUE(lost.note.has_value());
+  EXPECT_NE(lost.note->find("overload"), std::string::npos) << *lost.note;
+  EXPECT_NE(lost.note->find("19"), std::string::npos) << *lost.note;
+  Result<DbSessionCounts> c = CountSession(rig_.database(), sid);
+  ASSERT_TRUE(c.ok()) << c.status().ToString();
+  EXPECT_EQ(c->steps_pending, 0);
+  EXPECT_EQ(c->steps_done + 1, c->total_steps);
+  EXPECT_EQ(c->readings, c->measuring_steps_done);
+  EXPECT_EQ(c->duplicate_readings, 0);
+  EXPECT_EQ(c->orphan_readings, 0);
+  Result<std::string> problems = StorageProblems(rig_.database(), sid);
+  ASSERT_TRUE(problems.ok()) << problems.status().ToString();
+  EXPECT_EQ(*problems, "");
+
+  // The watchers heard which pose and why, as a fault that does not pause the session.
+  std::vector<v1::Fault> skips;
+  for (const v1::SessionEvent& e : op.events()) {
+    if (e.has_fault() && e.fault().reason().rfind("step skipped: ", 0) == 0) {
+      skips.push_back(e.fault());
+    }
+    if (e.has_state_changed()) {
+      EXPECT_NE(e.state_changed().to(), v1::SESSION_STATE_PAUSED) << e.DebugString();
+    }
+  }
+  ASSERT_EQ(skips.size(), 1u);
+  EXPECT_EQ(skips[0].step_index(), lost.step_index);
+  EXPECT_EQ(skips[0].device_code(), 19);
+  EXPECT_FALSE(skips[0].will_retry());
+  EXPECT_NE(skips[0].reason().find("δ"), std::string::npos) << skips[0].reason();
+
+  // Never chosen again: no later step measures that pose, and a round followed the skip.
+  bool round_after = false;
+  for (const storage::StepRecord& s : steps) {
+    if (s.step_index <= lost.step_index || s.kind != storage::StepKind::kSample) continue;
+    round_after = true;
+    EXPECT_FALSE(s.pose == lost.pose) << "step " << s.step_index << " measures it again";
+  }
+  EXPECT_TRUE(round_after);
+}
+
+TEST_F(AdaptiveDaemonTest, AFixedPlanStillPausesOnAnOverload) {
+  Result<v1::Session> submitted = rig_.Submit(kOverloadedFixedPlan);
+  ASSERT_TRUE(submitted.ok()) << submitted.status().ToString();
+  const std::string id = submitted->session_id();
+  Watch(id);
+  OverloadAfter(id, 1);
+
+  const v1::Session paused = rig_.WaitForState(id, v1::SESSION_STATE_PAUSED, 60s);
+  ASSERT_EQ(paused.state(), v1::SESSION_STATE_PAUSED) << paused.DebugString() << rig_.log();
+  ASSERT_TRUE(paused.has_last_fault());
+  EXPECT_EQ(paused.last_fault().device_code(), 19);
+  EXPECT_FALSE(paused.last_fault().will_retry());
+  EXPECT_EQ(paused.last_fault().reason().rfind("step skipped: ", 0), std::string::npos);
+  for (const storage::StepRecord& s : StoredSteps(rig_.database(), std::stoll(id))) {
+    EXPECT_NE(s.state, storage::StepState::kSkipped) << "step " << s.step_index;
+  }
+  ExpectIntact(std::stoll(id));
 }
 
 }  // namespace

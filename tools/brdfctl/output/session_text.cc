@@ -79,7 +79,11 @@ std::string FaultText(const v1::Fault& f) {
                     std::to_string(f.attempt()) + "): " + f.code();
   if (f.code() == "device_error") out += " " + std::to_string(f.device_code());
   out += ": " + f.reason();
-  out += f.will_retry() ? " — will retry" : " — session paused; `brdfctl resume` retries";
+  // An adaptive session's skipped pose (the daemon's reason starts "step skipped: "): it runs on.
+  const bool skipped = f.reason().rfind("step skipped: ", 0) == 0;
+  out += f.will_retry() ? " — will retry"
+         : skipped      ? " — the session goes on"
+                        : " — session paused; `brdfctl resume` retries";
   return out;
 }
 

@@ -27,7 +27,8 @@ void PrintSessionDetail(std::ostream& out, const v1::Session& session);
 // answered.
 void PrintPrompt(std::ostream& out, const v1::Prompt& prompt);
 
-// "fault at step 12 (attempt 3): timeout: <reason> — will retry" (or "— session paused").
+// "fault at step 12 (attempt 3): timeout: <reason> — will retry" (or "— session paused", or for
+// an adaptive session's skipped pose, "step skipped: …", "— the session goes on").
 std::string FaultText(const v1::Fault& fault);
 
 // "120 steps: 90 sample, 12 reference, 6 dark readings; 12 operator actions; rig time about 5:00
