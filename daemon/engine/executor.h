@@ -65,11 +65,11 @@ namespace brdf::daemon {
 struct ReadingRequest;  // engine_reading_step.h
 class PipelinedMove;
 
-// What the executor needs from whoever runs it (the SessionManager). Called on the executor's
-// thread.
 // The start of the reason of the fault event a skipped step publishes (the session runs on).
 inline constexpr std::string_view kSkippedFaultPrefix = "step skipped: ";
 
+// What the executor needs from whoever runs it (the SessionManager). Called on the executor's
+// thread.
 class ExecutorHost {
  public:
   // Every stored step is done: the session goes on with steps the host has just stored (an
