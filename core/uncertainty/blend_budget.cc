@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <iterator>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace brdf::uncertainty {
 
@@ -44,6 +46,34 @@ Result<BlendBudget> ToBlendBudget(const ReadingBudget& budget, NameCodes& codes,
   }
   out.not_estimated = std::move(notes);
   return out;
+}
+
+namespace {
+
+// glibc's bookkeeping per heap allocation, roughly.
+constexpr std::size_t kAllocationOverhead = 16;
+
+template <typename T>
+std::size_t VectorBytes(const std::vector<T>& v) {
+  return v.capacity() == 0 ? 0 : v.capacity() * sizeof(T) + kAllocationOverhead;
+}
+
+// A string's own storage, beyond what fits inside it (the short-string buffer).
+std::size_t StringBytes(const std::string& s) {
+  static const std::size_t kInline = std::string().capacity();
+  return s.capacity() <= kInline ? 0 : s.capacity() + 1 + kAllocationOverhead;
+}
+
+}  // namespace
+
+std::size_t HeapBytes(const BlendBudget& b, bool count_notes) {
+  std::size_t bytes = VectorBytes(b.independent) + VectorBytes(b.keys) + VectorBytes(b.shared_rows);
+  if (count_notes && b.not_estimated) {
+    bytes += sizeof(*b.not_estimated) + 2 * sizeof(void*) + kAllocationOverhead;
+    bytes += VectorBytes(*b.not_estimated);
+    for (const std::string& s : *b.not_estimated) bytes += StringBytes(s);
+  }
+  return bytes;
 }
 
 Result<BlendBudget> BlendBudgetMaker::Make(const ReadingBudget& budget, bool* new_notes) {

@@ -78,6 +78,13 @@ struct BlendBudget {
 Result<BlendBudget> ToBlendBudget(const ReadingBudget& budget, NameCodes& codes,
                                   std::shared_ptr<const std::vector<std::string>> notes = nullptr);
 
+// What `b`'s members hold on the heap (its vectors, each with glibc's ~16 bytes of bookkeeping),
+// not sizeof(b) itself; its not_estimated list too (make_shared's block, the vector, the strings
+// beyond their inline buffer) when `count_notes`: a list consecutive budgets share is counted
+// with the first of them. For the caches that bound their memory by it (brdfd's index, the
+// export's loaded sessions).
+std::size_t HeapBytes(const BlendBudget& b, bool count_notes);
+
 // A list's BlendBudgets made in order (brdfd's index, the grid export's chain): ToBlendBudget with
 // the list's NameCodes, each budget's not_estimated shared with the previous one's when it holds
 // the same entries. A copy goes on with the same codes.

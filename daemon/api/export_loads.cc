@@ -21,17 +21,8 @@ bool Current(storage::SessionReader& reader, const SessionReadings& copy) {
 // previous reading's, which consecutive readings share: counted once, with the first of them).
 std::uint64_t LoadedBudgetBytes(const uncertainty::LoadedBudget& budget,
                                 const std::vector<std::string>* last_notes) {
-  const uncertainty::BlendBudget& blend = budget.blend;
-  std::uint64_t bytes =
-      sizeof(budget) +
-      (blend.independent.capacity() + budget.white_standard.capacity()) * sizeof(double) +
-      blend.keys.capacity() * sizeof(uncertainty::SharedKey) +
-      blend.shared_rows.capacity() * sizeof(float);
-  if (blend.not_estimated && blend.not_estimated.get() != last_notes) {
-    bytes += sizeof(*blend.not_estimated) + blend.not_estimated->capacity() * sizeof(std::string);
-    for (const std::string& note : *blend.not_estimated) bytes += note.capacity();
-  }
-  return bytes;
+  return sizeof(budget) + budget.white_standard.capacity() * sizeof(double) +
+         uncertainty::HeapBytes(budget.blend, budget.blend.not_estimated.get() != last_notes);
 }
 
 }  // namespace

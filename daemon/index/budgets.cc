@@ -1,6 +1,5 @@
 #include "daemon/index/budgets.h"
 
-#include <string>
 #include <utility>
 #include <vector>
 
@@ -10,28 +9,10 @@ namespace {
 // glibc's bookkeeping per heap allocation, roughly.
 constexpr std::size_t kAllocationOverhead = 16;
 
-template <typename T>
-std::size_t VectorBytes(const std::vector<T>& v) {
-  return v.capacity() == 0 ? 0 : v.capacity() * sizeof(T) + kAllocationOverhead;
-}
-
-// A string's own storage, beyond what fits inside it (the short-string buffer).
-std::size_t StringBytes(const std::string& s) {
-  static const std::size_t kInline = std::string().capacity();
-  return s.capacity() <= kInline ? 0 : s.capacity() + 1 + kAllocationOverhead;
-}
-
 // One budget as make_shared allocates it (with the control block) and what its members hold;
 // its not_estimated list when it is not the previous budget's.
 std::size_t BudgetBytes(const uncertainty::BlendBudget& b, bool own_notes) {
-  std::size_t bytes = sizeof(b) + 2 * sizeof(void*) + kAllocationOverhead;
-  bytes += VectorBytes(b.independent) + VectorBytes(b.keys) + VectorBytes(b.shared_rows);
-  if (own_notes) {
-    bytes += sizeof(*b.not_estimated) + 2 * sizeof(void*) + kAllocationOverhead;
-    bytes += VectorBytes(*b.not_estimated);
-    for (const std::string& s : *b.not_estimated) bytes += StringBytes(s);
-  }
-  return bytes;
+  return sizeof(b) + 2 * sizeof(void*) + kAllocationOverhead + uncertainty::HeapBytes(b, own_notes);
 }
 
 }  // namespace
